@@ -1,0 +1,39 @@
+#include "editor/cli.h"
+
+#include "editor/commands.h"
+#include "tetops/error.h"
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+namespace waxwork {
+
+int run_cli(int argc, char** argv) {
+    CLI::App app{"Waxwork: carve, fracture and paint translucent solids with live subsurface light.", "waxwork"};
+    app.set_version_flag("--version", "waxwork 0.1.0");
+    app.require_subcommand(1);
+    app.failure_message([](const CLI::App*, const CLI::Error& e) { return std::string("waxwork: ") + e.what() + "\n"; });
+    register_commands(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::cerr << "waxwork: " << e.what() << " (see --help)\n";
+        return 2;
+    } catch (const Error& e) {
+        std::cerr << "waxwork: " << e.what() << "\n";
+        return 1;
+    } catch (const std::exception& e) {
+        std::cerr << "waxwork: internal error: " << e.what() << "\n";
+        return 1;
+    }
+    return 0;
+}
+
+}  // namespace waxwork

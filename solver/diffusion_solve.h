@@ -1,0 +1,56 @@
+// One call from a volume, its materials and the incident light to the fluence phi at every vertex:
+// the path `waxwork render` and the tests take. Finer control (keeping matrices between frames,
+// choosing solvers) is in diffusion_matrix.h and conjugate_gradient.h.
+#pragma once
+
+#include "solver/diffusion_matrix.h"
+#include "tetops/connectivity.h"
+#include "tetops/tet_mesh.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace waxwork {
+
+enum class SolverPrecision {
+    // The safe default: double CG converges on meshes with slivers (TransCut's cotangent weights reach
+    // 1e4-1e6 there) and to tolerances well below 1e-4, where float stalls at its rounding floor.
+    Double,
+    // About 1.5x faster per iteration (half the matrix bandwidth); accurate to ~1e-4 on good meshes.
+    // Reports AlgorithmError rather than a wrong answer when it cannot reach the tolerance.
+    Float,
+};
+
+struct DiffusionOptions {
+    Discretization discretization = Discretization::TransCut;
+    StiffnessForm stiffness_form = StiffnessForm::Gradient;
+    SolverPrecision precision = SolverPrecision::Double;
+    double mm_per_unit = 1.0;          // model units to millimetres (coefficients are per mm)
+    double relative_tolerance = 1e-3;  // stopping rule: estimated relative error of phi (D-norm, see
+                                       // conjugate_gradient.h)
+    int max_iterations = 10000;
+};
+
+struct DiffusionSolution {
+    // Per vertex, per rgb channel: the fluence phi (zero at vertices of no tet).
+    std::vector<std::array<double, 3>> phi;
+    std::array<int, 3> iterations{};
+    std::array<double, 3> estimated_relative_error{};
+    double assembly_ms = 0;
+    double solve_ms = 0;
+};
+
+// q: per vertex (volume vertex order), per channel, the diffuse incoming light (only boundary vertices
+// are read). materials: one per tet. Throws InvalidArgumentError for invalid coefficients or sizes and
+// AlgorithmError if the solver breaks down or fails to converge to the tolerance.
+DiffusionSolution solve_diffusion(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                  const std::vector<TetMaterial>& materials,
+                                  const std::vector<std::array<double, 3>>& q, const DiffusionOptions& options);
+
+// Solves an assembled system (all three channels) with Jacobi CG; phi is the warm start and result
+// (resized and zeroed if its size is wrong). Fills iterations, errors and solve_ms of `solution`.
+void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std::array<double, 3>>& q,
+                            const DiffusionOptions& options, DiffusionSolution& solution);
+
+}  // namespace waxwork

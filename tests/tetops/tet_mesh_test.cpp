@@ -1,0 +1,209 @@
+#include "tetops/connectivity.h"
+#include "tetops/error.h"
+#include "tetops/quality.h"
+#include "tetops/tet_mesh.h"
+#include "tetops/test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <set>
+
+namespace waxwork {
+namespace {
+
+using testing::concatenate;
+using testing::make_cube_mesh;
+
+TEST(TetMesh, MakeReorientsNegativeTets) {
+    std::vector<Eigen::Vector3d> p = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    TetMesh mesh = make_tet_mesh(p, {{0, 1, 3, 2}});
+    EXPECT_GT(signed_volume(mesh, 0), 0);
+    EXPECT_NEAR(total_volume(mesh), 1.0 / 6.0, 1e-15);
+    EXPECT_EQ(mesh.original_ids, std::vector<int32_t>{0});
+    EXPECT_EQ(mesh.piece_ids, std::vector<int32_t>{0});
+    EXPECT_EQ(mesh.piece_transforms.size(), 1u);
+    EXPECT_TRUE(find_invariant_violations(mesh).empty());
+}
+
+TEST(TetMesh, MakeRejectsDegenerateAndOutOfRange) {
+    std::vector<Eigen::Vector3d> p = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 0, 1}};
+    EXPECT_THROW(make_tet_mesh(p, {{0, 1, 2, 3}}), InvalidMeshError);  // collinear base: flat
+    EXPECT_THROW(make_tet_mesh(p, {{0, 1, 2, 7}}), InvalidMeshError);
+}
+
+TEST(TetMesh, ValidateFindsEveryKindOfViolation) {
+    TetMesh good = make_cube_mesh(2);
+    EXPECT_NO_THROW(validate(good));
+
+    TetMesh inverted = good;
+    std::swap(inverted.tets[3][0], inverted.tets[3][1]);
+    EXPECT_THROW(validate(inverted), InvalidMeshError);
+
+    TetMesh nan_point = good;
+    nan_point.positions[0].x() = std::nan("");
+    EXPECT_FALSE(find_invariant_violations(nan_point).empty());
+
+    TetMesh bad_piece = good;
+    bad_piece.piece_ids[0] = 5;
+    EXPECT_FALSE(find_invariant_violations(bad_piece).empty());
+
+    TetMesh bad_material = good;
+    bad_material.materials.assign(good.tet_count(), TetMaterial{{0.1, 0.1, 0.1}, {1, 1, 1}, 1.3});
+    EXPECT_TRUE(find_invariant_violations(bad_material).empty());
+    bad_material.materials[2].musp[1] = -1;
+    EXPECT_FALSE(find_invariant_violations(bad_material).empty());
+
+    TetMesh short_ids = good;
+    short_ids.original_ids.pop_back();
+    EXPECT_FALSE(find_invariant_violations(short_ids).empty());
+
+    TetMesh unreferenced = good;
+    unreferenced.positions.push_back({5, 5, 5});
+    EXPECT_FALSE(find_invariant_violations(unreferenced).empty());
+
+    TetMesh triple_face = good;  // a third tet on an existing face
+    const Tet& t0 = good.tets[0];
+    triple_face.positions.push_back({-3, -3, -3});
+    triple_face.tets.push_back({t0[1], t0[2], t0[3], static_cast<int32_t>(good.positions.size())});
+    triple_face.tets.push_back({t0[1], t0[2], t0[3], static_cast<int32_t>(good.positions.size())});
+    triple_face.original_ids.resize(triple_face.tets.size(), 0);
+    triple_face.piece_ids.resize(triple_face.tets.size(), 0);
+    EXPECT_FALSE(find_invariant_violations(triple_face).empty());
+}
+
+TEST(TetMesh, ValidateReportIsBoundedForBadlyBrokenMeshes) {
+    TetMesh mesh = make_cube_mesh(6);
+    for (auto& p : mesh.positions) p.x() = std::nan("");
+    const auto violations = find_invariant_violations(mesh);
+    EXPECT_LT(violations.size(), 20u);
+}
+
+TEST(Connectivity, SingleTet) {
+    TetMesh mesh = make_tet_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{0, 1, 2, 3}});
+    const TetConnectivity c = build_connectivity(mesh);
+    EXPECT_EQ(c.edges.size(), 6u);
+    EXPECT_EQ(c.boundary_faces.size(), 4u);
+    EXPECT_EQ(c.boundary_vertices.size(), 4u);
+    EXPECT_EQ(c.component_count, 1);
+    for (int v = 0; v < 4; ++v) EXPECT_EQ(c.vertex_vertices.row(v).size(), 3u);
+}
+
+// Outward orientation: the sum over boundary faces of the divergence-theorem volume term equals the
+// tet volume sum; with inward faces it would be negative.
+double volume_from_boundary(const TetMesh& mesh, const TetConnectivity& c) {
+    double volume = 0;
+    for (const BoundaryFace& f : c.boundary_faces) {
+        const auto& a = mesh.positions[f.vertices[0]];
+        const auto& b = mesh.positions[f.vertices[1]];
+        const auto& d = mesh.positions[f.vertices[2]];
+        volume += a.dot(b.cross(d)) / 6.0;
+    }
+    return volume;
+}
+
+TEST(Connectivity, CubeCountsMatchEuler) {
+    const int n = 4;
+    TetMesh mesh = make_cube_mesh(n);
+    const TetConnectivity c = build_connectivity(mesh);
+    const size_t V = mesh.vertex_count(), T = mesh.tet_count();
+    // Faces: each tet has 4 faces, interior ones are shared by 2: F = (4T + Fb)/2.
+    const size_t Fb = c.boundary_faces.size();
+    EXPECT_EQ(Fb, 6u * 2 * n * n);
+    const size_t F = (4 * T + Fb) / 2;
+    // Euler characteristic of a ball: V - E + F - T = 1.
+    EXPECT_EQ(static_cast<long>(V) - static_cast<long>(c.edges.size()) + static_cast<long>(F) - static_cast<long>(T), 1);
+    EXPECT_EQ(c.boundary_vertices.size(), static_cast<size_t>((n + 1) * (n + 1) * (n + 1) - (n - 1) * (n - 1) * (n - 1)));
+    EXPECT_NEAR(volume_from_boundary(mesh, c), 1.0, 1e-12);
+    EXPECT_EQ(c.component_count, 1);
+}
+
+TEST(Connectivity, NeighborsAreSymmetricAndShareAFace) {
+    TetMesh mesh = make_cube_mesh(3);
+    const TetConnectivity c = build_connectivity(mesh);
+    for (size_t t = 0; t < mesh.tet_count(); ++t)
+        for (int f = 0; f < 4; ++f) {
+            const int32_t o = c.tet_neighbors[t][f];
+            if (o < 0) continue;
+            const auto& back = c.tet_neighbors[o];
+            EXPECT_NE(std::find(back.begin(), back.end(), static_cast<int32_t>(t)), back.end());
+            std::set<int32_t> shared;
+            for (int32_t v : mesh.tets[t])
+                if (std::find(mesh.tets[o].begin(), mesh.tets[o].end(), v) != mesh.tets[o].end()) shared.insert(v);
+            EXPECT_EQ(shared.size(), 3u);
+            EXPECT_EQ(shared.count(mesh.tets[t][f]), 0u);  // the face opposite local vertex f
+        }
+}
+
+TEST(Connectivity, OneRingsMatchEdges) {
+    TetMesh mesh = make_cube_mesh(3);
+    const TetConnectivity c = build_connectivity(mesh);
+    size_t directed = 0;
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+        const auto row = c.vertex_vertices.row(v);
+        EXPECT_TRUE(std::is_sorted(row.begin(), row.end()));
+        directed += row.size();
+        for (int32_t t : c.vertex_tets.row(v))
+            EXPECT_NE(std::find(mesh.tets[t].begin(), mesh.tets[t].end(), static_cast<int32_t>(v)), mesh.tets[t].end());
+    }
+    EXPECT_EQ(directed, 2 * c.edges.size());
+    EXPECT_TRUE(std::is_sorted(c.edges.begin(), c.edges.end()));
+    for (const auto& e : c.edges) EXPECT_LT(e[0], e[1]);
+}
+
+TEST(Connectivity, TwoComponents) {
+    TetMesh mesh = concatenate(make_cube_mesh(2), make_cube_mesh(2, Eigen::Vector3d(3, 0, 0)));
+    const TetConnectivity c = build_connectivity(mesh);
+    EXPECT_EQ(c.component_count, 2);
+    const size_t half = mesh.tet_count() / 2;
+    for (size_t t = 0; t < mesh.tet_count(); ++t) EXPECT_EQ(c.tet_component[t], t < half ? 0 : 1);
+    EXPECT_NEAR(volume_from_boundary(mesh, c), 2.0, 1e-12);
+}
+
+TEST(Connectivity, RejectsFaceSharedByThreeTets) {
+    TetMesh mesh = make_tet_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.2, 0.2, 0.3}, {-1, -1, -1}},
+                                 {{0, 1, 2, 3}, {0, 1, 2, 4}, {0, 1, 2, 5}});
+    EXPECT_THROW(build_connectivity(mesh), InvalidMeshError);
+}
+
+TEST(Quality, RegularTet) {
+    const Eigen::Vector3d p0(1, 1, 1), p1(1, -1, -1), p2(-1, 1, -1), p3(-1, -1, 1);
+    const double expected = std::acos(1.0 / 3.0) * 180.0 / std::numbers::pi;  // 70.53 degrees
+    for (double a : dihedral_angles_deg(p0, p1, p2, p3)) EXPECT_NEAR(a, expected, 1e-9);
+    EXPECT_NEAR(radius_edge_ratio(p0, p1, p2, p3), std::sqrt(6.0) / 4.0, 1e-12);
+}
+
+TEST(Quality, CornerTetAnglesAndReport) {
+    // The corner tet of a cube has three right dihedral angles at the corner edges and
+    // three of acos(1/sqrt(3)) = 54.74 degrees at the far edges.
+    const auto angles = dihedral_angles_deg({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1});
+    std::vector<double> sorted(angles.begin(), angles.end());
+    std::sort(sorted.begin(), sorted.end());
+    const double far = std::acos(1.0 / std::sqrt(3.0)) * 180.0 / std::numbers::pi;
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(sorted[i], far, 1e-9);
+    for (int i = 3; i < 6; ++i) EXPECT_NEAR(sorted[i], 90.0, 1e-9);
+
+    TetMesh mesh = make_cube_mesh(2);
+    const QualityReport q = measure_quality(mesh);
+    EXPECT_NEAR(q.min_dihedral_deg, 45.0, 1e-9);  // Kuhn tets: angles of 45, 60 and 90 degrees
+    EXPECT_NEAR(q.max_dihedral_deg, 90.0, 1e-9);
+    EXPECT_EQ(q.tets_below_5_deg, 0u);
+    EXPECT_NEAR(q.min_edge_length, 0.5, 1e-12);
+}
+
+TEST(Quality, SliverIsCounted) {
+    // Four nearly coplanar points: a sliver with tiny dihedral angles.
+    TetMesh mesh = make_tet_mesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0.001}, {0, 1, 0}}, {{0, 1, 2, 3}});
+    const QualityReport q = measure_quality(mesh);
+    EXPECT_LT(q.min_dihedral_deg, 1.0);
+    EXPECT_GT(q.max_dihedral_deg, 179.0);
+    EXPECT_EQ(q.tets_below_5_deg, 1u);
+    // A sliver's circumradius is about half its diagonal, so its radius-edge ratio stays near 0.7:
+    // the ratio alone cannot see slivers, which is why the dihedral bound matters.
+    EXPECT_LT(q.max_radius_edge_ratio, 1.0);
+}
+
+}  // namespace
+}  // namespace waxwork

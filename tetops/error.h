@@ -1,0 +1,50 @@
+// Typed errors shared by every Waxwork library.
+//
+// Every failure a user can cause (a broken file, an absurd parameter) is reported by throwing one of
+// these; the command line catches them and prints what() as its one-line message. what() always names
+// the file (when there is one) and the problem, e.g. "bad_cow.obj: 1 non-manifold vertex (vertex 17)".
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace waxwork {
+
+// Base of every Waxwork error.
+class Error : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// A file could not be read or written, or its content is malformed. what() is "PATH: PROBLEM".
+class FileError : public Error {
+public:
+    FileError(std::string path, std::string problem)
+        : Error(path + ": " + problem), path_(std::move(path)), problem_(std::move(problem)) {}
+    const std::string& path() const { return path_; }
+    const std::string& problem() const { return problem_; }
+
+private:
+    std::string path_;
+    std::string problem_;
+};
+
+// Geometry that violates a requirement: an open or self-intersecting surface, an inverted tet.
+class InvalidMeshError : public Error {
+public:
+    using Error::Error;
+};
+
+// A parameter outside its meaningful range (negative edge length, NaN coefficient, ...).
+class InvalidArgumentError : public Error {
+public:
+    using Error::Error;
+};
+
+// An algorithm failed on valid input (a mesher gave up, a solver broke down beyond recovery).
+class AlgorithmError : public Error {
+public:
+    using Error::Error;
+};
+
+}  // namespace waxwork

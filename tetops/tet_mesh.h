@@ -1,0 +1,85 @@
+// The tetrahedral volume: the central data structure of Waxwork.
+//
+// Plain arrays, one entry per vertex or per tet, so every algorithm can run over them in parallel and
+// every file format can store them exactly. Derived data (edges, one-rings, boundary, components) lives
+// in TetConnectivity (connectivity.h) and is rebuilt after edits.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace waxwork {
+
+using Tet = std::array<int32_t, 4>;
+
+// Scattering coefficients of one tet, per rgb channel, in 1/mm (see solver/material.h for meaning).
+// Stored with the geometry so that painted volumes save and reload; tetops never interprets them.
+struct TetMaterial {
+    std::array<double, 3> mua{};   // absorption coefficient mu_a
+    std::array<double, 3> musp{};  // reduced scattering coefficient mu_s'
+    double eta = 1.0;              // relative index of refraction
+
+    friend bool operator==(const TetMaterial&, const TetMaterial&) = default;
+};
+
+// Rigid motion of one piece: x_world = rotation * x_rest + translation.
+struct RigidTransform {
+    Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+    friend bool operator==(const RigidTransform& a, const RigidTransform& b) {
+        return a.rotation == b.rotation && a.translation == b.translation;
+    }
+};
+
+struct TetMesh {
+    // Vertex positions in model units, in the rest frame of their piece.
+    std::vector<Eigen::Vector3d> positions;
+    // Tets as four vertex indices, positively oriented: (p1-p0) . ((p2-p0) x (p3-p0)) > 0.
+    std::vector<Tet> tets;
+    // One material per tet, or empty when the volume stores none (the renderer then picks one).
+    std::vector<TetMaterial> materials;
+    // Per tet: its index in the mesh before any edit. Paint and undo key on it.
+    std::vector<int32_t> original_ids;
+    // Per tet: the piece it belongs to, an index into piece_transforms.
+    std::vector<int32_t> piece_ids;
+    // One rigid transform per piece.
+    std::vector<RigidTransform> piece_transforms;
+
+    size_t vertex_count() const { return positions.size(); }
+    size_t tet_count() const { return tets.size(); }
+    bool has_materials() const { return !materials.empty(); }
+
+    friend bool operator==(const TetMesh&, const TetMesh&) = default;
+};
+
+// A mesh from bare geometry: original ids 0..n-1, everything in piece 0 with the identity transform,
+// no materials. Reorients negatively oriented tets; throws InvalidMeshError on degenerate ones.
+TetMesh make_tet_mesh(std::vector<Eigen::Vector3d> positions, std::vector<Tet> tets);
+
+// Signed volume of tet t (positive for a correctly oriented tet).
+double signed_volume(const TetMesh& mesh, size_t t);
+double signed_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                     const Eigen::Vector3d& d);
+
+// Total volume (sum of tet volumes).
+double total_volume(const TetMesh& mesh);
+
+// Axis-aligned bounding box of the vertices: {min, max}.
+std::array<Eigen::Vector3d, 2> bounding_box(const TetMesh& mesh);
+
+// Every broken invariant, described in one line each; empty when the mesh is valid. Checks array
+// sizes, index ranges, finite coordinates, positive orientation, distinct vertices per tet, piece ids,
+// unreferenced vertices, finite and non-negative materials, and that no face is shared by more than
+// two tets.
+std::vector<std::string> find_invariant_violations(const TetMesh& mesh);
+
+// Throws InvalidMeshError listing the first violations when find_invariant_violations is non-empty.
+void validate(const TetMesh& mesh);
+
+}  // namespace waxwork
