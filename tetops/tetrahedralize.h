@@ -14,6 +14,17 @@ enum class Mesher { TetGen, Cgal };
 // How fine the volume is. Exactly one of the three ways is used, in this order of precedence:
 // an explicit edge length, a target tet count, or a graded size (fine near the surface, where the
 // light varies over the diffusion length, coarser inside).
+// - edge_length L: TetGen gets the volume bound -a 2.85 L^3/(6 sqrt 2) (calibrated so the mean edge
+//   is ~L); CGAL gets cell_size 0.9 L, facet_size 0.8 L, edge_size L, facet_distance 0.1 L.
+// - target_tets N: starts from L = (1.2 * 6 sqrt 2 * V / N)^(1/3), then secant steps on
+//   log(count) vs log(L), at most 4 passes, stopping within 10% and failing (AlgorithmError) beyond 20%.
+//   TetGen keeps every input triangle, so below the tet count of its unbounded quality mesh (spot:
+//   ~50K) it throws InvalidArgumentError; CGAL remeshes the surface and can go coarser.
+// - graded: edge(d) = min(surface_edge + grading * d, max_edge) at depth d; max_edge == 0: no cap.
+//   TetGen: a quality mesh at max_edge is the background mesh (-m) carrying 0.9 edge(d) per vertex;
+//   CGAL: the same rule as a sizing field, d from an AABB tree.
+// Sizes whose predicted count (1.2 V / regular-tet volume, or the graded shell integral) exceeds 20M
+// tets are refused with InvalidArgumentError.
 struct MeshSizing {
     std::optional<double> edge_length;   // target edge length in model units, uniform
     std::optional<size_t> target_tets;   // about this many tets (within 20%)

@@ -1,0 +1,166 @@
+#include "tetops/tetgen_mesher.h"
+
+#include "tetops/error.h"
+
+#include <tetgen.h>
+
+#include <cmath>
+#include <cstdio>
+#include <new>
+#include <string>
+
+namespace waxwork {
+
+namespace {
+
+// Ratio of TetGen's -a bound to the volume of the regular tet whose edge is the mean edge it produces
+// (measured: -a 1e-5 on spot gives a mean edge of 0.031).
+constexpr double kVolumeBoundPerRegularVolume = 2.85;
+// TetGen's -m metric bounds the circumradius of each tet; this maps a wanted mean edge to it (a
+// regular tet has circumradius 0.61 L; Delaunay refinement leaves tets smaller than the bound).
+constexpr double kMetricPerEdge = 0.9;
+
+std::string tetgen_reason(int code) {
+    switch (code) {
+    case 1: return "out of memory";
+    case 2: return "internal error";
+    case 3: return "the surface intersects itself";
+    case 4: return "a very small input feature (nearly coincident vertices or edges)";
+    case 5: return "two nearly coincident input facets";
+    case 10: return "invalid input";
+    default: return "error code " + std::to_string(code);
+    }
+}
+
+// The surface as a TetGen piecewise linear complex: its points and one triangular facet per triangle.
+void fill_plc(const TriangleSurface& surface, tetgenio& in) {
+    in.firstnumber = 0;
+    in.numberofpoints = static_cast<int>(surface.points.size());
+    in.pointlist = new REAL[3 * surface.points.size()];
+    for (size_t i = 0; i < surface.points.size(); ++i) {
+        for (int k = 0; k < 3; ++k) in.pointlist[3 * i + k] = surface.points[i][k];
+    }
+    in.numberoffacets = static_cast<int>(surface.triangles.size());
+    in.facetlist = new tetgenio::facet[surface.triangles.size()];
+    for (size_t i = 0; i < surface.triangles.size(); ++i) {
+        tetgenio::facet& facet = in.facetlist[i];
+        tetgenio::init(&facet);
+        facet.numberofpolygons = 1;
+        facet.polygonlist = new tetgenio::polygon[1];
+        tetgenio::init(&facet.polygonlist[0]);
+        facet.polygonlist[0].numberofvertices = 3;
+        facet.polygonlist[0].vertexlist = new int[3];
+        for (int k = 0; k < 3; ++k) facet.polygonlist[0].vertexlist[k] = surface.triangles[i][k];
+    }
+}
+
+std::string format_number(double value) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%.9g", value);
+    return buffer;
+}
+
+// -p: the input is a PLC; -z: zero-based indices; -q: quality; -a: volume bound; -m: sizes from the
+// metric of the background mesh. No -V (verbose) ever: TetGen would print per element.
+std::string make_switches(const TetGenSettings& settings, bool volume_bound, bool metric) {
+    std::string switches = "pz";
+    if (settings.quality) {
+        switches += "q" + format_number(settings.max_radius_edge_ratio) + "/" +
+                    format_number(settings.min_dihedral_deg);
+    }
+    if (volume_bound) switches += "a" + format_number(tetgen_volume_bound_for_edge(settings.size.max_edge));
+    if (metric) switches += "m";
+    if (settings.quiet) switches += "Q";
+    return switches;
+}
+
+// Runs TetGen and turns what it throws into Waxwork errors. TetGen built as a library (TETLIBRARY)
+// throws an int from terminatetetgen() instead of calling exit().
+void run_tetgen(const std::string& switches, tetgenio& in, tetgenio& out, tetgenio* background) {
+    std::string mutable_switches = switches;  // TetGen's signature takes a non-const char*
+    try {
+        tetrahedralize(mutable_switches.data(), &in, &out, nullptr, background);
+    } catch (int code) {
+        throw AlgorithmError("TetGen (-" + switches + ") failed: " + tetgen_reason(code));
+    } catch (const std::bad_alloc&) {
+        throw AlgorithmError("TetGen (-" + switches + ") failed: out of memory");
+    }
+    if (out.numberoftetrahedra <= 0 || out.numberofcorners != 4) {
+        throw AlgorithmError("TetGen (-" + switches + ") produced no tetrahedra");
+    }
+}
+
+// TetGen's output without the points no tet uses (input duplicates, removed Steiner points), with
+// every tet positively oriented.
+TetMesh to_tet_mesh(const tetgenio& out) {
+    std::vector<int32_t> new_index(out.numberofpoints, -1);
+    std::vector<Eigen::Vector3d> positions;
+    std::vector<Tet> tets(out.numberoftetrahedra);
+    for (int t = 0; t < out.numberoftetrahedra; ++t) {
+        for (int k = 0; k < 4; ++k) {
+            const int old_index = out.tetrahedronlist[4 * t + k];
+            if (old_index < 0 || old_index >= out.numberofpoints) {
+                throw AlgorithmError("TetGen produced a tet with an invalid vertex index");
+            }
+            if (new_index[old_index] < 0) {
+                new_index[old_index] = static_cast<int32_t>(positions.size());
+                const REAL* p = &out.pointlist[3 * old_index];
+                positions.emplace_back(p[0], p[1], p[2]);
+            }
+            tets[t][k] = new_index[old_index];
+        }
+        // TetGen 1.5 emits positively oriented tets in Waxwork's convention; checked rather than
+        // assumed so that a different TetGen build cannot flip the whole mesh.
+        Tet& tet = tets[t];
+        if (signed_volume(positions[tet[0]], positions[tet[1]], positions[tet[2]], positions[tet[3]]) < 0) {
+            std::swap(tet[2], tet[3]);
+        }
+    }
+    return make_tet_mesh(std::move(positions), std::move(tets));
+}
+
+}  // namespace
+
+double tetgen_volume_bound_for_edge(double edge) {
+    return kVolumeBoundPerRegularVolume * edge * edge * edge / (6 * std::sqrt(2.0));
+}
+
+TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettings& settings) {
+    const SizeField& size = settings.size;
+    if (!size.is_bounded() || size.is_uniform()) {
+        TetGenSettings uniform = settings;
+        uniform.size.max_edge = std::min(size.surface_edge, size.max_edge);
+        tetgenio in;
+        tetgenio out;
+        fill_plc(surface, in);
+        run_tetgen(make_switches(uniform, std::isfinite(uniform.size.max_edge), false), in, out, nullptr);
+        return to_tet_mesh(out);
+    }
+
+    // Graded: the background mesh is a quality mesh at the coarsest size; each of its vertices gets
+    // the wanted circumradius bound at its depth, and TetGen interpolates it linearly inside its tets,
+    // which reproduces edge(d) exactly where it is linear.
+    tetgenio background;
+    {
+        tetgenio in;
+        fill_plc(surface, in);
+        run_tetgen(make_switches(settings, std::isfinite(size.max_edge), false), in, background, nullptr);
+    }
+    const SurfaceDistance distance(surface);
+    background.numberofpointmtrs = 1;
+    background.pointmtrlist = new REAL[background.numberofpoints];
+    for (int i = 0; i < background.numberofpoints; ++i) {
+        const REAL* p = &background.pointlist[3 * i];
+        background.pointmtrlist[i] = kMetricPerEdge * size.edge_at_depth(distance({p[0], p[1], p[2]}));
+    }
+    tetgenio in;
+    tetgenio out;
+    fill_plc(surface, in);
+    in.numberofpointmtrs = 1;
+    in.pointmtrlist = new REAL[in.numberofpoints];
+    for (int i = 0; i < in.numberofpoints; ++i) in.pointmtrlist[i] = kMetricPerEdge * size.surface_edge;
+    run_tetgen(make_switches(settings, false, true), in, out, &background);
+    return to_tet_mesh(out);
+}
+
+}  // namespace waxwork

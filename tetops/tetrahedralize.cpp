@@ -1,0 +1,248 @@
+#include "tetops/tetrahedralize.h"
+
+#include "tetops/cgal_mesher.h"
+#include "tetops/error.h"
+#include "tetops/size_field.h"
+#include "tetops/tetgen_mesher.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace waxwork {
+
+namespace {
+
+constexpr size_t kMaxTargetTets = 50'000'000;
+// Refuse sizes whose predicted output is larger than this: it would not fit in memory on the
+// machines Waxwork targets and the solver could not run on it anyway.
+constexpr double kMaxPredictedTets = 20e6;
+// Mean tet volume over the volume of the regular tet with the mean edge: 0.88 measured on TetGen's
+// output (spot, 230K tets), so count ~ 1.14 V / regular_volume(edge); rounded up for the estimate.
+constexpr double kTetsPerRegularVolume = 1.2;
+// target_tets: stop as soon as a pass is this close, accept up to the promised 20% after the last.
+constexpr double kTargetTolerance = 0.10;
+constexpr double kTargetPromise = 0.20;
+constexpr int kMaxTargetPasses = 4;
+
+std::string to_string(double value) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%g", value);
+    return buffer;
+}
+
+void validate_options(const MeshingOptions& options) {
+    if (options.mesher != Mesher::TetGen && options.mesher != Mesher::Cgal) {
+        throw InvalidArgumentError("meshing option mesher: unknown mesher");
+    }
+    if (!(options.max_radius_edge_ratio >= 1.0) || !std::isfinite(options.max_radius_edge_ratio)) {
+        throw InvalidArgumentError("meshing option max_radius_edge_ratio = " +
+                                   to_string(options.max_radius_edge_ratio) + ": must be finite and >= 1");
+    }
+    if (!(options.min_dihedral_deg > 0 && options.min_dihedral_deg <= 30)) {
+        throw InvalidArgumentError("meshing option min_dihedral_deg = " + to_string(options.min_dihedral_deg) +
+                                   ": must be in (0, 30] degrees");
+    }
+    const MeshSizing& sizing = options.sizing;
+    if (sizing.edge_length) {
+        if (!(*sizing.edge_length > 0) || !std::isfinite(*sizing.edge_length)) {
+            throw InvalidArgumentError("meshing option sizing.edge_length = " + to_string(*sizing.edge_length) +
+                                       ": must be a positive length");
+        }
+    } else if (sizing.target_tets) {
+        if (*sizing.target_tets == 0 || *sizing.target_tets > kMaxTargetTets) {
+            throw InvalidArgumentError("meshing option sizing.target_tets = " +
+                                       std::to_string(*sizing.target_tets) + ": must be in 1.." +
+                                       std::to_string(kMaxTargetTets));
+        }
+    } else {
+        if (!(sizing.surface_edge > 0) || !std::isfinite(sizing.surface_edge)) {
+            throw InvalidArgumentError("meshing option sizing.surface_edge = " + to_string(sizing.surface_edge) +
+                                       ": must be a positive length (or set sizing.edge_length or "
+                                       "sizing.target_tets)");
+        }
+        if (!(sizing.grading >= 0) || !std::isfinite(sizing.grading)) {
+            throw InvalidArgumentError("meshing option sizing.grading = " + to_string(sizing.grading) +
+                                       ": must be finite and >= 0");
+        }
+        if (!(sizing.max_edge == 0 || (sizing.max_edge >= sizing.surface_edge && std::isfinite(sizing.max_edge)))) {
+            throw InvalidArgumentError("meshing option sizing.max_edge = " + to_string(sizing.max_edge) +
+                                       ": must be 0 (no cap) or at least sizing.surface_edge");
+        }
+    }
+}
+
+// The mesher asserts (and may crash) on malformed input, so the surface is checked first: indices in
+// range, finite points, closed and consistently oriented (every directed edge has its reverse exactly
+// once), positive enclosed volume.
+void validate_surface(const TriangleSurface& surface) {
+    if (surface.triangles.size() < 4) {
+        throw InvalidMeshError("surface to mesh: " + std::to_string(surface.triangles.size()) +
+                               " triangles cannot enclose a volume");
+    }
+    for (size_t i = 0; i < surface.points.size(); ++i) {
+        if (!surface.points[i].allFinite()) {
+            throw InvalidMeshError("surface to mesh: point " + std::to_string(i) + " is not finite");
+        }
+    }
+    const auto n = static_cast<int64_t>(surface.points.size());
+    std::vector<std::pair<int64_t, int64_t>> directed;
+    directed.reserve(3 * surface.triangles.size());
+    for (size_t t = 0; t < surface.triangles.size(); ++t) {
+        const auto& tri = surface.triangles[t];
+        for (int k = 0; k < 3; ++k) {
+            if (tri[k] < 0 || tri[k] >= n) {
+                throw InvalidMeshError("surface to mesh: triangle " + std::to_string(t) +
+                                       " has an out-of-range vertex index " + std::to_string(tri[k]));
+            }
+        }
+        if (tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0]) {
+            throw InvalidMeshError("surface to mesh: triangle " + std::to_string(t) + " repeats a vertex");
+        }
+        for (int k = 0; k < 3; ++k) directed.emplace_back(tri[k], tri[(k + 1) % 3]);
+    }
+    std::sort(directed.begin(), directed.end());
+    for (size_t i = 0; i < directed.size(); ++i) {
+        const auto [a, b] = directed[i];
+        if (i + 1 < directed.size() && directed[i + 1] == directed[i]) {
+            throw InvalidMeshError("surface to mesh: edge (" + std::to_string(a) + ", " + std::to_string(b) +
+                                   ") is used twice in the same direction (non-manifold or inconsistently "
+                                   "oriented)");
+        }
+        if (!std::binary_search(directed.begin(), directed.end(), std::pair{b, a})) {
+            throw InvalidMeshError("surface to mesh: edge (" + std::to_string(a) + ", " + std::to_string(b) +
+                                   ") is on a hole (the surface is not closed)");
+        }
+    }
+    if (!(enclosed_volume(surface) > 0)) {
+        throw InvalidMeshError("surface to mesh: enclosed volume is not positive (inward-facing triangles?)");
+    }
+}
+
+// Predicted tet count of a size field: V / regular_volume(edge) for a uniform size; for a graded one
+// the shell at depth d (area A, to first order) holds A dd / regular_volume(s + g d) tets, whose
+// integral is bounded by A / (2 g s^2) * 6 sqrt 2, plus the interior at max_edge.
+double predicted_tets(const SizeField& size, double volume, double area) {
+    const double s = size.surface_edge;
+    double per_regular_volume = volume / (s * s * s);
+    if (!size.is_uniform()) {
+        const double m = size.max_edge;
+        const double graded = area / (2 * size.grading * s * s) + (std::isfinite(m) ? volume / (m * m * m) : 0.0);
+        per_regular_volume = std::min(per_regular_volume, graded);
+    }
+    return kTetsPerRegularVolume * 6 * std::sqrt(2.0) * per_regular_volume;
+}
+
+void check_predicted_size(const SizeField& size, double volume, double area, const std::string& option) {
+    const double predicted = predicted_tets(size, volume, area);
+    if (predicted > kMaxPredictedTets) {
+        throw InvalidArgumentError("meshing option " + option + ": about " + to_string(predicted) +
+                                   " tets predicted for a volume of " + to_string(volume) +
+                                   ", above the limit of " + to_string(kMaxPredictedTets) +
+                                   "; use a larger edge length");
+    }
+}
+
+TetMesh run_mesher(const TriangleSurface& surface, const MeshingOptions& options, const SizeField& size) {
+    if (options.mesher == Mesher::Cgal) {
+        return cgal_tetrahedralize(surface, {size, options.max_radius_edge_ratio, options.min_dihedral_deg});
+    }
+    TetGenSettings settings;
+    settings.size = size;
+    settings.max_radius_edge_ratio = options.max_radius_edge_ratio;
+    settings.min_dihedral_deg = options.min_dihedral_deg;
+    settings.quiet = options.quiet;
+    return tetgen_tetrahedralize(surface, settings);
+}
+
+// About `target` tets: a uniform edge length from V / target, then secant steps on log(count) against
+// log(edge) (count ~ edge^-3 where the size bound, not the surface, decides the mesh).
+TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& options, size_t target,
+                       double volume) {
+    const double log_target = std::log(double(target));
+    double edge = std::cbrt(kTetsPerRegularVolume * 6 * std::sqrt(2.0) * volume / double(target));
+    double slope = 3;  // -d log(count) / d log(edge)
+    double previous_log_edge = 0;
+    double previous_log_count = 0;
+    TetMesh best;
+    double best_error = INFINITY;
+    for (int pass = 0; pass < kMaxTargetPasses; ++pass) {
+        TetMesh mesh = run_mesher(surface, options, SizeField::uniform(edge));
+        const double log_count = std::log(double(mesh.tet_count()));
+        const double error = std::abs(double(mesh.tet_count()) - double(target)) / double(target);
+        if (error < best_error) {
+            best_error = error;
+            best = std::move(mesh);
+        }
+        if (best_error <= kTargetTolerance) break;
+        if (pass == 0 && options.mesher == Mesher::TetGen && log_count > log_target) {
+            // TetGen keeps every input triangle: the quality mesh without a size bound is the coarsest
+            // it can make. Below that the target is out of reach.
+            TetMesh coarsest = run_mesher(surface, options, SizeField::unbounded());
+            const double coarsest_count = double(coarsest.tet_count());
+            if (coarsest_count > (1 + kTargetPromise) * double(target)) {
+                throw InvalidArgumentError(
+                    "meshing option sizing.target_tets = " + std::to_string(target) +
+                    ": TetGen keeps the surface's triangles and needs at least " +
+                    std::to_string(coarsest.tet_count()) +
+                    " tets on this surface at this quality; ask for more tets or use Mesher::Cgal, "
+                    "which remeshes the surface");
+            }
+            const double coarsest_error = std::abs(coarsest_count - double(target)) / double(target);
+            if (coarsest_error < best_error) {
+                best_error = coarsest_error;
+                best = std::move(coarsest);
+            }
+            if (best_error <= kTargetTolerance) break;
+        }
+        const double log_edge = std::log(edge);
+        if (pass > 0 && log_edge != previous_log_edge) {
+            // Flat stretches (surface-dominated) would give huge steps: keep the slope in [1, 6].
+            slope = std::clamp(-(log_count - previous_log_count) / (log_edge - previous_log_edge), 1.0, 6.0);
+        }
+        previous_log_edge = log_edge;
+        previous_log_count = log_count;
+        edge = std::exp(log_edge + (log_count - log_target) / slope);
+    }
+    if (best_error > kTargetPromise) {
+        throw AlgorithmError("sizing.target_tets = " + std::to_string(target) + ": the closest of " +
+                             std::to_string(kMaxTargetPasses) + " meshing passes had " +
+                             std::to_string(best.tet_count()) + " tets");
+    }
+    return best;
+}
+
+}  // namespace
+
+MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    validate_options(options);
+    validate_surface(surface);
+    const double volume = enclosed_volume(surface);
+    const double area = surface_area(surface);
+
+    MeshingResult result;
+    const MeshSizing& sizing = options.sizing;
+    if (sizing.edge_length) {
+        const SizeField size = SizeField::uniform(*sizing.edge_length);
+        check_predicted_size(size, volume, area, "sizing.edge_length = " + to_string(*sizing.edge_length));
+        result.mesh = run_mesher(surface, options, size);
+    } else if (sizing.target_tets) {
+        result.mesh = mesh_to_target(surface, options, *sizing.target_tets, volume);
+    } else {
+        SizeField size{sizing.surface_edge, sizing.grading,
+                       sizing.max_edge > 0 ? sizing.max_edge : SizeField::unbounded().max_edge};
+        check_predicted_size(size, volume, area, "sizing.surface_edge = " + to_string(sizing.surface_edge));
+        result.mesh = run_mesher(surface, options, size);
+    }
+    result.quality = measure_quality(result.mesh);
+    result.milliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+}  // namespace waxwork
