@@ -1,0 +1,369 @@
+#include "io/surface_reader.h"
+
+#include "tetops/error.h"
+
+#include <OpenMesh/Core/IO/IOManager.hh>
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/IO/importer/ImporterT.hh>
+#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
+#include <OpenMesh/Core/System/omstream.hh>
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <sstream>
+#include <string_view>
+
+namespace waxwork {
+namespace {
+
+struct DoublePrecisionTraits : OpenMesh::DefaultTraits {
+    using Point = OpenMesh::Vec3d;
+    using Normal = OpenMesh::Vec3d;
+};
+using ReaderMesh = OpenMesh::PolyMesh_ArrayKernelT<DoublePrecisionTraits>;
+
+// Records the faces exactly as the reader passes them. OpenMesh's own importer refuses faces that
+// repeat a vertex and, for faces that would make an edge or vertex non-manifold, silently adds copies
+// of their vertices; either would hide the defects that validation must see. The mesh is still built
+// (readers may query it), but the soup comes from what was recorded.
+class SoupImporter : public OpenMesh::IO::ImporterT<ReaderMesh> {
+public:
+    using Base = OpenMesh::IO::ImporterT<ReaderMesh>;
+    explicit SoupImporter(ReaderMesh& mesh) : Base(mesh), mesh_(mesh) {}
+
+    OpenMesh::VertexHandle add_vertex(const OpenMesh::Vec3f& p) override { return record(Base::add_vertex(p)); }
+    OpenMesh::VertexHandle add_vertex(const OpenMesh::Vec3d& p) override { return record(Base::add_vertex(p)); }
+    OpenMesh::VertexHandle add_vertex() override { return record(Base::add_vertex()); }
+
+    OpenMesh::FaceHandle add_face(const VHandles& handles) override {
+        std::vector<int32_t> face;
+        face.reserve(handles.size());
+        bool usable = handles.size() >= 3;
+        for (auto h : handles) {
+            const int i = h.idx();
+            const bool known = i >= 0 && static_cast<size_t>(i) < soup_index_.size() && soup_index_[i] >= 0;
+            face.push_back(known ? soup_index_[i] : -1);
+            usable = usable && known;
+        }
+        faces_.push_back(face);
+        for (size_t a = 0; a < handles.size() && usable; ++a)
+            for (size_t b = a + 1; b < handles.size(); ++b) usable = usable && handles[a] != handles[b];
+        // Only faces OpenMesh can represent go to its mesh; the others would just produce console noise.
+        return usable ? Base::add_face(handles) : OpenMesh::FaceHandle();
+    }
+
+    // The recorded vertices with their final positions (a reader may set them after creating them).
+    std::vector<Eigen::Vector3d> points() const {
+        std::vector<Eigen::Vector3d> result;
+        result.reserve(vertices_.size());
+        for (auto v : vertices_) {
+            const auto& p = mesh_.point(v);
+            result.emplace_back(p[0], p[1], p[2]);
+        }
+        return result;
+    }
+    const std::vector<std::vector<int32_t>>& faces() const { return faces_; }
+
+private:
+    OpenMesh::VertexHandle record(OpenMesh::VertexHandle v) {
+        if (v.idx() >= 0) {
+            if (static_cast<size_t>(v.idx()) >= soup_index_.size()) soup_index_.resize(v.idx() + 1, -1);
+            soup_index_[v.idx()] = static_cast<int32_t>(vertices_.size());
+            vertices_.push_back(v);
+        }
+        return v;
+    }
+
+    ReaderMesh& mesh_;
+    std::vector<OpenMesh::VertexHandle> vertices_;  // in the order the reader created them
+    std::vector<int32_t> soup_index_;               // OpenMesh vertex index -> soup index, -1 for copies
+    std::vector<std::vector<int32_t>> faces_;
+};
+
+// OpenMesh prints to its own global streams (omerr, omlog, omout), connected to the standard streams.
+// While reading, they are disconnected from those and omerr goes to a buffer, so that the problem can
+// be reported in the FileError instead of on the console. The streams are global, hence the mutex
+// serialising all reads (OpenMesh's IOManager is a global singleton too).
+class OpenMeshOutputCapture {
+public:
+    OpenMeshOutputCapture() {
+        for (size_t s = 0; s < streams_.size(); ++s) {
+            connected_[s][0] = streams_[s]->disconnect(std::cerr);
+            connected_[s][1] = streams_[s]->disconnect(std::clog);
+            connected_[s][2] = streams_[s]->disconnect(std::cout);
+        }
+        errors_enabled_ = ::omerr().is_enabled();
+        ::omerr().enable();
+        ::omerr().connect(errors_);
+    }
+    ~OpenMeshOutputCapture() {
+        ::omerr().flush();
+        ::omerr().disconnect(errors_);
+        if (!errors_enabled_) ::omerr().disable();
+        for (size_t s = 0; s < streams_.size(); ++s) {
+            if (connected_[s][0]) streams_[s]->connect(std::cerr);
+            if (connected_[s][1]) streams_[s]->connect(std::clog);
+            if (connected_[s][2]) streams_[s]->connect(std::cout);
+        }
+    }
+    OpenMeshOutputCapture(const OpenMeshOutputCapture&) = delete;
+    OpenMeshOutputCapture& operator=(const OpenMeshOutputCapture&) = delete;
+
+    // The first line OpenMesh complained with, or "".
+    std::string first_error() {
+        ::omerr().flush();
+        std::string line;
+        std::istringstream in(errors_.str());
+        while (std::getline(in, line))
+            if (line.find_first_not_of(" \t\r") != std::string::npos) return line;
+        return {};
+    }
+
+private:
+    std::array<OpenMesh::mostream*, 3> streams_{&::omerr(), &::omlog(), &::omout()};
+    std::array<std::array<bool, 3>, 3> connected_{};
+    bool errors_enabled_ = true;
+    std::ostringstream errors_;
+};
+
+std::mutex& reader_mutex() {
+    static std::mutex mutex;
+    return mutex;
+}
+
+std::string lower_extension(const std::filesystem::path& path) {
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext;
+}
+
+std::string format_name(const std::string& ext) {
+    std::string name = ext.substr(1);
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::toupper(c)); });
+    return name;
+}
+
+// OpenMesh trusts the element counts in OFF and PLY headers: a corrupt count makes it reserve memory
+// for it, and in ascii files a truncated body makes it loop on a failed stream and invent elements
+// from stale values (faces like 0 0 0), which would pass for a smaller mesh. So the header is checked
+// against the body before OpenMesh reads it: every element needs at least two bytes, and an ascii
+// body must hold enough numbers (OFF: 3 per vertex, 4 per face) or lines (PLY: one per element).
+// Binary PLY needs no such check: OpenMesh reports its end of file itself.
+std::string read_all(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void check_count_fits(const std::filesystem::path& path, const std::string& what, unsigned long long count,
+                      std::uintmax_t size) {
+    if (count > size / 2)
+        throw FileError(path.string(), "header declares " + std::to_string(count) + " " + what +
+                                           " but the file has only " + std::to_string(size) + " bytes");
+}
+
+unsigned long long parse_count(const std::filesystem::path& path, const std::string& token) {
+    if (token.empty() || token.find_first_not_of("0123456789") != std::string::npos)
+        throw FileError(path.string(), "malformed header: '" + token + "' is not an element count");
+    try {
+        return std::stoull(token);
+    } catch (const std::out_of_range&) {
+        throw FileError(path.string(), "malformed header: element count " + token + " is out of range");
+    }
+}
+
+void check_off_body(const std::filesystem::path& path, std::uintmax_t size) {
+    const std::string text = read_all(path);
+    // Whitespace-separated tokens with '#' comments removed; only counted past the header.
+    std::vector<std::string_view> header;
+    size_t body_tokens = 0;
+    bool in_comment = false;
+    for (size_t i = 0; i < text.size();) {
+        const char c = text[i];
+        if (c == '\n') in_comment = false;
+        if (in_comment || std::isspace(static_cast<unsigned char>(c))) {
+            ++i;
+            continue;
+        }
+        if (c == '#') {
+            in_comment = true;
+            continue;
+        }
+        size_t j = i;
+        while (j < text.size() && !std::isspace(static_cast<unsigned char>(text[j])) && text[j] != '#') ++j;
+        if (header.size() < 5)
+            header.emplace_back(text.data() + i, j - i);
+        else
+            ++body_tokens;
+        i = j;
+    }
+    // Only the plain ascii layout "[ST][C][N]OFF nv nf ne" is checked; other variants go to OpenMesh
+    // as they are.
+    if (header.size() < 4 || header[0].find("OFF") == std::string_view::npos || header[0].find('n') != std::string_view::npos ||
+        header[0].find('4') != std::string_view::npos || header[1] == "BINARY")
+        return;
+    const auto vertices = parse_count(path, std::string(header[1]));
+    const auto faces = parse_count(path, std::string(header[2]));
+    check_count_fits(path, "vertices", vertices, size);
+    check_count_fits(path, "faces", faces, size);
+    body_tokens += header.size() - 4;  // tokens after "OFF nv nf ne" that were kept as header
+    if (body_tokens < 3 * vertices + 4 * faces)
+        throw FileError(path.string(), "truncated: the header declares " + std::to_string(vertices) +
+                                           " vertices and " + std::to_string(faces) +
+                                           " faces but the file ends before them");
+}
+
+void check_ply_body(const std::filesystem::path& path, std::uintmax_t size) {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    bool ascii = false;
+    unsigned long long elements = 0;
+    for (int lines = 0;; ++lines) {
+        // OpenMesh loops forever on a header without end_header, so that is caught here.
+        if (!std::getline(in, line) || lines > 10000)
+            throw FileError(path.string(), "truncated or malformed PLY header (no end_header)");
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        std::istringstream words(line);
+        std::string keyword, first, second;
+        words >> keyword >> first >> second;
+        if (keyword == "end_header") break;
+        if (keyword == "format") ascii = first == "ascii";
+        if (keyword == "element") {
+            const auto count = parse_count(path, second);
+            check_count_fits(path, first + " elements", count, size);
+            elements += count;
+        }
+    }
+    if (!ascii) return;
+    unsigned long long body_lines = 0;
+    while (std::getline(in, line))
+        if (line.find_first_not_of(" \t\r") != std::string::npos) ++body_lines;
+    if (body_lines < elements)
+        throw FileError(path.string(), "truncated: the header declares " + std::to_string(elements) +
+                                           " elements but the file holds only " + std::to_string(body_lines) +
+                                           " lines of them");
+}
+
+// A binary STL is an 80-byte header, a triangle count and 50 bytes per triangle; OpenMesh takes any
+// file whose size does not match for ascii, so a cut binary file would read as "no faces". Files
+// starting with "solid" are ascii unless their size matches the binary layout exactly (some binary
+// exporters write "solid" into the header).
+void check_stl_size(const std::filesystem::path& path, std::uintmax_t size) {
+    std::ifstream in(path, std::ios::binary);
+    char header[80] = {};
+    in.read(header, sizeof header);
+    const std::string start(header, header + in.gcount());
+    uint32_t count = 0;
+    const bool has_count = static_cast<bool>(in.read(reinterpret_cast<char*>(&count), sizeof count));
+    const auto first = start.find_first_not_of(" \t\r\n");
+    const bool says_solid = first != std::string::npos && start.compare(first, 5, "solid") == 0;
+    // Binary STL stores the count little-endian; so do the machines Waxwork runs on.
+    const std::uintmax_t binary_size = 84 + 50 * static_cast<std::uintmax_t>(count);
+    if (has_count && binary_size == size) return;
+    if (says_solid || size < 5) {
+        if (!says_solid)
+            throw FileError(path.string(), "neither an ascii STL (no 'solid') nor a binary STL (too short)");
+        return;
+    }
+    if (!has_count)
+        throw FileError(path.string(), "truncated binary STL: " + std::to_string(size) +
+                                           " bytes, shorter than its 84-byte header");
+    throw FileError(path.string(), "not an ascii STL (no 'solid') and, as a binary STL, truncated or corrupt: "
+                                   "it declares " + std::to_string(count) + " triangles (" +
+                                   std::to_string(binary_size) + " bytes) but has " + std::to_string(size) + " bytes");
+}
+
+}  // namespace
+
+TriangleSurface read_surface_file(const std::filesystem::path& path) {
+    const std::string name = path.string();
+    const std::string ext = lower_extension(path);
+    if (ext != ".obj" && ext != ".off" && ext != ".ply" && ext != ".stl")
+        throw FileError(name, "unknown surface format '" + ext + "' (expected .obj, .off, .ply or .stl)");
+    std::error_code error;
+    const auto status = std::filesystem::status(path, error);
+    if (!std::filesystem::exists(status)) throw FileError(name, "no such file");
+    if (!std::filesystem::is_regular_file(status)) throw FileError(name, "not a regular file");
+    const auto size = std::filesystem::file_size(path, error);
+    if (error) throw FileError(name, "cannot read: " + error.message());
+    if (size == 0) throw FileError(name, "empty file");
+    if (!std::ifstream(path, std::ios::binary)) throw FileError(name, "cannot open for reading");
+    if (ext == ".off") check_off_body(path, size);
+    if (ext == ".ply") check_ply_body(path, size);
+    if (ext == ".stl") check_stl_size(path, size);
+
+    ReaderMesh mesh;
+    SoupImporter importer(mesh);
+    bool ok = false;
+    std::string complaint;
+    {
+        std::lock_guard lock(reader_mutex());
+        OpenMeshOutputCapture capture;
+        OpenMesh::IO::Options options;  // geometry only: no normals, colours or texture coordinates
+        try {
+            ok = OpenMesh::IO::IOManager().read(name, importer, options);
+        } catch (const std::exception& e) {
+            complaint = e.what();
+            ok = false;
+        }
+        if (complaint.empty()) complaint = capture.first_error();
+    }
+    if (!ok)
+        throw FileError(name, "not a readable " + format_name(ext) + " file" +
+                                  (complaint.empty() ? "" : " (" + complaint + ")"));
+
+    TriangleSurface surface;
+    surface.points = importer.points();
+    const auto& faces = importer.faces();
+    for (size_t f = 0; f < faces.size(); ++f) {
+        const auto& face = faces[f];
+        if (face.size() < 3)
+            throw FileError(name, "face " + std::to_string(f) + " has fewer than 3 vertices");
+        if (std::any_of(face.begin(), face.end(), [](int32_t i) { return i < 0; }))
+            throw FileError(name, "face " + std::to_string(f) + " refers to a vertex that does not exist");
+        // Polygons become fans; every format here stores planar convex polygons in practice.
+        for (size_t k = 1; k + 1 < face.size(); ++k) surface.triangles.push_back({face[0], face[k], face[k + 1]});
+    }
+    if (surface.triangles.empty())
+        throw FileError(name, "no faces" + (complaint.empty() ? std::string() : " (" + complaint + ")"));
+    return surface;
+}
+
+LoadedSurface load_closed_surface(const std::filesystem::path& path, const SurfaceRepairOptions& options) {
+    LoadedSurface loaded;
+    loaded.surface = read_surface_file(path);
+    const std::string name = path.string();
+    auto reject = [&](const std::vector<std::string>& defects) {
+        std::string message = name + ": ";
+        for (size_t k = 0; k < defects.size(); ++k) message += (k ? "; " : "") + defects[k];
+        throw InvalidMeshError(message);
+    };
+
+    SurfaceIndexMap origin;
+    loaded.repairs = repair_safe_defects(loaded.surface, &origin);
+    SurfaceDefects defects = find_surface_defects(loaded.surface);
+    std::vector<std::string> problems = defects.describe(&origin);
+    if (problems.empty()) return loaded;
+    if (!options.fill_holes && !options.autorefine) {
+        // The safe repairs were defects of the file too; name them after the blocking ones.
+        for (const auto& repair : loaded.repairs) problems.push_back("also repaired: " + repair);
+        reject(problems);
+    }
+
+    for (auto& line : repair_hard_defects(loaded.surface, options)) loaded.repairs.push_back(std::move(line));
+    // After a shape-changing repair, indices no longer match the file; the messages use the new ones.
+    problems = find_surface_defects(loaded.surface).describe();
+    if (!problems.empty()) {
+        problems.push_back("repairs tried: " + [&] {
+            std::string all;
+            for (size_t k = 0; k < loaded.repairs.size(); ++k) all += (k ? ", " : "") + loaded.repairs[k];
+            return all;
+        }());
+        reject(problems);
+    }
+    return loaded;
+}
+
+}  // namespace waxwork

@@ -1,0 +1,349 @@
+#include "io/surface_reader.h"
+
+#include "tetops/error.h"
+
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+namespace waxwork {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path shared_meshes = fs::path(WAXWORK_SHARED_DIR) / "data" / "meshes";
+const fs::path asset_meshes = fs::path(WAXWORK_ASSET_DIR) / "meshes";
+
+#define SKIP_WITHOUT_SHARED()                                                     \
+    if (!fs::exists(shared_meshes)) GTEST_SKIP() << shared_meshes << " is absent"
+
+// A fresh directory per test, removed afterwards.
+class SurfaceReaderFiles : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() /
+               ("waxwork_surface_" + std::string(info->name()) + "_" + std::to_string(std::random_device{}()));
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    fs::path file(const std::string& name) const { return dir_ / name; }
+    fs::path write_text(const std::string& name, const std::string& text) const {
+        std::ofstream(file(name), std::ios::binary) << text;
+        return file(name);
+    }
+    fs::path truncated_copy(const fs::path& source, const std::string& name, double fraction) const {
+        std::ifstream in(source, std::ios::binary);
+        std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        bytes.resize(static_cast<size_t>(bytes.size() * fraction));
+        return write_text(name, bytes);
+    }
+
+    fs::path dir_;
+};
+
+// The unit cube as an OpenMesh mesh, written with OpenMesh's writers so the readers get real files.
+OpenMesh::TriMesh_ArrayKernelT<> make_openmesh_cube() {
+    OpenMesh::TriMesh_ArrayKernelT<> mesh;
+    std::vector<OpenMesh::VertexHandle> v;
+    for (int k = 0; k < 8; ++k) v.push_back(mesh.add_vertex({float(k & 1), float((k >> 1) & 1), float((k >> 2) & 1)}));
+    const int faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                              {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    for (const auto& f : faces) mesh.add_face(v[f[0]], v[f[1]], v[f[2]]);
+    return mesh;
+}
+
+// The cube as OBJ text; inward flips every triangle, split gives every triangle its own vertices.
+std::string cube_obj(bool inward = false, bool split = false) {
+    const int faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                              {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    auto vertex = [](int k) {
+        return "v " + std::to_string(k & 1) + " " + std::to_string((k >> 1) & 1) + " " + std::to_string((k >> 2) & 1) + "\n";
+    };
+    std::string text;
+    if (!split)
+        for (int k = 0; k < 8; ++k) text += vertex(k);
+    int next = 1;
+    for (const auto& f : faces) {
+        int a = f[0], b = inward ? f[2] : f[1], c = inward ? f[1] : f[2];
+        if (split) {
+            text += vertex(a) + vertex(b) + vertex(c);
+            text += "f " + std::to_string(next) + " " + std::to_string(next + 1) + " " + std::to_string(next + 2) + "\n";
+            next += 3;
+        } else {
+            text += "f " + std::to_string(a + 1) + " " + std::to_string(b + 1) + " " + std::to_string(c + 1) + "\n";
+        }
+    }
+    return text;
+}
+
+void expect_file_error(const fs::path& path, const std::string& fragment) {
+    try {
+        read_surface_file(path);
+        ADD_FAILURE() << path << " was read without error";
+    } catch (const FileError& e) {
+        EXPECT_EQ(e.path(), path.string());
+        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+}
+
+std::string load_error(const fs::path& path) {
+    try {
+        load_closed_surface(path);
+    } catch (const InvalidMeshError& e) {
+        return e.what();
+    }
+    ADD_FAILURE() << path << " loaded without an InvalidMeshError";
+    return {};
+}
+
+// ---- the real broken inputs ------------------------------------------------------------------------
+
+TEST(SurfaceReaderShared, BadCowIsPinchedAndSelfIntersecting) {
+    SKIP_WITHOUT_SHARED();
+    const fs::path path = shared_meshes / "bad_cow.obj";
+    const std::string message = load_error(path);
+    EXPECT_EQ(message.rfind(path.string() + ": ", 0), 0u) << message;  // starts with the file name
+    EXPECT_NE(message.find("non-manifold vertex"), std::string::npos) << message;
+    EXPECT_NE(message.find("81 self-intersecting triangle pairs"), std::string::npos) << message;
+    // Most important first: topology before intersections.
+    EXPECT_LT(message.find("non-manifold"), message.find("self-intersecting")) << message;
+}
+
+TEST(SurfaceReaderShared, BadBunnyIsOpenWithUnreferencedVertices) {
+    SKIP_WITHOUT_SHARED();
+    const std::string message = load_error(shared_meshes / "bad_stanford-bunny.obj");
+    EXPECT_NE(message.find("223 boundary edges"), std::string::npos) << message;
+    EXPECT_NE(message.find("removed 1113 unreferenced vertices"), std::string::npos) << message;
+}
+
+TEST(SurfaceReaderShared, BadBunnyHolesCanBeFilledOnRequest) {
+    SKIP_WITHOUT_SHARED();
+    const LoadedSurface loaded =
+        load_closed_surface(shared_meshes / "bad_stanford-bunny.obj", {.fill_holes = true, .autorefine = false});
+    EXPECT_TRUE(find_surface_defects(loaded.surface).is_clean());
+    bool filled = false;
+    for (const auto& r : loaded.repairs) filled |= r.find("filled") != std::string::npos;
+    EXPECT_TRUE(filled);
+}
+
+TEST(SurfaceReaderShared, HorseSelfIntersects) {
+    SKIP_WITHOUT_SHARED();
+    const std::string message = load_error(shared_meshes / "horse.ply");
+    EXPECT_NE(message.find("4 self-intersecting triangle pairs"), std::string::npos) << message;
+}
+
+TEST(SurfaceReaderShared, HorseRawSoupMatchesTheFile) {
+    SKIP_WITHOUT_SHARED();
+    const TriangleSurface horse = read_surface_file(shared_meshes / "horse.ply");  // binary PLY
+    EXPECT_EQ(horse.points.size(), 48485u);
+    EXPECT_EQ(horse.triangles.size(), 96966u);
+}
+
+TEST(SurfaceReaderShared, BadCowKeepsItsPinchedVertexInTheSoup) {
+    SKIP_WITHOUT_SHARED();
+    // OpenMesh would duplicate the pinched vertex; the soup must keep the file's vertices only.
+    const TriangleSurface cow = read_surface_file(shared_meshes / "bad_cow.obj");
+    EXPECT_EQ(cow.points.size(), 2903u);
+    EXPECT_EQ(cow.triangles.size(), 5804u);
+    EXPECT_EQ(find_surface_defects(cow).non_manifold_vertices, 1u);
+}
+
+TEST(SurfaceReaderShared, CleanMeshesLoad) {
+    SKIP_WITHOUT_SHARED();
+    for (const char* name : {"cube.obj", "spot.obj", "bunny.off", "torus.obj", "fandisk.obj", "armadillo.obj", "skull.obj"}) {
+        SCOPED_TRACE(name);
+        const fs::path path = shared_meshes / name;
+        const TriangleSurface raw = read_surface_file(path);
+        LoadedSurface loaded;
+        EXPECT_NO_THROW(loaded = load_closed_surface(path));
+        EXPECT_TRUE(loaded.repairs.empty()) << loaded.repairs.front();
+        EXPECT_EQ(loaded.surface.triangles.size(), raw.triangles.size());
+        EXPECT_GT(find_surface_defects(loaded.surface).signed_volume, 0.0);
+    }
+}
+
+TEST(SurfaceReader, AssetMeshesLoad) {
+    for (const char* name : {"cube.obj", "spot.obj", "torus.obj", "skull.obj"}) {
+        SCOPED_TRACE(name);
+        EXPECT_NO_THROW(load_closed_surface(asset_meshes / name));
+    }
+}
+
+// ---- formats -----------------------------------------------------------------------------------------
+
+TEST_F(SurfaceReaderFiles, RoundTripThroughEveryFormat) {
+    const auto cube = make_openmesh_cube();
+    struct Case {
+        std::string name;
+        OpenMesh::IO::Options options;
+    };
+    const Case cases[] = {{"cube.obj", {}},
+                          {"cube.off", {}},
+                          {"cube_ascii.ply", {}},
+                          {"cube_binary.ply", OpenMesh::IO::Options::Binary},
+                          {"cube_ascii.stl", {}},
+                          {"cube_binary.stl", OpenMesh::IO::Options::Binary}};
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.name);
+        const fs::path path = file(c.name);
+        ASSERT_TRUE(OpenMesh::IO::write_mesh(cube, path.string(), c.options));
+        const TriangleSurface raw = read_surface_file(path);
+        EXPECT_EQ(raw.triangles.size(), 12u);
+        const LoadedSurface loaded = load_closed_surface(path);
+        EXPECT_EQ(loaded.surface.points.size(), 8u);
+        EXPECT_EQ(loaded.surface.triangles.size(), 12u);
+        const SurfaceDefects d = find_surface_defects(loaded.surface);
+        EXPECT_TRUE(d.is_clean());
+        EXPECT_NEAR(d.signed_volume, 1.0, 1e-6);
+        // Every corner of the cube came back.
+        for (int k = 0; k < 8; ++k) {
+            const Eigen::Vector3d corner(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+            EXPECT_TRUE(std::any_of(loaded.surface.points.begin(), loaded.surface.points.end(),
+                                    [&](const Eigen::Vector3d& p) { return (p - corner).norm() < 1e-6; }));
+        }
+    }
+    // The binary files really are binary.
+    EXPECT_EQ(fs::file_size(file("cube_binary.stl")), 84u + 50u * 12u);
+    std::ifstream ply(file("cube_binary.ply"), std::ios::binary);
+    std::string header((std::istreambuf_iterator<char>(ply)), std::istreambuf_iterator<char>());
+    EXPECT_NE(header.find("format binary"), std::string::npos);
+}
+
+TEST_F(SurfaceReaderFiles, UpperCaseExtensionIsAccepted) {
+    const fs::path path = write_text("CUBE.OBJ", cube_obj());
+    EXPECT_EQ(read_surface_file(path).triangles.size(), 12u);
+}
+
+TEST_F(SurfaceReaderFiles, QuadsAreSplitIntoTriangles) {
+    const fs::path path = write_text("quads.obj",
+                                     "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
+                                     "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n");
+    const LoadedSurface loaded = load_closed_surface(path);
+    EXPECT_EQ(loaded.surface.triangles.size(), 12u);
+    EXPECT_NEAR(find_surface_defects(loaded.surface).signed_volume, 1.0, 1e-12);
+}
+
+// ---- repairs -----------------------------------------------------------------------------------------
+
+TEST_F(SurfaceReaderFiles, InwardCubeIsReorientedAndReported) {
+    const LoadedSurface loaded = load_closed_surface(write_text("inward.obj", cube_obj(true)));
+    ASSERT_EQ(loaded.repairs.size(), 1u);
+    EXPECT_NE(loaded.repairs[0].find("flipped all 12 triangles to face outward"), std::string::npos) << loaded.repairs[0];
+    EXPECT_NEAR(find_surface_defects(loaded.surface).signed_volume, 1.0, 1e-12);
+}
+
+TEST_F(SurfaceReaderFiles, DuplicateVerticesAreMergedAndReported) {
+    const fs::path path = write_text("split.obj", cube_obj(false, true));
+    EXPECT_EQ(read_surface_file(path).points.size(), 36u);  // the raw soup keeps them
+    const LoadedSurface loaded = load_closed_surface(path);
+    EXPECT_EQ(loaded.surface.points.size(), 8u);
+    ASSERT_EQ(loaded.repairs.size(), 1u);
+    EXPECT_NE(loaded.repairs[0].find("merged 28 duplicate vertices"), std::string::npos) << loaded.repairs[0];
+}
+
+TEST_F(SurfaceReaderFiles, OpenSurfaceNamesFileAndDefect) {
+    std::string text = cube_obj();
+    text.erase(text.rfind("f "));  // drop the last triangle
+    const fs::path path = write_text("open.obj", text);
+    const std::string message = load_error(path);
+    EXPECT_EQ(message.rfind(path.string() + ": 3 boundary edges", 0), 0u) << message;
+}
+
+TEST_F(SurfaceReaderFiles, PinchedCubesAreRejected) {
+    std::string text = cube_obj();
+    for (int k = 0; k < 8; ++k)
+        text += "v " + std::to_string(1 + (k & 1)) + " " + std::to_string(1 + ((k >> 1) & 1)) + " " +
+                std::to_string(1 + ((k >> 2) & 1)) + "\n";
+    // The second cube's faces, shifted by 8 vertices.
+    std::istringstream in(cube_obj().substr(cube_obj().find("f ")));
+    std::string tag;
+    int a, b, c;
+    while (in >> tag >> a >> b >> c)
+        text += "f " + std::to_string(a + 8) + " " + std::to_string(b + 8) + " " + std::to_string(c + 8) + "\n";
+    const std::string message = load_error(write_text("pinched.obj", text));
+    EXPECT_NE(message.find("1 non-manifold vertex"), std::string::npos) << message;
+    EXPECT_EQ(message.find("self-intersecting"), std::string::npos) << message;
+}
+
+// ---- broken files ------------------------------------------------------------------------------------
+
+TEST_F(SurfaceReaderFiles, MissingEmptyAndUnknownFilesGiveFileErrors) {
+    expect_file_error(file("missing.obj"), "no such file");
+    expect_file_error(write_text("empty.off", ""), "empty file");
+    expect_file_error(write_text("cube.xyz", cube_obj()), "unknown surface format");
+    expect_file_error(dir_ / "folder.obj", "no such file");
+    fs::create_directories(dir_ / "dir.obj");
+    expect_file_error(dir_ / "dir.obj", "not a regular file");
+}
+
+TEST_F(SurfaceReaderFiles, GarbageGivesFileErrors) {
+    std::string garbage = "this is not a mesh \x01\x02\xff\n";
+    std::mt19937 random(7);
+    for (int k = 0; k < 2000; ++k) garbage += static_cast<char>(random() % 256);
+    for (const char* name : {"garbage.obj", "garbage.off", "garbage.ply", "garbage.stl"}) {
+        SCOPED_TRACE(name);
+        EXPECT_THROW(read_surface_file(write_text(name, garbage)), FileError);
+    }
+}
+
+TEST_F(SurfaceReaderFiles, AbsurdHeaderCountsGiveFileErrors) {
+    expect_file_error(write_text("huge.off", "OFF\n1000000000 2000000000 0\n0 0 0\n"), "header declares");
+    expect_file_error(write_text("huge.ply",
+                                 "ply\nformat binary_little_endian 1.0\nelement vertex 999999999\n"
+                                 "property float x\nproperty float y\nproperty float z\nelement face 1\n"
+                                 "property list uchar int vertex_indices\nend_header\n"),
+                      "header declares");
+}
+
+TEST_F(SurfaceReaderFiles, FaceWithMissingVertexGivesFileError) {
+    expect_file_error(write_text("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "");
+}
+
+TEST_F(SurfaceReaderFiles, TruncatedFilesGiveFileErrors) {
+    const auto cube = make_openmesh_cube();
+    const struct {
+        std::string name;
+        OpenMesh::IO::Options options;
+    } cases[] = {{"cube.off", {}},
+                 {"cube_ascii.ply", {}},
+                 {"cube_binary.ply", OpenMesh::IO::Options::Binary},
+                 {"cube_binary.stl", OpenMesh::IO::Options::Binary}};
+    for (const auto& c : cases) {
+        ASSERT_TRUE(OpenMesh::IO::write_mesh(cube, file(c.name).string(), c.options));
+        for (double fraction : {0.3, 0.6, 0.9}) {
+            SCOPED_TRACE(c.name + " cut at " + std::to_string(fraction));
+            const fs::path cut = truncated_copy(file(c.name), "cut_" + c.name, fraction);
+            EXPECT_THROW(read_surface_file(cut), FileError);
+        }
+    }
+}
+
+TEST_F(SurfaceReaderFiles, TruncatedTextFilesNeverPassSilently) {
+    // OBJ and ascii STL have no element counts: a cut at a line boundary is a smaller, valid file.
+    // Whatever the cut, the result is a FileError or a rejected (open) surface, never a surface.
+    const auto cube = make_openmesh_cube();
+    ASSERT_TRUE(OpenMesh::IO::write_mesh(cube, file("cube_ascii.stl").string()));
+    write_text("cube.obj", cube_obj());
+    for (const char* name : {"cube.obj", "cube_ascii.stl"}) {
+        for (double fraction : {0.2, 0.5, 0.75, 0.95}) {
+            SCOPED_TRACE(std::string(name) + " cut at " + std::to_string(fraction));
+            const fs::path cut = truncated_copy(file(name), std::string("cut_") + name, fraction);
+            try {
+                load_closed_surface(cut);
+                ADD_FAILURE() << "a truncated file loaded";
+            } catch (const FileError&) {
+            } catch (const InvalidMeshError&) {
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace waxwork
