@@ -1,0 +1,57 @@
+#include "io/volume_file.h"
+
+#include "io/gmsh_format.h"
+#include "io/medit_format.h"
+#include "io/tetgen_format.h"
+#include "io/vtu_format.h"
+#include "tetops/error.h"
+
+#include <algorithm>
+#include <cctype>
+#include <string>
+
+namespace waxwork {
+namespace {
+
+enum class VolumeFormat { Vtu, Gmsh, Medit, TetGen };
+
+VolumeFormat format_of(const std::filesystem::path& path) {
+    std::string extension = path.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (extension == ".vtu") return VolumeFormat::Vtu;
+    if (extension == ".msh") return VolumeFormat::Gmsh;
+    if (extension == ".mesh") return VolumeFormat::Medit;
+    if (extension == ".node" || extension == ".ele") return VolumeFormat::TetGen;
+    throw FileError(path.string(), "unknown volume file extension '" + path.extension().string() +
+                                       "' (expected .vtu, .msh, .mesh, .node or .ele)");
+}
+
+}  // namespace
+
+TetMesh read_volume(const std::filesystem::path& path) {
+    switch (format_of(path)) {
+        case VolumeFormat::Vtu: return read_vtu(path);
+        case VolumeFormat::Gmsh: return read_gmsh(path);
+        case VolumeFormat::Medit: return read_medit(path);
+        case VolumeFormat::TetGen: return read_tetgen(path);
+    }
+    throw FileError(path.string(), "unknown volume format");
+}
+
+void write_volume(const TetMesh& mesh, const std::filesystem::path& path) {
+    const VolumeFormat format = format_of(path);
+    try {
+        validate(mesh);
+    } catch (const InvalidMeshError& error) {
+        throw InvalidMeshError(path.string() + ": not saved: " + error.what());
+    }
+    switch (format) {
+        case VolumeFormat::Vtu: write_vtu(mesh, path); return;
+        case VolumeFormat::Gmsh: write_gmsh(mesh, path); return;
+        case VolumeFormat::Medit: write_medit(mesh, path); return;
+        case VolumeFormat::TetGen: write_tetgen(mesh, path); return;
+    }
+}
+
+}  // namespace waxwork

@@ -1,0 +1,534 @@
+// Volume files: exact round trips in every format, rejection of broken files, atomic saves.
+#include "io/atomic_file.h"
+#include "io/gmsh_format.h"
+#include "io/medit_format.h"
+#include "io/tetgen_format.h"
+#include "io/volume_file.h"
+#include "io/vtu_format.h"
+#include "tetops/error.h"
+#include "tetops/tet_mesh.h"
+
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <sstream>
+#include <string>
+
+namespace waxwork {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A 2x2x2 block of cubes, each split into the 6 Kuhn tets around its main diagonal (a conforming
+// mesh), with jittered coordinates so every mantissa bit matters, random materials, scrambled
+// original ids and two pieces, the second one rotated and translated.
+TetMesh make_test_mesh(bool with_materials = true) {
+    std::mt19937 random(12345);
+    std::uniform_real_distribution<double> jitter(-0.05, 0.05);
+    constexpr int n = 2;
+    std::vector<Eigen::Vector3d> positions;
+    auto vertex = [&](int x, int y, int z) { return static_cast<int32_t>((z * (n + 1) + y) * (n + 1) + x); };
+    for (int z = 0; z <= n; ++z)
+        for (int y = 0; y <= n; ++y)
+            for (int x = 0; x <= n; ++x)
+                positions.emplace_back(x + jitter(random), y + jitter(random), z + jitter(random));
+    std::vector<Tet> tets;
+    std::vector<int32_t> pieces;
+    const int axis_orders[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    for (int z = 0; z < n; ++z)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x)
+                for (const auto& order : axis_orders) {
+                    int corner[3] = {x, y, z};
+                    Tet tet;
+                    tet[0] = vertex(corner[0], corner[1], corner[2]);
+                    for (int k = 0; k < 3; ++k) {
+                        ++corner[order[k]];
+                        tet[k + 1] = vertex(corner[0], corner[1], corner[2]);
+                    }
+                    tets.push_back(tet);
+                    pieces.push_back(x == 0 ? 0 : 1);
+                }
+    TetMesh mesh = make_tet_mesh(std::move(positions), std::move(tets));
+    mesh.piece_ids = pieces;
+    mesh.piece_transforms.resize(2);
+    mesh.piece_transforms[1].rotation =
+        Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 2.0, -0.5).normalized()).toRotationMatrix();
+    mesh.piece_transforms[1].translation = Eigen::Vector3d(0.1, -2.0 / 3.0, 1e-7);
+    for (size_t t = 0; t < mesh.tet_count(); ++t) mesh.original_ids[t] = static_cast<int32_t>(1000 - 7 * t);
+    if (with_materials) {
+        std::uniform_real_distribution<double> coefficient(0.0, 3.0);
+        mesh.materials.resize(mesh.tet_count());
+        for (TetMaterial& material : mesh.materials) {
+            for (int c = 0; c < 3; ++c) {
+                material.mua[c] = coefficient(random) * 1e-3;
+                material.musp[c] = coefficient(random);
+            }
+            material.eta = 1.0 + coefficient(random) / 10;
+        }
+    }
+    validate(mesh);
+    return mesh;
+}
+
+std::string read_text(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+}
+
+class VolumeFileTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        directory_ = fs::temp_directory_path() /
+                     ("waxwork_volume_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+        fs::remove_all(directory_);
+        fs::create_directories(directory_);
+    }
+    void TearDown() override { fs::remove_all(directory_); }
+
+    fs::path path(const std::string& name) const { return directory_ / name; }
+    size_t file_count() const {
+        return static_cast<size_t>(std::distance(fs::directory_iterator(directory_), fs::directory_iterator()));
+    }
+
+    fs::path directory_;
+};
+
+void expect_same_geometry(const TetMesh& expected, const TetMesh& actual) {
+    ASSERT_EQ(expected.positions.size(), actual.positions.size());
+    ASSERT_EQ(expected.tets, actual.tets);
+    // Bit-exact, not merely equal (== treats 0.0 and -0.0 alike).
+    EXPECT_EQ(0, std::memcmp(expected.positions.data(), actual.positions.data(),
+                             expected.positions.size() * sizeof(Eigen::Vector3d)));
+    EXPECT_FALSE(actual.has_materials());
+    EXPECT_EQ(actual.piece_transforms.size(), 1u);
+    EXPECT_EQ(actual.piece_ids, std::vector<int32_t>(actual.tet_count(), 0));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Round trips.
+
+TEST_F(VolumeFileTest, VtuRoundTripIsBitExact) {
+    const TetMesh mesh = make_test_mesh();
+    write_volume(mesh, path("volume.vtu"));
+    const TetMesh loaded = read_volume(path("volume.vtu"));
+    EXPECT_EQ(mesh, loaded);
+    EXPECT_EQ(0, std::memcmp(mesh.positions.data(), loaded.positions.data(),
+                             mesh.positions.size() * sizeof(Eigen::Vector3d)));
+    EXPECT_EQ(0, std::memcmp(mesh.materials.data(), loaded.materials.data(),
+                             mesh.materials.size() * sizeof(TetMaterial)));
+    ASSERT_EQ(loaded.piece_transforms.size(), 2u);
+    EXPECT_TRUE(loaded.piece_transforms[1] == mesh.piece_transforms[1]);
+}
+
+TEST_F(VolumeFileTest, VtuWithoutMaterialsStaysWithoutMaterials) {
+    const TetMesh mesh = make_test_mesh(/*with_materials=*/false);
+    write_volume(mesh, path("plain.VTU"));
+    const TetMesh loaded = read_volume(path("plain.VTU"));
+    EXPECT_FALSE(loaded.has_materials());
+    EXPECT_EQ(mesh, loaded);
+    EXPECT_EQ(read_text(path("plain.VTU")).find("Name=\"mua\""), std::string::npos);
+}
+
+TEST_F(VolumeFileTest, VtuIsAnUnstructuredGridOfTetra) {
+    const TetMesh mesh = make_test_mesh();
+    std::ostringstream out;
+    format_vtu(mesh, out);
+    const std::string text = out.str();
+    EXPECT_NE(text.find("<VTKFile type=\"UnstructuredGrid\""), std::string::npos);
+    EXPECT_NE(text.find("NumberOfCells=\"" + std::to_string(mesh.tet_count()) + "\""), std::string::npos);
+    EXPECT_NE(text.find("NumberOfPoints=\"" + std::to_string(mesh.vertex_count()) + "\""), std::string::npos);
+    for (const char* name : {"Points", "connectivity", "offsets", "types", "mua", "musp", "eta", "original_id",
+                             "piece", "piece_transforms", "waxwork_format_version"})
+        EXPECT_NE(text.find("Name=\"" + std::string(name) + "\""), std::string::npos) << name;
+}
+
+TEST_F(VolumeFileTest, VtuAsciiArraysAreRead) {
+    // A minimal ascii .vtu as a third-party tool might write it: no waxwork version, one triangle
+    // that is ignored, one inverted tet that is reoriented, one unused point that is dropped.
+    const std::string text = R"(<?xml version="1.0"?>
+<VTKFile type="UnstructuredGrid" version="0.1" byte_order="LittleEndian">
+  <UnstructuredGrid>
+    <Piece NumberOfPoints="5" NumberOfCells="2">
+      <Points><DataArray type="Float32" NumberOfComponents="3" format="ascii">
+        0 0 0  1 0 0  0 1 0  0 0 1  7 7 7
+      </DataArray></Points>
+      <Cells>
+        <DataArray type="Int32" Name="connectivity" format="ascii">0 1 2  0 2 1 3</DataArray>
+        <DataArray type="Int32" Name="offsets" format="ascii">3 7</DataArray>
+        <DataArray type="UInt8" Name="types" format="ascii">5 10</DataArray>
+      </Cells>
+    </Piece>
+  </UnstructuredGrid>
+</VTKFile>
+)";
+    const TetMesh mesh = parse_vtu(text, "third_party.vtu");
+    ASSERT_EQ(mesh.tet_count(), 1u);
+    EXPECT_EQ(mesh.vertex_count(), 4u);
+    EXPECT_GT(signed_volume(mesh, 0), 0.0);
+}
+
+TEST_F(VolumeFileTest, GmshRoundTripKeepsGeometryExactly) {
+    const TetMesh mesh = make_test_mesh();
+    write_volume(mesh, path("volume.msh"));
+    expect_same_geometry(mesh, read_volume(path("volume.msh")));
+}
+
+TEST_F(VolumeFileTest, MeditRoundTripKeepsGeometryExactly) {
+    const TetMesh mesh = make_test_mesh();
+    write_volume(mesh, path("volume.mesh"));
+    expect_same_geometry(mesh, read_volume(path("volume.mesh")));
+}
+
+TEST_F(VolumeFileTest, TetGenRoundTripKeepsGeometryExactly) {
+    const TetMesh mesh = make_test_mesh();
+    write_volume(mesh, path("volume.node"));
+    EXPECT_TRUE(fs::exists(path("volume.ele")));
+    expect_same_geometry(mesh, read_volume(path("volume.node")));
+    expect_same_geometry(mesh, read_volume(path("volume.ele")));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Foreign files with features our writers do not produce.
+
+TEST_F(VolumeFileTest, GmshSparseTagsOtherElementsAndSectionsAreHandled) {
+    // Nodes 10, 20, 30, 40, 50 (+ 99, a geometry point used by no tet) in two blocks, one parametric;
+    // a point element, triangles, and two tets of which the second is inverted.
+    const std::string text = R"($MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+1
+3 1 "wax"
+$EndPhysicalNames
+$Entities
+1 0 0 1
+1 0 0 0 0
+1 0 0 0 1 1 1 0 0
+$EndEntities
+$Nodes
+2 6 10 99
+0 1 0 1
+99
+5 5 5
+3 1 1 5
+10
+20
+30
+40
+50
+0 0 0 0.1 0.2 0.3
+1 0 0 0.1 0.2 0.3
+0 1 0 0.1 0.2 0.3
+0 0 1 0.1 0.2 0.3
+1 1 1 0.1 0.2 0.3
+$EndNodes
+$Elements
+3 4 1 40
+0 1 15 1
+1 99
+2 1 2 1
+5 10 20 30
+3 1 4 2
+7 10 20 30 40
+40 20 30 40 50
+$EndElements
+)";
+    const TetMesh mesh = parse_gmsh(text, "sparse.msh");
+    ASSERT_EQ(mesh.tet_count(), 2u);
+    EXPECT_EQ(mesh.vertex_count(), 5u);
+    for (size_t t = 0; t < mesh.tet_count(); ++t) EXPECT_GT(signed_volume(mesh, t), 0.0);
+    EXPECT_EQ(mesh.positions[4], Eigen::Vector3d(1, 1, 1));
+}
+
+TEST_F(VolumeFileTest, MeditSkipsUnknownSectionsAndReorients) {
+    const std::string text = R"(MeshVersionFormatted 1
+# a comment
+Dimension
+3
+Vertices
+5
+0 0 0 1
+1 0 0 1
+0 1 0 1
+0 0 1 1
+1e0 1.0E+0 +1 1
+Triangles
+1
+1 2 3 7
+Corners 2 1 2
+Tetrahedra
+2
+1 3 2 4 0
+2 3 4 5 0
+End
+)";
+    const TetMesh mesh = parse_medit(text, "skip.mesh");
+    ASSERT_EQ(mesh.tet_count(), 2u);
+    for (size_t t = 0; t < mesh.tet_count(); ++t) EXPECT_GT(signed_volume(mesh, t), 0.0);
+}
+
+TEST_F(VolumeFileTest, TetGenOneBasedWithAttributesAndMarkers) {
+    const std::string node = "# points\n4 3 2 1\n1 0 0 0 5 6 1\n2 1 0 0 5 6 1\n3 0 1 0 5 6 1\n4 0 0 1 5 6 1\n";
+    const std::string ele = "1 4 1\n1 1 3 2 4 -2.5  # inverted, with a region\n";
+    const TetMesh mesh = parse_tetgen(node, "a.node", ele, "a.ele");
+    ASSERT_EQ(mesh.tet_count(), 1u);
+    EXPECT_GT(signed_volume(mesh, 0), 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Broken files: a FileError that names the file and the problem.
+
+template <class Function>
+std::string error_of(Function&& function) {
+    try {
+        function();
+    } catch (const FileError& error) {
+        return error.what();
+    }
+    ADD_FAILURE() << "no FileError";
+    return {};
+}
+
+TEST_F(VolumeFileTest, ErrorsNameTheFileAndTheProblem) {
+    const std::string gmsh = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n3\n4\n"
+                             "0 0 0\n1 0 0\n0 1 0\n0 0 1\n$EndNodes\n$Elements\n1 1 17 17\n3 1 4 1\n"
+                             "17 1 2 3 99999\n$EndElements\n";
+    const std::string message = error_of([&] { parse_gmsh(gmsh, "x.msh"); });
+    EXPECT_NE(message.find("x.msh: "), std::string::npos) << message;
+    EXPECT_NE(message.find("tet 17 references node 99999 which does not exist"), std::string::npos) << message;
+
+    EXPECT_NE(error_of([] { parse_gmsh("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n", "old.msh"); })
+                  .find("unsupported Gmsh format version 2.2"),
+              std::string::npos);
+    EXPECT_NE(error_of([] {
+                  parse_medit("MeshVersionFormatted 2\nDimension 3\nVertices\n4\n0 0 0 0\n1 0 0 0\nnan 1 0 0\n"
+                              "0 0 1 0\nTetrahedra\n1\n1 2 3 4 0\nEnd\n",
+                              "nan.mesh");
+              }).find("not finite"),
+              std::string::npos);
+
+    std::ostringstream vtu;
+    format_vtu(make_test_mesh(), vtu);
+    std::string future = vtu.str();
+    // Version 1 is base64 "AQAAAA==" after the 8-byte header; version 2 is "AgAAAA==".
+    const size_t at = future.find("BAAAAAAAAAABAAAA");
+    ASSERT_NE(at, std::string::npos);
+    future.replace(at, 16, "BAAAAAAAAAACAAAA");
+    EXPECT_NE(error_of([&] { parse_vtu(future, "future.vtu"); }).find("unsupported waxwork_format_version 2"),
+              std::string::npos);
+
+    EXPECT_NE(error_of([&] { read_volume(path("missing.vtu")); }).find("missing.vtu"), std::string::npos);
+}
+
+TEST_F(VolumeFileTest, VtuTruncatedBase64IsReported) {
+    std::ostringstream out;
+    format_vtu(make_test_mesh(), out);
+    std::string text = out.str();
+    // Drop 40 characters (a multiple of 4) from the middle of the connectivity data.
+    const size_t name = text.find("Name=\"connectivity\"");
+    const size_t data = text.find('>', name) + 20;
+    text.erase(data, 40);
+    const std::string message = error_of([&] { parse_vtu(text, "spot.vtu"); });
+    EXPECT_NE(message.find("spot.vtu: truncated base64 data in DataArray 'connectivity'"), std::string::npos)
+        << message;
+}
+
+TEST_F(VolumeFileTest, VtuInconsistentFilesAreRejected) {
+    const TetMesh mesh = make_test_mesh();
+    TetMesh inverted = mesh;
+    std::swap(inverted.tets[3][0], inverted.tets[3][1]);
+    std::ostringstream out;
+    format_vtu(inverted, out);
+    EXPECT_NE(error_of([&] { parse_vtu(out.str(), "inverted.vtu"); }).find("not positively oriented"),
+              std::string::npos);
+
+    TetMesh bad_piece = mesh;
+    bad_piece.piece_ids[0] = 5;
+    std::ostringstream out2;
+    format_vtu(bad_piece, out2);
+    EXPECT_THROW(parse_vtu(out2.str(), "piece.vtu"), FileError);
+
+    std::ostringstream out3;
+    format_vtu(mesh, out3);
+    std::string wrong_count = out3.str();
+    const std::string cells = "NumberOfCells=\"" + std::to_string(mesh.tet_count()) + "\"";
+    wrong_count.replace(wrong_count.find(cells), cells.size(), "NumberOfCells=\"47\"");
+    EXPECT_THROW(parse_vtu(wrong_count, "count.vtu"), FileError);
+}
+
+TEST_F(VolumeFileTest, UnknownExtensionIsAFileError) {
+    const std::string message = error_of([&] { read_volume(path("volume.obj")); });
+    EXPECT_NE(message.find("volume.obj"), std::string::npos);
+    EXPECT_NE(message.find("unknown volume file extension"), std::string::npos);
+    EXPECT_THROW(write_volume(make_test_mesh(), path("volume.stl")), FileError);
+    EXPECT_THROW(write_volume(make_test_mesh(), path("no_extension")), FileError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fuzzing: truncation and garbage never crash and never slip through.
+
+struct Format {
+    std::string name;
+    std::function<std::string(const TetMesh&)> format;
+    std::function<TetMesh(const std::string&)> parse;
+};
+
+std::vector<Format> all_formats() {
+    auto text_of = [](void (*writer)(const TetMesh&, std::ostream&)) {
+        return [writer](const TetMesh& mesh) {
+            std::ostringstream out;
+            writer(mesh, out);
+            return out.str();
+        };
+    };
+    std::ostringstream node;
+    format_tetgen_node(make_test_mesh(), node);
+    std::ostringstream ele;
+    format_tetgen_ele(make_test_mesh(), ele);
+    const std::string valid_node = node.str();
+    const std::string valid_ele = ele.str();
+    return {
+        {"vtu", text_of(format_vtu), [](const std::string& s) { return parse_vtu(s, "fuzz.vtu"); }},
+        {"gmsh", text_of(format_gmsh), [](const std::string& s) { return parse_gmsh(s, "fuzz.msh"); }},
+        {"medit", text_of(format_medit), [](const std::string& s) { return parse_medit(s, "fuzz.mesh"); }},
+        {"tetgen_node", text_of(format_tetgen_node),
+         [valid_ele](const std::string& s) { return parse_tetgen(s, "fuzz.node", valid_ele, "fuzz.ele"); }},
+        {"tetgen_ele", text_of(format_tetgen_ele),
+         [valid_node](const std::string& s) { return parse_tetgen(valid_node, "fuzz.node", s, "fuzz.ele"); }},
+    };
+}
+
+TEST_F(VolumeFileTest, TruncatedFilesAreRejectedByEveryReader) {
+    const TetMesh mesh = make_test_mesh();
+    for (const Format& format : all_formats()) {
+        const std::string valid = format.format(mesh);
+        ASSERT_NO_THROW(format.parse(valid)) << format.name;
+        // Every cut that removes more than the final newline; at most ~1500 cuts per format.
+        const size_t step = std::max<size_t>(1, valid.size() / 1500);
+        for (size_t length = 0; length + 1 < valid.size(); length += step) {
+            EXPECT_THROW(format.parse(valid.substr(0, length)), FileError)
+                << format.name << " cut at " << length << " of " << valid.size();
+        }
+    }
+}
+
+TEST_F(VolumeFileTest, GarbageIsRejectedByEveryReader) {
+    std::mt19937 random(2024);
+    for (const Format& format : all_formats()) {
+        for (int trial = 0; trial < 200; ++trial) {
+            std::string garbage(random() % 2000, '\0');
+            for (char& c : garbage) c = static_cast<char>(random());
+            EXPECT_THROW(format.parse(garbage), FileError) << format.name << " trial " << trial;
+        }
+    }
+}
+
+TEST_F(VolumeFileTest, MutatedFilesNeverCrashOrReturnInvalidMeshes) {
+    const TetMesh mesh = make_test_mesh();
+    std::mt19937 random(7);
+    const std::string alphabet = "0123456789.-+eE \n$<>\"=/ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz\xff";
+    for (const Format& format : all_formats()) {
+        const std::string valid = format.format(mesh);
+        int rejected = 0;
+        for (int trial = 0; trial < 400; ++trial) {
+            std::string mutated = valid;
+            const int mutations = 1 + static_cast<int>(random() % 4);
+            for (int m = 0; m < mutations; ++m) {
+                const size_t at = random() % mutated.size();
+                switch (random() % 3) {
+                    case 0: mutated[at] = alphabet[random() % alphabet.size()]; break;
+                    case 1: mutated.erase(at, 1 + random() % 8); break;
+                    default: mutated.insert(at, 1, alphabet[random() % alphabet.size()]); break;
+                }
+            }
+            try {
+                const TetMesh loaded = format.parse(mutated);
+                EXPECT_TRUE(find_invariant_violations(loaded).empty()) << format.name << " trial " << trial;
+            } catch (const FileError&) {
+                ++rejected;
+            }
+        }
+        EXPECT_GT(rejected, 0) << format.name;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Atomic saves.
+
+TEST_F(VolumeFileTest, AtomicWriteReplacesTheFile) {
+    write_text(path("data.txt"), "old content");
+    ::chmod(path("data.txt").c_str(), 0640);
+    write_file_atomically(path("data.txt"), [](std::ostream& out) { out << "new content"; });
+    EXPECT_EQ(read_text(path("data.txt")), "new content");
+    struct stat status {};
+    ASSERT_EQ(::stat(path("data.txt").c_str(), &status), 0);
+    EXPECT_EQ(status.st_mode & 0777, 0640u);
+    EXPECT_EQ(file_count(), 1u);
+}
+
+TEST_F(VolumeFileTest, AtomicWriteThatThrowsLeavesTheOldFile) {
+    write_text(path("data.txt"), "old content");
+    auto failing = [](std::ostream& out) {
+        out << std::string(3 << 20, 'x');  // larger than the buffer: some of it reaches the disk
+        throw std::runtime_error("writer failed midway");
+    };
+    EXPECT_THROW(write_file_atomically(path("data.txt"), failing), std::runtime_error);
+    EXPECT_EQ(read_text(path("data.txt")), "old content");
+    EXPECT_EQ(file_count(), 1u) << "the temporary file was not removed";
+}
+
+TEST_F(VolumeFileTest, AtomicWriteOfSeveralFilesIsAllOrNothingOnWriterFailure) {
+    write_text(path("v.node"), "old node");
+    write_text(path("v.ele"), "old ele");
+    EXPECT_THROW(write_files_atomically({
+                     FileWriter{path("v.node"), [](std::ostream& out) { out << "new node"; }},
+                     FileWriter{path("v.ele"), [](std::ostream&) { throw std::runtime_error("no"); }},
+                 }),
+                 std::runtime_error);
+    EXPECT_EQ(read_text(path("v.node")), "old node");
+    EXPECT_EQ(read_text(path("v.ele")), "old ele");
+    EXPECT_EQ(file_count(), 2u);
+}
+
+TEST_F(VolumeFileTest, AtomicWriteIntoMissingDirectoryIsAFileError) {
+    const fs::path target = path("no/such/dir/volume.vtu");
+    const std::string message = error_of([&] { write_volume(make_test_mesh(), target); });
+    EXPECT_NE(message.find(target.string()), std::string::npos) << message;
+}
+
+TEST_F(VolumeFileTest, AtomicWriteOverADirectoryFailsCleanly) {
+    fs::create_directory(path("volume.vtu"));
+    EXPECT_THROW(write_volume(make_test_mesh(), path("volume.vtu")), FileError);
+    EXPECT_TRUE(fs::is_directory(path("volume.vtu")));
+    EXPECT_EQ(file_count(), 1u);
+}
+
+TEST_F(VolumeFileTest, SavingAnInvalidMeshKeepsTheOldFile) {
+    const TetMesh mesh = make_test_mesh();
+    write_volume(mesh, path("volume.vtu"));
+    const std::string before = read_text(path("volume.vtu"));
+    TetMesh broken = mesh;
+    broken.tets[0][0] = 12345;
+    EXPECT_THROW(write_volume(broken, path("volume.vtu")), InvalidMeshError);
+    EXPECT_EQ(read_text(path("volume.vtu")), before);
+    EXPECT_EQ(file_count(), 1u);
+}
+
+}  // namespace
+}  // namespace waxwork
