@@ -15,6 +15,18 @@ int run_cli(int argc, char** argv) {
     app.require_subcommand(1);
     app.failure_message([](const CLI::App*, const CLI::Error& e) { return std::string("waxwork: ") + e.what() + "\n"; });
     register_commands(app);
+    // CLI11 reports an unknown first word as a missing subcommand; name it instead.
+    const auto is_command = [&app](const char* word) {
+        try {
+            return app.get_subcommand(word) != nullptr;
+        } catch (const CLI::OptionNotFound&) {
+            return false;
+        }
+    };
+    if (argc > 1 && argv[1][0] != '-' && !is_command(argv[1])) {
+        std::cerr << "waxwork: unknown command '" << argv[1] << "' (see waxwork --help)\n";
+        return 2;
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

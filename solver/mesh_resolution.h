@@ -1,0 +1,39 @@
+// "Model no more than a scene needs": the default mesh size for a surface filled with a material.
+//
+// Light entering a scattering solid decays over the diffusion length l_d = 1/sigma_tr, so the tets
+// near the surface must be small against l_d, while deep inside, where phi is smooth, they may grow.
+// The rule (all lengths in model units, D = bounding-box diagonal, l_d the smallest over the rgb
+// channels, converted from mm with mm_per_unit):
+//   surface edge  h_s = clamp(l_d / 2, D / 150, D / 25)
+//   inward growth h(d) = h_s + 0.5 d            (d = depth below the surface)
+//   largest edge  h_max = max(h_s, D / 8)
+// Why these numbers: linear elements interpolate exp(-x/l_d) with a relative error of about
+// h^2 / (8 l_d^2), i.e. ~3% per element at h = l_d/2, and the solution error is smaller still (the
+// ball test in tests/solver measures it). The cap D/25 keeps enough resolution of the shape and of the
+// incident light (shadow edges, curvature) when l_d is large (marble, milk, spectralon: mu_a -> 0);
+// the floor D/150 bounds the cost (a few million tets at most) for strongly absorbing materials on
+// large objects, where a finer mesh would not change the rendered image at screen resolution.
+#pragma once
+
+#include "tetops/tet_mesh.h"
+#include "tetops/tetrahedralize.h"
+#include "tetops/triangle_surface.h"
+
+namespace waxwork {
+
+struct MeshResolutionRule {
+    double diffusion_length_fraction = 0.5;  // h_s <= fraction * l_d
+    double finest_fraction_of_diagonal = 1.0 / 150.0;
+    double coarsest_surface_fraction_of_diagonal = 1.0 / 25.0;
+    double interior_fraction_of_diagonal = 1.0 / 8.0;
+    double grading = 0.5;
+};
+
+// The smallest diffusion length over the rgb channels, in mm (infinite when every mu_a is 0).
+double smallest_diffusion_length_mm(const TetMaterial& material);
+
+// Graded sizing for `surface` filled with `material` at mm_per_unit millimetres per model unit.
+MeshSizing default_mesh_sizing(const TriangleSurface& surface, const TetMaterial& material, double mm_per_unit,
+                               const MeshResolutionRule& rule = {});
+
+}  // namespace waxwork

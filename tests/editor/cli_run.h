@@ -1,0 +1,53 @@
+// Runs the waxwork executable from tests and captures what it prints.
+#pragma once
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace waxwork::testing {
+
+struct CommandResult {
+    int exit_code = -1;
+    std::string out;
+    std::string err;
+};
+
+inline std::string read_text(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+// `arguments` is appended to the binary's path as-is (quote paths with spaces yourself).
+inline CommandResult run_waxwork(const std::string& arguments) {
+    static int counter = 0;
+    const auto dir = std::filesystem::temp_directory_path();
+    const std::string tag = std::to_string(::getpid()) + "_" + std::to_string(counter++);
+    const auto out_path = dir / ("waxwork_out_" + tag), err_path = dir / ("waxwork_err_" + tag);
+    const std::string command = std::string(WAXWORK_BINARY) + " " + arguments + " >" + out_path.string() + " 2>" +
+                                err_path.string() + " </dev/null";
+    const int status = std::system(command.c_str());
+    CommandResult result;
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    result.out = read_text(out_path);
+    result.err = read_text(err_path);
+    std::filesystem::remove(out_path);
+    std::filesystem::remove(err_path);
+    return result;
+}
+
+// A fresh, empty scratch directory for one test.
+inline std::filesystem::path scratch_dir(const std::string& name) {
+    const auto dir = std::filesystem::temp_directory_path() / ("waxwork_test_" + std::to_string(::getpid())) / name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+}  // namespace waxwork::testing
