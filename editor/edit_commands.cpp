@@ -1,0 +1,215 @@
+// `waxwork cut` and `waxwork paint`: the editing operations of TransCut Sec. 5 from the command line.
+//   waxwork cut VOLUME -o OUT --plane=NX,NY,NZ,D [--relax ITERS] [--no-guard]
+//   waxwork paint VOLUME -o OUT --at "X,Y,Z;X,Y,Z" (--material NAME | --mua R,G,B --musp R,G,B --eta N)
+//                 --sigma S [--base NAME]
+// Each prints a one-line JSON summary on stdout.
+#include "editor/material_options.h"
+#include "io/volume_file.h"
+#include "solver/material.h"
+#include "tetops/connectivity.h"
+#include "tetops/cut.h"
+#include "tetops/error.h"
+#include "tetops/paint.h"
+#include "tetops/quality.h"
+#include "tetops/relaxation.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace waxwork {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double milliseconds_since(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// Comma-separated finite numbers, exactly `count` of them; `what` names the option in errors.
+std::vector<double> parse_numbers(const std::string& text, size_t count, const std::string& what) {
+    std::vector<double> values;
+    size_t begin = 0;
+    while (true) {
+        const size_t end = text.find(',', begin);
+        const std::string field = text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+        char* stop = nullptr;
+        errno = 0;
+        const double value = std::strtod(field.c_str(), &stop);
+        const char* field_end = field.c_str() + field.size();
+        const bool blank_rest = stop && std::all_of(static_cast<const char*>(stop), field_end, [](char c) {
+            return std::isspace(static_cast<unsigned char>(c)) != 0;
+        });
+        if (field.empty() || stop == field.c_str() || !blank_rest || errno == ERANGE || !std::isfinite(value))
+            throw InvalidArgumentError(what + ": \"" + text + "\" is not " + std::to_string(count) +
+                                       " comma-separated finite numbers");
+        values.push_back(value);
+        if (end == std::string::npos) break;
+        begin = end + 1;
+    }
+    if (values.size() != count)
+        throw InvalidArgumentError(what + ": expected " + std::to_string(count) + " comma-separated numbers, got " +
+                                   std::to_string(values.size()) + " in \"" + text + "\"");
+    return values;
+}
+
+double min_dihedral_or_zero(const TetMesh& mesh) {
+    const std::vector<double> angles = min_dihedral_angles_deg(mesh);
+    return angles.empty() ? 0.0 : *std::min_element(angles.begin(), angles.end());
+}
+
+struct CutCommandOptions {
+    std::string input;
+    std::string output;
+    std::string plane;
+    int relax_iterations = 10;
+    bool no_guard = false;
+    bool exact = false;
+};
+
+void run_cut_command(const CutCommandOptions& o) {
+    if (o.exact)
+        throw InvalidArgumentError("cut --exact (splitting tets along the surface) is not implemented yet");
+    if (o.relax_iterations < 0) throw InvalidArgumentError("cut --relax: the iteration count must be >= 0");
+    const std::vector<double> p = parse_numbers(o.plane, 4, "cut --plane");
+    const PlaneCut plane(Eigen::Vector3d(p[0], p[1], p[2]), p[3]);
+
+    TetMesh mesh = read_volume(o.input);
+    const size_t tets_before = mesh.tet_count();
+    const size_t vertices_before = mesh.vertex_count();
+
+    const auto start = Clock::now();
+    const CutResult cut = remove_cut_away_tets(mesh, plane);
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    RelaxationOptions relax;
+    relax.max_iterations = o.relax_iterations;
+    relax.min_dihedral_guard_deg = o.no_guard ? 0.0 : relax.min_dihedral_guard_deg;
+    const RelaxationReport report = relax_cut_vertices(mesh, connectivity, plane, relax);
+    const double elapsed = milliseconds_since(start);
+
+    write_volume(mesh, o.output);
+    nlohmann::ordered_json summary = {
+        {"output", o.output},
+        {"tets_before", tets_before},
+        {"vertices_before", vertices_before},
+        {"tets_after", mesh.tet_count()},
+        {"vertices_after", mesh.vertex_count()},
+        {"tets_removed", cut.tets_removed},
+        {"components", connectivity.component_count},
+        {"relax_iterations", report.iterations},
+        {"vertices_moved", report.vertices_moved},
+        {"moves_rejected", report.moves_rejected},
+        {"guard_deg", relax.min_dihedral_guard_deg},
+        {"min_dihedral_deg", report.min_dihedral_deg},
+        {"milliseconds", elapsed},
+    };
+    std::cout << summary.dump() << "\n";
+}
+
+struct PaintCommandOptions {
+    std::string input;
+    std::string output;
+    std::string at;
+    double sigma = 0;
+    std::string base = "marble";
+    MaterialOptions material;
+};
+
+std::vector<Eigen::Vector3d> parse_points(const std::string& text) {
+    std::vector<Eigen::Vector3d> points;
+    size_t begin = 0;
+    while (begin <= text.size()) {
+        const size_t end = text.find(';', begin);
+        const std::string item = text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+        const bool blank = std::all_of(item.begin(), item.end(),
+                                       [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; });
+        if (!blank) {
+            const std::vector<double> v = parse_numbers(item, 3, "paint --at");
+            points.emplace_back(v[0], v[1], v[2]);
+        }
+        if (end == std::string::npos) break;
+        begin = end + 1;
+    }
+    if (points.empty()) throw InvalidArgumentError("paint --at: no stroke points given (expected X,Y,Z[;X,Y,Z...])");
+    return points;
+}
+
+void run_paint_command(const PaintCommandOptions& o) {
+    const std::vector<Eigen::Vector3d> stroke = parse_points(o.at);
+    if (!(o.sigma > 0) || !std::isfinite(o.sigma))
+        throw InvalidArgumentError("paint --sigma: must be a positive number (world units)");
+    const std::optional<TetMaterial> brush_material = chosen_material(o.material);
+    if (!brush_material)
+        throw InvalidArgumentError("paint: choose the brush with --material NAME or --mua R,G,B --musp R,G,B --eta N");
+    PaintBrush brush;
+    brush.material = *brush_material;
+    brush.sigma = o.sigma;
+    const TetMaterial base = material_preset(o.base);
+
+    TetMesh mesh = read_volume(o.input);
+    const auto start = Clock::now();
+    const PaintIndex index(mesh);
+    const PaintResult result = paint_stroke(mesh, index, stroke, brush, base);
+    const double elapsed = milliseconds_since(start);
+
+    write_volume(mesh, o.output);
+    nlohmann::ordered_json summary = {
+        {"output", o.output},
+        {"tets_before", mesh.tet_count()},
+        {"vertices_before", mesh.vertex_count()},
+        {"tets_after", mesh.tet_count()},
+        {"vertices_after", mesh.vertex_count()},
+        {"stroke_points", stroke.size()},
+        {"tets_changed", result.changed_tets.size()},
+        {"min_dihedral_deg", min_dihedral_or_zero(mesh)},
+        {"milliseconds", elapsed},
+    };
+    std::cout << summary.dump() << "\n";
+}
+
+}  // namespace
+
+void add_cut_command(CLI::App& app) {
+    auto options = std::make_shared<CutCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("cut", "Cut a volume with a plane and relax the cross-section");
+    cmd->add_option("input", options->input, "Volume file (.vtu, .msh, .mesh, .node)")->required()->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", options->output, "Volume file to write")->required();
+    cmd->add_option("--plane", options->plane, "NX,NY,NZ,D: removes the side n.x > D (write --plane=-1,0,0,0 when "
+                                               "the first number is negative)")
+        ->required();
+    cmd->add_option("--relax", options->relax_iterations, "Relaxation sweeps moving cut vertices onto the plane")
+        ->capture_default_str();
+    cmd->add_flag("--no-guard", options->no_guard,
+                  "Let relaxation create tets under 0.5 degrees (paper Fig. 9(a); for comparison only)");
+    cmd->add_flag("--exact", options->exact, "Split tets along the plane (not implemented yet)");
+    cmd->footer("Tets with all four vertices on the side n.x > D are removed (TransCut Sec. 5); vertices left there\n"
+                "then move toward their one-ring average, never across the plane and never below the guard.");
+    cmd->callback([options] { run_cut_command(*options); });
+}
+
+void add_paint_command(CLI::App& app) {
+    auto options = std::make_shared<PaintCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("paint", "Blend a material into the tets around stroke points");
+    cmd->add_option("input", options->input, "Volume file (.vtu, .msh, .mesh, .node)")->required()->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", options->output, "Volume file to write (.vtu keeps the materials)")->required();
+    cmd->add_option("--at", options->at, "Stroke points in world space: \"X,Y,Z;X,Y,Z;...\"")->required();
+    cmd->add_option("--sigma", options->sigma, "Gaussian width of the brush in world units")->required();
+    cmd->add_option("--base", options->base, "Material of every tet when the volume stores none")
+        ->capture_default_str();
+    add_material_options(*cmd, options->material);
+    cmd->footer("Weight w = exp(-d^2 / (2 sigma^2)), d from a tet's centroid to the nearest stroke point; tets with\n"
+                "w < 0.001 are untouched; material <- (1 - w) material + w brush (TransCut Sec. 5).");
+    cmd->callback([options] { run_paint_command(*options); });
+}
+
+}  // namespace waxwork
