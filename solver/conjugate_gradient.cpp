@@ -1,0 +1,298 @@
+#include "solver/conjugate_gradient.h"
+
+#include "tetops/error.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/partitioner.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace waxwork {
+namespace {
+
+// Fixed chunks and a deterministic reduction: the same input gives bit-identical iterates on any
+// number of threads, which keeps tests and frame-to-frame results reproducible.
+constexpr size_t kGrain = 4096;
+
+struct Sums {
+    double a = 0, b = 0;
+};
+
+template <typename Body>
+double reduce_rows(size_t n, const Body& body) {
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<size_t>(0, n, kGrain), 0.0,
+        [&](const tbb::blocked_range<size_t>& r, double acc) { return acc + body(r.begin(), r.end()); },
+        [](double x, double y) { return x + y; }, tbb::simple_partitioner());
+}
+
+template <typename Body>
+Sums reduce_rows2(size_t n, const Body& body) {
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<size_t>(0, n, kGrain), Sums{},
+        [&](const tbb::blocked_range<size_t>& r, Sums acc) {
+            const Sums s = body(r.begin(), r.end());
+            return Sums{acc.a + s.a, acc.b + s.b};
+        },
+        [](Sums x, Sums y) { return Sums{x.a + y.a, x.b + y.b}; }, tbb::simple_partitioner());
+}
+
+template <typename Scalar>
+double row_product(const CsrMatrixView<Scalar>& m, const Scalar* x, size_t i) {
+    double sum = 0;
+    for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k)
+        sum += static_cast<double>(m.values[k]) * static_cast<double>(x[m.columns[k]]);
+    return sum;
+}
+
+// r = b - M x (accumulated in double); returns r . D^-1 r and fills z = D^-1 r.
+template <typename Scalar>
+double true_residual(const CsrMatrixView<Scalar>& m, const Scalar* b, const Scalar* x, const Scalar* inv_diag,
+                     Scalar* r, Scalar* z) {
+    return reduce_rows(m.rows, [&](size_t begin, size_t end) {
+        double acc = 0;
+        for (size_t i = begin; i < end; ++i) {
+            const double ri = static_cast<double>(b[i]) - row_product(m, x, i);
+            r[i] = static_cast<Scalar>(ri);
+            z[i] = static_cast<Scalar>(ri * static_cast<double>(inv_diag[i]));
+            acc += static_cast<double>(r[i]) * static_cast<double>(z[i]);
+        }
+        return acc;
+    });
+}
+
+[[noreturn]] void breakdown(int iteration, const std::string& what) {
+    throw AlgorithmError("conjugate gradient: " + what + " at iteration " + std::to_string(iteration) +
+                         " (matrix not positive definite, or values lost to rounding: degenerate tets?)");
+}
+
+}  // namespace
+
+double smallest_tridiagonal_eigenvalue(std::span<const double> diag, std::span<const double> off, double upper_bound) {
+    const size_t k = diag.size();
+    if (k == 0) return 0;
+    // Number of eigenvalues below x: the negative pivots of the LDL^T factorisation of T - x I.
+    auto count_below = [&](double x) {
+        int count = 0;
+        double d = diag[0] - x;
+        for (size_t i = 0;; ++i) {
+            if (d < 0) ++count;
+            if (i + 1 == k) break;
+            if (d == 0) d = std::numeric_limits<double>::min();
+            d = diag[i + 1] - x - off[i] * off[i] / d;
+        }
+        return count;
+    };
+    double hi = upper_bound > 0 ? upper_bound : std::numeric_limits<double>::infinity();
+    if (!std::isfinite(hi)) {
+        hi = 0;  // Gershgorin upper bound
+        for (size_t i = 0; i < k; ++i)
+            hi = std::max(hi, diag[i] + (i > 0 ? std::abs(off[i - 1]) : 0.0) + (i + 1 < k ? std::abs(off[i]) : 0.0));
+    }
+    if (count_below(hi) == 0) return hi;
+    // T is positive definite when M is, so lambda_min > 0: find a lower bracket by decades, then bisect
+    // geometrically (lambda_min may lie many orders of magnitude below hi).
+    double lo = hi;
+    while (count_below(lo) > 0) {
+        hi = lo;
+        lo *= 1e-2;
+        if (lo < 1e-300) {
+            lo = 0;
+            break;
+        }
+    }
+    for (int it = 0; it < 200 && hi - lo > 1e-6 * hi; ++it) {
+        const double mid = lo > 0 ? std::sqrt(lo * hi) : 0.5 * hi;
+        (count_below(mid) > 0 ? hi : lo) = mid;
+    }
+    return hi;
+}
+
+template <typename Scalar>
+void multiply(const CsrMatrixView<Scalar>& m, std::span<const Scalar> x, std::span<Scalar> y) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, m.rows, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) y[i] = static_cast<Scalar>(row_product(m, x.data(), i));
+    });
+}
+
+template <typename Scalar>
+ConjugateGradientResult solve_jacobi_cg(const CsrMatrixView<Scalar>& m, std::span<const Scalar> b, std::span<Scalar> x,
+                                        const ConjugateGradientOptions& options) {
+    const size_t n = m.rows;
+    if (b.size() != n || x.size() != n)
+        throw InvalidArgumentError("conjugate gradient: vector sizes (" + std::to_string(b.size()) + ", " +
+                                   std::to_string(x.size()) + ") differ from the matrix size " + std::to_string(n));
+    if (!(options.relative_tolerance > 0) || options.max_iterations < 0)
+        throw InvalidArgumentError("conjugate gradient: tolerance must be positive and max_iterations non-negative");
+    ConjugateGradientResult result;
+    if (n == 0) {
+        result.converged = true;
+        return result;
+    }
+
+    std::vector<Scalar> inv_diag(n), r(n), z(n), p(n), q(n);
+    std::vector<double> diag(n);
+    bool bad_input = false;
+    for (size_t i = 0; i < n; ++i) {
+        double d = 0;
+        for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k)
+            if (static_cast<size_t>(m.columns[k]) == i) d = m.values[k];
+        if (!(d > 0) || !std::isfinite(d)) {
+            throw AlgorithmError("conjugate gradient: diagonal entry " + std::to_string(i) + " is " +
+                                 std::to_string(d) + " (must be positive and finite)");
+        }
+        diag[i] = d;
+        inv_diag[i] = static_cast<Scalar>(1.0 / d);
+        if (!std::isfinite(static_cast<double>(b[i])) || !std::isfinite(static_cast<double>(x[i]))) bad_input = true;
+    }
+    if (bad_input) throw AlgorithmError("conjugate gradient: right-hand side or start vector is not finite");
+
+    const double tol = options.relative_tolerance;
+    double rz = true_residual(m, b.data(), x.data(), inv_diag.data(), r.data(), z.data());
+    double bnorm2 = reduce_rows(n, [&](size_t begin, size_t end) {
+        double acc = 0;
+        for (size_t i = begin; i < end; ++i) acc += static_cast<double>(b[i]) * b[i] / diag[i];
+        return acc;
+    });
+    if (bnorm2 == 0) {  // the solution is exactly zero
+        std::fill(x.begin(), x.end(), Scalar(0));
+        result.converged = true;
+        return result;
+    }
+    double xnorm2 = reduce_rows(n, [&](size_t begin, size_t end) {
+        double acc = 0;
+        for (size_t i = begin; i < end; ++i) acc += diag[i] * static_cast<double>(x[i]) * x[i];
+        return acc;
+    });
+    std::copy(z.begin(), z.end(), p.begin());
+
+    const double hint = options.smallest_eigenvalue_hint > 0 ? options.smallest_eigenvalue_hint
+                                                             : std::numeric_limits<double>::infinity();
+    std::vector<double> t_diag, t_off;  // the Lanczos tridiagonal matrix of the current CG cycle
+    double ritz = std::numeric_limits<double>::infinity();  // its smallest eigenvalue (lazily updated)
+    bool ritz_stale = true;
+    double ritz_floor = std::numeric_limits<double>::infinity();  // from cycles before a restart
+    double alpha_prev = 0, beta_prev = 0;
+    double last_restart_estimate = std::numeric_limits<double>::infinity();
+    auto lambda = [&] {
+        if (ritz_stale && !t_diag.empty()) {
+            ritz = smallest_tridiagonal_eigenvalue(t_diag, t_off, std::isfinite(ritz) ? ritz : 0);
+            ritz_stale = false;
+        }
+        return std::min({hint, ritz, ritz_floor});
+    };
+    auto estimate = [&](double rz_value, double lam) {
+        if (xnorm2 <= 0) return std::numeric_limits<double>::infinity();
+        return std::sqrt(std::max(rz_value, 0.0)) / lam / std::sqrt(xnorm2);
+    };
+
+    // A warm start can already be good enough (only checkable with a known eigenvalue bound).
+    if (std::isfinite(hint) && estimate(rz, hint) <= tol) {
+        result.converged = true;
+        result.estimated_relative_error = estimate(rz, hint);
+        result.smallest_eigenvalue_estimate = hint;
+        return result;
+    }
+
+    int k = 0;
+    for (; k < options.max_iterations; ++k) {
+        // q = M p and p . q in one pass.
+        const double pq = reduce_rows(n, [&](size_t begin, size_t end) {
+            double acc = 0;
+            for (size_t i = begin; i < end; ++i) {
+                const double qi = row_product(m, p.data(), i);
+                q[i] = static_cast<Scalar>(qi);
+                acc += static_cast<double>(p[i]) * qi;
+            }
+            return acc;
+        });
+        if (!std::isfinite(pq)) breakdown(k, "p.Mp is not finite");
+        if (!(pq > 0)) breakdown(k, "p.Mp = " + std::to_string(pq) + " is not positive");
+        const double alpha = rz / pq;
+        const Scalar a = static_cast<Scalar>(alpha);
+        // x += alpha p, r -= alpha q, z = D^-1 r, and the two norms, in one pass.
+        const Sums s = reduce_rows2(n, [&](size_t begin, size_t end) {
+            Sums acc;
+            for (size_t i = begin; i < end; ++i) {
+                x[i] += a * p[i];
+                r[i] -= a * q[i];
+                z[i] = inv_diag[i] * r[i];
+                acc.a += static_cast<double>(r[i]) * static_cast<double>(z[i]);
+                acc.b += diag[i] * static_cast<double>(x[i]) * static_cast<double>(x[i]);
+            }
+            return acc;
+        });
+        if (!std::isfinite(s.a) || !std::isfinite(s.b)) breakdown(k, "the iterate became non-finite");
+        const double rz_new = s.a;
+        xnorm2 = s.b;
+        const double beta = rz_new / rz;
+        // Lanczos coefficients (Saad, Iterative Methods, Sec. 6.7.3).
+        t_diag.push_back(1.0 / alpha + (t_diag.empty() ? 0.0 : beta_prev / alpha_prev));
+        if (t_diag.size() > 1) t_off.push_back(std::sqrt(beta_prev) / alpha_prev);
+        ritz_stale = true;
+        alpha_prev = alpha;
+        beta_prev = beta;
+        rz = rz_new;
+
+        // Cheap test with the last Ritz value (an over-estimate of lambda_min, so an under-estimate of
+        // the error); refresh the Ritz value only when the cheap test passes or a callback wants it.
+        double lam = std::min({hint, ritz, ritz_floor});
+        double est = estimate(rz, std::isfinite(lam) ? lam : t_diag.front());
+        if (est <= tol || options.on_iteration || k == 0) {
+            lam = lambda();
+            est = estimate(rz, lam);
+        }
+        if (options.on_iteration) options.on_iteration(k + 1, est);
+        if (est <= tol) {
+            // Confirm with the true residual: the recursive one drifts (far, in float).
+            const double rz_true = true_residual(m, b.data(), x.data(), inv_diag.data(), r.data(), z.data());
+            if (!std::isfinite(rz_true)) breakdown(k, "the true residual is not finite");
+            const double est_true = estimate(rz_true, lam);
+            if (est_true <= tol) {
+                result.converged = true;
+                result.estimated_relative_error = est_true;
+                ++k;
+                break;
+            }
+            // Restart from the true residual; give up when restarts stop paying (precision floor).
+            ++result.residual_replacements;
+            const bool stagnating = est_true > 0.5 * last_restart_estimate;
+            last_restart_estimate = est_true;
+            result.estimated_relative_error = est_true;
+            if (stagnating || result.residual_replacements > 8) {
+                ++k;
+                break;
+            }
+            rz = rz_true;
+            std::copy(z.begin(), z.end(), p.begin());
+            ritz_floor = lam;
+            t_diag.clear();
+            t_off.clear();
+            ritz = std::numeric_limits<double>::infinity();
+            continue;
+        }
+        result.estimated_relative_error = est;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& range) {
+            const Scalar bt = static_cast<Scalar>(beta);
+            for (size_t i = range.begin(); i != range.end(); ++i) p[i] = z[i] + bt * p[i];
+        });
+    }
+    result.iterations = k;
+    result.smallest_eigenvalue_estimate = lambda();
+    if (!result.converged && k == options.max_iterations) result.estimated_relative_error = estimate(rz, lambda());
+    return result;
+}
+
+template ConjugateGradientResult solve_jacobi_cg<float>(const CsrMatrixView<float>&, std::span<const float>,
+                                                        std::span<float>, const ConjugateGradientOptions&);
+template ConjugateGradientResult solve_jacobi_cg<double>(const CsrMatrixView<double>&, std::span<const double>,
+                                                         std::span<double>, const ConjugateGradientOptions&);
+template void multiply<float>(const CsrMatrixView<float>&, std::span<const float>, std::span<float>);
+template void multiply<double>(const CsrMatrixView<double>&, std::span<const double>, std::span<double>);
+
+}  // namespace waxwork

@@ -1,0 +1,341 @@
+#include "solver/diffusion_matrix.h"
+
+#include "solver/material.h"
+#include "tetops/error.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <string>
+
+namespace waxwork {
+namespace {
+
+// Edge index (kTetEdges order) of the local vertex pair (a, b).
+constexpr std::array<std::array<int, 4>, 4> kEdgeOfPair = {{{-1, 0, 1, 2}, {0, -1, 3, 4}, {1, 3, -1, 5}, {2, 4, 5, -1}}};
+// For local vertex a, the other three in ascending order (the order of TetIncidence::slots).
+constexpr std::array<std::array<int, 3>, 4> kOthers = {{{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}}};
+
+constexpr size_t kRowGrain = 512;
+
+int32_t find_slot(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns, int32_t row, int32_t col) {
+    const auto begin = columns.begin() + offsets[row];
+    const auto end = columns.begin() + offsets[row + 1];
+    const auto it = std::lower_bound(begin, end, col);
+    return static_cast<int32_t>(it - columns.begin());
+}
+
+DiffusionMatrix::TetCoefficients tet_coefficients_of(const TetMaterial& m) {
+    DiffusionMatrix::TetCoefficients c{};
+    for (int ch = 0; ch < 3; ++ch) {
+        c.kappa[ch] = diffusion_coefficient(m.mua[ch], m.musp[ch]);
+        c.mua[ch] = m.mua[ch];
+    }
+    const double fdr = diffuse_fresnel_reflectance(m.eta);
+    const double a = (1.0 + fdr) / (1.0 - fdr);
+    c.inv_a = 1.0 / a;
+    c.inv_a_one_minus_fdr = 1.0 / (a * (1.0 - fdr));
+    return c;
+}
+
+void check_materials(const TetMesh& mesh, const std::vector<TetMaterial>& materials) {
+    if (materials.size() != mesh.tet_count())
+        throw InvalidArgumentError("diffusion matrix: " + std::to_string(materials.size()) + " materials for " +
+                                   std::to_string(mesh.tet_count()) + " tets");
+}
+
+// Validates in parallel and reports the lowest bad tet, so the message is deterministic.
+void validate_materials(const std::vector<TetMaterial>& materials, std::span<const int32_t> which) {
+    std::atomic<int64_t> first_bad{-1};
+    auto check = [&](int64_t t) {
+        try {
+            validate_material(materials[t]);
+        } catch (const InvalidArgumentError&) {
+            int64_t seen = first_bad.load();
+            while ((seen < 0 || t < seen) && !first_bad.compare_exchange_weak(seen, t)) {
+            }
+        }
+    };
+    const size_t n = which.empty() ? materials.size() : which.size();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k != r.end(); ++k) check(which.empty() ? static_cast<int64_t>(k) : which[k]);
+    });
+    if (first_bad >= 0) validate_material(materials[first_bad], "material of tet " + std::to_string(first_bad.load()));
+}
+
+// Writes row i of all three matrices and of the source operator from the cached geometry and
+// coefficients. Only row i is written, so rows can be assembled in parallel without races.
+void assemble_row(DiffusionMatrix& m, const TetConnectivity& conn, int32_t i) {
+    const int32_t begin = m.offsets[i], end = m.offsets[i + 1];
+    for (auto& v : m.values) std::fill(v.begin() + begin, v.begin() + end, 0.0);
+    std::fill(m.source.begin() + begin, m.source.begin() + end, 0.0);
+    const int32_t d = m.diagonal[i];
+    const int32_t tet_begin = conn.vertex_tets.offsets[i], tet_end = conn.vertex_tets.offsets[i + 1];
+    if (tet_begin == tet_end) {  // unreferenced vertex: phi_i = 0
+        for (auto& v : m.values) v[d] = 1.0;
+        return;
+    }
+    const bool fem = m.options.discretization == Discretization::Fem;
+    // Lumped absorption (Eq. 13: V_i mu = sum_t 4 * mu V_t / 4); consistent: 4 mu V (1 + delta) / 20.
+    const double mass_diag = fem ? 0.4 : 1.0;
+    const double mass_off = 0.2;
+    std::array<double, 3> diag{};
+    for (int32_t k = tet_begin; k < tet_end; ++k) {
+        const int32_t t = conn.vertex_tets.indices[k];
+        const auto& inc = m.tet_incidences[k];
+        const auto& geo = m.tet_geometry[t];
+        const auto& co = m.tet_coefficients[t];
+        for (int s = 0; s < 3; ++s) {
+            const double g = 4.0 * geo.edge_stiffness[kEdgeOfPair[inc.local][kOthers[inc.local][s]]];
+            const int32_t slot = inc.slots[s];
+            for (int c = 0; c < 3; ++c) {
+                const double w = co.kappa[c] * g;  // M_ij = 4 w_ij (Eq. 14)
+                m.values[c][slot] += w;
+                diag[c] -= w;  // M_ii = -4 sum_j w_ij + ... (Eq. 13): the stiffness annihilates constants
+                if (fem) m.values[c][slot] += mass_off * co.mua[c] * geo.volume;
+            }
+        }
+        for (int c = 0; c < 3; ++c) diag[c] += mass_diag * co.mua[c] * geo.volume;
+    }
+    // Robin boundary (Eq. 11 times -4|Upsilon|): 4 (1 / (2A)) times the lumped (S_f / 3) or consistent
+    // (S_f (1 + delta) / 12) face mass; the source carries the extra 4 / (1 - F_dr) of Eq. 2 (Eq. 12).
+    double source_diag = 0;
+    for (int32_t k = m.vertex_face_offsets[i]; k < m.vertex_face_offsets[i + 1]; ++k) {
+        const int32_t f = m.vertex_faces[k];
+        const double area = m.boundary_face_area[f];
+        const auto& co = m.tet_coefficients[conn.boundary_faces[f].tet];
+        if (fem) {
+            const double r_diag = area * co.inv_a / 3.0, r_off = area * co.inv_a / 6.0;
+            const double s_diag = 8.0 * co.inv_a_one_minus_fdr * area / 6.0;
+            const double s_off = 8.0 * co.inv_a_one_minus_fdr * area / 12.0;
+            for (int c = 0; c < 3; ++c) diag[c] += r_diag;
+            source_diag += s_diag;
+            for (int32_t slot : m.vertex_face_slots[k]) {
+                for (int c = 0; c < 3; ++c) m.values[c][slot] += r_off;
+                m.source[slot] += s_off;
+            }
+        } else {
+            for (int c = 0; c < 3; ++c) diag[c] += 2.0 * area * co.inv_a / 3.0;  // Eq. 13: 2 S_i / (3A)
+            source_diag += 8.0 * area * co.inv_a_one_minus_fdr / 3.0;             // Eq. 12
+        }
+    }
+    for (int c = 0; c < 3; ++c) m.values[c][d] += diag[c];
+    m.source[d] += source_diag;
+}
+
+}  // namespace
+
+template <typename Scalar>
+std::array<Scalar, 6> tet_edge_stiffness(const Eigen::Matrix<Scalar, 3, 1>& p0, const Eigen::Matrix<Scalar, 3, 1>& p1,
+                                         const Eigen::Matrix<Scalar, 3, 1>& p2, const Eigen::Matrix<Scalar, 3, 1>& p3,
+                                         StiffnessForm form) {
+    using Vec = Eigen::Matrix<Scalar, 3, 1>;
+    std::array<Scalar, 6> k{};
+    if (form == StiffnessForm::Gradient) {
+        // 6 V grad(b_a) = c_a: c_1 = e2 x e3, c_2 = e3 x e1, c_3 = e1 x e2, c_0 = -(c_1 + c_2 + c_3),
+        // with e_j = p_j - p0. K_ab / kappa = V grad(b_a).grad(b_b) = c_a . c_b / (36 V) = c_a . c_b / (6 det).
+        const Vec e1 = p1 - p0, e2 = p2 - p0, e3 = p3 - p0;
+        std::array<Vec, 4> c;
+        c[1] = e2.cross(e3);
+        c[2] = e3.cross(e1);
+        c[3] = e1.cross(e2);
+        c[0] = -(c[1] + c[2] + c[3]);
+        const Scalar det = e1.dot(c[1]);
+        const Scalar inv = Scalar(1) / (Scalar(6) * det);
+        for (int e = 0; e < 6; ++e) k[e] = c[kTetEdges[e][0]].dot(c[kTetEdges[e][1]]) * inv;
+    } else {
+        // Eq. 10: for edge (a, b) the opposite edge is (k, l); theta_kl is the dihedral angle there,
+        // between faces (k, l, a) and (k, l, b), whose normals n1 = (l - k) x (a - k), n2 = (l - k) x (b - k)
+        // enclose exactly theta_kl.
+        const std::array<const Vec*, 4> p = {&p0, &p1, &p2, &p3};
+        for (int e = 0; e < 6; ++e) {
+            const int a = kTetEdges[e][0], b = kTetEdges[e][1];
+            const int kl = 5 - e;  // kTetEdges lists opposite edges symmetrically: (0,1)<->(2,3), ...
+            const int kk = kTetEdges[kl][0], ll = kTetEdges[kl][1];
+            const Vec edge = *p[ll] - *p[kk];
+            const Vec n1 = edge.cross(*p[a] - *p[kk]).normalized();
+            const Vec n2 = edge.cross(*p[b] - *p[kk]).normalized();
+            const Scalar cot = n1.dot(n2) / n1.cross(n2).norm();
+            k[e] = -edge.norm() * cot / Scalar(6);
+        }
+    }
+    return k;
+}
+
+template std::array<float, 6> tet_edge_stiffness<float>(const Eigen::Vector3f&, const Eigen::Vector3f&,
+                                                        const Eigen::Vector3f&, const Eigen::Vector3f&, StiffnessForm);
+template std::array<double, 6> tet_edge_stiffness<double>(const Eigen::Vector3d&, const Eigen::Vector3d&,
+                                                          const Eigen::Vector3d&, const Eigen::Vector3d&, StiffnessForm);
+template std::array<long double, 6> tet_edge_stiffness<long double>(
+    const Eigen::Matrix<long double, 3, 1>&, const Eigen::Matrix<long double, 3, 1>&,
+    const Eigen::Matrix<long double, 3, 1>&, const Eigen::Matrix<long double, 3, 1>&, StiffnessForm);
+
+DiffusionMatrix assemble_diffusion_matrix(const TetMesh& mesh, const TetConnectivity& conn,
+                                          const std::vector<TetMaterial>& materials, const AssemblyOptions& options) {
+    if (!std::isfinite(options.mm_per_unit) || options.mm_per_unit <= 0)
+        throw InvalidArgumentError("diffusion matrix: mm_per_unit = " + std::to_string(options.mm_per_unit) +
+                                   " must be positive and finite");
+    check_materials(mesh, materials);
+    if (conn.vertex_tets.row_count() != mesh.vertex_count() || conn.vertex_vertices.row_count() != mesh.vertex_count())
+        throw InvalidArgumentError("diffusion matrix: connectivity does not match the mesh (rebuild it after edits)");
+
+    const size_t n = mesh.vertex_count();
+    const size_t tet_count = mesh.tet_count();
+    DiffusionMatrix m;
+    m.options = options;
+
+    // Pattern: the one-ring plus the diagonal, columns ascending.
+    m.offsets.assign(n + 1, 0);
+    for (size_t i = 0; i < n; ++i)
+        m.offsets[i + 1] = m.offsets[i] + static_cast<int32_t>(conn.vertex_vertices.row(i).size()) + 1;
+    m.columns.resize(m.offsets.back());
+    m.diagonal.resize(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kRowGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            const auto ring = conn.vertex_vertices.row(i);
+            const auto split = std::lower_bound(ring.begin(), ring.end(), static_cast<int32_t>(i));
+            int32_t* out = m.columns.data() + m.offsets[i];
+            out = std::copy(ring.begin(), split, out);
+            m.diagonal[i] = static_cast<int32_t>(out - m.columns.data());
+            *out++ = static_cast<int32_t>(i);
+            std::copy(split, ring.end(), out);
+        }
+    });
+
+    // Per tet: geometry in mm, and the slots of its vertices' rows.
+    m.tet_geometry.resize(tet_count);
+    m.tet_incidences.resize(conn.vertex_tets.indices.size());
+    std::atomic<int64_t> bad_tet{-1};
+    const double scale = options.mm_per_unit;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, tet_count, 1024), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t t = r.begin(); t != r.end(); ++t) {
+            const Tet& tet = mesh.tets[t];
+            // Relative to the first vertex before scaling: keeps the rounding of large coordinates out.
+            const Eigen::Vector3d o = mesh.positions[tet[0]];
+            const Eigen::Vector3d p1 = (mesh.positions[tet[1]] - o) * scale;
+            const Eigen::Vector3d p2 = (mesh.positions[tet[2]] - o) * scale;
+            const Eigen::Vector3d p3 = (mesh.positions[tet[3]] - o) * scale;
+            const double volume = p1.dot(p2.cross(p3)) / 6.0;
+            if (!(volume > 0)) bad_tet = static_cast<int64_t>(t);
+            m.tet_geometry[t] = {tet_edge_stiffness<double>(Eigen::Vector3d::Zero(), p1, p2, p3, options.stiffness_form),
+                                 volume};
+        }
+    });
+    if (bad_tet >= 0)
+        throw InvalidMeshError("diffusion matrix: tet " + std::to_string(bad_tet.load()) +
+                               " has non-positive volume (inverted or degenerate)");
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kRowGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            for (int32_t k = conn.vertex_tets.offsets[i]; k < conn.vertex_tets.offsets[i + 1]; ++k) {
+                const Tet& tet = mesh.tets[conn.vertex_tets.indices[k]];
+                auto& inc = m.tet_incidences[k];
+                inc.local = static_cast<int32_t>(std::find(tet.begin(), tet.end(), static_cast<int32_t>(i)) - tet.begin());
+                for (int s = 0; s < 3; ++s)
+                    inc.slots[s] = find_slot(m.offsets, m.columns, static_cast<int32_t>(i), tet[kOthers[inc.local][s]]);
+            }
+        }
+    });
+
+    // Boundary faces per vertex (serial counting sort: boundary faces are few).
+    const auto& faces = conn.boundary_faces;
+    m.vertex_face_offsets.assign(n + 1, 0);
+    for (const auto& f : faces)
+        for (int32_t v : f.vertices) ++m.vertex_face_offsets[v + 1];
+    for (size_t i = 0; i < n; ++i) m.vertex_face_offsets[i + 1] += m.vertex_face_offsets[i];
+    m.vertex_faces.resize(m.vertex_face_offsets.back());
+    m.vertex_face_slots.resize(m.vertex_faces.size());
+    m.boundary_face_area.resize(faces.size());
+    {
+        std::vector<int32_t> cursor(m.vertex_face_offsets.begin(), m.vertex_face_offsets.end() - 1);
+        for (size_t f = 0; f < faces.size(); ++f) {
+            const auto& v = faces[f].vertices;
+            m.boundary_face_area[f] =
+                0.5 * scale * scale *
+                (mesh.positions[v[1]] - mesh.positions[v[0]]).cross(mesh.positions[v[2]] - mesh.positions[v[0]]).norm();
+            for (int a = 0; a < 3; ++a) {
+                const int32_t k = cursor[v[a]]++;
+                m.vertex_faces[k] = static_cast<int32_t>(f);
+                m.vertex_face_slots[k] = {find_slot(m.offsets, m.columns, v[a], v[(a + 1) % 3]),
+                                          find_slot(m.offsets, m.columns, v[a], v[(a + 2) % 3])};
+            }
+        }
+    }
+
+    assemble_diffusion_values(m, conn, materials);
+    return m;
+}
+
+void assemble_diffusion_values(DiffusionMatrix& m, const TetConnectivity& conn, const std::vector<TetMaterial>& materials) {
+    const size_t tet_count = m.tet_geometry.size();
+    if (materials.size() != tet_count)
+        throw InvalidArgumentError("diffusion matrix: " + std::to_string(materials.size()) + " materials for " +
+                                   std::to_string(tet_count) + " tets");
+    validate_materials(materials, {});
+    m.tet_coefficients.resize(tet_count);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, tet_count, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t t = r.begin(); t != r.end(); ++t) m.tet_coefficients[t] = tet_coefficients_of(materials[t]);
+    });
+    for (auto& v : m.values) v.resize(m.columns.size());
+    m.source.resize(m.columns.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, m.size(), kRowGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) assemble_row(m, conn, static_cast<int32_t>(i));
+    });
+}
+
+std::vector<int32_t> update_diffusion_matrix(DiffusionMatrix& m, const TetMesh& mesh, const TetConnectivity& conn,
+                                             const std::vector<TetMaterial>& materials,
+                                             std::span<const int32_t> changed_tets) {
+    if (materials.size() != m.tet_coefficients.size() || mesh.tet_count() != m.tet_coefficients.size())
+        throw InvalidArgumentError("diffusion matrix update: " + std::to_string(materials.size()) + " materials and " +
+                                   std::to_string(mesh.tet_count()) + " tets for a matrix assembled on " +
+                                   std::to_string(m.tet_coefficients.size()) + " tets");
+    for (int32_t t : changed_tets)
+        if (t < 0 || static_cast<size_t>(t) >= materials.size())
+            throw InvalidArgumentError("diffusion matrix update: tet index " + std::to_string(t) + " out of range");
+    if (changed_tets.empty()) return {};
+    validate_materials(materials, changed_tets);
+    // A tet's material enters exactly the rows of its four vertices (its edges, its mass and, through
+    // eta, its boundary faces all lie in those rows), so rewriting them reproduces a full assembly.
+    std::vector<int32_t> rows;
+    rows.reserve(4 * changed_tets.size());
+    for (int32_t t : changed_tets) {
+        m.tet_coefficients[t] = tet_coefficients_of(materials[t]);
+        rows.insert(rows.end(), mesh.tets[t].begin(), mesh.tets[t].end());
+    }
+    std::sort(rows.begin(), rows.end());
+    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, rows.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k != r.end(); ++k) assemble_row(m, conn, rows[k]);
+    });
+    return rows;
+}
+
+void diffusion_right_hand_side(const DiffusionMatrix& m, const std::vector<std::array<double, 3>>& q, int channel,
+                               std::span<double> b) {
+    if (q.size() != m.size() || b.size() != m.size())
+        throw InvalidArgumentError("diffusion right-hand side: sizes of q (" + std::to_string(q.size()) + ") and b (" +
+                                   std::to_string(b.size()) + ") must equal the vertex count " +
+                                   std::to_string(m.size()));
+    if (channel < 0 || channel > 2) throw InvalidArgumentError("diffusion right-hand side: channel must be 0, 1 or 2");
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, m.size(), kRowGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            double sum = 0;
+            if (m.vertex_face_offsets[i] != m.vertex_face_offsets[i + 1])
+                for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) sum += m.source[k] * q[m.columns[k]][channel];
+            b[i] = sum;
+        }
+    });
+}
+
+std::vector<double> lumped_vertex_volumes(const DiffusionMatrix& m, const TetConnectivity& conn) {
+    std::vector<double> volumes(m.size(), 0.0);
+    for (size_t i = 0; i < m.size(); ++i)
+        for (int32_t k = conn.vertex_tets.offsets[i]; k < conn.vertex_tets.offsets[i + 1]; ++k)
+            volumes[i] += m.tet_geometry[conn.vertex_tets.indices[k]].volume / 4.0;
+    return volumes;
+}
+
+}  // namespace waxwork

@@ -1,0 +1,42 @@
+// Exitant radiance at the surface from the fluence (Li et al. 2013, Eq. 3, after Arbree et al. 2011):
+//     L_o = F_t(theta_o) / (4 pi) [ (1 + 1/A) phi - 4 q / (1 + F_dr) ].
+// The bracket divided by 4 pi does not depend on the view: it is computed once per boundary vertex
+// and channel (exitant_radiance_factor) and a fragment shader multiplies it by F_t(theta_o) per pixel.
+//
+// Negative values. In the continuous problem the bracket is non-negative; the discrete solution can
+// dip slightly below zero next to shadow edges (phi is interpolated linearly while q jumps). Those
+// values are discretisation noise and would show as black speckles or, in HDR, as negative light, so
+// the factor is clamped at zero by default (RadianceOptions::clamp_negative).
+#pragma once
+
+#include "tetops/connectivity.h"
+#include "tetops/tet_mesh.h"
+
+#include <array>
+#include <vector>
+
+namespace waxwork {
+
+// The view-independent factor for one vertex and channel.
+double exitant_radiance_factor(double phi, double q, double eta, bool clamp_negative = true);
+
+// L_o for a view direction at angle acos(cos_view) to the outward normal.
+double exitant_radiance(double phi, double q, double eta, double cos_view, bool clamp_negative = true);
+
+// Per vertex, the relative index of refraction seen by its boundary faces: the area-weighted mean of
+// the eta of the tets owning them (painted volumes may differ per face); 1 at interior vertices.
+std::vector<double> boundary_vertex_eta(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                        const std::vector<TetMaterial>& materials);
+
+struct RadianceOptions {
+    bool clamp_negative = true;
+};
+
+// exitant_radiance_factor at every vertex (zero at interior vertices), per channel, in float for upload.
+std::vector<std::array<float, 3>> exitant_radiance_factors(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                                           const std::vector<TetMaterial>& materials,
+                                                           const std::vector<std::array<double, 3>>& phi,
+                                                           const std::vector<std::array<double, 3>>& q,
+                                                           const RadianceOptions& options = {});
+
+}  // namespace waxwork

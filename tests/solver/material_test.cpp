@@ -1,0 +1,113 @@
+#include "solver/material.h"
+#include "tetops/error.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+namespace waxwork {
+namespace {
+
+TEST(Material, DerivedQuantities) {
+    EXPECT_DOUBLE_EQ(diffusion_coefficient(0.01, 1.0), 1.0 / 3.03);
+    EXPECT_DOUBLE_EQ(effective_transport_coefficient(0.01, 1.0), std::sqrt(0.0303));
+    EXPECT_DOUBLE_EQ(diffusion_length(0.01, 1.0), 1.0 / std::sqrt(0.0303));
+    EXPECT_TRUE(std::isinf(diffusion_length(0.0, 1.0)));
+    const double fdr = diffuse_fresnel_reflectance(1.3);
+    EXPECT_NEAR(fdr, -1.440 / 1.69 + 0.710 / 1.3 + 0.668 + 0.0636 * 1.3, 1e-15);
+    EXPECT_GT(fdr, 0.3);
+    EXPECT_LT(fdr, 0.5);
+    EXPECT_NEAR(boundary_reflection_parameter(1.3), (1 + fdr) / (1 - fdr), 1e-15);
+    EXPECT_NEAR(diffuse_fresnel_reflectance(1.0), 0.0016, 1e-12);  // nearly no reflection at a matched index
+}
+
+TEST(Material, FresnelTransmittance) {
+    const double eta = 1.5;
+    EXPECT_NEAR(fresnel_transmittance(1.0, eta), 1.0 - std::pow((eta - 1) / (eta + 1), 2), 1e-14);
+    EXPECT_NEAR(fresnel_transmittance(0.0, eta), 0.0, 1e-14);
+    // Reciprocity: entering at theta_i equals leaving at the refracted angle.
+    const double cos_i = std::cos(0.9);
+    const double sin_t = std::sin(0.9) / eta, cos_t = std::sqrt(1 - sin_t * sin_t);
+    EXPECT_NEAR(fresnel_transmittance(cos_i, eta), fresnel_transmittance(cos_t, 1 / eta), 1e-14);
+    // Total internal reflection from inside beyond the critical angle asin(1/eta).
+    EXPECT_EQ(fresnel_transmittance(std::cos(std::asin(1 / eta) + 0.01), 1 / eta), 0.0);
+    EXPECT_GT(fresnel_transmittance(std::cos(std::asin(1 / eta) - 0.01), 1 / eta), 0.0);
+    // Monotone in the angle, within [0, 1].
+    double previous = 1;
+    for (double c = 1; c >= 0; c -= 0.01) {
+        const double t = fresnel_transmittance(c, 1.3);
+        EXPECT_LE(t, previous + 1e-15);
+        EXPECT_GE(t, 0);
+        previous = t;
+    }
+}
+
+TEST(Material, PresetsMatchTheJensenTable) {
+    const auto names = material_preset_names();
+    ASSERT_EQ(names.size(), 12u);
+    const std::filesystem::path path = std::filesystem::path(WAXWORK_ASSET_DIR) / "jensen2001.json";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " missing";
+    std::ifstream in(path);
+    const auto json = nlohmann::json::parse(in);
+    ASSERT_EQ(json["materials"].size(), names.size());
+    for (const auto& [name, entry] : json["materials"].items()) {
+        const TetMaterial m = material_preset(name);
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_DOUBLE_EQ(m.mua[c], entry["mu_a"][c].get<double>()) << name;
+            EXPECT_DOUBLE_EQ(m.musp[c], entry["mu_s_prime"][c].get<double>()) << name;
+        }
+        EXPECT_DOUBLE_EQ(m.eta, entry["eta"].get<double>()) << name;
+        EXPECT_NO_THROW(validate_material(m)) << name;
+    }
+}
+
+TEST(Material, UnknownPresetNamesTheKnownOnes) {
+    try {
+        material_preset("jade");
+        FAIL();
+    } catch (const InvalidArgumentError& e) {
+        EXPECT_NE(std::string(e.what()).find("jade"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("marble"), std::string::npos);
+    }
+}
+
+TEST(Material, ValidationRejectsBadCoefficients) {
+    const TetMaterial good = material_preset("marble");
+    auto expect_bad = [&](TetMaterial m, const std::string& fragment) {
+        try {
+            validate_material(m, "tet 3");
+            ADD_FAILURE() << "accepted: " << fragment;
+        } catch (const InvalidArgumentError& e) {
+            EXPECT_NE(std::string(e.what()).find("tet 3"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+        }
+    };
+    TetMaterial m = good;
+    m.mua[1] = std::numeric_limits<double>::quiet_NaN();
+    expect_bad(m, "mu_a is not finite");
+    m = good;
+    m.mua[0] = -0.1;
+    expect_bad(m, "negative");
+    m = good;
+    m.musp[2] = 0;
+    expect_bad(m, "must be positive");
+    m = good;
+    m.eta = 0;
+    expect_bad(m, "eta");
+    m = good;
+    m.eta = 40;
+    expect_bad(m, "eta");
+    m = good;
+    m.musp[0] = 1e7;
+    expect_bad(m, "per millimetre");
+    m = good;
+    m.mua = {0, 0, 0};  // spectralon-like: allowed
+    EXPECT_NO_THROW(validate_material(m));
+}
+
+}  // namespace
+}  // namespace waxwork
