@@ -1,0 +1,29 @@
+// 8-bit RGBA images and PNG files: what the headless renderer produces and the tests compare.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace waxwork {
+
+// Row-major, top row first, 4 bytes (r, g, b, a) per pixel, non-premultiplied alpha, sRGB-encoded.
+struct Image {
+    int width = 0;
+    int height = 0;
+    std::vector<uint8_t> rgba;
+
+    const uint8_t* pixel(int x, int y) const { return rgba.data() + 4 * (static_cast<size_t>(y) * width + x); }
+    uint8_t* pixel(int x, int y) { return rgba.data() + 4 * (static_cast<size_t>(y) * width + x); }
+    friend bool operator==(const Image&, const Image&) = default;
+};
+
+// Writes an RGBA PNG atomically (temporary file + rename, io/atomic_file.h). Throws
+// InvalidArgumentError for an image whose size and pixel count disagree, FileError on I/O failure.
+void write_png(const Image& image, const std::filesystem::path& path);
+
+// Reads any PNG (grey, grey-alpha, rgb, rgba, palette; 8 or 16 bits) as 8-bit RGBA. Throws
+// FileError("PATH: PROBLEM") for a missing, unreadable, truncated or corrupt file.
+Image read_png(const std::filesystem::path& path);
+
+}  // namespace waxwork

@@ -1,0 +1,217 @@
+#include "solver/lighting.h"
+
+#include "solver/material.h"
+#include "solver/radiance.h"
+#include "tetops/error.h"
+
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <string>
+
+namespace waxwork {
+
+namespace {
+
+std::string light_name(size_t index, const Light& light) {
+    return std::string("light ") + std::to_string(index) + " (" +
+           (light.type == LightType::Directional ? "directional" : "point") + ")";
+}
+
+bool finite_non_negative(const Rgb& c) {
+    for (double x : c) {
+        if (!std::isfinite(x) || x < 0) return false;
+    }
+    return true;
+}
+
+// Shadow-ray origins sit this fraction of the local mean edge length off the surface along the normal:
+// far enough that float round-off cannot make the ray hit the faces around its own vertex, close
+// enough that contact shadows between touching pieces survive.
+constexpr double kShadowOffset = 1e-2;
+
+}  // namespace
+
+void validate(const Lighting& lighting) {
+    for (size_t i = 0; i < lighting.lights.size(); ++i) {
+        const Light& light = lighting.lights[i];
+        if (light.type != LightType::Directional && light.type != LightType::Point) {
+            throw InvalidArgumentError(light_name(i, light) + ": unknown light type");
+        }
+        if (!light.vector.allFinite()) {
+            throw InvalidArgumentError(light_name(i, light) +
+                                       (light.type == LightType::Directional ? ": direction" : ": position") +
+                                       " has a non-finite component");
+        }
+        if (light.type == LightType::Directional && light.vector.squaredNorm() == 0.0) {
+            throw InvalidArgumentError(light_name(i, light) + ": direction is the zero vector");
+        }
+        if (!finite_non_negative(light.intensity)) {
+            throw InvalidArgumentError(light_name(i, light) + ": intensity must be finite and non-negative");
+        }
+    }
+    if (!finite_non_negative(lighting.ambient)) {
+        throw InvalidArgumentError("ambient light must be finite and non-negative");
+    }
+}
+
+std::vector<Eigen::Vector3d> area_weighted_normals(const std::vector<Eigen::Vector3d>& positions,
+                                                   const std::vector<std::array<int32_t, 3>>& triangles) {
+    std::vector<Eigen::Vector3d> normals(positions.size(), Eigen::Vector3d::Zero());
+    // The cross product is twice the area times the unit normal: summing it weights by area.
+    for (const auto& t : triangles) {
+        const Eigen::Vector3d n = (positions[t[1]] - positions[t[0]]).cross(positions[t[2]] - positions[t[0]]);
+        for (int32_t v : t) normals[v] += n;
+    }
+    tbb::parallel_for(size_t{0}, normals.size(), [&](size_t i) {
+        const double length = normals[i].norm();
+        normals[i] = length > 0 ? Eigen::Vector3d(normals[i] / length) : Eigen::Vector3d::Zero();
+    });
+    return normals;
+}
+
+BoundarySurface extract_boundary_surface(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                         const std::vector<TetMaterial>& materials, double default_eta) {
+    if (!materials.empty() && materials.size() != mesh.tet_count()) {
+        throw InvalidArgumentError("extract_boundary_surface: " + std::to_string(materials.size()) +
+                                   " materials for " + std::to_string(mesh.tet_count()) + " tets");
+    }
+    BoundarySurface surface;
+    surface.vertices = connectivity.boundary_vertices;
+    const size_t n = surface.vertices.size();
+    std::vector<int32_t> surface_index(mesh.vertex_count(), -1);
+    for (size_t s = 0; s < n; ++s) surface_index[surface.vertices[s]] = static_cast<int32_t>(s);
+
+    surface.triangles.reserve(connectivity.boundary_faces.size());
+    surface.triangle_tets.reserve(connectivity.boundary_faces.size());
+    // A vertex belongs to exactly one piece (fracture duplicates shared vertices), so any of its
+    // boundary faces tells which transform moves it.
+    std::vector<int32_t> piece(n, 0);
+    for (const BoundaryFace& face : connectivity.boundary_faces) {
+        std::array<int32_t, 3> tri;
+        for (int k = 0; k < 3; ++k) {
+            const int32_t s = surface_index[face.vertices[k]];
+            tri[k] = s;
+            piece[s] = mesh.piece_ids.empty() ? 0 : mesh.piece_ids[face.tet];
+        }
+        surface.triangles.push_back(tri);
+        surface.triangle_tets.push_back(face.tet);
+    }
+
+    surface.positions.resize(n);
+    surface.eta.resize(n);
+    // The same per-vertex eta as the exitant radiance (solver/radiance.h), so q and L_o agree.
+    const std::vector<double> vertex_eta =
+        materials.empty() ? std::vector<double>() : boundary_vertex_eta(mesh, connectivity, materials);
+    tbb::parallel_for(size_t{0}, n, [&](size_t s) {
+        const Eigen::Vector3d& rest = mesh.positions[surface.vertices[s]];
+        if (static_cast<size_t>(piece[s]) < mesh.piece_transforms.size()) {
+            const RigidTransform& transform = mesh.piece_transforms[piece[s]];
+            surface.positions[s] = transform.rotation * rest + transform.translation;
+        } else {
+            surface.positions[s] = rest;
+        }
+        surface.eta[s] = materials.empty() ? default_eta : vertex_eta[surface.vertices[s]];
+    });
+    surface.normals = area_weighted_normals(surface.positions, surface.triangles);
+    return surface;
+}
+
+TriangleBvh build_shadow_bvh(const BoundarySurface& surface) {
+    std::vector<Eigen::Vector3f> points(surface.positions.size());
+    for (size_t i = 0; i < points.size(); ++i) points[i] = surface.positions[i].cast<float>();
+    return TriangleBvh(points, surface.triangles);
+}
+
+std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting) {
+    validate(lighting);
+    const size_t n = surface.positions.size();
+    if (surface.normals.size() != n || surface.eta.size() != n) {
+        throw InvalidArgumentError("incident_light: surface has " + std::to_string(n) + " positions, " +
+                                   std::to_string(surface.normals.size()) + " normals and " +
+                                   std::to_string(surface.eta.size()) + " eta values");
+    }
+    if (lighting.shadows && bvh.triangle_count() != surface.triangles.size()) {
+        throw InvalidArgumentError("incident_light: the shadow BVH was not built from this surface");
+    }
+
+    // Mean incident edge length sets the scale of the shadow-ray offset.
+    std::vector<double> offset(n, 0.0);
+    if (lighting.shadows) {
+        std::vector<int32_t> count(n, 0);
+        for (const auto& t : surface.triangles) {
+            for (int k = 0; k < 3; ++k) {
+                const double length = (surface.positions[t[k]] - surface.positions[t[(k + 1) % 3]]).norm();
+                offset[t[k]] += length;
+                offset[t[(k + 1) % 3]] += length;
+                ++count[t[k]];
+                ++count[t[(k + 1) % 3]];
+            }
+        }
+        for (size_t s = 0; s < n; ++s) {
+            if (count[s] > 0) offset[s] *= kShadowOffset / count[s];
+        }
+    }
+
+    std::vector<Rgb> q(n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t s = range.begin(); s != range.end(); ++s) {
+            Rgb sum = lighting.ambient;
+            const Eigen::Vector3d& p = surface.positions[s];
+            const Eigen::Vector3d& normal = surface.normals[s];
+            const Eigen::Vector3f origin = (p + offset[s] * normal).cast<float>();
+            for (const Light& light : lighting.lights) {
+                Eigen::Vector3d to_light;
+                double scale = 1.0;
+                double distance = std::numeric_limits<double>::infinity();
+                if (light.type == LightType::Directional) {
+                    to_light = -light.vector.normalized();
+                } else {
+                    to_light = light.vector - p;
+                    distance = to_light.norm();
+                    if (!(distance > 0)) continue;  // light on the vertex: no direction
+                    to_light /= distance;
+                    scale = 1.0 / (distance * distance);
+                }
+                const double cos_theta = normal.dot(to_light);
+                if (!(cos_theta > 0)) continue;
+                if (lighting.shadows) {
+                    // The ray stops just short of a point light so that a light lying on a surface
+                    // does not shadow itself.
+                    const float t_max = std::isinf(distance) ? std::numeric_limits<float>::infinity()
+                                                             : static_cast<float>(distance * (1.0 - 1e-6));
+                    if (bvh.occluded(origin, to_light.cast<float>(), 0.0f, t_max)) continue;
+                }
+                const double factor = scale * cos_theta * fresnel_transmittance(cos_theta, surface.eta[s]);
+                for (int c = 0; c < 3; ++c) sum[c] += light.intensity[c] * factor;
+            }
+            q[s] = sum;
+        }
+    });
+    return q;
+}
+
+std::vector<Rgb> incident_light(const BoundarySurface& surface, const Lighting& lighting) {
+    validate(lighting);
+    const TriangleBvh bvh = lighting.shadows ? build_shadow_bvh(surface) : TriangleBvh();
+    return incident_light(surface, bvh, lighting);
+}
+
+std::vector<Rgb> incident_light(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                const std::vector<TetMaterial>& materials, const Lighting& lighting) {
+    const BoundarySurface surface = extract_boundary_surface(mesh, connectivity, materials);
+    return to_volume_vertices(surface, incident_light(surface, lighting), mesh.vertex_count());
+}
+
+std::vector<Rgb> to_volume_vertices(const BoundarySurface& surface, const std::vector<Rgb>& values,
+                                    size_t volume_vertex_count) {
+    if (values.size() != surface.vertices.size()) {
+        throw InvalidArgumentError("to_volume_vertices: " + std::to_string(values.size()) + " values for " +
+                                   std::to_string(surface.vertices.size()) + " surface vertices");
+    }
+    std::vector<Rgb> result(volume_vertex_count, Rgb{0, 0, 0});
+    for (size_t s = 0; s < values.size(); ++s) result[surface.vertices[s]] = values[s];
+    return result;
+}
+
+}  // namespace waxwork

@@ -1,0 +1,96 @@
+// Lights and the diffuse incoming light q at the boundary: the source term of the diffusion equation
+// (the Robin boundary phi + 2 A kappa dphi/dn = 4/(1-F_dr) q, TransCut Eq. 5 / Arbree et al. 2011).
+//
+//   q_i = ambient + sum_lights I_l * max(0, n_i . w_il) * F_t(n_i . w_il, eta_i) * V_il   [* 1/d_il^2]
+//
+// w_il is the unit vector from boundary vertex i towards light l, n_i the area-weighted outward vertex
+// normal, F_t the Fresnel transmittance into the medium, V_il in {0, 1} the visibility from a shadow ray
+// against every boundary triangle of the volume in world space (so pieces shadow each other), and the
+// 1/d^2 falloff applies to point lights. The ambient term is a constant per channel added to every
+// boundary vertex (no F_t, no visibility): it stands in for the light of the environment and keeps the
+// unlit side from going black.
+//
+// Lights inside the object: a point light inside a closed volume reaches no boundary vertex (every
+// shadow ray to it crosses the surface, and on a convex part n_i . w_il < 0), so it contributes zero
+// everywhere; with shadows off it lights the inner sides of faces that happen to face it. A point light
+// exactly on a vertex contributes nothing to that vertex (no direction; never NaN).
+#pragma once
+
+#include "solver/ray_caster.h"
+#include "tetops/connectivity.h"
+#include "tetops/tet_mesh.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace waxwork {
+
+using Rgb = std::array<double, 3>;
+
+enum class LightType {
+    Directional,  // parallel rays; `vector` is the direction in which the light travels
+    Point,        // `vector` is the position (world space, model units); falloff 1/d^2
+};
+
+struct Light {
+    LightType type = LightType::Directional;
+    Eigen::Vector3d vector = Eigen::Vector3d(0, 0, -1);
+    // Directional: irradiance on a surface facing the light. Point: radiant intensity, so the
+    // irradiance at distance d facing the light is intensity / d^2 (d in model units).
+    Rgb intensity = {1, 1, 1};
+};
+
+struct Lighting {
+    std::vector<Light> lights;
+    Rgb ambient = {0, 0, 0};
+    bool shadows = true;
+};
+
+// Throws InvalidArgumentError naming the light for non-finite components, a zero direction or
+// negative intensities / ambient.
+void validate(const Lighting& lighting);
+
+// The boundary of a volume in world space, as the lighting and the renderer see it. Surface vertex s
+// is volume vertex `vertices[s]`.
+struct BoundarySurface {
+    std::vector<int32_t> vertices;                 // volume vertex of each surface vertex (ascending)
+    std::vector<Eigen::Vector3d> positions;        // world space (piece transform applied)
+    std::vector<Eigen::Vector3d> normals;          // unit, area-weighted, outward
+    std::vector<std::array<int32_t, 3>> triangles; // into the surface arrays, counter-clockwise outside
+    std::vector<int32_t> triangle_tets;            // the tet each triangle is a face of
+    std::vector<double> eta;                       // relative index of refraction per surface vertex
+};
+
+// Unit area-weighted vertex normals of a triangle surface (zero for vertices of no or only degenerate
+// triangles).
+std::vector<Eigen::Vector3d> area_weighted_normals(const std::vector<Eigen::Vector3d>& positions,
+                                                   const std::vector<std::array<int32_t, 3>>& triangles);
+
+// Extracts the boundary faces of the volume, moves each vertex by the rigid transform of its piece
+// and computes normals. eta per vertex is boundary_vertex_eta (solver/radiance.h: area-weighted over
+// its boundary faces' tets; materials one per tet), or default_eta when materials is empty.
+BoundarySurface extract_boundary_surface(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                         const std::vector<TetMaterial>& materials, double default_eta = 1.3);
+
+// The triangles of `surface` in float, for shadow rays; build once per geometry change and pass it to
+// incident_light while only the lights change.
+TriangleBvh build_shadow_bvh(const BoundarySurface& surface);
+
+// q per surface vertex and channel. `bvh` must have been built from `surface` (only used with
+// lighting.shadows). Parallel over vertices (TBB).
+std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting);
+// Same, building the BVH when lighting.shadows is set.
+std::vector<Rgb> incident_light(const BoundarySurface& surface, const Lighting& lighting);
+
+// q per volume vertex (zero at interior vertices): the form solve_diffusion takes.
+std::vector<Rgb> incident_light(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                const std::vector<TetMaterial>& materials, const Lighting& lighting);
+
+// Scatters per-surface-vertex values to volume vertices (zero elsewhere).
+std::vector<Rgb> to_volume_vertices(const BoundarySurface& surface, const std::vector<Rgb>& values,
+                                    size_t volume_vertex_count);
+
+}  // namespace waxwork

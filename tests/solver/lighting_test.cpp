@@ -1,0 +1,272 @@
+#include "solver/lighting.h"
+#include "solver/ray_caster.h"
+#include "tetops/connectivity.h"
+#include "tetops/error.h"
+#include "tetops/tet_mesh.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace waxwork {
+namespace {
+
+// A box [lo, hi] cut into n^3 cells of 6 tets each (Kuhn subdivision: every cell splits along its
+// main diagonal, so neighbouring cells share conforming faces).
+TetMesh make_box(int n, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+    std::vector<Eigen::Vector3d> points;
+    auto id = [n](int i, int j, int k) { return (k * (n + 1) + j) * (n + 1) + i; };
+    for (int k = 0; k <= n; ++k)
+        for (int j = 0; j <= n; ++j)
+            for (int i = 0; i <= n; ++i)
+                points.push_back(lo + (hi - lo).cwiseProduct(Eigen::Vector3d(i, j, k) / n));
+    std::vector<Tet> tets;
+    const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i)
+                for (const auto& p : perms) {
+                    int c[3] = {i, j, k};
+                    Tet t;
+                    t[0] = id(c[0], c[1], c[2]);
+                    for (int s = 0; s < 3; ++s) {
+                        ++c[p[s]];
+                        t[s + 1] = id(c[0], c[1], c[2]);
+                    }
+                    tets.push_back(t);
+                }
+    return make_tet_mesh(std::move(points), std::move(tets));
+}
+
+// Appends b to a as a new piece moved by `transform`.
+void append_piece(TetMesh& a, const TetMesh& b, const RigidTransform& transform) {
+    const auto offset = static_cast<int32_t>(a.positions.size());
+    const auto piece = static_cast<int32_t>(a.piece_transforms.size());
+    a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
+    for (Tet t : b.tets) {
+        for (int32_t& v : t) v += offset;
+        a.tets.push_back(t);
+        a.original_ids.push_back(static_cast<int32_t>(a.original_ids.size()));
+        a.piece_ids.push_back(piece);
+    }
+    a.piece_transforms.push_back(transform);
+}
+
+std::vector<TetMaterial> materials_with_eta(const TetMesh& mesh, double eta) {
+    TetMaterial m;
+    m.mua = {0.01, 0.01, 0.01};
+    m.musp = {1, 1, 1};
+    m.eta = eta;
+    return std::vector<TetMaterial>(mesh.tet_count(), m);
+}
+
+// Fresnel transmittance at normal incidence, the textbook closed form 1 - ((eta-1)/(eta+1))^2.
+double normal_transmittance(double eta) {
+    const double r = (eta - 1) / (eta + 1);
+    return 1 - r * r;
+}
+
+bool on_top_face_interior(const Eigen::Vector3d& p, double top) {
+    return std::abs(p.z() - top) < 1e-12 && p.x() > 1e-9 && p.x() < 1 - 1e-9 && p.y() > 1e-9 && p.y() < 1 - 1e-9;
+}
+
+TEST(Lighting, CubeLitFromAboveIsLitOnlyOnTheTopFace) {
+    const TetMesh mesh = make_box(4, {0, 0, 0}, {1, 1, 1});
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    const double eta = 1.4;
+    Lighting lighting;
+    lighting.lights.push_back({LightType::Directional, {0, 0, -3}, {1.0, 2.0, 0.5}});
+    lighting.ambient = {0.05, 0.1, 0.2};
+    const BoundarySurface surface = extract_boundary_surface(mesh, connectivity, materials_with_eta(mesh, eta));
+    const std::vector<Rgb> q = incident_light(surface, lighting);
+    ASSERT_EQ(q.size(), surface.positions.size());
+
+    const double ft = normal_transmittance(eta);
+    int top_interior = 0;
+    for (size_t s = 0; s < q.size(); ++s) {
+        const Eigen::Vector3d& p = surface.positions[s];
+        for (int c = 0; c < 3; ++c) {
+            if (on_top_face_interior(p, 1.0)) {
+                EXPECT_NEAR(q[s][c], lighting.lights[0].intensity[c] * ft + lighting.ambient[c], 1e-6) << p.transpose();
+            } else if (p.z() < 1 - 1e-9) {
+                // Sides and bottom: their normals have no +z component, so only the ambient term.
+                EXPECT_EQ(q[s][c], lighting.ambient[c]) << p.transpose();
+            } else {
+                // Rim of the top face: the normal leans towards the light.
+                EXPECT_GT(q[s][c], lighting.ambient[c]) << p.transpose();
+            }
+        }
+        top_interior += on_top_face_interior(p, 1.0);
+    }
+    EXPECT_EQ(top_interior, 9);
+}
+
+TEST(Lighting, VolumeVertexFormZeroesInteriorVertices) {
+    const TetMesh mesh = make_box(3, {0, 0, 0}, {1, 1, 1});
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    Lighting lighting;
+    lighting.lights.push_back({LightType::Directional, {0, 0, -1}, {1, 1, 1}});
+    lighting.ambient = {0.1, 0.1, 0.1};
+    const std::vector<Rgb> q = incident_light(mesh, connectivity, materials_with_eta(mesh, 1.3), lighting);
+    ASSERT_EQ(q.size(), mesh.vertex_count());
+    for (size_t v = 0; v < q.size(); ++v) {
+        if (connectivity.is_boundary_vertex[v]) {
+            EXPECT_GE(q[v][0], 0.1);
+        } else {
+            EXPECT_EQ(q[v][0], 0.0);
+        }
+    }
+}
+
+TEST(Lighting, PieceBetweenLightAndCubeCastsAShadow) {
+    // Cube A in [0,1]^3; a wider slab, as a second piece moved above it by its rigid transform.
+    TetMesh mesh = make_box(4, {0, 0, 0}, {1, 1, 1});
+    const TetMesh slab = make_box(2, {-0.5, -0.5, 0}, {1.5, 1.5, 0.3});
+    RigidTransform lift;
+    lift.translation = {0, 0, 2};
+    append_piece(mesh, slab, lift);
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    Lighting lighting;
+    lighting.lights.push_back({LightType::Directional, {0, 0, -1}, {1, 1, 1}});
+    lighting.ambient = {0.05, 0.05, 0.05};
+    const BoundarySurface surface = extract_boundary_surface(mesh, connectivity, materials_with_eta(mesh, 1.3));
+    const std::vector<Rgb> shadowed = incident_light(surface, lighting);
+    lighting.shadows = false;
+    const std::vector<Rgb> unshadowed = incident_light(surface, lighting);
+
+    int cube_top = 0, slab_top = 0;
+    for (size_t s = 0; s < surface.positions.size(); ++s) {
+        const Eigen::Vector3d& p = surface.positions[s];
+        if (std::abs(p.z() - 1.0) < 1e-12) {  // top of the cube: behind the slab
+            ++cube_top;
+            EXPECT_EQ(shadowed[s][0], 0.05) << p.transpose();
+            EXPECT_GT(unshadowed[s][0], 0.05) << p.transpose();
+        } else if (std::abs(p.z() - 2.3) < 1e-12) {  // top of the slab (moved by the transform): lit
+            ++slab_top;
+            EXPECT_GT(shadowed[s][0], 0.05) << p.transpose();
+            EXPECT_EQ(shadowed[s][0], unshadowed[s][0]);
+        }
+    }
+    EXPECT_EQ(cube_top, 25);
+    EXPECT_EQ(slab_top, 9);
+}
+
+TEST(Lighting, PointLightFallsOffWithInverseSquareDistance) {
+    const TetMesh mesh = make_box(4, {0, 0, 0}, {1, 1, 1});
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    const double eta = 1.5;
+    const BoundarySurface surface = extract_boundary_surface(mesh, connectivity, materials_with_eta(mesh, eta));
+    size_t centre = surface.positions.size();
+    for (size_t s = 0; s < surface.positions.size(); ++s) {
+        if ((surface.positions[s] - Eigen::Vector3d(0.5, 0.5, 1)).norm() < 1e-12) centre = s;
+    }
+    ASSERT_LT(centre, surface.positions.size());
+    for (double d : {0.5, 1.0, 2.0, 7.0}) {
+        Lighting lighting;
+        lighting.lights.push_back({LightType::Point, {0.5, 0.5, 1 + d}, {3, 3, 3}});
+        const std::vector<Rgb> q = incident_light(surface, lighting);
+        EXPECT_NEAR(q[centre][1], 3 / (d * d) * normal_transmittance(eta), 1e-9) << d;
+    }
+}
+
+TEST(Lighting, PointLightInsideOrOnTheObjectGivesOnlyAmbientAndNoNaN) {
+    const TetMesh mesh = make_box(3, {0, 0, 0}, {1, 1, 1});
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    const BoundarySurface surface = extract_boundary_surface(mesh, connectivity, {});
+    Lighting lighting;
+    lighting.ambient = {0.25, 0.25, 0.25};
+    lighting.lights.push_back({LightType::Point, {0.5, 0.5, 0.5}, {10, 10, 10}});  // inside
+    lighting.lights.push_back({LightType::Point, {0, 0, 0}, {10, 10, 10}});        // on a corner vertex
+    for (const Rgb& q : incident_light(surface, lighting)) {
+        for (double x : q) {
+            ASSERT_TRUE(std::isfinite(x));
+            EXPECT_EQ(x, 0.25);
+        }
+    }
+}
+
+TEST(Lighting, InvalidLightsThrow) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double inf = std::numeric_limits<double>::infinity();
+    auto expect_throw = [](Light light) {
+        Lighting lighting;
+        lighting.lights.push_back(light);
+        EXPECT_THROW(validate(lighting), InvalidArgumentError);
+    };
+    expect_throw({LightType::Directional, {0, 0, 0}, {1, 1, 1}});
+    expect_throw({LightType::Directional, {nan, 0, -1}, {1, 1, 1}});
+    expect_throw({LightType::Point, {0, inf, 0}, {1, 1, 1}});
+    expect_throw({LightType::Point, {0, 0, 0}, {1, nan, 1}});
+    expect_throw({LightType::Directional, {0, 0, 1}, {1, inf, 1}});
+    expect_throw({LightType::Directional, {0, 0, 1}, {-1, 1, 1}});
+    Lighting bad_ambient;
+    bad_ambient.ambient = {0, nan, 0};
+    EXPECT_THROW(validate(bad_ambient), InvalidArgumentError);
+    // A point light at the origin is fine (its position, unlike a direction, may be zero).
+    Lighting ok;
+    ok.lights.push_back({LightType::Point, {0, 0, 0}, {1, 1, 1}});
+    EXPECT_NO_THROW(validate(ok));
+
+    // The throwing path through incident_light, too.
+    const TetMesh mesh = make_box(1, {0, 0, 0}, {1, 1, 1});
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    Lighting lighting;
+    lighting.lights.push_back({LightType::Directional, {0, 0, 0}, {1, 1, 1}});
+    EXPECT_THROW(incident_light(mesh, connectivity, {}, lighting), InvalidArgumentError);
+}
+
+TEST(RayCaster, BvhAnyHitAgreesWithBruteForce) {
+    std::mt19937 rng(12345);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    // Random small triangles in the unit cube plus a few large ones, so that both deep leaves and
+    // boxes spanning everything occur.
+    std::vector<Eigen::Vector3f> points;
+    std::vector<std::array<int32_t, 3>> triangles;
+    for (int t = 0; t < 3000; ++t) {
+        const Eigen::Vector3f c(unit(rng), unit(rng), unit(rng));
+        const float size = t < 20 ? 0.5f : 0.04f;
+        for (int k = 0; k < 3; ++k) points.push_back(c + size * Eigen::Vector3f(gauss(rng), gauss(rng), gauss(rng)));
+        const auto base = static_cast<int32_t>(points.size() - 3);
+        triangles.push_back({base, base + 1, base + 2});
+    }
+    const TriangleBvh bvh(points, triangles);
+    EXPECT_EQ(bvh.triangle_count(), triangles.size());
+    EXPECT_GT(bvh.node_count(), 1u);
+
+    int hits = 0, misses = 0;
+    for (int r = 0; r < 5000; ++r) {
+        const Eigen::Vector3f origin(1.6f * unit(rng) - 0.3f, 1.6f * unit(rng) - 0.3f, 1.6f * unit(rng) - 0.3f);
+        Eigen::Vector3f direction(gauss(rng), gauss(rng), gauss(rng));
+        if (r % 10 == 0) direction = Eigen::Vector3f(0, 0, r % 20 == 0 ? 1.0f : -1.0f);  // axis-parallel rays
+        const float t_max = r % 3 == 0 ? std::numeric_limits<float>::infinity() : 0.5f * unit(rng);
+        bool brute = false;
+        for (const auto& t : triangles) {
+            if (ray_hits_triangle(origin, direction, 0.0f, t_max, points[t[0]], points[t[1]], points[t[2]])) {
+                brute = true;
+                break;
+            }
+        }
+        ASSERT_EQ(bvh.occluded(origin, direction, 0.0f, t_max), brute) << "ray " << r;
+        (brute ? hits : misses)++;
+    }
+    // Both outcomes must be well represented for the comparison to mean anything.
+    EXPECT_GT(hits, 500);
+    EXPECT_GT(misses, 500);
+}
+
+TEST(RayCaster, EmptyAndInvalidInput) {
+    const TriangleBvh empty;
+    EXPECT_FALSE(empty.occluded({0, 0, 0}, {0, 0, 1}, 0, 1));
+    std::vector<Eigen::Vector3f> points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    std::vector<std::array<int32_t, 3>> bad = {{0, 1, 3}};
+    EXPECT_THROW(TriangleBvh(points, bad), InvalidArgumentError);
+    points[1].x() = std::numeric_limits<float>::quiet_NaN();
+    std::vector<std::array<int32_t, 3>> ok = {{0, 1, 2}};
+    EXPECT_THROW(TriangleBvh(points, ok), InvalidArgumentError);
+}
+
+}  // namespace
+}  // namespace waxwork
