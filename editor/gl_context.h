@@ -1,0 +1,119 @@
+// Headless OpenGL: an OSMesa (Mesa's off-screen interface, llvmpipe software rasteriser) OpenGL 4.5
+// core context, so `waxwork render` and the tests draw without a display or a GPU; and the table of
+// OpenGL entry points the renderers call, loaded from whichever context is current.
+#pragma once
+
+#include <GL/glcorearb.h>
+
+#include <memory>
+#include <string>
+
+namespace waxwork {
+
+// Every OpenGL function the renderers use. Loaded through the context's GetProcAddress instead of
+// linking gl* symbols directly: libOSMesa and libGL (GLFW windows) both export them, and whichever
+// the dynamic linker binds first would silently receive every call.
+#define WAXWORK_GL_FUNCTIONS(X)                                                   \
+    X(PFNGLGETSTRINGPROC, GetString)                                              \
+    X(PFNGLGETINTEGERVPROC, GetIntegerv)                                          \
+    X(PFNGLGETERRORPROC, GetError)                                                \
+    X(PFNGLENABLEPROC, Enable)                                                    \
+    X(PFNGLDISABLEPROC, Disable)                                                  \
+    X(PFNGLVIEWPORTPROC, Viewport)                                                \
+    X(PFNGLCLEARCOLORPROC, ClearColor)                                            \
+    X(PFNGLCLEARDEPTHPROC, ClearDepth)                                            \
+    X(PFNGLCLEARPROC, Clear)                                                      \
+    X(PFNGLDEPTHFUNCPROC, DepthFunc)                                              \
+    X(PFNGLREADPIXELSPROC, ReadPixels)                                            \
+    X(PFNGLPIXELSTOREIPROC, PixelStorei)                                          \
+    X(PFNGLFINISHPROC, Finish)                                                    \
+    X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers)                                  \
+    X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers)                            \
+    X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer)                                  \
+    X(PFNGLFRAMEBUFFERRENDERBUFFERPROC, FramebufferRenderbuffer)                  \
+    X(PFNGLCHECKFRAMEBUFFERSTATUSPROC, CheckFramebufferStatus)                    \
+    X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer)                                  \
+    X(PFNGLGENRENDERBUFFERSPROC, GenRenderbuffers)                                \
+    X(PFNGLDELETERENDERBUFFERSPROC, DeleteRenderbuffers)                          \
+    X(PFNGLBINDRENDERBUFFERPROC, BindRenderbuffer)                                \
+    X(PFNGLRENDERBUFFERSTORAGEPROC, RenderbufferStorage)                          \
+    X(PFNGLRENDERBUFFERSTORAGEMULTISAMPLEPROC, RenderbufferStorageMultisample)    \
+    X(PFNGLCREATESHADERPROC, CreateShader)                                        \
+    X(PFNGLSHADERSOURCEPROC, ShaderSource)                                        \
+    X(PFNGLCOMPILESHADERPROC, CompileShader)                                      \
+    X(PFNGLGETSHADERIVPROC, GetShaderiv)                                          \
+    X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog)                                \
+    X(PFNGLDELETESHADERPROC, DeleteShader)                                        \
+    X(PFNGLCREATEPROGRAMPROC, CreateProgram)                                      \
+    X(PFNGLATTACHSHADERPROC, AttachShader)                                        \
+    X(PFNGLLINKPROGRAMPROC, LinkProgram)                                          \
+    X(PFNGLGETPROGRAMIVPROC, GetProgramiv)                                        \
+    X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog)                              \
+    X(PFNGLDELETEPROGRAMPROC, DeleteProgram)                                      \
+    X(PFNGLUSEPROGRAMPROC, UseProgram)                                            \
+    X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation)                            \
+    X(PFNGLUNIFORM1IPROC, Uniform1i)                                              \
+    X(PFNGLUNIFORM1FPROC, Uniform1f)                                              \
+    X(PFNGLUNIFORM2FPROC, Uniform2f)                                              \
+    X(PFNGLUNIFORM3FVPROC, Uniform3fv)                                            \
+    X(PFNGLUNIFORM4FVPROC, Uniform4fv)                                            \
+    X(PFNGLUNIFORMMATRIX4FVPROC, UniformMatrix4fv)                                \
+    X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays)                                  \
+    X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays)                            \
+    X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray)                                  \
+    X(PFNGLGENBUFFERSPROC, GenBuffers)                                            \
+    X(PFNGLDELETEBUFFERSPROC, DeleteBuffers)                                      \
+    X(PFNGLBINDBUFFERPROC, BindBuffer)                                            \
+    X(PFNGLBUFFERDATAPROC, BufferData)                                            \
+    X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray)                  \
+    X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)                          \
+    X(PFNGLDRAWELEMENTSPROC, DrawElements)                                        \
+    X(PFNGLGENTEXTURESPROC, GenTextures)                                          \
+    X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                    \
+    X(PFNGLBINDTEXTUREPROC, BindTexture)                                          \
+    X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                                      \
+    X(PFNGLTEXIMAGE2DPROC, TexImage2D)                                            \
+    X(PFNGLTEXPARAMETERIPROC, TexParameteri)
+
+struct GlApi {
+#define WAXWORK_GL_DECLARE(type, name) type name = nullptr;
+    WAXWORK_GL_FUNCTIONS(WAXWORK_GL_DECLARE)
+#undef WAXWORK_GL_DECLARE
+};
+
+using GlProcLoader = void* (*)(const char* name);
+
+// Resolves every entry of GlApi ("gl" + name) with `loader` for the current context. Throws
+// waxwork::Error naming the first missing function.
+GlApi load_gl_api(GlProcLoader loader);
+
+// Throws waxwork::Error("WHAT: OpenGL error 0x...") when glGetError reports one.
+void check_gl_error(const GlApi& gl, const char* what);
+
+// An off-screen OSMesa context, current on the creating thread from construction on. It has only a
+// tiny default framebuffer: renderers draw into their own framebuffer objects.
+//
+// Asks for OpenGL 4.5 core, then 4.3 core (the minimum: the shaders are GLSL 4.30). If GALLIUM_DRIVER
+// is unset it is set to "llvmpipe" first: softpipe, Mesa's other software driver, stops at OpenGL 3.3.
+// Throws waxwork::Error explaining what the driver offers when neither version can be created.
+class HeadlessGlContext {
+public:
+    HeadlessGlContext();
+    ~HeadlessGlContext();
+    HeadlessGlContext(const HeadlessGlContext&) = delete;
+    HeadlessGlContext& operator=(const HeadlessGlContext&) = delete;
+
+    // Makes the context current on the calling thread (one context per thread at a time).
+    void make_current();
+    const GlApi& gl() const { return gl_; }
+    // "4.5 (Core Profile) Mesa 22.3.6", "llvmpipe (LLVM 15.0.6, 256 bits)".
+    std::string version() const;
+    std::string renderer() const;
+
+private:
+    struct State;
+    std::unique_ptr<State> state_;
+    GlApi gl_;
+};
+
+}  // namespace waxwork

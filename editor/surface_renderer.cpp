@@ -1,0 +1,433 @@
+#include "editor/surface_renderer.h"
+
+#include "solver/material.h"
+#include "tetops/error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <string>
+
+namespace waxwork {
+
+namespace {
+
+// F_t is tabulated from solver/material.h's fresnel_transmittance rather than re-derived in GLSL, so
+// the shader and the solver can never disagree about it. 128 x 41 samples with bilinear filtering:
+// the table error is far below one 8-bit output step.
+constexpr int kLutCosSamples = 128;
+constexpr int kLutEtaSamples = 41;
+constexpr float kLutEtaMin = 1.0f;  // the range validate_material accepts
+constexpr float kLutEtaMax = 3.0f;
+
+constexpr const char* kVertexShader = R"glsl(
+#version 430 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec3 radiance_factor;
+layout(location = 3) in float eta;
+uniform mat4 view_projection;
+out vec3 v_position;
+out vec3 v_normal;
+out vec3 v_factor;
+out float v_eta;
+void main() {
+    v_position = position;
+    v_normal = normal;
+    v_factor = radiance_factor;
+    v_eta = eta;
+    gl_Position = view_projection * vec4(position, 1.0);
+}
+)glsl";
+
+constexpr const char* kFragmentShader = R"glsl(
+#version 430 core
+const int kMaxLights = 8;
+const float kPi = 3.14159265358979;
+in vec3 v_position;
+in vec3 v_normal;
+in vec3 v_factor;
+in float v_eta;
+out vec4 color;
+uniform vec3 eye;
+uniform sampler2D transmittance_lut;  // x: cos(theta) in [0, 1], y: eta over lut_eta_range
+uniform vec2 lut_eta_range;
+uniform vec2 lut_size;
+uniform int light_count;
+uniform vec4 light_vector[kMaxLights];     // w = 0: direction of travel; w = 1: position
+uniform vec3 light_intensity[kMaxLights];
+uniform float roughness;
+uniform float specular_scale;
+uniform float exposure;
+uniform int tone_map;                      // 0 ACES, 1 Reinhard, 2 clamp
+
+float transmittance(float cos_theta, float eta) {
+    vec2 t = vec2(clamp(cos_theta, 0.0, 1.0),
+                  clamp((eta - lut_eta_range.x) / (lut_eta_range.y - lut_eta_range.x), 0.0, 1.0));
+    // Samples sit at texel centres: map [0, 1] onto [0.5, size - 0.5] texels.
+    return texture(transmittance_lut, (t * (lut_size - 1.0) + 0.5) / lut_size).r;
+}
+
+vec3 aces(vec3 x) {  // Narkowicz's fit of the ACES filmic curve
+    return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
+}
+
+vec3 srgb_encode(vec3 c) {
+    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+
+void main() {
+    vec3 n = normalize(v_normal);
+    if (!gl_FrontFacing) n = -n;  // inside of an open cut: shade the side we see
+    vec3 v = normalize(eye - v_position);
+    float nv = max(dot(n, v), 1e-4);
+    // Subsurface part: L_o = F_t(theta_o) E (Li et al. 2013, Eq. 3).
+    vec3 radiance = transmittance(nv, v_eta) * max(v_factor, vec3(0.0));
+
+    // Cook-Torrance: GGX distribution, Smith-Schlick geometry (k = alpha / 2), Fresnel reflectance
+    // 1 - F_t at the half vector.
+    float alpha = roughness * roughness;
+    float alpha2 = alpha * alpha;
+    float k = alpha * 0.5;
+    for (int i = 0; i < light_count; ++i) {
+        vec3 l;
+        vec3 irradiance = light_intensity[i];
+        if (light_vector[i].w == 0.0) {
+            l = -normalize(light_vector[i].xyz);
+        } else {
+            vec3 d = light_vector[i].xyz - v_position;
+            float d2 = max(dot(d, d), 1e-12);
+            l = d * inversesqrt(d2);
+            irradiance /= d2;
+        }
+        float nl = dot(n, l);
+        if (nl <= 0.0) continue;
+        vec3 h = normalize(l + v);
+        float nh = max(dot(n, h), 0.0);
+        float vh = max(dot(v, h), 0.0);
+        float denom = nh * nh * (alpha2 - 1.0) + 1.0;
+        float D = alpha2 / (kPi * denom * denom);
+        float G = (nl / (nl * (1.0 - k) + k)) * (nv / (nv * (1.0 - k) + k));
+        float F = 1.0 - transmittance(vh, v_eta);
+        radiance += specular_scale * irradiance * nl * D * G * F / (4.0 * nl * nv);
+    }
+
+    vec3 c = max(radiance * exposure, vec3(0.0));
+    if (tone_map == 0) c = aces(c);
+    else if (tone_map == 1) c = c / (1.0 + c);
+    else c = clamp(c, 0.0, 1.0);
+    color = vec4(srgb_encode(c), 1.0);
+}
+)glsl";
+
+GLuint compile_shader(const GlApi& gl, GLenum type, const char* source, const char* name) {
+    const GLuint shader = gl.CreateShader(type);
+    gl.ShaderSource(shader, 1, &source, nullptr);
+    gl.CompileShader(shader);
+    GLint ok = GL_FALSE;
+    gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (ok != GL_TRUE) {
+        GLint length = 0;
+        gl.GetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+        std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
+        gl.GetShaderInfoLog(shader, length, nullptr, log.data());
+        gl.DeleteShader(shader);
+        throw Error(std::string("surface renderer: the ") + name + " shader failed to compile: " + log.c_str());
+    }
+    return shader;
+}
+
+GLuint link_program(const GlApi& gl) {
+    const GLuint vertex = compile_shader(gl, GL_VERTEX_SHADER, kVertexShader, "vertex");
+    GLuint fragment = 0;
+    try {
+        fragment = compile_shader(gl, GL_FRAGMENT_SHADER, kFragmentShader, "fragment");
+    } catch (...) {
+        gl.DeleteShader(vertex);
+        throw;
+    }
+    const GLuint program = gl.CreateProgram();
+    gl.AttachShader(program, vertex);
+    gl.AttachShader(program, fragment);
+    gl.LinkProgram(program);
+    gl.DeleteShader(vertex);
+    gl.DeleteShader(fragment);
+    GLint ok = GL_FALSE;
+    gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (ok != GL_TRUE) {
+        GLint length = 0;
+        gl.GetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
+        std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
+        gl.GetProgramInfoLog(program, length, nullptr, log.data());
+        gl.DeleteProgram(program);
+        throw Error(std::string("surface renderer: the shader program failed to link: ") + log.c_str());
+    }
+    return program;
+}
+
+// Every GL object of one render(), released on every path including exceptions.
+struct FrameResources {
+    const GlApi& gl;
+    GLuint framebuffers[2] = {0, 0};   // multisampled, resolved
+    GLuint renderbuffers[3] = {0, 0, 0};  // msaa colour, msaa depth, resolved colour
+    GLuint vertex_array = 0;
+    GLuint buffers[5] = {0, 0, 0, 0, 0};  // positions, normals, factors, eta, indices
+
+    explicit FrameResources(const GlApi& g) : gl(g) {}
+    ~FrameResources() {
+        gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+        gl.BindVertexArray(0);
+        gl.DeleteFramebuffers(2, framebuffers);
+        gl.DeleteRenderbuffers(3, renderbuffers);
+        gl.DeleteVertexArrays(1, &vertex_array);
+        gl.DeleteBuffers(5, buffers);
+    }
+};
+
+void check_framebuffer(const GlApi& gl, const char* which) {
+    const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+        char code[16];
+        std::snprintf(code, sizeof code, "0x%04X", status);
+        throw Error(std::string("surface renderer: the ") + which + " framebuffer is incomplete (status " + code + ")");
+    }
+}
+
+Eigen::Matrix4f to_float(const Eigen::Matrix4d& m) { return m.cast<float>(); }
+
+void validate_input(const SurfaceRenderInput& input) {
+    const size_t n = input.positions.size();
+    auto fail = [](const std::string& what) { throw InvalidArgumentError("render_surface: " + what); };
+    if (input.normals.size() != n) fail(std::to_string(input.normals.size()) + " normals for " + std::to_string(n) + " vertices");
+    if (input.radiance_factor.size() != n) {
+        fail(std::to_string(input.radiance_factor.size()) + " radiance factors for " + std::to_string(n) + " vertices");
+    }
+    if (!input.eta.empty() && input.eta.size() != n) fail(std::to_string(input.eta.size()) + " eta values for " + std::to_string(n) + " vertices");
+    for (size_t t = 0; t < input.triangles.size(); ++t) {
+        for (int32_t v : input.triangles[t]) {
+            if (v < 0 || static_cast<size_t>(v) >= n) fail("triangle " + std::to_string(t) + " has vertex index " + std::to_string(v) + " out of range");
+        }
+    }
+    for (size_t i = 0; i < n; ++i) {
+        if (!input.positions[i].allFinite() || !input.normals[i].allFinite()) fail("non-finite position or normal at vertex " + std::to_string(i));
+    }
+    if (input.width <= 0 || input.height <= 0) fail("image size must be positive");
+    if (!(input.roughness > 0.0f && input.roughness <= 1.0f)) fail("roughness must be in (0, 1]");
+    if (!std::isfinite(input.exposure) || input.exposure < 0) fail("exposure must be finite and non-negative");
+    if (!std::isfinite(input.specular_scale) || input.specular_scale < 0) fail("specular_scale must be finite and non-negative");
+    if (input.lighting.lights.size() > static_cast<size_t>(kMaxRenderLights)) {
+        fail(std::to_string(input.lighting.lights.size()) + " lights; at most " + std::to_string(kMaxRenderLights) + " are drawn");
+    }
+    validate(input.lighting);
+}
+
+}  // namespace
+
+CameraFrame frame_camera(const Eigen::AlignedBox3d& box, const CameraSettings& camera, double aspect) {
+    if (box.isEmpty() || !box.min().allFinite() || !box.max().allFinite()) {
+        throw InvalidArgumentError("camera: empty or non-finite bounding box");
+    }
+    if (!camera.eye_direction.allFinite() || camera.eye_direction.norm() == 0) {
+        throw InvalidArgumentError("camera: eye direction must be finite and non-zero");
+    }
+    if (!(camera.fov_y_degrees > 0 && camera.fov_y_degrees < 180)) {
+        throw InvalidArgumentError("camera: vertical field of view must be in (0, 180) degrees");
+    }
+    if (!(aspect > 0) || !std::isfinite(aspect) || !(camera.margin > 0)) {
+        throw InvalidArgumentError("camera: aspect ratio and margin must be positive");
+    }
+    const Eigen::Vector3d forward = -camera.eye_direction.normalized();  // eye -> target
+    Eigen::Vector3d right = forward.cross(camera.up);
+    if (!right.allFinite() || right.norm() < 1e-9 * camera.up.norm() || camera.up.norm() == 0) {
+        throw InvalidArgumentError("camera: up vector is zero or parallel to the view direction");
+    }
+    right.normalize();
+    const Eigen::Vector3d up = right.cross(forward);
+
+    const Eigen::Vector3d centre = box.center();
+    const double radius = std::max(0.5 * box.diagonal().norm(), 1e-12);
+    const double half_fov_y = 0.5 * camera.fov_y_degrees * std::numbers::pi / 180.0;
+    const double half_fov_x = std::atan(std::tan(half_fov_y) * aspect);
+    const double distance = camera.margin * radius / std::sin(std::min(half_fov_x, half_fov_y));
+
+    CameraFrame frame;
+    frame.eye = centre - distance * forward;
+    frame.view.setIdentity();
+    frame.view.block<1, 3>(0, 0) = right.transpose();
+    frame.view.block<1, 3>(1, 0) = up.transpose();
+    frame.view.block<1, 3>(2, 0) = -forward.transpose();
+    frame.view.block<3, 1>(0, 3) = -frame.view.block<3, 3>(0, 0) * frame.eye;
+
+    // The sphere lies within [distance - radius, distance + radius] in front of the eye.
+    const double near_plane = std::max(distance - 1.5 * radius, 1e-3 * distance);
+    const double far_plane = distance + 1.5 * radius;
+    const double f = 1.0 / std::tan(half_fov_y);
+    frame.projection.setZero();
+    frame.projection(0, 0) = f / aspect;
+    frame.projection(1, 1) = f;
+    frame.projection(2, 2) = (far_plane + near_plane) / (near_plane - far_plane);
+    frame.projection(2, 3) = 2 * far_plane * near_plane / (near_plane - far_plane);
+    frame.projection(3, 2) = -1;
+    return frame;
+}
+
+SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {
+    program_ = link_program(gl_);
+
+    std::vector<float> table(kLutCosSamples * kLutEtaSamples);
+    for (int j = 0; j < kLutEtaSamples; ++j) {
+        const double eta = kLutEtaMin + (kLutEtaMax - kLutEtaMin) * j / (kLutEtaSamples - 1);
+        for (int i = 0; i < kLutCosSamples; ++i) {
+            table[j * kLutCosSamples + i] =
+                static_cast<float>(fresnel_transmittance(static_cast<double>(i) / (kLutCosSamples - 1), eta));
+        }
+    }
+    gl_.GenTextures(1, &transmittance_lut_);
+    gl_.BindTexture(GL_TEXTURE_2D, transmittance_lut_);
+    gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, kLutCosSamples, kLutEtaSamples, 0, GL_RED, GL_FLOAT, table.data());
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    gl_.BindTexture(GL_TEXTURE_2D, 0);
+    check_gl_error(gl_, "surface renderer: creating the transmittance table");
+}
+
+SurfaceRenderer::~SurfaceRenderer() {
+    gl_.DeleteTextures(1, &transmittance_lut_);
+    gl_.DeleteProgram(program_);
+}
+
+Image SurfaceRenderer::render(const SurfaceRenderInput& input) {
+    validate_input(input);
+    const GlApi& gl = gl_;
+    GLint max_size = 0, max_samples = 0;
+    gl.GetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
+    gl.GetIntegerv(GL_MAX_SAMPLES, &max_samples);
+    if (input.width > max_size || input.height > max_size) {
+        throw InvalidArgumentError("render_surface: " + std::to_string(input.width) + "x" + std::to_string(input.height) +
+                                   " exceeds the driver's maximum of " + std::to_string(max_size) + " pixels per side");
+    }
+    const int samples = std::clamp(input.samples, 1, std::max(max_samples, 1));
+
+    FrameResources r(gl);
+    gl.GenFramebuffers(2, r.framebuffers);
+    gl.GenRenderbuffers(3, r.renderbuffers);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, r.renderbuffers[0]);
+    gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, input.width, input.height);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, r.renderbuffers[1]);
+    gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT24, input.width, input.height);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, r.renderbuffers[2]);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, input.width, input.height);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, r.framebuffers[1]);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, r.renderbuffers[2]);
+    check_framebuffer(gl, "resolve");
+    gl.BindFramebuffer(GL_FRAMEBUFFER, r.framebuffers[0]);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, r.renderbuffers[0]);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, r.renderbuffers[1]);
+    check_framebuffer(gl, "multisampled");
+
+    gl.Viewport(0, 0, input.width, input.height);
+    gl.ClearColor(input.background[0] / 255.0f, input.background[1] / 255.0f, input.background[2] / 255.0f, 1.0f);
+    gl.ClearDepth(1.0);
+    gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+
+    if (!input.triangles.empty()) {
+        const size_t n = input.positions.size();
+        std::vector<float> eta = input.eta.empty() ? std::vector<float>(n, input.uniform_eta) : input.eta;
+        gl.GenVertexArrays(1, &r.vertex_array);
+        gl.BindVertexArray(r.vertex_array);
+        gl.GenBuffers(5, r.buffers);
+        auto attribute = [&](GLuint index, GLuint buffer, const void* data, size_t bytes, GLint components) {
+            gl.BindBuffer(GL_ARRAY_BUFFER, buffer);
+            gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(bytes), data, GL_STATIC_DRAW);
+            gl.EnableVertexAttribArray(index);
+            gl.VertexAttribPointer(index, components, GL_FLOAT, GL_FALSE, 0, nullptr);
+        };
+        // Eigen::Vector3f and std::array<float, 3> are three packed floats.
+        static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float) && sizeof(std::array<float, 3>) == 3 * sizeof(float));
+        attribute(0, r.buffers[0], input.positions.data(), n * sizeof(Eigen::Vector3f), 3);
+        attribute(1, r.buffers[1], input.normals.data(), n * sizeof(Eigen::Vector3f), 3);
+        attribute(2, r.buffers[2], input.radiance_factor.data(), n * sizeof(std::array<float, 3>), 3);
+        attribute(3, r.buffers[3], eta.data(), n * sizeof(float), 1);
+        gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, r.buffers[4]);
+        gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(input.triangles.size() * sizeof(input.triangles[0])),
+                      input.triangles.data(), GL_STATIC_DRAW);
+
+        Eigen::AlignedBox3d box;
+        for (const Eigen::Vector3f& p : input.positions) box.extend(p.cast<double>());
+        const CameraFrame frame = frame_camera(box, input.camera, static_cast<double>(input.width) / input.height);
+        const Eigen::Matrix4f view_projection = to_float(frame.projection * frame.view);
+
+        gl.UseProgram(program_);
+        auto location = [&](const char* name) { return gl.GetUniformLocation(program_, name); };
+        gl.UniformMatrix4fv(location("view_projection"), 1, GL_FALSE, view_projection.data());  // column-major
+        const Eigen::Vector3f eye = frame.eye.cast<float>();
+        gl.Uniform3fv(location("eye"), 1, eye.data());
+        gl.Uniform2f(location("lut_eta_range"), kLutEtaMin, kLutEtaMax);
+        gl.Uniform2f(location("lut_size"), kLutCosSamples, kLutEtaSamples);
+        gl.Uniform1f(location("roughness"), input.roughness);
+        gl.Uniform1f(location("specular_scale"), input.specular_scale);
+        gl.Uniform1f(location("exposure"), input.exposure);
+        gl.Uniform1i(location("tone_map"), static_cast<int>(input.tone_map));
+        const auto light_count = static_cast<int>(input.lighting.lights.size());
+        gl.Uniform1i(location("light_count"), light_count);
+        for (int i = 0; i < light_count; ++i) {
+            const Light& light = input.lighting.lights[i];
+            const float vector[4] = {static_cast<float>(light.vector.x()), static_cast<float>(light.vector.y()),
+                                     static_cast<float>(light.vector.z()), light.type == LightType::Point ? 1.0f : 0.0f};
+            const float intensity[3] = {static_cast<float>(light.intensity[0]), static_cast<float>(light.intensity[1]),
+                                        static_cast<float>(light.intensity[2])};
+            const std::string index = "[" + std::to_string(i) + "]";
+            gl.Uniform4fv(location(("light_vector" + index).c_str()), 1, vector);
+            gl.Uniform3fv(location(("light_intensity" + index).c_str()), 1, intensity);
+        }
+        gl.ActiveTexture(GL_TEXTURE0);
+        gl.BindTexture(GL_TEXTURE_2D, transmittance_lut_);
+        gl.Uniform1i(location("transmittance_lut"), 0);
+
+        gl.Enable(GL_DEPTH_TEST);
+        gl.DepthFunc(GL_LESS);
+        gl.Enable(GL_MULTISAMPLE);
+        gl.Disable(GL_CULL_FACE);  // cut-open or non-closed surfaces show their inner side
+        gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * input.triangles.size()), GL_UNSIGNED_INT, nullptr);
+        gl.UseProgram(0);
+        gl.BindTexture(GL_TEXTURE_2D, 0);
+    }
+
+    // Resolve the samples, then read back.
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[0]);
+    gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, r.framebuffers[1]);
+    gl.BlitFramebuffer(0, 0, input.width, input.height, 0, 0, input.width, input.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[1]);
+    Image image;
+    image.width = input.width;
+    image.height = input.height;
+    image.rgba.resize(4 * static_cast<size_t>(input.width) * static_cast<size_t>(input.height));
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl.ReadPixels(0, 0, input.width, input.height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+    check_gl_error(gl, "surface renderer: drawing");
+
+    // OpenGL's first row is the bottom one; Image's is the top one.
+    const size_t row = 4 * static_cast<size_t>(input.width);
+    std::vector<uint8_t> swap(row);
+    for (int y = 0; y < input.height / 2; ++y) {
+        uint8_t* a = image.rgba.data() + y * row;
+        uint8_t* b = image.rgba.data() + (input.height - 1 - y) * row;
+        std::memcpy(swap.data(), a, row);
+        std::memcpy(a, b, row);
+        std::memcpy(b, swap.data(), row);
+    }
+    return image;
+}
+
+Image render_surface(const SurfaceRenderInput& input) {
+    validate_input(input);  // before paying for a context
+    HeadlessGlContext context;
+    SurfaceRenderer renderer(context.gl());
+    return renderer.render(input);
+}
+
+}  // namespace waxwork

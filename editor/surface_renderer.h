@@ -1,0 +1,87 @@
+// Draws the boundary surface of a volume with its subsurface radiance: per-vertex exitant radiance
+// factor E (solver/radiance.h) times the view-dependent Fresnel transmittance F_t(theta_o) per
+// fragment, plus a Cook-Torrance highlight for each light, tone-mapped to sRGB. Cross-sections need no
+// special case: after a cut they are boundary faces like any other.
+#pragma once
+
+#include "editor/gl_context.h"
+#include "io/image_io.h"
+#include "solver/lighting.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace waxwork {
+
+// Where the camera stands: it looks at the centre of the bounding box from `eye_direction` and backs
+// off until the bounding sphere fits the narrower field of view with `margin` to spare.
+struct CameraSettings {
+    // From the centre towards the eye. The default is a 3/4 view of a y-up model whose front faces +z:
+    // from the front right, somewhat above.
+    Eigen::Vector3d eye_direction = Eigen::Vector3d(0.7, 0.5, 1.0);
+    Eigen::Vector3d up = Eigen::Vector3d(0, 1, 0);
+    double fov_y_degrees = 30;
+    double margin = 1.1;
+};
+
+struct CameraFrame {
+    Eigen::Vector3d eye;
+    Eigen::Matrix4d view;
+    Eigen::Matrix4d projection;  // OpenGL clip space
+};
+
+// Throws InvalidArgumentError for a zero or non-finite direction, an up vector parallel to it, a field
+// of view outside (0, 180) degrees, or an empty box.
+CameraFrame frame_camera(const Eigen::AlignedBox3d& box, const CameraSettings& camera, double aspect);
+
+enum class ToneMap { Aces, Reinhard, Clamp };
+
+struct SurfaceRenderInput {
+    std::vector<Eigen::Vector3f> positions;            // world space
+    std::vector<std::array<int32_t, 3>> triangles;     // counter-clockwise seen from outside
+    std::vector<Eigen::Vector3f> normals;              // per vertex, outward
+    std::vector<std::array<float, 3>> radiance_factor; // per vertex: E, rgb, HDR (L_o = F_t(theta_o) E)
+    std::vector<float> eta;                            // per vertex; empty: uniform_eta everywhere
+    float uniform_eta = 1.3f;
+    Lighting lighting;                                 // for the specular highlight (at most kMaxLights)
+    float roughness = 0.35f;                           // GGX roughness of the surface, (0, 1]
+    float specular_scale = 1.0f;                       // 0 turns the highlight off
+    int width = 800;
+    int height = 600;
+    int samples = 4;                                   // MSAA, clamped to what the driver supports
+    CameraSettings camera;
+    float exposure = 1.0f;
+    ToneMap tone_map = ToneMap::Aces;
+    std::array<uint8_t, 3> background = {38, 40, 46}; // sRGB
+};
+
+inline constexpr int kMaxRenderLights = 8;
+
+// Compiles the program and builds the F_t lookup table once; render() may then be called many times.
+// Needs a current OpenGL >= 4.3 context (HeadlessGlContext or a window's) for its whole lifetime.
+class SurfaceRenderer {
+public:
+    // Throws waxwork::Error with the driver's info log when a shader fails to compile or link.
+    explicit SurfaceRenderer(const GlApi& gl);
+    ~SurfaceRenderer();
+    SurfaceRenderer(const SurfaceRenderer&) = delete;
+    SurfaceRenderer& operator=(const SurfaceRenderer&) = delete;
+
+    // Throws InvalidArgumentError for inconsistent input (array sizes, indices, non-finite values,
+    // sizes beyond the driver's limits, too many lights) and waxwork::Error for driver failures.
+    Image render(const SurfaceRenderInput& input);
+
+private:
+    const GlApi& gl_;
+    GLuint program_ = 0;
+    GLuint transmittance_lut_ = 0;
+};
+
+// One-shot headless render: creates an OSMesa context (gl_context.h) and a renderer, draws, returns.
+Image render_surface(const SurfaceRenderInput& input);
+
+}  // namespace waxwork
