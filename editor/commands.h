@@ -8,6 +8,20 @@ class App;
 
 namespace waxwork {
 
-inline void register_commands(CLI::App&) {}
+void add_mesh_command(CLI::App& app);
+void add_info_command(CLI::App& app);
+void add_render_command(CLI::App& app);
+void add_demo_command(CLI::App& app);
+void add_cut_command(CLI::App& app);
+void add_paint_command(CLI::App& app);
+
+inline void register_commands(CLI::App& app) {
+    add_mesh_command(app);
+    add_info_command(app);
+    add_render_command(app);
+    add_cut_command(app);
+    add_paint_command(app);
+    add_demo_command(app);
+}
 
 }  // namespace waxwork

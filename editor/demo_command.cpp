@@ -1,0 +1,207 @@
+// `waxwork demo [-o DIR]`: the tour of what Waxwork does, on the embedded model (Spot, CC0): mesh it,
+// save the volume, and render it in a few materials and lights, a cut and a painted variant.
+#include "editor/commands.h"
+#include "editor/render_pipeline.h"
+#include "io/surface_reader.h"
+#include "io/volume_file.h"
+#include "solver/material.h"
+#include "solver/mesh_resolution.h"
+#include "tetops/cut.h"
+#include "tetops/error.h"
+#include "tetops/paint.h"
+#include "tetops/relaxation.h"
+#include "tetops/tetrahedralize.h"
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+namespace waxwork {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct DemoCommandOptions {
+    std::string output = "out/demo";
+    // Spot is about 1.7 model units long and tall. At 30 mm per unit it is a 5 cm figurine: marble's
+    // diffusion length (3.9 mm blue, 8.5 mm red) is then small against the body (about 25 mm across),
+    // which stays opaque-looking and shaded, but large against the ears, horns and legs (1-10 mm),
+    // which glow when back-lit. At 1 mm per unit the whole cow would be thinner than one diffusion
+    // length and look flat and uniformly lit; at 300 it would look like a chalky, nearly opaque cow.
+    double scale = 30.0;
+    std::optional<size_t> max_tets;
+    int width = 800;
+    int height = 600;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// One image of the tour.
+struct DemoShot {
+    std::string file;
+    std::string what;
+    const TetMesh* mesh;
+    const TetConnectivity* connectivity;
+    std::vector<TetMaterial> materials;
+    Lighting lighting;
+};
+
+// Spot faces -z (its horns and ears are at z < 0, its tail at z = +1): the camera looks at its face
+// from the front right, somewhat above.
+const Eigen::Vector3d kCameraDirection(0.75, 0.5, -1.0);
+
+// The key light comes from the upper left of the camera, in front of the cow, so the camera sees the
+// lit face next to the shaded flank and the soft, reddish terminator marble gets from diffusion.
+Light key_light() {
+    Light light;
+    light.vector = Eigen::Vector3d(1.0, -0.8, 0.3).normalized();
+    return light;
+}
+
+// A light from behind the cow, above, travelling towards the camera: the camera sees mostly faces in
+// shade, and what glows is light that crossed thin parts (ears, horns, legs).
+Light back_light() {
+    Light light;
+    light.vector = Eigen::Vector3d(0.75, -1.1, -1.0).normalized();
+    light.intensity = {1.5, 1.5, 1.5};
+    return light;
+}
+
+// A stroke along the top of the back, found on the surface itself so it follows the model: for a few
+// positions along z, the highest boundary vertex near the mid-plane x = 0, pushed a little inside.
+std::vector<Eigen::Vector3d> back_stroke(const TetMesh& mesh, const TetConnectivity& connectivity) {
+    const auto [lo, hi] = bounding_box(mesh);
+    const double length = hi.z() - lo.z();
+    const double band = 0.04 * length;
+    std::vector<Eigen::Vector3d> stroke;
+    for (double f = 0.25; f <= 0.6 + 1e-9; f += 0.05) {
+        const double z = lo.z() + f * length;
+        std::optional<Eigen::Vector3d> top;
+        for (const int32_t v : connectivity.boundary_vertices) {
+            const Eigen::Vector3d& p = mesh.positions[v];
+            if (std::abs(p.x()) < band && std::abs(p.z() - z) < band && (!top || p.y() > top->y())) top = p;
+        }
+        if (top) stroke.push_back(*top - Eigen::Vector3d(0, 0.01 * length, 0));
+    }
+    return stroke;
+}
+
+void run_demo_command(const DemoCommandOptions& o) {
+    if (o.width <= 0 || o.height <= 0 || o.width > kMaxImageSide || o.height > kMaxImageSide)
+        throw InvalidArgumentError("--width/--height must be between 1 and " + std::to_string(kMaxImageSide));
+    if (!std::isfinite(o.scale) || o.scale <= 0) throw InvalidArgumentError("--scale must be positive");
+    const fs::path dir = o.output;
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw FileError(dir.string(), "cannot create the directory: " + ec.message());
+
+    const std::string model = std::string(WAXWORK_ASSET_DIR) + "/meshes/spot.obj";
+    const auto mesh_start = std::chrono::steady_clock::now();
+    const LoadedSurface loaded = load_closed_surface(model);
+    const TetMaterial marble = material_preset("marble");
+    MeshingOptions meshing;
+    if (o.max_tets) {
+        meshing.sizing.target_tets = o.max_tets;
+    } else {
+        meshing.sizing = default_mesh_sizing(loaded.surface, marble, o.scale);
+    }
+    const TetMesh mesh = tetrahedralize(loaded.surface, meshing).mesh;
+    const fs::path volume_path = dir / "spot.vtu";
+    write_volume(mesh, volume_path);
+    std::cout << "wrote " << volume_path.string() << " (" << mesh.tet_count() << " tets, " << mesh.vertex_count()
+              << " vertices, marble-driven sizing at " << o.scale << " mm per unit, " << seconds_since(mesh_start)
+              << " s)\n";
+    const TetConnectivity connectivity = build_connectivity(mesh);
+
+    Lighting key;
+    key.lights = {key_light()};
+    key.ambient = {0.02, 0.02, 0.02};
+    Lighting back;
+    back.lights = {back_light()};
+    back.ambient = {0.01, 0.01, 0.01};
+
+    const size_t n = mesh.tet_count();
+    std::vector<DemoShot> shots = {
+        {"spot_marble.png", "marble, key light from the upper front-left", &mesh, &connectivity,
+         std::vector<TetMaterial>(n, marble), key},
+        {"spot_marble_backlit.png", "marble, back-lit: thin ears, horns and legs glow", &mesh, &connectivity,
+         std::vector<TetMaterial>(n, marble), back},
+        {"spot_skin1.png", "skin1, key light", &mesh, &connectivity,
+         std::vector<TetMaterial>(n, material_preset("skin1")), key},
+        {"spot_ketchup.png", "ketchup, key light", &mesh, &connectivity,
+         std::vector<TetMaterial>(n, material_preset("ketchup")), key},
+    };
+
+    // Painted: a ketchup stripe blended into a marble cow along its back (tetops/paint.h).
+    TetMesh painted = mesh;
+    PaintBrush brush;
+    brush.material = material_preset("ketchup");
+    brush.sigma = 0.03 * (bounding_box(mesh)[1] - bounding_box(mesh)[0]).norm();
+    paint_stroke(painted, back_stroke(mesh, connectivity), brush, marble);
+    shots.push_back({"spot_painted.png", "marble painted with a ketchup stripe along the back", &painted,
+                     &connectivity, painted.materials, key});
+
+    // Cut: the right half (x > 0) cut away by a plane and the cross-section relaxed onto it
+    // (tetops/cut.h, relaxation.h); the camera looks at the cut face, lit only from inside.
+    TetMesh cut = mesh;
+    const PlaneCut plane(Eigen::Vector3d(1, 0, 0), 0.0);
+    remove_cut_away_tets(cut, plane);
+    const TetConnectivity cut_connectivity = build_connectivity(cut);
+    // More and longer steps than the editor's per-frame default (10 x 0.1): the demo relaxes once, so
+    // it runs until the jagged tet faces have settled onto the plane.
+    RelaxationOptions relaxation;
+    relaxation.max_iterations = 60;
+    relaxation.step = 0.3;
+    relax_cut_vertices(cut, cut_connectivity, plane, relaxation);
+    shots.push_back({"spot_marble_cut.png", "marble cut in half: the cross-section glows with light from inside",
+                     &cut, &cut_connectivity, std::vector<TetMaterial>(cut.tet_count(), marble), key});
+
+    HeadlessGlContext context;
+    SurfaceRenderer renderer(context.gl());
+    DiffusionOptions diffusion;
+    diffusion.mm_per_unit = o.scale;
+    ImageSettings settings;
+    settings.width = o.width;
+    settings.height = o.height;
+    settings.camera.eye_direction = kCameraDirection;
+    for (const DemoShot& shot : shots) {
+        const auto start = std::chrono::steady_clock::now();
+        const SolvedScene scene = solve_scene(*shot.mesh, *shot.connectivity, shot.materials, shot.lighting, diffusion);
+        const Image image = render_scene(renderer, make_render_input(*shot.mesh, scene, shot.lighting, settings));
+        const fs::path path = dir / shot.file;
+        write_png(image, path);
+        std::cout << "wrote " << path.string() << " (" << shot.what << "; " << scene.diffusion.iterations[0] << "/"
+                  << scene.diffusion.iterations[1] << "/" << scene.diffusion.iterations[2] << " CG iterations, "
+                  << seconds_since(start) << " s)\n";
+    }
+
+    if (std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY")) {
+        std::cout << "a display is available, but the interactive editor is not built yet: open the images above, "
+                     "or render your own with `waxwork render "
+                  << volume_path.string() << " -o IMAGE.png`\n";
+    }
+}
+
+}  // namespace
+
+void add_demo_command(CLI::App& app) {
+    auto options = std::make_shared<DemoCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("demo", "Mesh the embedded model (Spot) and render it in several materials");
+    cmd->add_option("-o,--output", options->output, "Directory to write into")->capture_default_str();
+    cmd->add_option("--scale", options->scale, "Millimetres per model unit (Spot is about 1.7 units long)")
+        ->capture_default_str();
+    cmd->add_option("--max-tets", options->max_tets, "About this many tets (default: sized by marble's diffusion length)");
+    cmd->add_option("--width", options->width, "Image width in pixels")->capture_default_str();
+    cmd->add_option("--height", options->height, "Image height in pixels")->capture_default_str();
+    cmd->callback([options] { run_demo_command(*options); });
+}
+
+}  // namespace waxwork

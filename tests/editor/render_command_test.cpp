@@ -1,0 +1,266 @@
+// `waxwork render` and `waxwork demo` end to end: the binary meshes, solves, renders and writes files.
+#include "editor/cli_run.h"
+#include "io/image_io.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace waxwork {
+namespace {
+
+using testing::run_waxwork;
+using testing::scratch_dir;
+namespace fs = std::filesystem;
+
+const std::string kAssets = WAXWORK_ASSET_DIR;
+constexpr const char* kHeader = "x,y,z,boundary,q_r,q_g,q_b,phi_r,phi_g,phi_b,lo_r,lo_g,lo_b";
+
+size_t line_count(const std::string& s) { return static_cast<size_t>(std::count(s.begin(), s.end(), '\n')); }
+
+struct FieldRow {
+    double x, y, z;
+    bool boundary;
+    std::array<double, 3> q, phi, lo;
+};
+
+struct Fields {
+    std::string header;
+    std::vector<FieldRow> rows;
+    bool all_finite = true;
+};
+
+Fields read_fields(const fs::path& path) {
+    std::ifstream in(path);
+    Fields fields;
+    std::getline(in, fields.header);
+    std::string line;
+    while (std::getline(in, line)) {
+        std::vector<double> v;
+        std::stringstream s(line);
+        std::string item;
+        while (std::getline(s, item, ',')) {
+            // strtod accepts "nan" and "inf", which is what the test must catch.
+            v.push_back(std::strtod(item.c_str(), nullptr));
+            if (!std::isfinite(v.back())) fields.all_finite = false;
+        }
+        if (v.size() != 13) {
+            ADD_FAILURE() << "row with " << v.size() << " columns: " << line;
+            continue;
+        }
+        fields.rows.push_back({v[0], v[1], v[2], v[3] != 0, {v[4], v[5], v[6]}, {v[7], v[8], v[9]}, {v[10], v[11], v[12]}});
+    }
+    return fields;
+}
+
+// Mean lo per channel over boundary vertices whose coordinate `axis` is within 5% of the box of `bound`.
+std::array<double, 3> mean_lo_near(const Fields& f, int axis, bool at_max) {
+    double lo = 1e300, hi = -1e300;
+    for (const auto& r : f.rows) {
+        const double c = axis == 0 ? r.x : axis == 1 ? r.y : r.z;
+        lo = std::min(lo, c);
+        hi = std::max(hi, c);
+    }
+    const double cut = 0.05 * (hi - lo);
+    std::array<double, 3> sum{};
+    int count = 0;
+    for (const auto& r : f.rows) {
+        const double c = axis == 0 ? r.x : axis == 1 ? r.y : r.z;
+        if (!r.boundary || (at_max ? c < hi - cut : c > lo + cut)) continue;
+        for (int k = 0; k < 3; ++k) sum[k] += r.lo[k];
+        ++count;
+    }
+    EXPECT_GT(count, 0);
+    for (double& s : sum) s /= std::max(count, 1);
+    return sum;
+}
+
+std::array<double, 3> mean_lo(const Fields& f) {
+    std::array<double, 3> sum{};
+    int count = 0;
+    for (const auto& r : f.rows) {
+        if (!r.boundary) continue;
+        for (int k = 0; k < 3; ++k) sum[k] += r.lo[k];
+        ++count;
+    }
+    for (double& s : sum) s /= std::max(count, 1);
+    return sum;
+}
+
+// One cube volume for the whole suite (meshing is the slow part).
+class Render : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        dir_ = scratch_dir("render_command");
+        volume_ = dir_ / "cube.vtu";
+        const auto m = run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + volume_.string() + " --max-tets 5000");
+        ASSERT_EQ(m.exit_code, 0) << m.err;
+        const auto i = run_waxwork("info " + volume_.string());
+        ASSERT_EQ(i.exit_code, 0) << i.err;
+        vertices_ = nlohmann::json::parse(i.out)["vertices"];
+    }
+    static fs::path dir_, volume_;
+    static size_t vertices_;
+};
+fs::path Render::dir_, Render::volume_;
+size_t Render::vertices_ = 0;
+
+TEST_F(Render, MarbleLitFromPlusXIsBrighterOnThePlusXSide) {
+    const fs::path image = dir_ / "marble.png", fields = dir_ / "marble.csv";
+    // The cube spans 2 model units: at 10 mm per unit it is 2 cm of marble, several diffusion lengths.
+    const auto r = run_waxwork("render " + volume_.string() + " -o " + image.string() +
+                               " --material marble --light dir:-1,0,0 --scale 10 --width 160 --height 120 --fields " +
+                               fields.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto summary = nlohmann::json::parse(r.out);
+    EXPECT_EQ(summary["vertices"], vertices_);
+    for (const char* key : {"tets", "iterations", "estimated_error", "assembly_ms", "solve_ms", "lighting_ms",
+                            "render_ms", "output", "exposure"})
+        EXPECT_TRUE(summary.contains(key)) << key;
+
+    const Image png = read_png(image);
+    ASSERT_EQ(png.width, 160);
+    ASSERT_EQ(png.height, 120);
+    int bright = 0;
+    for (int y = 0; y < png.height; ++y)
+        for (int x = 0; x < png.width; ++x) bright += png.pixel(x, y)[0] > 80;
+    EXPECT_GT(bright, png.width * png.height / 20) << "the image is (nearly) black";
+
+    const Fields f = read_fields(fields);
+    EXPECT_EQ(f.header, kHeader);
+    EXPECT_EQ(f.rows.size(), vertices_);
+    EXPECT_TRUE(f.all_finite);
+    const auto lit = mean_lo_near(f, 0, true), dark = mean_lo_near(f, 0, false);
+    for (int c = 0; c < 3; ++c) EXPECT_GT(lit[c], 3 * dark[c]) << "channel " << c;
+    // Interior vertices carry no q or lo; every q and lo is non-negative.
+    for (const auto& row : f.rows) {
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_GE(row.lo[c], 0);
+            EXPECT_GE(row.q[c], 0);
+            if (!row.boundary) {
+                EXPECT_EQ(row.q[c], 0);
+                EXPECT_EQ(row.lo[c], 0);
+            }
+        }
+    }
+}
+
+TEST_F(Render, FemAgreesWithTransCut) {
+    // Marble at 10 mm per unit: the diffusion length (3.9-8.5 mm) spans several edges (about 1.2 mm),
+    // where the two discretisations must agree; on an under-resolved mesh they legitimately differ.
+    const std::string common = volume_.string() + " --material marble --light dir:-1,-0.5,-0.2 --scale 10 "
+                                                  "--width 64 --height 48 --tol 1e-6";
+    const auto a = run_waxwork("render " + common + " -o " + (dir_ / "t.png").string() + " --fields " +
+                               (dir_ / "t.csv").string());
+    const auto b = run_waxwork("render " + common + " --method fem -o " + (dir_ / "f.png").string() + " --fields " +
+                               (dir_ / "f.csv").string());
+    ASSERT_EQ(a.exit_code, 0) << a.err;
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    const Fields t = read_fields(dir_ / "t.csv"), f = read_fields(dir_ / "f.csv");
+    ASSERT_EQ(t.rows.size(), f.rows.size());
+    // Lumped and consistent mass differ by O(h^2): compare phi in the energy-like mean over vertices.
+    for (int c = 0; c < 3; ++c) {
+        double diff = 0, norm = 0;
+        for (size_t v = 0; v < t.rows.size(); ++v) {
+            diff += std::abs(t.rows[v].phi[c] - f.rows[v].phi[c]);
+            norm += std::abs(t.rows[v].phi[c]);
+        }
+        ASSERT_GT(norm, 0);
+        EXPECT_LT(diff / norm, 0.05) << "channel " << c;
+    }
+}
+
+TEST_F(Render, StoredMaterialsAreUsedWithoutAMaterialOption) {
+    const fs::path ketchup = dir_ / "ketchup.vtu";
+    const auto m = run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + ketchup.string() +
+                               " --max-tets 3000 --material ketchup");
+    ASSERT_EQ(m.exit_code, 0) << m.err;
+    const std::string args = " --light dir:0,0,-1 --scale 10 --width 64 --height 48";
+    const auto k = run_waxwork("render " + ketchup.string() + " -o " + (dir_ / "k.png").string() + " --fields " +
+                               (dir_ / "k.csv").string() + args);
+    const auto w = run_waxwork("render " + ketchup.string() + " --material marble -o " + (dir_ / "w.png").string() +
+                               " --fields " + (dir_ / "w.csv").string() + args);
+    ASSERT_EQ(k.exit_code, 0) << k.err;
+    ASSERT_EQ(w.exit_code, 0) << w.err;
+    EXPECT_EQ(nlohmann::json::parse(k.out)["materials"], "stored");
+    const auto red = mean_lo(read_fields(dir_ / "k.csv")), white = mean_lo(read_fields(dir_ / "w.csv"));
+    ASSERT_GT(red[2], 0);
+    ASSERT_GT(white[2], 0);
+    EXPECT_GT(red[0] / red[2], 3 * white[0] / white[2]);
+}
+
+TEST_F(Render, BackLitThinSlabGlowsMoreThanAThickOne) {
+    // The same cube at two scales: 1 mm per unit (2 mm of skin) passes light through; 40 (8 cm) does not.
+    std::array<double, 2> back{};
+    for (int i = 0; i < 2; ++i) {
+        const fs::path fields = dir_ / ("slab" + std::to_string(i) + ".csv");
+        const auto r = run_waxwork("render " + volume_.string() + " --material skin1 --light dir:1,0,0 --scale " +
+                                   (i == 0 ? "1" : "40") + " --ambient 0 --width 32 --height 24 -o " +
+                                   (dir_ / "slab.png").string() + " --fields " + fields.string());
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const Fields f = read_fields(fields);
+        const auto far = mean_lo_near(f, 0, true), near = mean_lo_near(f, 0, false);
+        back[i] = far[0] / near[0];  // red: transmitted over reflected
+    }
+    EXPECT_GT(back[0], 10 * back[1]);
+}
+
+TEST_F(Render, PointLightInsideTheObjectLightsNothing) {
+    const fs::path fields = dir_ / "inside.csv";
+    const auto r = run_waxwork("render " + volume_.string() + " --light point:0,0,0 --ambient 0 --width 32 --height 24 -o " +
+                               (dir_ / "inside.png").string() + " --fields " + fields.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["lights_inside"], 1);
+    const Fields f = read_fields(fields);
+    EXPECT_TRUE(f.all_finite);
+    for (const auto& row : f.rows)
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(row.lo[c], 0);
+}
+
+TEST_F(Render, BadInputIsAOneLineError) {
+    const fs::path image = dir_ / "bad.png";
+    const std::string base = "render " + volume_.string() + " -o " + image.string() + " --width 32 --height 24";
+    for (const std::string args :
+         {" --light dir:1,0", " --light spot:0,0,1", " --light dir:1,0,0:1,1", " --light dir:0,0,0",
+          " --light dir:1,0,0:-1,1,1", " --light dir:1,x,0", " --light point:1,2,3extra", " --material unobtainium",
+          " --mua 0.1,0.1,0.1 --musp 0,1,1 --eta 1.3", " --mua nan,0.1,0.1 --musp 1,1,1 --eta 1.3", " --tol nan",
+          " --width 0", " --height -5", " --width 20000", " --scale 0", " --scale -3", " --scale inf",
+          " --method magic", " --view 0,0,0", " --exposure -1"}) {
+        const auto r = run_waxwork(base + args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_EQ(line_count(r.err), 1u) << args << ": " << r.err;
+        EXPECT_EQ(r.err.rfind("waxwork: ", 0), 0u) << r.err;
+    }
+    const auto light = run_waxwork(base + " --light dir:1,0");
+    EXPECT_NE(light.err.find("dir:1,0"), std::string::npos) << light.err;
+    EXPECT_FALSE(fs::exists(image));
+    const auto missing = run_waxwork("render " + (dir_ / "absent.vtu").string() + " -o " + image.string());
+    EXPECT_NE(missing.exit_code, 0);
+    EXPECT_NE(missing.err.find("absent.vtu"), std::string::npos) << missing.err;
+}
+
+TEST(Demo, WritesTheVolumeAndImages) {
+    const fs::path dir = scratch_dir("demo");
+    // Small images keep it quick; the mesh is the default marble-driven one the README demo uses.
+    const auto r = run_waxwork("demo -o " + dir.string() + " --width 96 --height 72");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir / "spot.vtu"));
+    size_t images = 0;
+    for (const auto& entry : fs::directory_iterator(dir)) {
+        if (entry.path().extension() != ".png") continue;
+        ++images;
+        const Image png = read_png(entry.path());
+        EXPECT_EQ(png.width, 96);
+        EXPECT_EQ(png.height, 72);
+        EXPECT_NE(r.out.find(entry.path().string()), std::string::npos) << "not reported: " << entry.path();
+    }
+    EXPECT_GE(images, 4u);
+}
+
+}  // namespace
+}  // namespace waxwork
