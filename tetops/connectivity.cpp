@@ -32,33 +32,53 @@ CompressedRows build_vertex_tets(const TetMesh& mesh) {
     return rows;
 }
 
-bool tet_contains(const Tet& tet, int32_t v) { return tet[0] == v || tet[1] == v || tet[2] == v || tet[3] == v; }
-
-// Face neighbours by intersecting vertex stars: the tet across a face is the other tet that contains
-// all three of its vertices, found in the shortest of the three vertex stars. Linear in the mesh size
-// and free of the global sort that a face-hashing approach needs.
+// Face neighbours, each face matched exactly once at its smallest vertex: the faces of that vertex's
+// star for which it is the minimum are keyed by their other two vertices and sorted, so equal
+// neighbouring keys are the two sides of one interior face. The work per vertex is a sort of a few
+// dozen keys read from contiguous star arrays, linear overall and free of the global face sort that a
+// hashing approach needs; every (tet, face) slot is written by exactly one task, so no locks.
 std::vector<std::array<int32_t, 4>> build_tet_neighbors(const TetMesh& mesh, const CompressedRows& vertex_tets) {
     std::vector<std::array<int32_t, 4>> neighbors(mesh.tets.size());
     std::atomic<int64_t> overfull_face{-1};
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.tets.size()), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t t = r.begin(); t != r.end(); ++t) {
-            const Tet& tet = mesh.tets[t];
-            for (int f = 0; f < 4; ++f) {
-                const auto& local = kTetFaces[f];
-                const int32_t a = tet[local[0]], b = tet[local[1]], c = tet[local[2]];
-                int32_t pivot = a;
-                for (int32_t v : {b, c})
-                    if (vertex_tets.row(v).size() < vertex_tets.row(pivot).size()) pivot = v;
-                int32_t found = -1;
-                for (int32_t other : vertex_tets.row(pivot)) {
-                    if (other == static_cast<int32_t>(t)) continue;
-                    const Tet& o = mesh.tets[other];
-                    if (tet_contains(o, a) && tet_contains(o, b) && tet_contains(o, c)) {
-                        if (found >= 0) overfull_face = static_cast<int64_t>(t);
-                        found = other;
+    struct FaceEntry {
+        uint64_t key;  // the face's two larger vertices
+        int32_t tet;
+        int32_t face;
+        bool operator<(const FaceEntry& o) const { return key < o.key; }
+    };
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.vertex_count()), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<FaceEntry> entries;
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            entries.clear();
+            for (int32_t t : vertex_tets.row(v)) {
+                const Tet& tet = mesh.tets[t];
+                for (int f = 0; f < 4; ++f) {
+                    if (tet[f] == static_cast<int32_t>(v)) continue;  // face f is opposite vertex f
+                    int32_t others[2], n = 0;
+                    bool v_is_min = true;
+                    for (int k : kTetFaces[f]) {
+                        if (tet[k] == static_cast<int32_t>(v)) continue;
+                        if (tet[k] < static_cast<int32_t>(v)) v_is_min = false;
+                        others[n++] = tet[k];
                     }
+                    if (!v_is_min) continue;
+                    const auto lo = static_cast<uint32_t>(std::min(others[0], others[1]));
+                    const auto hi = static_cast<uint32_t>(std::max(others[0], others[1]));
+                    entries.push_back({(uint64_t{lo} << 32) | hi, t, f});
                 }
-                neighbors[t][f] = found;
+            }
+            std::sort(entries.begin(), entries.end());
+            for (size_t i = 0; i < entries.size();) {
+                size_t j = i + 1;
+                while (j < entries.size() && entries[j].key == entries[i].key) ++j;
+                if (j - i == 1) {
+                    neighbors[entries[i].tet][entries[i].face] = -1;
+                } else {
+                    if (j - i > 2) overfull_face = entries[i].tet;
+                    neighbors[entries[i].tet][entries[i].face] = entries[i + 1].tet;
+                    neighbors[entries[i + 1].tet][entries[i + 1].face] = entries[i].tet;
+                }
+                i = j;
             }
         }
     });
@@ -68,50 +88,46 @@ std::vector<std::array<int32_t, 4>> build_tet_neighbors(const TetMesh& mesh, con
     return neighbors;
 }
 
-// Vertex one-rings: the union of the vertices of each vertex's tets, sorted and deduplicated in
-// place in a scratch buffer whose rows are sized 3x the star (an upper bound), then compacted.
-CompressedRows build_vertex_vertices(const TetMesh& mesh, const CompressedRows& vertex_tets) {
+// Edges and vertex one-rings. Each vertex collects its larger neighbours from its star (sorted and
+// deduplicated in place in a scratch buffer sized 3x the star, an upper bound): these rows, in vertex
+// order, are exactly the sorted unique edge list. The one-rings are then the edge list read in both
+// directions; scattering the smaller neighbours in edge order keeps every row sorted. Sorting only the
+// larger half of each neighbourhood halves the dominant cost.
+void build_edges_and_one_rings(const TetMesh& mesh, TetConnectivity& c) {
     const size_t n = mesh.vertex_count();
+    const CompressedRows& vertex_tets = c.vertex_tets;
     std::vector<int32_t> scratch(3 * vertex_tets.indices.size());
-    std::vector<int32_t> counts(n, 0);
+    std::vector<int32_t> upper_counts(n, 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v != r.end(); ++v) {
             int32_t* begin = scratch.data() + 3 * static_cast<size_t>(vertex_tets.offsets[v]);
             int32_t* out = begin;
             for (int32_t t : vertex_tets.row(v))
                 for (int32_t u : mesh.tets[t])
-                    if (u != static_cast<int32_t>(v)) *out++ = u;
+                    if (u > static_cast<int32_t>(v)) *out++ = u;
             std::sort(begin, out);
-            counts[v] = static_cast<int32_t>(std::unique(begin, out) - begin);
+            upper_counts[v] = static_cast<int32_t>(std::unique(begin, out) - begin);
         }
     });
-    CompressedRows rows;
+    const std::vector<int32_t> edge_offsets = offsets_from_counts(upper_counts);
+    c.edges.resize(edge_offsets.back());
+    tbb::parallel_for(size_t{0}, n, [&](size_t v) {
+        const int32_t* upper = scratch.data() + 3 * static_cast<size_t>(vertex_tets.offsets[v]);
+        for (int32_t k = 0; k < upper_counts[v]; ++k)
+            c.edges[edge_offsets[v] + k] = {static_cast<int32_t>(v), upper[k]};
+    });
+
+    std::vector<int32_t> counts = upper_counts;
+    for (const auto& e : c.edges) ++counts[e[1]];
+    CompressedRows& rows = c.vertex_vertices;
     rows.offsets = offsets_from_counts(counts);
     rows.indices.resize(rows.offsets.back());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t v = r.begin(); v != r.end(); ++v)
-            std::copy_n(scratch.data() + 3 * static_cast<size_t>(vertex_tets.offsets[v]), counts[v],
-                        rows.indices.data() + rows.offsets[v]);
-    });
-    return rows;
-}
-
-std::vector<std::array<int32_t, 2>> build_edges(const CompressedRows& vertex_vertices) {
-    const size_t n = vertex_vertices.row_count();
-    std::vector<int32_t> counts(n, 0);
+    std::vector<int32_t> cursor(rows.offsets.begin(), rows.offsets.end() - 1);
+    for (const auto& e : c.edges) rows.indices[cursor[e[1]]++] = e[0];  // smaller neighbours, ascending
     tbb::parallel_for(size_t{0}, n, [&](size_t v) {
-        const auto row = vertex_vertices.row(v);
-        counts[v] = static_cast<int32_t>(row.end() - std::upper_bound(row.begin(), row.end(), static_cast<int32_t>(v)));
+        std::copy_n(scratch.data() + 3 * static_cast<size_t>(vertex_tets.offsets[v]), upper_counts[v],
+                    rows.indices.data() + cursor[v]);
     });
-    const std::vector<int32_t> offsets = offsets_from_counts(counts);
-    std::vector<std::array<int32_t, 2>> edges(offsets.back());
-    tbb::parallel_for(size_t{0}, n, [&](size_t v) {
-        const auto row = vertex_vertices.row(v);
-        auto first = std::upper_bound(row.begin(), row.end(), static_cast<int32_t>(v));
-        int32_t out = offsets[v];
-        for (auto it = first; it != row.end(); ++it) edges[out++] = {static_cast<int32_t>(v), *it};
-    });
-    return edges;
 }
 
 std::vector<BoundaryFace> build_boundary_faces(const TetMesh& mesh,
@@ -174,8 +190,7 @@ TetConnectivity build_connectivity(const TetMesh& mesh) {
     TetConnectivity c;
     c.vertex_tets = build_vertex_tets(mesh);
     c.tet_neighbors = build_tet_neighbors(mesh, c.vertex_tets);
-    c.vertex_vertices = build_vertex_vertices(mesh, c.vertex_tets);
-    c.edges = build_edges(c.vertex_vertices);
+    build_edges_and_one_rings(mesh, c);
     c.boundary_faces = build_boundary_faces(mesh, c.tet_neighbors);
     c.is_boundary_vertex.assign(mesh.vertex_count(), 0);
     for (const BoundaryFace& f : c.boundary_faces)

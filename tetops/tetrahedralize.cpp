@@ -3,6 +3,7 @@
 #include "tetops/cgal_mesher.h"
 #include "tetops/error.h"
 #include "tetops/size_field.h"
+#include "tetops/spatial_order.h"
 #include "tetops/tetgen_mesher.h"
 
 #include <algorithm>
@@ -239,6 +240,7 @@ MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOption
         check_predicted_size(size, volume, area, "sizing.surface_edge = " + to_string(sizing.surface_edge));
         result.mesh = run_mesher(surface, options, size);
     }
+    sort_spatially(result.mesh);
     result.quality = measure_quality(result.mesh);
     result.milliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

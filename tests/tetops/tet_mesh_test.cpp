@@ -1,6 +1,7 @@
 #include "tetops/connectivity.h"
 #include "tetops/error.h"
 #include "tetops/quality.h"
+#include "tetops/spatial_order.h"
 #include "tetops/tet_mesh.h"
 #include "tetops/test_meshes.h"
 
@@ -8,6 +9,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <random>
 #include <set>
 
@@ -203,6 +205,61 @@ TEST(Quality, SliverIsCounted) {
     // A sliver's circumradius is about half its diagonal, so its radius-edge ratio stays near 0.7:
     // the ratio alone cannot see slivers, which is why the dihedral bound matters.
     EXPECT_LT(q.max_radius_edge_ratio, 1.0);
+}
+
+}  // namespace
+}  // namespace waxwork
+
+namespace waxwork {
+namespace {
+
+TEST(SpatialOrder, KeepsTheMeshAndImprovesLocality) {
+    // Scramble a structured cube, then sort it back into spatial order.
+    TetMesh mesh = testing::make_cube_mesh(6);
+    std::vector<int32_t> perm(mesh.tet_count());
+    std::iota(perm.begin(), perm.end(), 0);
+    std::shuffle(perm.begin(), perm.end(), std::mt19937(7));
+    std::vector<Tet> shuffled;
+    for (int32_t t : perm) shuffled.push_back(mesh.tets[t]);
+    TetMesh scrambled = make_tet_mesh(mesh.positions, shuffled);
+    scrambled.materials.resize(scrambled.tet_count());
+    for (size_t t = 0; t < scrambled.tet_count(); ++t) scrambled.materials[t].eta = 1.0 + double(t) / 1e6;
+    const double volume = total_volume(scrambled);
+
+    // The mean index distance between face neighbours measures memory locality.
+    auto neighbor_spread = [](const TetMesh& m) {
+        const TetConnectivity c = build_connectivity(m);
+        double sum = 0;
+        size_t count = 0;
+        for (size_t t = 0; t < m.tet_count(); ++t)
+            for (int32_t o : c.tet_neighbors[t])
+                if (o >= 0) sum += std::abs(double(o) - double(t)), ++count;
+        return sum / double(count);
+    };
+    TetMesh sorted = scrambled;
+    sort_spatially(sorted);
+    EXPECT_NO_THROW(validate(sorted));
+    EXPECT_NEAR(total_volume(sorted), volume, 1e-12);
+    EXPECT_LT(neighbor_spread(sorted), 0.25 * neighbor_spread(scrambled));
+    // Materials moved with their tets: the multiset of tet (centroid, eta) pairs is unchanged.
+    auto tagged = [](const TetMesh& m) {
+        std::vector<std::array<double, 4>> rows;
+        for (size_t t = 0; t < m.tet_count(); ++t) {
+            Eigen::Vector3d c = Eigen::Vector3d::Zero();
+            for (int32_t v : m.tets[t]) c += m.positions[v];
+            rows.push_back({c.x(), c.y(), c.z(), m.materials[t].eta});
+        }
+        std::sort(rows.begin(), rows.end());
+        return rows;
+    };
+    EXPECT_EQ(tagged(sorted), tagged(scrambled));
+    // Vertices are numbered in order of first use.
+    int32_t next = 0;
+    for (const Tet& tet : sorted.tets)
+        for (int32_t v : tet) {
+            EXPECT_LE(v, next);
+            if (v == next) ++next;
+        }
 }
 
 }  // namespace
