@@ -1,0 +1,211 @@
+// The independent-set multi-resolution solver (multires/, Li et al. 2013 Sec. 4) against plain Jacobi
+// CG on spot (bench::spot_volume) at ~50K and ~500K tets: hierarchy build time, and the time for one
+// channel (green) to reach a true relative error of 1% against the direct solution (Fig. 7's measure).
+//
+// "To 1%": for each solver (and intermediate-level budget) the smallest level-0 CG iteration count whose result is within 1% of the
+// direct solution is found once (doubling, then bisection) and then timed; the multires time includes
+// the coarse-to-fine pass but not the hierarchy build (reported separately, and together in
+// BM_MultiresBuildAndSolve: what a frame after a cut pays). Marble (the longest diffusion length of the
+// presets), lit from +z as in solver_bench.cpp. Wall and process CPU time are both reported: the
+// machine may be shared.
+//
+// Run: build-bench/bench/multires_bench (configure with -DWAXWORK_BUILD_BENCH=ON).
+#include "bench_meshes.h"
+#include "multires/multires_solver.h"
+#include "solver/conjugate_gradient.h"
+#include "solver/diffusion_matrix.h"
+#include "solver/material.h"
+#include "solver/reference_solvers.h"
+#include "tetops/connectivity.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <memory>
+
+namespace waxwork {
+namespace {
+
+struct Scene {
+    const TetMesh* mesh = nullptr;
+    TetConnectivity conn;
+    DiffusionMatrix matrix;
+    std::vector<double> b;      // green channel
+    Eigen::VectorXd exact;      // direct solution, green channel
+    int cg_iterations = 0;      // Jacobi CG iterations to 1%
+};
+
+double relative_error(std::span<const double> x, const Eigen::VectorXd& ref) {
+    return (Eigen::Map<const Eigen::VectorXd>(x.data(), static_cast<Eigen::Index>(x.size())) - ref).norm() / ref.norm();
+}
+
+// Smallest k in [0, limit] with error(k) <= 1e-2 (error assumed non-increasing in k).
+int smallest_budget(const std::function<double(int)>& error, int limit) {
+    if (error(0) <= 1e-2) return 0;
+    int hi = 1;
+    while (hi < limit && error(hi) > 1e-2) hi *= 2;
+    int lo = hi / 2;  // error(lo) > 1e-2
+    while (hi - lo > 1) {
+        const int mid = (lo + hi) / 2;
+        (error(mid) <= 1e-2 ? hi : lo) = mid;
+    }
+    return hi;
+}
+
+ConjugateGradientOptions fixed_budget(int iterations) {
+    ConjugateGradientOptions options;
+    options.relative_tolerance = 1e-14;  // never stop on the estimate: run exactly the budget
+    options.max_iterations = iterations;
+    return options;
+}
+
+std::unique_ptr<MultiresSolver> make_solver(const Scene& s) {
+    return std::make_unique<MultiresSolver>(s.matrix, s.mesh->positions);
+}
+
+MultiresSolveOptions multires_budget(int iterations, int level_iterations) {
+    MultiresSolveOptions options;
+    options.relative_tolerance = 1e-14;
+    options.max_iterations = iterations;
+    options.level_max_iterations = level_iterations;
+    return options;
+}
+
+const Scene& scene(size_t target_tets);
+
+// Level-0 iterations after the coarse-to-fine pass to reach 1%, per (size, intermediate-level budget).
+int multires_iterations(size_t target_tets, int level_iterations) {
+    static std::map<std::pair<size_t, int>, int> cache;
+    auto [it, inserted] = cache.try_emplace({target_tets, level_iterations}, 0);
+    if (!inserted) return it->second;
+    const Scene& s = scene(target_tets);
+    auto solver = make_solver(s);
+    std::vector<double> x(s.b.size());
+    it->second = smallest_budget(
+        [&](int k) {
+            solver->solve(s.b, 1, x, multires_budget(k, level_iterations));
+            return relative_error(x, s.exact);
+        },
+        100000);
+    std::fprintf(stderr, "spot %zu: levels", s.mesh->tet_count());
+    for (const auto& level : solver->hierarchy().levels) std::fprintf(stderr, " %zu", level.size());
+    std::fprintf(stderr, "; %d iterations per intermediate level: %d level-0 iterations to 1%%\n", level_iterations,
+                 it->second);
+    return it->second;
+}
+
+const Scene& scene(size_t target_tets) {
+    static std::map<size_t, std::unique_ptr<Scene>> cache;
+    auto& slot = cache[target_tets];
+    if (slot) return *slot;
+    slot = std::make_unique<Scene>();
+    Scene& s = *slot;
+    s.mesh = &bench::spot_volume(target_tets);
+    s.conn = build_connectivity(*s.mesh);
+    const auto box = bounding_box(*s.mesh);
+    AssemblyOptions assembly;
+    assembly.mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();
+    const std::vector<TetMaterial> materials(s.mesh->tet_count(), material_preset("marble"));
+    s.matrix = assemble_diffusion_matrix(*s.mesh, s.conn, materials, assembly);
+    std::vector<Eigen::Vector3d> normals(s.mesh->vertex_count(), Eigen::Vector3d::Zero());
+    for (const auto& f : s.conn.boundary_faces) {
+        const auto& p = s.mesh->positions;
+        const Eigen::Vector3d n = (p[f.vertices[1]] - p[f.vertices[0]]).cross(p[f.vertices[2]] - p[f.vertices[0]]);
+        for (int32_t v : f.vertices) normals[static_cast<size_t>(v)] += n;
+    }
+    std::vector<std::array<double, 3>> q(s.mesh->vertex_count(), {0, 0, 0});
+    for (int32_t v : s.conn.boundary_vertices) {
+        const double c = normals[static_cast<size_t>(v)].normalized().z();
+        const double value = c > 0 ? c * fresnel_transmittance(c, 1.5) : 0.0;
+        q[static_cast<size_t>(v)] = {value, value, value};
+    }
+    s.b.resize(s.matrix.size());
+    diffusion_right_hand_side(s.matrix, q, 1, s.b);
+    const Eigen::Map<const Eigen::VectorXd> bm(s.b.data(), static_cast<Eigen::Index>(s.b.size()));
+    s.exact = DirectSolver(to_eigen_sparse(s.matrix, 1)).solve(bm);
+
+    const CsrMatrixView<double> view{s.matrix.size(), s.matrix.offsets.data(), s.matrix.columns.data(),
+                                     s.matrix.values[1].data()};
+    std::vector<double> x(s.b.size());
+    s.cg_iterations = smallest_budget(
+        [&](int k) {
+            std::fill(x.begin(), x.end(), 0.0);
+            solve_jacobi_cg<double>(view, s.b, x, fixed_budget(k));
+            return relative_error(x, s.exact);
+        },
+        100000);
+    std::fprintf(stderr, "spot: %zu tets, %zu vertices; to 1%%: Jacobi CG %d iterations\n", s.mesh->tet_count(),
+                 s.mesh->vertex_count(), s.cg_iterations);
+    return s;
+}
+
+void BM_MultiresBuild(benchmark::State& state) {
+    const Scene& s = scene(static_cast<size_t>(state.range(0)));
+    size_t levels = 0, coarse = 0;
+    for (auto _ : state) {
+        const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh->positions);
+        levels = h.level_count();
+        coarse = h.levels.back().size();
+    }
+    state.counters["tets"] = static_cast<double>(s.mesh->tet_count());
+    state.counters["levels"] = static_cast<double>(levels);
+    state.counters["coarsest"] = static_cast<double>(coarse);
+}
+
+void BM_JacobiCgTo1Percent(benchmark::State& state) {
+    const Scene& s = scene(static_cast<size_t>(state.range(0)));
+    const CsrMatrixView<double> view{s.matrix.size(), s.matrix.offsets.data(), s.matrix.columns.data(),
+                                     s.matrix.values[1].data()};
+    std::vector<double> x(s.b.size());
+    for (auto _ : state) {
+        std::fill(x.begin(), x.end(), 0.0);
+        solve_jacobi_cg<double>(view, s.b, x, fixed_budget(s.cg_iterations));
+    }
+    state.counters["iters"] = s.cg_iterations;
+    state.counters["true_err"] = relative_error(x, s.exact);
+}
+
+void BM_MultiresTo1Percent(benchmark::State& state) {
+    const Scene& s = scene(static_cast<size_t>(state.range(0)));
+    const int level_iterations = static_cast<int>(state.range(1));
+    const int iterations = multires_iterations(static_cast<size_t>(state.range(0)), level_iterations);
+    auto solver = make_solver(s);
+    std::vector<double> x(s.b.size());
+    MultiresSolveReport report;
+    for (auto _ : state) report = solver->solve(s.b, 1, x, multires_budget(iterations, level_iterations));
+    state.counters["iters0"] = iterations;
+    state.counters["coarse_ms"] = report.coarse_ms;
+    state.counters["fallbacks"] = report.fallbacks();
+    state.counters["true_err"] = relative_error(x, s.exact);
+}
+
+void BM_MultiresBuildAndSolve(benchmark::State& state) {
+    const Scene& s = scene(static_cast<size_t>(state.range(0)));
+    const int iterations = multires_iterations(static_cast<size_t>(state.range(0)), 10);
+    std::vector<double> x(s.b.size());
+    for (auto _ : state) {
+        MultiresSolver solver(s.matrix, s.mesh->positions);
+        solver.solve(s.b, 1, x, multires_budget(iterations, 10));
+    }
+    state.counters["true_err"] = relative_error(x, s.exact);
+}
+
+#define WAXWORK_SIZES \
+    Arg(50000)->Arg(500000)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()
+BENCHMARK(BM_MultiresBuild)->WAXWORK_SIZES;
+BENCHMARK(BM_JacobiCgTo1Percent)->WAXWORK_SIZES;
+// Second argument: BiCGSTAB iterations on each intermediate level (the default is 10).
+BENCHMARK(BM_MultiresTo1Percent)
+    ->ArgsProduct({{50000, 500000}, {2, 10}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
+BENCHMARK(BM_MultiresBuildAndSolve)->WAXWORK_SIZES;
+
+}  // namespace
+}  // namespace waxwork
+
+BENCHMARK_MAIN();

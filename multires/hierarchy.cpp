@@ -1,0 +1,188 @@
+#include "multires/hierarchy.h"
+
+#include "multires/independent_set.h"
+#include "tetops/error.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <string>
+
+namespace waxwork {
+
+namespace {
+
+HierarchyLevel fine_level(const DiffusionMatrix& matrix) {
+    HierarchyLevel level;
+    const size_t n = matrix.size();
+    level.offsets = matrix.offsets;
+    level.columns = matrix.columns;
+    level.diagonal = matrix.diagonal;
+    level.values = matrix.values;
+    level.original_vertex.resize(n);
+    for (size_t v = 0; v < n; ++v) level.original_vertex[v] = static_cast<int32_t>(v);
+    // G^0: the matrix pattern without the diagonal (the mesh's vertex_vertices).
+    level.graph.offsets.assign(n + 1, 0);
+    level.graph.indices.reserve(matrix.nonzeros() - n);
+    for (size_t i = 0; i < n; ++i) {
+        for (int32_t k = matrix.offsets[i]; k < matrix.offsets[i + 1]; ++k)
+            if (static_cast<size_t>(matrix.columns[static_cast<size_t>(k)]) != i)
+                level.graph.indices.push_back(matrix.columns[static_cast<size_t>(k)]);
+        level.graph.offsets[i + 1] = static_cast<int32_t>(level.graph.indices.size());
+    }
+    return level;
+}
+
+}  // namespace
+
+InterpolationOperator build_interpolation(const CompressedRows& graph, std::span<const uint8_t> retained,
+                                          std::span<const int32_t> coarse_index,
+                                          std::span<const int32_t> original_vertex,
+                                          std::span<const Eigen::Vector3d> positions) {
+    const size_t n = graph.row_count();
+    InterpolationOperator p;
+    p.offsets.assign(n + 1, 0);
+    for (size_t v = 0; v < n; ++v) {
+        int32_t count = 1;
+        if (!retained[v]) {
+            count = 0;
+            for (int32_t u : graph.row(v)) count += retained[u] ? 1 : 0;
+        }
+        p.offsets[v + 1] = p.offsets[v] + count;
+    }
+    p.columns.resize(static_cast<size_t>(p.offsets[n]));
+    p.weights.resize(p.columns.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 2048), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            auto slot = static_cast<size_t>(p.offsets[v]);
+            if (retained[v]) {  // Eq. 16, first case: copy the coarse value
+                p.columns[slot] = coarse_index[v];
+                p.weights[slot] = 1.0;
+                continue;
+            }
+            // Eq. 16, second case: lambda_vu = 1 / |x_v - x_u| over R(v), normalised by lambda_v. The
+            // floor on the length only guards coincident points (a degenerate mesh), which would
+            // otherwise give an infinite weight.
+            const Eigen::Vector3d& xv = positions[static_cast<size_t>(original_vertex[v])];
+            double total = 0;
+            const size_t first = slot;
+            for (int32_t u : graph.row(v)) {
+                if (!retained[u]) continue;
+                const double length = (positions[static_cast<size_t>(original_vertex[u])] - xv).norm();
+                const double lambda = 1.0 / std::max(length, 1e-300);
+                p.columns[slot] = coarse_index[u];
+                p.weights[slot] = lambda;
+                total += lambda;
+                ++slot;
+            }
+            for (size_t k = first; k < slot; ++k) p.weights[k] /= total;
+        }
+    });
+    return p;
+}
+
+void build_coarse_matrix(const HierarchyLevel& fine, std::span<const int32_t> coarse_to_fine, HierarchyLevel& coarse) {
+    const size_t m = coarse_to_fine.size();
+    const CompressedRows& g = coarse.graph;
+    coarse.offsets.assign(m + 1, 0);
+    for (size_t c = 0; c < m; ++c) coarse.offsets[c + 1] = coarse.offsets[c] + static_cast<int32_t>(g.row(c).size()) + 1;
+    const auto nnz = static_cast<size_t>(coarse.offsets[m]);
+    coarse.columns.resize(nnz);
+    coarse.diagonal.resize(m);
+    for (auto& v : coarse.values) v.assign(nnz, 0.0);
+    const InterpolationOperator& p = fine.interpolation;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 256), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t c = r.begin(); c != r.end(); ++c) {
+            // Pattern: the coarse graph row with the diagonal merged in, ascending.
+            const auto begin = static_cast<size_t>(coarse.offsets[c]);
+            size_t out = begin;
+            bool diagonal_placed = false;
+            for (int32_t k : g.row(c)) {
+                if (!diagonal_placed && k > static_cast<int32_t>(c)) {
+                    coarse.diagonal[c] = static_cast<int32_t>(out);
+                    coarse.columns[out++] = static_cast<int32_t>(c);
+                    diagonal_placed = true;
+                }
+                coarse.columns[out++] = k;
+            }
+            if (!diagonal_placed) {
+                coarse.diagonal[c] = static_cast<int32_t>(out);
+                coarse.columns[out++] = static_cast<int32_t>(c);
+            }
+            const int32_t* row_begin = coarse.columns.data() + begin;
+            const int32_t* row_end = coarse.columns.data() + out;
+            // Eq. 17: sum over the fine row of i of M_ij P_jk into coarse column k.
+            const auto i = static_cast<size_t>(coarse_to_fine[c]);
+            for (int32_t e = fine.offsets[i]; e < fine.offsets[i + 1]; ++e) {
+                const auto j = static_cast<size_t>(fine.columns[static_cast<size_t>(e)]);
+                for (int32_t q = p.offsets[j]; q < p.offsets[j + 1]; ++q) {
+                    const int32_t k = p.columns[static_cast<size_t>(q)];
+                    const double w = p.weights[static_cast<size_t>(q)];
+                    const size_t slot = begin + static_cast<size_t>(std::lower_bound(row_begin, row_end, k) - row_begin);
+                    for (size_t ch = 0; ch < 3; ++ch)
+                        coarse.values[ch][slot] += fine.values[ch][static_cast<size_t>(e)] * w;
+                }
+            }
+        }
+    });
+}
+
+void interpolate(const InterpolationOperator& p, std::span<const double> coarse, std::span<double> fine) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, p.rows(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            double sum = 0;
+            for (int32_t q = p.offsets[v]; q < p.offsets[v + 1]; ++q)
+                sum += p.weights[static_cast<size_t>(q)] * coarse[static_cast<size_t>(p.columns[static_cast<size_t>(q)])];
+            fine[v] = sum;
+        }
+    });
+}
+
+void restrict_right_hand_side(const HierarchyLevel& level, std::span<const double> level0_b, std::span<double> b) {
+    for (size_t v = 0; v < level.size(); ++v) b[v] = level0_b[static_cast<size_t>(level.original_vertex[v])];
+}
+
+MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
+                                           const HierarchyOptions& options) {
+    if (positions.size() != matrix.size())
+        throw InvalidArgumentError("multires hierarchy: " + std::to_string(positions.size()) + " positions for a " +
+                                   std::to_string(matrix.size()) + "-vertex matrix");
+    const auto start = std::chrono::steady_clock::now();
+    MultiresHierarchy hierarchy;
+    hierarchy.levels.push_back(fine_level(matrix));
+    while (static_cast<int>(hierarchy.levels.size()) < options.max_levels) {
+        HierarchyLevel& fine = hierarchy.levels.back();
+        const size_t n = fine.size();
+        if (static_cast<int64_t>(n) < options.min_coarse_vertices) break;
+        // Each level gets its own key so that successive selections are uncorrelated.
+        const uint32_t seed = options.seed * 0x9e3779b1u + static_cast<uint32_t>(hierarchy.levels.size());
+        VertexSelection selection = select_coarse_vertices(fine.graph, seed, options.enhance);
+        const std::vector<int32_t> coarse_index = coarse_vertex_index(selection.retained);
+        std::vector<int32_t> coarse_to_fine;
+        for (size_t v = 0; v < n; ++v)
+            if (selection.retained[v]) coarse_to_fine.push_back(static_cast<int32_t>(v));
+        if (static_cast<double>(coarse_to_fine.size()) > options.max_keep_ratio * static_cast<double>(n) ||
+            coarse_to_fine.empty())
+            break;
+        HierarchyLevel coarse;
+        coarse.parent_vertex = coarse_to_fine;
+        coarse.original_vertex.resize(coarse_to_fine.size());
+        for (size_t c = 0; c < coarse_to_fine.size(); ++c)
+            coarse.original_vertex[c] = fine.original_vertex[static_cast<size_t>(coarse_to_fine[c])];
+        coarse.graph = build_coarse_graph(fine.graph, selection.retained, coarse_index);
+        fine.interpolation =
+            build_interpolation(fine.graph, selection.retained, coarse_index, fine.original_vertex, positions);
+        fine.independent_set_rounds = selection.independent_set_rounds;
+        fine.enhancement_passes = selection.enhancement_passes;
+        fine.enhancement_vertices = selection.enhancement_vertices;
+        build_coarse_matrix(fine, coarse_to_fine, coarse);
+        hierarchy.levels.push_back(std::move(coarse));
+    }
+    hierarchy.build_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return hierarchy;
+}
+
+}  // namespace waxwork

@@ -1,0 +1,139 @@
+#include "multires/multires_solver.h"
+
+#include "tetops/error.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace waxwork {
+
+namespace {
+
+double elapsed_ms(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void check_channel(int channel) {
+    if (channel < 0 || channel > 2)
+        throw InvalidArgumentError("multires solve: channel " + std::to_string(channel) + " is not 0, 1 or 2");
+}
+
+}  // namespace
+
+MultiresSolver::MultiresSolver(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
+                               const HierarchyOptions& options)
+    : hierarchy_(build_multires_hierarchy(matrix, positions, options)) {}
+
+void MultiresSolver::update_values(const DiffusionMatrix& matrix) {
+    HierarchyLevel& level0 = hierarchy_.levels[0];
+    if (matrix.offsets != level0.offsets || matrix.columns != level0.columns)
+        throw InvalidArgumentError("multires update_values: the matrix pattern changed (rebuild the solver)");
+    level0.values = matrix.values;
+    for (size_t l = 1; l < hierarchy_.level_count(); ++l)
+        build_coarse_matrix(hierarchy_.levels[l - 1], hierarchy_.levels[l].parent_vertex, hierarchy_.levels[l]);
+}
+
+void MultiresSolver::reset_warm_start() {
+    for (auto& s : last_solution_) s.clear();
+    eigenvalue_hint_ = {};
+}
+
+void MultiresSolver::solve_fine(std::span<const double> b, int channel, std::span<double> x,
+                                const MultiresSolveOptions& options, MultiresSolveReport& report) {
+    const auto start = std::chrono::steady_clock::now();
+    const HierarchyLevel& level0 = hierarchy_.levels[0];
+    ConjugateGradientOptions cg;
+    cg.relative_tolerance = options.relative_tolerance;
+    cg.max_iterations = options.max_iterations;
+    cg.smallest_eigenvalue_hint = eigenvalue_hint_[static_cast<size_t>(channel)];
+    try {
+        report.fine = solve_jacobi_cg<double>(level0.view(channel), b, x, cg);
+    } catch (const AlgorithmError& error) {
+        // A warm start cannot make an SPD system fail; if CG still objects, record it and retry from
+        // zero so the answer does not depend on the coarse levels at all. A second failure is real.
+        report.fine_failure = error.what();
+        report.fine_restarted_cold = true;
+        std::fill(x.begin(), x.end(), 0.0);
+        cg.smallest_eigenvalue_hint = 0;
+        report.fine = solve_jacobi_cg<double>(level0.view(channel), b, x, cg);
+    }
+    if (report.fine.smallest_eigenvalue_estimate > 0)
+        eigenvalue_hint_[static_cast<size_t>(channel)] = report.fine.smallest_eigenvalue_estimate;
+    report.fine_ms = elapsed_ms(start);
+}
+
+MultiresSolveReport MultiresSolver::solve(std::span<const double> b, int channel, std::span<double> x,
+                                          const MultiresSolveOptions& options) {
+    check_channel(channel);
+    const size_t n0 = hierarchy_.levels[0].size();
+    if (b.size() != n0 || x.size() != n0)
+        throw InvalidArgumentError("multires solve: vectors of size " + std::to_string(b.size()) + " and " +
+                                   std::to_string(x.size()) + " for " + std::to_string(n0) + " vertices");
+    MultiresSolveReport report;
+    const auto start = std::chrono::steady_clock::now();
+    const size_t levels = hierarchy_.level_count();
+    std::vector<double> coarse_x;  // the current level's iterate, starting on the coarsest level at zero
+    std::vector<double> level_b;
+    for (size_t l = levels; l-- > 1;) {
+        const HierarchyLevel& level = hierarchy_.levels[l];
+        level_b.resize(level.size());
+        restrict_right_hand_side(level, b, level_b);
+        if (l == levels - 1) {
+            coarse_x.assign(level.size(), 0.0);
+        } else {
+            std::vector<double> finer(level.size());
+            interpolate(level.interpolation, coarse_x, finer);
+            coarse_x.swap(finer);
+        }
+        const bool coarsest = l == levels - 1;
+        BicgstabOptions bicg;
+        bicg.relative_tolerance = coarsest ? options.coarsest_tolerance : options.level_tolerance;
+        bicg.max_iterations = coarsest ? options.coarsest_max_iterations : options.level_max_iterations;
+        const BicgstabResult result = solve_jacobi_bicgstab(level.view(channel), level.diagonal, level_b, coarse_x, bicg);
+        LevelSolveReport entry;
+        entry.level = static_cast<int>(l);
+        entry.iterations = result.iterations;
+        entry.initial_relative_residual = result.initial_relative_residual;
+        entry.relative_residual = result.relative_residual;
+        entry.status = result.status;
+        // A breakdown after progress keeps the improved iterate (it is a valid start vector); a level
+        // that made things worse is skipped: BiCGSTAB already handed back its start vector.
+        entry.skipped = result.reverted;
+        if (result.reverted || result.failed())
+            entry.reason = std::string(to_string(result.status)) + (result.reverted ? ", start vector kept" : "");
+        report.coarse_levels.push_back(std::move(entry));
+    }
+    if (levels > 1) {
+        interpolate(hierarchy_.levels[0].interpolation, coarse_x, x);
+    } else {
+        std::fill(x.begin(), x.end(), 0.0);
+    }
+    report.coarse_ms = elapsed_ms(start);
+    solve_fine(b, channel, x, options, report);
+    std::vector<double>& last = last_solution_[static_cast<size_t>(channel)];
+    if (last.data() != x.data()) last.assign(x.begin(), x.end());  // solve_frame passes `last` itself
+    return report;
+}
+
+std::span<const double> MultiresSolver::solve_frame(std::span<const double> b, int channel, int iteration_budget,
+                                                    MultiresSolveReport* report, const MultiresSolveOptions& options) {
+    check_channel(channel);
+    MultiresSolveOptions budgeted = options;
+    budgeted.max_iterations = std::max(iteration_budget, 0);
+    std::vector<double>& last = last_solution_[static_cast<size_t>(channel)];
+    MultiresSolveReport local;
+    if (last.size() != hierarchy_.levels[0].size()) {
+        last.assign(hierarchy_.levels[0].size(), 0.0);
+        local = solve(b, channel, last, budgeted);
+    } else {
+        if (b.size() != last.size())
+            throw InvalidArgumentError("multires solve_frame: right-hand side of size " + std::to_string(b.size()) +
+                                       " for " + std::to_string(last.size()) + " vertices");
+        solve_fine(b, channel, last, budgeted, local);
+    }
+    if (report) *report = std::move(local);
+    return last;
+}
+
+}  // namespace waxwork

@@ -1,0 +1,102 @@
+// The multi-resolution diffusion solver of Li et al. 2013 (TransCut, Sec. 4): solve the coarsest
+// level to convergence, interpolate (Eq. 16) to the next finer level as its start vector, iterate
+// there, and so on down to level 0. Coarse levels (non-symmetric, Eq. 17) use BiCGSTAB; level 0
+// (symmetric positive definite, Eqs. 12-14) uses the project's Jacobi CG, warm-started.
+//
+// Fallback. Coarse matrices may be singular (Sec. 4.2). When BiCGSTAB breaks down or fails to
+// improve on a level, that level's iterations are skipped: its start vector (the interpolated coarser
+// solution, or zero on the coarsest level) is passed on unchanged and the reason is recorded. The
+// result is always finite; the fine CG guarantees the accuracy.
+//
+// The object keeps its hierarchy and the last solution per channel, so a frame whose matrix pattern
+// is unchanged (relighting, painting within tolerance) warm-starts from the previous frame
+// (solve_frame) instead of repeating the coarse-to-fine pass.
+#pragma once
+
+#include "multires/bicgstab.h"
+#include "multires/hierarchy.h"
+#include "solver/conjugate_gradient.h"
+#include "solver/diffusion_matrix.h"
+
+#include <array>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace waxwork {
+
+struct MultiresSolveOptions {
+    double coarsest_tolerance = 1e-6;   // relative residual on the coarsest level
+    int coarsest_max_iterations = 2000;
+    double level_tolerance = 1e-4;      // relative residual on intermediate levels
+    // Iteration budget per intermediate level. 2 rather than more: on spot (bench/multires_bench.cpp)
+    // 10 iterations per level saved only 2 level-0 CG iterations over 2 and cost three times as much.
+    int level_max_iterations = 2;
+    double relative_tolerance = 1e-3;   // level-0 CG: estimated relative error (conjugate_gradient.h)
+    int max_iterations = 10000;         // level-0 CG iteration budget
+};
+
+struct LevelSolveReport {
+    int level = 0;
+    int iterations = 0;
+    double initial_relative_residual = 0;
+    double relative_residual = 0;
+    BicgstabStatus status = BicgstabStatus::Converged;
+    bool skipped = false;  // the level's iterate was discarded (fallback)
+    std::string reason;    // why, when skipped
+};
+
+struct MultiresSolveReport {
+    std::vector<LevelSolveReport> coarse_levels;  // coarsest first
+    ConjugateGradientResult fine;
+    bool fine_restarted_cold = false;  // level-0 CG rejected the warm start and ran from zero
+    std::string fine_failure;          // what the level-0 CG reported, if anything
+    double coarse_ms = 0;
+    double fine_ms = 0;
+
+    int fallbacks() const {
+        int count = 0;
+        for (const auto& l : coarse_levels) count += l.skipped ? 1 : 0;
+        return count;
+    }
+};
+
+class MultiresSolver {
+public:
+    // Builds the hierarchy from the assembled system and the mesh positions (Eq. 16 weights).
+    MultiresSolver(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
+                   const HierarchyOptions& options = {});
+
+    const MultiresHierarchy& hierarchy() const { return hierarchy_; }
+    // Mutable access for callers that update coarse values in place (and for fault-injection tests).
+    MultiresHierarchy& hierarchy() { return hierarchy_; }
+
+    // Coarse-to-fine solve of M^0 x = b for one channel. x: output (its content is ignored).
+    MultiresSolveReport solve(std::span<const double> b, int channel, std::span<double> x,
+                              const MultiresSolveOptions& options = {});
+
+    // Per-frame mode: at most `iteration_budget` level-0 CG iterations, warm-started from this
+    // channel's previous solution (the first call runs the coarse-to-fine pass). The solution stays
+    // in the object; returns it.
+    std::span<const double> solve_frame(std::span<const double> b, int channel, int iteration_budget,
+                                        MultiresSolveReport* report = nullptr,
+                                        const MultiresSolveOptions& options = {});
+
+    // After a material change (painting) on the same mesh: takes the new level-0 values and recomputes
+    // the coarse matrices (Eq. 17) on the kept graphs and interpolation, without a new selection.
+    // Throws InvalidArgumentError when the matrix pattern differs from the one the hierarchy was built on.
+    void update_values(const DiffusionMatrix& matrix);
+
+    // Forget the previous frames' solutions (after an edit that changes the solution a lot).
+    void reset_warm_start();
+
+private:
+    void solve_fine(std::span<const double> b, int channel, std::span<double> x, const MultiresSolveOptions& options,
+                    MultiresSolveReport& report);
+
+    MultiresHierarchy hierarchy_;
+    std::array<std::vector<double>, 3> last_solution_;
+    std::array<double, 3> eigenvalue_hint_{};
+};
+
+}  // namespace waxwork

@@ -1,0 +1,252 @@
+#include "multires/bicgstab.h"
+#include "multires/multires_solver.h"
+#include "multires_test_systems.h"
+#include "tetops/error.h"
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace waxwork {
+namespace {
+
+double relative_error(std::span<const double> x, std::span<const double> reference) {
+    double e = 0, r = 0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        e += (x[i] - reference[i]) * (x[i] - reference[i]);
+        r += reference[i] * reference[i];
+    }
+    return std::sqrt(e / r);
+}
+
+bool all_finite(std::span<const double> x) {
+    for (double v : x)
+        if (!std::isfinite(v)) return false;
+    return true;
+}
+
+std::vector<double> reference_solution(const DiffusionMatrix& m, const std::vector<double>& b, int channel) {
+    std::vector<double> x(b.size(), 0.0);
+    ConjugateGradientOptions options;
+    options.relative_tolerance = 1e-11;
+    const CsrMatrixView<double> view{m.size(), m.offsets.data(), m.columns.data(), m.values[static_cast<size_t>(channel)].data()};
+    EXPECT_TRUE(solve_jacobi_cg<double>(view, b, x, options).converged);
+    return x;
+}
+
+// A small non-symmetric CSR system with its diagonal slots.
+struct SmallSystem {
+    std::vector<int32_t> offsets{0}, columns, diagonal;
+    std::vector<double> values;
+    CsrMatrixView<double> view() const { return {diagonal.size(), offsets.data(), columns.data(), values.data()}; }
+};
+
+SmallSystem from_dense(const Eigen::MatrixXd& a) {
+    SmallSystem s;
+    for (Eigen::Index i = 0; i < a.rows(); ++i) {
+        for (Eigen::Index j = 0; j < a.cols(); ++j) {
+            if (a(i, j) == 0 && i != j) continue;
+            if (i == j) s.diagonal.push_back(static_cast<int32_t>(s.columns.size()));
+            s.columns.push_back(static_cast<int32_t>(j));
+            s.values.push_back(a(i, j));
+        }
+        s.offsets.push_back(static_cast<int32_t>(s.columns.size()));
+    }
+    return s;
+}
+
+TEST(Bicgstab, SolvesANonSymmetricSystem) {
+    const int n = 40;
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+    for (int i = 0; i < n; ++i) {
+        a(i, i) = 4 + 0.1 * i;
+        if (i > 0) a(i, i - 1) = -1.5;
+        if (i + 1 < n) a(i, i + 1) = -0.5;
+        if (i + 7 < n) a(i, i + 7) = 0.3;
+    }
+    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(n, 1, 2);
+    const Eigen::VectorXd expected = a.partialPivLu().solve(b);
+    const SmallSystem s = from_dense(a);
+    std::vector<double> x(n, 0.0);
+    std::vector<double> bv(b.data(), b.data() + n);
+    const BicgstabResult r = solve_jacobi_bicgstab(s.view(), s.diagonal, bv, x, {});
+    EXPECT_EQ(r.status, BicgstabStatus::Converged);
+    EXPECT_LT(r.relative_residual, 1e-6);
+    for (int i = 0; i < n; ++i) EXPECT_NEAR(x[static_cast<size_t>(i)], expected(i), 1e-5 * expected.cwiseAbs().maxCoeff());
+}
+
+TEST(Bicgstab, ZeroMatrixBreaksDownAndKeepsTheStartVector) {
+    const SmallSystem s = from_dense(Eigen::MatrixXd::Zero(5, 5));
+    std::vector<double> b(5, 1.0), x(5, 0.25);
+    const BicgstabResult r = solve_jacobi_bicgstab(s.view(), s.diagonal, b, x, {});
+    EXPECT_TRUE(r.failed());
+    EXPECT_TRUE(r.reverted);
+    for (double v : x) EXPECT_EQ(v, 0.25);
+}
+
+TEST(Bicgstab, NonFiniteMatrixIsReportedAndXStaysFinite) {
+    Eigen::MatrixXd a = Eigen::MatrixXd::Identity(4, 4);
+    a(2, 2) = std::numeric_limits<double>::quiet_NaN();
+    const SmallSystem s = from_dense(a);
+    std::vector<double> b(4, 1.0), x(4, 0.0);
+    const BicgstabResult r = solve_jacobi_bicgstab(s.view(), s.diagonal, b, x, {});
+    EXPECT_EQ(r.status, BicgstabStatus::NonFinite);
+    EXPECT_TRUE(all_finite(x));
+}
+
+TEST(MultiresSolver, ConvergesToTheFineSolution) {
+    const auto s = testing::make_test_system(14);  // 3375 vertices
+    HierarchyOptions h;
+    h.min_coarse_vertices = 100;
+    MultiresSolver solver(s.matrix, s.mesh.positions, h);
+    ASSERT_GE(solver.hierarchy().level_count(), 3u);
+    for (int channel = 0; channel < 3; ++channel) {
+        const auto reference = reference_solution(s.matrix, s.b[static_cast<size_t>(channel)], channel);
+        std::vector<double> x(reference.size());
+        MultiresSolveOptions options;
+        // Only the coarse-to-fine pass: its start vector must already be a useful approximation.
+        options.max_iterations = 0;
+        MultiresSolveReport report = solver.solve(s.b[static_cast<size_t>(channel)], channel, x, options);
+        EXPECT_EQ(report.fallbacks(), 0);
+        const double start_error = relative_error(x, reference);
+        EXPECT_LT(start_error, 0.5) << "channel " << channel;
+        options.max_iterations = 10000;
+        options.relative_tolerance = 1e-7;
+        report = solver.solve(s.b[static_cast<size_t>(channel)], channel, x, options);
+        EXPECT_TRUE(report.fine.converged);
+        EXPECT_LT(relative_error(x, reference), 1e-4) << "channel " << channel;
+        EXPECT_EQ(report.coarse_levels.size(), solver.hierarchy().level_count() - 1);
+        EXPECT_EQ(report.coarse_levels.front().status, BicgstabStatus::Converged);
+    }
+}
+
+TEST(MultiresSolver, SingularCoarsestLevelFallsBackAndStaysFinite) {
+    const auto s = testing::make_test_system(10);
+    HierarchyOptions h;
+    h.min_coarse_vertices = 100;
+    MultiresSolver solver(s.matrix, s.mesh.positions, h);
+    ASSERT_GE(solver.hierarchy().level_count(), 3u);
+    HierarchyLevel& coarsest = solver.hierarchy().levels.back();
+    for (auto& v : coarsest.values[0]) v = 0;  // a singular (zero) coarsest matrix
+    const auto reference = reference_solution(s.matrix, s.b[0], 0);
+    std::vector<double> x(reference.size());
+    MultiresSolveOptions options;
+    options.relative_tolerance = 1e-7;
+    const MultiresSolveReport report = solver.solve(s.b[0], 0, x, options);
+    ASSERT_FALSE(report.coarse_levels.empty());
+    EXPECT_TRUE(report.coarse_levels.front().skipped);
+    EXPECT_FALSE(report.coarse_levels.front().reason.empty());
+    EXPECT_GE(report.fallbacks(), 1);
+    EXPECT_TRUE(all_finite(x));
+    EXPECT_LT(relative_error(x, reference), 1e-4);
+}
+
+TEST(MultiresSolver, ZeroRowOnACoarseLevelStaysFinite) {
+    const auto s = testing::make_test_system(10);
+    HierarchyOptions h;
+    h.min_coarse_vertices = 100;
+    MultiresSolver solver(s.matrix, s.mesh.positions, h);
+    ASSERT_GE(solver.hierarchy().level_count(), 3u);
+    HierarchyLevel& level = solver.hierarchy().levels[1];
+    // Zero the row of a lit (boundary, b != 0) vertex: the coarse system becomes inconsistent.
+    std::vector<double> b1(level.size());
+    restrict_right_hand_side(level, s.b[1], b1);
+    size_t row = 0;
+    while (row < b1.size() && b1[row] == 0) ++row;
+    ASSERT_LT(row, b1.size());
+    for (int32_t k = level.offsets[row]; k < level.offsets[row + 1]; ++k) level.values[1][static_cast<size_t>(k)] = 0;
+    const auto reference = reference_solution(s.matrix, s.b[1], 1);
+    std::vector<double> x(reference.size());
+    MultiresSolveOptions options;
+    options.relative_tolerance = 1e-7;
+    const MultiresSolveReport report = solver.solve(s.b[1], 1, x, options);
+    EXPECT_TRUE(all_finite(x));
+    EXPECT_TRUE(report.fine.converged);
+    EXPECT_LT(relative_error(x, reference), 1e-4);
+}
+
+TEST(MultiresSolver, FrameModeWarmStartsFromTheLastSolution) {
+    const auto s = testing::make_test_system(10);
+    HierarchyOptions h;
+    h.min_coarse_vertices = 100;
+    MultiresSolver solver(s.matrix, s.mesh.positions, h);
+    MultiresSolveOptions options;
+    options.relative_tolerance = 1e-6;
+    MultiresSolveReport first, second;
+    const auto reference = reference_solution(s.matrix, s.b[2], 2);
+    solver.solve_frame(s.b[2], 2, 500, &first, options);
+    EXPECT_FALSE(first.coarse_levels.empty());  // the first frame runs the coarse-to-fine pass
+    // The light dims by 10%: the previous solution is a close start.
+    std::vector<double> dimmer = s.b[2];
+    for (double& v : dimmer) v *= 0.9;
+    const std::span<const double> x = solver.solve_frame(dimmer, 2, 500, &second, options);
+    EXPECT_TRUE(second.coarse_levels.empty());
+    EXPECT_TRUE(second.fine.converged);
+    std::vector<double> scaled = reference;
+    for (double& v : scaled) v *= 0.9;
+    EXPECT_LT(relative_error(x, scaled), 1e-4);
+    // A budget of 2 iterations is respected.
+    MultiresSolveReport third;
+    solver.solve_frame(s.b[2], 2, 2, &third, options);
+    EXPECT_LE(third.fine.iterations, 2);
+}
+
+TEST(MultiresSolver, SolveIsDeterministic) {
+    const auto s = testing::make_test_system(8);
+    HierarchyOptions h;
+    h.min_coarse_vertices = 50;
+    MultiresSolver a(s.matrix, s.mesh.positions, h), b(s.matrix, s.mesh.positions, h);
+    std::vector<double> xa(s.b[0].size()), xb(s.b[0].size());
+    a.solve(s.b[0], 0, xa);
+    b.solve(s.b[0], 0, xb);
+    EXPECT_EQ(xa, xb);
+}
+
+}  // namespace
+}  // namespace waxwork
+
+namespace waxwork {
+namespace {
+
+TEST(MultiresSolver, UpdateValuesEqualsARebuild) {
+    auto s = testing::make_test_system(6);
+    HierarchyOptions h;
+    h.min_coarse_vertices = 30;
+    MultiresSolver updated(s.matrix, s.mesh.positions, h);
+    const std::vector<TetMaterial> painted(s.mesh.tet_count(), TetMaterial{{0.3, 0.02, 0.1}, {2, 1, 0.5}, 1.4});
+    assemble_diffusion_values(s.matrix, s.connectivity, painted);
+    updated.update_values(s.matrix);
+    const MultiresSolver rebuilt(s.matrix, s.mesh.positions, h);
+    ASSERT_EQ(updated.hierarchy().level_count(), rebuilt.hierarchy().level_count());
+    for (size_t l = 0; l < rebuilt.hierarchy().level_count(); ++l)
+        EXPECT_EQ(updated.hierarchy().levels[l].values, rebuilt.hierarchy().levels[l].values) << "level " << l;
+    DiffusionMatrix other = testing::make_test_system(5).matrix;
+    EXPECT_THROW(updated.update_values(other), InvalidArgumentError);
+}
+
+}  // namespace
+}  // namespace waxwork
+
+namespace waxwork {
+namespace {
+
+TEST(MultiresSolver, SingleLevelMeshSolvesWithCgAlone) {
+    const auto s = testing::make_test_system(2);  // 27 vertices: below min_coarse_vertices
+    MultiresSolver solver(s.matrix, s.mesh.positions);
+    EXPECT_EQ(solver.hierarchy().level_count(), 1u);
+    std::vector<double> x(s.b[0].size(), 123.0);  // content ignored
+    MultiresSolveOptions options;
+    options.relative_tolerance = 1e-8;
+    const MultiresSolveReport report = solver.solve(s.b[0], 0, x, options);
+    EXPECT_TRUE(report.coarse_levels.empty());
+    EXPECT_TRUE(report.fine.converged);
+    EXPECT_LT(relative_error(x, reference_solution(s.matrix, s.b[0], 0)), 1e-6);
+    std::vector<double> wrong(3);
+    EXPECT_THROW(solver.solve(wrong, 0, x), InvalidArgumentError);
+    EXPECT_THROW(solver.solve(s.b[0], 3, x), InvalidArgumentError);
+}
+
+}  // namespace
+}  // namespace waxwork
