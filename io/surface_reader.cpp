@@ -84,35 +84,22 @@ private:
 };
 
 // OpenMesh prints to its own global streams (omerr, omlog, omout), connected to the standard streams.
-// While reading, they are disconnected from those and omerr goes to a buffer, so that the problem can
-// be reported in the FileError instead of on the console. The streams are global, hence the mutex
-// serialising all reads (OpenMesh's IOManager is a global singleton too).
+// On the first read they are disconnected from those for good and omerr is connected to a buffer, so
+// that a problem can be reported in the FileError instead of on the console. The redirection is made
+// once per process, not per read, because OpenMesh's mostream::disconnect drops the target wrapper
+// that connect allocated (a leak per read, found with LeakSanitizer). The streams are global, hence the
+// mutex serialising all reads (OpenMesh's IOManager is a global singleton too).
 class OpenMeshOutputCapture {
 public:
-    OpenMeshOutputCapture() {
-        for (size_t s = 0; s < streams_.size(); ++s) {
-            connected_[s][0] = streams_[s]->disconnect(std::cerr);
-            connected_[s][1] = streams_[s]->disconnect(std::clog);
-            connected_[s][2] = streams_[s]->disconnect(std::cout);
-        }
-        errors_enabled_ = ::omerr().is_enabled();
+    OpenMeshOutputCapture() : errors_(redirected_errors()) {
         ::omerr().enable();
-        ::omerr().connect(errors_);
-    }
-    ~OpenMeshOutputCapture() {
-        ::omerr().flush();
-        ::omerr().disconnect(errors_);
-        if (!errors_enabled_) ::omerr().disable();
-        for (size_t s = 0; s < streams_.size(); ++s) {
-            if (connected_[s][0]) streams_[s]->connect(std::cerr);
-            if (connected_[s][1]) streams_[s]->connect(std::clog);
-            if (connected_[s][2]) streams_[s]->connect(std::cout);
-        }
+        errors_.str("");
+        errors_.clear();
     }
     OpenMeshOutputCapture(const OpenMeshOutputCapture&) = delete;
     OpenMeshOutputCapture& operator=(const OpenMeshOutputCapture&) = delete;
 
-    // The first line OpenMesh complained with, or "".
+    // The first line OpenMesh complained with during this read, or "".
     std::string first_error() {
         ::omerr().flush();
         std::string line;
@@ -123,10 +110,22 @@ public:
     }
 
 private:
-    std::array<OpenMesh::mostream*, 3> streams_{&::omerr(), &::omlog(), &::omout()};
-    std::array<std::array<bool, 3>, 3> connected_{};
-    bool errors_enabled_ = true;
-    std::ostringstream errors_;
+    static std::ostringstream& redirected_errors() {
+        // Never destroyed: OpenMesh's static streams keep a reference to it until exit.
+        static std::ostringstream* const buffer = [] {
+            for (OpenMesh::mostream* stream : {&::omerr(), &::omlog(), &::omout()}) {
+                stream->disconnect(std::cerr);
+                stream->disconnect(std::clog);
+                stream->disconnect(std::cout);
+            }
+            auto* errors = new std::ostringstream;
+            ::omerr().connect(*errors);
+            return errors;
+        }();
+        return *buffer;
+    }
+
+    std::ostringstream& errors_;
 };
 
 std::mutex& reader_mutex() {
