@@ -190,8 +190,8 @@ TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& opt
                     "meshing option sizing.target_tets = " + std::to_string(target) +
                     ": TetGen keeps the surface's triangles and needs at least " +
                     std::to_string(coarsest.tet_count()) +
-                    " tets on this surface at this quality; ask for more tets or use Mesher::Cgal, "
-                    "which remeshes the surface");
+                    " tets on this surface at this quality; ask for more tets or use the CGAL mesher "
+                    "(--mesher cgal), which remeshes the surface");
             }
             const double coarsest_error = std::abs(coarsest_count - double(target)) / double(target);
             if (coarsest_error < best_error) {
