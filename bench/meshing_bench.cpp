@@ -1,41 +1,17 @@
 // Meshing spot (assets/meshes/spot.obj) to a tet count with TetGen and CGAL. Reports the tets produced
 // and the wall time of one tetrahedralize() call (which includes the target_tets search passes).
+#include "io/surface_reader.h"
 #include "tetops/tetrahedralize.h"
 
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 namespace {
 
-// Spot is a clean triangle OBJ (v and f records only matter); a local reader keeps the benchmark
-// independent of the io/ readers' validation cost.
 waxwork::TriangleSurface read_spot() {
-    std::ifstream in(std::filesystem::path(WAXWORK_ASSET_DIR) / "meshes" / "spot.obj");
-    waxwork::TriangleSurface surface;
-    std::string line;
-    while (std::getline(in, line)) {
-        std::istringstream words(line);
-        std::string tag;
-        words >> tag;
-        if (tag == "v") {
-            Eigen::Vector3d p;
-            words >> p.x() >> p.y() >> p.z();
-            surface.points.push_back(p);
-        } else if (tag == "f") {
-            std::array<int32_t, 3> t{};
-            std::string word;
-            for (auto& v : t) {
-                words >> word;
-                v = std::stoi(word.substr(0, word.find('/'))) - 1;
-            }
-            surface.triangles.push_back(t);
-        }
-    }
-    return surface;
+    return waxwork::read_surface_file(std::filesystem::path(WAXWORK_ASSET_DIR) / "meshes" / "spot.obj");
 }
 
 void mesh_spot(benchmark::State& state, waxwork::Mesher mesher) {

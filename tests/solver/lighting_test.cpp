@@ -3,6 +3,7 @@
 #include "tetops/connectivity.h"
 #include "tetops/error.h"
 #include "tetops/tet_mesh.h"
+#include "tetops/test_meshes.h"
 
 #include <gtest/gtest.h>
 
@@ -12,33 +13,6 @@
 
 namespace waxwork {
 namespace {
-
-// A box [lo, hi] cut into n^3 cells of 6 tets each (Kuhn subdivision: every cell splits along its
-// main diagonal, so neighbouring cells share conforming faces).
-TetMesh make_box(int n, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
-    std::vector<Eigen::Vector3d> points;
-    auto id = [n](int i, int j, int k) { return (k * (n + 1) + j) * (n + 1) + i; };
-    for (int k = 0; k <= n; ++k)
-        for (int j = 0; j <= n; ++j)
-            for (int i = 0; i <= n; ++i)
-                points.push_back(lo + (hi - lo).cwiseProduct(Eigen::Vector3d(i, j, k) / n));
-    std::vector<Tet> tets;
-    const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-    for (int k = 0; k < n; ++k)
-        for (int j = 0; j < n; ++j)
-            for (int i = 0; i < n; ++i)
-                for (const auto& p : perms) {
-                    int c[3] = {i, j, k};
-                    Tet t;
-                    t[0] = id(c[0], c[1], c[2]);
-                    for (int s = 0; s < 3; ++s) {
-                        ++c[p[s]];
-                        t[s + 1] = id(c[0], c[1], c[2]);
-                    }
-                    tets.push_back(t);
-                }
-    return make_tet_mesh(std::move(points), std::move(tets));
-}
 
 // Appends b to a as a new piece moved by `transform`.
 void append_piece(TetMesh& a, const TetMesh& b, const RigidTransform& transform) {
@@ -73,7 +47,7 @@ bool on_top_face_interior(const Eigen::Vector3d& p, double top) {
 }
 
 TEST(Lighting, CubeLitFromAboveIsLitOnlyOnTheTopFace) {
-    const TetMesh mesh = make_box(4, {0, 0, 0}, {1, 1, 1});
+    const TetMesh mesh = testing::make_box_mesh(4, {0, 0, 0}, {1, 1, 1});
     const TetConnectivity connectivity = build_connectivity(mesh);
     const double eta = 1.4;
     Lighting lighting;
@@ -104,7 +78,7 @@ TEST(Lighting, CubeLitFromAboveIsLitOnlyOnTheTopFace) {
 }
 
 TEST(Lighting, VolumeVertexFormZeroesInteriorVertices) {
-    const TetMesh mesh = make_box(3, {0, 0, 0}, {1, 1, 1});
+    const TetMesh mesh = testing::make_box_mesh(3, {0, 0, 0}, {1, 1, 1});
     const TetConnectivity connectivity = build_connectivity(mesh);
     Lighting lighting;
     lighting.lights.push_back({LightType::Directional, {0, 0, -1}, {1, 1, 1}});
@@ -122,8 +96,8 @@ TEST(Lighting, VolumeVertexFormZeroesInteriorVertices) {
 
 TEST(Lighting, PieceBetweenLightAndCubeCastsAShadow) {
     // Cube A in [0,1]^3; a wider slab, as a second piece moved above it by its rigid transform.
-    TetMesh mesh = make_box(4, {0, 0, 0}, {1, 1, 1});
-    const TetMesh slab = make_box(2, {-0.5, -0.5, 0}, {1.5, 1.5, 0.3});
+    TetMesh mesh = testing::make_box_mesh(4, {0, 0, 0}, {1, 1, 1});
+    const TetMesh slab = testing::make_box_mesh(2, {-0.5, -0.5, 0}, {1.5, 1.5, 0.3});
     RigidTransform lift;
     lift.translation = {0, 0, 2};
     append_piece(mesh, slab, lift);
@@ -154,7 +128,7 @@ TEST(Lighting, PieceBetweenLightAndCubeCastsAShadow) {
 }
 
 TEST(Lighting, PointLightFallsOffWithInverseSquareDistance) {
-    const TetMesh mesh = make_box(4, {0, 0, 0}, {1, 1, 1});
+    const TetMesh mesh = testing::make_box_mesh(4, {0, 0, 0}, {1, 1, 1});
     const TetConnectivity connectivity = build_connectivity(mesh);
     const double eta = 1.5;
     const BoundarySurface surface = extract_boundary_surface(mesh, connectivity, materials_with_eta(mesh, eta));
@@ -172,7 +146,7 @@ TEST(Lighting, PointLightFallsOffWithInverseSquareDistance) {
 }
 
 TEST(Lighting, PointLightInsideOrOnTheObjectGivesOnlyAmbientAndNoNaN) {
-    const TetMesh mesh = make_box(3, {0, 0, 0}, {1, 1, 1});
+    const TetMesh mesh = testing::make_box_mesh(3, {0, 0, 0}, {1, 1, 1});
     const TetConnectivity connectivity = build_connectivity(mesh);
     const BoundarySurface surface = extract_boundary_surface(mesh, connectivity, {});
     Lighting lighting;
@@ -210,7 +184,7 @@ TEST(Lighting, InvalidLightsThrow) {
     EXPECT_NO_THROW(validate(ok));
 
     // The throwing path through incident_light, too.
-    const TetMesh mesh = make_box(1, {0, 0, 0}, {1, 1, 1});
+    const TetMesh mesh = testing::make_box_mesh(1, {0, 0, 0}, {1, 1, 1});
     const TetConnectivity connectivity = build_connectivity(mesh);
     Lighting lighting;
     lighting.lights.push_back({LightType::Directional, {0, 0, 0}, {1, 1, 1}});

@@ -5,6 +5,7 @@
 #include "tetops/connectivity.h"
 #include "tetops/quality.h"
 #include "tetops/tet_mesh.h"
+#include "tetops/test_meshes.h"
 #include "tetops/tetrahedralize.h"
 #include "tetops/triangle_surface.h"
 
@@ -19,27 +20,7 @@ namespace waxwork::test {
 // n x n x n cubes of side h, each split into the six Kuhn tets (a conforming, all-good mesh:
 // dihedral angles 45-90 degrees).
 inline TetMesh make_cube_mesh(int n, double h = 1.0) {
-    std::vector<Eigen::Vector3d> points;
-    auto id = [n](int i, int j, int k) { return static_cast<int32_t>((k * (n + 1) + j) * (n + 1) + i); };
-    for (int k = 0; k <= n; ++k)
-        for (int j = 0; j <= n; ++j)
-            for (int i = 0; i <= n; ++i) points.emplace_back(i * h, j * h, k * h);
-    std::vector<Tet> tets;
-    const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-    for (int k = 0; k < n; ++k)
-        for (int j = 0; j < n; ++j)
-            for (int i = 0; i < n; ++i)
-                for (const auto& p : perms) {
-                    int c[3] = {i, j, k};
-                    Tet t;
-                    t[0] = id(c[0], c[1], c[2]);
-                    for (int s = 0; s < 3; ++s) {
-                        ++c[p[s]];
-                        t[s + 1] = id(c[0], c[1], c[2]);
-                    }
-                    tets.push_back(t);
-                }
-    return make_tet_mesh(std::move(points), std::move(tets));
+    return testing::make_box_mesh(n, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(n * h));
 }
 
 // Moves `count` interior vertices of a cube mesh towards a face of their (convex) star, so that one tet

@@ -5,15 +5,16 @@
 
 namespace waxwork::testing {
 
-// The unit cube [0,1]^3 split into `n`^3 sub-cubes of 6 tets each (Kuhn subdivision, conforming).
-inline TetMesh make_cube_mesh(int n, const Eigen::Vector3d& origin = Eigen::Vector3d::Zero(), double size = 1.0) {
+// The box [lo, hi] split into n^3 cells of 6 tets each (Kuhn subdivision, conforming: the six tets of
+// a cell share its main diagonal, one per permutation of the axes, so neighbouring cells match without
+// any flipping; dihedral angles 45-90 degrees on a cube).
+inline TetMesh make_box_mesh(int n, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
     std::vector<Eigen::Vector3d> points;
     auto index = [n](int i, int j, int k) { return static_cast<int32_t>((k * (n + 1) + j) * (n + 1) + i); };
     for (int k = 0; k <= n; ++k)
         for (int j = 0; j <= n; ++j)
-            for (int i = 0; i <= n; ++i) points.push_back(origin + size * Eigen::Vector3d(i, j, k) / n);
-    // The six tets of the Kuhn subdivision share the main diagonal (0,0,0)-(1,1,1): one per
-    // permutation of the axes, which makes neighbouring cubes conform without any flipping.
+            for (int i = 0; i <= n; ++i)
+                points.push_back(lo + (hi - lo).cwiseProduct(Eigen::Vector3d(i, j, k) / n));
     const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
     std::vector<Tet> tets;
     for (int k = 0; k < n; ++k)
@@ -30,6 +31,11 @@ inline TetMesh make_cube_mesh(int n, const Eigen::Vector3d& origin = Eigen::Vect
                     tets.push_back(tet);
                 }
     return make_tet_mesh(std::move(points), std::move(tets));
+}
+
+// The cube [origin, origin + size]^3 split into n^3 Kuhn cells.
+inline TetMesh make_cube_mesh(int n, const Eigen::Vector3d& origin = Eigen::Vector3d::Zero(), double size = 1.0) {
+    return make_box_mesh(n, origin, origin + Eigen::Vector3d::Constant(size));
 }
 
 // Appends mesh b to mesh a as further tets (vertex indices shifted), keeping piece 0.

@@ -1,3 +1,4 @@
+#include "io/surface_reader.h"
 #include "tetops/error.h"
 #include "tetops/quality.h"
 #include "tetops/tetrahedralize.h"
@@ -7,9 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 
 namespace waxwork {
@@ -17,46 +16,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A minimal OBJ/OFF reader for clean test meshes: keeps the tetops suite independent of io/.
-TriangleSurface read_test_surface(const fs::path& path) {
-    std::ifstream in(path);
-    if (!in) throw std::runtime_error("cannot open " + path.string());
-    TriangleSurface surface;
-    if (path.extension() == ".off") {
-        std::string header;
-        size_t vertices = 0, faces = 0, edges = 0;
-        in >> header >> vertices >> faces >> edges;
-        surface.points.resize(vertices);
-        for (auto& p : surface.points) in >> p.x() >> p.y() >> p.z();
-        for (size_t f = 0; f < faces; ++f) {
-            int count = 0;
-            std::array<int32_t, 3> t{};
-            in >> count >> t[0] >> t[1] >> t[2];
-            if (count != 3) throw std::runtime_error("non-triangle face in " + path.string());
-            surface.triangles.push_back(t);
-        }
-        return surface;
-    }
-    std::string line;
-    while (std::getline(in, line)) {
-        std::istringstream words(line);
-        std::string tag;
-        words >> tag;
-        if (tag == "v") {
-            Eigen::Vector3d p;
-            words >> p.x() >> p.y() >> p.z();
-            surface.points.push_back(p);
-        } else if (tag == "f") {
-            std::vector<int32_t> corners;
-            std::string word;
-            while (words >> word) corners.push_back(std::stoi(word.substr(0, word.find('/'))) - 1);
-            for (size_t k = 1; k + 1 < corners.size(); ++k) {
-                surface.triangles.push_back({corners[0], corners[k], corners[k + 1]});
-            }
-        }
-    }
-    return surface;
-}
+// The raw file contents (no repairs): the shared clean meshes are already valid.
+TriangleSurface read_test_surface(const fs::path& path) { return read_surface_file(path); }
 
 fs::path shared_mesh_dir() { return fs::path(WAXWORK_SHARED_DIR) / "data" / "meshes"; }
 
