@@ -8,7 +8,8 @@
 // uses its own error estimate (conjugate_gradient.h) with tolerance 1e-2; Eigen's CG+IC uses the
 // loosest residual tolerance (from 1e-2 down by factors of 3) whose true error is <= 1%, found once.
 //
-// Run: build-solver-bench/bench/solver_bench (configure with -DWAXWORK_BUILD_BENCH=ON).
+// Run: build-solver-bench/bench/solver_bench (configure with -DWAXWORK_BUILD_BENCH=ON). Three-channel
+// solves: Float runs the channels in one loop, Double one after the other (diffusion_solve.cpp says why).
 #include "io/surface_reader.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
@@ -190,7 +191,9 @@ void BM_DirectOneChannel(benchmark::State& state) {
     state.SetLabel(DirectSolver::backend());
 }
 
-#define WAXWORK_SIZES Arg(50000)->Arg(500000)->Unit(benchmark::kMillisecond)
+// Wall time decides (UseRealTime); the CPU column is the whole process (all TBB threads), so that on
+// a machine shared with other jobs a slow wall time can be told apart from a slow program.
+#define WAXWORK_SIZES Arg(50000)->Arg(500000)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime()
 BENCHMARK(BM_AssembleFull)->WAXWORK_SIZES;
 BENCHMARK(BM_AssembleValues)->WAXWORK_SIZES;
 BENCHMARK(BM_JacobiCg<SolverPrecision::Float>)->WAXWORK_SIZES;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 namespace waxwork {
@@ -20,6 +21,8 @@ constexpr std::array<std::array<int, 4>, 4> kEdgeOfPair = {{{-1, 0, 1, 2}, {0, -
 constexpr std::array<std::array<int, 3>, 4> kOthers = {{{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}}};
 
 constexpr size_t kRowGrain = 512;
+// Materials are compared bitwise (assemble_diffusion_values): valid only without padding bytes.
+static_assert(sizeof(TetMaterial) == 7 * sizeof(double), "TetMaterial must have no padding");
 
 int32_t find_slot(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns, int32_t row, int32_t col) {
     const auto begin = columns.begin() + offsets[row];
@@ -68,38 +71,57 @@ void validate_materials(const std::vector<TetMaterial>& materials, std::span<con
 
 // Writes row i of all three matrices and of the source operator from the cached geometry and
 // coefficients. Only row i is written, so rows can be assembled in parallel without races.
-void assemble_row(DiffusionMatrix& m, const TetConnectivity& conn, int32_t i) {
+// Templated on the discretisation so that the per-incidence loop carries no FEM branches, and written
+// on raw row pointers: this loop is most of a material change's cost (bench/solver_bench.cpp,
+// BM_AssembleValues), and its summation order is the one every caller (full assembly and
+// update_diffusion_matrix) shares, so both still agree bit for bit.
+template <bool Fem>
+void assemble_row_impl(DiffusionMatrix& m, const TetConnectivity& conn, int32_t i) {
     const int32_t begin = m.offsets[i], end = m.offsets[i + 1];
-    for (auto& v : m.values) std::fill(v.begin() + begin, v.begin() + end, 0.0);
-    std::fill(m.source.begin() + begin, m.source.begin() + end, 0.0);
+    std::array<double*, 3> val = {m.values[0].data(), m.values[1].data(), m.values[2].data()};
+    double* const source = m.source.data();
+    for (double* v : val) std::fill(v + begin, v + end, 0.0);
+    std::fill(source + begin, source + end, 0.0);
     const int32_t d = m.diagonal[i];
     const int32_t tet_begin = conn.vertex_tets.offsets[i], tet_end = conn.vertex_tets.offsets[i + 1];
     if (tet_begin == tet_end) {  // unreferenced vertex: phi_i = 0
-        for (auto& v : m.values) v[d] = 1.0;
+        for (double* v : val) v[d] = 1.0;
         return;
     }
-    const bool fem = m.options.discretization == Discretization::Fem;
     // Lumped absorption (Eq. 13: V_i mu = sum_t 4 * mu V_t / 4); consistent: 4 mu V (1 + delta) / 20.
-    const double mass_diag = fem ? 0.4 : 1.0;
-    const double mass_off = 0.2;
-    std::array<double, 3> diag{};
+    constexpr double mass_diag = Fem ? 0.4 : 1.0;
+    constexpr double mass_off = 0.2;
+    const int32_t* tets = conn.vertex_tets.indices.data();
+    const DiffusionMatrix::TetIncidence* incidences = m.tet_incidences.data();
+    const DiffusionMatrix::TetGeometry* geometry = m.tet_geometry.data();
+    const DiffusionMatrix::TetCoefficients* coefficients = m.tet_coefficients.data();
+    double diag0 = 0, diag1 = 0, diag2 = 0;
     for (int32_t k = tet_begin; k < tet_end; ++k) {
-        const int32_t t = conn.vertex_tets.indices[k];
-        const auto& inc = m.tet_incidences[k];
-        const auto& geo = m.tet_geometry[t];
-        const auto& co = m.tet_coefficients[t];
+        const int32_t t = tets[k];
+        const auto& inc = incidences[k];
+        const auto& geo = geometry[t];
+        const auto& co = coefficients[t];
+        const double k0 = co.kappa[0], k1 = co.kappa[1], k2 = co.kappa[2];
         for (int s = 0; s < 3; ++s) {
             const double g = 4.0 * geo.edge_stiffness[kEdgeOfPair[inc.local][kOthers[inc.local][s]]];
             const int32_t slot = inc.slots[s];
-            for (int c = 0; c < 3; ++c) {
-                const double w = co.kappa[c] * g;  // M_ij = 4 w_ij (Eq. 14)
-                m.values[c][slot] += w;
-                diag[c] -= w;  // M_ii = -4 sum_j w_ij + ... (Eq. 13): the stiffness annihilates constants
-                if (fem) m.values[c][slot] += mass_off * co.mua[c] * geo.volume;
+            const double w0 = k0 * g, w1 = k1 * g, w2 = k2 * g;  // M_ij = 4 w_ij (Eq. 14)
+            val[0][slot] += w0;
+            val[1][slot] += w1;
+            val[2][slot] += w2;
+            // M_ii = -4 sum_j w_ij + ... (Eq. 13): the stiffness annihilates constants.
+            diag0 -= w0;
+            diag1 -= w1;
+            diag2 -= w2;
+            if constexpr (Fem) {
+                for (int c = 0; c < 3; ++c) val[c][slot] += mass_off * co.mua[c] * geo.volume;
             }
         }
-        for (int c = 0; c < 3; ++c) diag[c] += mass_diag * co.mua[c] * geo.volume;
+        diag0 += mass_diag * co.mua[0] * geo.volume;
+        diag1 += mass_diag * co.mua[1] * geo.volume;
+        diag2 += mass_diag * co.mua[2] * geo.volume;
     }
+    std::array<double, 3> diag = {diag0, diag1, diag2};
     // Robin boundary (Eq. 11 times -4|Upsilon|): 4 (1 / (2A)) times the lumped (S_f / 3) or consistent
     // (S_f (1 + delta) / 12) face mass; the source carries the extra 4 / (1 - F_dr) of Eq. 2 (Eq. 12).
     double source_diag = 0;
@@ -107,23 +129,30 @@ void assemble_row(DiffusionMatrix& m, const TetConnectivity& conn, int32_t i) {
         const int32_t f = m.vertex_faces[k];
         const double area = m.boundary_face_area[f];
         const auto& co = m.tet_coefficients[conn.boundary_faces[f].tet];
-        if (fem) {
+        if constexpr (Fem) {
             const double r_diag = area * co.inv_a / 3.0, r_off = area * co.inv_a / 6.0;
             const double s_diag = 8.0 * co.inv_a_one_minus_fdr * area / 6.0;
             const double s_off = 8.0 * co.inv_a_one_minus_fdr * area / 12.0;
             for (int c = 0; c < 3; ++c) diag[c] += r_diag;
             source_diag += s_diag;
             for (int32_t slot : m.vertex_face_slots[k]) {
-                for (int c = 0; c < 3; ++c) m.values[c][slot] += r_off;
-                m.source[slot] += s_off;
+                for (int c = 0; c < 3; ++c) val[c][slot] += r_off;
+                source[slot] += s_off;
             }
         } else {
             for (int c = 0; c < 3; ++c) diag[c] += 2.0 * area * co.inv_a / 3.0;  // Eq. 13: 2 S_i / (3A)
             source_diag += 8.0 * area * co.inv_a_one_minus_fdr / 3.0;             // Eq. 12
         }
     }
-    for (int c = 0; c < 3; ++c) m.values[c][d] += diag[c];
-    m.source[d] += source_diag;
+    for (int c = 0; c < 3; ++c) val[c][d] += diag[c];
+    source[d] += source_diag;
+}
+
+void assemble_row(DiffusionMatrix& m, const TetConnectivity& conn, int32_t i) {
+    if (m.options.discretization == Discretization::Fem)
+        assemble_row_impl<true>(m, conn, i);
+    else
+        assemble_row_impl<false>(m, conn, i);
 }
 
 }  // namespace
@@ -276,7 +305,14 @@ void assemble_diffusion_values(DiffusionMatrix& m, const TetConnectivity& conn, 
     validate_materials(materials, {});
     m.tet_coefficients.resize(tet_count);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tet_count, 4096), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t t = r.begin(); t != r.end(); ++t) m.tet_coefficients[t] = tet_coefficients_of(materials[t]);
+        for (size_t t = r.begin(); t != r.end(); ++t) {
+            // Materials come in long runs (painted regions, whole-object presets): a bitwise repeat of
+            // the previous tet's material reuses its coefficients (identical bits, no divisions).
+            if (t > r.begin() && std::memcmp(&materials[t], &materials[t - 1], sizeof(TetMaterial)) == 0)
+                m.tet_coefficients[t] = m.tet_coefficients[t - 1];
+            else
+                m.tet_coefficients[t] = tet_coefficients_of(materials[t]);
+        }
     });
     for (auto& v : m.values) v.resize(m.columns.size());
     m.source.resize(m.columns.size());

@@ -3,9 +3,18 @@
 #include "solver/conjugate_gradient.h"
 #include "tetops/error.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/partitioner.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
+#include <string>
+#include <type_traits>
 
 namespace waxwork {
 namespace {
@@ -14,21 +23,298 @@ double ms_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+// --- Three channels in one CG loop --------------------------------------------------------------
+// The three rgb systems share one pattern, so one pass over the pattern serves all three: the column
+// indices are read once per iteration instead of three times, and the three row sums are independent
+// dependency chains, which hides the latency of the double additions (the single-channel row
+// product is bound by that latency, not by memory). Values and vectors are interleaved (3 per slot,
+// 3 per vertex) so each gather fetches one cache line for all channels.
+//
+// Each channel runs exactly the algorithm of solve_jacobi_cg (same stopping rule, Ritz estimate,
+// true-residual confirmation and restarts, same deterministic reduction tree and summation order per
+// channel), so its iterates are those of a separate solve; a channel that has stopped is frozen while
+// the others continue. Used for float (see solve_diffusion_system for why not double). Written here
+// rather than in conjugate_gradient.h because it is specific to the shared-pattern rgb triple of
+// DiffusionMatrix.
+constexpr size_t kGrain = 4096;  // as conjugate_gradient.cpp: fixed chunks, deterministic reductions
+
+struct Sums3 {
+    std::array<double, 3> v{};
+};
+struct Sums6 {
+    std::array<double, 6> v{};
+};
+
+template <typename Sums, typename Body>
+Sums reduce_rows(size_t n, const Body& body) {
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<size_t>(0, n, kGrain), Sums{},
+        [&](const tbb::blocked_range<size_t>& r, Sums acc) {
+            const Sums s = body(r.begin(), r.end());
+            for (size_t c = 0; c < acc.v.size(); ++c) acc.v[c] = acc.v[c] + s.v[c];
+            return acc;
+        },
+        [](Sums x, const Sums& y) {
+            for (size_t c = 0; c < x.v.size(); ++c) x.v[c] = x.v[c] + y.v[c];
+            return x;
+        },
+        tbb::simple_partitioner());
+}
+
+[[noreturn]] void breakdown(int iteration, const std::string& what) {
+    throw AlgorithmError("conjugate gradient: " + what + " at iteration " + std::to_string(iteration) +
+                         " (matrix not positive definite, or values lost to rounding: degenerate tets?)");
+}
+
 template <typename Scalar>
-ConjugateGradientResult solve_channel(const DiffusionMatrix& m, const std::vector<double>& b, int channel,
-                                      const DiffusionOptions& options, std::vector<std::array<double, 3>>& phi) {
-    const size_t n = m.size();
-    std::vector<Scalar> values(m.values[channel].begin(), m.values[channel].end());
-    std::vector<Scalar> rhs(b.begin(), b.end());
-    std::vector<Scalar> x(n);
-    for (size_t i = 0; i < n; ++i) x[i] = static_cast<Scalar>(phi[i][channel]);
-    const CsrMatrixView<Scalar> view{n, m.offsets.data(), m.columns.data(), values.data()};
-    ConjugateGradientOptions cg;
-    cg.relative_tolerance = options.relative_tolerance;
-    cg.max_iterations = options.max_iterations;
-    const ConjugateGradientResult result = solve_jacobi_cg<Scalar>(view, rhs, x, cg);
-    for (size_t i = 0; i < n; ++i) phi[i][channel] = x[i];
-    return result;
+struct Rgb {
+    const DiffusionMatrix& m;
+    size_t n;
+    std::vector<Scalar> values;  // 3 per slot
+    std::vector<Scalar> b, x, r, z, p, q, inv_diag;  // 3 per vertex
+    std::vector<double> diag;                        // 3 per vertex
+
+    // r = b - M x for channel c (double accumulation); fills z = D^-1 r, returns r . z.
+    double true_residual(int c) {
+        return reduce_rows<Sums3>(n, [&](size_t begin, size_t end) {
+                   Sums3 acc;
+                   for (size_t i = begin; i < end; ++i) {
+                       double sum = 0;
+                       for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k)
+                           sum += static_cast<double>(values[3 * k + c]) *
+                                  static_cast<double>(x[3 * static_cast<size_t>(m.columns[k]) + c]);
+                       const size_t j = 3 * i + c;
+                       const double ri = static_cast<double>(b[j]) - sum;
+                       r[j] = static_cast<Scalar>(ri);
+                       z[j] = static_cast<Scalar>(ri * static_cast<double>(inv_diag[j]));
+                       acc.v[0] += static_cast<double>(r[j]) * static_cast<double>(z[j]);
+                   }
+                   return acc;
+               }).v[0];
+    }
+};
+
+struct ChannelState {
+    bool active = true;
+    double rz = 0, xnorm2 = 0;
+    std::vector<double> t_diag, t_off;
+    double ritz = std::numeric_limits<double>::infinity();
+    bool ritz_stale = true;
+    double ritz_floor = std::numeric_limits<double>::infinity();
+    double alpha_prev = 0, beta_prev = 0;
+    double last_restart_estimate = std::numeric_limits<double>::infinity();
+    ConjugateGradientResult result;
+
+    double lambda() {
+        if (ritz_stale && !t_diag.empty()) {
+            ritz = smallest_tridiagonal_eigenvalue(t_diag, t_off, std::isfinite(ritz) ? ritz : 0);
+            ritz_stale = false;
+        }
+        return std::min(ritz, ritz_floor);
+    }
+    double estimate(double rz_value, double lam) const {
+        if (xnorm2 <= 0) return std::numeric_limits<double>::infinity();
+        return std::sqrt(std::max(rz_value, 0.0)) / lam / std::sqrt(xnorm2);
+    }
+};
+
+template <typename Scalar>
+std::array<ConjugateGradientResult, 3> solve_rgb(const DiffusionMatrix& m, const std::array<std::vector<double>, 3>& b,
+                                                 const DiffusionOptions& options,
+                                                 std::vector<std::array<double, 3>>& phi) {
+    const size_t n = m.size(), nnz = m.nonzeros();
+    if (!(options.relative_tolerance > 0) || options.max_iterations < 0)
+        throw InvalidArgumentError("conjugate gradient: tolerance must be positive and max_iterations non-negative");
+    std::array<ChannelState, 3> ch;
+    std::array<ConjugateGradientResult, 3> results;
+    if (n == 0) {
+        for (auto& r : results) r.converged = true;
+        return results;
+    }
+    Rgb<Scalar> s{m, n, std::vector<Scalar>(3 * nnz), {}, {}, {}, {}, {}, {}, {}, std::vector<double>(3 * n)};
+    for (auto* v : {&s.b, &s.x, &s.r, &s.z, &s.p, &s.q, &s.inv_diag}) v->resize(3 * n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nnz, 16 * kGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k != r.end(); ++k)
+            for (int c = 0; c < 3; ++c) s.values[3 * k + c] = static_cast<Scalar>(m.values[c][k]);
+    });
+    for (int c = 0; c < 3; ++c) {
+        bool bad_input = false;
+        for (size_t i = 0; i < n; ++i) {
+            const size_t j = 3 * i + c;
+            s.b[j] = static_cast<Scalar>(b[c][i]);
+            s.x[j] = static_cast<Scalar>(phi[i][c]);
+            // As solve_jacobi_cg: the diagonal is the stored (Scalar) value.
+            const double d = s.values[3 * static_cast<size_t>(m.diagonal[i]) + c];
+            if (!(d > 0) || !std::isfinite(d))
+                throw AlgorithmError("conjugate gradient: diagonal entry " + std::to_string(i) + " is " +
+                                     std::to_string(d) + " (must be positive and finite)");
+            s.diag[j] = d;
+            s.inv_diag[j] = static_cast<Scalar>(1.0 / d);
+            if (!std::isfinite(static_cast<double>(s.b[j])) || !std::isfinite(static_cast<double>(s.x[j])))
+                bad_input = true;
+        }
+        if (bad_input) throw AlgorithmError("conjugate gradient: right-hand side or start vector is not finite");
+    }
+
+    const double tol = options.relative_tolerance;
+    for (int c = 0; c < 3; ++c) {
+        ch[c].rz = s.true_residual(c);
+        const Sums6 norms = reduce_rows<Sums6>(n, [&](size_t begin, size_t end) {
+            Sums6 acc;
+            for (size_t i = begin; i < end; ++i) {
+                const size_t j = 3 * i + c;
+                acc.v[0] += static_cast<double>(s.b[j]) * s.b[j] / s.diag[j];
+                acc.v[1] += s.diag[j] * static_cast<double>(s.x[j]) * s.x[j];
+            }
+            return acc;
+        });
+        if (norms.v[0] == 0) {  // the solution is exactly zero
+            for (size_t i = 0; i < n; ++i) s.x[3 * i + c] = Scalar(0);
+            ch[c].active = false;
+            ch[c].result.converged = true;
+        }
+        ch[c].xnorm2 = norms.v[1];
+    }
+    s.p = s.z;
+
+    const Scalar* values = s.values.data();
+    const int32_t* offsets = m.offsets.data();
+    const int32_t* columns = m.columns.data();
+    int k = 0;
+    for (; k < options.max_iterations && (ch[0].active || ch[1].active || ch[2].active); ++k) {
+        const std::array<bool, 3> act = {ch[0].active, ch[1].active, ch[2].active};
+        // q = M p and p . q for the three channels in one pass (frozen channels are computed and ignored:
+        // cheaper than branching in the inner loop, and their p stays finite).
+        const Sums3 pq = reduce_rows<Sums3>(n, [&](size_t begin, size_t end) {
+            Sums3 acc;
+            const Scalar* p = s.p.data();
+            Scalar* q = s.q.data();
+            for (size_t i = begin; i < end; ++i) {
+                double s0 = 0, s1 = 0, s2 = 0;
+                for (int32_t kk = offsets[i]; kk < offsets[i + 1]; ++kk) {
+                    const Scalar* v = values + 3 * static_cast<size_t>(kk);
+                    const Scalar* pj = p + 3 * static_cast<size_t>(columns[kk]);
+                    s0 += static_cast<double>(v[0]) * static_cast<double>(pj[0]);
+                    s1 += static_cast<double>(v[1]) * static_cast<double>(pj[1]);
+                    s2 += static_cast<double>(v[2]) * static_cast<double>(pj[2]);
+                }
+                q[3 * i] = static_cast<Scalar>(s0);
+                q[3 * i + 1] = static_cast<Scalar>(s1);
+                q[3 * i + 2] = static_cast<Scalar>(s2);
+                acc.v[0] += static_cast<double>(p[3 * i]) * s0;
+                acc.v[1] += static_cast<double>(p[3 * i + 1]) * s1;
+                acc.v[2] += static_cast<double>(p[3 * i + 2]) * s2;
+            }
+            return acc;
+        });
+        std::array<Scalar, 3> a{};
+        std::array<double, 3> alpha{};
+        for (int c = 0; c < 3; ++c) {
+            if (!act[c]) continue;
+            if (!std::isfinite(pq.v[c])) breakdown(k, "p.Mp is not finite");
+            if (!(pq.v[c] > 0)) breakdown(k, "p.Mp = " + std::to_string(pq.v[c]) + " is not positive");
+            alpha[c] = ch[c].rz / pq.v[c];
+            a[c] = static_cast<Scalar>(alpha[c]);
+        }
+        // x += alpha p, r -= alpha q, z = D^-1 r, and the two norms per channel, in one pass.
+        // While all three channels run (nearly always: they converge within a few iterations of each
+        // other), the branch-free instance of the loop is taken.
+        const bool all_active = act[0] && act[1] && act[2];
+        const auto update = [&](auto every_channel) {
+            return reduce_rows<Sums6>(n, [&](size_t begin, size_t end) {
+                Sums6 acc;
+                for (size_t i = begin; i < end; ++i) {
+                    for (int c = 0; c < 3; ++c) {
+                        if (!every_channel && !act[c]) continue;
+                        const size_t j = 3 * i + c;
+                        s.x[j] += a[c] * s.p[j];
+                        s.r[j] -= a[c] * s.q[j];
+                        s.z[j] = s.inv_diag[j] * s.r[j];
+                        acc.v[2 * c] += static_cast<double>(s.r[j]) * static_cast<double>(s.z[j]);
+                        acc.v[2 * c + 1] += s.diag[j] * static_cast<double>(s.x[j]) * static_cast<double>(s.x[j]);
+                    }
+                }
+                return acc;
+            });
+        };
+        const Sums6 upd = all_active ? update(std::true_type{}) : update(std::false_type{});
+        std::array<double, 3> beta{};
+        std::array<bool, 3> update_p{};
+        for (int c = 0; c < 3; ++c) {
+            if (!act[c]) continue;
+            ChannelState& st = ch[c];
+            if (!std::isfinite(upd.v[2 * c]) || !std::isfinite(upd.v[2 * c + 1]))
+                breakdown(k, "the iterate became non-finite");
+            const double rz_new = upd.v[2 * c];
+            st.xnorm2 = upd.v[2 * c + 1];
+            beta[c] = rz_new / st.rz;
+            // Lanczos coefficients (Saad, Iterative Methods, Sec. 6.7.3).
+            st.t_diag.push_back(1.0 / alpha[c] + (st.t_diag.empty() ? 0.0 : st.beta_prev / st.alpha_prev));
+            if (st.t_diag.size() > 1) st.t_off.push_back(std::sqrt(st.beta_prev) / st.alpha_prev);
+            st.ritz_stale = true;
+            st.alpha_prev = alpha[c];
+            st.beta_prev = beta[c];
+            st.rz = rz_new;
+            double lam = std::min(st.ritz, st.ritz_floor);
+            double est = st.estimate(st.rz, std::isfinite(lam) ? lam : st.t_diag.front());
+            if (est <= tol || k == 0) {
+                lam = st.lambda();
+                est = st.estimate(st.rz, lam);
+            }
+            if (est <= tol) {
+                // Confirm with the true residual: the recursive one drifts (far, in float).
+                const double rz_true = s.true_residual(c);
+                if (!std::isfinite(rz_true)) breakdown(k, "the true residual is not finite");
+                const double est_true = st.estimate(rz_true, lam);
+                if (est_true <= tol) {
+                    st.result.converged = true;
+                    st.result.estimated_relative_error = est_true;
+                    st.result.iterations = k + 1;
+                    st.active = false;
+                    continue;
+                }
+                ++st.result.residual_replacements;
+                const bool stagnating = est_true > 0.5 * st.last_restart_estimate;
+                st.last_restart_estimate = est_true;
+                st.result.estimated_relative_error = est_true;
+                if (stagnating || st.result.residual_replacements > 8) {
+                    st.result.iterations = k + 1;
+                    st.active = false;
+                    continue;
+                }
+                st.rz = rz_true;
+                for (size_t i = 0; i < n; ++i) s.p[3 * i + c] = s.z[3 * i + c];
+                st.ritz_floor = lam;
+                st.t_diag.clear();
+                st.t_off.clear();
+                st.ritz = std::numeric_limits<double>::infinity();
+                continue;
+            }
+            st.result.estimated_relative_error = est;
+            update_p[c] = true;
+        }
+        if (update_p[0] || update_p[1] || update_p[2]) {
+            std::array<Scalar, 3> bt{};
+            for (int c = 0; c < 3; ++c) bt[c] = static_cast<Scalar>(beta[c]);
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t i = range.begin(); i != range.end(); ++i)
+                    for (int c = 0; c < 3; ++c)
+                        if (update_p[c]) s.p[3 * i + c] = s.z[3 * i + c] + bt[c] * s.p[3 * i + c];
+            });
+        }
+    }
+    for (int c = 0; c < 3; ++c) {
+        ChannelState& st = ch[c];
+        if (st.active) {  // ran out of iterations
+            st.result.iterations = k;
+            st.result.estimated_relative_error = st.estimate(st.rz, st.lambda());
+        }
+        if (!st.t_diag.empty() || std::isfinite(st.ritz_floor)) st.result.smallest_eigenvalue_estimate = st.lambda();
+        results[c] = st.result;
+    }
+    for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c) phi[i][c] = s.x[3 * i + c];
+    return results;
 }
 
 }  // namespace
@@ -41,12 +327,34 @@ void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std
     for (const auto& v : q)
         for (double c : v)
             if (!std::isfinite(c)) throw InvalidArgumentError("solve_diffusion: the incident light q is not finite");
-    std::vector<double> b(n);
+    std::array<std::vector<double>, 3> b;
     for (int c = 0; c < 3; ++c) {
-        diffusion_right_hand_side(matrix, q, c, b);
-        const ConjugateGradientResult r = options.precision == SolverPrecision::Float
-                                              ? solve_channel<float>(matrix, b, c, options, solution.phi)
-                                              : solve_channel<double>(matrix, b, c, options, solution.phi);
+        b[c].resize(n);
+        diffusion_right_hand_side(matrix, q, c, b[c]);
+    }
+    // Float: the three channels in one loop (solve_rgb); the interleaved float values and the pattern
+    // (~16 bytes per nonzero) stay in the last-level cache across iterations at 500K tets. Double:
+    // one channel after the other on the assembled values (no copy); interleaved, the three double
+    // channels (28 bytes per nonzero) no longer fit in that cache and the fused loop was measured
+    // slower (bench/solver_bench.cpp, BM_JacobiCg<Double> vs 3x BM_JacobiCgDoubleOneChannel).
+    std::array<ConjugateGradientResult, 3> results;
+    if (options.precision == SolverPrecision::Float) {
+        results = solve_rgb<float>(matrix, b, options, solution.phi);
+    } else {
+        ConjugateGradientOptions cg;
+        cg.relative_tolerance = options.relative_tolerance;
+        cg.max_iterations = options.max_iterations;
+        std::vector<double> x(n);
+        for (int c = 0; c < 3; ++c) {
+            for (size_t i = 0; i < n; ++i) x[i] = solution.phi[i][c];
+            const CsrMatrixView<double> view{n, matrix.offsets.data(), matrix.columns.data(), matrix.values[c].data()};
+            results[c] = solve_jacobi_cg<double>(view, b[c], x, cg);
+            for (size_t i = 0; i < n; ++i) solution.phi[i][c] = x[i];
+            if (!results[c].converged) break;  // reported below, as before, without solving the rest
+        }
+    }
+    for (int c = 0; c < 3; ++c) {
+        const ConjugateGradientResult& r = results[c];
         solution.iterations[c] = r.iterations;
         solution.estimated_relative_error[c] = r.estimated_relative_error;
         if (!r.converged) {
