@@ -10,14 +10,14 @@
 //
 // Run: build-solver-bench/bench/solver_bench (configure with -DWAXWORK_BUILD_BENCH=ON). Three-channel
 // solves: Float runs the channels in one loop, Double one after the other (diffusion_solve.cpp says why).
-#include "io/surface_reader.h"
+#include "bench_meshes.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
+#include "solver/lighting.h"
 #include "solver/material.h"
 #include "solver/reference_solvers.h"
 #include "tetops/connectivity.h"
-#include "tetops/tetrahedralize.h"
 
 #include <benchmark/benchmark.h>
 
@@ -47,10 +47,7 @@ const Scene& scene(size_t target_tets) {
     if (slot) return *slot;
     slot = std::make_unique<Scene>();
     Scene& s = *slot;
-    const auto surface = load_closed_surface(std::string(WAXWORK_ASSET_DIR) + "/meshes/spot.obj").surface;
-    MeshingOptions options;
-    options.sizing.target_tets = target_tets;
-    s.mesh = tetrahedralize(surface, options).mesh;
+    s.mesh = bench::spot_volume(target_tets);
     s.conn = build_connectivity(s.mesh);
     const auto box = bounding_box(s.mesh);
     s.mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();
@@ -58,19 +55,12 @@ const Scene& scene(size_t target_tets) {
     AssemblyOptions assembly;
     assembly.mm_per_unit = s.mm_per_unit;
     s.matrix = assemble_diffusion_matrix(s.mesh, s.conn, s.materials, assembly);
-    // Vertex normals from the outward boundary faces.
-    std::vector<Eigen::Vector3d> normals(s.mesh.vertex_count(), Eigen::Vector3d::Zero());
-    for (const auto& f : s.conn.boundary_faces) {
-        const auto& p = s.mesh.positions;
-        const Eigen::Vector3d n = (p[f.vertices[1]] - p[f.vertices[0]]).cross(p[f.vertices[2]] - p[f.vertices[0]]);
-        for (int32_t v : f.vertices) normals[v] += n;
-    }
-    s.q.assign(s.mesh.vertex_count(), {0, 0, 0});
-    for (int32_t v : s.conn.boundary_vertices) {
-        const double c = normals[v].normalized().z();
-        const double value = c > 0 ? c * fresnel_transmittance(c, 1.5) : 0.0;
-        s.q[v] = {value, value, value};
-    }
+    // One white directional light travelling along -z, without shadows: q = n.z F_t(n.z) on the
+    // boundary (the solve's cost does not depend on the light, only its right-hand side does).
+    Lighting lighting;
+    lighting.lights.push_back(Light{LightType::Directional, Eigen::Vector3d(0, 0, -1), {1, 1, 1}});
+    lighting.shadows = false;
+    s.q = incident_light(s.mesh, s.conn, s.materials, lighting);
     std::vector<double> b(s.matrix.size());
     diffusion_right_hand_side(s.matrix, s.q, 1, b);
     const Eigen::SparseMatrix<double> a = to_eigen_sparse(s.matrix, 1);

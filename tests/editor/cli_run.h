@@ -1,6 +1,7 @@
 // Runs the waxwork executable from tests and captures what it prints.
 #pragma once
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -41,6 +42,9 @@ inline CommandResult run_waxwork(const std::string& arguments) {
     std::filesystem::remove(err_path);
     return result;
 }
+
+// Number of lines in captured output (a one-line error message has exactly one).
+inline size_t line_count(const std::string& s) { return static_cast<size_t>(std::count(s.begin(), s.end(), '\n')); }
 
 // A fresh, empty scratch directory for one test.
 inline std::filesystem::path scratch_dir(const std::string& name) {

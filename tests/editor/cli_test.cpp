@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 const std::string kAssets = WAXWORK_ASSET_DIR;
 const std::string kShared = WAXWORK_SHARED_DIR;
 
-size_t line_count(const std::string& s) { return static_cast<size_t>(std::count(s.begin(), s.end(), '\n')); }
+using testing::line_count;
 
 TEST(Cli, HelpOnEveryCommand) {
     for (const std::string command : {"", "mesh", "info"}) {

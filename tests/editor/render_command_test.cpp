@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 const std::string kAssets = WAXWORK_ASSET_DIR;
 constexpr const char* kHeader = "x,y,z,boundary,q_r,q_g,q_b,phi_r,phi_g,phi_b,lo_r,lo_g,lo_b";
 
-size_t line_count(const std::string& s) { return static_cast<size_t>(std::count(s.begin(), s.end(), '\n')); }
+using testing::line_count;
 
 struct FieldRow {
     double x, y, z;
