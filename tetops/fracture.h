@@ -1,0 +1,65 @@
+// Breaking a volume into pieces (issue 6, part 3) and putting pieces back together.
+//
+// A piece is a set of tets with its own rigid transform (TetMesh::piece_ids, piece_transforms). Pieces
+// share no vertices: fracturing duplicates every vertex on a crack so each piece can move on its own;
+// welding merges coincident vertices of pieces whose crack faces meet again.
+//
+// CONTRACT HEADER: written by the lead so editor/ can be built against it while tetops/fracture.cpp
+// is implemented. Signatures may gain options but not lose them.
+#pragma once
+
+#include "tetops/tet_mesh.h"
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace waxwork {
+
+struct FractureOptions {
+    // Split tets crossed by a cell wall so crack faces are flat (exact_cut.h); false: cracks follow
+    // existing tet faces (each tet goes to the cell of its centroid).
+    bool exact = true;
+    // Pieces with fewer tets than this are merged into the neighbouring piece they share most faces
+    // with (no dust).
+    int min_piece_tets = 8;
+};
+
+struct FractureResult {
+    int pieces_before = 0;
+    int pieces_after = 0;
+    size_t vertices_duplicated = 0;  // vertices added on crack faces
+    size_t tets_split = 0;           // tets split along cell walls (exact mode)
+    double min_dihedral_deg = 0;     // of the whole mesh afterwards
+};
+
+// `count` seed points scattered inside the volume (world space), deterministic for `seed`.
+// Throws InvalidArgumentError for count < 1 or an empty mesh.
+std::vector<Eigen::Vector3d> scatter_fracture_seeds(const TetMesh& mesh, int count, uint32_t seed);
+
+// Breaks every existing piece along the Voronoi cells of `seeds` (world space): each cell's part of
+// each piece becomes a piece (new pieces take their parent's transform). Original ids and materials
+// follow their tets (split tets keep their parent's original id and material).
+FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> seeds,
+                                const FractureOptions& options = {});
+
+// Breaks along planes n.x = d (world space): each planar side region becomes a piece.
+FractureResult fracture_planes(TetMesh& mesh, std::span<const Eigen::Vector4d> planes,
+                               const FractureOptions& options = {});
+
+// Sets the transform of one piece. Throws InvalidArgumentError for a bad piece index or a
+// non-rigid / non-finite transform.
+void set_piece_transform(TetMesh& mesh, int piece, const RigidTransform& transform);
+
+struct WeldResult {
+    int pieces_before = 0;
+    int pieces_after = 0;
+    size_t vertices_merged = 0;
+};
+
+// Merges pieces whose boundary faces coincide in world space (within `tolerance`, world units):
+// coincident vertices become one, the pieces become one piece (the lowest index's transform; the
+// others' rest positions are re-expressed in it). Pieces that do not touch stay apart.
+WeldResult weld_touching_pieces(TetMesh& mesh, double tolerance);
+
+}  // namespace waxwork
