@@ -47,11 +47,6 @@ InterpolationOperator transpose(const InterpolationOperator& p, size_t coarse_ro
     return t;
 }
 
-// Per-thread scratch indexed by coarse vertex (the sparse accumulator of a row-by-row product).
-struct Marker {
-    std::vector<int32_t> mark;
-};
-
 }  // namespace
 
 // The smoother's arrays and the work vectors of one level in the V-cycle's precision.
@@ -71,6 +66,9 @@ struct MultigridPreconditioner::Level {
     std::array<double, 3> upper{};                 // max of row_bound
     const InterpolationOperator* p = nullptr;      // to this level from the next (null on the coarsest)
     InterpolationOperator pt;                      // P^T
+    // A P (this level's operator times P, all channels), kept for partial updates.
+    std::vector<int32_t> ap_offsets{0}, ap_columns;
+    std::array<std::vector<double>, 3> ap_values;
     MultigridLevelData<float> f;
     MultigridLevelData<double> d;
     std::array<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>, 3> coarsest;  // coarsest level only
@@ -114,7 +112,7 @@ MultigridPreconditioner::MultigridPreconditioner(const MultiresHierarchy& hierar
         next->n = hierarchy.levels[l + 1].size();
         levels_[l]->pt = transpose(*levels_[l]->p, next->n);
         levels_.push_back(std::move(next));
-        build_galerkin_pattern(l + 1);
+        build_product_pattern(l + 1);
         std::vector<int32_t> all(levels_[l + 1]->n);
         std::iota(all.begin(), all.end(), 0);
         compute_galerkin_rows(l + 1, all);
@@ -145,87 +143,183 @@ MultigridPreconditioner::MultigridPreconditioner(const MultiresHierarchy& hierar
     setup_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-void MultigridPreconditioner::build_galerkin_pattern(size_t l) {
-    const Level& fine = *levels_[l - 1];
+// Per-thread sparse accumulator over the columns of one product row.
+struct MultigridPreconditioner::Accumulator {
+    std::vector<int32_t> tag;                // row currently using the column, or -1
+    std::vector<int32_t> slot;               // where the column sits in the current row
+    std::vector<int32_t> touched;            // columns of the current row in first-touch order
+    std::array<std::vector<double>, 3> sum;  // per channel, indexed by column
+    explicit Accumulator(size_t columns) : tag(columns, -1), slot(columns, -1) {
+        for (auto& v : sum) v.assign(columns, 0.0);
+    }
+};
+
+void MultigridPreconditioner::build_product_pattern(size_t l) {
+    Level& fine = *levels_[l - 1];
     Level& coarse = *levels_[l];
     const InterpolationOperator& p = *fine.p;
-    const InterpolationOperator& pt = fine.pt;
-    const size_t m = coarse.n;
-    tbb::enumerable_thread_specific<Marker> markers([m] { return Marker{std::vector<int32_t>(m, -1)}; });
-    // Row I of P^T A P reaches K through I -P^T- v -A- j -P- K. Two passes over the same walk (count,
-    // then fill) instead of per-row containers: no allocation per row.
-    auto walk = [&](size_t row, std::vector<int32_t>& mark, auto&& emit) {
-        const auto tag = static_cast<int32_t>(row);
-        for (int32_t a = pt.offsets[row]; a < pt.offsets[row + 1]; ++a) {
-            const auto v = static_cast<size_t>(pt.columns[static_cast<size_t>(a)]);
+    const size_t n = fine.n, m = coarse.n;
+    // A P: row v reaches K through v -A- j -P- K. Two passes over the same walk (count, then fill)
+    // instead of per-row containers: no allocation per row.
+    {
+        tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
+        auto walk = [&](size_t v, Accumulator& acc, auto&& emit) {
+            const auto tag = static_cast<int32_t>(v);
             for (int32_t e = fine.offsets[v]; e < fine.offsets[v + 1]; ++e) {
                 const auto j = static_cast<size_t>(fine.columns[static_cast<size_t>(e)]);
                 for (int32_t q = p.offsets[j]; q < p.offsets[j + 1]; ++q) {
-                    const int32_t k = p.columns[static_cast<size_t>(q)];
-                    if (mark[static_cast<size_t>(k)] != tag) {
-                        mark[static_cast<size_t>(k)] = tag;
-                        emit(k);
+                    const auto k = static_cast<size_t>(p.columns[static_cast<size_t>(q)]);
+                    if (acc.tag[k] != tag) {
+                        acc.tag[k] = tag;
+                        emit(static_cast<int32_t>(k));
                     }
                 }
             }
-        }
+        };
+        fine.ap_offsets.assign(n + 1, 0);
+        for_rows(n, [&](size_t v) {
+            int32_t count = 0;
+            walk(v, scratch.local(), [&](int32_t) { ++count; });
+            fine.ap_offsets[v + 1] = count;
+        });
+        std::partial_sum(fine.ap_offsets.begin(), fine.ap_offsets.end(), fine.ap_offsets.begin());
+        fine.ap_columns.resize(static_cast<size_t>(fine.ap_offsets[n]));
+        for (auto& acc : scratch) std::fill(acc.tag.begin(), acc.tag.end(), -1);  // pass two walks the same rows
+        for_rows(n, [&](size_t v) {
+            auto out = static_cast<size_t>(fine.ap_offsets[v]);
+            walk(v, scratch.local(), [&](int32_t k) { fine.ap_columns[out++] = k; });
+        });
+        for (auto& v : fine.ap_values) v.assign(fine.ap_columns.size(), 0.0);
+    }
+    std::vector<int32_t> all(n);
+    std::iota(all.begin(), all.end(), 0);
+    compute_product_rows(l, all);
+
+    // P^T (A P), full: accumulated row by row; then the kept pattern (see drop_tolerance).
+    tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
+    std::array<std::vector<double>, 3> diagonal;
+    for (auto& d : diagonal) d.assign(m, 0.0);
+    for_rows(m, [&](size_t row) {
+        Accumulator& acc = scratch.local();
+        accumulate_galerkin_row(l, row, acc);
+        for (size_t ch = 0; ch < 3; ++ch) diagonal[ch][row] = acc.sum[ch][row];
+        clear(acc);
+    });
+    const double theta = options_.drop_tolerance;
+    auto kept = [&](size_t row, size_t k, const Accumulator& acc) {
+        if (k == row) return true;
+        for (size_t ch = 0; ch < 3; ++ch)
+            if (std::abs(acc.sum[ch][k]) >= theta * std::sqrt(std::abs(diagonal[ch][row] * diagonal[ch][k]))) return true;
+        return false;
     };
     coarse.offsets.assign(m + 1, 0);
     for_rows(m, [&](size_t row) {
-        auto& mark = markers.local().mark;
+        Accumulator& acc = scratch.local();
+        accumulate_galerkin_row(l, row, acc);
         int32_t count = 0;
-        walk(row, mark, [&](int32_t) { ++count; });
+        for (int32_t k : acc.touched) count += kept(row, static_cast<size_t>(k), acc) ? 1 : 0;
         coarse.offsets[row + 1] = count;
+        clear(acc);
     });
     std::partial_sum(coarse.offsets.begin(), coarse.offsets.end(), coarse.offsets.begin());
     coarse.columns.resize(static_cast<size_t>(coarse.offsets[m]));
     coarse.diagonal.assign(m, -1);
-    for (auto& mk : markers) std::fill(mk.mark.begin(), mk.mark.end(), -1);  // pass two walks the same rows
     for_rows(m, [&](size_t row) {
-        auto& mark = markers.local().mark;
+        Accumulator& acc = scratch.local();
+        accumulate_galerkin_row(l, row, acc);
         auto out = static_cast<size_t>(coarse.offsets[row]);
-        walk(row, mark, [&](int32_t k) { coarse.columns[out++] = k; });
+        for (int32_t k : acc.touched)
+            if (kept(row, static_cast<size_t>(k), acc)) coarse.columns[out++] = k;
+        clear(acc);
         auto* begin = coarse.columns.data() + coarse.offsets[row];
         auto* end = coarse.columns.data() + coarse.offsets[row + 1];
         std::sort(begin, end);
-        const auto* diag = std::lower_bound(begin, end, static_cast<int32_t>(row));
-        coarse.diagonal[row] = static_cast<int32_t>(diag - coarse.columns.data());
+        coarse.diagonal[row] = static_cast<int32_t>(std::lower_bound(begin, end, static_cast<int32_t>(row)) - coarse.columns.data());
     });
     for (auto& v : coarse.values) v.assign(coarse.columns.size(), 0.0);
 }
 
-void MultigridPreconditioner::compute_galerkin_rows(size_t l, std::span<const int32_t> rows) {
+void MultigridPreconditioner::clear(Accumulator& acc) {
+    for (int32_t k : acc.touched) {
+        acc.tag[static_cast<size_t>(k)] = -1;
+        for (auto& s : acc.sum) s[static_cast<size_t>(k)] = 0.0;
+    }
+    acc.touched.clear();
+}
+
+// Row `row` of P^T (A P) into acc (all three channels), summed in a fixed order (ascending v of
+// P^T's row, then A P's row): deterministic.
+void MultigridPreconditioner::accumulate_galerkin_row(size_t l, size_t row, Accumulator& acc) const {
     const Level& fine = *levels_[l - 1];
-    Level& coarse = *levels_[l];
-    const InterpolationOperator& p = *fine.p;
     const InterpolationOperator& pt = fine.pt;
-    const size_t m = coarse.n;
-    tbb::enumerable_thread_specific<Marker> slots([m] { return Marker{std::vector<int32_t>(m, -1)}; });
+    const auto tag = static_cast<int32_t>(row);
+    for (int32_t a = pt.offsets[row]; a < pt.offsets[row + 1]; ++a) {
+        const auto v = static_cast<size_t>(pt.columns[static_cast<size_t>(a)]);
+        const double w = pt.weights[static_cast<size_t>(a)];
+        for (int32_t e = fine.ap_offsets[v]; e < fine.ap_offsets[v + 1]; ++e) {
+            const auto k = static_cast<size_t>(fine.ap_columns[static_cast<size_t>(e)]);
+            if (acc.tag[k] != tag) {
+                acc.tag[k] = tag;
+                acc.touched.push_back(static_cast<int32_t>(k));
+            }
+            for (size_t ch = 0; ch < 3; ++ch) acc.sum[ch][k] += w * fine.ap_values[ch][static_cast<size_t>(e)];
+        }
+    }
+}
+
+void MultigridPreconditioner::compute_product_rows(size_t l, std::span<const int32_t> rows) {
+    Level& fine = *levels_[l - 1];
+    const InterpolationOperator& p = *fine.p;
+    const size_t m = levels_[l]->n;
+    tbb::enumerable_thread_specific<std::vector<int32_t>> slots([m] { return std::vector<int32_t>(m, -1); });
     for_rows(rows.size(), [&](size_t index) {
-        const auto row = static_cast<size_t>(rows[index]);
-        auto& slot = slots.local().mark;
-        const auto begin = static_cast<size_t>(coarse.offsets[row]), end = static_cast<size_t>(coarse.offsets[row + 1]);
-        for (size_t s = begin; s < end; ++s) slot[static_cast<size_t>(coarse.columns[s])] = static_cast<int32_t>(s);
-        for (auto& v : coarse.values)
-            std::fill(v.begin() + static_cast<std::ptrdiff_t>(begin), v.begin() + static_cast<std::ptrdiff_t>(end), 0.0);
-        // A fixed summation order (ascending v, then the fine row, then P's row): deterministic.
-        for (int32_t a = pt.offsets[row]; a < pt.offsets[row + 1]; ++a) {
-            const auto v = static_cast<size_t>(pt.columns[static_cast<size_t>(a)]);
-            const double wv = pt.weights[static_cast<size_t>(a)];
-            for (int32_t e = fine.offsets[v]; e < fine.offsets[v + 1]; ++e) {
-                const auto j = static_cast<size_t>(fine.columns[static_cast<size_t>(e)]);
-                const double m0 = wv * fine.values[0][static_cast<size_t>(e)];
-                const double m1 = wv * fine.values[1][static_cast<size_t>(e)];
-                const double m2 = wv * fine.values[2][static_cast<size_t>(e)];
-                for (int32_t q = p.offsets[j]; q < p.offsets[j + 1]; ++q) {
-                    const auto s = static_cast<size_t>(slot[static_cast<size_t>(p.columns[static_cast<size_t>(q)])]);
-                    const double w = p.weights[static_cast<size_t>(q)];
-                    coarse.values[0][s] += m0 * w;
-                    coarse.values[1][s] += m1 * w;
-                    coarse.values[2][s] += m2 * w;
-                }
+        const auto v = static_cast<size_t>(rows[index]);
+        auto& slot = slots.local();
+        const auto begin = static_cast<size_t>(fine.ap_offsets[v]), end = static_cast<size_t>(fine.ap_offsets[v + 1]);
+        for (size_t s = begin; s < end; ++s) slot[static_cast<size_t>(fine.ap_columns[s])] = static_cast<int32_t>(s);
+        for (auto& values : fine.ap_values)
+            std::fill(values.begin() + static_cast<std::ptrdiff_t>(begin), values.begin() + static_cast<std::ptrdiff_t>(end), 0.0);
+        for (int32_t e = fine.offsets[v]; e < fine.offsets[v + 1]; ++e) {
+            const auto j = static_cast<size_t>(fine.columns[static_cast<size_t>(e)]);
+            for (int32_t q = p.offsets[j]; q < p.offsets[j + 1]; ++q) {
+                const auto s = static_cast<size_t>(slot[static_cast<size_t>(p.columns[static_cast<size_t>(q)])]);
+                const double w = p.weights[static_cast<size_t>(q)];
+                for (size_t ch = 0; ch < 3; ++ch) fine.ap_values[ch][s] += fine.values[ch][static_cast<size_t>(e)] * w;
             }
         }
+    });
+}
+
+void MultigridPreconditioner::compute_galerkin_rows(size_t l, std::span<const int32_t> rows) {
+    Level& coarse = *levels_[l];
+    const size_t m = coarse.n;
+    tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
+    for_rows(rows.size(), [&](size_t index) {
+        const auto row = static_cast<size_t>(rows[index]);
+        Accumulator& acc = scratch.local();
+        accumulate_galerkin_row(l, row, acc);
+        // Dropped entries are added, as absolute values, to the diagonal: the correction
+        // diag(sum |dropped|) - dropped is diagonally dominant, so the operator stays positive definite.
+        const auto begin = static_cast<size_t>(coarse.offsets[row]), end = static_cast<size_t>(coarse.offsets[row + 1]);
+        for (size_t s = begin; s < end; ++s) acc.slot[static_cast<size_t>(coarse.columns[s])] = static_cast<int32_t>(s);
+        std::array<double, 3> lumped{};
+        for (size_t ch = 0; ch < 3; ++ch)
+            std::fill(coarse.values[ch].begin() + static_cast<std::ptrdiff_t>(begin),
+                      coarse.values[ch].begin() + static_cast<std::ptrdiff_t>(end), 0.0);
+        for (int32_t k : acc.touched) {
+            const int32_t s = acc.slot[static_cast<size_t>(k)];
+            const bool in_pattern = s >= static_cast<int32_t>(begin) && s < static_cast<int32_t>(end) &&
+                                    coarse.columns[static_cast<size_t>(s)] == k;
+            for (size_t ch = 0; ch < 3; ++ch) {
+                const double value = acc.sum[ch][static_cast<size_t>(k)];
+                if (in_pattern)
+                    coarse.values[ch][static_cast<size_t>(s)] = value;
+                else
+                    lumped[ch] += std::abs(value);
+            }
+        }
+        for (size_t ch = 0; ch < 3; ++ch) coarse.values[ch][static_cast<size_t>(coarse.diagonal[row])] += lumped[ch];
+        clear(acc);
     });
 }
 
@@ -314,6 +408,7 @@ void MultigridPreconditioner::update_values(std::span<const int32_t> changed_row
         // Coarse row I depends on the fine rows v with P_vI != 0 (and, by symmetry of A, on nothing
         // else: a changed entry a_vj sits in the changed row v).
         const InterpolationOperator& p = *levels_[l - 1]->p;
+        compute_product_rows(l, rows);
         touched.assign(levels_[l]->n, 0);
         for (int32_t v : rows)
             for (int32_t q = p.offsets[static_cast<size_t>(v)]; q < p.offsets[static_cast<size_t>(v) + 1]; ++q)

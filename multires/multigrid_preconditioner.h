@@ -42,6 +42,9 @@ struct MultigridOptions {
     int smoothing_steps = 2;         // Chebyshev degree, the same before and after the coarse correction
     double chebyshev_ratio = 8.0;    // the polynomial damps [upper / ratio, upper]
     bool single_precision = true;    // V-cycle vectors and smoothing matrices in float
+    // Coarse entries with |a_ij| < drop_tolerance sqrt(a_ii a_jj) in every channel are dropped from the
+    // Galerkin operator and their absolute values added to the diagonal (0: exact Galerkin products).
+    double drop_tolerance = 0.0;
 };
 
 class MultigridPreconditioner {
@@ -73,7 +76,11 @@ public:
 
 private:
     struct Level;
-    void build_galerkin_pattern(size_t l);
+    struct Accumulator;
+    void build_product_pattern(size_t l);
+    void compute_product_rows(size_t l, std::span<const int32_t> rows);
+    void accumulate_galerkin_row(size_t l, size_t row, Accumulator& acc) const;
+    static void clear(Accumulator& acc);
     void compute_galerkin_rows(size_t l, std::span<const int32_t> rows);
     void prepare_smoother(size_t l, std::span<const int32_t> rows);
     void factorize_coarsest();
