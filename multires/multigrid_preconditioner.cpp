@@ -298,8 +298,7 @@ void MultigridPreconditioner::compute_galerkin_rows(size_t l, std::span<const in
         const auto row = static_cast<size_t>(rows[index]);
         Accumulator& acc = scratch.local();
         accumulate_galerkin_row(l, row, acc);
-        // Dropped entries are added, as absolute values, to the diagonal: the correction
-        // diag(sum |dropped|) - dropped is diagonally dominant, so the operator stays positive definite.
+        // Dropped entries go to the diagonal (MultigridOptions::lumping says how).
         const auto begin = static_cast<size_t>(coarse.offsets[row]), end = static_cast<size_t>(coarse.offsets[row + 1]);
         for (size_t s = begin; s < end; ++s) acc.slot[static_cast<size_t>(coarse.columns[s])] = static_cast<int32_t>(s);
         std::array<double, 3> lumped{};
@@ -315,7 +314,7 @@ void MultigridPreconditioner::compute_galerkin_rows(size_t l, std::span<const in
                 if (in_pattern)
                     coarse.values[ch][static_cast<size_t>(s)] = value;
                 else
-                    lumped[ch] += std::abs(value);
+                    lumped[ch] += options_.lumping == DropLumping::Absolute ? std::abs(value) : value;
             }
         }
         for (size_t ch = 0; ch < 3; ++ch) coarse.values[ch][static_cast<size_t>(coarse.diagonal[row])] += lumped[ch];

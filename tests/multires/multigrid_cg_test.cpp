@@ -72,7 +72,9 @@ TEST(MultigridPreconditioner, CoarseOperatorsAreGalerkinProducts) {
     const auto s = testing::make_test_system(6);
     const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(20));
     ASSERT_GE(h.level_count(), 3u);
-    const MultigridPreconditioner mg(h);
+    MultigridOptions exact;
+    exact.drop_tolerance = 0;
+    const MultigridPreconditioner mg(h, exact);
     ASSERT_EQ(mg.level_count(), h.level_count());
     for (int channel = 0; channel < 3; ++channel) {
         for (size_t l = 0; l + 1 < h.level_count(); ++l) {
@@ -86,12 +88,15 @@ TEST(MultigridPreconditioner, CoarseOperatorsAreGalerkinProducts) {
 }
 
 // B assembled column by column from apply(): symmetric to rounding and positive definite.
-void expect_symmetric_positive(bool single_precision, double symmetry_tolerance) {
+void expect_symmetric_positive(bool single_precision, double symmetry_tolerance, double drop_tolerance,
+                               DropLumping lumping) {
     const auto s = testing::make_test_system(5);  // 216 vertices
     const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(20));
     ASSERT_GE(h.level_count(), 3u);
     MultigridOptions options;
     options.single_precision = single_precision;
+    options.drop_tolerance = drop_tolerance;
+    options.lumping = lumping;
     MultigridPreconditioner mg(h, options);
     const size_t n = h.levels[0].size();
     for (int channel = 0; channel < 3; ++channel) {
@@ -115,8 +120,20 @@ void expect_symmetric_positive(bool single_precision, double symmetry_tolerance)
     }
 }
 
-TEST(MultigridPreconditioner, IsSymmetricPositiveDefiniteInDouble) { expect_symmetric_positive(false, 1e-12); }
-TEST(MultigridPreconditioner, IsSymmetricToFloatRoundingInSingle) { expect_symmetric_positive(true, 1e-5); }
+TEST(MultigridPreconditioner, ExactGalerkinIsSymmetricPositiveDefiniteInDouble) {
+    expect_symmetric_positive(false, 1e-12, 0.0, DropLumping::RowSum);
+}
+TEST(MultigridPreconditioner, DefaultIsSymmetricPositiveDefiniteInDouble) {
+    const MultigridOptions defaults;
+    expect_symmetric_positive(false, 1e-12, defaults.drop_tolerance, defaults.lumping);
+}
+TEST(MultigridPreconditioner, AbsoluteLumpingIsSymmetricPositiveDefinite) {
+    expect_symmetric_positive(false, 1e-12, 0.1, DropLumping::Absolute);
+}
+TEST(MultigridPreconditioner, DefaultIsSymmetricToFloatRoundingInSingle) {
+    const MultigridOptions defaults;
+    expect_symmetric_positive(true, 1e-5, defaults.drop_tolerance, defaults.lumping);
+}
 
 TEST(MultigridCg, ConvergesToTheLevel0Solution) {
     const auto s = testing::make_test_system(12);  // 2197 vertices
@@ -209,7 +226,10 @@ TEST(MultigridPreconditioner, PartialUpdateAfterPaintingEqualsARebuild) {
     auto s = testing::make_test_system(8);
     MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(30));
     ASSERT_GE(h.level_count(), 3u);
-    MultigridPreconditioner updated(h);
+    // Exact products: with dropping, the kept pattern is chosen at build time and an update keeps it.
+    MultigridOptions exact;
+    exact.drop_tolerance = 0;
+    MultigridPreconditioner updated(h, exact);
     std::vector<TetMaterial> materials(s.mesh.tet_count(), TetMaterial{{0.01, 0.05, 0.2}, {1, 1, 1}, 1.3});
     std::vector<int32_t> painted;
     for (int32_t t = 0; t < 40; ++t) {
@@ -220,7 +240,7 @@ TEST(MultigridPreconditioner, PartialUpdateAfterPaintingEqualsARebuild) {
     ASSERT_LT(rows.size(), s.matrix.size() / 2);
     h.levels[0].values = s.matrix.values;
     updated.update_values(rows);
-    MultigridPreconditioner rebuilt(h);
+    MultigridPreconditioner rebuilt(h, exact);
     for (size_t l = 0; l < h.level_count(); ++l)
         for (int channel = 0; channel < 3; ++channel) {
             const auto a = updated.view(l, channel), b = rebuilt.view(l, channel);
