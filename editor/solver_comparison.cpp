@@ -64,13 +64,15 @@ public:
         out.name = name;
         const auto start = std::chrono::steady_clock::now();
         std::vector<std::pair<int, Run>> runs;  // every cap measured, for the bisection
+        run(solve, 0);  // warm-up: first-touch page faults and lazy initialisation are not the solver's time
+        std::vector<std::pair<double, double>> points;
         int cap = 0;
         double best_error = std::numeric_limits<double>::infinity();
         int stalled = 0;
         for (;;) {
             const Run r = run(solve, cap);
             runs.emplace_back(cap, r);
-            if (out.curve.empty() || r.ms > out.curve.back().first) out.curve.emplace_back(r.ms, r.error);
+            points.emplace_back(r.ms, r.error);
             stalled = r.error < 0.95 * best_error ? 0 : stalled + 1;
             best_error = std::min(best_error, r.error);
             if (r.error <= options_.floor_error || stalled >= 4 || cap >= 200000 ||
@@ -78,6 +80,11 @@ public:
                 break;
             cap = std::max(cap + 1, static_cast<int>(std::ceil(cap * 1.25)));
         }
+        // Monotone in time: from the last point backwards, keep a point only if it ran faster than every
+        // point kept after it (noise that made a small cap slow drops that point, not the later ones).
+        for (size_t i = points.size(); i-- > 0;)
+            if (out.curve.empty() || points[i].first < out.curve.back().first) out.curve.push_back(points[i]);
+        std::reverse(out.curve.begin(), out.curve.end());
         // Smallest cap reaching the target: bisection between the last cap above it and the first below.
         for (size_t i = 0; i < runs.size(); ++i) {
             if (runs[i].second.error > options_.target_error) continue;

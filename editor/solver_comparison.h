@@ -10,9 +10,9 @@
 // Curves. Each iterative solver is run from a cold start (zero; multires: its coarse-to-fine pass) for
 // an increasing schedule of iteration caps (0, 1, 2, ... growing by a quarter), all three channels per
 // run; a point is (time of that run, its error). Measuring the error is outside the timed region.
-// Runs shorter than 100 ms are repeated three times and the fastest kept. Points are kept only while
-// time increases strictly (a cap that ran faster than a smaller one, from noise, is dropped), so every
-// curve is monotone in time. A curve ends below floor_error, when the error stops falling (float's
+// Runs shorter than 100 ms are repeated three times and the fastest kept, after one untimed warm-up
+// run. A point is kept only if it ran faster than every later point (noise that made a small cap
+// slower than a larger one drops the small cap), so every curve is strictly monotone in time. A curve ends below floor_error, when the error stops falling (float's
 // precision floor), or after max_seconds of measuring. time_to_1pct_ms: the smallest cap with error
 // <= target_error is found by bisection between the curve's bracketing caps and timed again.
 //
