@@ -343,6 +343,42 @@ void BM_LightTurn10Degrees(benchmark::State& state) {
     state.counters["start_err"] = relative_error3(turn.start, turn.exact);
 }
 
+// After painting: the tets within 5% of the model's size of a surface point get a new material
+// (update_diffusion_matrix rewrites their vertices' rows). Second argument: 0 = MultiresSolver
+// update_values of all coarse rows, 1 = of the rows depending on the changed ones, 2 = multigrid
+// preconditioner rebuilt, 3 = multigrid update_values of the affected rows.
+void BM_PaintUpdate(benchmark::State& state) {
+    const Scene& s = scene(static_cast<size_t>(state.range(0)));
+    const int mode = static_cast<int>(state.range(1));
+    DiffusionMatrix matrix = s.matrix;
+    std::vector<TetMaterial> materials(s.mesh->tet_count(), material_preset("marble"));
+    const auto box = bounding_box(*s.mesh);
+    const Eigen::Vector3d centre = s.mesh->positions[static_cast<size_t>(s.conn.boundary_vertices.front())];
+    const double radius = 0.05 * (box[1] - box[0]).maxCoeff();
+    std::vector<int32_t> painted;
+    for (size_t t = 0; t < s.mesh->tet_count(); ++t)
+        if ((s.mesh->positions[static_cast<size_t>(s.mesh->tets[t][0])] - centre).norm() < radius) {
+            painted.push_back(static_cast<int32_t>(t));
+            materials[t] = material_preset("skin1");
+        }
+    const std::vector<int32_t> rows = update_diffusion_matrix(matrix, *s.mesh, s.conn, materials, painted);
+    MultiresSolver solver(s.matrix, s.mesh->positions);
+    MultiresHierarchy h = solver.hierarchy();
+    h.levels[0].values = matrix.values;
+    MultigridPreconditioner mg(h);
+    for (auto _ : state) {
+        if (mode == 0) solver.update_values(matrix);
+        if (mode == 1) solver.update_values(matrix, rows);
+        if (mode == 2) {
+            MultigridPreconditioner rebuilt(h);
+            benchmark::DoNotOptimize(rebuilt.level_count());
+        }
+        if (mode == 3) mg.update_values(rows);
+    }
+    state.counters["painted_tets"] = static_cast<double>(painted.size());
+    state.counters["changed_rows"] = static_cast<double>(rows.size());
+}
+
 #define WAXWORK_SIZES \
     Arg(50000)->Arg(500000)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()
 BENCHMARK(BM_MultiresBuild)->WAXWORK_SIZES;
@@ -361,6 +397,11 @@ BENCHMARK(BM_MultigridCgTo1Percent)
     ->MeasureProcessCPUTime();
 BENCHMARK(BM_LightTurn10Degrees)
     ->ArgsProduct({{50000, 500000}, {0, 1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
+BENCHMARK(BM_PaintUpdate)
+    ->ArgsProduct({{50000, 500000}, {0, 1, 2, 3}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
