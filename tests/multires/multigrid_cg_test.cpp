@@ -231,13 +231,7 @@ TEST(MultigridPreconditioner, PartialUpdateAfterPaintingEqualsARebuild) {
     MultigridOptions exact;
     exact.drop_tolerance = 0;
     MultigridPreconditioner updated(h, exact);
-    std::vector<TetMaterial> materials(s.mesh.tet_count(), TetMaterial{{0.01, 0.05, 0.2}, {1, 1, 1}, 1.3});
-    std::vector<int32_t> painted;
-    for (int32_t t = 0; t < 40; ++t) {
-        painted.push_back(t * 7);
-        materials[static_cast<size_t>(t * 7)] = TetMaterial{{0.3, 0.02, 0.1}, {2, 1, 0.5}, 1.4};
-    }
-    const std::vector<int32_t> rows = update_diffusion_matrix(s.matrix, s.mesh, s.connectivity, materials, painted);
+    const std::vector<int32_t> rows = testing::paint_test_system(s, 40, 7);
     ASSERT_LT(rows.size(), s.matrix.size() / 2);
     h.levels[0].values = s.matrix.values;
     updated.update_values(rows);
@@ -268,7 +262,7 @@ TEST(MultigridCg, LightTurnOfTenDegreesConvergesWithinAFewWarmIterations) {
     const auto s = testing::make_test_system(12);
     const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(100));
     MultigridPreconditioner mg(h);
-    const std::vector<TetMaterial> materials(s.mesh.tet_count(), TetMaterial{{0.01, 0.05, 0.2}, {1, 1, 1}, 1.3});
+    const std::vector<TetMaterial> materials(s.mesh.tet_count(), testing::test_material());
     auto rhs = [&](double degrees, int channel) {
         Lighting lighting;
         Light light;

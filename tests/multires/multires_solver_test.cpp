@@ -260,13 +260,7 @@ TEST(MultiresSolver, UpdateOfChangedRowsEqualsARebuild) {
     h.min_coarse_vertices = 30;
     MultiresSolver updated(s.matrix, s.mesh.positions, h);
     ASSERT_GE(updated.hierarchy().level_count(), 3u);
-    std::vector<TetMaterial> materials(s.mesh.tet_count(), TetMaterial{{0.01, 0.05, 0.2}, {1, 1, 1}, 1.3});
-    std::vector<int32_t> painted;
-    for (int32_t t = 0; t < 30; ++t) {
-        painted.push_back(t * 11);
-        materials[static_cast<size_t>(t * 11)] = TetMaterial{{0.3, 0.02, 0.1}, {2, 1, 0.5}, 1.4};
-    }
-    const std::vector<int32_t> rows = update_diffusion_matrix(s.matrix, s.mesh, s.connectivity, materials, painted);
+    const std::vector<int32_t> rows = testing::paint_test_system(s, 30, 11);
     ASSERT_LT(rows.size(), s.matrix.size() / 2);
     updated.update_values(s.matrix, rows);
     const MultiresSolver rebuilt(s.matrix, s.mesh.positions, h);

@@ -17,12 +17,15 @@ struct TestSystem {
     std::array<std::vector<double>, 3> b;  // right-hand side per channel
 };
 
+// The material of every tet of make_test_system.
+inline TetMaterial test_material() { return TetMaterial{{0.01, 0.05, 0.2}, {1, 1, 1}, 1.3}; }
+
 // A cube of n^3 * 6 tets with a different absorption per channel, lit unevenly on its boundary.
 inline TestSystem make_test_system(int n, double size = 4.0) {
     TestSystem s;
     s.mesh = make_cube_mesh(n, Eigen::Vector3d::Zero(), size);
     s.connectivity = build_connectivity(s.mesh);
-    const std::vector<TetMaterial> materials(s.mesh.tet_count(), TetMaterial{{0.01, 0.05, 0.2}, {1, 1, 1}, 1.3});
+    const std::vector<TetMaterial> materials(s.mesh.tet_count(), test_material());
     s.matrix = assemble_diffusion_matrix(s.mesh, s.connectivity, materials);
     std::vector<std::array<double, 3>> q(s.mesh.vertex_count());
     for (size_t v = 0; v < q.size(); ++v) {
@@ -35,6 +38,18 @@ inline TestSystem make_test_system(int n, double size = 4.0) {
         diffusion_right_hand_side(s.matrix, q, c, s.b[static_cast<size_t>(c)]);
     }
     return s;
+}
+
+// Paints `count` tets (every `stride`-th) of a make_test_system volume with another material and
+// updates the matrix in place; returns the rewritten rows (update_diffusion_matrix).
+inline std::vector<int32_t> paint_test_system(TestSystem& s, int count, int stride) {
+    std::vector<TetMaterial> materials(s.mesh.tet_count(), test_material());
+    std::vector<int32_t> painted;
+    for (int32_t t = 0; t < count; ++t) {
+        painted.push_back(t * stride);
+        materials[static_cast<size_t>(t * stride)] = TetMaterial{{0.3, 0.02, 0.1}, {2, 1, 0.5}, 1.4};
+    }
+    return update_diffusion_matrix(s.matrix, s.mesh, s.connectivity, materials, painted);
 }
 
 }  // namespace waxwork::testing
