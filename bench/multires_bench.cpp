@@ -9,6 +9,9 @@
 // presets), lit from +z as in solver_bench.cpp. Wall and process CPU time are both reported: the
 // machine may be shared.
 //
+// Also: MG-CG (multigrid_cg.h) to 1% and its setup, a 10-degree light turn per frame
+// (BM_LightTurn10Degrees) and the updates after painting (BM_PaintUpdate); see each benchmark.
+//
 // Run: build-bench/bench/multires_bench (configure with -DWAXWORK_BUILD_BENCH=ON).
 #include "bench_meshes.h"
 #include "multires/multigrid_cg.h"
