@@ -1,4 +1,5 @@
 // The accuracy test: the exact fluence in a homogeneous ball (seeds README) against solve_diffusion.
+#include "solver/analytic_ball.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
 #include "solver/material.h"
@@ -9,6 +10,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 namespace waxwork {
 namespace {
@@ -39,13 +41,13 @@ struct Ball {
 
 std::vector<double> light_coefficients(Light light) {
     if (light == Light::Uniform) return {1.0};
-    return test::directional_light_coefficients(kLegendreTerms, kEta);
+    return directional_ball_light_coefficients(kLegendreTerms, kEta);
 }
 
 BallResult solve_ball(const Ball& ball, Light light, Discretization disc, double mm_per_unit = 1.0) {
     std::vector<std::array<double, 3>> q(ball.mesh.vertex_count(), {0, 0, 0});
     for (int32_t v : ball.conn.boundary_vertices) {
-        const double value = light == Light::Uniform ? 1.0 : test::directional_light(ball.mesh.positions[v], kEta);
+        const double value = light == Light::Uniform ? 1.0 : directional_ball_light(ball.mesh.positions[v], kEta);
         q[v] = {value, value, value};
     }
     DiffusionOptions options;
@@ -53,7 +55,7 @@ BallResult solve_ball(const Ball& ball, Light light, Discretization disc, double
     options.relative_tolerance = 1e-7;
     options.mm_per_unit = mm_per_unit;
     const DiffusionSolution sol = solve_diffusion(ball.mesh, ball.conn, ball.materials, q, options);
-    const test::BallSolution exact(kRadius, kMua, kMusp, kEta, light_coefficients(light));
+    const AnalyticBall exact(kRadius, kMua, kMusp, kEta, light_coefficients(light));
     AssemblyOptions assembly;
     assembly.mm_per_unit = mm_per_unit;
     const auto volumes = lumped_vertex_volumes(assemble_diffusion_matrix(ball.mesh, ball.conn, ball.materials, assembly), ball.conn);
@@ -73,18 +75,18 @@ BallResult solve_ball(const Ball& ball, Light light, Discretization disc, double
 
 TEST(AnalyticBall, SeriesSatisfiesTheRobinBoundary) {
     // phi + 2 A kappa dphi/dr = 4 q / (1 - F_dr) at r = R, checked numerically on the series itself.
-    const auto ql = test::directional_light_coefficients(kLegendreTerms, kEta);
-    const test::BallSolution exact(kRadius, kMua, kMusp, kEta, ql);
+    const auto ql = directional_ball_light_coefficients(kLegendreTerms, kEta);
+    const AnalyticBall exact(kRadius, kMua, kMusp, kEta, ql);
     const double a = boundary_reflection_parameter(kEta), fdr = diffuse_fresnel_reflectance(kEta);
     for (double mu : {0.9, 0.5, -0.5}) {
         const Eigen::Vector3d dir(std::sqrt(1 - mu * mu), 0, mu);
         const double h = 1e-5;
         const double dphi = (exact(dir * kRadius) - exact(dir * (kRadius - h))) / h;
         double q = 0;
-        const auto p = test::legendre(kLegendreTerms, mu);
+        const auto p = legendre_polynomials(kLegendreTerms, mu);
         for (int l = 0; l <= kLegendreTerms; ++l) q += ql[l] * p[l];
         EXPECT_NEAR(q, std::max(mu, 0.0) * fresnel_transmittance(mu, kEta), 2e-3);
-        EXPECT_NEAR(exact(dir * kRadius) + 2 * a * exact.kappa * dphi, 4 * q / (1 - fdr), 1e-3);
+        EXPECT_NEAR(exact(dir * kRadius) + 2 * a * diffusion_coefficient(kMua, kMusp) * dphi, 4 * q / (1 - fdr), 1e-3);
     }
 }
 
@@ -157,7 +159,7 @@ TEST(AnalyticBall, FloatSolveMatchesDouble) {
     const Ball ball(3, 16000);
     std::vector<std::array<double, 3>> q(ball.mesh.vertex_count(), {0, 0, 0});
     for (int32_t v : ball.conn.boundary_vertices) {
-        const double value = test::directional_light(ball.mesh.positions[v], kEta);
+        const double value = directional_ball_light(ball.mesh.positions[v], kEta);
         q[v] = {value, 0.5 * value, 0.25 * value};
     }
     DiffusionOptions options;
