@@ -1,5 +1,6 @@
 #include "solver/analytic_ball.h"
 
+#include "solver/diffusion_matrix.h"
 #include "solver/material.h"
 #include "tetops/error.h"
 
@@ -75,6 +76,37 @@ std::vector<double> directional_ball_light_coefficients(int lmax, double eta) {
         for (int l = 0; l <= lmax; ++l) q[l] += (2 * l + 1) / 2.0 * w * value * p[l];
     }
     return q;
+}
+
+BallComparison compare_with_analytic_ball(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                          const TetMaterial& material, double radius_mm, BallLight light,
+                                          const DiffusionOptions& options) {
+    constexpr int kLegendreTerms = 60;
+    const double mm = options.mm_per_unit;
+    std::vector<std::array<double, 3>> q(mesh.vertex_count(), {0, 0, 0});
+    for (int32_t v : connectivity.boundary_vertices) {
+        const double value = light == BallLight::Uniform ? 1.0 : directional_ball_light(mesh.positions[v], material.eta);
+        q[v] = {value, value, value};
+    }
+    const std::vector<TetMaterial> materials(mesh.tet_count(), material);
+    BallComparison comparison;
+    comparison.solution = solve_diffusion(mesh, connectivity, materials, q, options);
+    const AnalyticBall exact(radius_mm, material.mua[0], material.musp[0], material.eta,
+                             light == BallLight::Uniform ? std::vector<double>{1.0}
+                                                         : directional_ball_light_coefficients(kLegendreTerms, material.eta));
+    AssemblyOptions assembly;
+    assembly.mm_per_unit = mm;
+    const std::vector<double> volumes =
+        lumped_vertex_volumes(assemble_diffusion_matrix(mesh, connectivity, materials, assembly), connectivity);
+    double error = 0, norm = 0;
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+        const double reference = exact(mesh.positions[v] * mm);
+        const double difference = comparison.solution.phi[v][0] - reference;
+        error += volumes[v] * difference * difference;
+        norm += volumes[v] * reference * reference;
+    }
+    comparison.relative_error = std::sqrt(error / norm);
+    return comparison;
 }
 
 }  // namespace waxwork

@@ -10,6 +10,10 @@
 // the l = 0 term survives a uniform light and phi is the constant 4 q_0 / (1 - F_dr).
 #pragma once
 
+#include "solver/diffusion_solve.h"
+#include "tetops/connectivity.h"
+#include "tetops/tet_mesh.h"
+
 #include <Eigen/Core>
 
 #include <vector>
@@ -49,5 +53,23 @@ double directional_ball_light(const Eigen::Vector3d& boundary_point, double eta)
 // Legendre coefficients of directional_ball_light up to lmax (composite Simpson on [0, 1], where the
 // function is smooth).
 std::vector<double> directional_ball_light_coefficients(int lmax, double eta);
+
+enum class BallLight {
+    Uniform,      // q = 1 everywhere on the boundary
+    Directional,  // directional_ball_light (a light travelling along -z)
+};
+
+struct BallComparison {
+    double relative_error = 0;  // channel 0, relative L2 weighted by lumped vertex volume
+    DiffusionSolution solution;
+};
+
+// Solves the ball problem on `mesh` (a ball centred at the origin whose radius is radius_mm in mm,
+// i.e. radius_mm / options.mm_per_unit model units) with one homogeneous material and compares
+// channel 0 with the series (60 Legendre terms for the directional light). The reference every
+// accuracy test and study uses. Throws what solve_diffusion throws.
+BallComparison compare_with_analytic_ball(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                          const TetMaterial& material, double radius_mm, BallLight light,
+                                          const DiffusionOptions& options);
 
 }  // namespace waxwork

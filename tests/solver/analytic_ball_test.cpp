@@ -39,37 +39,20 @@ struct Ball {
     }
 };
 
-std::vector<double> light_coefficients(Light light) {
-    if (light == Light::Uniform) return {1.0};
-    return directional_ball_light_coefficients(kLegendreTerms, kEta);
-}
-
 BallResult solve_ball(const Ball& ball, Light light, Discretization disc, double mm_per_unit = 1.0) {
-    std::vector<std::array<double, 3>> q(ball.mesh.vertex_count(), {0, 0, 0});
-    for (int32_t v : ball.conn.boundary_vertices) {
-        const double value = light == Light::Uniform ? 1.0 : directional_ball_light(ball.mesh.positions[v], kEta);
-        q[v] = {value, value, value};
-    }
     DiffusionOptions options;
     options.discretization = disc;
     options.relative_tolerance = 1e-7;
     options.mm_per_unit = mm_per_unit;
-    const DiffusionSolution sol = solve_diffusion(ball.mesh, ball.conn, ball.materials, q, options);
-    const AnalyticBall exact(kRadius, kMua, kMusp, kEta, light_coefficients(light));
-    AssemblyOptions assembly;
-    assembly.mm_per_unit = mm_per_unit;
-    const auto volumes = lumped_vertex_volumes(assemble_diffusion_matrix(ball.mesh, ball.conn, ball.materials, assembly), ball.conn);
-    double e = 0, n = 0;
-    for (size_t v = 0; v < ball.mesh.vertex_count(); ++v) {
-        const double ref = exact(ball.mesh.positions[v] * mm_per_unit);
-        e += volumes[v] * std::pow(sol.phi[v][0] - ref, 2);
-        n += volumes[v] * ref * ref;
-    }
+    const TetMaterial material{{kMua, kMua, kMua}, {kMusp, kMusp, kMusp}, kEta};
+    BallComparison comparison = compare_with_analytic_ball(
+        ball.mesh, ball.conn, material, kRadius, light == Light::Uniform ? BallLight::Uniform : BallLight::Directional,
+        options);
     BallResult r;
     r.tets = ball.mesh.tet_count();
     r.h = std::cbrt(4.0 / 3.0 * std::numbers::pi * std::pow(kRadius, 3) / static_cast<double>(r.tets));
-    r.error = std::sqrt(e / n);
-    r.phi = sol.phi;
+    r.error = comparison.relative_error;
+    r.phi = std::move(comparison.solution.phi);
     return r;
 }
 
