@@ -1,4 +1,4 @@
-#include "editor/gl_context.h"
+#include "solver/gl_context.h"
 
 #include "tetops/error.h"
 

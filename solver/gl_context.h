@@ -1,6 +1,8 @@
 // Headless OpenGL: an OSMesa (Mesa's off-screen interface, llvmpipe software rasteriser) OpenGL 4.5
-// core context, so `waxwork render` and the tests draw without a display or a GPU; and the table of
-// OpenGL entry points the renderers call, loaded from whichever context is current.
+// core context, so `waxwork render`, the GPU solver and the tests run without a display or a GPU; and
+// the table of OpenGL entry points the renderers and the compute kernels call, loaded from whichever
+// context is current. Lives in solver/ because the GPU solver (solver/gpu_*) and the renderer
+// (editor/) share one device and one context.
 #pragma once
 
 #include <GL/glcorearb.h>
@@ -10,7 +12,7 @@
 
 namespace waxwork {
 
-// Every OpenGL function the renderers use. Loaded through the context's GetProcAddress instead of
+// Every OpenGL function the renderers and the compute kernels use. Loaded through the context's GetProcAddress instead of
 // linking gl* symbols directly: libOSMesa and libGL (GLFW windows) both export them, and whichever
 // the dynamic linker binds first would silently receive every call.
 #define WAXWORK_GL_FUNCTIONS(X)                                                   \
@@ -73,7 +75,15 @@ namespace waxwork {
     X(PFNGLBINDTEXTUREPROC, BindTexture)                                          \
     X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                                      \
     X(PFNGLTEXIMAGE2DPROC, TexImage2D)                                            \
-    X(PFNGLTEXPARAMETERIPROC, TexParameteri)
+    X(PFNGLTEXPARAMETERIPROC, TexParameteri)                                      \
+    X(PFNGLDISPATCHCOMPUTEPROC, DispatchCompute)                                  \
+    X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)                                      \
+    X(PFNGLBINDBUFFERBASEPROC, BindBufferBase)                                    \
+    X(PFNGLBUFFERSUBDATAPROC, BufferSubData)                                      \
+    X(PFNGLGETBUFFERSUBDATAPROC, GetBufferSubData)                                \
+    X(PFNGLCOPYBUFFERSUBDATAPROC, CopyBufferSubData)                              \
+    X(PFNGLUNIFORM1UIPROC, Uniform1ui)                                            \
+    X(PFNGLUNIFORM3UIVPROC, Uniform3uiv)
 
 struct GlApi {
 #define WAXWORK_GL_DECLARE(type, name) type name = nullptr;

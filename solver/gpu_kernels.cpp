@@ -1,0 +1,363 @@
+#include "solver/gpu_kernels.h"
+
+#include <algorithm>
+#include <string>
+
+namespace waxwork {
+namespace {
+
+constexpr GLuint kGroupSize = 256;
+// Reductions use at most this many workgroups (grid-stride loops beyond): enough to fill a large GPU
+// (512 x 256 = 128K threads), few enough that the partials read back in one small transfer.
+constexpr GLuint kMaxGroups = 512;
+constexpr size_t kMaxSums = 6;
+
+GLuint groups_for(size_t count) {
+    const size_t g = (count + kGroupSize - 1) / kGroupSize;
+    return static_cast<GLuint>(std::clamp<size_t>(g, 1, kMaxGroups));
+}
+
+// Shared by every kernel: workgroup size, the grid-stride loop bound and the reduction of NSUMS
+// per-thread sums to one partial per workgroup (binding 5).
+const char* kPrelude = R"(#version 430
+layout(local_size_x = 256) in;
+layout(std430, binding = 5) writeonly buffer Partials { float partials[]; };
+uniform uint n;
+#ifdef NSUMS
+shared float sums[NSUMS * 256];
+void reduce_partials(float v[NSUMS]) {
+    uint lid = gl_LocalInvocationID.x;
+    for (int c = 0; c < NSUMS; ++c) sums[c * 256 + lid] = v[c];
+    barrier();
+    for (uint stride = 128u; stride > 0u; stride >>= 1) {
+        if (lid < stride)
+            for (int c = 0; c < NSUMS; ++c) sums[c * 256 + lid] += sums[c * 256 + lid + stride];
+        barrier();
+    }
+    if (lid == 0u)
+        for (int c = 0; c < NSUMS; ++c) partials[gl_WorkGroupID.x * uint(NSUMS) + uint(c)] = sums[c * 256];
+}
+#endif
+#define STRIDE (gl_NumWorkGroups.x * 256u)
+)";
+
+// The sparse row product of one slot, per format: ACC slot_product(uint t) reads the vector xin
+// (binding 3), int slot_row(uint t) is the row the slot computes (-1: padding).
+const char* kMatrixCommon = R"(
+layout(std430, binding = 0) readonly buffer Starts { int starts[]; };
+layout(std430, binding = 1) readonly buffer Columns { int columns[]; };
+layout(std430, binding = 2) readonly buffer Values { float values[]; };
+layout(std430, binding = 3) readonly buffer XIn { float xin[]; };
+ACC entry_product(int k) {
+    uint j = 3u * uint(columns[k]);
+    uint e = 3u * uint(k);
+    return ACC(values[e], values[e + 1u], values[e + 2u]) * ACC(xin[j], xin[j + 1u], xin[j + 2u]);
+}
+)";
+
+const char* kCsr = R"(
+int slot_row(uint t) { return int(t); }
+ACC slot_product(uint t) {
+    ACC s = ACC(0);
+    for (int k = starts[t]; k < starts[t + 1u]; ++k) s += entry_product(k);
+    return s;
+}
+)";
+
+const char* kSliced = R"(
+layout(std430, binding = 9) readonly buffer SlotRows { int slot_rows[]; };
+uniform uint slice_height;
+int slot_row(uint t) { return slot_rows[t]; }
+ACC slot_product(uint t) {
+    uint slice = t / slice_height;
+    int lane = int(t - slice * slice_height);
+    int begin = starts[slice];
+    int width = (starts[slice + 1u] - begin) / int(slice_height);
+    ACC s = ACC(0);
+    for (int k = 0; k < width; ++k) s += entry_product(begin + k * int(slice_height) + lane);
+    return s;
+}
+)";
+
+// q = M p, sums p . q. n = slots.
+const char* kMultiplyDot = R"(
+layout(std430, binding = 4) writeonly buffer QOut { float q[]; };
+void main() {
+    float acc[3] = float[3](0.0, 0.0, 0.0);
+    for (uint t = gl_GlobalInvocationID.x; t < n; t += STRIDE) {
+        int row = slot_row(t);
+        if (row < 0) continue;
+        vec3 s = slot_product(t);
+        uint i = 3u * uint(row);
+        q[i] = s.x; q[i + 1u] = s.y; q[i + 2u] = s.z;
+        acc[0] += xin[i] * s.x; acc[1] += xin[i + 1u] * s.y; acc[2] += xin[i + 2u] * s.z;
+    }
+    reduce_partials(acc);
+}
+)";
+
+// r = b - M x in double, z = D^-1 r, sums r . z (of the stored float values). n = slots.
+const char* kResidual = R"(
+layout(std430, binding = 4) writeonly buffer ROut { float r[]; };
+layout(std430, binding = 6) readonly buffer B { float b[]; };
+layout(std430, binding = 7) writeonly buffer ZOut { float z[]; };
+layout(std430, binding = 8) readonly buffer InvDiag { float inv_diag[]; };
+uniform uvec3 mask;
+void main() {
+    float acc[3] = float[3](0.0, 0.0, 0.0);
+    for (uint t = gl_GlobalInvocationID.x; t < n; t += STRIDE) {
+        int row = slot_row(t);
+        if (row < 0) continue;
+        dvec3 s = slot_product(t);
+        uint i = 3u * uint(row);
+        for (uint c = 0u; c < 3u; ++c) {
+            if (mask[c] == 0u) continue;
+            float rc = float(double(b[i + c]) - s[c]);
+            float zc = float(double(rc) * double(inv_diag[i + c]));
+            r[i + c] = rc;
+            z[i + c] = zc;
+            acc[c] += rc * zc;
+        }
+    }
+    reduce_partials(acc);
+}
+)";
+
+// sum u v (w) per channel. n = rows.
+const char* kDot = R"(
+layout(std430, binding = 0) readonly buffer U { float u[]; };
+layout(std430, binding = 1) readonly buffer V { float v[]; };
+layout(std430, binding = 2) readonly buffer W { float w[]; };
+uniform uint weighted;
+void main() {
+    float acc[3] = float[3](0.0, 0.0, 0.0);
+    for (uint i = gl_GlobalInvocationID.x; i < n; i += STRIDE)
+        for (uint c = 0u; c < 3u; ++c) {
+            uint j = 3u * i + c;
+            acc[c] += weighted != 0u ? u[j] * v[j] * w[j] : u[j] * v[j];
+        }
+    reduce_partials(acc);
+}
+)";
+
+// y = a x + b y. n = rows.
+const char* kAxpby = R"(
+layout(std430, binding = 0) readonly buffer X { float x[]; };
+layout(std430, binding = 1) buffer Y { float y[]; };
+uniform vec3 a;
+uniform vec3 b;
+void main() {
+    for (uint i = gl_GlobalInvocationID.x; i < n; i += STRIDE)
+        for (uint c = 0u; c < 3u; ++c) {
+            uint j = 3u * i + c;
+            y[j] = a[c] * x[j] + b[c] * y[j];
+        }
+}
+)";
+
+// diag and its inverse from the stored diagonal positions. n = rows.
+const char* kExtractDiagonal = R"(
+layout(std430, binding = 0) readonly buffer Diagonal { int diagonal[]; };
+layout(std430, binding = 2) readonly buffer Values { float values[]; };
+layout(std430, binding = 3) writeonly buffer Diag { float diag[]; };
+layout(std430, binding = 4) writeonly buffer InvDiag { float inv_diag[]; };
+void main() {
+    for (uint i = gl_GlobalInvocationID.x; i < n; i += STRIDE)
+        for (uint c = 0u; c < 3u; ++c) {
+            float d = values[3u * uint(diagonal[i]) + c];
+            diag[3u * i + c] = d;
+            inv_diag[3u * i + c] = float(1.0lf / double(d));
+        }
+}
+)";
+
+// x += alpha p, r -= alpha q, z = D^-1 r; sums r . z and x . D x per channel. n = rows.
+const char* kCgUpdate = R"(
+layout(std430, binding = 0) readonly buffer P { float p[]; };
+layout(std430, binding = 1) readonly buffer Q { float q[]; };
+layout(std430, binding = 2) readonly buffer Diag { float diag[]; };
+layout(std430, binding = 3) readonly buffer InvDiag { float inv_diag[]; };
+layout(std430, binding = 4) buffer X { float x[]; };
+layout(std430, binding = 6) buffer R { float r[]; };
+layout(std430, binding = 7) writeonly buffer Z { float z[]; };
+uniform vec3 alpha;
+void main() {
+    float acc[6] = float[6](0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for (uint i = gl_GlobalInvocationID.x; i < n; i += STRIDE)
+        for (uint c = 0u; c < 3u; ++c) {
+            uint j = 3u * i + c;
+            float xj = x[j] + alpha[c] * p[j];
+            float rj = r[j] - alpha[c] * q[j];
+            float zj = inv_diag[j] * rj;
+            x[j] = xj; r[j] = rj; z[j] = zj;
+            acc[2u * c] += rj * zj;
+            acc[2u * c + 1u] += diag[j] * xj * xj;
+        }
+    reduce_partials(acc);
+}
+)";
+
+// values[slot] = source, 3 channels. n = count.
+const char* kScatter = R"(
+layout(std430, binding = 0) readonly buffer Slots { int slots[]; };
+layout(std430, binding = 1) readonly buffer Source { float source[]; };
+layout(std430, binding = 2) buffer Values { float values[]; };
+void main() {
+    for (uint k = gl_GlobalInvocationID.x; k < n; k += STRIDE)
+        for (uint c = 0u; c < 3u; ++c) values[3u * uint(slots[k]) + c] = source[3u * k + c];
+}
+)";
+
+// One kernel's source: the prelude (with NSUMS per-thread sums to reduce, if any), the sparse product
+// for a matrix format (ACC: its accumulation type), and the body.
+std::string kernel(int sums, const char* acc, const char* format, const char* body) {
+    std::string s = kPrelude;
+    if (sums > 0) s.insert(s.find('\n') + 1, "#define NSUMS " + std::to_string(sums) + "\n");
+    if (acc) s += std::string("#define ACC ") + acc + "\n" + kMatrixCommon + format;
+    return s + body;
+}
+
+}  // namespace
+
+GpuKernels::GpuKernels(const GlApi& gl, std::initializer_list<GpuMatrixFormat> formats) : gl_(&gl) {
+    require_compute_support(gl);
+    for (GpuMatrixFormat f : formats) {
+        const char* format = f == GpuMatrixFormat::Csr ? kCsr : kSliced;
+        multiply_dot_.emplace(f, ComputeProgram(gl, "multiply_dot_" + to_string(f), kernel(3, "vec3", format, kMultiplyDot)));
+        residual_.emplace(f, ComputeProgram(gl, "residual_" + to_string(f), kernel(3, "dvec3", format, kResidual)));
+    }
+    dot_ = ComputeProgram(gl, "dot", kernel(3, nullptr, nullptr, kDot));
+    axpby_ = ComputeProgram(gl, "axpby", kernel(0, nullptr, nullptr, kAxpby));
+    extract_diagonal_ = ComputeProgram(gl, "extract_diagonal", kernel(0, nullptr, nullptr, kExtractDiagonal));
+    cg_update_ = ComputeProgram(gl, "cg_update", kernel(6, nullptr, nullptr, kCgUpdate));
+    scatter_ = ComputeProgram(gl, "scatter", kernel(0, nullptr, nullptr, kScatter));
+    partials_ = GpuBuffer(gl, kMaxGroups * kMaxSums * sizeof(float));
+    check_gpu_error(gl, "compiling the kernels");
+}
+
+GpuBuffer GpuKernels::vector(size_t rows, const float* data) const {
+    if (data) return GpuBuffer(*gl_, 3 * rows * sizeof(float), data);
+    const std::vector<float> zeros(3 * rows, 0.0f);
+    return GpuBuffer(*gl_, zeros.size() * sizeof(float), zeros.data());
+}
+
+template <size_t K>
+std::array<double, K> GpuKernels::sum_partials(GLuint groups) {
+    std::vector<float> partial(static_cast<size_t>(groups) * K);
+    partials_.read(0, partial.size() * sizeof(float), partial.data());
+    std::array<double, K> total{};
+    for (GLuint g = 0; g < groups; ++g)
+        for (size_t c = 0; c < K; ++c) total[c] += partial[g * K + c];
+    return total;
+}
+
+namespace {
+void set_matrix(const GlApi& gl, const ComputeProgram& program, const GpuMatrix& m) {
+    program.use();
+    m.starts.bind(0);
+    m.columns.bind(1);
+    m.values.bind(2);
+    m.slot_rows.bind(9);
+    gl.Uniform1ui(program.uniform("n"), m.layout.slots);
+    gl.Uniform1ui(program.uniform("slice_height"), std::max<uint32_t>(m.layout.slice_height, 1));
+}
+}  // namespace
+
+Rgbd GpuKernels::multiply_dot(const GpuMatrix& m, const GpuBuffer& p, GpuBuffer& q) {
+    const ComputeProgram& program = multiply_dot_.at(m.layout.format);
+    set_matrix(*gl_, program, m);
+    p.bind(3);
+    q.bind(4);
+    partials_.bind(5);
+    const GLuint groups = groups_for(m.layout.slots);
+    program.dispatch(groups);
+    return sum_partials<3>(groups);
+}
+
+Rgbd GpuKernels::residual(const GpuMatrix& m, const GpuBuffer& b, const GpuBuffer& x, const GpuBuffer& inv_diag,
+                          GpuBuffer& r, GpuBuffer& z, const std::array<bool, 3>& mask) {
+    const ComputeProgram& program = residual_.at(m.layout.format);
+    set_matrix(*gl_, program, m);
+    const GLint mask_location = program.uniform("mask");
+    if (mask_location >= 0) {
+        const GLuint bits[3] = {mask[0], mask[1], mask[2]};
+        gl_->Uniform3uiv(mask_location, 1, bits);
+    }
+    x.bind(3);
+    r.bind(4);
+    partials_.bind(5);
+    b.bind(6);
+    z.bind(7);
+    inv_diag.bind(8);
+    const GLuint groups = groups_for(m.layout.slots);
+    program.dispatch(groups);
+    return sum_partials<3>(groups);
+}
+
+Rgbd GpuKernels::dot(size_t rows, const GpuBuffer& u, const GpuBuffer& v) { return dot(rows, u, v, u); }
+
+Rgbd GpuKernels::dot(size_t rows, const GpuBuffer& u, const GpuBuffer& v, const GpuBuffer& w) {
+    dot_.use();
+    u.bind(0);
+    v.bind(1);
+    w.bind(2);
+    partials_.bind(5);
+    gl_->Uniform1ui(dot_.uniform("n"), static_cast<GLuint>(rows));
+    gl_->Uniform1ui(dot_.uniform("weighted"), &w == &u ? 0u : 1u);
+    const GLuint groups = groups_for(rows);
+    dot_.dispatch(groups);
+    return sum_partials<3>(groups);
+}
+
+void GpuKernels::axpby(size_t rows, const Rgbd& a, const GpuBuffer& x, const Rgbd& b, GpuBuffer& y) {
+    axpby_.use();
+    x.bind(0);
+    y.bind(1);
+    gl_->Uniform1ui(axpby_.uniform("n"), static_cast<GLuint>(rows));
+    const float af[3] = {static_cast<float>(a[0]), static_cast<float>(a[1]), static_cast<float>(a[2])};
+    const float bf[3] = {static_cast<float>(b[0]), static_cast<float>(b[1]), static_cast<float>(b[2])};
+    gl_->Uniform3fv(axpby_.uniform("a"), 1, af);
+    gl_->Uniform3fv(axpby_.uniform("b"), 1, bf);
+    axpby_.dispatch(groups_for(rows));
+}
+
+void GpuKernels::extract_diagonal(const GpuMatrix& m, GpuBuffer& diag, GpuBuffer& inv_diag) {
+    extract_diagonal_.use();
+    m.diagonal.bind(0);
+    m.values.bind(2);
+    diag.bind(3);
+    inv_diag.bind(4);
+    gl_->Uniform1ui(extract_diagonal_.uniform("n"), m.layout.rows);
+    extract_diagonal_.dispatch(groups_for(m.layout.rows));
+}
+
+std::array<double, 6> GpuKernels::cg_update(size_t rows, const Rgbd& alpha, const GpuBuffer& p, const GpuBuffer& q,
+                                            const GpuBuffer& diag, const GpuBuffer& inv_diag, GpuBuffer& x,
+                                            GpuBuffer& r, GpuBuffer& z) {
+    cg_update_.use();
+    p.bind(0);
+    q.bind(1);
+    diag.bind(2);
+    inv_diag.bind(3);
+    x.bind(4);
+    partials_.bind(5);
+    r.bind(6);
+    z.bind(7);
+    gl_->Uniform1ui(cg_update_.uniform("n"), static_cast<GLuint>(rows));
+    const float af[3] = {static_cast<float>(alpha[0]), static_cast<float>(alpha[1]), static_cast<float>(alpha[2])};
+    gl_->Uniform3fv(cg_update_.uniform("alpha"), 1, af);
+    const GLuint groups = groups_for(rows);
+    cg_update_.dispatch(groups);
+    return sum_partials<6>(groups);
+}
+
+void GpuKernels::scatter(size_t count, const GpuBuffer& slots, const GpuBuffer& source, GpuBuffer& values) {
+    scatter_.use();
+    slots.bind(0);
+    source.bind(1);
+    values.bind(2);
+    gl_->Uniform1ui(scatter_.uniform("n"), static_cast<GLuint>(count));
+    scatter_.dispatch(groups_for(count));
+}
+
+}  // namespace waxwork

@@ -1,0 +1,68 @@
+// The compute kernels of the GPU solvers (OpenGL 4.3 compute shaders, GLSL 4.30): sparse products in
+// the three storage formats of gpu_matrix.h, reductions, axpy, the Jacobi preconditioner and the fused
+// conjugate-gradient steps. Vectors are rgb-interleaved float buffers (3 floats per vertex), so one
+// dispatch advances the three channel systems, as the CPU float path does.
+//
+// Reductions. Each reduction kernel runs a fixed number of workgroups that stride over the rows, sums
+// per thread in float and per workgroup in shared memory, and writes one partial per workgroup and
+// channel; the host adds the partials in double in a fixed order. The result is deterministic (same
+// input, same bits) and the readback is a few KB, the only host round-trip of an iteration.
+// The true residual of the CG confirmation step accumulates its row products in double (GLSL 4.00
+// doubles, core since OpenGL 4.0) as the CPU path does: that is what lets float CG reach ~1e-6.
+#pragma once
+
+#include "solver/gpu_compute.h"
+#include "solver/gpu_matrix.h"
+
+#include <array>
+#include <cstdint>
+#include <initializer_list>
+#include <map>
+
+namespace waxwork {
+
+using Rgbd = std::array<double, 3>;
+
+class GpuKernels {
+public:
+    // Compiles every kernel (the products for the given matrix formats) now, so a driver problem
+    // surfaces as GpuError before any solving starts. Needs a current OpenGL >= 4.3 context.
+    explicit GpuKernels(const GlApi& gl, std::initializer_list<GpuMatrixFormat> formats = {
+                                             GpuMatrixFormat::Csr, GpuMatrixFormat::Ell, GpuMatrixFormat::SellCSigma});
+
+    const GlApi& gl() const { return *gl_; }
+    // An rgb vector of `rows` vertices (3 floats each), zero-filled or from `data` (3 * rows floats).
+    GpuBuffer vector(size_t rows, const float* data = nullptr) const;
+
+    // q = M p; returns p . q per channel.
+    Rgbd multiply_dot(const GpuMatrix& m, const GpuBuffer& p, GpuBuffer& q);
+    // r = b - M x (row sums in double), z = D^-1 r for the channels whose mask is set (the others'
+    // r and z are left alone); returns r . z per channel.
+    Rgbd residual(const GpuMatrix& m, const GpuBuffer& b, const GpuBuffer& x, const GpuBuffer& inv_diag, GpuBuffer& r,
+                  GpuBuffer& z, const std::array<bool, 3>& mask = {true, true, true});
+    // sum_i u_i v_i per channel, or sum_i u_i v_i w_i with a weight vector.
+    Rgbd dot(size_t rows, const GpuBuffer& u, const GpuBuffer& v);
+    Rgbd dot(size_t rows, const GpuBuffer& u, const GpuBuffer& v, const GpuBuffer& w);
+    // y = a x + b y per channel.
+    void axpby(size_t rows, const Rgbd& a, const GpuBuffer& x, const Rgbd& b, GpuBuffer& y);
+    // diag = diag(M), inv_diag = 1 / diag (per channel; the division in double, as on the CPU).
+    void extract_diagonal(const GpuMatrix& m, GpuBuffer& diag, GpuBuffer& inv_diag);
+    // Fused CG update, per channel c with alpha[c] (0 freezes a channel):
+    //   x += alpha p, r -= alpha q, z = D^-1 r; returns (r . z, x . D x) for r, g, b in that order.
+    std::array<double, 6> cg_update(size_t rows, const Rgbd& alpha, const GpuBuffer& p, const GpuBuffer& q,
+                                    const GpuBuffer& diag, const GpuBuffer& inv_diag, GpuBuffer& x, GpuBuffer& r,
+                                    GpuBuffer& z);
+    // values[3 * slot[k] + c] = source[3 * k + c] for k < count: row updates after painting.
+    void scatter(size_t count, const GpuBuffer& slots, const GpuBuffer& source, GpuBuffer& values);
+
+private:
+    template <size_t K>
+    std::array<double, K> sum_partials(GLuint groups);
+
+    const GlApi* gl_;
+    std::map<GpuMatrixFormat, ComputeProgram> multiply_dot_, residual_;
+    ComputeProgram dot_, axpby_, extract_diagonal_, cg_update_, scatter_;
+    GpuBuffer partials_;
+};
+
+}  // namespace waxwork
