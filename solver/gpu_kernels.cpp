@@ -17,25 +17,21 @@ GLuint groups_for(size_t count) {
     return static_cast<GLuint>(std::clamp<size_t>(g, 1, kMaxGroups));
 }
 
-// Shared by every kernel: workgroup size, the grid-stride loop bound and the reduction of NSUMS
-// per-thread sums to one partial per workgroup (binding 5).
+// Shared by every kernel: workgroup size, the grid-stride loop bound and the output of NSUMS
+// per-thread sums (binding 5, one slot per invocation; kFold adds them up).
+//
+// Why no shared-memory tree: llvmpipe runs each barrier() as a switch through all 256 invocations of
+// a workgroup (coroutines). On spot at 50K tets (13K vertices) a three-channel dot took 4.4 ms with a
+// binary tree (8 barriers), 2.3 ms with a 16 x 16 fold (2 barriers) and 0.5 ms with no barrier at all,
+// as here (bench/gpu_solver_bench.cpp, BM_GpuDot; the product went from 13 to 3 ms). On a GPU the
+// price is a few MB of writes at most (512 x 256 x 6 floats) and one more small dispatch.
 const char* kPrelude = R"(#version 430
 layout(local_size_x = 256) in;
-layout(std430, binding = 5) writeonly buffer Partials { float partials[]; };
+layout(std430, binding = 5) writeonly buffer ThreadSums { float thread_sums[]; };
 uniform uint n;
 #ifdef NSUMS
-shared float sums[NSUMS * 256];
 void reduce_partials(float v[NSUMS]) {
-    uint lid = gl_LocalInvocationID.x;
-    for (int c = 0; c < NSUMS; ++c) sums[c * 256 + lid] = v[c];
-    barrier();
-    for (uint stride = 128u; stride > 0u; stride >>= 1) {
-        if (lid < stride)
-            for (int c = 0; c < NSUMS; ++c) sums[c * 256 + lid] += sums[c * 256 + lid + stride];
-        barrier();
-    }
-    if (lid == 0u)
-        for (int c = 0; c < NSUMS; ++c) partials[gl_WorkGroupID.x * uint(NSUMS) + uint(c)] = sums[c * 256];
+    for (int c = 0; c < NSUMS; ++c) thread_sums[gl_GlobalInvocationID.x * uint(NSUMS) + uint(c)] = v[c];
 }
 #endif
 #define STRIDE (gl_NumWorkGroups.x * 256u)
@@ -208,6 +204,23 @@ void main() {
 }
 )";
 
+// One workgroup adds the per-invocation sums of `groups` workgroups lane by lane: folded[lane * nsums + c].
+const char* kFold = R"(#version 430
+layout(local_size_x = 256) in;
+layout(std430, binding = 5) readonly buffer ThreadSums { float thread_sums[]; };
+layout(std430, binding = 10) writeonly buffer Folded { float folded[]; };
+uniform uint groups;
+uniform uint nsums;
+void main() {
+    uint lane = gl_LocalInvocationID.x;
+    for (uint c = 0u; c < nsums; ++c) {
+        float s = 0.0;
+        for (uint g = 0u; g < groups; ++g) s += thread_sums[(g * 256u + lane) * nsums + c];
+        folded[lane * nsums + c] = s;
+    }
+}
+)";
+
 // One kernel's source: the prelude (with NSUMS per-thread sums to reduce, if any), the sparse product
 // for a matrix format (ACC: its accumulation type), and the body.
 std::string kernel(int sums, const char* acc, const char* format, const char* body) {
@@ -231,7 +244,9 @@ GpuKernels::GpuKernels(const GlApi& gl, std::initializer_list<GpuMatrixFormat> f
     extract_diagonal_ = ComputeProgram(gl, "extract_diagonal", kernel(0, nullptr, nullptr, kExtractDiagonal));
     cg_update_ = ComputeProgram(gl, "cg_update", kernel(6, nullptr, nullptr, kCgUpdate));
     scatter_ = ComputeProgram(gl, "scatter", kernel(0, nullptr, nullptr, kScatter));
-    partials_ = GpuBuffer(gl, kMaxGroups * kMaxSums * sizeof(float));
+    fold_ = ComputeProgram(gl, "fold", kFold);
+    partials_ = GpuBuffer(gl, kMaxGroups * kGroupSize * kMaxSums * sizeof(float));
+    folded_ = GpuBuffer(gl, kGroupSize * kMaxSums * sizeof(float));
     check_gpu_error(gl, "compiling the kernels");
 }
 
@@ -243,11 +258,17 @@ GpuBuffer GpuKernels::vector(size_t rows, const float* data) const {
 
 template <size_t K>
 std::array<double, K> GpuKernels::sum_partials(GLuint groups) {
-    std::vector<float> partial(static_cast<size_t>(groups) * K);
-    partials_.read(0, partial.size() * sizeof(float), partial.data());
+    fold_.use();
+    partials_.bind(5);
+    folded_.bind(10);
+    gl_->Uniform1ui(fold_.uniform("groups"), groups);
+    gl_->Uniform1ui(fold_.uniform("nsums"), static_cast<GLuint>(K));
+    fold_.dispatch(1);
+    std::vector<float> lanes(kGroupSize * K);
+    folded_.read(0, lanes.size() * sizeof(float), lanes.data());
     std::array<double, K> total{};
-    for (GLuint g = 0; g < groups; ++g)
-        for (size_t c = 0; c < K; ++c) total[c] += partial[g * K + c];
+    for (GLuint lane = 0; lane < kGroupSize; ++lane)
+        for (size_t c = 0; c < K; ++c) total[c] += lanes[lane * K + c];
     return total;
 }
 

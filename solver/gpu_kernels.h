@@ -3,10 +3,10 @@
 // conjugate-gradient steps. Vectors are rgb-interleaved float buffers (3 floats per vertex), so one
 // dispatch advances the three channel systems, as the CPU float path does.
 //
-// Reductions. Each reduction kernel runs a fixed number of workgroups that stride over the rows, sums
-// per thread in float and per workgroup in shared memory, and writes one partial per workgroup and
-// channel; the host adds the partials in double in a fixed order. The result is deterministic (same
-// input, same bits) and the readback is a few KB, the only host round-trip of an iteration.
+// Reductions. Each reduction kernel runs at most 512 workgroups that stride over the rows, sums per
+// invocation in float and writes one sum per invocation and channel; a second dispatch folds them to
+// 256 lane sums, which the host adds in double in a fixed order. The result is deterministic (same
+// input, same bits) and the read-back is at most 6 KB, the only host round-trip of an iteration.
 // The true residual of the CG confirmation step accumulates its row products in double (GLSL 4.00
 // doubles, core since OpenGL 4.0) as the CPU path does: that is what lets float CG reach ~1e-6.
 #pragma once
@@ -61,8 +61,8 @@ private:
 
     const GlApi* gl_;
     std::map<GpuMatrixFormat, ComputeProgram> multiply_dot_, residual_;
-    ComputeProgram dot_, axpby_, extract_diagonal_, cg_update_, scatter_;
-    GpuBuffer partials_;
+    ComputeProgram dot_, axpby_, extract_diagonal_, cg_update_, scatter_, fold_;
+    GpuBuffer partials_, folded_;
 };
 
 }  // namespace waxwork
