@@ -34,12 +34,15 @@ struct GpuCgOptions {
     std::function<void(int iteration, const Rgbd& estimated_relative_error)> on_iteration;
 };
 
-// The persistent GPU state of one volume's diffusion system.
+// The persistent GPU state of one volume's diffusion system. SELL-C-sigma by default: the fastest
+// product on llvmpipe (bench/gpu_solver_bench.cpp) and the coalesced layout GPUs want; CSR is kept for
+// comparison, ELL pads spot's matrix 2.6-3x.
 class GpuDiffusionSolver {
 public:
     // Uploads the pattern and values of `matrix` and compiles the kernels. The OpenGL context of `gl`
     // (>= 4.3) must stay current while the solver lives. Throws GpuError when the driver cannot run it.
-    GpuDiffusionSolver(const GlApi& gl, const DiffusionMatrix& matrix, GpuMatrixFormat format = GpuMatrixFormat::Csr);
+    GpuDiffusionSolver(const GlApi& gl, const DiffusionMatrix& matrix,
+                       GpuMatrixFormat format = GpuMatrixFormat::SellCSigma);
 
     size_t size() const { return matrix_.layout.rows; }
 
@@ -79,6 +82,6 @@ std::array<ConjugateGradientResult, 3> solve_diffusion_gpu(const GlApi& gl, cons
                                                            const std::vector<std::array<double, 3>>& q,
                                                            const GpuCgOptions& options,
                                                            std::vector<std::array<double, 3>>& phi,
-                                                           GpuMatrixFormat format = GpuMatrixFormat::Csr);
+                                                           GpuMatrixFormat format = GpuMatrixFormat::SellCSigma);
 
 }  // namespace waxwork

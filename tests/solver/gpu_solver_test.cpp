@@ -359,5 +359,27 @@ TEST(GpuDiffusionSolver, ShaderFailureFallsBackToTheCpuWithTheDriverLog) {
     EXPECT_FALSE(solution.gpu_fallback_reason.empty());
 }
 
+// WAXWORK_GL_DEVICE=egl: the path to a real GPU without a display. Here EGL finds llvmpipe again
+// (through a software device or Mesa's surfaceless platform); the solver must give the same answer.
+TEST(GpuDiffusionSolver, RunsOnAnEglContext) {
+    const System& s = cube_system();
+    std::vector<std::array<double, 3>> phi;
+    std::string renderer;
+    {
+        std::unique_ptr<HeadlessGlContext> egl;
+        try {
+            egl = std::make_unique<HeadlessGlContext>(GlDevice::Egl);
+        } catch (const Error& e) {
+            GTEST_SKIP() << "no EGL OpenGL 4.3 context here: " << e.what();
+        }
+        renderer = egl->renderer();
+        GpuCgOptions options;
+        options.relative_tolerance = 1e-5;
+        solve_diffusion_gpu(egl->gl(), s.matrix, s.q, options, phi);
+    }
+    std::printf("EGL renderer: %s\n", renderer.c_str());
+    EXPECT_LT(relative_difference(phi, cpu_double_solution(s, 1e-9)), 1e-4);
+}
+
 }  // namespace
 }  // namespace waxwork
