@@ -75,7 +75,7 @@ template <GpuMatrixFormat F>
 void BM_GpuProduct(benchmark::State& state) {
     const Scene& s = scene(state.range(0));
     GpuKernels kernels(context().gl(), {F});
-    const GpuMatrix m(context().gl(), s.matrix, F);
+    const GpuMatrix m(context().gl(), rgb_csr_view(s.matrix), F);
     const std::vector<float> ones(3 * s.matrix.size(), 1.0f);
     const GpuBuffer p = kernels.vector(s.matrix.size(), ones.data());
     GpuBuffer q = kernels.vector(s.matrix.size());

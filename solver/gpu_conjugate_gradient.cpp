@@ -25,7 +25,7 @@ std::vector<float> interleave(const std::vector<std::array<double, 3>>& v) {
 }  // namespace
 
 GpuDiffusionSolver::GpuDiffusionSolver(const GlApi& gl, const DiffusionMatrix& matrix, GpuMatrixFormat format)
-    : kernels_(gl, {format}), matrix_(gl, matrix, format) {
+    : kernels_(gl, {format}), matrix_(gl, rgb_csr_view(matrix), format) {
     const size_t n = matrix.size();
     for (GpuBuffer* v : {&b_, &x_, &r_, &z_, &p_, &q_, &diag_, &inv_diag_}) *v = kernels_.vector(n);
     kernels_.extract_diagonal(matrix_, diag_, inv_diag_);
@@ -35,7 +35,7 @@ GpuDiffusionSolver::GpuDiffusionSolver(const GlApi& gl, const DiffusionMatrix& m
 void GpuDiffusionSolver::update_values(const DiffusionMatrix& matrix) {
     if (matrix.size() != size() || matrix.nonzeros() != matrix_.layout.stored_index.size())
         throw InvalidArgumentError("GPU solver: update_values needs the matrix of the same pattern");
-    const std::vector<float> values = gpu_matrix_values(matrix_.layout, matrix);
+    const std::vector<float> values = gpu_matrix_values(matrix_.layout, rgb_csr_view(matrix));
     matrix_.values.write(0, values.size() * sizeof(float), values.data());
     kernels_.extract_diagonal(matrix_, diag_, inv_diag_);
 }
@@ -68,13 +68,22 @@ void GpuDiffusionSolver::set_light(const DiffusionMatrix& matrix, const std::vec
     if (matrix.size() != size() || q.size() != size())
         throw InvalidArgumentError("GPU solver: set_light: " + std::to_string(q.size()) + " light values for " +
                                    std::to_string(size()) + " vertices");
-    std::vector<std::array<double, 3>> b(size());
-    std::vector<double> channel(size());
+    std::array<std::vector<double>, 3> b;
     for (int c = 0; c < 3; ++c) {
-        diffusion_right_hand_side(matrix, q, c, channel);
-        for (size_t i = 0; i < size(); ++i) b[i][c] = channel[i];
+        b[c].resize(size());
+        diffusion_right_hand_side(matrix, q, c, b[c]);
     }
-    const std::vector<float> data = interleave(b);
+    set_right_hand_side(b);
+}
+
+void GpuDiffusionSolver::set_right_hand_side(const std::array<std::vector<double>, 3>& b) {
+    for (const auto& channel : b)
+        if (channel.size() != size())
+            throw InvalidArgumentError("GPU solver: right-hand side of size " + std::to_string(channel.size()) +
+                                       " for " + std::to_string(size()) + " vertices");
+    std::vector<float> data(3 * size());
+    for (size_t i = 0; i < size(); ++i)
+        for (int c = 0; c < 3; ++c) data[3 * i + c] = static_cast<float>(b[c][i]);
     b_.write(0, data.size() * sizeof(float), data.data());
 }
 

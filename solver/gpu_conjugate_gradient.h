@@ -52,6 +52,8 @@ public:
     void update_rows(const DiffusionMatrix& matrix, std::span<const int32_t> rows);
     // b = source q (Eq. 12) for the three channels, uploaded.
     void set_light(const DiffusionMatrix& matrix, const std::vector<std::array<double, 3>>& q);
+    // b per channel, directly.
+    void set_right_hand_side(const std::array<std::vector<double>, 3>& b);
     // The warm start (any finite values); the solver otherwise keeps the previous solution.
     void set_solution(const std::vector<std::array<double, 3>>& phi);
 
@@ -65,6 +67,9 @@ public:
     std::vector<std::array<double, 3>> solution() const;
     // phi on the device, 3 floats per vertex (rgb): what a renderer on the same context reads.
     const GpuBuffer& solution_buffer() const { return x_; }
+    // Writable, for a start vector computed on the device (multires interpolation).
+    GpuBuffer& solution_buffer() { return x_; }
+    const GpuBuffer& right_hand_side_buffer() const { return b_; }
     const GpuMatrix& matrix() const { return matrix_; }
     GpuKernels& kernels() { return kernels_; }
 

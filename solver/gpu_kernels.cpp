@@ -162,7 +162,10 @@ void main() {
         for (uint c = 0u; c < 3u; ++c) {
             float d = values[3u * uint(diagonal[i]) + c];
             diag[3u * i + c] = d;
-            inv_diag[3u * i + c] = float(1.0lf / double(d));
+            // A zero or non-finite diagonal (possible on coarse multires levels) preconditions with 1;
+            // the SPD level-0 matrix always has positive diagonals.
+            bool usable = d != 0.0 && !isinf(d) && !isnan(d);
+            inv_diag[3u * i + c] = usable ? float(1.0lf / double(d)) : 1.0;
         }
 }
 )";
@@ -201,6 +204,46 @@ layout(std430, binding = 2) buffer Values { float values[]; };
 void main() {
     for (uint k = gl_GlobalInvocationID.x; k < n; k += STRIDE)
         for (uint c = 0u; c < 3u; ++c) values[3u * uint(slots[k]) + c] = source[3u * k + c];
+}
+)";
+
+// y = w x elementwise (the Jacobi preconditioner applied to a vector). n = rows.
+const char* kHadamard = R"(
+layout(std430, binding = 0) readonly buffer W { float w[]; };
+layout(std430, binding = 1) readonly buffer X { float x[]; };
+layout(std430, binding = 2) writeonly buffer Y { float y[]; };
+void main() {
+    for (uint j = gl_GlobalInvocationID.x; j < 3u * n; j += STRIDE) y[j] = w[j] * x[j];
+}
+)";
+
+// target[i] = source[index[i]] (rgb): restriction by injection (multires, Eq. 17). n = rows.
+const char* kGather = R"(
+layout(std430, binding = 0) readonly buffer Index { int index[]; };
+layout(std430, binding = 1) readonly buffer Source { float source[]; };
+layout(std430, binding = 2) writeonly buffer Target { float target[]; };
+void main() {
+    for (uint i = gl_GlobalInvocationID.x; i < n; i += STRIDE)
+        for (uint c = 0u; c < 3u; ++c) target[3u * i + c] = source[3u * uint(index[i]) + c];
+}
+)";
+
+// fine = P coarse with a channel-independent compressed-row operator (multires, Eq. 16). n = rows.
+const char* kInterpolate = R"(
+layout(std430, binding = 0) readonly buffer Offsets { int offsets[]; };
+layout(std430, binding = 1) readonly buffer Columns { int columns[]; };
+layout(std430, binding = 2) readonly buffer Weights { float weights[]; };
+layout(std430, binding = 3) readonly buffer Coarse { float coarse[]; };
+layout(std430, binding = 4) writeonly buffer Fine { float fine[]; };
+void main() {
+    for (uint i = gl_GlobalInvocationID.x; i < n; i += STRIDE) {
+        vec3 s = vec3(0.0);
+        for (int k = offsets[i]; k < offsets[i + 1u]; ++k) {
+            uint j = 3u * uint(columns[k]);
+            s += weights[k] * vec3(coarse[j], coarse[j + 1u], coarse[j + 2u]);
+        }
+        fine[3u * i] = s.x; fine[3u * i + 1u] = s.y; fine[3u * i + 2u] = s.z;
+    }
 }
 )";
 
@@ -245,6 +288,9 @@ GpuKernels::GpuKernels(const GlApi& gl, std::initializer_list<GpuMatrixFormat> f
     cg_update_ = ComputeProgram(gl, "cg_update", kernel(6, nullptr, nullptr, kCgUpdate));
     scatter_ = ComputeProgram(gl, "scatter", kernel(0, nullptr, nullptr, kScatter));
     fold_ = ComputeProgram(gl, "fold", kFold);
+    hadamard_ = ComputeProgram(gl, "hadamard", kernel(0, nullptr, nullptr, kHadamard));
+    gather_ = ComputeProgram(gl, "gather", kernel(0, nullptr, nullptr, kGather));
+    interpolate_ = ComputeProgram(gl, "interpolate", kernel(0, nullptr, nullptr, kInterpolate));
     partials_ = GpuBuffer(gl, kMaxGroups * kGroupSize * kMaxSums * sizeof(float));
     folded_ = GpuBuffer(gl, kGroupSize * kMaxSums * sizeof(float));
     check_gpu_error(gl, "compiling the kernels");
@@ -379,6 +425,44 @@ void GpuKernels::scatter(size_t count, const GpuBuffer& slots, const GpuBuffer& 
     values.bind(2);
     gl_->Uniform1ui(scatter_.uniform("n"), static_cast<GLuint>(count));
     scatter_.dispatch(groups_for(count));
+}
+
+void GpuKernels::hadamard(size_t rows, const GpuBuffer& w, const GpuBuffer& x, GpuBuffer& y) {
+    hadamard_.use();
+    w.bind(0);
+    x.bind(1);
+    y.bind(2);
+    gl_->Uniform1ui(hadamard_.uniform("n"), static_cast<GLuint>(rows));
+    hadamard_.dispatch(groups_for(3 * rows));
+}
+
+void GpuKernels::gather(size_t rows, const GpuBuffer& index, const GpuBuffer& source, GpuBuffer& target) {
+    gather_.use();
+    index.bind(0);
+    source.bind(1);
+    target.bind(2);
+    gl_->Uniform1ui(gather_.uniform("n"), static_cast<GLuint>(rows));
+    gather_.dispatch(groups_for(rows));
+}
+
+GpuInterpolation::GpuInterpolation(const GlApi& gl, std::span<const int32_t> offsets_,
+                                   std::span<const int32_t> columns_, std::span<const double> weights_)
+    : rows(offsets_.empty() ? 0 : offsets_.size() - 1) {
+    offsets = GpuBuffer::from<int32_t>(gl, offsets_);
+    columns = GpuBuffer::from<int32_t>(gl, columns_);
+    const std::vector<float> w(weights_.begin(), weights_.end());
+    weights = GpuBuffer::from<float>(gl, w);
+}
+
+void GpuKernels::interpolate(const GpuInterpolation& p, const GpuBuffer& coarse, GpuBuffer& fine) {
+    interpolate_.use();
+    p.offsets.bind(0);
+    p.columns.bind(1);
+    p.weights.bind(2);
+    coarse.bind(3);
+    fine.bind(4);
+    gl_->Uniform1ui(interpolate_.uniform("n"), static_cast<GLuint>(p.rows));
+    interpolate_.dispatch(groups_for(p.rows));
 }
 
 }  // namespace waxwork

@@ -18,10 +18,20 @@
 #include <cstdint>
 #include <initializer_list>
 #include <map>
+#include <span>
 
 namespace waxwork {
 
 using Rgbd = std::array<double, 3>;
+
+// A channel-independent compressed-row operator on the device (multires interpolation, Eq. 16).
+struct GpuInterpolation {
+    size_t rows = 0;
+    GpuBuffer offsets, columns, weights;  // weights in float
+
+    GpuInterpolation(const GlApi& gl, std::span<const int32_t> offsets, std::span<const int32_t> columns,
+                     std::span<const double> weights);
+};
 
 class GpuKernels {
 public:
@@ -45,13 +55,20 @@ public:
     Rgbd dot(size_t rows, const GpuBuffer& u, const GpuBuffer& v, const GpuBuffer& w);
     // y = a x + b y per channel.
     void axpby(size_t rows, const Rgbd& a, const GpuBuffer& x, const Rgbd& b, GpuBuffer& y);
-    // diag = diag(M), inv_diag = 1 / diag (per channel; the division in double, as on the CPU).
+    // diag = diag(M), inv_diag = 1 / diag (per channel; the division in double, as on the CPU; 1 where
+    // the diagonal is zero or not finite).
     void extract_diagonal(const GpuMatrix& m, GpuBuffer& diag, GpuBuffer& inv_diag);
     // Fused CG update, per channel c with alpha[c] (0 freezes a channel):
     //   x += alpha p, r -= alpha q, z = D^-1 r; returns (r . z, x . D x) for r, g, b in that order.
     std::array<double, 6> cg_update(size_t rows, const Rgbd& alpha, const GpuBuffer& p, const GpuBuffer& q,
                                     const GpuBuffer& diag, const GpuBuffer& inv_diag, GpuBuffer& x, GpuBuffer& r,
                                     GpuBuffer& z);
+    // y = w x elementwise (e.g. the Jacobi preconditioner z = D^-1 r).
+    void hadamard(size_t rows, const GpuBuffer& w, const GpuBuffer& x, GpuBuffer& y);
+    // target[i] = source[index[i]] per channel (restriction by injection).
+    void gather(size_t rows, const GpuBuffer& index, const GpuBuffer& source, GpuBuffer& target);
+    // fine = P coarse.
+    void interpolate(const GpuInterpolation& p, const GpuBuffer& coarse, GpuBuffer& fine);
     // values[3 * slot[k] + c] = source[3 * k + c] for k < count: row updates after painting.
     void scatter(size_t count, const GpuBuffer& slots, const GpuBuffer& source, GpuBuffer& values);
 
@@ -61,7 +78,7 @@ private:
 
     const GlApi* gl_;
     std::map<GpuMatrixFormat, ComputeProgram> multiply_dot_, residual_;
-    ComputeProgram dot_, axpby_, extract_diagonal_, cg_update_, scatter_, fold_;
+    ComputeProgram dot_, axpby_, extract_diagonal_, cg_update_, scatter_, fold_, hadamard_, gather_, interpolate_;
     GpuBuffer partials_, folded_;
 };
 

@@ -14,9 +14,13 @@ std::string to_string(GpuMatrixFormat format) {
     return "?";
 }
 
-GpuMatrixLayout make_gpu_matrix_layout(const DiffusionMatrix& m, GpuMatrixFormat format, uint32_t slice_height,
+RgbCsrView rgb_csr_view(const DiffusionMatrix& m) {
+    return {m.offsets, m.columns, m.diagonal, {m.values[0], m.values[1], m.values[2]}};
+}
+
+GpuMatrixLayout make_gpu_matrix_layout(const RgbCsrView& m, GpuMatrixFormat format, uint32_t slice_height,
                                        uint32_t sigma) {
-    const auto n = static_cast<uint32_t>(m.size());
+    const auto n = static_cast<uint32_t>(m.rows());
     GpuMatrixLayout layout;
     layout.format = format;
     layout.rows = n;
@@ -24,10 +28,10 @@ GpuMatrixLayout make_gpu_matrix_layout(const DiffusionMatrix& m, GpuMatrixFormat
     layout.diagonal.resize(n);
     if (format == GpuMatrixFormat::Csr) {
         layout.slots = n;
-        layout.starts = m.offsets;
-        layout.columns = m.columns;
+        layout.starts.assign(m.offsets.begin(), m.offsets.end());
+        layout.columns.assign(m.columns.begin(), m.columns.end());
         std::iota(layout.stored_index.begin(), layout.stored_index.end(), 0);
-        layout.diagonal = m.diagonal;
+        layout.diagonal.assign(m.diagonal.begin(), m.diagonal.end());
         return layout;
     }
     if (format == GpuMatrixFormat::Ell) {
@@ -75,7 +79,7 @@ GpuMatrixLayout make_gpu_matrix_layout(const DiffusionMatrix& m, GpuMatrixFormat
     return layout;
 }
 
-std::vector<float> gpu_matrix_values(const GpuMatrixLayout& layout, const DiffusionMatrix& m) {
+std::vector<float> gpu_matrix_values(const GpuMatrixLayout& layout, const RgbCsrView& m) {
     std::vector<float> values(3 * layout.stored_entries(), 0.0f);
     for (size_t k = 0; k < m.nonzeros(); ++k)
         for (int c = 0; c < 3; ++c)
@@ -83,7 +87,7 @@ std::vector<float> gpu_matrix_values(const GpuMatrixLayout& layout, const Diffus
     return values;
 }
 
-GpuMatrix::GpuMatrix(const GlApi& gl, const DiffusionMatrix& matrix, GpuMatrixFormat format)
+GpuMatrix::GpuMatrix(const GlApi& gl, const RgbCsrView& matrix, GpuMatrixFormat format)
     : layout(make_gpu_matrix_layout(matrix, format)) {
     starts = GpuBuffer::from<int32_t>(gl, layout.starts);
     columns = GpuBuffer::from<int32_t>(gl, layout.columns);

@@ -17,6 +17,7 @@
 #include "solver/diffusion_matrix.h"
 #include "solver/gpu_compute.h"
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -27,6 +28,18 @@ namespace waxwork {
 enum class GpuMatrixFormat { Csr, Ell, SellCSigma };
 
 std::string to_string(GpuMatrixFormat format);
+
+// The pattern and rgb values of a compressed-row matrix triple: a DiffusionMatrix, or a level of the
+// multi-resolution hierarchy (multires/hierarchy.h). diagonal[i] is the position of (i, i).
+struct RgbCsrView {
+    std::span<const int32_t> offsets, columns, diagonal;
+    std::array<std::span<const double>, 3> values;
+
+    size_t rows() const { return diagonal.size(); }
+    size_t nonzeros() const { return columns.size(); }
+};
+
+RgbCsrView rgb_csr_view(const DiffusionMatrix& matrix);
 
 // Host-side description of the stored matrix (format independent for the kernels: ELL is SELL with one
 // slice of all rows and no sorting).
@@ -46,18 +59,18 @@ struct GpuMatrixLayout {
 };
 
 // slice_height C and sigma apply to SellCSigma only (sigma is rounded up to a multiple of C).
-GpuMatrixLayout make_gpu_matrix_layout(const DiffusionMatrix& matrix, GpuMatrixFormat format,
+GpuMatrixLayout make_gpu_matrix_layout(const RgbCsrView& matrix, GpuMatrixFormat format,
                                        uint32_t slice_height = 32, uint32_t sigma = 512);
 
 // The three channels' values in stored order, interleaved (3 floats per stored entry, padding 0).
-std::vector<float> gpu_matrix_values(const GpuMatrixLayout& layout, const DiffusionMatrix& matrix);
+std::vector<float> gpu_matrix_values(const GpuMatrixLayout& layout, const RgbCsrView& matrix);
 
 // A layout and its values on the device.
 struct GpuMatrix {
     GpuMatrixLayout layout;
     GpuBuffer starts, columns, slot_rows, diagonal, values;
 
-    GpuMatrix(const GlApi& gl, const DiffusionMatrix& matrix, GpuMatrixFormat format);
+    GpuMatrix(const GlApi& gl, const RgbCsrView& matrix, GpuMatrixFormat format);
 };
 
 }  // namespace waxwork

@@ -6,6 +6,7 @@
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
 #include "solver/gl_context.h"
+#include "solver/gpu_test_context.h"
 #include "solver/gpu_conjugate_gradient.h"
 #include "solver/gpu_kernels.h"
 #include "solver/gpu_matrix.h"
@@ -28,32 +29,6 @@
 
 namespace waxwork {
 namespace {
-
-// One context for the whole suite (creating an OSMesa context costs ~50 ms); nullptr with the reason
-// when this machine cannot give OpenGL 4.3.
-HeadlessGlContext* gl_context(std::string& why) {
-    static std::unique_ptr<HeadlessGlContext> context;
-    static std::string failure;
-    static bool tried = false;
-    if (!tried) {
-        tried = true;
-        try {
-            context = std::make_unique<HeadlessGlContext>();
-            require_compute_support(context->gl());
-        } catch (const Error& e) {
-            failure = e.what();
-            context.reset();
-        }
-    }
-    why = failure;
-    if (context) context->make_current();
-    return context.get();
-}
-
-#define REQUIRE_GL(context)                                                          \
-    std::string gl_skip_reason;                                                      \
-    HeadlessGlContext* context = gl_context(gl_skip_reason);                         \
-    if (!context) GTEST_SKIP() << "no OpenGL 4.3 context: " << gl_skip_reason
 
 struct System {
     TetMesh mesh;
@@ -158,7 +133,7 @@ std::vector<std::array<double, 3>> cpu_double_solution(const System& s, double t
 TEST(GpuMatrixLayout, SlicedFormatsStoreEveryEntryOnceAndKeepRows) {
     const DiffusionMatrix& m = cube_system().matrix;
     for (GpuMatrixFormat f : {GpuMatrixFormat::Ell, GpuMatrixFormat::SellCSigma}) {
-        const GpuMatrixLayout layout = make_gpu_matrix_layout(m, f, 32, 128);
+        const GpuMatrixLayout layout = make_gpu_matrix_layout(rgb_csr_view(m), f, 32, 128);
         std::vector<int> used(layout.stored_entries(), 0);
         for (size_t k = 0; k < m.nonzeros(); ++k) {
             ASSERT_EQ(layout.columns[layout.stored_index[k]], m.columns[k]);
@@ -172,19 +147,19 @@ TEST(GpuMatrixLayout, SlicedFormatsStoreEveryEntryOnceAndKeepRows) {
         for (size_t i = 0; i < m.size(); ++i) EXPECT_EQ(layout.diagonal[i], layout.stored_index[m.diagonal[i]]);
     }
     // Sorting within sigma windows pads less than ELLPACK's global width.
-    EXPECT_LT(make_gpu_matrix_layout(m, GpuMatrixFormat::SellCSigma).stored_entries(),
-              make_gpu_matrix_layout(m, GpuMatrixFormat::Ell).stored_entries());
+    EXPECT_LT(make_gpu_matrix_layout(rgb_csr_view(m), GpuMatrixFormat::SellCSigma).stored_entries(),
+              make_gpu_matrix_layout(rgb_csr_view(m), GpuMatrixFormat::Ell).stored_entries());
 }
 
 TEST(GpuKernels, ProductDotAndAxpbyMatchTheCpu) {
-    REQUIRE_GL(context);
+    WAXWORK_REQUIRE_GL(context);
     const DiffusionMatrix& m = spot_system().matrix;
     const size_t n = m.size();
     GpuKernels kernels(context->gl());
     const auto x = random_vector(n, 1), y = random_vector(n, 2);
     const GpuBuffer xg = kernels.vector(n, interleaved(x).data());
     for (GpuMatrixFormat f : {GpuMatrixFormat::Csr, GpuMatrixFormat::Ell, GpuMatrixFormat::SellCSigma}) {
-        const GpuMatrix gm(context->gl(), m, f);
+        const GpuMatrix gm(context->gl(), rgb_csr_view(m), f);
         GpuBuffer qg = kernels.vector(n);
         const Rgbd pq = kernels.multiply_dot(gm, xg, qg);
         const std::vector<float> q = qg.download<float>();
@@ -222,7 +197,7 @@ TEST(GpuKernels, ProductDotAndAxpbyMatchTheCpu) {
 
 // The correctness bar: float GPU CG at a tight tolerance against double CPU CG, 1e-4 relative.
 void expect_gpu_matches_cpu(const System& s, GpuMatrixFormat format, const char* label) {
-    REQUIRE_GL(context);
+    WAXWORK_REQUIRE_GL(context);
     const auto reference = cpu_double_solution(s, 1e-9);
     GpuCgOptions options;
     options.relative_tolerance = 1e-5;
@@ -251,7 +226,7 @@ TEST(GpuConjugateGradient, SellCSigmaGivesTheSameSolution) {
 }
 
 TEST(GpuConjugateGradient, StopsByTheSameRuleAsTheCpuFloatPath) {
-    REQUIRE_GL(context);
+    WAXWORK_REQUIRE_GL(context);
     const System& s = spot_system();
     DiffusionOptions cpu;
     cpu.precision = SolverPrecision::Float;
@@ -273,7 +248,7 @@ TEST(GpuConjugateGradient, StopsByTheSameRuleAsTheCpuFloatPath) {
 }
 
 TEST(GpuDiffusionSolver, FrameBudgetsWarmStartAndConverge) {
-    REQUIRE_GL(context);
+    WAXWORK_REQUIRE_GL(context);
     const System& s = spot_system();
     GpuDiffusionSolver solver(context->gl(), s.matrix);
     solver.set_light(s.matrix, s.q);
@@ -306,7 +281,7 @@ TEST(GpuDiffusionSolver, FrameBudgetsWarmStartAndConverge) {
 }
 
 TEST(GpuDiffusionSolver, RowUpdateAfterPaintingEqualsReupload) {
-    REQUIRE_GL(context);
+    WAXWORK_REQUIRE_GL(context);
     System s = cube_system();
     GpuDiffusionSolver updated(context->gl(), s.matrix, GpuMatrixFormat::SellCSigma);
     // "Paint" a blob of tets with ketchup.
@@ -331,7 +306,7 @@ TEST(GpuDiffusionSolver, RowUpdateAfterPaintingEqualsReupload) {
 }
 
 TEST(GpuDiffusionSolver, ShaderFailureFallsBackToTheCpuWithTheDriverLog) {
-    REQUIRE_GL(context);
+    WAXWORK_REQUIRE_GL(context);
     const System& s = cube_system();
     setenv("WAXWORK_GPU_FORCE_FAIL", "cg_update", 1);
     try {
