@@ -11,6 +11,8 @@
 //
 // Run: build/bench/gpu_solver_bench [--benchmark_filter=...]
 #include "bench_meshes.h"
+#include "multires/gpu_multires_solver.h"
+#include "multires/hierarchy.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
@@ -145,6 +147,22 @@ void BM_GpuCgWarm(benchmark::State& state) {
     state.counters["iters_g"] = r[1].iterations;
 }
 
+// The GPU multires path: coarse-to-fine BiCGSTAB (hierarchy built once on the CPU, excluded), then the
+// level-0 CG to an estimated 1% error.
+void BM_GpuMultires(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    const MultiresHierarchy hierarchy = build_multires_hierarchy(s.matrix, s.mesh.positions);
+    GpuMultiresSolver solver(context().gl(), s.matrix, hierarchy);
+    solver.set_light(s.matrix, s.q);
+    MultiresSolveOptions options;
+    options.relative_tolerance = 1e-2;
+    GpuMultiresReport report;
+    for (auto _ : state) report = solver.solve(options);
+    state.counters["levels"] = static_cast<double>(hierarchy.level_count());
+    state.counters["fine_iters_g"] = report.fine[1].iterations;
+    state.counters["coarsest_iters_g"] = report.coarse_levels.empty() ? 0 : report.coarse_levels.front()[1].iterations;
+}
+
 // What a scene load costs: kernels compiled, pattern and values uploaded, diagonal extracted.
 void BM_GpuSetup(benchmark::State& state) {
     const Scene& s = scene(state.range(0));
@@ -185,6 +203,7 @@ BENCHMARK(BM_GpuAxpby)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuCg<GpuMatrixFormat::Csr>)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuCg<GpuMatrixFormat::SellCSigma>)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuCgWarm)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuMultires)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuSetup)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuPaintRowUpdate)->WAXWORK_SIZES;
 

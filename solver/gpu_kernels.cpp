@@ -318,131 +318,86 @@ std::array<double, K> GpuKernels::sum_partials(GLuint groups) {
     return total;
 }
 
-namespace {
-void set_matrix(const GlApi& gl, const ComputeProgram& program, const GpuMatrix& m) {
+GLuint GpuKernels::launch(const ComputeProgram& program, size_t n, size_t threads, std::initializer_list<Binding> buffers,
+                          const std::function<void()>& uniforms) {
     program.use();
+    for (const Binding& binding : buffers) binding.buffer->bind(binding.index);
+    partials_.bind(5);  // reduction kernels write their per-invocation sums here
+    gl_->Uniform1ui(program.uniform("n"), static_cast<GLuint>(n));
+    if (uniforms) uniforms();
+    const GLuint groups = groups_for(threads);
+    program.dispatch(groups);
+    return groups;
+}
+
+GLuint GpuKernels::launch_matrix(const ComputeProgram& program, const GpuMatrix& m, std::initializer_list<Binding> buffers,
+                                 const std::function<void()>& uniforms) {
     m.starts.bind(0);
     m.columns.bind(1);
     m.values.bind(2);
     m.slot_rows.bind(9);
-    gl.Uniform1ui(program.uniform("n"), m.layout.slots);
-    gl.Uniform1ui(program.uniform("slice_height"), std::max<uint32_t>(m.layout.slice_height, 1));
+    return launch(program, m.layout.slots, m.layout.slots, buffers, [&] {
+        gl_->Uniform1ui(program.uniform("slice_height"), std::max<uint32_t>(m.layout.slice_height, 1));
+        if (uniforms) uniforms();
+    });
+}
+
+namespace {
+void set_vec3(const GlApi& gl, const ComputeProgram& program, const char* name, const Rgbd& v) {
+    const float f[3] = {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])};
+    gl.Uniform3fv(program.uniform(name), 1, f);
 }
 }  // namespace
 
 Rgbd GpuKernels::multiply_dot(const GpuMatrix& m, const GpuBuffer& p, GpuBuffer& q) {
-    const ComputeProgram& program = multiply_dot_.at(m.layout.format);
-    set_matrix(*gl_, program, m);
-    p.bind(3);
-    q.bind(4);
-    partials_.bind(5);
-    const GLuint groups = groups_for(m.layout.slots);
-    program.dispatch(groups);
-    return sum_partials<3>(groups);
+    return sum_partials<3>(launch_matrix(multiply_dot_.at(m.layout.format), m, {{3, &p}, {4, &q}}));
 }
 
 Rgbd GpuKernels::residual(const GpuMatrix& m, const GpuBuffer& b, const GpuBuffer& x, const GpuBuffer& inv_diag,
                           GpuBuffer& r, GpuBuffer& z, const std::array<bool, 3>& mask) {
     const ComputeProgram& program = residual_.at(m.layout.format);
-    set_matrix(*gl_, program, m);
-    const GLint mask_location = program.uniform("mask");
-    if (mask_location >= 0) {
-        const GLuint bits[3] = {mask[0], mask[1], mask[2]};
-        gl_->Uniform3uiv(mask_location, 1, bits);
-    }
-    x.bind(3);
-    r.bind(4);
-    partials_.bind(5);
-    b.bind(6);
-    z.bind(7);
-    inv_diag.bind(8);
-    const GLuint groups = groups_for(m.layout.slots);
-    program.dispatch(groups);
-    return sum_partials<3>(groups);
+    const GLuint bits[3] = {mask[0], mask[1], mask[2]};
+    return sum_partials<3>(launch_matrix(program, m, {{3, &x}, {4, &r}, {6, &b}, {7, &z}, {8, &inv_diag}},
+                                         [&] { gl_->Uniform3uiv(program.uniform("mask"), 1, bits); }));
 }
 
 Rgbd GpuKernels::dot(size_t rows, const GpuBuffer& u, const GpuBuffer& v) { return dot(rows, u, v, u); }
 
 Rgbd GpuKernels::dot(size_t rows, const GpuBuffer& u, const GpuBuffer& v, const GpuBuffer& w) {
-    dot_.use();
-    u.bind(0);
-    v.bind(1);
-    w.bind(2);
-    partials_.bind(5);
-    gl_->Uniform1ui(dot_.uniform("n"), static_cast<GLuint>(rows));
-    gl_->Uniform1ui(dot_.uniform("weighted"), &w == &u ? 0u : 1u);
-    const GLuint groups = groups_for(rows);
-    dot_.dispatch(groups);
-    return sum_partials<3>(groups);
+    const GLuint weighted = &w == &u ? 0u : 1u;
+    return sum_partials<3>(launch(dot_, rows, rows, {{0, &u}, {1, &v}, {2, &w}},
+                                  [&] { gl_->Uniform1ui(dot_.uniform("weighted"), weighted); }));
 }
 
 void GpuKernels::axpby(size_t rows, const Rgbd& a, const GpuBuffer& x, const Rgbd& b, GpuBuffer& y) {
-    axpby_.use();
-    x.bind(0);
-    y.bind(1);
-    gl_->Uniform1ui(axpby_.uniform("n"), static_cast<GLuint>(rows));
-    const float af[3] = {static_cast<float>(a[0]), static_cast<float>(a[1]), static_cast<float>(a[2])};
-    const float bf[3] = {static_cast<float>(b[0]), static_cast<float>(b[1]), static_cast<float>(b[2])};
-    gl_->Uniform3fv(axpby_.uniform("a"), 1, af);
-    gl_->Uniform3fv(axpby_.uniform("b"), 1, bf);
-    axpby_.dispatch(groups_for(rows));
+    launch(axpby_, rows, rows, {{0, &x}, {1, &y}}, [&] {
+        set_vec3(*gl_, axpby_, "a", a);
+        set_vec3(*gl_, axpby_, "b", b);
+    });
 }
 
 void GpuKernels::extract_diagonal(const GpuMatrix& m, GpuBuffer& diag, GpuBuffer& inv_diag) {
-    extract_diagonal_.use();
-    m.diagonal.bind(0);
-    m.values.bind(2);
-    diag.bind(3);
-    inv_diag.bind(4);
-    gl_->Uniform1ui(extract_diagonal_.uniform("n"), m.layout.rows);
-    extract_diagonal_.dispatch(groups_for(m.layout.rows));
+    launch(extract_diagonal_, m.layout.rows, m.layout.rows, {{0, &m.diagonal}, {2, &m.values}, {3, &diag}, {4, &inv_diag}});
 }
 
 std::array<double, 6> GpuKernels::cg_update(size_t rows, const Rgbd& alpha, const GpuBuffer& p, const GpuBuffer& q,
                                             const GpuBuffer& diag, const GpuBuffer& inv_diag, GpuBuffer& x,
                                             GpuBuffer& r, GpuBuffer& z) {
-    cg_update_.use();
-    p.bind(0);
-    q.bind(1);
-    diag.bind(2);
-    inv_diag.bind(3);
-    x.bind(4);
-    partials_.bind(5);
-    r.bind(6);
-    z.bind(7);
-    gl_->Uniform1ui(cg_update_.uniform("n"), static_cast<GLuint>(rows));
-    const float af[3] = {static_cast<float>(alpha[0]), static_cast<float>(alpha[1]), static_cast<float>(alpha[2])};
-    gl_->Uniform3fv(cg_update_.uniform("alpha"), 1, af);
-    const GLuint groups = groups_for(rows);
-    cg_update_.dispatch(groups);
-    return sum_partials<6>(groups);
+    return sum_partials<6>(launch(cg_update_, rows, rows,
+                                  {{0, &p}, {1, &q}, {2, &diag}, {3, &inv_diag}, {4, &x}, {6, &r}, {7, &z}},
+                                  [&] { set_vec3(*gl_, cg_update_, "alpha", alpha); }));
 }
 
 void GpuKernels::scatter(size_t count, const GpuBuffer& slots, const GpuBuffer& source, GpuBuffer& values) {
-    scatter_.use();
-    slots.bind(0);
-    source.bind(1);
-    values.bind(2);
-    gl_->Uniform1ui(scatter_.uniform("n"), static_cast<GLuint>(count));
-    scatter_.dispatch(groups_for(count));
+    launch(scatter_, count, count, {{0, &slots}, {1, &source}, {2, &values}});
 }
 
 void GpuKernels::hadamard(size_t rows, const GpuBuffer& w, const GpuBuffer& x, GpuBuffer& y) {
-    hadamard_.use();
-    w.bind(0);
-    x.bind(1);
-    y.bind(2);
-    gl_->Uniform1ui(hadamard_.uniform("n"), static_cast<GLuint>(rows));
-    hadamard_.dispatch(groups_for(3 * rows));
+    launch(hadamard_, rows, 3 * rows, {{0, &w}, {1, &x}, {2, &y}});
 }
 
 void GpuKernels::gather(size_t rows, const GpuBuffer& index, const GpuBuffer& source, GpuBuffer& target) {
-    gather_.use();
-    index.bind(0);
-    source.bind(1);
-    target.bind(2);
-    gl_->Uniform1ui(gather_.uniform("n"), static_cast<GLuint>(rows));
-    gather_.dispatch(groups_for(rows));
+    launch(gather_, rows, rows, {{0, &index}, {1, &source}, {2, &target}});
 }
 
 GpuInterpolation::GpuInterpolation(const GlApi& gl, std::span<const int32_t> offsets_,
@@ -455,14 +410,7 @@ GpuInterpolation::GpuInterpolation(const GlApi& gl, std::span<const int32_t> off
 }
 
 void GpuKernels::interpolate(const GpuInterpolation& p, const GpuBuffer& coarse, GpuBuffer& fine) {
-    interpolate_.use();
-    p.offsets.bind(0);
-    p.columns.bind(1);
-    p.weights.bind(2);
-    coarse.bind(3);
-    fine.bind(4);
-    gl_->Uniform1ui(interpolate_.uniform("n"), static_cast<GLuint>(p.rows));
-    interpolate_.dispatch(groups_for(p.rows));
+    launch(interpolate_, p.rows, p.rows, {{0, &p.offsets}, {1, &p.columns}, {2, &p.weights}, {3, &coarse}, {4, &fine}});
 }
 
 }  // namespace waxwork

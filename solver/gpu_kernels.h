@@ -16,6 +16,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <initializer_list>
 #include <map>
 #include <span>
@@ -73,6 +74,18 @@ public:
     void scatter(size_t count, const GpuBuffer& slots, const GpuBuffer& source, GpuBuffer& values);
 
 private:
+    struct Binding {
+        GLuint index;
+        const GpuBuffer* buffer;
+    };
+    // Binds, sets the uniform n (and whatever `uniforms` sets), dispatches enough workgroups for
+    // `threads` (capped: grid-stride loops) and returns their number.
+    GLuint launch(const ComputeProgram& program, size_t n, size_t threads, std::initializer_list<Binding> buffers,
+                  const std::function<void()>& uniforms = {});
+    // The same for a sparse-product kernel: the matrix at bindings 0, 1, 2, 9; n = its slots.
+    GLuint launch_matrix(const ComputeProgram& program, const GpuMatrix& m, std::initializer_list<Binding> buffers,
+                         const std::function<void()>& uniforms = {});
+    // Folds the per-invocation sums of the last reduction (`groups` workgroups) and adds them up.
     template <size_t K>
     std::array<double, K> sum_partials(GLuint groups);
 
