@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
+#include <numeric>
 #include <string>
 #include <tuple>
 
@@ -100,12 +102,14 @@ void split_tet(const Tet& g, const std::array<int, 4>& s, const std::array<int32
     }
 }
 
-// The faces of v's star that contain v and lie on the boundary: every tet sharing such a face also
-// contains v, so a face met once within the star is a boundary face.
+// The faces of v's star that contain v and lie on the boundary or between two regions: every tet
+// sharing such a face also contains v, so a face met once within the star is a boundary face, and a
+// face met twice by tets of different labels is an interface.
 std::vector<std::array<int32_t, 3>> boundary_faces_at(const TetMesh& mesh, const std::vector<int32_t>& star,
-                                                      int32_t v) {
+                                                      int32_t v, const std::vector<int64_t>* labels) {
     std::vector<std::array<int32_t, 3>> faces;  // sorted triples, then oriented copies
     std::vector<std::array<int32_t, 3>> oriented;
+    std::vector<int64_t> face_label;
     for (int32_t t : star) {
         const Tet& tet = mesh.tets[t];
         for (int k = 0; k < 4; ++k) {
@@ -115,25 +119,34 @@ std::vector<std::array<int32_t, 3>> boundary_faces_at(const TetMesh& mesh, const
             oriented.push_back(key);
             std::sort(key.begin(), key.end());
             faces.push_back(key);
+            face_label.push_back(labels ? (*labels)[t] : 0);
         }
     }
-    std::vector<std::array<int32_t, 3>> sorted = faces;
-    std::sort(sorted.begin(), sorted.end());
+    std::vector<size_t> order(faces.size());
+    std::iota(order.begin(), order.end(), size_t{0});
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return faces[a] < faces[b]; });
     std::vector<std::array<int32_t, 3>> boundary;
-    for (size_t i = 0; i < faces.size(); ++i)
-        if (std::upper_bound(sorted.begin(), sorted.end(), faces[i]) - std::lower_bound(sorted.begin(), sorted.end(), faces[i]) == 1)
-            boundary.push_back(oriented[i]);
+    for (size_t i = 0; i < order.size();) {
+        size_t j = i + 1;
+        while (j < order.size() && faces[order[j]] == faces[order[i]]) ++j;
+        if (j - i == 1 || (j - i == 2 && face_label[order[i]] != face_label[order[i + 1]])) boundary.push_back(oriented[order[i]]);
+        i = j;
+    }
     return boundary;
 }
 
-// True when the boundary faces all lie in one plane (v may then slide along a boundary edge without
-// changing the shape of the volume).
-bool flat_boundary(const TetMesh& mesh, const std::vector<std::array<int32_t, 3>>& faces) {
+// True when the boundary faces all lie in one plane, or bend by at most max_bend_deg (v may then slide
+// along a boundary edge; exactly flat faces keep the shape of the volume unchanged).
+bool flat_boundary(const TetMesh& mesh, const std::vector<std::array<int32_t, 3>>& faces, double max_bend_deg) {
+    const double min_cosine = std::cos(max_bend_deg * std::numbers::pi / 180.0);
     Eigen::Vector3d reference = Eigen::Vector3d::Zero();
     for (const auto& f : faces) {
         const Eigen::Vector3d n = (mesh.positions[f[1]] - mesh.positions[f[0]]).cross(mesh.positions[f[2]] - mesh.positions[f[0]]);
         if (reference.isZero()) reference = n;
-        if (n.cross(reference).norm() > 1e-12 * n.norm() * reference.norm() || n.dot(reference) <= 0) return false;
+        // Interface faces may be listed from either side: parallel normals of either sign count.
+        const double scale = n.norm() * reference.norm();
+        if (n.cross(reference).norm() <= 1e-12 * scale) continue;
+        if (max_bend_deg == 0 || std::abs(n.dot(reference)) < min_cosine * scale) return false;
     }
     return true;
 }
@@ -205,12 +218,12 @@ size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::ve
         const int32_t v = candidates[begin].vertex;
         size_t end = begin;
         while (end < candidates.size() && candidates[end].vertex == v) ++end;
-        const auto boundary = boundary_faces_at(mesh, star[slot[v]], v);
+        const auto boundary = boundary_faces_at(mesh, star[slot[v]], v, options.tet_labels);
         std::optional<Eigen::Vector3d> target_world;
         if (boundary.empty()) {
             target_world = field.project(world[v]);
             if (!target_world) target_world = candidates[begin].target;
-        } else if (flat_boundary(mesh, boundary)) {
+        } else if (flat_boundary(mesh, boundary, options.boundary_bend_deg)) {
             for (size_t i = begin; i < end && !target_world; ++i)
                 for (const auto& f : boundary)
                     if (std::find(f.begin(), f.end(), candidates[i].other) != f.end()) {
@@ -219,7 +232,7 @@ size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::ve
                     }
         }
         begin = end;
-        if (!target_world || values[v] == 0 || (options.pinned && (*options.pinned)[v])) continue;
+        if (!target_world || values[v] == 0) continue;
         const Eigen::Vector3d target = to_rest(mesh, piece_of[v], *target_world);
         if (!guard_holds(v, target)) continue;
         mesh.positions[v] = target;
@@ -270,8 +283,10 @@ SplitReport split_along_field(TetMesh& mesh, std::vector<Eigen::Vector3d>& world
     if (!(options.min_dihedral_guard_deg >= 0) || !(options.min_dihedral_guard_deg < 60))
         throw InvalidArgumentError("split: the dihedral guard must be in [0, 60) degrees");
     if (!(options.zero_tolerance >= 0)) throw InvalidArgumentError("split: negative zero tolerance");
-    if (options.pinned && options.pinned->size() != mesh.vertex_count())
-        throw InvalidArgumentError("split: one pinned flag per vertex expected");
+    if (!(options.boundary_bend_deg >= 0) || !(options.boundary_bend_deg < 90))
+        throw InvalidArgumentError("split: the boundary bend must be in [0, 90) degrees");
+    if (options.tet_labels && options.tet_labels->size() != mesh.tet_count())
+        throw InvalidArgumentError("split: one label per tet expected");
     for (double v : values)
         if (!std::isfinite(v)) throw InvalidArgumentError("split: non-finite field value");
 

@@ -27,6 +27,9 @@ struct FractureOptions {
     // of being cut off in a sliver (SplitOptions::snap_fraction); 0 splits every crossed edge, which
     // keeps every unsplit tet's shape but leaves thinner tets.
     double snap_fraction = 0.2;
+    // Exact mode: boundary vertices slide onto a wall where the surface bends by at most this angle
+    // (SplitOptions::boundary_bend_deg; 0 keeps the outer surface exactly).
+    double boundary_bend_deg = 20;
 };
 
 struct FractureResult {
