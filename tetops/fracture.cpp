@@ -127,11 +127,11 @@ void check_options(const FractureOptions& options) {
 void make_pieces(TetMesh& mesh, const std::vector<int64_t>& label, const FractureOptions& options,
                  FractureResult& result) {
     const size_t n = mesh.tet_count();
-    const TetConnectivity connectivity = build_connectivity(mesh);
+    const std::vector<std::array<int32_t, 4>> neighbors = build_face_neighbors(mesh);
     DisjointSets parts(n);
     for (size_t t = 0; t < n; ++t)
         for (int f = 0; f < 4; ++f) {
-            const int32_t u = connectivity.tet_neighbors[t][f];
+            const int32_t u = neighbors[t][f];
             if (u > static_cast<int32_t>(t) && label[u] == label[t] && mesh.piece_ids[u] == mesh.piece_ids[t])
                 parts.unite(static_cast<int32_t>(t), u);
         }
@@ -148,7 +148,7 @@ void make_pieces(TetMesh& mesh, const std::vector<int64_t>& label, const Fractur
             for (size_t t = 0; t < n; ++t) {
                 if (size[root[t]] >= options.min_piece_tets) continue;
                 for (int f = 0; f < 4; ++f) {
-                    const int32_t u = connectivity.tet_neighbors[t][f];
+                    const int32_t u = neighbors[t][f];
                     if (u >= 0 && root[u] != root[t]) ++shared[{root[t], root[u]}];
                 }
             }

@@ -115,6 +115,31 @@ TEST(ExactCut, SnappingImprovesTheWorstAngle) {
     EXPECT_NEAR(total_volume(snapped), total_volume(unsnapped), 1e-13);
 }
 
+TEST(ExactCut, BoundaryBendZeroKeepsACurvedSurfaceExactly) {
+    // A cube whose top is a gentle bump: its boundary faces bend by a few degrees.
+    TetMesh before = make_cube_mesh(8);
+    for (auto& p : before.positions) p.z() *= 1 + 0.08 * std::sin(3 * p.x()) * std::cos(2 * p.y());
+    ASSERT_NO_THROW(validate(before));
+    const PlaneCut plane(Eigen::Vector3d(1, 0.1, 0.03), 0.515);
+    TetMesh reference = before, flat_only = before, bent = before;
+    ExactCutOptions options;
+    options.split.snap_fraction = 0;
+    cut_exact(reference, plane, options);  // no vertex moves: the exact kept volume
+    options.split.snap_fraction = 0.2;
+    options.split.boundary_bend_deg = 0;
+    const ExactCutResult a = cut_exact(flat_only, plane, options);
+    options.split.boundary_bend_deg = 20;
+    const ExactCutResult b = cut_exact(bent, plane, options);
+    EXPECT_NEAR(total_volume(flat_only), total_volume(reference), 1e-13);
+    EXPECT_GT(b.vertices_snapped, a.vertices_snapped);  // curved boundary vertices slide too
+    EXPECT_GE(b.min_dihedral_deg, a.min_dihedral_deg);
+    EXPECT_NEAR(total_volume(bent), total_volume(reference), 1e-3 * total_volume(reference));
+    expect_valid_conforming(flat_only);
+    expect_valid_conforming(bent);
+    options.split.boundary_bend_deg = 90;
+    EXPECT_THROW(cut_exact(bent, plane, options), InvalidArgumentError);
+}
+
 TEST(ExactCut, PlanesThroughVerticesAndEdges) {
     // x = 0.4 is a grid plane of the 5-cell cube: nothing to split, the cut follows existing faces.
     TetMesh mesh = make_cube_mesh(5);
