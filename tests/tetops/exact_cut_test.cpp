@@ -17,6 +17,7 @@ namespace {
 
 using testing::expect_valid_conforming;
 using testing::make_cube_mesh;
+using testing::on_unit_cube_boundary;
 using testing::volume_by_original_id;
 
 // Volume of {x in [0,1]^3 : n.x <= d} for n with positive components: inclusion-exclusion over the
@@ -29,12 +30,6 @@ double kept_cube_volume(const Eigen::Vector3d& n, double d) {
         sum += ((corner & 1) + ((corner >> 1) & 1) + ((corner >> 2) & 1)) % 2 ? -s * s * s : s * s * s;
     }
     return sum / (6 * n.x() * n.y() * n.z());
-}
-
-bool on_unit_cube_boundary(const Eigen::Vector3d& p) {
-    for (int i = 0; i < 3; ++i)
-        if (std::abs(p[i]) < 1e-12 || std::abs(p[i] - 1) < 1e-12) return true;
-    return false;
 }
 
 // The largest |side| over vertices of boundary faces that are not on the cube's boundary (the
