@@ -42,15 +42,15 @@ struct SplitOptions {
     // Field values within this absolute tolerance count as on the surface (e.g. vertices created on
     // the same surface by an earlier split, which rounding puts a few ulps off it).
     double zero_tolerance = 0;
-    // A vertex on the boundary of the volume snaps only by sliding along a boundary edge, and only where
-    // the boundary faces around it bend by at most this angle (degrees): 0 keeps the shape of the volume
-    // exactly (only flat parts of the boundary slide), more trades a change of the outer surface
-    // under (1 - cos(bend)) x snap_fraction x edge length for fewer slivers where the surface is
-    // curved.
+    // A vertex on the boundary of the volume snaps only by sliding along a boundary edge, and only when
+    // that edge leaves the plane of every boundary face around the vertex by at most this angle
+    // (degrees): 0 keeps the shape of the volume exactly (vertices slide only within flat parts and
+    // along straight creases), more trades a change of the outer surface of at most
+    // sin(bend) x snap_fraction x edge length for fewer slivers where the surface is curved.
     double boundary_bend_deg = 0;
     // Per tet: a region label (e.g. the fracture cell). Faces between tets of different labels are
-    // treated like boundary faces: a vertex on them snaps only by sliding along one of their edges
-    // where they are flat, so earlier walls stay where they are. Null: one region.
+    // kept in their planes like flat boundary faces (bend 0): a vertex on them snaps only by sliding
+    // along an edge that stays in all of them, so earlier walls stay where they are. Null: one region.
     const std::vector<int64_t>* tet_labels = nullptr;
 };
 
