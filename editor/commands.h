@@ -13,6 +13,7 @@ void add_info_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_demo_command(CLI::App& app);
 void add_cut_command(CLI::App& app);
+void add_fracture_command(CLI::App& app);
 void add_paint_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 
@@ -21,6 +22,7 @@ inline void register_commands(CLI::App& app) {
     add_info_command(app);
     add_render_command(app);
     add_cut_command(app);
+    add_fracture_command(app);
     add_paint_command(app);
     add_demo_command(app);
     add_bench_command(app);
