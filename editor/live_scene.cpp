@@ -1,0 +1,244 @@
+#include "editor/live_scene.h"
+
+#include "solver/conjugate_gradient.h"
+#include "solver/radiance.h"
+#include "tetops/error.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace waxwork {
+namespace {
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+AssemblyOptions assembly_options(const LiveSceneOptions& options) {
+    AssemblyOptions a;
+    a.mm_per_unit = options.mm_per_unit;
+    return a;
+}
+
+void check_materials(const TetMesh& mesh) {
+    if (mesh.materials.size() != mesh.tet_count())
+        throw InvalidArgumentError("live scene: the volume must store one material per tet (" +
+                                   std::to_string(mesh.materials.size()) + " for " +
+                                   std::to_string(mesh.tet_count()) + " tets)");
+}
+
+}  // namespace
+
+LiveScene::LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSceneOptions& options)
+    : mesh_(&mesh), options_(options), lighting_(lighting) {
+    if (!(options.mm_per_unit > 0) || !std::isfinite(options.mm_per_unit))
+        throw InvalidArgumentError("live scene: mm_per_unit must be positive");
+    if (!(options.relative_tolerance > 0) || !(options.relative_tolerance < 1))
+        throw InvalidArgumentError("live scene: the relative tolerance must be in (0, 1)");
+    validate(lighting_);
+    check_materials(mesh);
+    SceneUpdate update;
+    rebuild_all(nullptr, update);
+}
+
+void LiveScene::mark_unconverged() {
+    converged_ = {false, false, false};
+}
+
+void LiveScene::rebuild_surface(SceneUpdate& update) {
+    surface_ = extract_boundary_surface(*mesh_, *connectivity_, mesh_->materials);
+    shadow_bvh_ = build_shadow_bvh(surface_);
+    update.rebuilt_surface = true;
+    relight(update);
+}
+
+void LiveScene::relight(SceneUpdate& update) {
+    q_ = to_volume_vertices(surface_, incident_light(surface_, shadow_bvh_, lighting_), mesh_->vertex_count());
+    update.recomputed_light = true;
+    refresh_right_hand_sides();
+}
+
+void LiveScene::refresh_right_hand_sides() {
+    const size_t n = matrix_.size();
+    for (int c = 0; c < 3; ++c) {
+        b_[c].resize(n);
+        diffusion_right_hand_side(matrix_, q_, c, b_[c]);
+    }
+    mark_unconverged();
+}
+
+void LiveScene::rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update) {
+    if (!connectivity) {
+        connectivity = std::make_shared<const TetConnectivity>(build_connectivity(*mesh_));
+        update.rebuilt_connectivity = true;
+    }
+    connectivity_ = std::move(connectivity);
+    matrix_ = assemble_diffusion_matrix(*mesh_, *connectivity_, mesh_->materials, assembly_options(options_));
+    update.reassembled_matrix = true;
+    rebuild_surface(update);
+    // The smallest-eigenvalue hints belong to the old matrix: a stale hint could be too large and
+    // make the error estimate optimistic.
+    eigenvalue_hint_ = {0, 0, 0};
+    for (auto& phi : phi_) phi.resize(matrix_.size(), 0.0);
+}
+
+SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& change) {
+    const std::lock_guard lock(mutex_);
+    const auto start = std::chrono::steady_clock::now();
+    SceneUpdate update;
+    mesh_ = &mesh;
+    check_materials(mesh);
+    if (change.topology) {
+        // Carry phi over where the change says where vertices went (a cut); else start cold.
+        std::array<std::vector<double>, 3> old = std::move(phi_);
+        const bool mapped = change.old_to_new_vertex.size() == old[0].size();
+        for (int c = 0; c < 3; ++c) phi_[c].assign(mesh.vertex_count(), 0.0);
+        if (mapped) {
+            for (size_t v = 0; v < change.old_to_new_vertex.size(); ++v) {
+                const int32_t to = change.old_to_new_vertex[v];
+                if (to >= 0 && static_cast<size_t>(to) < mesh.vertex_count())
+                    for (int c = 0; c < 3; ++c) phi_[c][to] = old[c][v];
+            }
+        }
+        update.warm_start = mapped;
+        const bool reuse = change.connectivity && change.connectivity->vertex_tets.row_count() == mesh.vertex_count() &&
+                           change.connectivity->tet_neighbors.size() == mesh.tet_count();
+        rebuild_all(reuse ? change.connectivity : nullptr, update);
+    } else if (change.positions) {
+        // Same tets, moved vertices: new geometry on the same connectivity.
+        matrix_ = assemble_diffusion_matrix(mesh, *connectivity_, mesh.materials, assembly_options(options_));
+        update.reassembled_matrix = true;
+        eigenvalue_hint_ = {0, 0, 0};
+        rebuild_surface(update);
+    } else {
+        bool eta_changed = false;
+        if (change.all_materials) {
+            assemble_diffusion_values(matrix_, *connectivity_, mesh.materials);
+            update.recomputed_values = true;
+            eta_changed = true;
+        } else if (!change.changed_material_tets.empty()) {
+            update.updated_rows = update_diffusion_matrix(matrix_, mesh, *connectivity_, mesh.materials,
+                                                          change.changed_material_tets);
+            // q depends on eta through the Fresnel transmittance: only a changed tet with a boundary
+            // face can change a boundary vertex's eta.
+            for (const int32_t t : change.changed_material_tets) {
+                const auto& n = connectivity_->tet_neighbors[t];
+                if (std::find(n.begin(), n.end(), -1) != n.end()) {
+                    eta_changed = true;
+                    break;
+                }
+            }
+        }
+        if (eta_changed) {
+            const std::vector<double> eta = boundary_vertex_eta(mesh, *connectivity_, mesh.materials);
+            bool differs = false;
+            for (size_t s = 0; s < surface_.vertices.size(); ++s) {
+                differs = differs || surface_.eta[s] != eta[surface_.vertices[s]];
+                surface_.eta[s] = eta[surface_.vertices[s]];
+            }
+            eta_changed = differs;
+        }
+        if (change.piece_transforms) {
+            // Rigid motions leave the matrix (built on rest positions) unchanged but move the pieces'
+            // shadows onto each other.
+            rebuild_surface(update);
+        } else if (eta_changed) {
+            relight(update);
+        } else if (update.recomputed_values || !update.updated_rows.empty()) {
+            refresh_right_hand_sides();  // the source operator (A, F_dr) follows the materials
+        }
+    }
+    mark_unconverged();
+    update.milliseconds = milliseconds_since(start);
+    return update;
+}
+
+SceneUpdate LiveScene::set_lighting(const Lighting& lighting) {
+    validate(lighting);
+    const std::lock_guard lock(mutex_);
+    const auto start = std::chrono::steady_clock::now();
+    lighting_ = lighting;
+    SceneUpdate update;
+    relight(update);
+    update.milliseconds = milliseconds_since(start);
+    return update;
+}
+
+FrameReport LiveScene::iterate(int iteration_budget) {
+    const auto start = std::chrono::steady_clock::now();
+    FrameReport report;
+    const size_t n = matrix_.size();
+    for (int c = 0; c < 3; ++c) {
+        if (converged_[c] || n == 0) {
+            converged_[c] = true;
+            report.estimated_relative_error[c] = n == 0 ? 0 : error_[c];
+            continue;
+        }
+        ConjugateGradientOptions cg;
+        cg.relative_tolerance = options_.relative_tolerance;
+        cg.max_iterations = iteration_budget;
+        cg.smallest_eigenvalue_hint = eigenvalue_hint_[c];
+        const CsrMatrixView<double> view{n, matrix_.offsets.data(), matrix_.columns.data(), matrix_.values[c].data()};
+        const ConjugateGradientResult r = solve_jacobi_cg<double>(view, b_[c], phi_[c], cg);
+        report.iterations[c] = r.iterations;
+        if (r.smallest_eigenvalue_estimate > 0) eigenvalue_hint_[c] = r.smallest_eigenvalue_estimate;
+        error_[c] = r.estimated_relative_error;
+        converged_[c] = r.converged;
+        report.estimated_relative_error[c] = error_[c];
+    }
+    report.converged = converged_[0] && converged_[1] && converged_[2];
+    report.milliseconds = milliseconds_since(start);
+    return report;
+}
+
+FrameReport LiveScene::step(int iteration_budget) {
+    if (iteration_budget < 0) throw InvalidArgumentError("live scene: the iteration budget must be >= 0");
+    const std::lock_guard lock(mutex_);
+    return iterate(iteration_budget);
+}
+
+FrameReport LiveScene::converge(int max_iterations) {
+    const std::lock_guard lock(mutex_);
+    FrameReport report = iterate(max_iterations);
+    if (!report.converged) {
+        std::ostringstream msg;
+        msg << "live scene: the diffusion solve did not reach relative error " << options_.relative_tolerance
+            << " in " << max_iterations << " iterations (estimated " << report.max_error() << ")";
+        throw AlgorithmError(msg.str());
+    }
+    return report;
+}
+
+bool LiveScene::converged() const {
+    const std::lock_guard lock(mutex_);
+    return converged_[0] && converged_[1] && converged_[2];
+}
+
+Lighting LiveScene::lighting() const {
+    const std::lock_guard lock(mutex_);
+    return lighting_;
+}
+
+std::vector<std::array<double, 3>> LiveScene::phi() const {
+    const std::lock_guard lock(mutex_);
+    std::vector<std::array<double, 3>> phi(matrix_.size());
+    for (size_t v = 0; v < phi.size(); ++v)
+        for (int c = 0; c < 3; ++c) phi[v][c] = phi_[c][v];
+    return phi;
+}
+
+SolvedScene LiveScene::solved_scene() const {
+    SolvedScene scene;
+    scene.diffusion.phi = phi();
+    const std::lock_guard lock(mutex_);
+    scene.surface = surface_;
+    scene.q = q_;
+    for (int c = 0; c < 3; ++c) scene.diffusion.estimated_relative_error[c] = error_[c];
+    scene.radiance_factor =
+        exitant_radiance_factors(*mesh_, *connectivity_, mesh_->materials, scene.diffusion.phi, scene.q);
+    return scene;
+}
+
+}  // namespace waxwork
