@@ -1,5 +1,7 @@
 #include "editor/edit_operation.h"
 
+#include "editor/json_fields.h"
+
 #include "solver/material.h"
 #include "tetops/error.h"
 
@@ -14,80 +16,6 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-std::string prefixed(const std::string& context, const std::string& message) {
-    return context.empty() ? message : context + ": " + message;
-}
-
-[[noreturn]] void fail(const std::string& context, const std::string& message) {
-    throw InvalidArgumentError(prefixed(context, message));
-}
-
-// Reads the fields of one JSON object, naming the object and field in every error, and rejects
-// fields nobody asked for (finish()).
-class FieldReader {
-public:
-    FieldReader(const Json& json, std::string context) : json_(json), context_(std::move(context)) {
-        if (!json_.is_object()) fail(context_, "expected a JSON object");
-    }
-
-    bool has(const std::string& key) const { return json_.contains(key); }
-    std::string field(const std::string& key) const { return prefixed(context_, "field '" + key + "'"); }
-
-    const Json& at(const std::string& key) {
-        seen_.insert(key);
-        if (!json_.contains(key)) fail(context_, "missing field '" + key + "'");
-        return json_.at(key);
-    }
-
-    double number(const std::string& key) {
-        const Json& v = at(key);
-        if (!v.is_number() || !std::isfinite(v.get<double>())) fail(field(key), "expected a finite number");
-        return v.get<double>();
-    }
-    double number(const std::string& key, double fallback) { return has(key) ? number(key) : fallback; }
-
-    int64_t integer(const std::string& key) {
-        const Json& v = at(key);
-        if (!v.is_number_integer()) fail(field(key), "expected an integer");
-        return v.get<int64_t>();
-    }
-    int64_t integer(const std::string& key, int64_t fallback) { return has(key) ? integer(key) : fallback; }
-
-    bool boolean(const std::string& key, bool fallback) {
-        if (!has(key)) return fallback;
-        const Json& v = at(key);
-        if (!v.is_boolean()) fail(field(key), "expected true or false");
-        return v.get<bool>();
-    }
-
-    Eigen::Vector3d vector(const std::string& key) { return vector_from_json(at(key), field(key)); }
-
-    std::vector<Eigen::Vector3d> points(const std::string& key) {
-        const Json& v = at(key);
-        if (!v.is_array()) fail(field(key), "expected an array of [x, y, z] points");
-        std::vector<Eigen::Vector3d> result;
-        for (size_t i = 0; i < v.size(); ++i)
-            result.push_back(vector_from_json(v[i], field(key) + " point " + std::to_string(i)));
-        return result;
-    }
-
-    TetMaterial material(const std::string& key) { return material_from_json(at(key), field(key)); }
-
-    void ignore(const std::string& key) { seen_.insert(key); }
-
-    void finish() const {
-        for (auto it = json_.begin(); it != json_.end(); ++it)
-            if (!seen_.count(it.key())) fail(context_, "unknown field '" + it.key() + "'");
-    }
-
-    const std::string& context() const { return context_; }
-
-private:
-    const Json& json_;
-    std::string context_;
-    std::set<std::string> seen_;
-};
-
 Json relax_to_json(const RelaxSettings& r) {
     return Json{{"iterations", r.iterations}, {"step", r.step}, {"guard_deg", r.guard_deg}};
 }
@@ -96,12 +24,12 @@ RelaxSettings relax_from_json(const Json& json, const std::string& context) {
     FieldReader in(json, context);
     RelaxSettings r;
     const int64_t iterations = in.integer("iterations", r.iterations);
-    if (iterations < 0 || iterations > 100000) fail(in.field("iterations"), "must be between 0 and 100000");
+    if (iterations < 0 || iterations > 100000) fail_json(in.field("iterations"), "must be between 0 and 100000");
     r.iterations = static_cast<int>(iterations);
     r.step = in.number("step", r.step);
-    if (!(r.step > 0) || r.step > 1) fail(in.field("step"), "must be in (0, 1]");
+    if (!(r.step > 0) || r.step > 1) fail_json(in.field("step"), "must be in (0, 1]");
     r.guard_deg = in.number("guard_deg", r.guard_deg);
-    if (r.guard_deg < 0 || r.guard_deg >= 60) fail(in.field("guard_deg"), "must be in [0, 60) degrees");
+    if (r.guard_deg < 0 || r.guard_deg >= 60) fail_json(in.field("guard_deg"), "must be in [0, 60) degrees");
     in.finish();
     return r;
 }
@@ -121,7 +49,7 @@ Json plane_to_json(const PlaneSurface& p) { return Json{{"normal", vector_to_jso
 PlaneSurface plane_from_fields(FieldReader& in) {
     PlaneSurface p;
     p.normal = in.vector("normal");
-    if (p.normal.norm() == 0) fail(in.field("normal"), "must not be zero");
+    if (p.normal.norm() == 0) fail_json(in.field("normal"), "must not be zero");
     p.offset = in.number("offset");
     return p;
 }
@@ -137,9 +65,9 @@ StrokeSurface stroke_from_fields(FieldReader& in) {
     StrokeSurface s;
     s.eye = in.vector("eye");
     s.view_direction = in.vector("view_direction");
-    if (s.view_direction.norm() == 0) fail(in.field("view_direction"), "must not be zero");
+    if (s.view_direction.norm() == 0) fail_json(in.field("view_direction"), "must not be zero");
     s.points = in.points("points");
-    if (s.points.size() < 2) fail(in.field("points"), "a stroke needs at least two points");
+    if (s.points.size() < 2) fail_json(in.field("points"), "a stroke needs at least two points");
     s.flip = in.boolean("flip", false);
     return s;
 }
@@ -151,7 +79,7 @@ Json rotation_to_json(const Eigen::Matrix3d& r) {
 }
 
 Eigen::Matrix3d rotation_from_json(const Json& json, const std::string& context) {
-    if (!json.is_array() || json.size() != 3) fail(context, "expected three rows of three numbers");
+    if (!json.is_array() || json.size() != 3) fail_json(context, "expected three rows of three numbers");
     Eigen::Matrix3d r;
     for (int i = 0; i < 3; ++i) r.row(i) = vector_from_json(json[i], context + " row " + std::to_string(i));
     return r;
@@ -223,11 +151,11 @@ std::string operation_name(const EditOperation& op) { return to_json(op).at("op"
 Json vector_to_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
 Eigen::Vector3d vector_from_json(const Json& json, const std::string& context) {
-    if (!json.is_array() || json.size() != 3) fail(context, "expected an array of three numbers");
+    if (!json.is_array() || json.size() != 3) fail_json(context, "expected an array of three numbers");
     Eigen::Vector3d v;
     for (int i = 0; i < 3; ++i) {
         if (!json[i].is_number() || !std::isfinite(json[i].get<double>()))
-            fail(context, "expected an array of three finite numbers");
+            fail_json(context, "expected an array of three finite numbers");
         v[i] = json[i].get<double>();
     }
     return v;
@@ -244,13 +172,13 @@ TetMaterial material_from_json(const Json& json, const std::string& context) {
         try {
             return material_preset(json.get<std::string>());
         } catch (const Error& e) {
-            fail(context, e.what());
+            fail_json(context, e.what());
         }
     }
     FieldReader in(json, context);
     if (in.has("preset")) {
         const Json& name = in.at("preset");
-        if (!name.is_string()) fail(in.field("preset"), "expected a preset name");
+        if (!name.is_string()) fail_json(in.field("preset"), "expected a preset name");
         in.finish();
         return material_from_json(name, in.field("preset"));
     }
@@ -274,9 +202,9 @@ TetMaterial material_from_json(const Json& json, const std::string& context) {
 Json to_json(const EditOperation& op) { return std::visit(ToJson{}, op); }
 
 EditOperation edit_operation_from_json(const Json& json, const std::string& context) {
-    if (!json.is_object()) fail(context, "an edit operation must be a JSON object with an \"op\" field");
+    if (!json.is_object()) fail_json(context, "an edit operation must be a JSON object with an \"op\" field");
     if (!json.contains("op") || !json.at("op").is_string())
-        fail(context, "missing field 'op' (plane_cut, stroke_cut, relax, fracture, move_piece, weld, paint, "
+        fail_json(context, "missing field 'op' (plane_cut, stroke_cut, relax, fracture, move_piece, weld, paint, "
                       "set_material)");
     const std::string name = json.at("op").get<std::string>();
     FieldReader in(json, prefixed(context, name));
@@ -296,7 +224,7 @@ EditOperation edit_operation_from_json(const Json& json, const std::string& cont
         result = op;
     } else if (name == "relax") {
         RelaxOp op;
-        if (in.has("plane") == in.has("stroke")) fail(in.context(), "give exactly one of 'plane' and 'stroke'");
+        if (in.has("plane") == in.has("stroke")) fail_json(in.context(), "give exactly one of 'plane' and 'stroke'");
         if (in.has("plane")) {
             FieldReader plane(in.at("plane"), in.field("plane"));
             op.surface = plane_from_fields(plane);
@@ -312,58 +240,58 @@ EditOperation edit_operation_from_json(const Json& json, const std::string& cont
         FractureOp op;
         if (in.has("seeds")) {
             op.seeds = in.points("seeds");
-            if (op.seeds.empty()) fail(in.field("seeds"), "needs at least one seed point");
-            if (in.has("pieces") || in.has("seed")) fail(in.context(), "give either 'seeds' or 'pieces' and 'seed'");
+            if (op.seeds.empty()) fail_json(in.field("seeds"), "needs at least one seed point");
+            if (in.has("pieces") || in.has("seed")) fail_json(in.context(), "give either 'seeds' or 'pieces' and 'seed'");
         } else {
             const int64_t pieces = in.integer("pieces");
-            if (pieces < 1 || pieces > 100000) fail(in.field("pieces"), "must be between 1 and 100000");
+            if (pieces < 1 || pieces > 100000) fail_json(in.field("pieces"), "must be between 1 and 100000");
             op.pieces = static_cast<int>(pieces);
             const int64_t seed = in.integer("seed", 0);
-            if (seed < 0 || seed > int64_t{UINT32_MAX}) fail(in.field("seed"), "must be in [0, 2^32)");
+            if (seed < 0 || seed > int64_t{UINT32_MAX}) fail_json(in.field("seed"), "must be in [0, 2^32)");
             op.seed = static_cast<uint32_t>(seed);
         }
         op.exact = in.boolean("exact", true);
         const int64_t min_tets = in.integer("min_piece_tets", op.min_piece_tets);
-        if (min_tets < 0 || min_tets > 1000000000) fail(in.field("min_piece_tets"), "must be non-negative");
+        if (min_tets < 0 || min_tets > 1000000000) fail_json(in.field("min_piece_tets"), "must be non-negative");
         op.min_piece_tets = static_cast<int>(min_tets);
         result = op;
     } else if (name == "move_piece") {
         MovePieceOp op;
         const int64_t piece = in.integer("piece");
-        if (piece < 0 || piece > INT32_MAX) fail(in.field("piece"), "must be a piece index >= 0");
+        if (piece < 0 || piece > INT32_MAX) fail_json(in.field("piece"), "must be a piece index >= 0");
         op.piece = static_cast<int>(piece);
         if (in.has("rotation")) op.transform.rotation = rotation_from_json(in.at("rotation"), in.field("rotation"));
         if (in.has("translation")) op.transform.translation = in.vector("translation");
         const Eigen::Matrix3d& r = op.transform.rotation;
         if (!((r.transpose() * r - Eigen::Matrix3d::Identity()).norm() < 1e-6) || !(r.determinant() > 0))
-            fail(in.field("rotation"), "must be a rotation matrix (orthonormal, determinant +1)");
+            fail_json(in.field("rotation"), "must be a rotation matrix (orthonormal, determinant +1)");
         result = op;
     } else if (name == "weld") {
         WeldOp op;
         op.tolerance = in.number("tolerance", op.tolerance);
-        if (op.tolerance < 0) fail(in.field("tolerance"), "must be non-negative");
+        if (op.tolerance < 0) fail_json(in.field("tolerance"), "must be non-negative");
         result = op;
     } else if (name == "paint") {
         PaintOp op;
         op.points = in.points("points");
-        if (op.points.empty()) fail(in.field("points"), "needs at least one stroke point");
+        if (op.points.empty()) fail_json(in.field("points"), "needs at least one stroke point");
         op.material = in.material("material");
         op.sigma = in.number("sigma");
-        if (!(op.sigma > 0)) fail(in.field("sigma"), "must be a positive number (world units)");
+        if (!(op.sigma > 0)) fail_json(in.field("sigma"), "must be a positive number (world units)");
         op.cutoff_weight = in.number("cutoff_weight", op.cutoff_weight);
-        if (!(op.cutoff_weight > 0 && op.cutoff_weight < 1)) fail(in.field("cutoff_weight"), "must be in (0, 1)");
+        if (!(op.cutoff_weight > 0 && op.cutoff_weight < 1)) fail_json(in.field("cutoff_weight"), "must be in (0, 1)");
         result = op;
     } else if (name == "set_material") {
         SetMaterialOp op;
         op.material = in.material("material");
         if (in.has("piece")) {
             const int64_t piece = in.integer("piece");
-            if (piece < 0 || piece > INT32_MAX) fail(in.field("piece"), "must be a piece index >= 0");
+            if (piece < 0 || piece > INT32_MAX) fail_json(in.field("piece"), "must be a piece index >= 0");
             op.piece = static_cast<int>(piece);
         }
         result = op;
     } else {
-        fail(context, "unknown op '" + name +
+        fail_json(context, "unknown op '" + name +
                           "' (plane_cut, stroke_cut, relax, fracture, move_piece, weld, paint, set_material)");
     }
     in.finish();

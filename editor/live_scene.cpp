@@ -45,6 +45,7 @@ LiveScene::LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSc
 
 void LiveScene::mark_unconverged() {
     converged_ = {false, false, false};
+    solved_since_change_ = false;
 }
 
 void LiveScene::rebuild_surface(SceneUpdate& update) {
@@ -189,6 +190,7 @@ FrameReport LiveScene::iterate(int iteration_budget) {
         report.estimated_relative_error[c] = error_[c];
     }
     report.converged = converged_[0] && converged_[1] && converged_[2];
+    solved_since_change_ = true;
     report.milliseconds = milliseconds_since(start);
     return report;
 }
@@ -214,6 +216,12 @@ FrameReport LiveScene::converge(int max_iterations) {
 bool LiveScene::converged() const {
     const std::lock_guard lock(mutex_);
     return converged_[0] && converged_[1] && converged_[2];
+}
+
+std::optional<double> LiveScene::estimated_error() const {
+    const std::lock_guard lock(mutex_);
+    if (!solved_since_change_) return std::nullopt;
+    return std::max({error_[0], error_[1], error_[2]});
 }
 
 Lighting LiveScene::lighting() const {

@@ -41,6 +41,7 @@
 #include <array>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 namespace waxwork {
@@ -92,6 +93,9 @@ public:
     // Iterates until the tolerance (or `max_iterations` per channel: AlgorithmError if not reached).
     FrameReport converge(int max_iterations = 10000);
     bool converged() const;
+    // The estimated relative error of phi (max over channels) after the last step(), or nullopt when
+    // nothing was solved since the last change.
+    std::optional<double> estimated_error() const;
 
     // A copy of the current state in the form render_pipeline.h renders (make_render_input), with the
     // exitant radiance factors computed from the current phi. Reads the mesh.
@@ -126,6 +130,7 @@ private:
     std::array<double, 3> eigenvalue_hint_{};
     std::array<double, 3> error_{1, 1, 1};
     std::array<bool, 3> converged_{};
+    bool solved_since_change_ = false;
 };
 
 }  // namespace waxwork
