@@ -133,7 +133,7 @@ PlaneCutOp middle_cut(const TetMesh& mesh) {
 void BM_CutWithRebuild(benchmark::State& state) {
     const TetMesh& source = bench::spot_volume(kEditTets);
     const PlaneCutOp cut = middle_cut(source);
-    double apply_ms = 0, scene_ms = 0;
+    double apply_ms = 0, scene_ms = 0, undo_mib = 0;
     size_t tets_after = 0;
     for (auto _ : state) {
         state.PauseTiming();
@@ -145,11 +145,13 @@ void BM_CutWithRebuild(benchmark::State& state) {
         apply_ms = report.milliseconds;
         scene_ms = update.milliseconds;
         tets_after = doc.mesh().tet_count();
+        undo_mib = doc.undo_bytes() / double(1 << 20);
     }
     state.counters["tets_before"] = static_cast<double>(source.tet_count());
     state.counters["tets_after"] = static_cast<double>(tets_after);
     state.counters["document_ms"] = apply_ms;
     state.counters["scene_ms"] = scene_ms;
+    state.counters["undo_MiB"] = undo_mib;  // the snapshot the cut keeps for undo
 }
 BENCHMARK(BM_CutWithRebuild)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -169,17 +171,21 @@ void BM_PaintStrokeWithRowUpdates(benchmark::State& state) {
     scene.apply_change(doc.mesh(), doc.apply(stroke));  // builds the paint index
     size_t tets = 0, rows = 0;
     double document_ms = 0;
+    size_t undo_before = doc.undo_bytes(), undo_bytes = 0;
     for (auto _ : state) {
         stroke.material.mua[1] *= 1.01;  // a slightly different brush each time: every tet changes
         const ChangeReport report = doc.apply(stroke);
         rows = scene.apply_change(doc.mesh(), report).updated_rows.size();
         tets = report.changed_material_tets.size();
         document_ms = report.milliseconds;
+        undo_bytes = doc.undo_bytes() - undo_before;
+        undo_before = doc.undo_bytes();
     }
     state.counters["tets"] = static_cast<double>(doc.mesh().tet_count());
     state.counters["tets_painted"] = static_cast<double>(tets);
     state.counters["rows_updated"] = static_cast<double>(rows);
     state.counters["document_ms"] = document_ms;
+    state.counters["undo_KiB"] = undo_bytes / 1024.0;  // the delta one stroke keeps for undo
 }
 BENCHMARK(BM_PaintStrokeWithRowUpdates)->Unit(benchmark::kMillisecond)->UseRealTime();
 

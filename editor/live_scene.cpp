@@ -201,6 +201,22 @@ FrameReport LiveScene::step(int iteration_budget) {
     return iterate(iteration_budget);
 }
 
+FrameReport LiveScene::step_for(double milliseconds, int chunk_iterations) {
+    if (!(milliseconds >= 0) || chunk_iterations < 1)
+        throw InvalidArgumentError("live scene: the time budget must be >= 0 and the chunk >= 1 iteration");
+    const std::lock_guard lock(mutex_);
+    const auto start = std::chrono::steady_clock::now();
+    FrameReport total;
+    do {
+        const FrameReport chunk = iterate(chunk_iterations);
+        for (int c = 0; c < 3; ++c) total.iterations[c] += chunk.iterations[c];
+        total.estimated_relative_error = chunk.estimated_relative_error;
+        total.converged = chunk.converged;
+    } while (!total.converged && milliseconds_since(start) < milliseconds);
+    total.milliseconds = milliseconds_since(start);
+    return total;
+}
+
 FrameReport LiveScene::converge(int max_iterations) {
     const std::lock_guard lock(mutex_);
     FrameReport report = iterate(max_iterations);

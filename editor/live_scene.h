@@ -90,6 +90,10 @@ public:
     // At most `iteration_budget` CG iterations per channel, from the current phi. Channels already
     // within the tolerance are not iterated (an idle scene costs nothing).
     FrameReport step(int iteration_budget);
+    // A time budget instead: CG in chunks of `chunk_iterations` per channel until `milliseconds` have
+    // passed or the tolerance is reached (each chunk restarts CG from the current phi, which costs a
+    // little convergence against one longer run; at least one chunk runs).
+    FrameReport step_for(double milliseconds, int chunk_iterations = 4);
     // Iterates until the tolerance (or `max_iterations` per channel: AlgorithmError if not reached).
     FrameReport converge(int max_iterations = 10000);
     bool converged() const;

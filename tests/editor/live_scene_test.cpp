@@ -1,5 +1,6 @@
 #include "editor/live_scene.h"
 #include "solver/material.h"
+#include "tetops/error.h"
 #include "tetops/test_meshes.h"
 
 #include <gtest/gtest.h>
@@ -148,6 +149,19 @@ TEST(LiveScene, StepsAreBoundedAndAConvergedSceneIsIdle) {
     scene.apply_change(doc.mesh(), doc.apply(paint_at({0.5, 0.5, 0.5})));
     EXPECT_FALSE(scene.converged());
     EXPECT_GT(scene.step(3).total_iterations(), 0);
+}
+
+TEST(LiveScene, TimeBudgetedStepsReachTheTolerance) {
+    Document doc(testing::make_cube_mesh(6), material_preset("marble"));
+    LiveSceneOptions o = options();
+    o.relative_tolerance = 1e-6;
+    LiveScene scene(doc.mesh(), key_lighting(), o);
+    FrameReport frame = scene.step_for(0, 2);  // a zero budget still runs one chunk
+    EXPECT_GT(frame.total_iterations(), 0);
+    EXPECT_LE(frame.iterations[0], 2);
+    for (int i = 0; i < 1000 && !frame.converged; ++i) frame = scene.step_for(1.0, 2);
+    EXPECT_TRUE(frame.converged);
+    EXPECT_THROW(scene.step_for(-1), InvalidArgumentError);
 }
 
 }  // namespace
