@@ -56,7 +56,8 @@ void LiveScene::rebuild_surface(SceneUpdate& update) {
 }
 
 void LiveScene::relight(SceneUpdate& update) {
-    q_ = to_volume_vertices(surface_, incident_light(surface_, shadow_bvh_, lighting_), mesh_->vertex_count());
+    surface_q_ = incident_light(surface_, shadow_bvh_, lighting_);
+    q_ = to_volume_vertices(surface_, surface_q_, mesh_->vertex_count());
     update.recomputed_light = true;
     refresh_right_hand_sides();
 }
@@ -134,21 +135,38 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
         }
         if (eta_changed) {
             const std::vector<double> eta = boundary_vertex_eta(mesh, *connectivity_, mesh.materials);
-            bool differs = false;
+            std::vector<int32_t> changed;
             for (size_t s = 0; s < surface_.vertices.size(); ++s) {
-                differs = differs || surface_.eta[s] != eta[surface_.vertices[s]];
+                // Blending equal etas ((1 - w) eta + w eta) can round by an ulp: that changes q by
+                // 1e-16 relative, not worth recomputing.
+                if (std::abs(surface_.eta[s] - eta[surface_.vertices[s]]) > 1e-12) changed.push_back(static_cast<int32_t>(s));
                 surface_.eta[s] = eta[surface_.vertices[s]];
             }
-            eta_changed = differs;
+            eta_changed = !changed.empty();
+            if (eta_changed && !change.piece_transforms) {
+                // Only those vertices' Fresnel transmittance changed: recompute q there (shadow rays
+                // included), not on the whole surface.
+                update_incident_light(surface_, shadow_bvh_, lighting_, changed, surface_q_);
+                for (const int32_t s : changed) q_[surface_.vertices[s]] = surface_q_[s];
+                update.recomputed_light = true;
+            }
         }
         if (change.piece_transforms) {
             // Rigid motions leave the matrix (built on rest positions) unchanged but move the pieces'
             // shadows onto each other.
             rebuild_surface(update);
-        } else if (eta_changed) {
-            relight(update);
-        } else if (update.recomputed_values || !update.updated_rows.empty()) {
+        } else if (eta_changed || update.recomputed_values) {
             refresh_right_hand_sides();  // the source operator (A, F_dr) follows the materials
+        } else if (!update.updated_rows.empty()) {
+            // q is unchanged and only the rewritten rows of the source operator can differ: b changes
+            // in those rows only (b = source * q, Eq. 12). Cheaper than a full product per channel.
+            for (const int32_t i : update.updated_rows) {
+                std::array<double, 3> sum{};
+                if (matrix_.vertex_face_offsets[i] != matrix_.vertex_face_offsets[i + 1])
+                    for (int32_t k = matrix_.offsets[i]; k < matrix_.offsets[i + 1]; ++k)
+                        for (int c = 0; c < 3; ++c) sum[c] += matrix_.source[k] * q_[matrix_.columns[k]][c];
+                for (int c = 0; c < 3; ++c) b_[c][i] = sum[c];
+            }
         }
     }
     mark_unconverged();

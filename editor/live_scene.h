@@ -7,7 +7,7 @@
 // Reacting to a change (Document's ChangeReport), the scene redoes only what the change invalidates:
 //   materials of some tets   rewrite only the matrix rows of their vertices (paper Sec. 5, "we only
 //                            update the rows ... affected"; diffusion_matrix.h update_diffusion_matrix);
-//                            q only when a boundary eta changed; phi kept as warm start
+//                            q only at boundary vertices whose eta changed; phi kept as warm start
 //   all materials            recompute matrix values on the kept pattern and geometry; warm start
 //   piece transforms         boundary surface, shadow BVH and q (pieces shadow each other); the matrix
 //                            is invariant under rigid motion; warm start
@@ -128,6 +128,7 @@ private:
     DiffusionMatrix matrix_;
     BoundarySurface surface_;
     TriangleBvh shadow_bvh_;
+    std::vector<Rgb> surface_q_;                // per surface vertex
     std::vector<Rgb> q_;                        // per volume vertex
     std::array<std::vector<double>, 3> b_;      // right-hand side per channel
     std::array<std::vector<double>, 3> phi_;    // current fluence per channel
