@@ -2,6 +2,8 @@
 
 #include "tetops/cut.h"
 #include "tetops/error.h"
+#include "tetops/exact_cut.h"
+#include "tetops/fracture.h"
 #include "tetops/paint.h"
 #include "tetops/quality.h"
 #include "tetops/relaxation.h"
@@ -67,26 +69,37 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
     std::ostringstream details;
 
     // Cut: remove the tets on the cut-away side, then relax the cut vertices onto the surface
-    // (TransCut Sec. 5). Works on a copy that becomes the mesh only when everything succeeded; the
+    // (TransCut Sec. 5), or split the crossed tets exactly along it. Works on a copy that becomes the mesh only when everything succeeded; the
     // old mesh becomes the undo snapshot, so the copy costs nothing extra.
     const auto cut = [&](const std::variant<PlaneSurface, StrokeSurface>& spec, const RelaxSettings& relax,
                          bool exact) {
-        if (exact)
-            throw InvalidArgumentError(report.name + ": exact cutting (splitting tets along the surface) is not "
-                                       "available in this build");
         const std::unique_ptr<CuttingSurface> surface = make_surface(spec);
         auto after = std::make_shared<TetMesh>(mesh_);
-        CutResult removed = remove_cut_away_tets(*after, *surface);
-        auto connectivity = std::make_shared<TetConnectivity>(build_connectivity(*after));
-        const RelaxationReport relaxed = relax_cut_vertices(*after, *connectivity, *surface, relaxation_options(relax));
+        std::shared_ptr<TetConnectivity> connectivity;
+        if (exact) {
+            // Crossed tets are split along the surface (tetops/exact_cut.h): nothing is left on the
+            // cut-away side, so there is nothing to relax.
+            ExactCutResult result = cut_exact(*after, *surface);
+            connectivity = std::make_shared<TetConnectivity>(build_connectivity(*after));
+            min_dihedral_deg_ = result.min_dihedral_deg;
+            report.vertex_origins = std::move(result.vertex_origins);
+            details << result.tets_split << " tets split, " << result.tets_removed << " tets removed, "
+                    << result.vertices_snapped << " vertices snapped onto the surface";
+        } else {
+            CutResult removed = remove_cut_away_tets(*after, *surface);
+            connectivity = std::make_shared<TetConnectivity>(build_connectivity(*after));
+            const RelaxationReport relaxed =
+                relax_cut_vertices(*after, *connectivity, *surface, relaxation_options(relax));
+            min_dihedral_deg_ = relaxed.min_dihedral_deg;
+            report.old_to_new_vertex = std::move(removed.old_to_new_vertex);
+            details << removed.tets_removed << " tets removed, " << relaxed.vertices_moved
+                    << " vertices relaxed (" << relaxed.iterations << " sweeps, " << relaxed.moves_rejected
+                    << " moves rejected by the guard)";
+        }
         entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
         mesh_ = std::move(*after);
-        min_dihedral_deg_ = relaxed.min_dihedral_deg;
         report.topology = true;
         report.connectivity = std::move(connectivity);
-        report.old_to_new_vertex = std::move(removed.old_to_new_vertex);
-        details << removed.tets_removed << " tets removed, " << relaxed.vertices_moved << " vertices relaxed ("
-                << relaxed.iterations << " sweeps, " << relaxed.moves_rejected << " moves rejected by the guard)";
     };
 
     if (const auto* o = std::get_if<PlaneCutOp>(&op)) {
@@ -244,10 +257,44 @@ std::optional<ChangeReport> Document::redo() {
     return report;
 }
 
-}  // namespace waxwork
-
-namespace waxwork {
-void Document::run_piece_operation(const EditOperation& op, UndoEntry&, ChangeReport&, std::ostringstream&) {
-    throw InvalidArgumentError(operation_name(op) + ": not available in this build (tetops/fracture.cpp)");
+// Fracture, piece moves and welds (tetops/fracture.h).
+void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, ChangeReport& report,
+                                   std::ostringstream& details) {
+    if (const auto* o = std::get_if<FractureOp>(&op)) {
+        const std::vector<Eigen::Vector3d> seeds =
+            o->seeds.empty() ? scatter_fracture_seeds(mesh_, o->pieces, o->seed) : o->seeds;
+        FractureOptions options;
+        options.exact = o->exact;
+        options.min_piece_tets = o->min_piece_tets;
+        auto after = std::make_shared<TetMesh>(mesh_);
+        const FractureResult result = fracture_voronoi(*after, seeds, options);
+        entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
+        mesh_ = std::move(*after);
+        min_dihedral_deg_ = result.min_dihedral_deg;
+        report.topology = true;
+        details << result.pieces_before << " -> " << result.pieces_after << " pieces, " << result.tets_split
+                << " tets split, " << result.vertices_duplicated << " crack vertices duplicated";
+    } else if (const auto* o = std::get_if<MovePieceOp>(&op)) {
+        if (o->piece < 0 || static_cast<size_t>(o->piece) >= mesh_.piece_transforms.size())
+            throw InvalidArgumentError("move_piece: piece " + std::to_string(o->piece) + " does not exist (" +
+                                       std::to_string(mesh_.piece_transforms.size()) + " pieces)");
+        entry.piece = o->piece;
+        entry.old_transform = mesh_.piece_transforms[o->piece];
+        set_piece_transform(mesh_, o->piece, o->transform);
+        report.piece_transforms = true;
+        details << "piece " << o->piece << " moved";
+    } else if (const auto* o = std::get_if<WeldOp>(&op)) {
+        auto after = std::make_shared<TetMesh>(mesh_);
+        const WeldResult result = weld_touching_pieces(*after, o->tolerance);
+        if (result.vertices_merged > 0 || result.pieces_after != result.pieces_before || !(*after == mesh_)) {
+            entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
+            mesh_ = std::move(*after);
+            min_dihedral_deg_ = min_dihedral_of(mesh_);
+            report.topology = true;
+        }
+        details << result.pieces_before << " -> " << result.pieces_after << " pieces, " << result.vertices_merged
+                << " vertices merged";
+    }
 }
+
 }  // namespace waxwork

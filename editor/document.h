@@ -23,6 +23,7 @@
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
@@ -55,6 +56,9 @@ struct ChangeReport {
     std::shared_ptr<const TetConnectivity> connectivity;
     // Cut only: per vertex before, its index after or -1 (lets the solver keep its warm start).
     std::vector<int32_t> old_to_new_vertex;
+    // Exact cut only: per vertex after, the vertices before it comes from ({v, v}: vertex v kept;
+    // {a, b}: created on edge ab).
+    std::vector<std::array<int32_t, 2>> vertex_origins;
 
     bool undoable = true;       // false when the entry exceeded the whole undo budget
     size_t undo_entries_evicted = 0;  // oldest entries dropped to make room for this one

@@ -95,7 +95,9 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
     if (change.topology) {
         // Carry phi over where the change says where vertices went (a cut); else start cold.
         std::array<std::vector<double>, 3> old = std::move(phi_);
-        const bool mapped = change.old_to_new_vertex.size() == old[0].size();
+        const size_t n_old = old[0].size();
+        const bool mapped = !change.old_to_new_vertex.empty() && change.old_to_new_vertex.size() == n_old;
+        const bool from_edges = change.vertex_origins.size() == mesh.vertex_count() && !mesh.positions.empty();
         for (int c = 0; c < 3; ++c) phi_[c].assign(mesh.vertex_count(), 0.0);
         if (mapped) {
             for (size_t v = 0; v < change.old_to_new_vertex.size(); ++v) {
@@ -103,8 +105,15 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
                 if (to >= 0 && static_cast<size_t>(to) < mesh.vertex_count())
                     for (int c = 0; c < 3; ++c) phi_[c][to] = old[c][v];
             }
+        } else if (from_edges) {
+            // A vertex made on an edge starts at the mean of the edge's ends (linear along it).
+            for (size_t v = 0; v < change.vertex_origins.size(); ++v) {
+                const auto [a, b] = change.vertex_origins[v];
+                if (a < 0 || b < 0 || static_cast<size_t>(a) >= n_old || static_cast<size_t>(b) >= n_old) continue;
+                for (int c = 0; c < 3; ++c) phi_[c][v] = 0.5 * (old[c][a] + old[c][b]);
+            }
         }
-        update.warm_start = mapped;
+        update.warm_start = mapped || from_edges;
         const bool reuse = change.connectivity && change.connectivity->vertex_tets.row_count() == mesh.vertex_count() &&
                            change.connectivity->tet_neighbors.size() == mesh.tet_count();
         rebuild_all(reuse ? change.connectivity : nullptr, update);

@@ -1,6 +1,6 @@
 #include "editor/session.h"
 
-#include "editor/gl_context.h"
+#include "solver/gl_context.h"
 #include "editor/json_fields.h"
 #include "editor/live_scene.h"
 #include "editor/render_pipeline.h"

@@ -30,8 +30,20 @@ std::vector<EditOperation> material_and_geometry_ops() {
     stroke.stroke = {Eigen::Vector3d(0.5, 0.5, 5), Eigen::Vector3d(0, 0, -1),
                      {Eigen::Vector3d(0.2, -1, 4), Eigen::Vector3d(0.75, 2, 4)}, false};
     RelaxOp relax{PlaneSurface{Eigen::Vector3d(1, 0.2, 0.1), 0.55}, RelaxSettings{4, 0.3, 0.5}};
-    return {plane_cut(0.55), stroke, relax, paint_at({0.3, 0.3, 0.3}),
-            SetMaterialOp{material_preset("skin1"), std::nullopt}, SetMaterialOp{material_preset("marble"), 0}};
+    PlaneCutOp exact = plane_cut(0.55);
+    exact.exact = true;
+    FractureOp scattered;
+    scattered.pieces = 3;
+    scattered.seed = 7;
+    FractureOp seeded;
+    seeded.seeds = {Eigen::Vector3d(0.2, 0.5, 0.5), Eigen::Vector3d(0.8, 0.5, 0.5)};
+    seeded.exact = false;
+    MovePieceOp move;
+    move.transform.rotation = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    move.transform.translation = Eigen::Vector3d(0.3, 0, 0);
+    return {plane_cut(0.55), exact, stroke, relax, paint_at({0.3, 0.3, 0.3}),
+            SetMaterialOp{material_preset("skin1"), std::nullopt}, SetMaterialOp{material_preset("marble"), 0},
+            scattered, seeded, move};
 }
 
 TEST(Document, LoadingWithoutMaterialsAssignsTheDefault) {
@@ -56,6 +68,43 @@ TEST(Document, UndoRestoresTheMeshBitForBitForEveryKind) {
         EXPECT_TRUE(doc.mesh() == after) << report.name;
         EXPECT_EQ(doc.history().size(), 2u);
     }
+}
+
+TEST(Document, FracturePullApartAndWeldUndoBitForBit) {
+    Document doc(test_cube(), material_preset("marble"));
+    FractureOp fracture;
+    fracture.seeds = {Eigen::Vector3d(0.25, 0.5, 0.5), Eigen::Vector3d(0.75, 0.5, 0.5)};
+    const ChangeReport broken = doc.apply(fracture);
+    EXPECT_TRUE(broken.topology);
+    ASSERT_EQ(doc.mesh().piece_transforms.size(), 2u);
+    EXPECT_GT(broken.vertices_after, broken.vertices_before);  // crack vertices duplicated
+    const TetMesh together = doc.mesh();
+
+    MovePieceOp pull;
+    pull.piece = 1;
+    pull.transform.translation = Eigen::Vector3d(0.4, 0, 0);
+    const size_t bytes_before_move = doc.undo_bytes();
+    const ChangeReport moved = doc.apply(pull);
+    EXPECT_TRUE(moved.piece_transforms);
+    EXPECT_FALSE(moved.topology);
+    EXPECT_LT(doc.undo_bytes() - bytes_before_move, 1024u);  // a move keeps only the old transform
+    const TetMesh apart = doc.mesh();
+    // Apart, nothing touches: the weld changes nothing. Back together, it merges the crack.
+    const ChangeReport no_weld = doc.apply(WeldOp{1e-9});
+    EXPECT_FALSE(no_weld.anything_changed());
+    EXPECT_TRUE(doc.mesh() == apart);
+    doc.undo();
+    doc.undo();
+    EXPECT_TRUE(doc.mesh() == together);
+    const ChangeReport welded = doc.apply(WeldOp{1e-9});
+    EXPECT_TRUE(welded.topology);
+    EXPECT_EQ(doc.mesh().piece_transforms.size(), 1u);
+    EXPECT_LT(welded.vertices_after, welded.vertices_before);
+    doc.undo();
+    EXPECT_TRUE(doc.mesh() == together);
+    doc.undo();
+    EXPECT_TRUE(doc.mesh() == Document(test_cube(), material_preset("marble")).mesh());
+    EXPECT_THROW(doc.apply(MovePieceOp{5, RigidTransform{}}), InvalidArgumentError);
 }
 
 TEST(Document, ReportsWhatChanged) {

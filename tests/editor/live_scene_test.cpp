@@ -113,6 +113,43 @@ TEST(LiveScene, FollowsEveryKindOfChangeToTheFreshSolution) {
     }
 }
 
+TEST(LiveScene, FollowsFracturesMovesWeldsAndExactCuts) {
+    Document doc(testing::make_cube_mesh(7), material_preset("marble"));
+    const Lighting lighting = key_lighting();
+    LiveScene scene(doc.mesh(), lighting, options());
+    scene.converge();
+
+    FractureOp fracture;
+    fracture.seeds = {Eigen::Vector3d(0.3, 0.5, 0.5), Eigen::Vector3d(0.7, 0.5, 0.5)};
+    SceneUpdate update = scene.apply_change(doc.mesh(), doc.apply(fracture));
+    EXPECT_TRUE(update.reassembled_matrix);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "fracture");
+
+    // Pulled apart and turned: light now reaches the crack faces, shadows move; the matrix stays.
+    MovePieceOp pull;
+    pull.piece = 1;
+    pull.transform.rotation = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    pull.transform.translation = Eigen::Vector3d(0.5, 0.1, 0);
+    update = scene.apply_change(doc.mesh(), doc.apply(pull));
+    EXPECT_TRUE(update.rebuilt_surface);
+    EXPECT_FALSE(update.reassembled_matrix);
+    EXPECT_TRUE(update.warm_start);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "move");
+
+    scene.apply_change(doc.mesh(), *doc.undo());
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "undo move");
+    scene.apply_change(doc.mesh(), doc.apply(WeldOp{1e-9}));
+    EXPECT_EQ(doc.mesh().piece_transforms.size(), 1u);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "weld");
+
+    PlaneCutOp exact;
+    exact.plane = {Eigen::Vector3d(1, 0.3, 0.2), 0.6};
+    exact.exact = true;
+    update = scene.apply_change(doc.mesh(), doc.apply(exact));
+    EXPECT_TRUE(update.warm_start);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "exact cut");
+}
+
 TEST(LiveScene, PaintRewritesExactlyTheRowsOfThePaintedTets) {
     Document doc(testing::make_cube_mesh(7), material_preset("marble"));
     LiveScene scene(doc.mesh(), key_lighting(), options());
