@@ -164,5 +164,31 @@ TEST(ExampleSessions, CarvingRendersEveryStageAndSavesTheVolume) {
     EXPECT_LT(r.result.steps[1].tets, original.tet_count());
 }
 
+// Columns of the image that show the object, as runs separated by background: pieces pulled apart
+// along the view's horizontal show as separate runs.
+int object_column_runs(const Image& image) {
+    int runs = 0;
+    bool inside = false;
+    for (int x = 0; x < image.width; ++x) {
+        bool any = false;
+        for (int y = 0; y < image.height && !any; ++y) any = !is_background(image, x, y);
+        if (any && !inside) ++runs;
+        inside = any;
+    }
+    return runs;
+}
+
+TEST(ExampleSessions, FracturedPiecesPullApart) {
+    const Replay r = replay("fracture");
+    const Image whole = read_png(r.out / "fracture_0_whole.png");
+    const Image apart = read_png(r.out / "fracture_1_apart.png");
+    expect_visible(whole, "whole");
+    expect_visible(apart, "apart");
+    EXPECT_EQ(object_column_runs(whole), 1);
+    EXPECT_GE(object_column_runs(apart), 2);
+    EXPECT_EQ(r.result.mesh.piece_transforms.size(), 3u);
+    EXPECT_TRUE(read_volume(r.out / "fractured.vtu") == r.result.mesh);
+}
+
 }  // namespace
 }  // namespace waxwork
