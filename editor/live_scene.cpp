@@ -280,6 +280,12 @@ std::vector<std::array<double, 3>> LiveScene::phi() const {
     return phi;
 }
 
+std::vector<std::array<float, 3>> LiveScene::radiance_factors() const {
+    const std::vector<std::array<double, 3>> phi = this->phi();
+    const std::lock_guard lock(mutex_);
+    return exitant_radiance_factors(*mesh_, *connectivity_, mesh_->materials, phi, q_);
+}
+
 SolvedScene LiveScene::solved_scene() const {
     SolvedScene scene;
     scene.diffusion.phi = phi();

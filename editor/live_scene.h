@@ -104,6 +104,9 @@ public:
     // A copy of the current state in the form render_pipeline.h renders (make_render_input), with the
     // exitant radiance factors computed from the current phi. Reads the mesh.
     SolvedScene solved_scene() const;
+    // Only the exitant radiance factors E per volume vertex from the current phi (what a window
+    // re-uploads each frame while the surface is unchanged). Reads the mesh.
+    std::vector<std::array<float, 3>> radiance_factors() const;
 
     Lighting lighting() const;
     const LiveSceneOptions& options() const { return options_; }

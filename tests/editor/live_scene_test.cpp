@@ -50,6 +50,7 @@ void expect_matches_fresh_solve(LiveScene& scene, const TetMesh& mesh, const Lig
     // The radiance the renderer gets follows phi.
     const SolvedScene snapshot = scene.solved_scene();
     ASSERT_EQ(snapshot.radiance_factor.size(), fresh.radiance_factor.size());
+    EXPECT_EQ(scene.radiance_factors(), snapshot.radiance_factor);
     for (size_t v = 0; v < fresh.radiance_factor.size(); ++v)
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(snapshot.radiance_factor[v][c], fresh.radiance_factor[v][c],
