@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <exception>
@@ -174,8 +175,14 @@ void run_bench_suite(const BenchSuiteOptions& o) {
     parts.emplace_back("stability", [&](Json& i) { run_stability_part(o, i); });
     parts.emplace_back("resolution", [&](Json& i) { run_resolution_part(o, i); });
 
+    for (const std::string& wanted : o.only)
+        if (std::none_of(parts.begin(), parts.end(), [&](const auto& part) { return part.first == wanted; }))
+            throw InvalidArgumentError("bench --only: unknown part '" + wanted + "'" +
+                                       (o.quick && wanted == "solvers_500k" ? " (not part of --quick)" : ""));
+
     std::exception_ptr first_failure;
     for (const auto& [name, part] : parts) {
+        if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), name) == o.only.end()) continue;
         if (o.progress) o.progress(name);
         const auto start = std::chrono::steady_clock::now();
         Json entry;

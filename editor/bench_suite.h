@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace waxwork {
 
@@ -21,6 +22,9 @@ struct BenchSuiteOptions {
     bool quick = false;
     std::filesystem::path asset_dir;                    // holds meshes/spot.obj, torus.obj, skull.obj
     std::function<void(const std::string&)> progress;   // one line per part started; may be empty
+    // Run only these parts (names as in bench.json: solvers_50k, solvers_500k, accuracy, table1,
+    // stability, resolution); empty: all. An unknown name is an InvalidArgumentError.
+    std::vector<std::string> only;
 };
 
 // Runs every part; a part that throws is recorded in bench.json with its error and the suite goes

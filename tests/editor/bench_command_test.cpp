@@ -96,5 +96,20 @@ TEST(BenchSuiteCommand, UnwritableOutputIsAClearError) {
     EXPECT_NE(result.err.find("cannot create the output directory"), std::string::npos) << result.err;
 }
 
+TEST(BenchSuiteCommand, OnlyRunsTheNamedParts) {
+    const auto dir = scratch_dir("bench_suite_only");
+    const auto result = run_waxwork("bench --quick --only stability -o " + dir.string());
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const auto index = nlohmann::json::parse(testing::read_text(dir / "bench.json"));
+    EXPECT_EQ(index["parts"].size(), 1u);
+    EXPECT_EQ(index["parts"]["stability"]["status"], "ok");
+    const auto stability = nlohmann::json::parse(testing::read_text(dir / "stability.json"));
+    EXPECT_EQ(stability.size(), 6u);
+    EXPECT_NE(testing::read_text(dir / "stability.md").find("### slivers"), std::string::npos);
+    const auto unknown = run_waxwork("bench --quick --only nonsense -o " + dir.string());
+    EXPECT_NE(unknown.exit_code, 0);
+    EXPECT_NE(unknown.err.find("unknown part 'nonsense'"), std::string::npos) << unknown.err;
+}
+
 }  // namespace
 }  // namespace waxwork
