@@ -15,6 +15,7 @@ void add_demo_command(CLI::App& app);
 void add_cut_command(CLI::App& app);
 void add_fracture_command(CLI::App& app);
 void add_paint_command(CLI::App& app);
+void add_run_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 
 inline void register_commands(CLI::App& app) {
@@ -24,6 +25,7 @@ inline void register_commands(CLI::App& app) {
     add_cut_command(app);
     add_fracture_command(app);
     add_paint_command(app);
+    add_run_command(app);
     add_demo_command(app);
     add_bench_command(app);
 }
