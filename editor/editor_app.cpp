@@ -292,7 +292,6 @@ void EditorApp::wait_for_tasks() {
 }
 
 void EditorApp::frame() {
-    poll_tasks();
     int fb_w = 0, fb_h = 0, win_w = 0, win_h = 0;
     glfwGetFramebufferSize(window_, &fb_w, &fb_h);
     glfwGetWindowSize(window_, &win_w, &win_h);
@@ -302,6 +301,7 @@ void EditorApp::frame() {
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
     layout_viewport(fb_w, fb_h);
+    poll_tasks();  // after the layout: a solve started now exposes for the current viewport
     if (!options_.hide_ui) draw_ui();
     file_dialog_result();
     handle_viewport_input();
