@@ -7,8 +7,10 @@
 #include "tetops/error.h"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <iostream>
 #include <memory>
 
 namespace waxwork {
@@ -51,7 +53,17 @@ void run_edit_command(const EditCommandOptions& o) {
         options.camera.eye_direction = v;
         if (v.normalized().cross(options.camera.up).norm() < 1e-3) options.camera.up = Eigen::Vector3d(0, 0, -1);
     }
-    run_editor(options);
+    const EditorRunStats stats = run_editor(options);
+    if (!o.screenshot.empty()) {
+        const nlohmann::ordered_json summary = {
+            {"screenshot", o.screenshot},  {"frames", stats.frames},
+            {"frame_ms", stats.mean_frame_ms}, {"view_ms", stats.mean_view_ms},
+            {"solve_ms", stats.solve_ms},  {"tets", stats.tets},
+            {"vertices", stats.vertices},  {"gl_version", stats.gl_version},
+            {"gl_renderer", stats.gl_renderer},
+        };
+        std::cout << summary.dump() << "\n";
+    }
 }
 
 }  // namespace

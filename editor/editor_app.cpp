@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <thread>
 
 namespace waxwork {
 
@@ -76,6 +77,7 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
     : window_(window), options_(options), scene_(std::make_unique<Scene>()) {
     gl_ = load_gl_api(gl_proc_address);
     renderer_ = std::make_unique<SurfaceRenderer>(gl_);
+    view_cache_ = std::make_unique<ViewCache>(gl_);
 
     lighting_.lights = options.lights.empty() ? std::vector<Light>{default_key_light()} : options.lights;
     lighting_.ambient = {0.02, 0.02, 0.02};  // `waxwork render`'s default --ambient
@@ -116,6 +118,7 @@ EditorApp::~EditorApp() {
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();
+    view_cache_.reset();
     renderer_.reset();
 }
 
@@ -268,6 +271,7 @@ void EditorApp::start_solve() {
             scene_->lighting_ms = lighting_ms;
             scene_->radiance_ms = radiance_ms;
             ++scene_->solve_count;
+            ++scene_version_;
         };
     });
 }
@@ -348,16 +352,24 @@ void EditorApp::draw_viewport(int fb_h) {
     }
     input.width = view_w_;
     input.height = view_h_;
+    input.samples = msaa_samples_;
     input.exposure = scene_->automatic_exposure * std::exp2(exposure_stops_);
-    const auto start = std::chrono::steady_clock::now();
-    try {
-        renderer_->draw(input, camera_->frame(static_cast<double>(view_w_) / view_h_), 0, view_x_,
-                        fb_h - view_y_ - view_h_);
-    } catch (const std::exception& e) {
-        scene_->render_input.reset();
-        set_error(std::string("drawing: ") + e.what());
+    const CameraFrame frame = camera_->frame(static_cast<double>(view_w_) / view_h_);
+    const ViewKey key{frame.view, frame.projection, view_w_, view_h_, input.samples, input.exposure, scene_version_};
+    const int y = fb_h - view_y_ - view_h_;
+    if (!view_cache_->holds(key)) {
+        const auto start = std::chrono::steady_clock::now();
+        try {
+            renderer_->draw(input, frame, view_cache_->begin_update(key), 0, 0);
+        } catch (const std::exception& e) {
+            view_cache_->invalidate();
+            scene_->render_input.reset();
+            set_error(std::string("drawing: ") + e.what());
+            return;
+        }
+        last_render_ms_ = ms_since(start);
     }
-    last_render_ms_ = ms_since(start);
+    view_cache_->blit(0, view_x_, y);
 }
 
 void EditorApp::handle_viewport_input() {
@@ -473,7 +485,7 @@ bool display_available() {
     return ok;
 }
 
-void run_editor(const EditorOptions& options) {
+EditorRunStats run_editor(const EditorOptions& options) {
     glfwSetErrorCallback(on_glfw_error);
     if (!glfwInit()) throw Error("editor: cannot open a window (" + glfw_error_text + "); is DISPLAY set?");
     struct Terminate {
@@ -485,27 +497,46 @@ void run_editor(const EditorOptions& options) {
     const bool screenshot = !options.screenshot.empty();
     glfwSwapInterval(screenshot ? 0 : 1);
 
-    EditorApp app(window, options);
-    int frames_after_idle = 0;
-    while (!glfwWindowShouldClose(window)) {
-        if (screenshot || !app.idle() || app.animating()) glfwPollEvents();
-        else glfwWaitEventsTimeout(0.5);  // nothing moves: sleep until input arrives
-        app.frame();
-        if (screenshot) {
-            if (!app.last_error().empty()) throw Error(app.last_error());
-            if (app.idle() && ++frames_after_idle >= std::max(options.frames, 1)) {
-                write_png(app.read_window(), options.screenshot);
-                break;
+    EditorRunStats stats;
+    {
+        EditorApp app(window, options);
+        stats.gl_version = reinterpret_cast<const char*>(app.gl().GetString(GL_VERSION));
+        stats.gl_renderer = reinterpret_cast<const char*>(app.gl().GetString(GL_RENDERER));
+        double frame_ms_sum = 0, view_ms_sum = 0;
+        while (!glfwWindowShouldClose(window)) {
+            if (screenshot || !app.idle() || app.animating()) glfwPollEvents();
+            else glfwWaitEventsTimeout(0.5);  // nothing moves: sleep until input arrives
+            const auto start = std::chrono::steady_clock::now();
+            app.frame();
+            if (screenshot) {
+                if (!app.last_error().empty()) throw Error(app.last_error());
+                if (!app.idle()) {
+                    stats.frames = 0;
+                    frame_ms_sum = view_ms_sum = 0;
+                    // Not interactive: no point drawing hundreds of progress frames meanwhile.
+                    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+                } else {
+                    app.gl().Finish();  // count the GPU's work in the frame time
+                    frame_ms_sum += ms_since(start);
+                    view_ms_sum += app.view_ms();
+                    if (++stats.frames >= std::max(options.frames, 1)) {
+                        write_png(app.read_window(), options.screenshot);
+                        break;
+                    }
+                }
             }
-            if (!app.idle()) {
-                frames_after_idle = 0;
-                // Screenshot mode is not interactive: no point drawing hundreds of progress frames.
-                std::this_thread::sleep_for(std::chrono::milliseconds(20));
-            }
+            glfwSwapBuffers(window);
         }
-        glfwSwapBuffers(window);
+        stats.mean_frame_ms = stats.frames ? frame_ms_sum / stats.frames : 0;
+        stats.mean_view_ms = stats.frames ? view_ms_sum / stats.frames : 0;
+        if (const EditorScene& scene = app.scene(); scene.mesh) {
+            stats.tets = scene.mesh->tet_count();
+            stats.vertices = scene.mesh->vertex_count();
+            stats.solve_ms = scene.lighting_ms + scene.stats.assembly_ms + scene.stats.solve_ms + scene.radiance_ms;
+        }
     }
     glfwDestroyWindow(window);
+    return stats;
 }
 
 }  // namespace waxwork

@@ -10,6 +10,7 @@
 #include "editor/orbit_camera.h"
 #include "editor/render_pipeline.h"
 #include "editor/surface_renderer.h"
+#include "editor/view_cache.h"
 #include "solver/diffusion_solve.h"
 #include "solver/ray_caster.h"
 #include "tetops/connectivity.h"
@@ -41,7 +42,15 @@ struct EditorOptions {
 // Opens the window and runs until it is closed (or, with a screenshot, until it is saved). Throws
 // waxwork::Error when no window or OpenGL 4.3+ context can be created, and what loading throws in
 // screenshot mode (interactively, errors are shown in the window instead).
-void run_editor(const EditorOptions& options);
+struct EditorRunStats {
+    int frames = 0;              // frames drawn after loading and solving finished
+    double mean_frame_ms = 0;    // per frame, UI + 3D view, GPU finished (screenshot mode)
+    double mean_view_ms = 0;     // drawing the 3D view (only when it changed; else a cached copy)
+    double solve_ms = 0;         // the last solve: lighting + assembly + CG + radiance
+    size_t tets = 0, vertices = 0;
+    std::string gl_version, gl_renderer;
+};
+EditorRunStats run_editor(const EditorOptions& options);
 
 // True when a window can be opened here (a display is set and GLFW initialises). `waxwork demo` asks
 // before opening the editor so it stays headless on servers.
@@ -93,6 +102,9 @@ public:
     bool animating() const { return stroke_active_; }
     // The first error of a failed load or solve (screenshot mode turns it into the exit status).
     const std::string& last_error() const { return last_error_; }
+    const GlApi& gl() const { return gl_; }
+    const EditorScene& scene() const { return *scene_; }
+    double view_ms() const { return last_render_ms_; }
 
     // Loads a surface (meshed with the current options) or a volume file, in the background.
     void open_file(const std::filesystem::path& path);
@@ -139,6 +151,9 @@ private:
     EditorOptions options_;
     GlApi gl_;
     std::unique_ptr<SurfaceRenderer> renderer_;
+    std::unique_ptr<ViewCache> view_cache_;
+    long long scene_version_ = 0;  // bumped whenever the render input changes (ViewKey)
+    int msaa_samples_ = 4;
     float ui_scale_ = 1.0f;
 
     // The scene: the volume, its materials and lights, the latest solved image input.
