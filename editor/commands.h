@@ -14,6 +14,7 @@ void add_render_command(CLI::App& app);
 void add_demo_command(CLI::App& app);
 void add_cut_command(CLI::App& app);
 void add_paint_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
 void add_edit_command(CLI::App& app);
 
 inline void register_commands(CLI::App& app) {
@@ -23,6 +24,7 @@ inline void register_commands(CLI::App& app) {
     add_cut_command(app);
     add_paint_command(app);
     add_demo_command(app);
+    add_bench_command(app);
     add_edit_command(app);
 }
 

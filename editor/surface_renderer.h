@@ -4,7 +4,7 @@
 // special case: after a cut they are boundary faces like any other.
 #pragma once
 
-#include "editor/gl_context.h"
+#include "solver/gl_context.h"
 #include "io/image_io.h"
 #include "solver/lighting.h"
 

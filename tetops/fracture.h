@@ -23,6 +23,10 @@ struct FractureOptions {
     // Pieces with fewer tets than this are merged into the neighbouring piece they share most faces
     // with (no dust).
     int min_piece_tets = 8;
+    // Exact mode: vertices this close to a wall (as a fraction of a crossed edge) move onto it instead
+    // of being cut off in a sliver (SplitOptions::snap_fraction); 0 splits every crossed edge, which
+    // keeps every unsplit tet's shape but leaves thinner tets.
+    double snap_fraction = 0.2;
 };
 
 struct FractureResult {

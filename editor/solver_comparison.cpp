@@ -1,0 +1,270 @@
+#include "editor/solver_comparison.h"
+
+#include "editor/svg_chart.h"
+#include "io/atomic_file.h"
+#include "multires/multigrid_cg.h"
+#include "multires/multires_solver.h"
+#include "solver/conjugate_gradient.h"
+#include "solver/diffusion_matrix.h"
+#include "solver/reference_solvers.h"
+#include "tetops/error.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+namespace waxwork {
+namespace {
+
+using Fields = std::array<std::vector<double>, 3>;
+// Runs one solver with an iteration cap on all three channels, writing x (zeroed before the call).
+using CappedSolve = std::function<void(int cap, Fields& x)>;
+
+double elapsed_ms(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+double relative_error(const Fields& x, const Fields& reference) {
+    double e = 0, r = 0;
+    for (size_t c = 0; c < 3; ++c)
+        for (size_t i = 0; i < x[c].size(); ++i) {
+            const double d = x[c][i] - reference[c][i];
+            e += d * d;
+            r += reference[c][i] * reference[c][i];
+        }
+    return r > 0 ? std::sqrt(e / r) : std::sqrt(e);
+}
+
+struct Run {
+    double ms = 0, error = 1;
+};
+
+class Measurer {
+public:
+    Measurer(const Fields& reference, const SolverComparisonOptions& options)
+        : reference_(reference), options_(options) {}
+
+    Run run(const CappedSolve& solve, int cap) {
+        Run best;
+        best.ms = std::numeric_limits<double>::infinity();
+        for (int repeat = 0; repeat < 3; ++repeat) {
+            for (size_t c = 0; c < 3; ++c) x_[c].assign(reference_[c].size(), 0.0);
+            const auto start = std::chrono::steady_clock::now();
+            solve(cap, x_);
+            best.ms = std::min(best.ms, elapsed_ms(start));
+            if (best.ms >= 100) break;
+        }
+        best.error = relative_error(x_, reference_);
+        return best;
+    }
+
+    SolverCurve curve(const std::string& name, const CappedSolve& solve) {
+        SolverCurve out;
+        out.name = name;
+        const auto start = std::chrono::steady_clock::now();
+        std::vector<std::pair<int, Run>> runs;  // every cap measured, for the bisection
+        run(solve, 0);  // warm-up: first-touch page faults and lazy initialisation are not the solver's time
+        std::vector<std::pair<double, double>> points;
+        int cap = 0;
+        double best_error = std::numeric_limits<double>::infinity();
+        int stalled = 0;
+        for (;;) {
+            const Run r = run(solve, cap);
+            runs.emplace_back(cap, r);
+            points.emplace_back(r.ms, r.error);
+            stalled = r.error < 0.95 * best_error ? 0 : stalled + 1;
+            best_error = std::min(best_error, r.error);
+            if (r.error <= options_.floor_error || stalled >= 4 || cap >= 200000 ||
+                elapsed_ms(start) > 1000 * options_.max_seconds)
+                break;
+            cap = std::max(cap + 1, static_cast<int>(std::ceil(cap * 1.25)));
+        }
+        // Monotone in time: from the last point backwards, keep a point only if it ran faster than every
+        // point kept after it (noise that made a small cap slow drops that point, not the later ones).
+        for (size_t i = points.size(); i-- > 0;)
+            if (out.curve.empty() || points[i].first < out.curve.back().first) out.curve.push_back(points[i]);
+        std::reverse(out.curve.begin(), out.curve.end());
+        // Smallest cap reaching the target: bisection between the last cap above it and the first below.
+        for (size_t i = 0; i < runs.size(); ++i) {
+            if (runs[i].second.error > options_.target_error) continue;
+            if (i == 0) {
+                out.time_to_target_ms = runs[i].second.ms;
+                break;
+            }
+            int lo = runs[i - 1].first, hi = runs[i].first;
+            Run at_hi = runs[i].second;
+            while (hi - lo > 1) {
+                const int mid = (lo + hi) / 2;
+                const Run r = run(solve, mid);
+                if (r.error <= options_.target_error) {
+                    hi = mid;
+                    at_hi = r;
+                } else {
+                    lo = mid;
+                }
+            }
+            out.time_to_target_ms = at_hi.ms;
+            break;
+        }
+        return out;
+    }
+
+private:
+    const Fields& reference_;
+    const SolverComparisonOptions& options_;
+    Fields x_;
+};
+
+ConjugateGradientOptions capped(int cap) {
+    ConjugateGradientOptions options;
+    options.relative_tolerance = 1e-15;  // never stop on the estimate: run the cap
+    options.max_iterations = cap;
+    return options;
+}
+
+}  // namespace
+
+SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                 const std::vector<TetMaterial>& materials, const Lighting& lighting,
+                                 const SolverComparisonOptions& options) {
+    if (!(options.target_error > 0) || !(options.floor_error > 0) || !(options.max_seconds > 0))
+        throw InvalidArgumentError("solver comparison: target, floor and time limit must be positive");
+    AssemblyOptions assembly;
+    assembly.mm_per_unit = options.mm_per_unit;
+    const DiffusionMatrix matrix = assemble_diffusion_matrix(mesh, connectivity, materials, assembly);
+    const std::vector<Rgb> q = incident_light(mesh, connectivity, materials, lighting);
+    const size_t n = matrix.size();
+    Fields b;
+    for (int c = 0; c < 3; ++c) {
+        b[static_cast<size_t>(c)].resize(n);
+        diffusion_right_hand_side(matrix, q, c, b[static_cast<size_t>(c)]);
+    }
+    std::array<Eigen::SparseMatrix<double>, 3> sparse;
+    for (int c = 0; c < 3; ++c) sparse[static_cast<size_t>(c)] = to_eigen_sparse(matrix, c);
+    auto as_eigen = [](const std::vector<double>& v) {
+        return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+    };
+
+    // Reference: direct solution plus one refinement step.
+    Fields reference;
+    for (size_t c = 0; c < 3; ++c) {
+        const DirectSolver direct(sparse[c]);
+        Eigen::VectorXd x = direct.solve(as_eigen(b[c]));
+        x += direct.solve(as_eigen(b[c]) - sparse[c] * x);
+        reference[c].assign(x.data(), x.data() + x.size());
+    }
+
+    SolverComparison result;
+    result.tets = mesh.tet_count();
+    result.vertices = mesh.vertex_count();
+    Measurer measurer(reference, options);
+
+    // Jacobi CG in float and double (solver/conjugate_gradient.h).
+    std::array<std::vector<float>, 3> values_f;
+    Fields b_copy = b;
+    std::array<std::vector<float>, 3> b_f;
+    for (size_t c = 0; c < 3; ++c) {
+        values_f[c].assign(matrix.values[c].begin(), matrix.values[c].end());
+        b_f[c].assign(b[c].begin(), b[c].end());
+    }
+    std::vector<float> x_f(n);
+    result.solvers.push_back(measurer.curve("jacobi_cg", [&](int cap, Fields& x) {
+        for (size_t c = 0; c < 3; ++c) {
+            const CsrMatrixView<float> view{n, matrix.offsets.data(), matrix.columns.data(), values_f[c].data()};
+            std::fill(x_f.begin(), x_f.end(), 0.0f);
+            solve_jacobi_cg<float>(view, b_f[c], x_f, capped(cap));
+            std::copy(x_f.begin(), x_f.end(), x[c].begin());
+        }
+    }));
+    result.solvers.push_back(measurer.curve("jacobi_cg_double", [&](int cap, Fields& x) {
+        for (size_t c = 0; c < 3; ++c) {
+            const CsrMatrixView<double> view{n, matrix.offsets.data(), matrix.columns.data(), matrix.values[c].data()};
+            solve_jacobi_cg<double>(view, b_copy[c], x[c], capped(cap));
+        }
+    }));
+
+    // The paper's coarse-to-fine scheme (multires_solver.h); cap = level-0 CG iterations.
+    MultiresSolver multires(matrix, mesh.positions);
+    result.levels = multires.hierarchy().level_count();
+    result.hierarchy_ms = multires.hierarchy().build_ms;
+    result.solvers.push_back(measurer.curve("multires", [&](int cap, Fields& x) {
+        MultiresSolveOptions solve;
+        solve.relative_tolerance = 1e-15;
+        solve.max_iterations = cap;
+        for (int c = 0; c < 3; ++c) multires.solve(b_copy[static_cast<size_t>(c)], c, x[static_cast<size_t>(c)], solve);
+    }));
+
+    // Multigrid-preconditioned CG on the same hierarchy (multigrid_cg.h).
+    MultigridPreconditioner multigrid(multires.hierarchy());
+    result.multigrid_setup_ms = multigrid.setup_ms();
+    result.solvers.push_back(measurer.curve("multigrid_cg", [&](int cap, Fields& x) {
+        for (int c = 0; c < 3; ++c)
+            solve_multigrid_cg(multigrid, c, b_copy[static_cast<size_t>(c)], x[static_cast<size_t>(c)], capped(cap));
+    }));
+
+    // Eigen's CG with incomplete Cholesky (reference_solvers.h); factorised in every run.
+    result.solvers.push_back(measurer.curve("eigen_ic_cg", [&](int cap, Fields& x) {
+        for (size_t c = 0; c < 3; ++c) {
+            Eigen::VectorXd xc = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+            solve_eigen_cg_ic(sparse[c], as_eigen(b_copy[c]), xc, 1e-16, cap);
+            std::copy(xc.data(), xc.data() + xc.size(), x[c].begin());
+        }
+    }));
+
+    // Direct: one point, factorisation and solve.
+    SolverCurve direct;
+    direct.name = "direct";
+    const Run r = measurer.run(
+        [&](int, Fields& x) {
+            for (size_t c = 0; c < 3; ++c) {
+                const DirectSolver solver(sparse[c]);
+                const Eigen::VectorXd xc = solver.solve(as_eigen(b_copy[c]));
+                std::copy(xc.data(), xc.data() + xc.size(), x[c].begin());
+            }
+        },
+        0);
+    direct.curve.emplace_back(r.ms, r.error);
+    if (r.error <= options.target_error) direct.time_to_target_ms = r.ms;
+    result.solvers.push_back(std::move(direct));
+    return result;
+}
+
+void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const std::string& mesh_name,
+                             const SolverComparison& comparison) {
+    nlohmann::ordered_json solvers = nlohmann::ordered_json::object();
+    std::vector<ChartSeries> series;
+    for (const SolverCurve& s : comparison.solvers) {
+        nlohmann::ordered_json curve = nlohmann::ordered_json::array();
+        for (const auto& [ms, error] : s.curve) curve.push_back({ms, error});
+        const nlohmann::ordered_json time = s.time_to_target_ms ? nlohmann::ordered_json(*s.time_to_target_ms) : nullptr;
+        solvers[s.name] = {{"time_to_1pct_ms", time}, {"curve", curve}};
+        ChartSeries line{s.name, {}, true};
+        // A direct solution can be exact to the last bit; draw it at 1e-16 rather than not at all.
+        for (const auto& [ms, error] : s.curve) line.points.emplace_back(ms, std::max(error, 1e-16));
+        series.push_back(std::move(line));
+    }
+    const nlohmann::ordered_json json = {
+        {"mesh", mesh_name},
+        {"tets", comparison.tets},
+        {"vertices", comparison.vertices},
+        {"levels", comparison.levels},
+        {"hierarchy_ms", comparison.hierarchy_ms},
+        {"multigrid_setup_ms", comparison.multigrid_setup_ms},
+        {"solvers", solvers},
+    };
+    write_file_atomically(dir / (stem + ".json"), [&](std::ostream& out) { out << json.dump(2) << "\n"; });
+
+    ChartOptions chart;
+    chart.title = "Diffusion solvers on " + std::filesystem::path(mesh_name).filename().string() + ", " +
+                  std::to_string(comparison.tets) + " tets (3 channels)";
+    chart.x = {"solve time (ms)", AxisScale::Linear, 0, 0};
+    chart.y = {"relative L2 error of phi vs direct reference", AxisScale::Log, 0, 0};
+    write_svg_chart(dir / (stem + ".svg"), series, chart);
+}
+
+}  // namespace waxwork

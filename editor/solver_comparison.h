@@ -1,0 +1,71 @@
+// The solver comparison behind `waxwork bench solvers`: one lit diffusion system, every solver of the
+// project on it, and for each the relative error of phi against a direct reference as a function of
+// solve time.
+//
+// Error. Relative L2 over all three channels together, sqrt(sum_c |x_c - ref_c|^2 / sum_c |ref_c|^2):
+// one number per run, dominated by the brightest channel, the same for every solver. The reference is
+// CHOLMOD's (or Eigen's) direct solution in double with one step of iterative refinement; the
+// `direct` entry is that method timed again, so its error only shows rounding.
+//
+// Curves. Each iterative solver is run from a cold start (zero; multires: its coarse-to-fine pass) for
+// an increasing schedule of iteration caps (0, 1, 2, ... growing by a quarter), all three channels per
+// run; a point is (time of that run, its error). Measuring the error is outside the timed region.
+// Runs shorter than 100 ms are repeated three times and the fastest kept, after one untimed warm-up
+// run. A point is kept only if it ran faster than every later point (noise that made a small cap
+// slower than a larger one drops the small cap), so every curve is strictly monotone in time. A curve ends below floor_error, when the error stops falling (float's
+// precision floor), or after max_seconds of measuring. time_to_1pct_ms: the smallest cap with error
+// <= target_error is found by bisection between the curve's bracketing caps and timed again.
+//
+// What is timed. Per-mesh setup that a frame does not repeat is excluded and reported separately: the
+// multires hierarchy (hierarchy_ms), the multigrid Galerkin operators and coarsest factorisation
+// (multigrid_setup_ms), the float copies of the matrices and the Eigen sparse matrices. Eigen's
+// incomplete Cholesky factorisation is part of every eigen_ic_cg run (its API factorises per solve),
+// and the direct solver's time is factorisation plus solve.
+#pragma once
+
+#include "solver/lighting.h"
+#include "tetops/connectivity.h"
+#include "tetops/tet_mesh.h"
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace waxwork {
+
+struct SolverComparisonOptions {
+    double mm_per_unit = 1.0;
+    double target_error = 1e-2;   // time_to_1pct_ms
+    double floor_error = 1e-4;    // a curve stops once below this
+    double max_seconds = 60.0;    // per solver, measuring included
+};
+
+struct SolverCurve {
+    std::string name;
+    std::vector<std::pair<double, double>> curve;  // (ms, relative error), time strictly increasing
+    std::optional<double> time_to_target_ms;       // nullopt when the target was not reached
+};
+
+struct SolverComparison {
+    size_t tets = 0, vertices = 0, levels = 0;
+    double hierarchy_ms = 0;
+    double multigrid_setup_ms = 0;
+    std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, eigen_ic_cg, direct
+};
+
+// Assembles the TransCut system (materials per tet), lights it (q from `lighting`) and compares the
+// solvers. Throws InvalidArgumentError for bad materials, lighting or options, AlgorithmError when a
+// solver breaks down.
+SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                 const std::vector<TetMaterial>& materials, const Lighting& lighting,
+                                 const SolverComparisonOptions& options);
+
+// Writes DIR/STEM.json, {"mesh", "tets", "vertices", "levels", "hierarchy_ms", "multigrid_setup_ms",
+// "solvers": {NAME: {"time_to_1pct_ms", "curve": [[ms, rel_error], ...]}}}, and DIR/STEM.svg (error
+// against time, one line per solver), atomically. `mesh_name` is recorded as given.
+void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const std::string& mesh_name,
+                             const SolverComparison& comparison);
+
+}  // namespace waxwork

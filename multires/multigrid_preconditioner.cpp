@@ -1,0 +1,529 @@
+#include "multires/multigrid_preconditioner.h"
+
+#include "tetops/error.h"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+namespace waxwork {
+
+namespace {
+
+constexpr size_t kGrain = 1024;
+
+template <typename Body>
+void for_rows(size_t n, const Body& body) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) body(i);
+    });
+}
+
+// P^T as compressed rows: row I lists the fine vertices v with P_vI != 0 in ascending v.
+InterpolationOperator transpose(const InterpolationOperator& p, size_t coarse_rows) {
+    InterpolationOperator t;
+    t.offsets.assign(coarse_rows + 1, 0);
+    for (int32_t c : p.columns) ++t.offsets[static_cast<size_t>(c) + 1];
+    std::partial_sum(t.offsets.begin(), t.offsets.end(), t.offsets.begin());
+    t.columns.resize(p.columns.size());
+    t.weights.resize(p.columns.size());
+    std::vector<int32_t> next(t.offsets.begin(), t.offsets.end() - 1);
+    for (size_t v = 0; v < p.rows(); ++v) {
+        for (int32_t q = p.offsets[v]; q < p.offsets[v + 1]; ++q) {
+            const auto slot = static_cast<size_t>(next[static_cast<size_t>(p.columns[static_cast<size_t>(q)])]++);
+            t.columns[slot] = static_cast<int32_t>(v);
+            t.weights[slot] = p.weights[static_cast<size_t>(q)];
+        }
+    }
+    return t;
+}
+
+}  // namespace
+
+// The smoother's arrays and the work vectors of one level in the V-cycle's precision.
+template <typename Scalar>
+struct MultigridLevelData {
+    std::array<std::vector<Scalar>, 3> values;    // the operator, per channel
+    std::array<std::vector<Scalar>, 3> inv_diag;  // 1 / a_ii
+    std::vector<Scalar> p_weights, pt_weights;    // P (this level to the next) and P^T
+    std::vector<Scalar> b, x, r, d;
+};
+
+struct MultigridPreconditioner::Level {
+    size_t n = 0;
+    std::vector<int32_t> offsets{0}, columns, diagonal;
+    std::array<std::vector<double>, 3> values;  // the operator in double
+    std::array<std::vector<double>, 3> row_bound;  // sum_j |a_ij| / a_ii per row (Gershgorin)
+    std::array<double, 3> upper{};                 // max of row_bound
+    const InterpolationOperator* p = nullptr;      // to this level from the next (null on the coarsest)
+    InterpolationOperator pt;                      // P^T
+    // A P (this level's operator times P, all channels), kept for partial updates.
+    std::vector<int32_t> ap_offsets{0}, ap_columns;
+    std::array<std::vector<double>, 3> ap_values;
+    MultigridLevelData<float> f;
+    MultigridLevelData<double> d;
+    std::array<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>, 3> coarsest;  // coarsest level only
+    Eigen::VectorXd coarse_rhs, coarse_solution;
+
+    template <typename Scalar>
+    MultigridLevelData<Scalar>& data() {
+        if constexpr (std::is_same_v<Scalar, float>)
+            return f;
+        else
+            return d;
+    }
+};
+
+MultigridPreconditioner::~MultigridPreconditioner() = default;
+
+size_t MultigridPreconditioner::level_count() const { return levels_.size(); }
+size_t MultigridPreconditioner::rows(size_t level) const { return levels_.at(level)->n; }
+size_t MultigridPreconditioner::nonzeros(size_t level) const { return levels_.at(level)->columns.size(); }
+CsrMatrixView<double> MultigridPreconditioner::view(size_t level, int channel) const {
+    const Level& l = *levels_.at(level);
+    return {l.n, l.offsets.data(), l.columns.data(), l.values.at(static_cast<size_t>(channel)).data()};
+}
+
+MultigridPreconditioner::MultigridPreconditioner(const MultiresHierarchy& hierarchy, const MultigridOptions& options)
+    : hierarchy_(hierarchy), options_(options) {
+    if (options.smoothing_steps < 1 || !(options.chebyshev_ratio > 1))
+        throw InvalidArgumentError("multigrid: smoothing_steps must be >= 1 and chebyshev_ratio > 1");
+    const auto start = std::chrono::steady_clock::now();
+    const HierarchyLevel& fine = hierarchy.levels.at(0);
+    auto level0 = std::make_unique<Level>();
+    level0->n = fine.size();
+    level0->offsets = fine.offsets;
+    level0->columns = fine.columns;
+    level0->diagonal = fine.diagonal;
+    level0->values = fine.values;
+    levels_.push_back(std::move(level0));
+    for (size_t l = 0; l + 1 < hierarchy.level_count(); ++l) {
+        levels_[l]->p = &hierarchy.levels[l].interpolation;
+        auto next = std::make_unique<Level>();
+        next->n = hierarchy.levels[l + 1].size();
+        levels_[l]->pt = transpose(*levels_[l]->p, next->n);
+        levels_.push_back(std::move(next));
+        build_product_pattern(l + 1);
+        std::vector<int32_t> all(levels_[l + 1]->n);
+        std::iota(all.begin(), all.end(), 0);
+        compute_galerkin_rows(l + 1, all);
+    }
+    for (size_t l = 0; l < levels_.size(); ++l) {
+        Level& level = *levels_[l];
+        for (auto& v : level.row_bound) v.assign(level.n, 0.0);
+        std::vector<int32_t> all(level.n);
+        std::iota(all.begin(), all.end(), 0);
+        prepare_smoother(l, all);
+        auto copy_transfer = [&](auto& data) {
+            using S = typename std::decay_t<decltype(data.b)>::value_type;
+            data.b.assign(level.n, S(0));
+            data.x.assign(level.n, S(0));
+            data.r.assign(level.n, S(0));
+            data.d.assign(level.n, S(0));
+            if (level.p) {
+                data.p_weights.assign(level.p->weights.begin(), level.p->weights.end());
+                data.pt_weights.assign(level.pt.weights.begin(), level.pt.weights.end());
+            }
+        };
+        if (options_.single_precision)
+            copy_transfer(level.f);
+        else
+            copy_transfer(level.d);
+    }
+    factorize_coarsest();
+    setup_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Per-thread sparse accumulator over the columns of one product row.
+struct MultigridPreconditioner::Accumulator {
+    std::vector<int32_t> tag;                // row currently using the column, or -1
+    std::vector<int32_t> slot;               // where the column sits in the current row
+    std::vector<int32_t> touched;            // columns of the current row in first-touch order
+    std::array<std::vector<double>, 3> sum;  // per channel, indexed by column
+    explicit Accumulator(size_t columns) : tag(columns, -1), slot(columns, -1) {
+        for (auto& v : sum) v.assign(columns, 0.0);
+    }
+};
+
+void MultigridPreconditioner::build_product_pattern(size_t l) {
+    Level& fine = *levels_[l - 1];
+    Level& coarse = *levels_[l];
+    const InterpolationOperator& p = *fine.p;
+    const size_t n = fine.n, m = coarse.n;
+    // A P: row v reaches K through v -A- j -P- K. Two passes over the same walk (count, then fill)
+    // instead of per-row containers: no allocation per row.
+    {
+        tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
+        auto walk = [&](size_t v, Accumulator& acc, auto&& emit) {
+            const auto tag = static_cast<int32_t>(v);
+            for (int32_t e = fine.offsets[v]; e < fine.offsets[v + 1]; ++e) {
+                const auto j = static_cast<size_t>(fine.columns[static_cast<size_t>(e)]);
+                for (int32_t q = p.offsets[j]; q < p.offsets[j + 1]; ++q) {
+                    const auto k = static_cast<size_t>(p.columns[static_cast<size_t>(q)]);
+                    if (acc.tag[k] != tag) {
+                        acc.tag[k] = tag;
+                        emit(static_cast<int32_t>(k));
+                    }
+                }
+            }
+        };
+        fine.ap_offsets.assign(n + 1, 0);
+        for_rows(n, [&](size_t v) {
+            int32_t count = 0;
+            walk(v, scratch.local(), [&](int32_t) { ++count; });
+            fine.ap_offsets[v + 1] = count;
+        });
+        std::partial_sum(fine.ap_offsets.begin(), fine.ap_offsets.end(), fine.ap_offsets.begin());
+        fine.ap_columns.resize(static_cast<size_t>(fine.ap_offsets[n]));
+        for (auto& acc : scratch) std::fill(acc.tag.begin(), acc.tag.end(), -1);  // pass two walks the same rows
+        for_rows(n, [&](size_t v) {
+            auto out = static_cast<size_t>(fine.ap_offsets[v]);
+            walk(v, scratch.local(), [&](int32_t k) { fine.ap_columns[out++] = k; });
+        });
+        for (auto& v : fine.ap_values) v.assign(fine.ap_columns.size(), 0.0);
+    }
+    std::vector<int32_t> all(n);
+    std::iota(all.begin(), all.end(), 0);
+    compute_product_rows(l, all);
+
+    // P^T (A P), full: accumulated row by row; then the kept pattern (see drop_tolerance).
+    tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
+    std::array<std::vector<double>, 3> diagonal;
+    for (auto& d : diagonal) d.assign(m, 0.0);
+    for_rows(m, [&](size_t row) {
+        Accumulator& acc = scratch.local();
+        accumulate_galerkin_row(l, row, acc);
+        for (size_t ch = 0; ch < 3; ++ch) diagonal[ch][row] = acc.sum[ch][row];
+        clear(acc);
+    });
+    const double theta = options_.drop_tolerance;
+    auto kept = [&](size_t row, size_t k, const Accumulator& acc) {
+        if (k == row) return true;
+        for (size_t ch = 0; ch < 3; ++ch)
+            if (std::abs(acc.sum[ch][k]) >= theta * std::sqrt(std::abs(diagonal[ch][row] * diagonal[ch][k]))) return true;
+        return false;
+    };
+    coarse.offsets.assign(m + 1, 0);
+    for_rows(m, [&](size_t row) {
+        Accumulator& acc = scratch.local();
+        accumulate_galerkin_row(l, row, acc);
+        int32_t count = 0;
+        for (int32_t k : acc.touched) count += kept(row, static_cast<size_t>(k), acc) ? 1 : 0;
+        coarse.offsets[row + 1] = count;
+        clear(acc);
+    });
+    std::partial_sum(coarse.offsets.begin(), coarse.offsets.end(), coarse.offsets.begin());
+    coarse.columns.resize(static_cast<size_t>(coarse.offsets[m]));
+    coarse.diagonal.assign(m, -1);
+    for_rows(m, [&](size_t row) {
+        Accumulator& acc = scratch.local();
+        accumulate_galerkin_row(l, row, acc);
+        auto out = static_cast<size_t>(coarse.offsets[row]);
+        for (int32_t k : acc.touched)
+            if (kept(row, static_cast<size_t>(k), acc)) coarse.columns[out++] = k;
+        clear(acc);
+        auto* begin = coarse.columns.data() + coarse.offsets[row];
+        auto* end = coarse.columns.data() + coarse.offsets[row + 1];
+        std::sort(begin, end);
+        coarse.diagonal[row] = static_cast<int32_t>(std::lower_bound(begin, end, static_cast<int32_t>(row)) - coarse.columns.data());
+    });
+    for (auto& v : coarse.values) v.assign(coarse.columns.size(), 0.0);
+}
+
+void MultigridPreconditioner::clear(Accumulator& acc) {
+    for (int32_t k : acc.touched) {
+        acc.tag[static_cast<size_t>(k)] = -1;
+        for (auto& s : acc.sum) s[static_cast<size_t>(k)] = 0.0;
+    }
+    acc.touched.clear();
+}
+
+// Row `row` of P^T (A P) into acc (all three channels), summed in a fixed order (ascending v of
+// P^T's row, then A P's row): deterministic.
+void MultigridPreconditioner::accumulate_galerkin_row(size_t l, size_t row, Accumulator& acc) const {
+    const Level& fine = *levels_[l - 1];
+    const InterpolationOperator& pt = fine.pt;
+    const auto tag = static_cast<int32_t>(row);
+    for (int32_t a = pt.offsets[row]; a < pt.offsets[row + 1]; ++a) {
+        const auto v = static_cast<size_t>(pt.columns[static_cast<size_t>(a)]);
+        const double w = pt.weights[static_cast<size_t>(a)];
+        for (int32_t e = fine.ap_offsets[v]; e < fine.ap_offsets[v + 1]; ++e) {
+            const auto k = static_cast<size_t>(fine.ap_columns[static_cast<size_t>(e)]);
+            if (acc.tag[k] != tag) {
+                acc.tag[k] = tag;
+                acc.touched.push_back(static_cast<int32_t>(k));
+            }
+            for (size_t ch = 0; ch < 3; ++ch) acc.sum[ch][k] += w * fine.ap_values[ch][static_cast<size_t>(e)];
+        }
+    }
+}
+
+void MultigridPreconditioner::compute_product_rows(size_t l, std::span<const int32_t> rows) {
+    Level& fine = *levels_[l - 1];
+    const InterpolationOperator& p = *fine.p;
+    const size_t m = levels_[l]->n;
+    tbb::enumerable_thread_specific<std::vector<int32_t>> slots([m] { return std::vector<int32_t>(m, -1); });
+    for_rows(rows.size(), [&](size_t index) {
+        const auto v = static_cast<size_t>(rows[index]);
+        auto& slot = slots.local();
+        const auto begin = static_cast<size_t>(fine.ap_offsets[v]), end = static_cast<size_t>(fine.ap_offsets[v + 1]);
+        for (size_t s = begin; s < end; ++s) slot[static_cast<size_t>(fine.ap_columns[s])] = static_cast<int32_t>(s);
+        for (auto& values : fine.ap_values)
+            std::fill(values.begin() + static_cast<std::ptrdiff_t>(begin), values.begin() + static_cast<std::ptrdiff_t>(end), 0.0);
+        for (int32_t e = fine.offsets[v]; e < fine.offsets[v + 1]; ++e) {
+            const auto j = static_cast<size_t>(fine.columns[static_cast<size_t>(e)]);
+            for (int32_t q = p.offsets[j]; q < p.offsets[j + 1]; ++q) {
+                const auto s = static_cast<size_t>(slot[static_cast<size_t>(p.columns[static_cast<size_t>(q)])]);
+                const double w = p.weights[static_cast<size_t>(q)];
+                for (size_t ch = 0; ch < 3; ++ch) fine.ap_values[ch][s] += fine.values[ch][static_cast<size_t>(e)] * w;
+            }
+        }
+    });
+}
+
+void MultigridPreconditioner::compute_galerkin_rows(size_t l, std::span<const int32_t> rows) {
+    Level& coarse = *levels_[l];
+    const size_t m = coarse.n;
+    tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
+    for_rows(rows.size(), [&](size_t index) {
+        const auto row = static_cast<size_t>(rows[index]);
+        Accumulator& acc = scratch.local();
+        accumulate_galerkin_row(l, row, acc);
+        // Dropped entries go to the diagonal (MultigridOptions::lumping says how).
+        const auto begin = static_cast<size_t>(coarse.offsets[row]), end = static_cast<size_t>(coarse.offsets[row + 1]);
+        for (size_t s = begin; s < end; ++s) acc.slot[static_cast<size_t>(coarse.columns[s])] = static_cast<int32_t>(s);
+        std::array<double, 3> lumped{};
+        for (size_t ch = 0; ch < 3; ++ch)
+            std::fill(coarse.values[ch].begin() + static_cast<std::ptrdiff_t>(begin),
+                      coarse.values[ch].begin() + static_cast<std::ptrdiff_t>(end), 0.0);
+        for (int32_t k : acc.touched) {
+            const int32_t s = acc.slot[static_cast<size_t>(k)];
+            const bool in_pattern = s >= static_cast<int32_t>(begin) && s < static_cast<int32_t>(end) &&
+                                    coarse.columns[static_cast<size_t>(s)] == k;
+            for (size_t ch = 0; ch < 3; ++ch) {
+                const double value = acc.sum[ch][static_cast<size_t>(k)];
+                if (in_pattern)
+                    coarse.values[ch][static_cast<size_t>(s)] = value;
+                else
+                    lumped[ch] += options_.lumping == DropLumping::Absolute ? std::abs(value) : value;
+            }
+        }
+        for (size_t ch = 0; ch < 3; ++ch) coarse.values[ch][static_cast<size_t>(coarse.diagonal[row])] += lumped[ch];
+        clear(acc);
+    });
+}
+
+void MultigridPreconditioner::prepare_smoother(size_t l, std::span<const int32_t> rows) {
+    Level& level = *levels_[l];
+    auto& data_f = level.f;
+    auto& data_d = level.d;
+    const bool single = options_.single_precision;
+    for (size_t ch = 0; ch < 3; ++ch) {
+        if (single) {
+            data_f.values[ch].resize(level.columns.size());
+            data_f.inv_diag[ch].resize(level.n);
+        } else {
+            data_d.values[ch].resize(level.columns.size());
+            data_d.inv_diag[ch].resize(level.n);
+        }
+    }
+    std::atomic<bool> bad{false};
+    for_rows(rows.size(), [&](size_t index) {
+        const auto i = static_cast<size_t>(rows[index]);
+        for (size_t ch = 0; ch < 3; ++ch) {
+            const std::vector<double>& values = level.values[ch];
+            const double diag = values[static_cast<size_t>(level.diagonal[i])];
+            if (!(diag > 0) || !std::isfinite(diag)) {
+                bad = true;
+                continue;
+            }
+            double sum = 0;
+            for (int32_t k = level.offsets[i]; k < level.offsets[i + 1]; ++k) {
+                sum += std::abs(values[static_cast<size_t>(k)]);
+                if (single)
+                    data_f.values[ch][static_cast<size_t>(k)] = static_cast<float>(values[static_cast<size_t>(k)]);
+                else
+                    data_d.values[ch][static_cast<size_t>(k)] = values[static_cast<size_t>(k)];
+            }
+            level.row_bound[ch][i] = sum / diag;
+            if (single)
+                data_f.inv_diag[ch][i] = static_cast<float>(1.0 / diag);
+            else
+                data_d.inv_diag[ch][i] = 1.0 / diag;
+        }
+    });
+    if (bad)
+        throw AlgorithmError("multigrid: level " + std::to_string(l) +
+                             " has a non-positive or non-finite diagonal (matrix not positive definite)");
+    for (size_t ch = 0; ch < 3; ++ch)
+        level.upper[ch] = *std::max_element(level.row_bound[ch].begin(), level.row_bound[ch].end());
+}
+
+void MultigridPreconditioner::factorize_coarsest() {
+    Level& level = *levels_.back();
+    const auto n = static_cast<Eigen::Index>(level.n);
+    for (size_t ch = 0; ch < 3; ++ch) {
+        std::vector<Eigen::Triplet<double>> triplets;
+        triplets.reserve(level.columns.size());
+        for (Eigen::Index i = 0; i < n; ++i)
+            for (int32_t k = level.offsets[static_cast<size_t>(i)]; k < level.offsets[static_cast<size_t>(i) + 1]; ++k)
+                triplets.emplace_back(static_cast<int>(i), level.columns[static_cast<size_t>(k)],
+                                      level.values[ch][static_cast<size_t>(k)]);
+        Eigen::SparseMatrix<double> a(n, n);
+        a.setFromTriplets(triplets.begin(), triplets.end());
+        level.coarsest[ch].compute(a);
+        if (level.coarsest[ch].info() != Eigen::Success || (level.coarsest[ch].vectorD().array() <= 0).any())
+            throw AlgorithmError("multigrid: the coarsest level (" + std::to_string(level.n) +
+                                 " vertices) is not positive definite");
+    }
+    level.coarse_rhs.resize(n);
+    level.coarse_solution.resize(n);
+}
+
+void MultigridPreconditioner::update_values(std::span<const int32_t> changed_rows) {
+    const HierarchyLevel& fine = hierarchy_.levels[0];
+    Level& level0 = *levels_[0];
+    for (int32_t row : changed_rows) {
+        if (row < 0 || static_cast<size_t>(row) >= level0.n)
+            throw InvalidArgumentError("multigrid update_values: row " + std::to_string(row) + " out of range");
+        for (size_t ch = 0; ch < 3; ++ch)
+            std::copy(fine.values[ch].begin() + fine.offsets[static_cast<size_t>(row)],
+                      fine.values[ch].begin() + fine.offsets[static_cast<size_t>(row) + 1],
+                      level0.values[ch].begin() + level0.offsets[static_cast<size_t>(row)]);
+    }
+    std::vector<int32_t> rows(changed_rows.begin(), changed_rows.end());
+    prepare_smoother(0, rows);
+    std::vector<uint8_t> touched;
+    for (size_t l = 1; l < levels_.size() && !rows.empty(); ++l) {
+        // Coarse row I depends on the fine rows v with P_vI != 0 (and, by symmetry of A, on nothing
+        // else: a changed entry a_vj sits in the changed row v).
+        const InterpolationOperator& p = *levels_[l - 1]->p;
+        compute_product_rows(l, rows);
+        touched.assign(levels_[l]->n, 0);
+        for (int32_t v : rows)
+            for (int32_t q = p.offsets[static_cast<size_t>(v)]; q < p.offsets[static_cast<size_t>(v) + 1]; ++q)
+                touched[static_cast<size_t>(p.columns[static_cast<size_t>(q)])] = 1;
+        rows.clear();
+        for (size_t i = 0; i < touched.size(); ++i)
+            if (touched[i]) rows.push_back(static_cast<int32_t>(i));
+        compute_galerkin_rows(l, rows);
+        prepare_smoother(l, rows);
+        if (l + 1 == levels_.size() && !rows.empty()) factorize_coarsest();
+    }
+}
+
+namespace {
+
+// y_i = (b_i - (A x)_i) / a_ii for every row.
+template <typename Scalar>
+void scaled_residual(size_t n, const int32_t* offsets, const int32_t* columns, const Scalar* values,
+                     const Scalar* inv_diag, const Scalar* b, const Scalar* x, Scalar* y) {
+    for_rows(n, [&](size_t i) {
+        Scalar sum = b[i];
+        for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) sum -= values[k] * x[columns[k]];
+        y[i] = sum * inv_diag[i];
+    });
+}
+
+}  // namespace
+
+template <typename Scalar>
+void MultigridPreconditioner::vcycle(size_t l, int channel) {
+    Level& level = *levels_[l];
+    MultigridLevelData<Scalar>& w = level.data<Scalar>();
+    const auto ch = static_cast<size_t>(channel);
+    const size_t n = level.n;
+    if (l + 1 == levels_.size()) {
+        for (size_t i = 0; i < n; ++i) level.coarse_rhs[static_cast<Eigen::Index>(i)] = static_cast<double>(w.b[i]);
+        level.coarse_solution = level.coarsest[ch].solve(level.coarse_rhs);
+        for (size_t i = 0; i < n; ++i) w.x[i] = static_cast<Scalar>(level.coarse_solution[static_cast<Eigen::Index>(i)]);
+        return;
+    }
+    const Scalar* values = w.values[ch].data();
+    const Scalar* inv_diag = w.inv_diag[ch].data();
+    const int32_t* offsets = level.offsets.data();
+    const int32_t* columns = level.columns.data();
+    // Chebyshev smoothing on [upper / ratio, upper] (Saad, Iterative Methods, Alg. 12.1 on D^-1 A).
+    const double upper = level.upper[ch];
+    const double lower = upper / options_.chebyshev_ratio;
+    const double theta = 0.5 * (upper + lower), delta = 0.5 * (upper - lower), sigma = theta / delta;
+    auto smooth = [&](bool zero_start) {
+        if (zero_start) {
+            for_rows(n, [&](size_t i) { w.r[i] = w.b[i] * inv_diag[i]; });
+        } else {
+            scaled_residual(n, offsets, columns, values, inv_diag, w.b.data(), w.x.data(), w.r.data());
+        }
+        const auto inv_theta = static_cast<Scalar>(1.0 / theta);
+        for_rows(n, [&](size_t i) {
+            w.d[i] = w.r[i] * inv_theta;
+            w.x[i] = zero_start ? w.d[i] : w.x[i] + w.d[i];
+        });
+        double rho = 1.0 / sigma;
+        for (int step = 1; step < options_.smoothing_steps; ++step) {
+            const double rho_next = 1.0 / (2.0 * sigma - rho);
+            const auto c_d = static_cast<Scalar>(rho_next * rho), c_r = static_cast<Scalar>(2.0 * rho_next / delta);
+            rho = rho_next;
+            // d = c_d d + c_r D^-1 (b - A x), then x += d (a second pass: rows read neighbours' x).
+            for_rows(n, [&](size_t i) {
+                Scalar sum = w.b[i];
+                for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) sum -= values[k] * w.x[static_cast<size_t>(columns[k])];
+                w.d[i] = c_d * w.d[i] + c_r * (sum * inv_diag[i]);
+            });
+            for_rows(n, [&](size_t i) { w.x[i] += w.d[i]; });
+        }
+    };
+    smooth(true);
+    // r = b - A x, restricted with P^T to the next level's right-hand side.
+    for_rows(n, [&](size_t i) {
+        Scalar sum = w.b[i];
+        for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) sum -= values[k] * w.x[static_cast<size_t>(columns[k])];
+        w.r[i] = sum;
+    });
+    MultigridLevelData<Scalar>& next = levels_[l + 1]->data<Scalar>();
+    const InterpolationOperator& pt = level.pt;
+    for_rows(levels_[l + 1]->n, [&](size_t c) {
+        Scalar sum = 0;
+        for (int32_t a = pt.offsets[c]; a < pt.offsets[c + 1]; ++a)
+            sum += w.pt_weights[static_cast<size_t>(a)] * w.r[static_cast<size_t>(pt.columns[static_cast<size_t>(a)])];
+        next.b[c] = sum;
+    });
+    vcycle<Scalar>(l + 1, channel);
+    const InterpolationOperator& p = *level.p;
+    for_rows(n, [&](size_t i) {
+        Scalar sum = 0;
+        for (int32_t q = p.offsets[i]; q < p.offsets[i + 1]; ++q)
+            sum += w.p_weights[static_cast<size_t>(q)] * next.x[static_cast<size_t>(p.columns[static_cast<size_t>(q)])];
+        w.x[i] += sum;
+    });
+    smooth(false);
+}
+
+void MultigridPreconditioner::apply(int channel, std::span<const double> r, std::span<double> z) {
+    if (channel < 0 || channel > 2)
+        throw InvalidArgumentError("multigrid: channel " + std::to_string(channel) + " is not 0, 1 or 2");
+    const size_t n = levels_[0]->n;
+    if (r.size() != n || z.size() != n)
+        throw InvalidArgumentError("multigrid: vectors of size " + std::to_string(r.size()) + " and " +
+                                   std::to_string(z.size()) + " for " + std::to_string(n) + " vertices");
+    auto run = [&](auto& data, auto tag) {
+        using Scalar = decltype(tag);
+        for_rows(n, [&](size_t i) { data.b[i] = static_cast<Scalar>(r[i]); });
+        vcycle<Scalar>(0, channel);
+        for_rows(n, [&](size_t i) { z[i] = static_cast<double>(data.x[i]); });
+    };
+    if (options_.single_precision)
+        run(levels_[0]->f, float{});
+    else
+        run(levels_[0]->d, double{});
+}
+
+}  // namespace waxwork

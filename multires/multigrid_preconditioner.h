@@ -1,0 +1,115 @@
+// A multigrid V-cycle on the independent-set hierarchy (multires/hierarchy.h), used as the
+// preconditioner of CG on level 0 (multires/multigrid_cg.h). Beyond the paper: TransCut (Li et al.
+// 2013, Sec. 4) only runs its levels once, coarse to fine; here the same graphs and the same Eq. 16
+// interpolation P^l serve every CG iteration.
+//
+// Why Galerkin operators and not Eq. 17. A CG preconditioner must be symmetric positive definite.
+// Eq. 17's coarse matrices S M^l P^l (S the row injection) are not symmetric, so a V-cycle built on
+// them is not a symmetric operator and CG would lose its short recurrence. The Galerkin product
+// A^{l+1} = (P^l)^T A^l P^l is symmetric, and positive definite whenever A^l is and P^l has full column
+// rank (every retained vertex interpolates itself with weight 1, so it has). Its pattern is wider than
+// Eq. 17's (row I reaches I -P- v -A- j -P- K, up to three fine hops), which costs setup time and memory,
+// not correctness. The paper's operators remain in the hierarchy for MultiresSolver.
+//
+// Why this smoother. The V-cycle B = V(r) is symmetric when the post-smoother is the adjoint of the
+// pre-smoother. A Chebyshev polynomial in D^-1 A is self-adjoint in the A inner product, so the same
+// polynomial before and after (from a zero start before) gives a symmetric B, and it is fully parallel
+// (Gauss-Seidel is sequential, or needs a colouring). B is positive definite when the smoother
+// contracts, |p(lambda)| < 1 on the spectrum of D^-1 A: the polynomial is built on [upper/ratio, upper]
+// with upper the Gershgorin bound max_i sum_j |a_ij| / a_ii, which is a true upper bound (a power
+// iteration estimate could fall short and make high modes grow). The coarsest level is solved
+// exactly by a sparse LDL^T factorisation (Eigen SimplicialLDLT, in double).
+//
+// Precision. The Galerkin products are formed in double (rows sum entries of both signs); the
+// V-cycle runs in float when `single_precision` (half the memory traffic of the smoothing sweeps).
+// The outer CG runs in double, so the preconditioner's rounding only changes how fast it converges,
+// not what it converges to (bench/multires_bench.cpp measures both).
+//
+// Determinism. Every parallel loop writes disjoint rows and sums in a fixed order: identical results
+// on any thread count.
+#pragma once
+
+#include "multires/hierarchy.h"
+
+#include <array>
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace waxwork {
+
+// Where the entries dropped from a coarse operator go (MultigridOptions::drop_tolerance).
+enum class DropLumping {
+    // Their absolute values are added to the diagonal. The change diag(sum_j |e_ij|) - E is positive
+    // semi-definite for either sign of e_ij ((x_i +- x_j)^2 terms), so the operator stays positive
+    // definite by construction; but it is stiffer than the Galerkin one, and the coarse correction
+    // weaker (on spot, 500K tets, drop 0.02: 7 MG-CG iterations to 1% instead of 2).
+    Absolute,
+    // Their signed values are added to the diagonal, preserving row sums (A 1, the smooth mode the
+    // coarse levels exist for). Positive dropped entries keep definiteness, negative ones can lose it
+    // in principle; the coarsest factorisation checks it, and MG-CG reports a preconditioner that is
+    // not positive (r.Br < 0) as AlgorithmError. On spot it keeps 2-3 iterations with 40% of the
+    // operator entries of the exact products (bench/multires_bench.cpp).
+    RowSum,
+};
+
+struct MultigridOptions {
+    int smoothing_steps = 2;         // Chebyshev degree, the same before and after the coarse correction
+    double chebyshev_ratio = 8.0;    // the polynomial damps [upper / ratio, upper]
+    bool single_precision = true;    // V-cycle vectors and smoothing matrices in float
+    // Coarse entries with |a_ij| < drop_tolerance sqrt(a_ii a_jj) in every channel are dropped from the
+    // Galerkin operator and added to the diagonal as `lumping` says (0: exact Galerkin products). The
+    // exact products of Eq. 16's wide interpolation fill in (spot, 500K tets: 14, 55, 126, 179 entries
+    // per row on levels 0-3, 3.6 times level 0's entries in all), which makes each V-cycle and the
+    // setup expensive; 0.02 keeps 1.45 times level 0's.
+    double drop_tolerance = 0.02;
+    DropLumping lumping = DropLumping::RowSum;
+};
+
+class MultigridPreconditioner {
+public:
+    // Galerkin operators for all three channels on the hierarchy's levels and interpolation. The
+    // hierarchy must outlive the preconditioner (its interpolation operators are borrowed).
+    // Throws AlgorithmError when a diagonal is not positive or the coarsest factorisation fails.
+    explicit MultigridPreconditioner(const MultiresHierarchy& hierarchy, const MultigridOptions& options = {});
+    ~MultigridPreconditioner();
+    MultigridPreconditioner(const MultigridPreconditioner&) = delete;
+    MultigridPreconditioner& operator=(const MultigridPreconditioner&) = delete;
+
+    size_t level_count() const;
+    // Rows and stored entries of level l's Galerkin operator (level 0: the fine matrix).
+    size_t rows(size_t level) const;
+    size_t nonzeros(size_t level) const;
+    // Level l's operator for one channel, in double (for tests).
+    CsrMatrixView<double> view(size_t level, int channel) const;
+    double setup_ms() const { return setup_ms_; }
+
+    // z = B r for one channel: one V-cycle from a zero start. Not thread-safe (shared work vectors).
+    void apply(int channel, std::span<const double> r, std::span<double> z);
+
+    // After the level-0 values changed in the rows `changed_rows` (ascending; pattern and hierarchy
+    // unchanged; the hierarchy's level 0 already holds the new values): recomputes exactly the coarse
+    // rows that depend on them, level by level, and refactorises the coarsest level if it was
+    // reached. The result equals a new preconditioner built on the updated hierarchy.
+    void update_values(std::span<const int32_t> changed_rows);
+
+private:
+    struct Level;
+    struct Accumulator;
+    void build_product_pattern(size_t l);
+    void compute_product_rows(size_t l, std::span<const int32_t> rows);
+    void accumulate_galerkin_row(size_t l, size_t row, Accumulator& acc) const;
+    static void clear(Accumulator& acc);
+    void compute_galerkin_rows(size_t l, std::span<const int32_t> rows);
+    void prepare_smoother(size_t l, std::span<const int32_t> rows);
+    void factorize_coarsest();
+    template <typename Scalar>
+    void vcycle(size_t l, int channel);
+
+    const MultiresHierarchy& hierarchy_;
+    MultigridOptions options_;
+    std::vector<std::unique_ptr<Level>> levels_;
+    double setup_ms_ = 0;
+};
+
+}  // namespace waxwork

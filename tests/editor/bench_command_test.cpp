@@ -1,0 +1,100 @@
+// `waxwork bench solvers` end to end on a small volume: the JSON schema, monotone curves, iterative
+// solvers reaching 1%, the chart, and clean errors.
+#include "cli_run.h"
+
+#include "io/volume_file.h"
+#include "tetops/test_meshes.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+namespace waxwork {
+namespace {
+
+using testing::run_waxwork;
+using testing::scratch_dir;
+
+TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
+    const auto dir = scratch_dir("bench_solvers");
+    const auto volume = dir / "cube.vtu";
+    write_volume(testing::make_cube_mesh(9, Eigen::Vector3d::Zero(), 1.0), volume);
+    const auto out = dir / "out";
+    const auto result = run_waxwork("bench solvers --mesh " + volume.string() + " -o " + out.string() +
+                                    " --backend cpu --floor 1e-3 --max-seconds 20");
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const auto json = nlohmann::json::parse(testing::read_text(out / "solvers.json"));
+    std::vector<std::string> keys;
+    for (const auto& [key, value] : json.items()) keys.push_back(key);
+    EXPECT_EQ(keys, (std::vector<std::string>{"hierarchy_ms", "levels", "mesh", "multigrid_setup_ms", "solvers", "tets", "vertices"}));
+    EXPECT_EQ(json["tets"].get<size_t>(), 9u * 9u * 9u * 6u);
+    EXPECT_EQ(json["vertices"].get<size_t>(), 1000u);
+    EXPECT_GE(json["levels"].get<int>(), 1);
+    EXPECT_GE(json["hierarchy_ms"].get<double>(), 0.0);
+    const auto& solvers = json["solvers"];
+    for (const std::string name : {"jacobi_cg", "jacobi_cg_double", "multires", "multigrid_cg", "eigen_ic_cg", "direct"}) {
+        ASSERT_TRUE(solvers.contains(name)) << name;
+        const auto& s = solvers[name];
+        EXPECT_EQ(s.size(), 2u) << name;
+        const auto& curve = s["curve"];
+        ASSERT_FALSE(curve.empty()) << name;
+        double last_ms = 0, best_error = 2;
+        for (const auto& point : curve) {
+            ASSERT_EQ(point.size(), 2u);
+            const double ms = point[0].get<double>(), error = point[1].get<double>();
+            EXPECT_GT(ms, last_ms) << name;  // strictly increasing time
+            EXPECT_GE(error, 0.0);
+            last_ms = ms;
+            best_error = std::min(best_error, error);
+        }
+        EXPECT_LT(best_error, 1e-2) << name;
+        ASSERT_TRUE(s["time_to_1pct_ms"].is_number()) << name;
+        EXPECT_GT(s["time_to_1pct_ms"].get<double>(), 0.0) << name;
+        if (name != "direct") {
+            // The iterative curves start from the cold start (error 1, or multires' coarse pass) and fall.
+            EXPECT_GT(curve.front()[1].get<double>(), 1e-2) << name;
+            EXPECT_LT(curve.back()[1].get<double>(), 1e-2) << name;
+        }
+    }
+    const std::string svg = testing::read_text(out / "solvers.svg");
+    EXPECT_NE(svg.find("<svg"), std::string::npos);
+    for (const std::string name : {"jacobi_cg", "multigrid_cg", "direct"}) EXPECT_NE(svg.find(name), std::string::npos);
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(out), std::filesystem::directory_iterator{}), 2);
+}
+
+TEST(BenchSolversCommand, RejectsBadInvocationsWithOneLine) {
+    const auto dir = scratch_dir("bench_solvers_errors");
+    const auto missing = run_waxwork("bench solvers --mesh " + (dir / "none.obj").string() + " -o " + dir.string());
+    EXPECT_NE(missing.exit_code, 0);
+    EXPECT_EQ(testing::line_count(missing.err), 1u) << missing.err;
+    const auto surface_without_size =
+        run_waxwork("bench solvers --mesh " + std::string(WAXWORK_ASSET_DIR) + "/meshes/spot.obj -o " + dir.string());
+    EXPECT_EQ(surface_without_size.exit_code, 1);
+    EXPECT_NE(surface_without_size.err.find("--max-tets"), std::string::npos) << surface_without_size.err;
+    const auto gpu = run_waxwork("bench solvers --mesh " + std::string(WAXWORK_ASSET_DIR) +
+                                 "/meshes/spot.obj --max-tets 50000 --backend gpu -o " + dir.string());
+    EXPECT_EQ(gpu.exit_code, 2);
+    const auto bare = run_waxwork("bench");
+    EXPECT_NE(bare.exit_code, 0);
+    EXPECT_EQ(testing::line_count(bare.err), 1u) << bare.err;
+}
+
+TEST(BenchSuiteCommand, NeedsAnOutputDirectoryOrABenchmark) {
+    const auto result = run_waxwork("bench");
+    EXPECT_NE(result.exit_code, 0);
+    EXPECT_NE(result.err.find("give -o DIR"), std::string::npos) << result.err;
+}
+
+TEST(BenchSuiteCommand, UnwritableOutputIsAClearError) {
+    const auto dir = scratch_dir("bench_suite_unwritable");
+    const auto blocker = dir / "file";
+    std::ofstream(blocker) << "not a directory";
+    const auto result = run_waxwork("bench --quick -o " + (blocker / "out").string());
+    EXPECT_NE(result.exit_code, 0);
+    EXPECT_NE(result.err.find("cannot create the output directory"), std::string::npos) << result.err;
+}
+
+}  // namespace
+}  // namespace waxwork

@@ -1,0 +1,258 @@
+#include "multires/multigrid_cg.h"
+#include "multires/multigrid_preconditioner.h"
+#include "multires_test_systems.h"
+#include "tetops/error.h"
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <random>
+
+namespace waxwork {
+namespace {
+
+std::vector<double> random_vector(size_t n, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<double> v(n);
+    for (double& x : v) x = u(rng);
+    return v;
+}
+
+double dot(const std::vector<double>& a, const std::vector<double>& b) {
+    double s = 0;
+    for (size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
+    return s;
+}
+
+Eigen::MatrixXd dense(const CsrMatrixView<double>& m) {
+    const auto n = static_cast<Eigen::Index>(m.rows);
+    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(n, n);
+    for (Eigen::Index i = 0; i < n; ++i)
+        for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) d(i, m.columns[k]) += m.values[k];
+    return d;
+}
+
+Eigen::MatrixXd dense(const InterpolationOperator& p, Eigen::Index coarse_rows) {
+    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(p.rows()), coarse_rows);
+    for (size_t v = 0; v < p.rows(); ++v)
+        for (int32_t q = p.offsets[v]; q < p.offsets[v + 1]; ++q)
+            d(static_cast<Eigen::Index>(v), p.columns[static_cast<size_t>(q)]) += p.weights[static_cast<size_t>(q)];
+    return d;
+}
+
+HierarchyOptions small_levels(int64_t min_coarse) {
+    HierarchyOptions h;
+    h.min_coarse_vertices = min_coarse;
+    return h;
+}
+
+std::vector<double> reference_solution(const DiffusionMatrix& m, const std::vector<double>& b, int channel) {
+    std::vector<double> x(b.size(), 0.0);
+    ConjugateGradientOptions options;
+    options.relative_tolerance = 1e-12;
+    const CsrMatrixView<double> view{m.size(), m.offsets.data(), m.columns.data(),
+                                     m.values[static_cast<size_t>(channel)].data()};
+    EXPECT_TRUE(solve_jacobi_cg<double>(view, b, x, options).converged);
+    return x;
+}
+
+double relative_error(const std::vector<double>& x, const std::vector<double>& reference) {
+    double e = 0, r = 0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        e += (x[i] - reference[i]) * (x[i] - reference[i]);
+        r += reference[i] * reference[i];
+    }
+    return std::sqrt(e / r);
+}
+
+TEST(MultigridPreconditioner, CoarseOperatorsAreGalerkinProducts) {
+    const auto s = testing::make_test_system(6);
+    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(20));
+    ASSERT_GE(h.level_count(), 3u);
+    MultigridOptions exact;
+    exact.drop_tolerance = 0;
+    const MultigridPreconditioner mg(h, exact);
+    ASSERT_EQ(mg.level_count(), h.level_count());
+    for (int channel = 0; channel < 3; ++channel) {
+        for (size_t l = 0; l + 1 < h.level_count(); ++l) {
+            const Eigen::MatrixXd p = dense(h.levels[l].interpolation, static_cast<Eigen::Index>(h.levels[l + 1].size()));
+            const Eigen::MatrixXd expected = p.transpose() * dense(mg.view(l, channel)) * p;
+            const Eigen::MatrixXd actual = dense(mg.view(l + 1, channel));
+            EXPECT_LT((actual - expected).norm(), 1e-12 * expected.norm()) << "level " << l + 1;
+            EXPECT_LT((actual - actual.transpose()).norm(), 1e-12 * actual.norm());
+        }
+    }
+}
+
+// B assembled column by column from apply(): symmetric to rounding and positive definite.
+void expect_symmetric_positive(bool single_precision, double symmetry_tolerance, double drop_tolerance,
+                               DropLumping lumping) {
+    const auto s = testing::make_test_system(5);  // 216 vertices
+    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(20));
+    ASSERT_GE(h.level_count(), 3u);
+    MultigridOptions options;
+    options.single_precision = single_precision;
+    options.drop_tolerance = drop_tolerance;
+    options.lumping = lumping;
+    MultigridPreconditioner mg(h, options);
+    const size_t n = h.levels[0].size();
+    for (int channel = 0; channel < 3; ++channel) {
+        Eigen::MatrixXd b(n, n);
+        std::vector<double> e(n, 0.0), z(n);
+        for (size_t j = 0; j < n; ++j) {
+            e[j] = 1;
+            mg.apply(channel, e, z);
+            e[j] = 0;
+            for (size_t i = 0; i < n; ++i) b(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = z[i];
+        }
+        EXPECT_LT((b - b.transpose()).norm(), symmetry_tolerance * b.norm()) << "channel " << channel;
+        const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (b + b.transpose()));
+        EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0) << "channel " << channel;
+        // x^T B y == y^T B x for random vectors.
+        const auto x = random_vector(n, 1), y = random_vector(n, 2);
+        std::vector<double> bx(n), by(n);
+        mg.apply(channel, x, bx);
+        mg.apply(channel, y, by);
+        EXPECT_NEAR(dot(x, by), dot(y, bx), symmetry_tolerance * std::sqrt(dot(bx, bx) * dot(y, y)));
+    }
+}
+
+TEST(MultigridPreconditioner, ExactGalerkinIsSymmetricPositiveDefiniteInDouble) {
+    expect_symmetric_positive(false, 1e-12, 0.0, DropLumping::RowSum);
+}
+TEST(MultigridPreconditioner, DefaultIsSymmetricPositiveDefiniteInDouble) {
+    const MultigridOptions defaults;
+    expect_symmetric_positive(false, 1e-12, defaults.drop_tolerance, defaults.lumping);
+}
+TEST(MultigridPreconditioner, AbsoluteLumpingIsSymmetricPositiveDefinite) {
+    expect_symmetric_positive(false, 1e-12, 0.1, DropLumping::Absolute);
+}
+TEST(MultigridPreconditioner, DefaultIsSymmetricToFloatRoundingInSingle) {
+    const MultigridOptions defaults;
+    expect_symmetric_positive(true, 1e-5, defaults.drop_tolerance, defaults.lumping);
+}
+
+TEST(MultigridCg, ConvergesToTheLevel0Solution) {
+    const auto s = testing::make_test_system(12);  // 2197 vertices
+    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(100));
+    ASSERT_GE(h.level_count(), 3u);
+    for (bool single : {true, false}) {
+        MultigridOptions options;
+        options.single_precision = single;
+        MultigridPreconditioner mg(h, options);
+        for (int channel = 0; channel < 3; ++channel) {
+            const auto& b = s.b[static_cast<size_t>(channel)];
+            const auto reference = reference_solution(s.matrix, b, channel);
+            std::vector<double> x(b.size(), 0.0);
+            ConjugateGradientOptions cg;
+            cg.relative_tolerance = 1e-9;
+            const ConjugateGradientResult result = solve_multigrid_cg(mg, channel, b, x, cg);
+            EXPECT_TRUE(result.converged);
+            EXPECT_LT(relative_error(x, reference), 1e-7) << "channel " << channel << " single " << single;
+            EXPECT_GT(result.smallest_eigenvalue_estimate, 0.0);
+        }
+    }
+}
+
+TEST(MultigridCg, NeedsFarFewerIterationsThanJacobiCg) {
+    const auto s = testing::make_test_system(16);  // 4913 vertices
+    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(100));
+    MultigridPreconditioner mg(h);
+    const auto& b = s.b[0];  // the weakest absorption: the slowest channel
+    const CsrMatrixView<double> view{s.matrix.size(), s.matrix.offsets.data(), s.matrix.columns.data(),
+                                     s.matrix.values[0].data()};
+    const auto reference = reference_solution(s.matrix, b, 0);
+    ConjugateGradientOptions options;
+    options.relative_tolerance = 1e-6;
+    std::vector<double> xj(b.size(), 0.0), xm(b.size(), 0.0);
+    const int jacobi = solve_jacobi_cg<double>(view, b, xj, options).iterations;
+    const ConjugateGradientResult mgcg = solve_multigrid_cg(mg, 0, b, xm, options);
+    EXPECT_TRUE(mgcg.converged);
+    EXPECT_LT(relative_error(xm, reference), 1e-5);
+    EXPECT_LT(4 * mgcg.iterations, jacobi) << "MG-CG " << mgcg.iterations << ", Jacobi CG " << jacobi;
+}
+
+TEST(MultigridCg, IsDeterministicAcrossThreadCounts) {
+    const auto s = testing::make_test_system(10);
+    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(50));
+    std::vector<double> xa(s.b[1].size(), 0.0), xb(s.b[1].size(), 0.0);
+    {
+        MultigridPreconditioner mg(h);
+        solve_multigrid_cg(mg, 1, s.b[1], xa);
+    }
+    {
+        const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+        MultigridPreconditioner mg(h);
+        solve_multigrid_cg(mg, 1, s.b[1], xb);
+    }
+    EXPECT_EQ(xa, xb);
+}
+
+TEST(MultigridCg, WarmStartFromTheSolutionStopsAtOnce) {
+    const auto s = testing::make_test_system(10);
+    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(50));
+    MultigridPreconditioner mg(h);
+    std::vector<double> x(s.b[2].size(), 0.0);
+    ConjugateGradientOptions options;
+    options.relative_tolerance = 1e-8;
+    const ConjugateGradientResult first = solve_multigrid_cg(mg, 2, s.b[2], x, options);
+    options.relative_tolerance = 1e-6;
+    options.smallest_eigenvalue_hint = first.smallest_eigenvalue_estimate;
+    const ConjugateGradientResult again = solve_multigrid_cg(mg, 2, s.b[2], x, options);
+    EXPECT_TRUE(again.converged);
+    EXPECT_EQ(again.iterations, 0);
+}
+
+TEST(MultigridCg, RejectsBadInput) {
+    const auto s = testing::make_test_system(4);
+    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(20));
+    MultigridPreconditioner mg(h);
+    std::vector<double> x(s.b[0].size(), 0.0), wrong(3);
+    EXPECT_THROW(solve_multigrid_cg(mg, 3, s.b[0], x), InvalidArgumentError);
+    EXPECT_THROW(solve_multigrid_cg(mg, 0, wrong, x), InvalidArgumentError);
+    std::vector<double> nan_b = s.b[0];
+    nan_b[0] = std::nan("");
+    EXPECT_THROW(solve_multigrid_cg(mg, 0, nan_b, x), AlgorithmError);
+    std::vector<double> zero(s.b[0].size(), 0.0);
+    x.assign(x.size(), 1.0);
+    EXPECT_TRUE(solve_multigrid_cg(mg, 0, zero, x).converged);
+    for (double v : x) EXPECT_EQ(v, 0.0);
+}
+
+TEST(MultigridPreconditioner, PartialUpdateAfterPaintingEqualsARebuild) {
+    auto s = testing::make_test_system(8);
+    MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(30));
+    ASSERT_GE(h.level_count(), 3u);
+    // Exact products: with dropping, the kept pattern is chosen at build time and an update keeps it.
+    MultigridOptions exact;
+    exact.drop_tolerance = 0;
+    MultigridPreconditioner updated(h, exact);
+    std::vector<TetMaterial> materials(s.mesh.tet_count(), TetMaterial{{0.01, 0.05, 0.2}, {1, 1, 1}, 1.3});
+    std::vector<int32_t> painted;
+    for (int32_t t = 0; t < 40; ++t) {
+        painted.push_back(t * 7);
+        materials[static_cast<size_t>(t * 7)] = TetMaterial{{0.3, 0.02, 0.1}, {2, 1, 0.5}, 1.4};
+    }
+    const std::vector<int32_t> rows = update_diffusion_matrix(s.matrix, s.mesh, s.connectivity, materials, painted);
+    ASSERT_LT(rows.size(), s.matrix.size() / 2);
+    h.levels[0].values = s.matrix.values;
+    updated.update_values(rows);
+    MultigridPreconditioner rebuilt(h, exact);
+    for (size_t l = 0; l < h.level_count(); ++l)
+        for (int channel = 0; channel < 3; ++channel) {
+            const auto a = updated.view(l, channel), b = rebuilt.view(l, channel);
+            ASSERT_EQ(a.rows, b.rows);
+            const size_t nnz = static_cast<size_t>(a.offsets[a.rows]);
+            EXPECT_TRUE(std::equal(a.values, a.values + nnz, b.values)) << "level " << l << " channel " << channel;
+        }
+    std::vector<double> xa(s.b[0].size(), 0.0), xb(s.b[0].size(), 0.0);
+    updated.apply(0, s.b[0], xa);
+    rebuilt.apply(0, s.b[0], xb);
+    EXPECT_EQ(xa, xb);
+}
+
+}  // namespace
+}  // namespace waxwork
