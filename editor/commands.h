@@ -17,6 +17,7 @@ void add_fracture_command(CLI::App& app);
 void add_paint_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_edit_command(CLI::App& app);
 
 inline void register_commands(CLI::App& app) {
     add_mesh_command(app);
@@ -28,6 +29,7 @@ inline void register_commands(CLI::App& app) {
     add_run_command(app);
     add_demo_command(app);
     add_bench_command(app);
+    add_edit_command(app);
 }
 
 }  // namespace waxwork
