@@ -18,7 +18,7 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev libtbb-dev libcgal-dev libgmp-dev libmpfr-dev libboost-dev
   libtet1.5-dev libopenmesh-dev libsuitesparse-dev
-  libglfw3-dev libosmesa6-dev libgl-dev libimgui-dev libstb-dev libpng-dev
+  libglfw3-dev libosmesa6-dev libgl-dev libegl-dev libimgui-dev libstb-dev libpng-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libpugixml-dev libnanoflann-dev
   xvfb xauth
 )

@@ -2,11 +2,10 @@
 //   waxwork bench solvers --mesh MESH [--max-tets N] -o DIR [--backend cpu]
 // `bench` itself takes the subcommand; it is a CLI11 app with an optional subcommand so that a later
 // `waxwork bench [--quick] -o DIR` (all benchmarks) can be the parent's own action.
+#include "editor/bench_suite.h"
 #include "editor/commands.h"
 #include "editor/render_pipeline.h"
 #include "editor/solver_comparison.h"
-#include "editor/svg_chart.h"
-#include "io/atomic_file.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
 #include "tetops/error.h"
@@ -16,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -80,41 +80,15 @@ void run_solvers_command(const SolversCommandOptions& o) {
     options.max_seconds = o.max_seconds;
     const SolverComparison comparison = compare_solvers(mesh, connectivity, materials, lighting, options);
 
-    nlohmann::ordered_json solvers = nlohmann::ordered_json::object();
-    nlohmann::ordered_json summary_times = nlohmann::ordered_json::object();
-    std::vector<ChartSeries> series;
-    for (const SolverCurve& s : comparison.solvers) {
-        nlohmann::ordered_json curve = nlohmann::ordered_json::array();
-        for (const auto& [ms, error] : s.curve) curve.push_back({ms, error});
-        const nlohmann::ordered_json time = s.time_to_target_ms ? nlohmann::ordered_json(*s.time_to_target_ms) : nullptr;
-        solvers[s.name] = {{"time_to_1pct_ms", time}, {"curve", curve}};
-        summary_times[s.name] = time;
-        ChartSeries line{s.name, {}, true};
-        // A direct solution can be exact to the last bit; draw it at 1e-16 rather than not at all.
-        for (const auto& [ms, error] : s.curve) line.points.emplace_back(ms, std::max(error, 1e-16));
-        series.push_back(std::move(line));
-    }
-    const nlohmann::ordered_json json = {
-        {"mesh", o.mesh},
-        {"tets", comparison.tets},
-        {"vertices", comparison.vertices},
-        {"levels", comparison.levels},
-        {"hierarchy_ms", comparison.hierarchy_ms},
-        {"solvers", solvers},
-    };
     const std::filesystem::path dir(o.output);
     std::error_code error;
     std::filesystem::create_directories(dir, error);
     if (error) throw FileError(dir, "cannot create the directory (" + error.message() + ")");
-    write_file_atomically(dir / "solvers.json", [&](std::ostream& out) { out << json.dump(2) << "\n"; });
+    write_solver_comparison(dir, "solvers", o.mesh, comparison);
 
-    ChartOptions chart;
-    chart.title = "Diffusion solvers on " + std::filesystem::path(o.mesh).filename().string() + ", " +
-                  std::to_string(comparison.tets) + " tets (3 channels)";
-    chart.x = {"solve time (ms, log scale)", AxisScale::Log, 0, 0};  // direct is orders of magnitude slower
-    chart.y = {"relative L2 error of phi vs direct reference", AxisScale::Log, 0, 0};
-    write_svg_chart(dir / "solvers.svg", series, chart);
-
+    nlohmann::ordered_json summary_times = nlohmann::ordered_json::object();
+    for (const SolverCurve& s : comparison.solvers)
+        summary_times[s.name] = s.time_to_target_ms ? nlohmann::ordered_json(*s.time_to_target_ms) : nullptr;
     const nlohmann::ordered_json summary = {
         {"output", o.output},
         {"tets", comparison.tets},
@@ -130,11 +104,32 @@ void run_solvers_command(const SolversCommandOptions& o) {
 }  // namespace
 
 void add_bench_command(CLI::App& app) {
-    CLI::App* bench = app.add_subcommand("bench", "Measure solvers and write JSON results and SVG charts");
+    auto suite = std::make_shared<BenchSuiteOptions>();
+    auto suite_output = std::make_shared<std::string>();
+    CLI::App* bench = app.add_subcommand(
+        "bench", "Speed against accuracy: the whole suite (-o DIR [--quick]) or one benchmark (solvers)");
     bench->require_subcommand(0, 1);
-    bench->callback([bench] {
-        if (bench->get_subcommands().empty())
-            throw InvalidArgumentError("bench: name a benchmark (solvers); see waxwork bench --help");
+    bench->add_option("-o,--output", *suite_output, "Output directory of the whole suite");
+    bench->add_flag("--quick", suite->quick, "Smaller meshes and fewer samples (under 2 minutes)");
+    bench->add_option("--only", suite->only, "Run only these parts (solvers_50k, solvers_500k, accuracy, table1, "
+                                             "stability, resolution)")
+        ->delimiter(',');
+    bench->footer("Without a subcommand runs every part (editor/bench_suite.h) and writes JSON, SVG charts and\n"
+                  "markdown tables into the output directory.");
+    bench->callback([bench, suite, suite_output] {
+        if (!bench->get_subcommands().empty()) return;
+        if (suite_output->empty())
+            throw InvalidArgumentError("bench: give -o DIR for the whole suite, or name a benchmark (solvers)");
+        suite->output_dir = *suite_output;
+        suite->asset_dir = WAXWORK_ASSET_DIR;
+        suite->progress = [](const std::string& part) { std::cerr << "bench: " << part << "\n"; };
+        const auto start = std::chrono::steady_clock::now();
+        run_bench_suite(*suite);
+        std::cout << nlohmann::ordered_json{{"output", *suite_output},
+                                            {"quick", suite->quick},
+                                            {"seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}}
+                         .dump()
+                  << "\n";
     });
 
     auto options = std::make_shared<SolversCommandOptions>();

@@ -32,6 +32,7 @@ struct RenderCommandOptions {
     double ambient = 0.02;
     std::vector<double> view;
     std::optional<double> exposure;
+    std::string backend = "cpu";
 };
 
 // Physically meaningless values are refused before any work: a scale beyond these bounds is a unit
@@ -80,11 +81,19 @@ void run_render_command(const RenderCommandOptions& o) {
     const TetConnectivity connectivity = build_connectivity(mesh);
     const std::vector<TetMaterial> materials = resolve_materials(mesh, chosen);
 
+    // One OpenGL context for the GPU solve and the renderer (the same device).
+    HeadlessGlContext context;
     DiffusionOptions diffusion;
     diffusion.discretization = o.method == "fem" ? Discretization::Fem : Discretization::TransCut;
     diffusion.mm_per_unit = o.scale;
     diffusion.relative_tolerance = o.tolerance;
+    if (o.backend == "gpu") {
+        diffusion.backend = SolverBackend::Gpu;
+        diffusion.gl = &context.gl();
+    }
     const SolvedScene scene = solve_scene(mesh, connectivity, materials, lighting, diffusion);
+    if (!scene.diffusion.gpu_fallback_reason.empty())
+        std::cerr << "warning: solving on the CPU instead: " << scene.diffusion.gpu_fallback_reason << "\n";
 
     const auto render_start = std::chrono::steady_clock::now();
     ImageSettings settings;
@@ -93,7 +102,6 @@ void run_render_command(const RenderCommandOptions& o) {
     settings.camera = camera_for_view(o.view);
     if (o.exposure) settings.exposure = static_cast<float>(*o.exposure);
     const SurfaceRenderInput input = make_render_input(mesh, scene, lighting, settings);
-    HeadlessGlContext context;
     SurfaceRenderer renderer(context.gl());
     const Image image = render_scene(renderer, input);
     const double render_ms =
@@ -111,6 +119,7 @@ void run_render_command(const RenderCommandOptions& o) {
         {"tets", mesh.tet_count()},
         {"materials", chosen ? "option" : mesh.has_materials() ? "stored" : "marble default"},
         {"method", o.method},
+        {"backend", s.backend == SolverBackend::Gpu ? "gpu" : "cpu"},
         {"mm_per_unit", o.scale},
         {"lights", lighting.lights.size()},
         {"lights_inside", lights_inside},
@@ -146,6 +155,11 @@ void add_render_command(CLI::App& app) {
         ->check(CLI::IsMember({"transcut", "fem"}))
         ->capture_default_str();
     cmd->add_option("--tol", options->tolerance, "Relative tolerance of the diffusion solve")->capture_default_str();
+    cmd->add_option("--backend", options->backend,
+                    "Diffusion solver: cpu, or gpu (float CG on OpenGL 4.3 compute shaders in the render context; "
+                    "falls back to the CPU with a warning when the driver cannot run it)")
+        ->check(CLI::IsMember({"cpu", "gpu"}))
+        ->capture_default_str();
     cmd->add_option("--scale", options->scale, "Millimetres per model unit (coefficients are per mm)")
         ->capture_default_str();
     cmd->add_option("--ambient", options->ambient, "Ambient irradiance added to every boundary vertex")

@@ -27,6 +27,7 @@
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <utility>
@@ -60,5 +61,11 @@ struct SolverComparison {
 SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& connectivity,
                                  const std::vector<TetMaterial>& materials, const Lighting& lighting,
                                  const SolverComparisonOptions& options);
+
+// Writes DIR/STEM.json, {"mesh", "tets", "vertices", "levels", "hierarchy_ms", "multigrid_setup_ms",
+// "solvers": {NAME: {"time_to_1pct_ms", "curve": [[ms, rel_error], ...]}}}, and DIR/STEM.svg (error
+// against time, one line per solver), atomically. `mesh_name` is recorded as given.
+void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const std::string& mesh_name,
+                             const SolverComparison& comparison);
 
 }  // namespace waxwork

@@ -1,6 +1,8 @@
 #include "solver/diffusion_solve.h"
 
+#include "solver/cg_channel_state.h"
 #include "solver/conjugate_gradient.h"
+#include "solver/gpu_conjugate_gradient.h"
 #include "tetops/error.h"
 
 #include <tbb/blocked_range.h>
@@ -94,30 +96,6 @@ struct Rgb {
     }
 };
 
-struct ChannelState {
-    bool active = true;
-    double rz = 0, xnorm2 = 0;
-    std::vector<double> t_diag, t_off;
-    double ritz = std::numeric_limits<double>::infinity();
-    bool ritz_stale = true;
-    double ritz_floor = std::numeric_limits<double>::infinity();
-    double alpha_prev = 0, beta_prev = 0;
-    double last_restart_estimate = std::numeric_limits<double>::infinity();
-    ConjugateGradientResult result;
-
-    double lambda() {
-        if (ritz_stale && !t_diag.empty()) {
-            ritz = smallest_tridiagonal_eigenvalue(t_diag, t_off, std::isfinite(ritz) ? ritz : 0);
-            ritz_stale = false;
-        }
-        return std::min(ritz, ritz_floor);
-    }
-    double estimate(double rz_value, double lam) const {
-        if (xnorm2 <= 0) return std::numeric_limits<double>::infinity();
-        return std::sqrt(std::max(rz_value, 0.0)) / lam / std::sqrt(xnorm2);
-    }
-};
-
 template <typename Scalar>
 std::array<ConjugateGradientResult, 3> solve_rgb(const DiffusionMatrix& m, const std::array<std::vector<double>, 3>& b,
                                                  const DiffusionOptions& options,
@@ -125,7 +103,7 @@ std::array<ConjugateGradientResult, 3> solve_rgb(const DiffusionMatrix& m, const
     const size_t n = m.size(), nnz = m.nonzeros();
     if (!(options.relative_tolerance > 0) || options.max_iterations < 0)
         throw InvalidArgumentError("conjugate gradient: tolerance must be positive and max_iterations non-negative");
-    std::array<ChannelState, 3> ch;
+    std::array<CgChannelState, 3> ch;
     std::array<ConjugateGradientResult, 3> results;
     if (n == 0) {
         for (auto& r : results) r.converged = true;
@@ -242,52 +220,18 @@ std::array<ConjugateGradientResult, 3> solve_rgb(const DiffusionMatrix& m, const
         std::array<bool, 3> update_p{};
         for (int c = 0; c < 3; ++c) {
             if (!act[c]) continue;
-            ChannelState& st = ch[c];
+            CgChannelState& st = ch[c];
             if (!std::isfinite(upd.v[2 * c]) || !std::isfinite(upd.v[2 * c + 1]))
                 breakdown(k, "the iterate became non-finite");
-            const double rz_new = upd.v[2 * c];
-            st.xnorm2 = upd.v[2 * c + 1];
-            beta[c] = rz_new / st.rz;
-            // Lanczos coefficients (Saad, Iterative Methods, Sec. 6.7.3).
-            st.t_diag.push_back(1.0 / alpha[c] + (st.t_diag.empty() ? 0.0 : st.beta_prev / st.alpha_prev));
-            if (st.t_diag.size() > 1) st.t_off.push_back(std::sqrt(st.beta_prev) / st.alpha_prev);
-            st.ritz_stale = true;
-            st.alpha_prev = alpha[c];
-            st.beta_prev = beta[c];
-            st.rz = rz_new;
-            double lam = std::min(st.ritz, st.ritz_floor);
-            double est = st.estimate(st.rz, std::isfinite(lam) ? lam : st.t_diag.front());
-            if (est <= tol || k == 0) {
-                lam = st.lambda();
-                est = st.estimate(st.rz, lam);
-            }
+            beta[c] = st.record_step(alpha[c], upd.v[2 * c], upd.v[2 * c + 1]);
+            double lam = 0;
+            const double est = st.current_estimate(k, tol, false, lam);
             if (est <= tol) {
                 // Confirm with the true residual: the recursive one drifts (far, in float).
                 const double rz_true = s.true_residual(c);
                 if (!std::isfinite(rz_true)) breakdown(k, "the true residual is not finite");
-                const double est_true = st.estimate(rz_true, lam);
-                if (est_true <= tol) {
-                    st.result.converged = true;
-                    st.result.estimated_relative_error = est_true;
-                    st.result.iterations = k + 1;
-                    st.active = false;
-                    continue;
-                }
-                ++st.result.residual_replacements;
-                const bool stagnating = est_true > 0.5 * st.last_restart_estimate;
-                st.last_restart_estimate = est_true;
-                st.result.estimated_relative_error = est_true;
-                if (stagnating || st.result.residual_replacements > 8) {
-                    st.result.iterations = k + 1;
-                    st.active = false;
-                    continue;
-                }
-                st.rz = rz_true;
+                if (st.confirm(k, rz_true, st.estimate(rz_true, lam), lam, tol)) continue;
                 for (size_t i = 0; i < n; ++i) s.p[3 * i + c] = s.z[3 * i + c];
-                st.ritz_floor = lam;
-                st.t_diag.clear();
-                st.t_off.clear();
-                st.ritz = std::numeric_limits<double>::infinity();
                 continue;
             }
             st.result.estimated_relative_error = est;
@@ -303,15 +247,7 @@ std::array<ConjugateGradientResult, 3> solve_rgb(const DiffusionMatrix& m, const
             });
         }
     }
-    for (int c = 0; c < 3; ++c) {
-        ChannelState& st = ch[c];
-        if (st.active) {  // ran out of iterations
-            st.result.iterations = k;
-            st.result.estimated_relative_error = st.estimate(st.rz, st.lambda());
-        }
-        if (!st.t_diag.empty() || std::isfinite(st.ritz_floor)) st.result.smallest_eigenvalue_estimate = st.lambda();
-        results[c] = st.result;
-    }
+    for (int c = 0; c < 3; ++c) results[c] = ch[c].finish(k);
     for (size_t i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c) phi[i][c] = s.x[3 * i + c];
     return results;
@@ -338,7 +274,30 @@ void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std
     // channels (28 bytes per nonzero) no longer fit in that cache and the fused loop was measured
     // slower (bench/solver_bench.cpp, BM_JacobiCg<Double> vs 3x BM_JacobiCgDoubleOneChannel).
     std::array<ConjugateGradientResult, 3> results;
-    if (options.precision == SolverPrecision::Float) {
+    bool solved = false;
+    solution.backend = SolverBackend::Cpu;
+    solution.gpu_fallback_reason.clear();
+    if (options.backend == SolverBackend::Gpu) {
+        try {
+            if (!options.gl) throw GpuError("GPU solver: no OpenGL context was given");
+            GpuCgOptions gpu;
+            gpu.relative_tolerance = options.relative_tolerance;
+            gpu.max_iterations = options.max_iterations;
+            GpuDiffusionSolver gpu_solver(*options.gl, matrix);
+            gpu_solver.set_right_hand_side(b);
+            gpu_solver.set_solution(solution.phi);  // the warm start
+            results = gpu_solver.solve(gpu);
+            solution.phi = gpu_solver.solution();
+            solution.backend = SolverBackend::Gpu;
+            solved = true;
+        } catch (const GpuError& e) {
+            solution.gpu_fallback_reason = e.what();
+        }
+    }
+    const bool float_path = options.precision == SolverPrecision::Float || solution.backend == SolverBackend::Gpu;
+    if (solved) {
+        // phi came from the GPU
+    } else if (options.precision == SolverPrecision::Float) {
         results = solve_rgb<float>(matrix, b, options, solution.phi);
     } else {
         ConjugateGradientOptions cg;
@@ -362,8 +321,7 @@ void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std
             msg << "solve_diffusion: channel " << "rgb"[c] << " did not converge to relative error "
                 << options.relative_tolerance << " (" << r.iterations << " iterations, estimated error "
                 << r.estimated_relative_error << ", "
-                << (options.precision == SolverPrecision::Float ? "float: try double precision or "
-                                                                 : "")
+                << (float_path ? "float: try double precision or " : "")
                 << "check the mesh for slivers)";
             throw AlgorithmError(msg.str());
         }

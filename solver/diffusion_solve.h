@@ -4,6 +4,7 @@
 #pragma once
 
 #include "solver/diffusion_matrix.h"
+#include "solver/gl_context.h"
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
@@ -22,6 +23,14 @@ enum class SolverPrecision {
     Float,
 };
 
+enum class SolverBackend {
+    Cpu,
+    // Jacobi CG in float on OpenGL 4.3 compute shaders (solver/gpu_conjugate_gradient.h), on the
+    // context of DiffusionOptions::gl. Falls back to the CPU when the GPU path cannot run (see
+    // DiffusionSolution::gpu_fallback_reason); `precision` does not apply (always float).
+    Gpu,
+};
+
 struct DiffusionOptions {
     Discretization discretization = Discretization::TransCut;
     StiffnessForm stiffness_form = StiffnessForm::Gradient;
@@ -30,6 +39,8 @@ struct DiffusionOptions {
     double relative_tolerance = 1e-3;  // stopping rule: estimated relative error of phi (D-norm, see
                                        // conjugate_gradient.h)
     int max_iterations = 10000;
+    SolverBackend backend = SolverBackend::Cpu;
+    const GlApi* gl = nullptr;  // Gpu: the entry points of a current OpenGL context (e.g. HeadlessGlContext)
 };
 
 struct DiffusionSolution {
@@ -39,6 +50,10 @@ struct DiffusionSolution {
     std::array<double, 3> estimated_relative_error{};
     double assembly_ms = 0;
     double solve_ms = 0;
+    SolverBackend backend = SolverBackend::Cpu;  // the backend that produced phi
+    // Backend Gpu requested but the CPU solved: why (no OpenGL 4.3, a shader that failed to compile with
+    // the driver's log, ...); empty otherwise. Callers print it as a warning.
+    std::string gpu_fallback_reason;
 };
 
 // q: per vertex (volume vertex order), per channel, the diffuse incoming light (only boundary vertices
@@ -49,7 +64,8 @@ DiffusionSolution solve_diffusion(const TetMesh& mesh, const TetConnectivity& co
                                   const std::vector<std::array<double, 3>>& q, const DiffusionOptions& options);
 
 // Solves an assembled system (all three channels) with Jacobi CG; phi is the warm start and result
-// (resized and zeroed if its size is wrong). Fills iterations, errors and solve_ms of `solution`.
+// (resized and zeroed if its size is wrong). Fills iterations, errors, solve_ms, backend and
+// gpu_fallback_reason of `solution`.
 void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std::array<double, 3>>& q,
                             const DiffusionOptions& options, DiffusionSolution& solution);
 

@@ -145,15 +145,29 @@ CutResult remove_cut_away_tets(TetMesh& mesh, const CuttingSurface& surface) {
         for (size_t v = range.begin(); v != range.end(); ++v) cut_away[v] = surface.cuts_away(world[v]);
     });
 
+    std::vector<uint8_t> remove(mesh.tet_count());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.tet_count(), 4096), [&](const auto& range) {
+        for (size_t t = range.begin(); t != range.end(); ++t) {
+            const Tet& tet = mesh.tets[t];
+            remove[t] = cut_away[tet[0]] && cut_away[tet[1]] && cut_away[tet[2]] && cut_away[tet[3]];
+        }
+    });
+    return remove_tets(mesh, remove);
+}
+
+CutResult remove_tets(TetMesh& mesh, const std::vector<uint8_t>& remove) {
     CutResult result;
     const size_t tet_count = mesh.tet_count();
+    if (remove.size() != tet_count)
+        throw InvalidArgumentError("remove_tets: one flag per tet expected, got " + std::to_string(remove.size()) +
+                                   " for " + std::to_string(tet_count) + " tets");
     // Compaction is a single ordered pass: at 500K tets it costs a few milliseconds, less than
     // the bookkeeping a parallel prefix sum would need on two cores.
     std::vector<uint8_t> vertex_used(mesh.vertex_count(), 0);
     result.new_to_old_tet.reserve(tet_count);
     for (size_t t = 0; t < tet_count; ++t) {
         const Tet& tet = mesh.tets[t];
-        if (cut_away[tet[0]] && cut_away[tet[1]] && cut_away[tet[2]] && cut_away[tet[3]]) continue;
+        if (remove[t]) continue;
         result.new_to_old_tet.push_back(static_cast<int32_t>(t));
         for (int32_t v : tet) vertex_used[v] = 1;
     }

@@ -96,4 +96,9 @@ std::vector<Eigen::Vector3d> world_positions(const TetMesh& mesh);
 // become empty). Cutting everything away leaves a valid empty mesh.
 CutResult remove_cut_away_tets(TetMesh& mesh, const CuttingSurface& surface);
 
+// Removes the tets flagged in `remove` (one flag per tet) and the vertices left without a tet, with
+// the same compaction and bookkeeping as remove_cut_away_tets (which is this with a side test).
+// Throws InvalidArgumentError when the flag count differs from the tet count.
+CutResult remove_tets(TetMesh& mesh, const std::vector<uint8_t>& remove);
+
 }  // namespace waxwork

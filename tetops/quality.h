@@ -33,6 +33,9 @@ struct QualityReport {
 // Per-tet minimum dihedral angle in degrees (parallel).
 std::vector<double> min_dihedral_angles_deg(const TetMesh& mesh);
 
+// Smallest dihedral angle over all tets, in degrees (parallel; 0 for an empty mesh).
+double mesh_min_dihedral_deg(const TetMesh& mesh);
+
 // Summary over all tets (parallel). An empty mesh gives a zero report.
 QualityReport measure_quality(const TetMesh& mesh);
 

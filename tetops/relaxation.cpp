@@ -17,21 +17,6 @@ namespace {
 // report does not depend on scheduling.
 enum class Outcome : uint8_t { Skipped, Moved, Landed, Rejected };
 
-double mesh_min_dihedral_deg(const TetMesh& mesh) {
-    if (mesh.tets.empty()) return 0;
-    return tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, mesh.tets.size(), 2048), std::numeric_limits<double>::infinity(),
-        [&](const tbb::blocked_range<size_t>& range, double worst) {
-            for (size_t t = range.begin(); t != range.end(); ++t) {
-                const Tet& tet = mesh.tets[t];
-                worst = std::min(worst, min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]],
-                                                               mesh.positions[tet[2]], mesh.positions[tet[3]]));
-            }
-            return worst;
-        },
-        [](double a, double b) { return std::min(a, b); });
-}
-
 }  // namespace
 
 RelaxationReport relax_cut_vertices(TetMesh& mesh, const TetConnectivity& connectivity,

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <fstream>
 
 namespace waxwork {
 namespace {
@@ -27,7 +28,7 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
     const auto json = nlohmann::json::parse(testing::read_text(out / "solvers.json"));
     std::vector<std::string> keys;
     for (const auto& [key, value] : json.items()) keys.push_back(key);
-    EXPECT_EQ(keys, (std::vector<std::string>{"hierarchy_ms", "levels", "mesh", "solvers", "tets", "vertices"}));
+    EXPECT_EQ(keys, (std::vector<std::string>{"hierarchy_ms", "levels", "mesh", "multigrid_setup_ms", "solvers", "tets", "vertices"}));
     EXPECT_EQ(json["tets"].get<size_t>(), 9u * 9u * 9u * 6u);
     EXPECT_EQ(json["vertices"].get<size_t>(), 1000u);
     EXPECT_GE(json["levels"].get<int>(), 1);
@@ -75,6 +76,36 @@ TEST(BenchSolversCommand, RejectsBadInvocationsWithOneLine) {
     const auto bare = run_waxwork("bench");
     EXPECT_NE(bare.exit_code, 0);
     EXPECT_EQ(testing::line_count(bare.err), 1u) << bare.err;
+}
+
+TEST(BenchSuiteCommand, NeedsAnOutputDirectoryOrABenchmark) {
+    const auto result = run_waxwork("bench");
+    EXPECT_NE(result.exit_code, 0);
+    EXPECT_NE(result.err.find("give -o DIR"), std::string::npos) << result.err;
+}
+
+TEST(BenchSuiteCommand, UnwritableOutputIsAClearError) {
+    const auto dir = scratch_dir("bench_suite_unwritable");
+    const auto blocker = dir / "file";
+    std::ofstream(blocker) << "not a directory";
+    const auto result = run_waxwork("bench --quick -o " + (blocker / "out").string());
+    EXPECT_NE(result.exit_code, 0);
+    EXPECT_NE(result.err.find("cannot create the output directory"), std::string::npos) << result.err;
+}
+
+TEST(BenchSuiteCommand, OnlyRunsTheNamedParts) {
+    const auto dir = scratch_dir("bench_suite_only");
+    const auto result = run_waxwork("bench --quick --only stability -o " + dir.string());
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const auto index = nlohmann::json::parse(testing::read_text(dir / "bench.json"));
+    EXPECT_EQ(index["parts"].size(), 1u);
+    EXPECT_EQ(index["parts"]["stability"]["status"], "ok");
+    const auto stability = nlohmann::json::parse(testing::read_text(dir / "stability.json"));
+    EXPECT_EQ(stability.size(), 6u);
+    EXPECT_NE(testing::read_text(dir / "stability.md").find("### slivers"), std::string::npos);
+    const auto unknown = run_waxwork("bench --quick --only nonsense -o " + dir.string());
+    EXPECT_NE(unknown.exit_code, 0);
+    EXPECT_NE(unknown.err.find("unknown part 'nonsense'"), std::string::npos) << unknown.err;
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -173,6 +174,41 @@ TEST_F(Render, FemAgreesWithTransCut) {
         ASSERT_GT(norm, 0);
         EXPECT_LT(diff / norm, 0.05) << "channel " << c;
     }
+}
+
+TEST_F(Render, GpuBackendAgreesWithTheCpuAndFallsBackWithAWarning) {
+    const std::string common = volume_.string() + " --material marble --light dir:-1,-0.5,-0.2 --scale 10 "
+                                                  "--width 64 --height 48";
+    const auto cpu = run_waxwork("render " + common + " --tol 1e-8 -o " + (dir_ / "c.png").string() + " --fields " +
+                                 (dir_ / "c.csv").string());
+    const auto gpu = run_waxwork("render " + common + " --tol 1e-5 --backend gpu -o " + (dir_ / "g.png").string() +
+                                 " --fields " + (dir_ / "g.csv").string());
+    ASSERT_EQ(cpu.exit_code, 0) << cpu.err;
+    ASSERT_EQ(gpu.exit_code, 0) << gpu.err;
+    EXPECT_EQ(nlohmann::json::parse(cpu.out)["backend"], "cpu");
+    EXPECT_EQ(nlohmann::json::parse(gpu.out)["backend"], "gpu") << gpu.err;
+    EXPECT_TRUE(gpu.err.empty()) << gpu.err;
+    const Fields c = read_fields(dir_ / "c.csv"), g = read_fields(dir_ / "g.csv");
+    ASSERT_EQ(c.rows.size(), g.rows.size());
+    for (int ch = 0; ch < 3; ++ch) {
+        double diff = 0, peak = 0;
+        for (size_t v = 0; v < c.rows.size(); ++v) {
+            diff = std::max(diff, std::abs(c.rows[v].phi[ch] - g.rows[v].phi[ch]));
+            peak = std::max(peak, std::abs(c.rows[v].phi[ch]));
+        }
+        ASSERT_GT(peak, 0);
+        EXPECT_LT(diff / peak, 1e-4) << "channel " << ch;
+    }
+
+    // A driver that rejects a shader: one warning line naming it, and the CPU result.
+    setenv("WAXWORK_GPU_FORCE_FAIL", "1", 1);
+    const auto fallback = run_waxwork("render " + common + " --backend gpu -o " + (dir_ / "f.png").string());
+    unsetenv("WAXWORK_GPU_FORCE_FAIL");
+    ASSERT_EQ(fallback.exit_code, 0) << fallback.err;
+    EXPECT_EQ(nlohmann::json::parse(fallback.out)["backend"], "cpu");
+    EXPECT_EQ(line_count(fallback.err), 1u) << fallback.err;
+    EXPECT_NE(fallback.err.find("warning: solving on the CPU instead"), std::string::npos) << fallback.err;
+    EXPECT_NE(fallback.err.find("failed to compile"), std::string::npos) << fallback.err;
 }
 
 TEST_F(Render, StoredMaterialsAreUsedWithoutAMaterialOption) {

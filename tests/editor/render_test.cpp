@@ -1,4 +1,4 @@
-#include "editor/gl_context.h"
+#include "solver/gl_context.h"
 #include "editor/surface_renderer.h"
 #include "io/image_io.h"
 #include "solver/lighting.h"

@@ -1,4 +1,5 @@
 // The accuracy test: the exact fluence in a homogeneous ball (seeds README) against solve_diffusion.
+#include "solver/analytic_ball.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
 #include "solver/material.h"
@@ -9,6 +10,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 namespace waxwork {
 namespace {
@@ -37,54 +39,37 @@ struct Ball {
     }
 };
 
-std::vector<double> light_coefficients(Light light) {
-    if (light == Light::Uniform) return {1.0};
-    return test::directional_light_coefficients(kLegendreTerms, kEta);
-}
-
 BallResult solve_ball(const Ball& ball, Light light, Discretization disc, double mm_per_unit = 1.0) {
-    std::vector<std::array<double, 3>> q(ball.mesh.vertex_count(), {0, 0, 0});
-    for (int32_t v : ball.conn.boundary_vertices) {
-        const double value = light == Light::Uniform ? 1.0 : test::directional_light(ball.mesh.positions[v], kEta);
-        q[v] = {value, value, value};
-    }
     DiffusionOptions options;
     options.discretization = disc;
     options.relative_tolerance = 1e-7;
     options.mm_per_unit = mm_per_unit;
-    const DiffusionSolution sol = solve_diffusion(ball.mesh, ball.conn, ball.materials, q, options);
-    const test::BallSolution exact(kRadius, kMua, kMusp, kEta, light_coefficients(light));
-    AssemblyOptions assembly;
-    assembly.mm_per_unit = mm_per_unit;
-    const auto volumes = lumped_vertex_volumes(assemble_diffusion_matrix(ball.mesh, ball.conn, ball.materials, assembly), ball.conn);
-    double e = 0, n = 0;
-    for (size_t v = 0; v < ball.mesh.vertex_count(); ++v) {
-        const double ref = exact(ball.mesh.positions[v] * mm_per_unit);
-        e += volumes[v] * std::pow(sol.phi[v][0] - ref, 2);
-        n += volumes[v] * ref * ref;
-    }
+    const TetMaterial material{{kMua, kMua, kMua}, {kMusp, kMusp, kMusp}, kEta};
+    BallComparison comparison = compare_with_analytic_ball(
+        ball.mesh, ball.conn, material, kRadius, light == Light::Uniform ? BallLight::Uniform : BallLight::Directional,
+        options);
     BallResult r;
     r.tets = ball.mesh.tet_count();
     r.h = std::cbrt(4.0 / 3.0 * std::numbers::pi * std::pow(kRadius, 3) / static_cast<double>(r.tets));
-    r.error = std::sqrt(e / n);
-    r.phi = sol.phi;
+    r.error = comparison.relative_error;
+    r.phi = std::move(comparison.solution.phi);
     return r;
 }
 
 TEST(AnalyticBall, SeriesSatisfiesTheRobinBoundary) {
     // phi + 2 A kappa dphi/dr = 4 q / (1 - F_dr) at r = R, checked numerically on the series itself.
-    const auto ql = test::directional_light_coefficients(kLegendreTerms, kEta);
-    const test::BallSolution exact(kRadius, kMua, kMusp, kEta, ql);
+    const auto ql = directional_ball_light_coefficients(kLegendreTerms, kEta);
+    const AnalyticBall exact(kRadius, kMua, kMusp, kEta, ql);
     const double a = boundary_reflection_parameter(kEta), fdr = diffuse_fresnel_reflectance(kEta);
     for (double mu : {0.9, 0.5, -0.5}) {
         const Eigen::Vector3d dir(std::sqrt(1 - mu * mu), 0, mu);
         const double h = 1e-5;
         const double dphi = (exact(dir * kRadius) - exact(dir * (kRadius - h))) / h;
         double q = 0;
-        const auto p = test::legendre(kLegendreTerms, mu);
+        const auto p = legendre_polynomials(kLegendreTerms, mu);
         for (int l = 0; l <= kLegendreTerms; ++l) q += ql[l] * p[l];
         EXPECT_NEAR(q, std::max(mu, 0.0) * fresnel_transmittance(mu, kEta), 2e-3);
-        EXPECT_NEAR(exact(dir * kRadius) + 2 * a * exact.kappa * dphi, 4 * q / (1 - fdr), 1e-3);
+        EXPECT_NEAR(exact(dir * kRadius) + 2 * a * diffusion_coefficient(kMua, kMusp) * dphi, 4 * q / (1 - fdr), 1e-3);
     }
 }
 
@@ -157,7 +142,7 @@ TEST(AnalyticBall, FloatSolveMatchesDouble) {
     const Ball ball(3, 16000);
     std::vector<std::array<double, 3>> q(ball.mesh.vertex_count(), {0, 0, 0});
     for (int32_t v : ball.conn.boundary_vertices) {
-        const double value = test::directional_light(ball.mesh.positions[v], kEta);
+        const double value = directional_ball_light(ball.mesh.positions[v], kEta);
         q[v] = {value, 0.5 * value, 0.25 * value};
     }
     DiffusionOptions options;

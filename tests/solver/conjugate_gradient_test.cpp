@@ -4,6 +4,7 @@
 #include "solver/reference_solvers.h"
 #include "solver_test_meshes.h"
 #include "tetops/error.h"
+#include "tetops/sliver_maker.h"
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
@@ -186,7 +187,7 @@ TEST(ConjugateGradient, SliversDoubleConvergesFloatNeverLies) {
     for (double flatness : {1e-2, 1e-3, 1e-4}) {
         TetMesh mesh = test::make_cube_mesh(10, 2.0);
         auto conn = build_connectivity(mesh);
-        const auto slivers = test::make_slivers(mesh, conn, 6, flatness);
+        const auto slivers = flatten_into_slivers(mesh, conn, 6, flatness);
         const auto dihedral = min_dihedral_angles_deg(mesh);
         double worst = 180;
         for (int32_t t : slivers) worst = std::min(worst, dihedral[t]);

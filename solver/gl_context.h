@@ -1,6 +1,9 @@
 // Headless OpenGL: an OSMesa (Mesa's off-screen interface, llvmpipe software rasteriser) OpenGL 4.5
-// core context, so `waxwork render` and the tests draw without a display or a GPU; and the table of
-// OpenGL entry points the renderers call, loaded from whichever context is current.
+// core context, so `waxwork render`, the GPU solver and the tests run without a display or a GPU (or,
+// with WAXWORK_GL_DEVICE=egl, an EGL context on a real GPU without a display); and
+// the table of OpenGL entry points the renderers and the compute kernels call, loaded from whichever
+// context is current. Lives in solver/ because the GPU solver (solver/gpu_*) and the renderer
+// (editor/) share one device and one context.
 #pragma once
 
 #include <GL/glcorearb.h>
@@ -10,9 +13,9 @@
 
 namespace waxwork {
 
-// Every OpenGL function the renderers use. Loaded through the context's GetProcAddress instead of
-// linking gl* symbols directly: libOSMesa and libGL (GLFW windows) both export them, and whichever
-// the dynamic linker binds first would silently receive every call.
+// Every OpenGL function the renderers and the compute kernels use. Loaded through the context's
+// GetProcAddress instead of linking gl* symbols directly: libOSMesa and libGL (GLFW windows) both
+// export them, and whichever the dynamic linker binds first would silently receive every call.
 #define WAXWORK_GL_FUNCTIONS(X)                                                   \
     X(PFNGLGETSTRINGPROC, GetString)                                              \
     X(PFNGLGETINTEGERVPROC, GetIntegerv)                                          \
@@ -73,7 +76,15 @@ namespace waxwork {
     X(PFNGLBINDTEXTUREPROC, BindTexture)                                          \
     X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                                      \
     X(PFNGLTEXIMAGE2DPROC, TexImage2D)                                            \
-    X(PFNGLTEXPARAMETERIPROC, TexParameteri)
+    X(PFNGLTEXPARAMETERIPROC, TexParameteri)                                      \
+    X(PFNGLDISPATCHCOMPUTEPROC, DispatchCompute)                                  \
+    X(PFNGLMEMORYBARRIERPROC, MemoryBarrier)                                      \
+    X(PFNGLBINDBUFFERBASEPROC, BindBufferBase)                                    \
+    X(PFNGLBUFFERSUBDATAPROC, BufferSubData)                                      \
+    X(PFNGLGETBUFFERSUBDATAPROC, GetBufferSubData)                                \
+    X(PFNGLCOPYBUFFERSUBDATAPROC, CopyBufferSubData)                              \
+    X(PFNGLUNIFORM1UIPROC, Uniform1ui)                                            \
+    X(PFNGLUNIFORM3UIVPROC, Uniform3uiv)
 
 struct GlApi {
 #define WAXWORK_GL_DECLARE(type, name) type name = nullptr;
@@ -90,15 +101,34 @@ GlApi load_gl_api(GlProcLoader loader);
 // Throws waxwork::Error("WHAT: OpenGL error 0x...") when glGetError reports one.
 void check_gl_error(const GlApi& gl, const char* what);
 
-// An off-screen OSMesa context, current on the creating thread from construction on. It has only a
-// tiny default framebuffer: renderers draw into their own framebuffer objects.
+// Where a HeadlessGlContext comes from.
+enum class GlDevice {
+    // Mesa's OSMesa: always software (llvmpipe), needs no display, no GPU and no driver setup. The
+    // default: tests and `waxwork render` give the same pixels on every machine.
+    OsMesa,
+    // EGL without a window system: the first EGL device that gives an OpenGL 4.3 core context
+    // (EGL_EXT_platform_device: a GPU's driver, e.g. NVIDIA's or Mesa's on /dev/dri/renderD*), else
+    // Mesa's surfaceless platform. This is how the GPU solver and its benchmark reach a real GPU on a
+    // machine without a display; on this machine it finds llvmpipe again.
+    Egl,
+};
+
+// The device the environment asks for: WAXWORK_GL_DEVICE=egl selects Egl, unset or "osmesa" OsMesa.
+// Throws waxwork::Error for any other value.
+GlDevice gl_device_from_environment();
+
+// An off-screen OpenGL context, current on the creating thread from construction on. It has only a
+// tiny default framebuffer (OSMesa) or none (EGL): renderers draw into their own framebuffer objects.
 //
-// Asks for OpenGL 4.5 core, then 4.3 core (the minimum: the shaders are GLSL 4.30). If GALLIUM_DRIVER
-// is unset it is set to "llvmpipe" first: softpipe, Mesa's other software driver, stops at OpenGL 3.3.
-// Throws waxwork::Error explaining what the driver offers when neither version can be created.
+// Asks for OpenGL 4.5 core, then 4.3 core (the minimum: the shaders are GLSL 4.30). OSMesa: if
+// GALLIUM_DRIVER is unset it is set to "llvmpipe" first: softpipe, Mesa's other software driver,
+// stops at OpenGL 3.3. Throws waxwork::Error explaining what the driver offers when neither version
+// can be created.
 class HeadlessGlContext {
 public:
+    // The device of gl_device_from_environment().
     HeadlessGlContext();
+    explicit HeadlessGlContext(GlDevice device);
     ~HeadlessGlContext();
     HeadlessGlContext(const HeadlessGlContext&) = delete;
     HeadlessGlContext& operator=(const HeadlessGlContext&) = delete;
@@ -109,11 +139,13 @@ public:
     // "4.5 (Core Profile) Mesa 22.3.6", "llvmpipe (LLVM 15.0.6, 256 bits)".
     std::string version() const;
     std::string renderer() const;
+    GlDevice device() const { return device_; }
 
 private:
     struct State;
     std::unique_ptr<State> state_;
     GlApi gl_;
+    GlDevice device_ = GlDevice::OsMesa;
 };
 
 }  // namespace waxwork

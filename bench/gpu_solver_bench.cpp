@@ -1,0 +1,213 @@
+// The GPU solver (OpenGL 4.3 compute shaders, solver/gpu_*) on spot at ~50K and ~500K tets: the sparse
+// product in the three storage formats, and Jacobi CG (three channels, float) to an estimated 1% error,
+// cold and warm, as bench/solver_bench.cpp measures the CPU path (same scene: spot 100 mm across,
+// marble, a directional light along -z without shadows).
+//
+// Which device runs it: the context of solver/gl_context.h, i.e. Mesa's llvmpipe through OSMesa by
+// default -- a software rasteriser running the compute shaders on this machine's CPU cores, so these
+// numbers say nothing about GPU speed. On a machine with a GPU the same binary runs on it with
+// WAXWORK_GL_DEVICE=egl (EGL without a display; see gl_context.h). The first lines of the output name
+// the renderer that ran.
+//
+// Run: build/bench/gpu_solver_bench [--benchmark_filter=...]
+#include "bench_meshes.h"
+#include "multires/gpu_multires_solver.h"
+#include "multires/hierarchy.h"
+#include "solver/conjugate_gradient.h"
+#include "solver/diffusion_matrix.h"
+#include "solver/diffusion_solve.h"
+#include "solver/gl_context.h"
+#include "solver/gpu_conjugate_gradient.h"
+#include "solver/lighting.h"
+#include "solver/material.h"
+#include "tetops/connectivity.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <map>
+#include <memory>
+
+namespace waxwork {
+namespace {
+
+struct Scene {
+    TetMesh mesh;
+    TetConnectivity conn;
+    std::vector<TetMaterial> materials;
+    DiffusionMatrix matrix;
+    std::vector<std::array<double, 3>> q;
+};
+
+HeadlessGlContext& context() {
+    static std::unique_ptr<HeadlessGlContext> c;
+    if (!c) {
+        c = std::make_unique<HeadlessGlContext>();
+        std::fprintf(stderr, "OpenGL %s on %s\n", c->version().c_str(), c->renderer().c_str());
+    }
+    c->make_current();
+    return *c;
+}
+
+const Scene& scene(size_t target_tets) {
+    static std::map<size_t, std::unique_ptr<Scene>> cache;
+    auto& slot = cache[target_tets];
+    if (slot) return *slot;
+    slot = std::make_unique<Scene>();
+    Scene& s = *slot;
+    s.mesh = bench::spot_volume(target_tets);
+    s.conn = build_connectivity(s.mesh);
+    const auto box = bounding_box(s.mesh);
+    s.materials.assign(s.mesh.tet_count(), material_preset("marble"));
+    AssemblyOptions assembly;
+    assembly.mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();
+    s.matrix = assemble_diffusion_matrix(s.mesh, s.conn, s.materials, assembly);
+    Lighting lighting;
+    lighting.lights.push_back(Light{LightType::Directional, Eigen::Vector3d(0, 0, -1), {1, 1, 1}});
+    lighting.shadows = false;
+    s.q = incident_light(s.mesh, s.conn, s.materials, lighting);
+    std::fprintf(stderr, "spot: %zu tets, %zu vertices, %zu nonzeros\n", s.mesh.tet_count(), s.mesh.vertex_count(),
+                 s.matrix.nonzeros());
+    return s;
+}
+
+// q = M p for the three channels with the fused p . q reduction (what a CG iteration runs), including
+// the read-back of the reduction partials that ends each call.
+template <GpuMatrixFormat F>
+void BM_GpuProduct(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    GpuKernels kernels(context().gl(), {F});
+    const GpuMatrix m(context().gl(), rgb_csr_view(s.matrix), F);
+    const std::vector<float> ones(3 * s.matrix.size(), 1.0f);
+    const GpuBuffer p = kernels.vector(s.matrix.size(), ones.data());
+    GpuBuffer q = kernels.vector(s.matrix.size());
+    for (auto _ : state) benchmark::DoNotOptimize(kernels.multiply_dot(m, p, q));
+    state.counters["stored_per_nnz"] = static_cast<double>(m.layout.stored_entries()) / s.matrix.nonzeros();
+    state.counters["nnz_rgb_per_s"] =
+        benchmark::Counter(3.0 * s.matrix.nonzeros(), benchmark::Counter::kIsIterationInvariantRate);
+}
+
+// The two vector kernels of an iteration: a three-channel dot product (reduction + read-back) and axpby.
+void BM_GpuDot(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    GpuKernels kernels(context().gl(), {});
+    const std::vector<float> ones(3 * s.matrix.size(), 1.0f);
+    const GpuBuffer u = kernels.vector(s.matrix.size(), ones.data());
+    for (auto _ : state) benchmark::DoNotOptimize(kernels.dot(s.matrix.size(), u, u));
+}
+
+void BM_GpuAxpby(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    GpuKernels kernels(context().gl(), {});
+    const std::vector<float> ones(3 * s.matrix.size(), 1.0f);
+    const GpuBuffer x = kernels.vector(s.matrix.size(), ones.data());
+    GpuBuffer y = kernels.vector(s.matrix.size(), ones.data());
+    for (auto _ : state) {
+        kernels.axpby(s.matrix.size(), {0.5, 0.5, 0.5}, x, {0.5, 0.5, 0.5}, y);
+        context().gl().Finish();
+    }
+}
+
+// Cold start to an estimated 1% error, matrix resident (upload and compilation excluded).
+template <GpuMatrixFormat F>
+void BM_GpuCg(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    GpuDiffusionSolver solver(context().gl(), s.matrix, F);
+    solver.set_light(s.matrix, s.q);
+    const std::vector<std::array<double, 3>> zero(s.matrix.size(), {0.0, 0.0, 0.0});
+    GpuCgOptions options;
+    options.relative_tolerance = 1e-2;
+    std::array<ConjugateGradientResult, 3> r;
+    for (auto _ : state) {
+        solver.set_solution(zero);
+        r = solver.solve(options);
+    }
+    state.counters["iters_g"] = r[1].iterations;
+    state.counters["converged"] = r[0].converged && r[1].converged && r[2].converged;
+}
+
+// A frame after a 5% light change, warm-started from the previous frame's solution.
+void BM_GpuCgWarm(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    GpuDiffusionSolver solver(context().gl(), s.matrix);
+    solver.set_light(s.matrix, s.q);
+    GpuCgOptions options;
+    options.relative_tolerance = 1e-2;
+    solver.solve(options);
+    const auto previous = solver.solution();
+    auto q2 = s.q;
+    for (auto& v : q2)
+        for (double& c : v) c *= 1.05;
+    solver.set_light(s.matrix, q2);
+    std::array<ConjugateGradientResult, 3> r;
+    for (auto _ : state) {
+        solver.set_solution(previous);
+        r = solver.solve(options);
+    }
+    state.counters["iters_g"] = r[1].iterations;
+}
+
+// The GPU multires path: coarse-to-fine BiCGSTAB (hierarchy built once on the CPU, excluded), then the
+// level-0 CG to an estimated 1% error.
+void BM_GpuMultires(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    const MultiresHierarchy hierarchy = build_multires_hierarchy(s.matrix, s.mesh.positions);
+    GpuMultiresSolver solver(context().gl(), s.matrix, hierarchy);
+    solver.set_light(s.matrix, s.q);
+    MultiresSolveOptions options;
+    options.relative_tolerance = 1e-2;
+    GpuMultiresReport report;
+    for (auto _ : state) report = solver.solve(options);
+    state.counters["levels"] = static_cast<double>(hierarchy.level_count());
+    state.counters["fine_iters_g"] = report.fine[1].iterations;
+    state.counters["coarsest_iters_g"] = report.coarse_levels.empty() ? 0 : report.coarse_levels.front()[1].iterations;
+}
+
+// What a scene load costs: kernels compiled, pattern and values uploaded, diagonal extracted.
+void BM_GpuSetup(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    for (auto _ : state) {
+        GpuDiffusionSolver solver(context().gl(), s.matrix);
+        context().gl().Finish();
+    }
+}
+
+// A paint stroke: ~1% of the tets change material; the CPU rewrites their rows (update_diffusion_matrix)
+// and the GPU receives only those rows.
+void BM_GpuPaintRowUpdate(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    DiffusionMatrix matrix = s.matrix;
+    std::vector<TetMaterial> materials = s.materials;
+    GpuDiffusionSolver solver(context().gl(), matrix);
+    std::vector<int32_t> stroke;
+    for (size_t t = 0; t < s.mesh.tet_count() / 100; ++t) stroke.push_back(static_cast<int32_t>(t));
+    bool ketchup = false;
+    size_t rows = 0;
+    for (auto _ : state) {
+        ketchup = !ketchup;
+        for (int32_t t : stroke) materials[t] = material_preset(ketchup ? "ketchup" : "marble");
+        const std::vector<int32_t> changed = update_diffusion_matrix(matrix, s.mesh, s.conn, materials, stroke);
+        solver.update_rows(matrix, changed);
+        context().gl().Finish();
+        rows = changed.size();
+    }
+    state.counters["rows"] = static_cast<double>(rows);
+}
+
+#define WAXWORK_SIZES Arg(50000)->Arg(500000)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime()
+BENCHMARK(BM_GpuProduct<GpuMatrixFormat::Csr>)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuProduct<GpuMatrixFormat::Ell>)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuProduct<GpuMatrixFormat::SellCSigma>)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuDot)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuAxpby)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuCg<GpuMatrixFormat::Csr>)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuCg<GpuMatrixFormat::SellCSigma>)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuCgWarm)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuMultires)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuSetup)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuPaintRowUpdate)->WAXWORK_SIZES;
+
+}  // namespace
+}  // namespace waxwork
+
+BENCHMARK_MAIN();

@@ -1,0 +1,203 @@
+#include "editor/bench_suite.h"
+
+#include "editor/accuracy_study.h"
+#include "editor/render_pipeline.h"
+#include "editor/resolution_study.h"
+#include "editor/solver_comparison.h"
+#include "editor/stability_study.h"
+#include "editor/svg_chart.h"
+#include "editor/timing_table.h"
+#include "io/atomic_file.h"
+#include "io/surface_reader.h"
+#include "solver/material.h"
+#include "tetops/connectivity.h"
+#include "tetops/error.h"
+#include "tetops/tetrahedralize.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <exception>
+#include <map>
+#include <thread>
+
+namespace waxwork {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+void write_json(const std::filesystem::path& path, const Json& json) {
+    write_file_atomically(path, [&](std::ostream& out) { out << json.dump(2) << "\n"; });
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+    write_file_atomically(path, [&](std::ostream& out) { out << text; });
+}
+
+void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index) {
+    const TriangleSurface surface = load_closed_surface(o.asset_dir / "meshes/spot.obj").surface;
+    MeshingOptions meshing;
+    meshing.sizing.target_tets = target_tets;
+    const TetMesh mesh = tetrahedralize(surface, meshing).mesh;
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    const std::vector<TetMaterial> materials(mesh.tet_count(), material_preset("marble"));
+    Lighting lighting;
+    lighting.lights.push_back(default_key_light());
+    SolverComparisonOptions options;
+    options.mm_per_unit = 30;
+    options.max_seconds = o.quick ? 8.0 : 60.0;
+    const SolverComparison comparison = compare_solvers(mesh, connectivity, materials, lighting, options);
+    const std::string stem = "solvers_spot_" + std::to_string((target_tets + 500) / 1000) + "k";
+    write_solver_comparison(o.output_dir, stem, "assets/meshes/spot.obj", comparison);
+    index["solvers"].push_back(stem + ".json");
+}
+
+void run_accuracy_part(const BenchSuiteOptions& o, Json& index) {
+    const StudySize size{.quick = o.quick};
+    const std::vector<ConvergenceSeries> ball = study_ball_convergence(size);
+    SurfaceConvergenceOptions spot_options;
+    spot_options.surface = o.asset_dir / "meshes/spot.obj";
+    if (o.quick) {
+        spot_options.mm_per_unit = 3;  // the coarse (D/25) default mesh: seconds, not minutes
+        spot_options.size_factors = {2.0, 1.5, 1.0};
+        spot_options.reference_size_factor = 0.6;
+    }
+    const ConvergenceSeries spot = study_surface_convergence(spot_options);
+    write_json(o.output_dir / "accuracy.json", Json{{"ball", to_json(ball)}, {"surface", to_json({spot})}});
+
+    auto chart = [&](const std::vector<ConvergenceSeries>& series, const std::string& title,
+                     const std::filesystem::path& path) {
+        std::vector<ChartSeries> lines;
+        for (const ConvergenceSeries& s : series) {
+            ChartSeries line;
+            char name[160];
+            std::snprintf(name, sizeof name, "%s (order %.2f)", s.name.c_str(), s.observed_order());
+            line.name = name;
+            for (const ConvergencePoint& p : s.points) line.points.emplace_back(p.tet_size_mm, p.relative_error);
+            lines.push_back(std::move(line));
+        }
+        ChartOptions options;
+        options.title = title;
+        options.x = {"mean tet size (mm)", AxisScale::Log};
+        options.y = {"relative L2 error of phi", AxisScale::Log};
+        write_svg_chart(path, lines, options);
+    };
+    chart(ball, "Ball (R = 10 mm) against the analytic solution", o.output_dir / "accuracy_ball.svg");
+    chart({spot}, "Spot against a mesh of half the default size", o.output_dir / "accuracy_spot.svg");
+    index["accuracy"] = "accuracy.json";
+}
+
+void run_table1_part(const BenchSuiteOptions& o, Json& index) {
+    std::vector<TimingRow> rows;
+    TimingOptions options;
+    options.target_tets = o.quick ? 100'000 : 500'000;
+    const std::vector<std::string> models =
+        o.quick ? std::vector<std::string>{"spot"} : std::vector<std::string>{"spot", "torus", "skull"};
+    for (const std::string& model : models)
+        rows.push_back(measure_timing_row(o.asset_dir / "meshes" / (model + ".obj"), options));
+    write_json(o.output_dir / "table1.json", to_json(rows));
+    write_text(o.output_dir / "table1.md", timing_table_markdown(rows));
+    index["table1"] = "table1.md";
+}
+
+void run_stability_part(const BenchSuiteOptions& o, Json& index) {
+    const std::vector<StudyTable> tables = run_stability_studies({.quick = o.quick});
+    Json json = Json::array();
+    std::string markdown;
+    for (const StudyTable& t : tables) {
+        json.push_back(t.to_json());
+        markdown += t.to_markdown() + "\n";
+    }
+    write_json(o.output_dir / "stability.json", json);
+    write_text(o.output_dir / "stability.md", markdown);
+    index["stability"] = "stability.md";
+}
+
+void run_resolution_part(const BenchSuiteOptions& o, Json& index) {
+    ResolutionStudyOptions options;
+    options.surface = o.asset_dir / "meshes/spot.obj";
+    if (o.quick) {
+        options.mm_per_unit = 3;
+        options.size_factors = {2.0, 1.0};
+        options.tolerances = {0.1, 0.01, 1e-3};
+        options.reference_size_factor = 0.7;
+    }
+    const ResolutionStudy study = run_resolution_study(options);
+    Json json = study.to_json();
+    json["material"] = options.material;
+    json["mm_per_unit"] = options.mm_per_unit;
+    json["error_bound"] = options.error_bound;
+    write_json(o.output_dir / "resolution.json", json);
+
+    std::map<double, ChartSeries> by_factor;
+    for (const ResolutionSample& s : study.samples) {
+        ChartSeries& line = by_factor[s.size_factor];
+        char name[96];
+        std::snprintf(name, sizeof name, "%.2g x default size (%zu tets)", s.size_factor, s.tets);
+        line.name = name;
+        line.points.emplace_back(s.solve_ms, s.image_error);
+    }
+    std::vector<ChartSeries> lines;
+    for (auto& [factor, line] : by_factor) lines.push_back(std::move(line));
+    ChartOptions chart;
+    chart.title = "Rendered image error against solve time (tolerances along each line)";
+    chart.x = {"assembly + solve (ms)", AxisScale::Log};
+    chart.y = {"relative image error", AxisScale::Log};
+    write_svg_chart(o.output_dir / "resolution.svg", lines, chart);
+    index["resolution"] = "resolution.json";
+}
+
+}  // namespace
+
+void run_bench_suite(const BenchSuiteOptions& o) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.output_dir, ec);
+    if (ec) throw FileError(o.output_dir.string(), "cannot create the output directory: " + ec.message());
+
+    Json index;
+    index["quick"] = o.quick;
+    index["hardware_threads"] = std::thread::hardware_concurrency();
+    const std::time_t now = std::time(nullptr);
+    char date[32];
+    std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+    index["date"] = date;
+    index["parts"] = Json::object();
+
+    using Part = std::function<void(Json&)>;
+    std::vector<std::pair<std::string, Part>> parts = {
+        {"solvers_50k", [&](Json& i) { run_solver_part(o, 50'000, i); }},
+    };
+    if (!o.quick) parts.emplace_back("solvers_500k", [&](Json& i) { run_solver_part(o, 500'000, i); });
+    parts.emplace_back("accuracy", [&](Json& i) { run_accuracy_part(o, i); });
+    parts.emplace_back("table1", [&](Json& i) { run_table1_part(o, i); });
+    parts.emplace_back("stability", [&](Json& i) { run_stability_part(o, i); });
+    parts.emplace_back("resolution", [&](Json& i) { run_resolution_part(o, i); });
+
+    for (const std::string& wanted : o.only)
+        if (std::none_of(parts.begin(), parts.end(), [&](const auto& part) { return part.first == wanted; }))
+            throw InvalidArgumentError("bench --only: unknown part '" + wanted + "'" +
+                                       (o.quick && wanted == "solvers_500k" ? " (not part of --quick)" : ""));
+
+    std::exception_ptr first_failure;
+    for (const auto& [name, part] : parts) {
+        if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), name) == o.only.end()) continue;
+        if (o.progress) o.progress(name);
+        const auto start = std::chrono::steady_clock::now();
+        Json entry;
+        try {
+            part(index);
+            entry["status"] = "ok";
+        } catch (const std::exception& e) {
+            entry["status"] = std::string("failed: ") + e.what();
+            if (!first_failure) first_failure = std::current_exception();
+        }
+        entry["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        index["parts"][name] = entry;
+        write_json(o.output_dir / "bench.json", index);  // after every part: a crash keeps what ran
+    }
+    if (first_failure) std::rethrow_exception(first_failure);
+}
+
+}  // namespace waxwork

@@ -1,0 +1,484 @@
+#include "tetops/fracture.h"
+
+#include "tetops/connectivity.h"
+#include "tetops/cut.h"
+#include "tetops/error.h"
+#include "tetops/exact_cut.h"
+#include "tetops/quality.h"
+
+#include <nanoflann.hpp>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <random>
+#include <string>
+#include <unordered_map>
+
+namespace waxwork {
+namespace {
+
+// nanoflann reads the seed points through this adaptor.
+struct PointCloud {
+    std::span<const Eigen::Vector3d> points;
+    size_t kdtree_get_point_count() const { return points.size(); }
+    double kdtree_get_pt(size_t index, size_t dim) const { return points[index][static_cast<int>(dim)]; }
+    template <class BoundingBox>
+    bool kdtree_get_bbox(BoundingBox&) const { return false; }
+};
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloud>, PointCloud, 3, uint32_t>;
+
+// Union-find with path halving; unions keep the smaller index as the root so results are deterministic.
+class DisjointSets {
+public:
+    explicit DisjointSets(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+    int32_t find(int32_t x) {
+        while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+        return x;
+    }
+    void unite(int32_t a, int32_t b) {
+        a = find(a), b = find(b);
+        if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+    }
+
+private:
+    std::vector<int32_t> parent_;
+};
+
+Eigen::Vector3d tet_centroid(const std::vector<Eigen::Vector3d>& points, const Tet& tet) {
+    return 0.25 * (points[tet[0]] + points[tet[1]] + points[tet[2]] + points[tet[3]]);
+}
+
+double extent_of(const std::vector<Eigen::Vector3d>& world) {
+    if (world.empty()) return 1.0;
+    Eigen::Vector3d lo = world[0], hi = world[0];
+    for (const auto& p : world) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    return std::max({(hi - lo).norm(), lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff(), 1e-300});
+}
+
+// Field of the wall of Voronoi cell k: the minimum over the other seeds j of the signed distance to the
+// bisector plane of (k, j), positive on k's side. Its zero set is exactly the cell's boundary; along
+// a segment it is concave and piecewise linear, so a crossing is the first bisector the segment
+// leaves k's side of.
+class VoronoiWallField final : public SplitField {
+public:
+    VoronoiWallField(std::span<const Eigen::Vector3d> seeds, size_t k) {
+        for (size_t j = 0; j < seeds.size(); ++j) {
+            const Eigen::Vector3d d = seeds[j] - seeds[k];
+            const double length = d.norm();
+            if (j == k || !(length > 0)) continue;
+            normals_.push_back(d / length);  // pointing away from k
+            offsets_.push_back(0.5 * (seeds[j].squaredNorm() - seeds[k].squaredNorm()) / length);
+        }
+    }
+    double plane(size_t i, const Eigen::Vector3d& x) const { return offsets_[i] - normals_[i].dot(x); }
+    double value(const Eigen::Vector3d& x) const {
+        double v = std::numeric_limits<double>::infinity();
+        for (size_t i = 0; i < normals_.size(); ++i) v = std::min(v, plane(i, x));
+        return v;
+    }
+    double crossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double va, double /*vb*/) const override {
+        const bool from_a = va > 0;
+        const Eigen::Vector3d& inside = from_a ? a : b;
+        const Eigen::Vector3d& outside = from_a ? b : a;
+        double t = 1.0;
+        for (size_t i = 0; i < normals_.size(); ++i) {
+            const double gi = plane(i, inside), go = plane(i, outside);
+            if (go < 0 && gi > 0) t = std::min(t, gi / (gi - go));
+        }
+        return from_a ? t : 1.0 - t;
+    }
+
+private:
+    std::vector<Eigen::Vector3d> normals_;
+    std::vector<double> offsets_;
+};
+
+// A plane n.x = d as a field (positive where n.x > d).
+class PlaneField final : public SplitField {
+public:
+    explicit PlaneField(const PlaneCut& plane) : plane_(plane) {}
+    double crossing(const Eigen::Vector3d&, const Eigen::Vector3d&, double va, double vb) const override {
+        return va / (va - vb);
+    }
+    std::optional<Eigen::Vector3d> project(const Eigen::Vector3d& x) const override {
+        return x - plane_.side(x) * plane_.unit_normal();
+    }
+
+private:
+    const PlaneCut& plane_;
+};
+
+void check_options(const FractureOptions& options) {
+    if (options.min_piece_tets < 0) throw InvalidArgumentError("fracture: min_piece_tets must be >= 0");
+    if (!(options.snap_fraction >= 0 && options.snap_fraction < 0.5))
+        throw InvalidArgumentError("fracture: the snap fraction must be in [0, 0.5)");
+    if (!(options.boundary_bend_deg >= 0 && options.boundary_bend_deg < 90))
+        throw InvalidArgumentError("fracture: the boundary bend must be in [0, 90) degrees");
+}
+
+// Turns per-tet cell labels into pieces: each face-connected part of one cell within one existing
+// piece becomes a piece, parts under min_piece_tets join the neighbouring part they share most faces
+// with, and every vertex on a crack is duplicated so pieces share none. Pieces are numbered by their
+// lowest tet and take their parent's transform.
+void make_pieces(TetMesh& mesh, const std::vector<int64_t>& label, const FractureOptions& options,
+                 FractureResult& result) {
+    const size_t n = mesh.tet_count();
+    const std::vector<std::array<int32_t, 4>> neighbors = build_face_neighbors(mesh);
+    DisjointSets parts(n);
+    for (size_t t = 0; t < n; ++t)
+        for (int f = 0; f < 4; ++f) {
+            const int32_t u = neighbors[t][f];
+            if (u > static_cast<int32_t>(t) && label[u] == label[t] && mesh.piece_ids[u] == mesh.piece_ids[t])
+                parts.unite(static_cast<int32_t>(t), u);
+        }
+
+    // Dust: each part under min_piece_tets joins the neighbouring part it shares most faces with,
+    // smallest parts first; rounds repeat (sizes change) until no part is both small and next to
+    // another part (an isolated small component stays a piece). Each round is one pass over the faces.
+    if (options.min_piece_tets > 1) {
+        for (bool merged = true; merged;) {
+            merged = false;
+            std::vector<int32_t> root(n), size(n, 0);
+            for (size_t t = 0; t < n; ++t) ++size[root[t] = parts.find(static_cast<int32_t>(t))];
+            std::map<std::pair<int32_t, int32_t>, int32_t> shared;  // (dust part, neighbour part) -> faces
+            for (size_t t = 0; t < n; ++t) {
+                if (size[root[t]] >= options.min_piece_tets) continue;
+                for (int f = 0; f < 4; ++f) {
+                    const int32_t u = neighbors[t][f];
+                    if (u >= 0 && root[u] != root[t]) ++shared[{root[t], root[u]}];
+                }
+            }
+            std::map<int32_t, std::pair<int32_t, int32_t>> best;  // dust part -> (faces, neighbour)
+            for (const auto& [key, faces] : shared) {
+                auto& b = best[key.first];
+                if (faces > b.first) b = {faces, key.second};
+            }
+            std::vector<int32_t> dust;
+            for (const auto& entry : best) dust.push_back(entry.first);
+            std::stable_sort(dust.begin(), dust.end(), [&](int32_t a, int32_t b) { return size[a] < size[b]; });
+            for (int32_t part : dust) {
+                // A part that already absorbed or joined another this round waits for the recount.
+                if (parts.find(part) != part || parts.find(best[part].second) != best[part].second) continue;
+                parts.unite(part, best[part].second);
+                merged = true;
+            }
+        }
+    }
+
+    // Number the parts by their lowest tet.
+    std::vector<int32_t> piece_of_root(n, -1);
+    std::vector<RigidTransform> transforms;
+    std::vector<int32_t> new_piece(n);
+    for (size_t t = 0; t < n; ++t) {
+        const int32_t root = parts.find(static_cast<int32_t>(t));
+        if (piece_of_root[root] < 0) {
+            piece_of_root[root] = static_cast<int32_t>(transforms.size());
+            transforms.push_back(mesh.piece_transforms[mesh.piece_ids[t]]);
+        }
+        new_piece[t] = piece_of_root[root];
+    }
+
+    // Duplicate crack vertices: the first piece (in tet order) to use a vertex keeps it.
+    std::vector<int32_t> owner(mesh.vertex_count(), -1);
+    std::unordered_map<uint64_t, int32_t> copies;
+    for (size_t t = 0; t < n; ++t) {
+        for (int32_t& v : mesh.tets[t]) {
+            if (owner[v] < 0) owner[v] = new_piece[t];
+            if (owner[v] == new_piece[t]) continue;
+            const uint64_t key = (uint64_t{static_cast<uint32_t>(v)} << 32) | static_cast<uint32_t>(new_piece[t]);
+            auto [it, inserted] = copies.try_emplace(key, static_cast<int32_t>(mesh.positions.size()));
+            if (inserted) mesh.positions.push_back(mesh.positions[v]);
+            v = it->second;
+        }
+    }
+    result.vertices_duplicated = copies.size();
+    mesh.piece_ids = std::move(new_piece);
+    mesh.piece_transforms = std::move(transforms);
+    result.pieces_after = static_cast<int>(mesh.piece_transforms.size());
+    result.min_dihedral_deg = mesh_min_dihedral_deg(mesh);
+}
+
+// Common start: the checks the fracture relies on (a full validate() sorts every face, costlier than
+// the fracture itself) and the world positions every field is evaluated at.
+std::vector<Eigen::Vector3d> prepare(TetMesh& mesh, FractureResult& result) {
+    const size_t n = mesh.tet_count();
+    if (mesh.piece_ids.size() != n || mesh.original_ids.size() != n || (mesh.has_materials() && mesh.materials.size() != n))
+        throw InvalidMeshError("fracture: per-tet arrays do not match the tet count");
+    for (size_t t = 0; t < n; ++t) {
+        if (mesh.piece_ids[t] < 0 || static_cast<size_t>(mesh.piece_ids[t]) >= mesh.piece_transforms.size())
+            throw InvalidMeshError("fracture: tet " + std::to_string(t) + " has a piece without a transform");
+        for (int32_t v : mesh.tets[t])
+            if (v < 0 || static_cast<size_t>(v) >= mesh.vertex_count())
+                throw InvalidMeshError("fracture: tet " + std::to_string(t) + " has a vertex index out of range");
+    }
+    result.pieces_before = static_cast<int>(mesh.piece_transforms.size());
+    return world_positions(mesh);
+}
+
+// Same tolerances as cut_exact: values within rounding of the model's extent are on the wall.
+SplitOptions wall_split_options(const std::vector<Eigen::Vector3d>& world, const FractureOptions& options) {
+    SplitOptions split;
+    split.snap_fraction = options.snap_fraction;
+    split.boundary_bend_deg = options.boundary_bend_deg;
+    split.zero_tolerance = 1e-12 * extent_of(world);
+    return split;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> scatter_fracture_seeds(const TetMesh& mesh, int count, uint32_t seed) {
+    if (count < 1) throw InvalidArgumentError("fracture: the number of pieces must be at least 1");
+    if (mesh.tets.empty()) throw InvalidArgumentError("fracture: the volume has no tets");
+    if (static_cast<size_t>(count) > mesh.tet_count())
+        throw InvalidArgumentError("fracture: " + std::to_string(count) + " pieces requested from a volume of only " +
+                                   std::to_string(mesh.tet_count()) + " tets");
+    const std::vector<Eigen::Vector3d> world = world_positions(mesh);
+    // A tet with probability proportional to its volume, then a uniform point in it (barycentric
+    // weights from normalised exponentials are uniform on the simplex). Uniform doubles are built from
+    // the raw mt19937 output because std's distributions differ between standard libraries.
+    std::vector<double> cumulative(mesh.tet_count());
+    double sum = 0;
+    for (size_t t = 0; t < mesh.tet_count(); ++t) cumulative[t] = sum += std::abs(signed_volume(mesh, t));
+    std::mt19937 random(seed);
+    auto uniform = [&] { return (static_cast<double>(random()) + 0.5) / 4294967296.0; };
+    std::vector<Eigen::Vector3d> seeds;
+    for (int i = 0; i < count; ++i) {
+        const double pick = uniform() * sum;
+        const size_t t = std::min(static_cast<size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), pick) -
+                                                      cumulative.begin()),
+                                  mesh.tet_count() - 1);
+        std::array<double, 4> w;
+        double total = 0;
+        for (double& x : w) total += x = -std::log(uniform());
+        Eigen::Vector3d p = Eigen::Vector3d::Zero();
+        for (int k = 0; k < 4; ++k) p += (w[k] / total) * world[mesh.tets[t][k]];
+        seeds.push_back(p);
+    }
+    return seeds;
+}
+
+FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> seeds,
+                                const FractureOptions& options) {
+    check_options(options);
+    if (seeds.empty()) throw InvalidArgumentError("fracture: no seed points");
+    for (const auto& s : seeds)
+        if (!s.allFinite()) throw InvalidArgumentError("fracture: non-finite seed point");
+    FractureResult result;
+    std::vector<Eigen::Vector3d> world = prepare(mesh, result);
+    if (mesh.tets.empty()) return result;
+
+    PointCloud cloud{seeds};
+    const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+    auto nearest = [&](const Eigen::Vector3d& x) {
+        uint32_t index = 0;
+        double distance = 0;
+        tree.knnSearch(x.data(), 1, &index, &distance);
+        return static_cast<int32_t>(index);
+    };
+
+    std::vector<int64_t> label(mesh.tet_count(), 0);
+    if (options.exact && seeds.size() > 1) {
+        // The Voronoi diagram built one seed at a time: adding seed k takes from every tet of cell j
+        // the part closer to k than to j. Every tet lies in one cell of the previous diagram, where the
+        // wall field of k is sign-equivalent to the bisector of (j, k), a linear function, so the
+        // vertex signs tell exactly which tets it crosses (a field that is only concave could bulge
+        // into a tet between its vertices). Snapping treats earlier walls between cells like the
+        // boundary (split.tet_labels), so they stay flat.
+        SplitOptions split = wall_split_options(world, options);
+        std::vector<double> best(world.size());
+        tbb::parallel_for(size_t{0}, world.size(), [&](size_t v) { best[v] = (world[v] - seeds[0]).squaredNorm(); });
+        for (size_t k = 1; k < seeds.size(); ++k) {
+            std::vector<uint8_t> closer(world.size());
+            tbb::parallel_for(size_t{0}, world.size(),
+                              [&](size_t v) { closer[v] = (world[v] - seeds[k]).squaredNorm() < best[v]; });
+            std::vector<uint8_t> needs_value(world.size(), 0);
+            for (const Tet& tet : mesh.tets) {
+                const int inside = closer[tet[0]] + closer[tet[1]] + closer[tet[2]] + closer[tet[3]];
+                if (inside > 0 && inside < 4)
+                    for (int32_t v : tet) needs_value[v] = 1;
+            }
+            const VoronoiWallField field(seeds.first(k + 1), k);
+            std::vector<double> values(world.size());
+            tbb::parallel_for(size_t{0}, world.size(), [&](size_t v) {
+                values[v] = needs_value[v] ? field.value(world[v]) : (closer[v] ? 1.0 : -1.0);
+            });
+            split.tet_labels = &label;
+            const SplitReport report = split_along_field(mesh, world, values, field, split);
+            result.tets_split += report.tets_split;
+            for (int32_t parent : report.appended_parents) label.push_back(label[parent]);
+            for (size_t t = 0; t < mesh.tet_count(); ++t)
+                if (report.positive[t]) label[t] = static_cast<int64_t>(k);
+            const size_t old_count = best.size();
+            best.resize(world.size());
+            tbb::parallel_for(size_t{0}, world.size(), [&](size_t v) {
+                if (v < old_count) {
+                    best[v] = std::min(best[v], (world[v] - seeds[k]).squaredNorm());
+                } else {
+                    best[v] = std::numeric_limits<double>::infinity();
+                    for (size_t j = 0; j <= k; ++j) best[v] = std::min(best[v], (world[v] - seeds[j]).squaredNorm());
+                }
+            });
+        }
+    } else {
+        // Each tet goes to the cell of its centroid; cracks follow tet faces.
+        tbb::parallel_for(size_t{0}, mesh.tet_count(),
+                          [&](size_t t) { label[t] = nearest(tet_centroid(world, mesh.tets[t])); });
+    }
+    make_pieces(mesh, label, options, result);
+    return result;
+}
+
+FractureResult fracture_planes(TetMesh& mesh, std::span<const Eigen::Vector4d> planes,
+                               const FractureOptions& options) {
+    check_options(options);
+    std::vector<PlaneCut> cuts;
+    for (const Eigen::Vector4d& p : planes) cuts.emplace_back(p.head<3>(), p[3]);  // validates
+    FractureResult result;
+    std::vector<Eigen::Vector3d> world = prepare(mesh, result);
+    if (mesh.tets.empty()) return result;
+
+    if (options.exact) {
+        // Regions so far (sides of the earlier planes) label the tets, so snapping onto a later
+        // plane keeps the earlier ones flat (split.tet_labels).
+        SplitOptions split = wall_split_options(world, options);
+        std::vector<int64_t> region(mesh.tet_count(), 0);
+        split.tet_labels = &region;
+        for (const PlaneCut& cut : cuts) {
+            const PlaneField field(cut);
+            std::vector<double> values(world.size());
+            tbb::parallel_for(size_t{0}, world.size(), [&](size_t v) { values[v] = cut.side(world[v]); });
+            const SplitReport report = split_along_field(mesh, world, values, field, split);
+            result.tets_split += report.tets_split;
+            for (int32_t parent : report.appended_parents) region.push_back(region[parent]);
+            std::map<std::pair<int64_t, uint8_t>, int64_t> renumber;
+            for (size_t t = 0; t < region.size(); ++t)
+                region[t] = renumber.try_emplace({region[t], report.positive[t]}, static_cast<int64_t>(renumber.size()))
+                                .first->second;
+        }
+    }
+
+    // The region of a tet: which side of every plane its centroid is on.
+    std::map<std::vector<bool>, int64_t> regions;
+    std::vector<int64_t> label(mesh.tet_count());
+    std::vector<bool> sides(cuts.size());
+    for (size_t t = 0; t < mesh.tet_count(); ++t) {
+        const Eigen::Vector3d c = tet_centroid(world, mesh.tets[t]);
+        for (size_t i = 0; i < cuts.size(); ++i) sides[i] = cuts[i].side(c) > 0;
+        label[t] = regions.try_emplace(sides, static_cast<int64_t>(regions.size())).first->second;
+    }
+    make_pieces(mesh, label, options, result);
+    return result;
+}
+
+void set_piece_transform(TetMesh& mesh, int piece, const RigidTransform& transform) {
+    if (piece < 0 || static_cast<size_t>(piece) >= mesh.piece_transforms.size())
+        throw InvalidArgumentError("piece " + std::to_string(piece) + " does not exist (the volume has " +
+                                   std::to_string(mesh.piece_transforms.size()) + " pieces)");
+    const Eigen::Matrix3d& r = transform.rotation;
+    if (!r.allFinite() || !transform.translation.allFinite())
+        throw InvalidArgumentError("piece transform: non-finite rotation or translation");
+    if ((r.transpose() * r - Eigen::Matrix3d::Identity()).norm() > 1e-9 || !(r.determinant() > 0))
+        throw InvalidArgumentError("piece transform: the rotation is not a rotation (R^T R != I or det R != +1)");
+    mesh.piece_transforms[piece] = transform;
+}
+
+WeldResult weld_touching_pieces(TetMesh& mesh, double tolerance) {
+    if (!(tolerance >= 0) || !std::isfinite(tolerance))
+        throw InvalidArgumentError("weld: the tolerance must be a finite number >= 0");
+    validate(mesh);
+    WeldResult result;
+    result.pieces_before = result.pieces_after = static_cast<int>(mesh.piece_transforms.size());
+    if (mesh.tets.empty()) return result;
+
+    const std::vector<Eigen::Vector3d> world = world_positions(mesh);
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    std::vector<int32_t> vertex_piece(mesh.vertex_count(), -1);
+    for (size_t t = 0; t < mesh.tet_count(); ++t)
+        for (int32_t v : mesh.tets[t]) vertex_piece[v] = mesh.piece_ids[t];
+
+    // Coincident boundary vertices of different pieces: a kd-tree over the boundary vertices.
+    const std::vector<int32_t>& boundary = connectivity.boundary_vertices;
+    std::vector<Eigen::Vector3d> boundary_points(boundary.size());
+    for (size_t i = 0; i < boundary.size(); ++i) boundary_points[i] = world[boundary[i]];
+    PointCloud cloud{boundary_points};
+    const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    DisjointSets clusters(mesh.vertex_count());
+    const double radius_sq = tolerance * tolerance;
+    std::vector<std::pair<uint32_t, double>> matches;
+    for (size_t i = 0; i < boundary.size(); ++i) {
+        matches.clear();
+        tree.radiusSearch(boundary_points[i].data(), radius_sq, matches, nanoflann::SearchParams(32, 0, false));
+        for (const auto& [j, d] : matches)
+            if (vertex_piece[boundary[j]] != vertex_piece[boundary[i]]) clusters.unite(boundary[i], boundary[j]);
+    }
+    // A cluster holding two vertices of one piece would collapse an edge of that piece: leave it alone.
+    std::map<std::pair<int32_t, int32_t>, int32_t> seen;  // (cluster, piece) -> count
+    std::vector<uint8_t> bad_cluster(mesh.vertex_count(), 0);
+    for (int32_t v : boundary)
+        if (++seen[{clusters.find(v), vertex_piece[v]}] > 1) bad_cluster[clusters.find(v)] = 1;
+    auto merged_vertex = [&](int32_t v) {
+        const int32_t root = clusters.find(v);
+        return bad_cluster[root] ? v : root;
+    };
+
+    // Pieces touch when a boundary face of one maps onto a boundary face of another.
+    std::map<std::array<int32_t, 3>, int32_t> face_piece;
+    const size_t piece_count = mesh.piece_transforms.size();
+    DisjointSets groups(piece_count);
+    for (const BoundaryFace& face : connectivity.boundary_faces) {
+        std::array<int32_t, 3> key;
+        for (int k = 0; k < 3; ++k) key[k] = merged_vertex(face.vertices[k]);
+        std::sort(key.begin(), key.end());
+        const int32_t piece = mesh.piece_ids[face.tet];
+        auto [it, inserted] = face_piece.try_emplace(key, piece);
+        if (!inserted && it->second != piece) groups.unite(it->second, piece);
+    }
+
+    // Merge: vertices only between pieces of one group (point or edge contact alone joins nothing);
+    // every piece of a group is re-expressed in the frame of its lowest piece.
+    TetMesh welded = mesh;
+    std::vector<int32_t> target(mesh.vertex_count());
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+        const int32_t m = merged_vertex(static_cast<int32_t>(v));
+        target[v] = vertex_piece[v] >= 0 && vertex_piece[m] >= 0 &&
+                            groups.find(vertex_piece[v]) == groups.find(vertex_piece[m])
+                        ? m
+                        : static_cast<int32_t>(v);
+    }
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+        const int32_t piece = vertex_piece[v];
+        if (piece < 0) continue;
+        const int32_t group = groups.find(piece);
+        if (group == piece) continue;
+        const RigidTransform& frame = mesh.piece_transforms[group];
+        welded.positions[v] = frame.rotation.transpose() * (world[v] - frame.translation);
+    }
+    for (size_t v = 0; v < mesh.vertex_count(); ++v)
+        if (target[v] != static_cast<int32_t>(v)) ++result.vertices_merged;
+    std::vector<int32_t> new_index(piece_count, -1);
+    std::vector<RigidTransform> transforms;
+    for (size_t p = 0; p < piece_count; ++p)
+        if (groups.find(static_cast<int32_t>(p)) == static_cast<int32_t>(p)) {
+            new_index[p] = static_cast<int32_t>(transforms.size());
+            transforms.push_back(mesh.piece_transforms[p]);
+        }
+    for (size_t t = 0; t < welded.tet_count(); ++t) {
+        for (int32_t& v : welded.tets[t]) v = target[v];
+        welded.piece_ids[t] = new_index[groups.find(mesh.piece_ids[t])];
+        if (!(signed_volume(welded, t) > 0))
+            throw AlgorithmError("weld: merging vertices within " + std::to_string(tolerance) +
+                                 " would flatten tet " + std::to_string(t) + "; use a smaller tolerance");
+    }
+    welded.piece_transforms = std::move(transforms);
+    remove_tets(welded, std::vector<uint8_t>(welded.tet_count(), 0));  // drops the merged-away vertices
+    validate(welded);
+    mesh = std::move(welded);
+    result.pieces_after = static_cast<int>(mesh.piece_transforms.size());
+    return result;
+}
+
+}  // namespace waxwork
