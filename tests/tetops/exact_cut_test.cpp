@@ -93,6 +93,21 @@ TEST(ExactCut, ObliquePlaneThroughACube) {
     }
 }
 
+TEST(ExactCut, ChildrenKeepMaterialOriginalIdAndPiece) {
+    TetMesh before = make_cube_mesh(4);
+    before.materials.resize(before.tet_count());
+    for (size_t t = 0; t < before.tet_count(); ++t) before.materials[t].mua = {0.01 * static_cast<double>(t), 0.5, 1.0};
+    TetMesh mesh = before;
+    const ExactCutResult r = cut_exact(mesh, PlaneCut(Eigen::Vector3d(0.3, 1, 0.2), 0.61));
+    ASSERT_GT(r.tets_split, 0u);
+    ASSERT_EQ(mesh.materials.size(), mesh.tet_count());
+    for (size_t t = 0; t < mesh.tet_count(); ++t) {
+        EXPECT_EQ(mesh.materials[t], before.materials[r.new_to_old_tet[t]]);
+        EXPECT_EQ(mesh.original_ids[t], before.original_ids[r.new_to_old_tet[t]]);
+        EXPECT_EQ(mesh.piece_ids[t], 0);
+    }
+}
+
 TEST(ExactCut, SnappingImprovesTheWorstAngle) {
     const TetMesh before = make_cube_mesh(8);
     // A plane just past a grid plane: without snapping, thin tets next to x = 0.5.

@@ -300,6 +300,15 @@ TEST(Weld, MovedApartPiecesStayApartAndMovedBackWeld) {
     EXPECT_EQ(w.vertices_merged, 0u);
     EXPECT_EQ(mesh, apart);
 
+    // Moved away and back: they touch again.
+    {
+        TetMesh back = apart;
+        set_piece_transform(back, 1, RigidTransform{});
+        EXPECT_EQ(weld_touching_pieces(back, 1e-9).pieces_after, 1);
+        const TetConnectivity cb = expect_valid_conforming(back);
+        EXPECT_NEAR(boundary_area(back, cb), 6.0, 1e-12);
+    }
+
     // Move both pieces by the same rigid motion: they touch again, in a rotated frame.
     RigidTransform motion;
     motion.rotation = Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, 1, -0.4).normalized()).toRotationMatrix();
