@@ -1,7 +1,9 @@
 // `waxwork demo [-o DIR]`: the tour of what Waxwork does, on the embedded model (Spot, CC0): mesh it,
-// save the volume, and render it in a few materials and lights, a cut and a painted variant.
+// save the volume, render it in a few materials and lights, a cut and a painted variant, then replay
+// the example editing sessions of assets/sessions/.
 #include "editor/commands.h"
 #include "editor/render_pipeline.h"
+#include "editor/session.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
 #include "solver/material.h"
@@ -14,6 +16,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -21,6 +24,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <vector>
 
 namespace waxwork {
 namespace {
@@ -92,6 +96,37 @@ std::vector<Eigen::Vector3d> back_stroke(const TetMesh& mesh, const TetConnectiv
         if (top) stroke.push_back(*top - Eigen::Vector3d(0, 0.01 * length, 0));
     }
     return stroke;
+}
+
+// The example editing sessions (assets/sessions/*.json: carving, a painted marble vein, relighting
+// from behind) replayed headless into DIR/sessions/NAME/. A session that meshes the embedded spot at
+// the demo's scale with the default sizing starts from the volume the demo just made instead of
+// meshing it again; images take the demo's size.
+void run_example_sessions(const fs::path& dir, const fs::path& spot_volume, const DemoCommandOptions& o) {
+    const fs::path sessions_dir = fs::path(WAXWORK_ASSET_DIR) / "sessions";
+    std::vector<fs::path> files;
+    for (const auto& entry : fs::directory_iterator(sessions_dir))
+        if (entry.path().extension() == ".json") files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
+    for (const fs::path& file : files) {
+        const auto start = std::chrono::steady_clock::now();
+        Session session = read_session(file);
+        const bool default_spot = session.input.surface.filename() == "spot.obj" && !session.input.max_tets &&
+                                  !session.input.edge && session.scale == o.scale && !o.max_tets;
+        if (default_spot) {
+            session.input = SessionInput{};
+            session.input.volume = spot_volume;
+        }
+        session.width = o.width;
+        session.height = o.height;
+        const fs::path out = dir / "sessions" / file.stem();
+        const SessionResult result = run_session(session, out);
+        std::cout << "ran session " << file.filename().string() << " (" << session.steps.size() << " steps, "
+                  << seconds_since(start) << " s): ";
+        for (size_t i = 0; i < result.written.size(); ++i)
+            std::cout << (i ? ", " : "") << result.written[i].lexically_relative(dir).string();
+        std::cout << "\n";
+    }
 }
 
 void run_demo_command(const DemoCommandOptions& o) {
@@ -183,6 +218,10 @@ void run_demo_command(const DemoCommandOptions& o) {
                   << seconds_since(start) << " s)\n";
     }
 
+    run_example_sessions(dir, volume_path, o);
+
+    // Hook for the interactive editor: when a window can open, this is where the demo hands over
+    // (the example sessions in assets/sessions/ are the scenes to offer).
     if (std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY")) {
         std::cout << "a display is available, but the interactive editor is not built yet: open the images above, "
                      "or render your own with `waxwork render "

@@ -123,7 +123,9 @@ TriangleBvh build_shadow_bvh(const BoundarySurface& surface) {
     return TriangleBvh(points, surface.triangles);
 }
 
-std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting) {
+namespace {
+
+void check_lighting_inputs(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting) {
     validate(lighting);
     const size_t n = surface.positions.size();
     if (surface.normals.size() != n || surface.eta.size() != n) {
@@ -134,61 +136,95 @@ std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBv
     if (lighting.shadows && bvh.triangle_count() != surface.triangles.size()) {
         throw InvalidArgumentError("incident_light: the shadow BVH was not built from this surface");
     }
+}
 
-    // Mean incident edge length sets the scale of the shadow-ray offset.
+// Shadow-ray offset per surface vertex: kShadowOffset times its mean incident edge length (zero
+// without shadows).
+std::vector<double> shadow_ray_offsets(const BoundarySurface& surface, const Lighting& lighting) {
+    const size_t n = surface.positions.size();
     std::vector<double> offset(n, 0.0);
-    if (lighting.shadows) {
-        std::vector<int32_t> count(n, 0);
-        for (const auto& t : surface.triangles) {
-            for (int k = 0; k < 3; ++k) {
-                const double length = (surface.positions[t[k]] - surface.positions[t[(k + 1) % 3]]).norm();
-                offset[t[k]] += length;
-                offset[t[(k + 1) % 3]] += length;
-                ++count[t[k]];
-                ++count[t[(k + 1) % 3]];
-            }
-        }
-        for (size_t s = 0; s < n; ++s) {
-            if (count[s] > 0) offset[s] *= kShadowOffset / count[s];
+    if (!lighting.shadows) return offset;
+    std::vector<int32_t> count(n, 0);
+    for (const auto& t : surface.triangles) {
+        for (int k = 0; k < 3; ++k) {
+            const double length = (surface.positions[t[k]] - surface.positions[t[(k + 1) % 3]]).norm();
+            offset[t[k]] += length;
+            offset[t[(k + 1) % 3]] += length;
+            ++count[t[k]];
+            ++count[t[(k + 1) % 3]];
         }
     }
+    for (size_t s = 0; s < n; ++s) {
+        if (count[s] > 0) offset[s] *= kShadowOffset / count[s];
+    }
+    return offset;
+}
 
+// q at surface vertex s.
+Rgb incident_light_at(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
+                      double offset, size_t s) {
+    Rgb sum = lighting.ambient;
+    const Eigen::Vector3d& p = surface.positions[s];
+    const Eigen::Vector3d& normal = surface.normals[s];
+    const Eigen::Vector3f origin = (p + offset * normal).cast<float>();
+    for (const Light& light : lighting.lights) {
+        Eigen::Vector3d to_light;
+        double scale = 1.0;
+        double distance = std::numeric_limits<double>::infinity();
+        if (light.type == LightType::Directional) {
+            to_light = -light.vector.normalized();
+        } else {
+            to_light = light.vector - p;
+            distance = to_light.norm();
+            if (!(distance > 0)) continue;  // light on the vertex: no direction
+            to_light /= distance;
+            scale = 1.0 / (distance * distance);
+        }
+        const double cos_theta = normal.dot(to_light);
+        if (!(cos_theta > 0)) continue;
+        if (lighting.shadows) {
+            // The ray stops just short of a point light so that a light lying on a surface
+            // does not shadow itself.
+            const float t_max = std::isinf(distance) ? std::numeric_limits<float>::infinity()
+                                                     : static_cast<float>(distance * (1.0 - 1e-6));
+            if (bvh.occluded(origin, to_light.cast<float>(), 0.0f, t_max)) continue;
+        }
+        const double factor = scale * cos_theta * fresnel_transmittance(cos_theta, surface.eta[s]);
+        for (int c = 0; c < 3; ++c) sum[c] += light.intensity[c] * factor;
+    }
+    return sum;
+}
+
+}  // namespace
+
+std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting) {
+    check_lighting_inputs(surface, bvh, lighting);
+    const size_t n = surface.positions.size();
+    const std::vector<double> offset = shadow_ray_offsets(surface, lighting);
     std::vector<Rgb> q(n);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t s = range.begin(); s != range.end(); ++s) {
-            Rgb sum = lighting.ambient;
-            const Eigen::Vector3d& p = surface.positions[s];
-            const Eigen::Vector3d& normal = surface.normals[s];
-            const Eigen::Vector3f origin = (p + offset[s] * normal).cast<float>();
-            for (const Light& light : lighting.lights) {
-                Eigen::Vector3d to_light;
-                double scale = 1.0;
-                double distance = std::numeric_limits<double>::infinity();
-                if (light.type == LightType::Directional) {
-                    to_light = -light.vector.normalized();
-                } else {
-                    to_light = light.vector - p;
-                    distance = to_light.norm();
-                    if (!(distance > 0)) continue;  // light on the vertex: no direction
-                    to_light /= distance;
-                    scale = 1.0 / (distance * distance);
-                }
-                const double cos_theta = normal.dot(to_light);
-                if (!(cos_theta > 0)) continue;
-                if (lighting.shadows) {
-                    // The ray stops just short of a point light so that a light lying on a surface
-                    // does not shadow itself.
-                    const float t_max = std::isinf(distance) ? std::numeric_limits<float>::infinity()
-                                                             : static_cast<float>(distance * (1.0 - 1e-6));
-                    if (bvh.occluded(origin, to_light.cast<float>(), 0.0f, t_max)) continue;
-                }
-                const double factor = scale * cos_theta * fresnel_transmittance(cos_theta, surface.eta[s]);
-                for (int c = 0; c < 3; ++c) sum[c] += light.intensity[c] * factor;
-            }
-            q[s] = sum;
-        }
+        for (size_t s = range.begin(); s != range.end(); ++s) q[s] = incident_light_at(surface, bvh, lighting, offset[s], s);
     });
     return q;
+}
+
+void update_incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
+                           std::span<const int32_t> surface_vertices, std::vector<Rgb>& q) {
+    check_lighting_inputs(surface, bvh, lighting);
+    if (q.size() != surface.positions.size())
+        throw InvalidArgumentError("update_incident_light: q has " + std::to_string(q.size()) + " values for " +
+                                   std::to_string(surface.positions.size()) + " surface vertices");
+    for (const int32_t s : surface_vertices)
+        if (s < 0 || static_cast<size_t>(s) >= q.size())
+            throw InvalidArgumentError("update_incident_light: surface vertex " + std::to_string(s) + " out of range");
+    const std::vector<double> offset = shadow_ray_offsets(surface, lighting);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, surface_vertices.size(), 64),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                          for (size_t i = range.begin(); i != range.end(); ++i) {
+                              const size_t s = static_cast<size_t>(surface_vertices[i]);
+                              q[s] = incident_light_at(surface, bvh, lighting, offset[s], s);
+                          }
+                      });
 }
 
 std::vector<Rgb> incident_light(const BoundarySurface& surface, const Lighting& lighting) {

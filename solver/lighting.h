@@ -24,6 +24,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace waxwork {
@@ -82,6 +83,10 @@ TriangleBvh build_shadow_bvh(const BoundarySurface& surface);
 // q per surface vertex and channel. `bvh` must have been built from `surface` (only used with
 // lighting.shadows). Parallel over vertices (TBB).
 std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting);
+// Recomputes q (per surface vertex, as above) at `surface_vertices` only, e.g. after their eta
+// changed (painting): equal to the full computation at those vertices, other entries untouched.
+void update_incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
+                           std::span<const int32_t> surface_vertices, std::vector<Rgb>& q);
 // Same, building the BVH when lighting.shadows is set.
 std::vector<Rgb> incident_light(const BoundarySurface& surface, const Lighting& lighting);
 

@@ -18,7 +18,7 @@ namespace {
 using testing::run_waxwork;
 using testing::scratch_dir;
 
-// A solver's entry: a strictly monotone curve from the cold start down below 1%, and its time to 1%.
+// A solver's entry: a strictly monotone curve ending below 1%, and its time to 1%.
 void expect_valid_curve(const nlohmann::json& solvers, const std::string& name) {
     ASSERT_TRUE(solvers.contains(name)) << name;
     const auto& s = solvers[name];
@@ -37,11 +37,8 @@ void expect_valid_curve(const nlohmann::json& solvers, const std::string& name) 
     EXPECT_LT(best_error, 1e-2) << name;
     ASSERT_TRUE(s["time_to_1pct_ms"].is_number()) << name;
     EXPECT_GT(s["time_to_1pct_ms"].get<double>(), 0.0) << name;
-    if (name != "direct") {
-        // The iterative curves start from the cold start (error 1, or multires' coarse pass) and fall.
-        EXPECT_GT(curve.front()[1].get<double>(), 1e-2) << name;
-        EXPECT_LT(curve.back()[1].get<double>(), 1e-2) << name;
-    }
+    // The last cap is always kept (noise only drops earlier points) and is below 1%.
+    EXPECT_LT(curve.back()[1].get<double>(), 1e-2) << name;
 }
 
 TEST(BenchSolversCommand, WritesCurvesForEverySolver) {

@@ -242,5 +242,36 @@ TEST(RayCaster, EmptyAndInvalidInput) {
     EXPECT_THROW(TriangleBvh(points, ok), InvalidArgumentError);
 }
 
+TEST(Lighting, UpdatingSomeVerticesEqualsTheFullComputationThere) {
+    // Two boxes, one shadowing the other, and a point light: the update must reproduce shadows too.
+    const TetMesh mesh = testing::concatenate(testing::make_box_mesh(3, {0, 0, 0}, {1, 1, 1}),
+                                              testing::make_box_mesh(2, {-0.5, 1.5, -0.5}, {1.5, 1.8, 1.5}));
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    BoundarySurface surface = extract_boundary_surface(mesh, connectivity, {});
+    const TriangleBvh bvh = build_shadow_bvh(surface);
+    Lighting lighting;
+    lighting.lights = {Light{LightType::Directional, Eigen::Vector3d(0.3, -1, 0.2), {1, 1, 1}},
+                       Light{LightType::Point, Eigen::Vector3d(2, 0.5, 0.5), {2, 1, 1}}};
+    lighting.ambient = {0.01, 0.02, 0.03};
+    std::vector<Rgb> q = incident_light(surface, bvh, lighting);
+    // Change eta at every third vertex, update those, compare with a full recomputation.
+    std::vector<int32_t> changed;
+    for (size_t s = 0; s < surface.eta.size(); s += 3) {
+        surface.eta[s] = 1.8;
+        changed.push_back(static_cast<int32_t>(s));
+    }
+    const std::vector<Rgb> before = q;
+    update_incident_light(surface, bvh, lighting, changed, q);
+    const std::vector<Rgb> full = incident_light(surface, bvh, lighting);
+    size_t differing = 0;
+    for (size_t s = 0; s < q.size(); ++s) {
+        EXPECT_EQ(q[s], full[s]) << s;
+        differing += q[s] != before[s] ? 1 : 0;
+    }
+    EXPECT_GT(differing, changed.size() / 4);  // eta matters where light arrives
+    const std::vector<int32_t> bad = {static_cast<int32_t>(q.size())};
+    EXPECT_THROW(update_incident_light(surface, bvh, lighting, bad, q), InvalidArgumentError);
+}
+
 }  // namespace
 }  // namespace waxwork

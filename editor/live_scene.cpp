@@ -1,0 +1,301 @@
+#include "editor/live_scene.h"
+
+#include "solver/conjugate_gradient.h"
+#include "solver/radiance.h"
+#include "tetops/error.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace waxwork {
+namespace {
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+AssemblyOptions assembly_options(const LiveSceneOptions& options) {
+    AssemblyOptions a;
+    a.mm_per_unit = options.mm_per_unit;
+    return a;
+}
+
+void check_materials(const TetMesh& mesh) {
+    if (mesh.materials.size() != mesh.tet_count())
+        throw InvalidArgumentError("live scene: the volume must store one material per tet (" +
+                                   std::to_string(mesh.materials.size()) + " for " +
+                                   std::to_string(mesh.tet_count()) + " tets)");
+}
+
+}  // namespace
+
+LiveScene::LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSceneOptions& options)
+    : mesh_(&mesh), options_(options), lighting_(lighting) {
+    if (!(options.mm_per_unit > 0) || !std::isfinite(options.mm_per_unit))
+        throw InvalidArgumentError("live scene: mm_per_unit must be positive");
+    if (!(options.relative_tolerance > 0) || !(options.relative_tolerance < 1))
+        throw InvalidArgumentError("live scene: the relative tolerance must be in (0, 1)");
+    validate(lighting_);
+    check_materials(mesh);
+    SceneUpdate update;
+    rebuild_all(nullptr, update);
+}
+
+void LiveScene::mark_unconverged() {
+    converged_ = {false, false, false};
+    solved_since_change_ = false;
+}
+
+void LiveScene::rebuild_surface(SceneUpdate& update) {
+    surface_ = extract_boundary_surface(*mesh_, *connectivity_, mesh_->materials);
+    shadow_bvh_ = build_shadow_bvh(surface_);
+    update.rebuilt_surface = true;
+    relight(update);
+}
+
+void LiveScene::relight(SceneUpdate& update) {
+    surface_q_ = incident_light(surface_, shadow_bvh_, lighting_);
+    q_ = to_volume_vertices(surface_, surface_q_, mesh_->vertex_count());
+    update.recomputed_light = true;
+    refresh_right_hand_sides();
+}
+
+void LiveScene::refresh_right_hand_sides() {
+    const size_t n = matrix_.size();
+    for (int c = 0; c < 3; ++c) {
+        b_[c].resize(n);
+        diffusion_right_hand_side(matrix_, q_, c, b_[c]);
+    }
+    mark_unconverged();
+}
+
+void LiveScene::rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update) {
+    if (!connectivity) {
+        connectivity = std::make_shared<const TetConnectivity>(build_connectivity(*mesh_));
+        update.rebuilt_connectivity = true;
+    }
+    connectivity_ = std::move(connectivity);
+    matrix_ = assemble_diffusion_matrix(*mesh_, *connectivity_, mesh_->materials, assembly_options(options_));
+    update.reassembled_matrix = true;
+    rebuild_surface(update);
+    // The smallest-eigenvalue hints belong to the old matrix: a stale hint could be too large and
+    // make the error estimate optimistic.
+    eigenvalue_hint_ = {0, 0, 0};
+    for (auto& phi : phi_) phi.resize(matrix_.size(), 0.0);
+}
+
+SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& change) {
+    const std::lock_guard lock(mutex_);
+    const auto start = std::chrono::steady_clock::now();
+    SceneUpdate update;
+    mesh_ = &mesh;
+    check_materials(mesh);
+    if (change.topology) {
+        // Carry phi over where the change says where vertices went (a cut); else start cold.
+        std::array<std::vector<double>, 3> old = std::move(phi_);
+        const size_t n_old = old[0].size();
+        const bool mapped = !change.old_to_new_vertex.empty() && change.old_to_new_vertex.size() == n_old;
+        const bool from_edges = change.vertex_origins.size() == mesh.vertex_count() && !mesh.positions.empty();
+        for (int c = 0; c < 3; ++c) phi_[c].assign(mesh.vertex_count(), 0.0);
+        if (mapped) {
+            for (size_t v = 0; v < change.old_to_new_vertex.size(); ++v) {
+                const int32_t to = change.old_to_new_vertex[v];
+                if (to >= 0 && static_cast<size_t>(to) < mesh.vertex_count())
+                    for (int c = 0; c < 3; ++c) phi_[c][to] = old[c][v];
+            }
+        } else if (from_edges) {
+            // A vertex made on an edge starts at the mean of the edge's ends (linear along it).
+            for (size_t v = 0; v < change.vertex_origins.size(); ++v) {
+                const auto [a, b] = change.vertex_origins[v];
+                if (a < 0 || b < 0 || static_cast<size_t>(a) >= n_old || static_cast<size_t>(b) >= n_old) continue;
+                for (int c = 0; c < 3; ++c) phi_[c][v] = 0.5 * (old[c][a] + old[c][b]);
+            }
+        }
+        update.warm_start = mapped || from_edges;
+        const bool reuse = change.connectivity && change.connectivity->vertex_tets.row_count() == mesh.vertex_count() &&
+                           change.connectivity->tet_neighbors.size() == mesh.tet_count();
+        rebuild_all(reuse ? change.connectivity : nullptr, update);
+    } else if (change.positions) {
+        // Same tets, moved vertices: new geometry on the same connectivity.
+        matrix_ = assemble_diffusion_matrix(mesh, *connectivity_, mesh.materials, assembly_options(options_));
+        update.reassembled_matrix = true;
+        eigenvalue_hint_ = {0, 0, 0};
+        rebuild_surface(update);
+    } else {
+        bool eta_changed = false;
+        if (change.all_materials) {
+            assemble_diffusion_values(matrix_, *connectivity_, mesh.materials);
+            update.recomputed_values = true;
+            eta_changed = true;
+        } else if (!change.changed_material_tets.empty()) {
+            update.updated_rows = update_diffusion_matrix(matrix_, mesh, *connectivity_, mesh.materials,
+                                                          change.changed_material_tets);
+            // q depends on eta through the Fresnel transmittance: only a changed tet with a boundary
+            // face can change a boundary vertex's eta.
+            for (const int32_t t : change.changed_material_tets) {
+                const auto& n = connectivity_->tet_neighbors[t];
+                if (std::find(n.begin(), n.end(), -1) != n.end()) {
+                    eta_changed = true;
+                    break;
+                }
+            }
+        }
+        if (eta_changed) {
+            const std::vector<double> eta = boundary_vertex_eta(mesh, *connectivity_, mesh.materials);
+            std::vector<int32_t> changed;
+            for (size_t s = 0; s < surface_.vertices.size(); ++s) {
+                // Blending equal etas ((1 - w) eta + w eta) can round by an ulp: that changes q by
+                // 1e-16 relative, not worth recomputing.
+                if (std::abs(surface_.eta[s] - eta[surface_.vertices[s]]) > 1e-12) changed.push_back(static_cast<int32_t>(s));
+                surface_.eta[s] = eta[surface_.vertices[s]];
+            }
+            eta_changed = !changed.empty();
+            if (eta_changed && !change.piece_transforms) {
+                // Only those vertices' Fresnel transmittance changed: recompute q there (shadow rays
+                // included), not on the whole surface.
+                update_incident_light(surface_, shadow_bvh_, lighting_, changed, surface_q_);
+                for (const int32_t s : changed) q_[surface_.vertices[s]] = surface_q_[s];
+                update.recomputed_light = true;
+            }
+        }
+        if (change.piece_transforms) {
+            // Rigid motions leave the matrix (built on rest positions) unchanged but move the pieces'
+            // shadows onto each other.
+            rebuild_surface(update);
+        } else if (eta_changed || update.recomputed_values) {
+            refresh_right_hand_sides();  // the source operator (A, F_dr) follows the materials
+        } else if (!update.updated_rows.empty()) {
+            // q is unchanged and only the rewritten rows of the source operator can differ: b changes
+            // in those rows only (b = source * q, Eq. 12). Cheaper than a full product per channel.
+            for (const int32_t i : update.updated_rows) {
+                std::array<double, 3> sum{};
+                if (matrix_.vertex_face_offsets[i] != matrix_.vertex_face_offsets[i + 1])
+                    for (int32_t k = matrix_.offsets[i]; k < matrix_.offsets[i + 1]; ++k)
+                        for (int c = 0; c < 3; ++c) sum[c] += matrix_.source[k] * q_[matrix_.columns[k]][c];
+                for (int c = 0; c < 3; ++c) b_[c][i] = sum[c];
+            }
+        }
+    }
+    mark_unconverged();
+    update.milliseconds = milliseconds_since(start);
+    return update;
+}
+
+SceneUpdate LiveScene::set_lighting(const Lighting& lighting) {
+    validate(lighting);
+    const std::lock_guard lock(mutex_);
+    const auto start = std::chrono::steady_clock::now();
+    lighting_ = lighting;
+    SceneUpdate update;
+    relight(update);
+    update.milliseconds = milliseconds_since(start);
+    return update;
+}
+
+FrameReport LiveScene::iterate(int iteration_budget) {
+    const auto start = std::chrono::steady_clock::now();
+    FrameReport report;
+    const size_t n = matrix_.size();
+    for (int c = 0; c < 3; ++c) {
+        if (converged_[c] || n == 0) {
+            converged_[c] = true;
+            report.estimated_relative_error[c] = n == 0 ? 0 : error_[c];
+            continue;
+        }
+        ConjugateGradientOptions cg;
+        cg.relative_tolerance = options_.relative_tolerance;
+        cg.max_iterations = iteration_budget;
+        cg.smallest_eigenvalue_hint = eigenvalue_hint_[c];
+        const CsrMatrixView<double> view{n, matrix_.offsets.data(), matrix_.columns.data(), matrix_.values[c].data()};
+        const ConjugateGradientResult r = solve_jacobi_cg<double>(view, b_[c], phi_[c], cg);
+        report.iterations[c] = r.iterations;
+        if (r.smallest_eigenvalue_estimate > 0) eigenvalue_hint_[c] = r.smallest_eigenvalue_estimate;
+        error_[c] = r.estimated_relative_error;
+        converged_[c] = r.converged;
+        report.estimated_relative_error[c] = error_[c];
+    }
+    report.converged = converged_[0] && converged_[1] && converged_[2];
+    solved_since_change_ = true;
+    report.milliseconds = milliseconds_since(start);
+    return report;
+}
+
+FrameReport LiveScene::step(int iteration_budget) {
+    if (iteration_budget < 0) throw InvalidArgumentError("live scene: the iteration budget must be >= 0");
+    const std::lock_guard lock(mutex_);
+    return iterate(iteration_budget);
+}
+
+FrameReport LiveScene::step_for(double milliseconds, int chunk_iterations) {
+    if (!(milliseconds >= 0) || chunk_iterations < 1)
+        throw InvalidArgumentError("live scene: the time budget must be >= 0 and the chunk >= 1 iteration");
+    const std::lock_guard lock(mutex_);
+    const auto start = std::chrono::steady_clock::now();
+    FrameReport total;
+    do {
+        const FrameReport chunk = iterate(chunk_iterations);
+        for (int c = 0; c < 3; ++c) total.iterations[c] += chunk.iterations[c];
+        total.estimated_relative_error = chunk.estimated_relative_error;
+        total.converged = chunk.converged;
+    } while (!total.converged && milliseconds_since(start) < milliseconds);
+    total.milliseconds = milliseconds_since(start);
+    return total;
+}
+
+FrameReport LiveScene::converge(int max_iterations) {
+    const std::lock_guard lock(mutex_);
+    FrameReport report = iterate(max_iterations);
+    if (!report.converged) {
+        std::ostringstream msg;
+        msg << "live scene: the diffusion solve did not reach relative error " << options_.relative_tolerance
+            << " in " << max_iterations << " iterations (estimated " << report.max_error() << ")";
+        throw AlgorithmError(msg.str());
+    }
+    return report;
+}
+
+bool LiveScene::converged() const {
+    const std::lock_guard lock(mutex_);
+    return converged_[0] && converged_[1] && converged_[2];
+}
+
+std::optional<double> LiveScene::estimated_error() const {
+    const std::lock_guard lock(mutex_);
+    if (!solved_since_change_) return std::nullopt;
+    return std::max({error_[0], error_[1], error_[2]});
+}
+
+Lighting LiveScene::lighting() const {
+    const std::lock_guard lock(mutex_);
+    return lighting_;
+}
+
+std::vector<std::array<double, 3>> LiveScene::phi() const {
+    const std::lock_guard lock(mutex_);
+    std::vector<std::array<double, 3>> phi(matrix_.size());
+    for (size_t v = 0; v < phi.size(); ++v)
+        for (int c = 0; c < 3; ++c) phi[v][c] = phi_[c][v];
+    return phi;
+}
+
+std::vector<std::array<float, 3>> LiveScene::radiance_factors() const {
+    const std::vector<std::array<double, 3>> phi = this->phi();
+    const std::lock_guard lock(mutex_);
+    return exitant_radiance_factors(*mesh_, *connectivity_, mesh_->materials, phi, q_);
+}
+
+SolvedScene LiveScene::solved_scene() const {
+    SolvedScene scene;
+    scene.diffusion.phi = phi();
+    const std::lock_guard lock(mutex_);
+    scene.surface = surface_;
+    scene.q = q_;
+    for (int c = 0; c < 3; ++c) scene.diffusion.estimated_relative_error[c] = error_[c];
+    scene.radiance_factor =
+        exitant_radiance_factors(*mesh_, *connectivity_, mesh_->materials, scene.diffusion.phi, scene.q);
+    return scene;
+}
+
+}  // namespace waxwork

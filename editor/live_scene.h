@@ -1,0 +1,144 @@
+// The solver state the editor and scripted sessions keep between frames for one document (issue 7):
+// connectivity, boundary surface with its shadow BVH and incident light q, the TransCut matrix
+// (Eqs. 10-14) with its right-hand sides (Eq. 12), and the current fluence phi per channel. Each frame
+// advances the solve a bounded number of iterations from the previous frame's phi (warm start), so
+// light follows edits progressively instead of stalling the frame.
+//
+// Reacting to a change (Document's ChangeReport), the scene redoes only what the change invalidates:
+//   materials of some tets   rewrite only the matrix rows of their vertices (paper Sec. 5, "we only
+//                            update the rows ... affected"; diffusion_matrix.h update_diffusion_matrix);
+//                            q only at boundary vertices whose eta changed; phi kept as warm start
+//   all materials            recompute matrix values on the kept pattern and geometry; warm start
+//   piece transforms         boundary surface, shadow BVH and q (pieces shadow each other); the matrix
+//                            is invariant under rigid motion; warm start
+//   positions (relaxation)   matrix geometry and values, lighting; warm start
+//   topology (cut, ...)      connectivity (reused from the report when the edit built it), matrix,
+//                            lighting; warm start through the cut's vertex map, else cold
+//   lights (set_lighting)    q and the right-hand sides only; warm start
+//
+// Solver choice: Jacobi-preconditioned CG in double, warm-started, per channel. The multires solver
+// (multires/multires_solver.h) is not used per frame: on spot it does not beat Jacobi CG to 1%
+// (README, multires_bench: 2.3 vs 2.1 ms at 50K, 27.1 vs 26.8 ms at 500K) and its hierarchy build
+// (224 ms at 500K) would take half of a cut's 500 ms budget, for no gain.
+//
+// Threading: every public member locks one internal mutex, so the window may call step() on a worker
+// thread while the UI thread applies edits; apply_change() and set_lighting() then wait for the
+// running step() to finish (one frame). The TetMesh passed to the constructor and apply_change() is
+// borrowed: it must outlive the scene and must not be modified while any member runs (the document
+// changes it only inside Document::apply/undo/redo: call those and apply_change() under the same
+// external lock or on the same thread, and never concurrently with solved_scene()).
+#pragma once
+
+#include "editor/document.h"
+#include "editor/render_pipeline.h"
+#include "solver/diffusion_matrix.h"
+#include "solver/diffusion_solve.h"
+#include "solver/lighting.h"
+#include "solver/ray_caster.h"
+#include "tetops/connectivity.h"
+#include "tetops/tet_mesh.h"
+
+#include <array>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+namespace waxwork {
+
+struct LiveSceneOptions {
+    double mm_per_unit = 1.0;
+    // converge() and converged() stop at this estimated relative error of phi (conjugate_gradient.h).
+    double relative_tolerance = 1e-3;
+};
+
+// One frame of the solve.
+struct FrameReport {
+    std::array<int, 3> iterations{};                 // CG iterations per rgb channel this frame
+    std::array<double, 3> estimated_relative_error{}; // after this frame
+    bool converged = false;                          // every channel within the tolerance
+    double milliseconds = 0;
+
+    int total_iterations() const { return iterations[0] + iterations[1] + iterations[2]; }
+    double max_error() const {
+        return std::max({estimated_relative_error[0], estimated_relative_error[1], estimated_relative_error[2]});
+    }
+};
+
+// What apply_change()/set_lighting() redid.
+struct SceneUpdate {
+    bool rebuilt_connectivity = false;
+    bool reassembled_matrix = false;     // pattern and/or geometry and all values
+    bool recomputed_values = false;      // all values on the kept pattern
+    std::vector<int32_t> updated_rows;   // rows rewritten by the incremental update (ascending)
+    bool rebuilt_surface = false;        // boundary surface and shadow BVH
+    bool recomputed_light = false;       // q and the right-hand sides
+    bool warm_start = true;              // phi kept (possibly through a vertex map)
+    double milliseconds = 0;
+};
+
+class LiveScene {
+public:
+    // Builds everything for `mesh` (which must store one material per tet, as Document guarantees).
+    // Throws InvalidArgumentError for bad lights, options or materials.
+    LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSceneOptions& options = {});
+
+    // After Document::apply/undo/redo changed `mesh` (the document's mesh, same object or not).
+    SceneUpdate apply_change(const TetMesh& mesh, const ChangeReport& change);
+    SceneUpdate set_lighting(const Lighting& lighting);
+
+    // At most `iteration_budget` CG iterations per channel, from the current phi. Channels already
+    // within the tolerance are not iterated (an idle scene costs nothing).
+    FrameReport step(int iteration_budget);
+    // A time budget instead: CG in chunks of `chunk_iterations` per channel until `milliseconds` have
+    // passed or the tolerance is reached (each chunk restarts CG from the current phi, which costs a
+    // little convergence against one longer run; at least one chunk runs).
+    FrameReport step_for(double milliseconds, int chunk_iterations = 4);
+    // Iterates until the tolerance (or `max_iterations` per channel: AlgorithmError if not reached).
+    FrameReport converge(int max_iterations = 10000);
+    bool converged() const;
+    // The estimated relative error of phi (max over channels) after the last step(), or nullopt when
+    // nothing was solved since the last change.
+    std::optional<double> estimated_error() const;
+
+    // A copy of the current state in the form render_pipeline.h renders (make_render_input), with the
+    // exitant radiance factors computed from the current phi. Reads the mesh.
+    SolvedScene solved_scene() const;
+    // Only the exitant radiance factors E per volume vertex from the current phi (what a window
+    // re-uploads each frame while the surface is unchanged). Reads the mesh.
+    std::vector<std::array<float, 3>> radiance_factors() const;
+
+    Lighting lighting() const;
+    const LiveSceneOptions& options() const { return options_; }
+    // For tests and the bench; not synchronised (call when no step() runs).
+    const DiffusionMatrix& matrix() const { return matrix_; }
+    const TetConnectivity& connectivity() const { return *connectivity_; }
+    std::vector<std::array<double, 3>> phi() const;
+
+private:
+    void rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update);
+    void rebuild_surface(SceneUpdate& update);
+    void relight(SceneUpdate& update);
+    void refresh_right_hand_sides();
+    void mark_unconverged();
+    FrameReport iterate(int iteration_budget);
+
+    mutable std::mutex mutex_;
+    const TetMesh* mesh_;
+    LiveSceneOptions options_;
+    Lighting lighting_;
+    std::shared_ptr<const TetConnectivity> connectivity_;
+    DiffusionMatrix matrix_;
+    BoundarySurface surface_;
+    TriangleBvh shadow_bvh_;
+    std::vector<Rgb> surface_q_;                // per surface vertex
+    std::vector<Rgb> q_;                        // per volume vertex
+    std::array<std::vector<double>, 3> b_;      // right-hand side per channel
+    std::array<std::vector<double>, 3> phi_;    // current fluence per channel
+    std::array<double, 3> eigenvalue_hint_{};
+    std::array<double, 3> error_{1, 1, 1};
+    std::array<bool, 3> converged_{};
+    bool solved_since_change_ = false;
+};
+
+}  // namespace waxwork

@@ -1,0 +1,130 @@
+// Scripted editing sessions (issue 7): a JSON file that names an input, a material, lights, a camera
+// and a list of steps, replayed headless by `waxwork run SESSION.json -o OUTDIR` through the same
+// Document and LiveScene the editor uses, rendering frames with the OSMesa renderer.
+//
+//   {
+//     "input": {"surface": "spot.obj", "max_tets": 20000, "mesher": "tetgen"}   (or "edge": L; neither:
+//              sized for the material and scale, solver/mesh_resolution.h) | {"volume": "spot.vtu"},
+//     "material": "marble" | {"mua": [..], "musp": [..], "eta": 1.3},   (tets without a stored material)
+//     "scale": 30,                         millimetres per model unit
+//     "lights": [{"direction": [1,-1,-1], "intensity": [1,1,1]}, {"position": [0,2,0]}],
+//     "ambient": [0.02, 0.02, 0.02], "shadows": true,
+//     "camera": {"eye_direction": [0.75,0.5,-1], "up": [0,1,0], "fov_y_deg": 30},
+//     "image": {"width": 640, "height": 480},
+//     "tolerance": 0.001,                  relative error a converged frame reaches
+//     "frame_iterations": 10,              CG iterations per channel of one live frame
+//     "steps": [
+//       {"op": "plane_cut", ...},          any edit operation (edit_operation.h)
+//       {"render": "cut.png"},             a converged frame; {"render": "f.png", "frames": 3}: the frame
+//                                          a live editor shows 3 frames after the last change
+//       {"save": "cut.vtu"},               the volume (format from the extension)
+//       {"light": {"lights": [...], "ambient": [...], "shadows": true}},   new lighting
+//       {"camera": {...}},
+//       {"undo": 1}, {"redo": 2}
+//     ]
+//   }
+// Input paths are relative to the session file, output names to OUTDIR. Errors name the session file
+// and the step index ("s.json: step 3 (paint): field 'sigma': ...").
+#pragma once
+
+#include "editor/document.h"
+#include "editor/edit_operation.h"
+#include "editor/surface_renderer.h"
+#include "solver/lighting.h"
+#include "tetops/tet_mesh.h"
+#include "tetops/tetrahedralize.h"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace waxwork {
+
+struct SessionInput {
+    std::filesystem::path surface;  // exactly one of surface / volume (absolute after reading)
+    std::filesystem::path volume;
+    std::optional<size_t> max_tets;
+    std::optional<double> edge;
+    Mesher mesher = Mesher::TetGen;
+};
+
+struct RenderStep {
+    std::string file;
+    std::optional<int> frames;  // nullopt: converged
+};
+struct SaveStep {
+    std::string file;
+};
+struct LightStep {
+    Lighting lighting;
+};
+struct CameraStep {
+    CameraSettings camera;
+};
+struct UndoStep {
+    int count = 1;
+};
+struct RedoStep {
+    int count = 1;
+};
+
+using SessionStep = std::variant<EditOperation, RenderStep, SaveStep, LightStep, CameraStep, UndoStep, RedoStep>;
+
+struct Session {
+    std::string name;  // the file it came from, for errors ("session" when built in memory)
+    SessionInput input;
+    TetMaterial material;
+    double scale = 30;
+    Lighting lighting;
+    CameraSettings camera;
+    int width = 640;
+    int height = 480;
+    double tolerance = 1e-3;
+    int frame_iterations = 10;
+    std::vector<SessionStep> steps;
+};
+
+// Parses a session; relative input paths resolve against `base_directory`. Throws
+// InvalidArgumentError "NAME: [step N (kind): ]field 'x': problem".
+Session parse_session(const nlohmann::ordered_json& json, const std::filesystem::path& base_directory,
+                      const std::string& name);
+// Reads and parses; FileError for unreadable files or malformed JSON.
+Session read_session(const std::filesystem::path& path);
+
+nlohmann::ordered_json session_to_json(const Session& session);
+// Writes atomically. Input paths are written relative to the file's directory when possible.
+void write_session(const std::filesystem::path& path, const Session& session);
+
+// The recording of an editing session: `setup`'s input, material, lights and camera, and as steps the
+// document's history (the operations that made its current mesh), followed by `extra_steps`
+// (e.g. a final render or save). Replaying it gives the document's mesh bit for bit.
+Session record_session(const Session& setup, const Document& document,
+                       const std::vector<SessionStep>& extra_steps = {});
+
+// The volume a session starts from (meshing the surface, or reading the volume).
+TetMesh load_session_input(const Session& session);
+
+struct StepMetrics {
+    std::string name;
+    double milliseconds = 0;     // the whole step (edit + scene update, or solve + render, ...)
+    size_t tets = 0, vertices = 0;
+    int solver_iterations = 0;   // summed over channels and frames
+    double estimated_error = -1; // of phi after the step (max over channels); -1: not solved since the change
+};
+
+struct SessionResult {
+    TetMesh mesh;  // the final volume
+    std::vector<StepMetrics> steps;
+    double load_ms = 0;  // meshing or reading the input
+    std::vector<std::filesystem::path> written;  // images and volumes, in order
+};
+
+// Replays the session, writing renders and saves under `output_directory` (created) and
+// OUTDIR/metrics.json. Errors name the session and the step index.
+SessionResult run_session(const Session& session, const std::filesystem::path& output_directory);
+
+}  // namespace waxwork

@@ -1,0 +1,206 @@
+#include "editor/live_scene.h"
+#include "solver/material.h"
+#include "tetops/error.h"
+#include "tetops/test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+namespace waxwork {
+namespace {
+
+constexpr double kTolerance = 1e-9;
+
+Lighting key_lighting() {
+    Lighting l;
+    Light light;
+    light.vector = Eigen::Vector3d(1, -0.8, -0.5).normalized();
+    l.lights = {light};
+    l.ambient = {0.02, 0.02, 0.02};
+    return l;
+}
+
+LiveSceneOptions options() {
+    LiveSceneOptions o;
+    o.mm_per_unit = 10;  // a 1 cm marble cube: phi varies strongly across it
+    o.relative_tolerance = kTolerance;
+    return o;
+}
+
+// The live scene, converged, against a from-scratch solve_scene of the same mesh and lights.
+void expect_matches_fresh_solve(LiveScene& scene, const TetMesh& mesh, const Lighting& lighting,
+                                const std::string& what) {
+    scene.converge();
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    DiffusionOptions diffusion;
+    diffusion.mm_per_unit = options().mm_per_unit;
+    diffusion.relative_tolerance = kTolerance;
+    const SolvedScene fresh = solve_scene(mesh, connectivity, mesh.materials, lighting, diffusion);
+    const auto live = scene.phi();
+    ASSERT_EQ(live.size(), fresh.diffusion.phi.size()) << what;
+    double largest = 0, difference = 0;
+    for (size_t v = 0; v < live.size(); ++v)
+        for (int c = 0; c < 3; ++c) {
+            largest = std::max(largest, std::abs(fresh.diffusion.phi[v][c]));
+            difference = std::max(difference, std::abs(live[v][c] - fresh.diffusion.phi[v][c]));
+        }
+    EXPECT_GT(largest, 0) << what;
+    EXPECT_LT(difference, 1e-6 * largest) << what;
+    // The radiance the renderer gets follows phi.
+    const SolvedScene snapshot = scene.solved_scene();
+    ASSERT_EQ(snapshot.radiance_factor.size(), fresh.radiance_factor.size());
+    EXPECT_EQ(scene.radiance_factors(), snapshot.radiance_factor);
+    for (size_t v = 0; v < fresh.radiance_factor.size(); ++v)
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(snapshot.radiance_factor[v][c], fresh.radiance_factor[v][c],
+                        1e-4 * std::abs(fresh.radiance_factor[v][c]) + 1e-6)
+                << what;
+}
+
+PaintOp paint_at(const Eigen::Vector3d& p, const char* material = "ketchup") {
+    PaintOp op;
+    op.points = {p};
+    op.material = material_preset(material);
+    op.sigma = 0.08;
+    return op;
+}
+
+TEST(LiveScene, FollowsEveryKindOfChangeToTheFreshSolution) {
+    Document doc(testing::make_cube_mesh(7), material_preset("marble"));
+    Lighting lighting = key_lighting();
+    LiveScene scene(doc.mesh(), lighting, options());
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "initial");
+
+    // Paint inside (eta unchanged for the rows) and at the surface with a different eta.
+    auto update = scene.apply_change(doc.mesh(), doc.apply(paint_at({0.5, 0.5, 0.5})));
+    EXPECT_FALSE(update.reassembled_matrix);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "paint inside");
+    update = scene.apply_change(doc.mesh(), doc.apply(paint_at({0.0, 0.5, 0.5}, "skin1")));
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "paint at the surface");
+
+    PaintOp glassy = paint_at({1.0, 0.3, 0.5});
+    glassy.material.eta = 1.9;  // unlike marble (1.5) and the other presets (1.3): q changes at the surface
+    update = scene.apply_change(doc.mesh(), doc.apply(glassy));
+    EXPECT_TRUE(update.recomputed_light);
+    EXPECT_FALSE(update.rebuilt_surface);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "paint with another eta");
+
+    update = scene.apply_change(doc.mesh(), doc.apply(SetMaterialOp{material_preset("skin2"), std::nullopt}));
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "set material");
+
+    PlaneCutOp cut;
+    cut.plane = {Eigen::Vector3d(1, 0.3, 0.2), 0.6};
+    update = scene.apply_change(doc.mesh(), doc.apply(cut));
+    EXPECT_TRUE(update.reassembled_matrix);
+    EXPECT_FALSE(update.rebuilt_connectivity);  // reused from the cut
+    EXPECT_TRUE(update.warm_start);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "cut");
+
+    update = scene.apply_change(doc.mesh(), doc.apply(RelaxOp{cut.plane, RelaxSettings{5, 0.3, 0.5}}));
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "relax");
+
+    lighting.lights[0].vector = Eigen::Vector3d(-1, -0.2, 0.4).normalized();
+    lighting.lights.push_back(Light{LightType::Point, Eigen::Vector3d(0.5, 2, 0.5), {0.5, 0.4, 0.3}});
+    update = scene.set_lighting(lighting);
+    EXPECT_TRUE(update.recomputed_light);
+    EXPECT_FALSE(update.reassembled_matrix);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "relight");
+
+    while (doc.can_undo()) {
+        const auto report = doc.undo();
+        scene.apply_change(doc.mesh(), *report);
+        expect_matches_fresh_solve(scene, doc.mesh(), lighting, report->name);
+    }
+}
+
+TEST(LiveScene, FollowsFracturesMovesWeldsAndExactCuts) {
+    Document doc(testing::make_cube_mesh(7), material_preset("marble"));
+    const Lighting lighting = key_lighting();
+    LiveScene scene(doc.mesh(), lighting, options());
+    scene.converge();
+
+    FractureOp fracture;
+    fracture.seeds = {Eigen::Vector3d(0.3, 0.5, 0.5), Eigen::Vector3d(0.7, 0.5, 0.5)};
+    SceneUpdate update = scene.apply_change(doc.mesh(), doc.apply(fracture));
+    EXPECT_TRUE(update.reassembled_matrix);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "fracture");
+
+    // Pulled apart and turned: light now reaches the crack faces, shadows move; the matrix stays.
+    MovePieceOp pull;
+    pull.piece = 1;
+    pull.transform.rotation = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    pull.transform.translation = Eigen::Vector3d(0.5, 0.1, 0);
+    update = scene.apply_change(doc.mesh(), doc.apply(pull));
+    EXPECT_TRUE(update.rebuilt_surface);
+    EXPECT_FALSE(update.reassembled_matrix);
+    EXPECT_TRUE(update.warm_start);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "move");
+
+    scene.apply_change(doc.mesh(), *doc.undo());
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "undo move");
+    scene.apply_change(doc.mesh(), doc.apply(WeldOp{1e-9}));
+    EXPECT_EQ(doc.mesh().piece_transforms.size(), 1u);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "weld");
+
+    PlaneCutOp exact;
+    exact.plane = {Eigen::Vector3d(1, 0.3, 0.2), 0.6};
+    exact.exact = true;
+    update = scene.apply_change(doc.mesh(), doc.apply(exact));
+    EXPECT_TRUE(update.warm_start);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "exact cut");
+}
+
+TEST(LiveScene, PaintRewritesExactlyTheRowsOfThePaintedTets) {
+    Document doc(testing::make_cube_mesh(7), material_preset("marble"));
+    LiveScene scene(doc.mesh(), key_lighting(), options());
+    const ChangeReport paint = doc.apply(paint_at({0.4, 0.5, 0.6}));
+    const SceneUpdate update = scene.apply_change(doc.mesh(), paint);
+    std::set<int32_t> expected;
+    for (const int32_t t : paint.changed_material_tets)
+        for (const int32_t v : doc.mesh().tets[t]) expected.insert(v);
+    ASSERT_FALSE(expected.empty());
+    EXPECT_LT(expected.size(), doc.mesh().vertex_count() / 2);
+    EXPECT_EQ(update.updated_rows, std::vector<int32_t>(expected.begin(), expected.end()));
+    EXPECT_FALSE(update.reassembled_matrix);
+    EXPECT_FALSE(update.recomputed_values);
+    EXPECT_FALSE(update.rebuilt_surface);
+    EXPECT_FALSE(update.recomputed_light);  // the brush stays inside: no boundary eta, so no q, changes
+}
+
+TEST(LiveScene, StepsAreBoundedAndAConvergedSceneIsIdle) {
+    Document doc(testing::make_cube_mesh(7), material_preset("marble"));
+    LiveSceneOptions o = options();
+    o.relative_tolerance = 1e-6;
+    LiveScene scene(doc.mesh(), key_lighting(), o);
+    FrameReport frame = scene.step(3);
+    for (int c = 0; c < 3; ++c) EXPECT_LE(frame.iterations[c], 3);
+    EXPECT_FALSE(frame.converged);
+    const double first_error = frame.max_error();
+    for (int i = 0; i < 200 && !frame.converged; ++i) frame = scene.step(3);
+    EXPECT_TRUE(frame.converged);
+    EXPECT_LT(frame.max_error(), first_error);
+    EXPECT_LE(frame.max_error(), 1e-6);
+    EXPECT_TRUE(scene.converged());
+    EXPECT_EQ(scene.step(3).total_iterations(), 0);
+    // An edit makes it work again.
+    scene.apply_change(doc.mesh(), doc.apply(paint_at({0.5, 0.5, 0.5})));
+    EXPECT_FALSE(scene.converged());
+    EXPECT_GT(scene.step(3).total_iterations(), 0);
+}
+
+TEST(LiveScene, TimeBudgetedStepsReachTheTolerance) {
+    Document doc(testing::make_cube_mesh(6), material_preset("marble"));
+    LiveSceneOptions o = options();
+    o.relative_tolerance = 1e-6;
+    LiveScene scene(doc.mesh(), key_lighting(), o);
+    FrameReport frame = scene.step_for(0, 2);  // a zero budget still runs one chunk
+    EXPECT_GT(frame.total_iterations(), 0);
+    EXPECT_LE(frame.iterations[0], 2);
+    for (int i = 0; i < 1000 && !frame.converged; ++i) frame = scene.step_for(1.0, 2);
+    EXPECT_TRUE(frame.converged);
+    EXPECT_THROW(scene.step_for(-1), InvalidArgumentError);
+}
+
+}  // namespace
+}  // namespace waxwork

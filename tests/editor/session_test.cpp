@@ -1,0 +1,142 @@
+#include "editor/session.h"
+#include "io/volume_file.h"
+#include "solver/material.h"
+#include "tetops/error.h"
+#include "tetops/test_meshes.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+namespace waxwork {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+fs::path scratch(const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() / ("waxwork_session_test_" + name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+const fs::path kSessions = fs::path(WAXWORK_ASSET_DIR) / "sessions";
+
+TEST(Session, ExampleSessionsParseAndRoundTripThroughJson) {
+    int count = 0;
+    for (const auto& entry : fs::directory_iterator(kSessions)) {
+        if (entry.path().extension() != ".json") continue;
+        ++count;
+        const Session session = read_session(entry.path());
+        EXPECT_FALSE(session.steps.empty()) << entry.path();
+        const Json json = session_to_json(session);
+        const Session again = parse_session(json, "", "again");
+        EXPECT_EQ(session_to_json(again).dump(), json.dump()) << entry.path();
+    }
+    EXPECT_GE(count, 3);
+}
+
+std::string session_error(const std::string& text) {
+    const fs::path dir = scratch("errors");
+    const fs::path path = dir / "bad.json";
+    std::ofstream(path) << text;
+    try {
+        read_session(path);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+TEST(Session, ErrorsNameTheFileAndTheStep) {
+    const std::string head = R"({"input": {"volume": "v.vtu"}, "steps": [{"render": "a.png"}, )";
+    std::string e = session_error(head + R"({"op": "paint", "points": [[0,0,0]], "material": "marble", "sigma": 0}]})");
+    EXPECT_NE(e.find("bad.json: step 1: paint: field 'sigma'"), std::string::npos) << e;
+    e = session_error(head + R"({"undo": 0}]})");
+    EXPECT_NE(e.find("bad.json: step 1: field 'undo'"), std::string::npos) << e;
+    e = session_error(head + R"({"render": "b.png", "frame": 2}]})");
+    EXPECT_NE(e.find("step 1: unknown field 'frame'"), std::string::npos) << e;
+    e = session_error(head + R"({"light": {"lights": [{"direction": [0,0,0]}]}}]})");
+    EXPECT_NE(e.find("step 1: field 'light'"), std::string::npos) << e;
+    e = session_error(R"({"input": {"volume": "v.vtu", "max_tets": 5}, "steps": []})");
+    EXPECT_NE(e.find("bad.json: field 'input'"), std::string::npos) << e;
+    e = session_error(R"({"input": {"volume": "v.vtu"}, "steps": [})");
+    EXPECT_NE(e.find("bad.json: not valid JSON"), std::string::npos) << e;
+}
+
+TEST(Session, RunErrorsNameTheStep) {
+    const fs::path dir = scratch("run_errors");
+    write_volume(testing::make_cube_mesh(3), dir / "cube.vtu");
+    std::ofstream(dir / "s.json") << R"({"input": {"volume": "cube.vtu"}, "steps": [{"save": "a.vtu"}, {"undo": 1}]})";
+    try {
+        run_session(read_session(dir / "s.json"), dir / "out");
+        FAIL() << "no error";
+    } catch (const InvalidArgumentError& e) {
+        EXPECT_NE(std::string(e.what()).find("s.json: step 1 (undo): nothing left to undo"), std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(Session, RecordedHistoryReplaysToTheSameVolumeBitForBit) {
+    const fs::path dir = scratch("record");
+    write_volume(testing::make_cube_mesh(6), dir / "cube.vtu");
+    Session setup;
+    setup.name = "setup";
+    setup.input.volume = dir / "cube.vtu";
+    setup.material = material_preset("marble");
+    setup.scale = 10;
+
+    Document doc(read_volume(setup.input.volume), setup.material);
+    PaintOp paint;
+    paint.points = {Eigen::Vector3d(0.3, 0.4, 0.5), Eigen::Vector3d(0.35, 0.45, 0.5)};
+    paint.material = material_preset("ketchup");
+    paint.sigma = 0.1;
+    PlaneCutOp cut;
+    cut.plane = {Eigen::Vector3d(1, 0.1, -0.2), 0.6};
+    doc.apply(paint);
+    doc.apply(cut);
+    doc.apply(SetMaterialOp{material_preset("skin1"), 0});
+    doc.undo();  // not part of the record
+    StrokeCutOp stroke;
+    stroke.stroke = {Eigen::Vector3d(0.5, 0.5, 5), Eigen::Vector3d(0, 0, -1),
+                     {Eigen::Vector3d(0.1, -1, 4), Eigen::Vector3d(0.3, 2, 4)}, true};
+    doc.apply(stroke);
+    paint.points = {Eigen::Vector3d(0.5, 0.5, 0.5)};
+    doc.apply(paint);
+
+    write_session(dir / "recorded.json", record_session(setup, doc, {SaveStep{"replayed.vtu"}}));
+    const Session replay = read_session(dir / "recorded.json");
+    EXPECT_EQ(replay.steps.size(), 5u);
+    const SessionResult result = run_session(replay, dir / "out");
+    EXPECT_TRUE(result.mesh == doc.mesh());
+    EXPECT_TRUE(read_volume(dir / "out" / "replayed.vtu") == doc.mesh());
+    // Metrics: one entry per step with the sizes after it.
+    std::ifstream metrics_file(dir / "out" / "metrics.json");
+    const Json metrics = Json::parse(metrics_file);
+    ASSERT_EQ(metrics.at("steps").size(), replay.steps.size());
+    EXPECT_EQ(metrics.at("steps").back().at("tets").get<size_t>(), doc.mesh().tet_count());
+    EXPECT_EQ(metrics.at("steps").front().at("name"), "paint");
+}
+
+TEST(Session, UndoAndRedoStepsReplay) {
+    const fs::path dir = scratch("undo");
+    const TetMesh cube = testing::make_cube_mesh(4);
+    write_volume(cube, dir / "cube.vtu");
+    std::ofstream(dir / "s.json") << R"({"input": {"volume": "cube.vtu"}, "scale": 10, "steps": [
+        {"op": "plane_cut", "normal": [1, 0, 0], "offset": 0.5},
+        {"op": "paint", "points": [[0.2, 0.2, 0.2]], "material": "ketchup", "sigma": 0.1},
+        {"undo": 2}, {"save": "start.vtu"}, {"redo": 1}, {"save": "cut.vtu"}]})";
+    const SessionResult result = run_session(read_session(dir / "s.json"), dir / "out");
+    Document expected(cube, material_preset("marble"));
+    EXPECT_TRUE(read_volume(dir / "out" / "start.vtu") == expected.mesh());
+    PlaneCutOp cut;
+    cut.plane = {Eigen::Vector3d(1, 0, 0), 0.5};
+    expected.apply(cut);
+    EXPECT_TRUE(result.mesh == expected.mesh());
+}
+
+}  // namespace
+}  // namespace waxwork
