@@ -1,5 +1,5 @@
 // `waxwork bench`: measurements that back the README's performance claims, written as JSON and SVG.
-//   waxwork bench solvers --mesh MESH [--max-tets N] -o DIR [--backend cpu]
+//   waxwork bench solvers --mesh MESH [--max-tets N] -o DIR [--backend cpu|gpu]
 // `bench` itself takes the subcommand; it is a CLI11 app with an optional subcommand so that a later
 // `waxwork bench [--quick] -o DIR` (all benchmarks) can be the parent's own action.
 #include "editor/bench_suite.h"
@@ -78,7 +78,20 @@ void run_solvers_command(const SolversCommandOptions& o) {
     options.mm_per_unit = mm_per_unit(mesh, o.scale);
     options.floor_error = o.floor_error;
     options.max_seconds = o.max_seconds;
+    // --backend gpu adds the GPU curves (OpenGL compute shaders; OSMesa's llvmpipe unless
+    // WAXWORK_GL_DEVICE=egl finds a GPU); the CPU curves stay for comparison.
+    std::unique_ptr<HeadlessGlContext> context;
+    if (o.backend == "gpu") {
+        try {
+            context = std::make_unique<HeadlessGlContext>();
+            options.gl = &context->gl();
+        } catch (const Error& e) {
+            std::cerr << "warning: no GPU curves: " << e.what() << "\n";
+        }
+    }
     const SolverComparison comparison = compare_solvers(mesh, connectivity, materials, lighting, options);
+    if (!comparison.gpu_fallback_reason.empty())
+        std::cerr << "warning: no GPU curves: " << comparison.gpu_fallback_reason << "\n";
 
     const std::filesystem::path dir(o.output);
     std::error_code error;
@@ -89,7 +102,7 @@ void run_solvers_command(const SolversCommandOptions& o) {
     nlohmann::ordered_json summary_times = nlohmann::ordered_json::object();
     for (const SolverCurve& s : comparison.solvers)
         summary_times[s.name] = s.time_to_target_ms ? nlohmann::ordered_json(*s.time_to_target_ms) : nullptr;
-    const nlohmann::ordered_json summary = {
+    nlohmann::ordered_json summary = {
         {"output", o.output},
         {"tets", comparison.tets},
         {"vertices", comparison.vertices},
@@ -98,6 +111,7 @@ void run_solvers_command(const SolversCommandOptions& o) {
         {"multigrid_setup_ms", comparison.multigrid_setup_ms},
         {"time_to_1pct_ms", summary_times},
     };
+    if (context) summary["gpu_renderer"] = context->renderer();
     std::cout << summary.dump() << "\n";
 }
 
@@ -140,8 +154,9 @@ void add_bench_command(CLI::App& app) {
         ->check(CLI::ExistingFile);
     cmd->add_option("--max-tets", options->max_tets, "Mesh a surface with about this many tets");
     cmd->add_option("-o,--output", options->output, "Output directory")->required();
-    cmd->add_option("--backend", options->backend, "Solver backend")
-        ->check(CLI::IsMember({"cpu"}))
+    cmd->add_option("--backend", options->backend,
+                    "cpu, or gpu: also the GPU solvers (gpu_cg, gpu_multires) on OpenGL compute shaders")
+        ->check(CLI::IsMember({"cpu", "gpu"}))
         ->capture_default_str();
     cmd->add_option("--scale", options->scale, "Millimetres per model unit (default: longest side 100 mm)");
     cmd->add_option("--floor", options->floor_error, "Stop each curve below this relative error")

@@ -2,10 +2,12 @@
 
 #include "editor/svg_chart.h"
 #include "io/atomic_file.h"
+#include "multires/gpu_multires_solver.h"
 #include "multires/multigrid_cg.h"
 #include "multires/multires_solver.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
+#include "solver/gpu_conjugate_gradient.h"
 #include "solver/reference_solvers.h"
 #include "tetops/error.h"
 
@@ -215,6 +217,39 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
             std::copy(xc.data(), xc.data() + xc.size(), x[c].begin());
         }
     }));
+
+    // The GPU path: CG and the multires scheme in float on compute shaders, matrices resident (the
+    // upload is per-mesh setup, excluded); cap = level-0 CG iterations.
+    if (options.gl) {
+        try {
+            auto read_back = [](const std::vector<std::array<double, 3>>& phi, Fields& x) {
+                for (size_t i = 0; i < phi.size(); ++i)
+                    for (size_t c = 0; c < 3; ++c) x[c][i] = phi[i][c];
+            };
+            GpuDiffusionSolver gpu(*options.gl, matrix);
+            gpu.set_right_hand_side(b);
+            const std::vector<std::array<double, 3>> zero(n, {0.0, 0.0, 0.0});
+            result.solvers.push_back(measurer.curve("gpu_cg", [&](int cap, Fields& x) {
+                gpu.set_solution(zero);
+                GpuCgOptions cg;
+                cg.relative_tolerance = 1e-15;
+                cg.max_iterations = cap;
+                gpu.solve(cg);
+                read_back(gpu.solution(), x);
+            }));
+            GpuMultiresSolver gpu_multires(*options.gl, matrix, multires.hierarchy());
+            gpu_multires.set_right_hand_side(b);
+            result.solvers.push_back(measurer.curve("gpu_multires", [&](int cap, Fields& x) {
+                MultiresSolveOptions solve;
+                solve.relative_tolerance = 1e-15;
+                solve.max_iterations = cap;
+                gpu_multires.solve(solve);
+                read_back(gpu_multires.solution(), x);
+            }));
+        } catch (const GpuError& e) {
+            result.gpu_fallback_reason = e.what();
+        }
+    }
 
     // Direct: one point, factorisation and solve.
     SolverCurve direct;

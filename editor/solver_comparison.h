@@ -23,6 +23,7 @@
 // and the direct solver's time is factorisation plus solve.
 #pragma once
 
+#include "solver/gl_context.h"
 #include "solver/lighting.h"
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
@@ -40,6 +41,9 @@ struct SolverComparisonOptions {
     double target_error = 1e-2;   // time_to_1pct_ms
     double floor_error = 1e-4;    // a curve stops once below this
     double max_seconds = 60.0;    // per solver, measuring included
+    // When set (a current OpenGL >= 4.3 context): also the GPU curves gpu_cg (solver/gpu_conjugate_gradient.h)
+    // and gpu_multires (multires/gpu_multires_solver.h); their times include reading phi back.
+    const GlApi* gl = nullptr;
 };
 
 struct SolverCurve {
@@ -52,7 +56,9 @@ struct SolverComparison {
     size_t tets = 0, vertices = 0, levels = 0;
     double hierarchy_ms = 0;
     double multigrid_setup_ms = 0;
-    std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, eigen_ic_cg, direct
+    std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, eigen_ic_cg,
+                                       // [gpu_cg, gpu_multires,] direct
+    std::string gpu_fallback_reason;   // options.gl given but the GPU could not run (curves left out)
 };
 
 // Assembles the TransCut system (materials per tet), lights it (q from `lighting`) and compares the

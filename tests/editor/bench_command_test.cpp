@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -16,6 +17,29 @@ namespace {
 
 using testing::run_waxwork;
 using testing::scratch_dir;
+
+// A solver's entry: a strictly monotone curve ending below 1%, and its time to 1%.
+void expect_valid_curve(const nlohmann::json& solvers, const std::string& name) {
+    ASSERT_TRUE(solvers.contains(name)) << name;
+    const auto& s = solvers[name];
+    EXPECT_EQ(s.size(), 2u) << name;
+    const auto& curve = s["curve"];
+    ASSERT_FALSE(curve.empty()) << name;
+    double last_ms = 0, best_error = 2;
+    for (const auto& point : curve) {
+        ASSERT_EQ(point.size(), 2u);
+        const double ms = point[0].get<double>(), error = point[1].get<double>();
+        EXPECT_GT(ms, last_ms) << name;  // strictly increasing time
+        EXPECT_GE(error, 0.0);
+        last_ms = ms;
+        best_error = std::min(best_error, error);
+    }
+    EXPECT_LT(best_error, 1e-2) << name;
+    ASSERT_TRUE(s["time_to_1pct_ms"].is_number()) << name;
+    EXPECT_GT(s["time_to_1pct_ms"].get<double>(), 0.0) << name;
+    // The last cap is always kept (noise only drops earlier points) and is below 1%.
+    EXPECT_LT(curve.back()[1].get<double>(), 1e-2) << name;
+}
 
 TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
     const auto dir = scratch_dir("bench_solvers");
@@ -34,31 +58,38 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
     EXPECT_GE(json["levels"].get<int>(), 1);
     EXPECT_GE(json["hierarchy_ms"].get<double>(), 0.0);
     const auto& solvers = json["solvers"];
-    for (const std::string name : {"jacobi_cg", "jacobi_cg_double", "multires", "multigrid_cg", "eigen_ic_cg", "direct"}) {
-        ASSERT_TRUE(solvers.contains(name)) << name;
-        const auto& s = solvers[name];
-        EXPECT_EQ(s.size(), 2u) << name;
-        const auto& curve = s["curve"];
-        ASSERT_FALSE(curve.empty()) << name;
-        double last_ms = 0, best_error = 2;
-        for (const auto& point : curve) {
-            ASSERT_EQ(point.size(), 2u);
-            const double ms = point[0].get<double>(), error = point[1].get<double>();
-            EXPECT_GT(ms, last_ms) << name;  // strictly increasing time
-            EXPECT_GE(error, 0.0);
-            last_ms = ms;
-            best_error = std::min(best_error, error);
-        }
-        EXPECT_LT(best_error, 1e-2) << name;
-        ASSERT_TRUE(s["time_to_1pct_ms"].is_number()) << name;
-        EXPECT_GT(s["time_to_1pct_ms"].get<double>(), 0.0) << name;
-        // The last cap is always kept (noise only drops earlier points) and is below 1%.
-        EXPECT_LT(curve.back()[1].get<double>(), 1e-2) << name;
-    }
+    for (const std::string name : {"jacobi_cg", "jacobi_cg_double", "multires", "multigrid_cg", "eigen_ic_cg", "direct"})
+        expect_valid_curve(solvers, name);
+    EXPECT_FALSE(solvers.contains("gpu_cg"));
     const std::string svg = testing::read_text(out / "solvers.svg");
     EXPECT_NE(svg.find("<svg"), std::string::npos);
     for (const std::string name : {"jacobi_cg", "multigrid_cg", "direct"}) EXPECT_NE(svg.find(name), std::string::npos);
     EXPECT_EQ(std::distance(std::filesystem::directory_iterator(out), std::filesystem::directory_iterator{}), 2);
+}
+
+// --backend gpu adds the GPU curves (llvmpipe here); a driver that rejects a shader leaves them out
+// with a one-line warning.
+TEST(BenchSolversCommand, GpuBackendAddsGpuCurvesOrWarns) {
+    const auto dir = scratch_dir("bench_solvers_gpu");
+    const auto volume = dir / "cube.vtu";
+    write_volume(testing::make_cube_mesh(9, Eigen::Vector3d::Zero(), 1.0), volume);
+    const std::string args = "bench solvers --mesh " + volume.string() + " --backend gpu --floor 1e-3 --max-seconds 20 -o ";
+    const auto result = run_waxwork(args + (dir / "gpu").string());
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    EXPECT_TRUE(result.err.empty()) << result.err;
+    EXPECT_FALSE(nlohmann::json::parse(result.out)["gpu_renderer"].get<std::string>().empty());
+    const auto json = nlohmann::json::parse(testing::read_text(dir / "gpu" / "solvers.json"));
+    for (const std::string name : {"gpu_cg", "gpu_multires", "jacobi_cg"}) expect_valid_curve(json["solvers"], name);
+
+    setenv("WAXWORK_GPU_FORCE_FAIL", "1", 1);
+    const auto forced = run_waxwork(args + (dir / "forced").string());
+    unsetenv("WAXWORK_GPU_FORCE_FAIL");
+    ASSERT_EQ(forced.exit_code, 0) << forced.err;
+    EXPECT_EQ(testing::line_count(forced.err), 1u) << forced.err;
+    EXPECT_NE(forced.err.find("warning: no GPU curves"), std::string::npos) << forced.err;
+    const auto without = nlohmann::json::parse(testing::read_text(dir / "forced" / "solvers.json"));
+    EXPECT_FALSE(without["solvers"].contains("gpu_cg"));
+    EXPECT_TRUE(without["solvers"].contains("jacobi_cg"));
 }
 
 TEST(BenchSolversCommand, RejectsBadInvocationsWithOneLine) {
@@ -70,9 +101,9 @@ TEST(BenchSolversCommand, RejectsBadInvocationsWithOneLine) {
         run_waxwork("bench solvers --mesh " + std::string(WAXWORK_ASSET_DIR) + "/meshes/spot.obj -o " + dir.string());
     EXPECT_EQ(surface_without_size.exit_code, 1);
     EXPECT_NE(surface_without_size.err.find("--max-tets"), std::string::npos) << surface_without_size.err;
-    const auto gpu = run_waxwork("bench solvers --mesh " + std::string(WAXWORK_ASSET_DIR) +
-                                 "/meshes/spot.obj --max-tets 50000 --backend gpu -o " + dir.string());
-    EXPECT_EQ(gpu.exit_code, 2);
+    const auto backend = run_waxwork("bench solvers --mesh " + std::string(WAXWORK_ASSET_DIR) +
+                                     "/meshes/spot.obj --max-tets 50000 --backend cuda -o " + dir.string());
+    EXPECT_EQ(backend.exit_code, 2);
     const auto bare = run_waxwork("bench");
     EXPECT_NE(bare.exit_code, 0);
     EXPECT_EQ(testing::line_count(bare.err), 1u) << bare.err;
