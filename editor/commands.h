@@ -13,19 +13,23 @@ void add_info_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_demo_command(CLI::App& app);
 void add_cut_command(CLI::App& app);
+void add_fracture_command(CLI::App& app);
 void add_paint_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_edit_command(CLI::App& app);
 
 inline void register_commands(CLI::App& app) {
     add_mesh_command(app);
     add_info_command(app);
     add_render_command(app);
     add_cut_command(app);
+    add_fracture_command(app);
     add_paint_command(app);
     add_run_command(app);
     add_demo_command(app);
     add_bench_command(app);
+    add_edit_command(app);
 }
 
 }  // namespace waxwork

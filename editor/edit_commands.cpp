@@ -1,5 +1,7 @@
-// `waxwork cut` and `waxwork paint`: the editing operations of TransCut Sec. 5 from the command line.
-//   waxwork cut VOLUME -o OUT --plane=NX,NY,NZ,D [--relax ITERS] [--no-guard]
+// `waxwork cut`, `waxwork fracture` and `waxwork paint`: the editing operations of TransCut Sec. 5 (and
+// issue 6's exact cut and fracture) from the command line.
+//   waxwork cut VOLUME -o OUT --plane=NX,NY,NZ,D [--relax ITERS] [--no-guard] [--exact]
+//   waxwork fracture VOLUME -o OUT --pieces N [--seed K] [--exact|--no-exact] [--min-piece-tets M]
 //   waxwork paint VOLUME -o OUT --at "X,Y,Z;X,Y,Z" (--material NAME | --mua R,G,B --musp R,G,B --eta N)
 //                 --sigma S [--base NAME]
 // Each prints a one-line JSON summary on stdout.
@@ -9,6 +11,8 @@
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
 #include "tetops/error.h"
+#include "tetops/exact_cut.h"
+#include "tetops/fracture.h"
 #include "tetops/paint.h"
 #include "tetops/quality.h"
 #include "tetops/relaxation.h"
@@ -63,11 +67,6 @@ std::vector<double> parse_numbers(const std::string& text, size_t count, const s
     return values;
 }
 
-double min_dihedral_or_zero(const TetMesh& mesh) {
-    const std::vector<double> angles = min_dihedral_angles_deg(mesh);
-    return angles.empty() ? 0.0 : *std::min_element(angles.begin(), angles.end());
-}
-
 struct CutCommandOptions {
     std::string input;
     std::string output;
@@ -77,12 +76,39 @@ struct CutCommandOptions {
     bool exact = false;
 };
 
+// Exact mode: tets crossed by the plane are split along it, so no relaxation is needed.
+void run_exact_cut(const CutCommandOptions& o, const PlaneCut& plane) {
+    TetMesh mesh = read_volume(o.input);
+    const size_t tets_before = mesh.tet_count();
+    const size_t vertices_before = mesh.vertex_count();
+    const auto start = Clock::now();
+    const ExactCutResult cut = cut_exact(mesh, plane);
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    const double elapsed = milliseconds_since(start);
+    write_volume(mesh, o.output);
+    nlohmann::ordered_json summary = {
+        {"output", o.output},
+        {"mode", "exact"},
+        {"tets_before", tets_before},
+        {"vertices_before", vertices_before},
+        {"tets_after", mesh.tet_count()},
+        {"vertices_after", mesh.vertex_count()},
+        {"tets_removed", cut.tets_removed},
+        {"tets_split", cut.tets_split},
+        {"vertices_snapped", cut.vertices_snapped},
+        {"vertices_added", cut.vertices_added},
+        {"components", connectivity.component_count},
+        {"min_dihedral_deg", cut.min_dihedral_deg},
+        {"milliseconds", elapsed},
+    };
+    std::cout << summary.dump() << "\n";
+}
+
 void run_cut_command(const CutCommandOptions& o) {
-    if (o.exact)
-        throw InvalidArgumentError("cut --exact (splitting tets along the surface) is not implemented yet");
-    if (o.relax_iterations < 0) throw InvalidArgumentError("cut --relax: the iteration count must be >= 0");
     const std::vector<double> p = parse_numbers(o.plane, 4, "cut --plane");
     const PlaneCut plane(Eigen::Vector3d(p[0], p[1], p[2]), p[3]);
+    if (o.exact) return run_exact_cut(o, plane);
+    if (o.relax_iterations < 0) throw InvalidArgumentError("cut --relax: the iteration count must be >= 0");
 
     TetMesh mesh = read_volume(o.input);
     const size_t tets_before = mesh.tet_count();
@@ -100,6 +126,7 @@ void run_cut_command(const CutCommandOptions& o) {
     write_volume(mesh, o.output);
     nlohmann::ordered_json summary = {
         {"output", o.output},
+        {"mode", "relax"},
         {"tets_before", tets_before},
         {"vertices_before", vertices_before},
         {"tets_after", mesh.tet_count()},
@@ -111,6 +138,52 @@ void run_cut_command(const CutCommandOptions& o) {
         {"moves_rejected", report.moves_rejected},
         {"guard_deg", relax.min_dihedral_guard_deg},
         {"min_dihedral_deg", report.min_dihedral_deg},
+        {"milliseconds", elapsed},
+    };
+    std::cout << summary.dump() << "\n";
+}
+
+struct FractureCommandOptions {
+    std::string input;
+    std::string output;
+    int pieces = 0;
+    uint32_t seed = 1;
+    bool exact = true;
+    int min_piece_tets = FractureOptions{}.min_piece_tets;
+};
+
+// More cells than this is not a fracture but a re-meshing; the passes cost O(pieces x tets).
+constexpr int kMaxFracturePieces = 1000;
+
+void run_fracture_command(const FractureCommandOptions& o) {
+    if (o.pieces < 1 || o.pieces > kMaxFracturePieces)
+        throw InvalidArgumentError("fracture --pieces: must be between 1 and " + std::to_string(kMaxFracturePieces) +
+                                   ", got " + std::to_string(o.pieces));
+    if (o.min_piece_tets < 0) throw InvalidArgumentError("fracture --min-piece-tets: must be >= 0");
+    TetMesh mesh = read_volume(o.input);
+    const size_t tets_before = mesh.tet_count();
+    const size_t vertices_before = mesh.vertex_count();
+    const auto start = Clock::now();
+    const std::vector<Eigen::Vector3d> seeds = scatter_fracture_seeds(mesh, o.pieces, o.seed);
+    FractureOptions options;
+    options.exact = o.exact;
+    options.min_piece_tets = o.min_piece_tets;
+    const FractureResult result = fracture_voronoi(mesh, seeds, options);
+    const double elapsed = milliseconds_since(start);
+    write_volume(mesh, o.output);
+    nlohmann::ordered_json summary = {
+        {"output", o.output},
+        {"mode", o.exact ? "exact" : "tet_faces"},
+        {"seed", o.seed},
+        {"tets_before", tets_before},
+        {"vertices_before", vertices_before},
+        {"tets_after", mesh.tet_count()},
+        {"vertices_after", mesh.vertex_count()},
+        {"pieces_before", result.pieces_before},
+        {"pieces", result.pieces_after},
+        {"tets_split", result.tets_split},
+        {"vertices_duplicated", result.vertices_duplicated},
+        {"min_dihedral_deg", result.min_dihedral_deg},
         {"milliseconds", elapsed},
     };
     std::cout << summary.dump() << "\n";
@@ -171,7 +244,7 @@ void run_paint_command(const PaintCommandOptions& o) {
         {"vertices_after", mesh.vertex_count()},
         {"stroke_points", stroke.size()},
         {"tets_changed", result.changed_tets.size()},
-        {"min_dihedral_deg", min_dihedral_or_zero(mesh)},
+        {"min_dihedral_deg", mesh_min_dihedral_deg(mesh)},
         {"milliseconds", elapsed},
     };
     std::cout << summary.dump() << "\n";
@@ -191,10 +264,31 @@ void add_cut_command(CLI::App& app) {
         ->capture_default_str();
     cmd->add_flag("--no-guard", options->no_guard,
                   "Let relaxation create tets under 0.5 degrees (paper Fig. 9(a); for comparison only)");
-    cmd->add_flag("--exact", options->exact, "Split tets along the plane (not implemented yet)");
+    cmd->add_flag("--exact", options->exact,
+                  "Split the tets crossed by the plane along it instead of relaxing (--relax and --no-guard are "
+                  "then unused)");
     cmd->footer("Tets with all four vertices on the side n.x > D are removed (TransCut Sec. 5); vertices left there\n"
-                "then move toward their one-ring average, never across the plane and never below the guard.");
+                "then move toward their one-ring average, never across the plane and never below the guard.\n"
+                "--exact: vertices within 20% of an edge from the plane snap onto it (when no tet of their star\n"
+                "drops under 0.5 degrees), every other crossed edge is split, crossed tets are split into tets on\n"
+                "either side and the side n.x > D is removed: the cross-section lies on the plane.");
     cmd->callback([options] { run_cut_command(*options); });
+}
+
+void add_fracture_command(CLI::App& app) {
+    auto options = std::make_shared<FractureCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("fracture", "Break a volume into pieces along Voronoi cells");
+    cmd->add_option("input", options->input, "Volume file (.vtu, .msh, .mesh, .node)")->required()->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", options->output, "Volume file to write (.vtu keeps the pieces)")->required();
+    cmd->add_option("--pieces", options->pieces, "Number of Voronoi seeds (pieces)")->required();
+    cmd->add_option("--seed", options->seed, "Random seed for the seed points")->capture_default_str();
+    cmd->add_flag("--exact,!--no-exact", options->exact,
+                  "Split tets along the cell walls (flat cracks; default) or keep whole tets (cracks on tet faces)");
+    cmd->add_option("--min-piece-tets", options->min_piece_tets, "Smaller pieces join their largest neighbour")
+        ->capture_default_str();
+    cmd->footer("Seeds are scattered uniformly in the volume; each cell's part of each piece becomes a piece (a cell\n"
+                "cut in two by a concave volume gives two), with the crack vertices duplicated so pieces move apart.");
+    cmd->callback([options] { run_fracture_command(*options); });
 }
 
 void add_paint_command(CLI::App& app) {

@@ -224,35 +224,29 @@ void validate_input(const SurfaceRenderInput& input) {
 
 }  // namespace
 
-CameraFrame frame_camera(const Eigen::AlignedBox3d& box, const CameraSettings& camera, double aspect) {
-    if (box.isEmpty() || !box.min().allFinite() || !box.max().allFinite()) {
-        throw InvalidArgumentError("camera: empty or non-finite bounding box");
+CameraFrame look_at_frame(const Eigen::Vector3d& target, const Eigen::Vector3d& eye_direction,
+                          const Eigen::Vector3d& up_hint, double distance, double radius, double fov_y_degrees,
+                          double aspect) {
+    if (!target.allFinite() || !std::isfinite(distance) || !(distance > 0) || !std::isfinite(radius) || !(radius > 0)) {
+        throw InvalidArgumentError("camera: target, distance and radius must be finite, distance and radius positive");
     }
-    if (!camera.eye_direction.allFinite() || camera.eye_direction.norm() == 0) {
+    if (!eye_direction.allFinite() || eye_direction.norm() == 0) {
         throw InvalidArgumentError("camera: eye direction must be finite and non-zero");
     }
-    if (!(camera.fov_y_degrees > 0 && camera.fov_y_degrees < 180)) {
+    if (!(fov_y_degrees > 0 && fov_y_degrees < 180)) {
         throw InvalidArgumentError("camera: vertical field of view must be in (0, 180) degrees");
     }
-    if (!(aspect > 0) || !std::isfinite(aspect) || !(camera.margin > 0)) {
-        throw InvalidArgumentError("camera: aspect ratio and margin must be positive");
-    }
-    const Eigen::Vector3d forward = -camera.eye_direction.normalized();  // eye -> target
-    Eigen::Vector3d right = forward.cross(camera.up);
-    if (!right.allFinite() || right.norm() < 1e-9 * camera.up.norm() || camera.up.norm() == 0) {
+    if (!(aspect > 0) || !std::isfinite(aspect)) throw InvalidArgumentError("camera: aspect ratio must be positive");
+    const Eigen::Vector3d forward = -eye_direction.normalized();  // eye -> target
+    Eigen::Vector3d right = forward.cross(up_hint);
+    if (!right.allFinite() || right.norm() < 1e-9 * up_hint.norm() || up_hint.norm() == 0) {
         throw InvalidArgumentError("camera: up vector is zero or parallel to the view direction");
     }
     right.normalize();
     const Eigen::Vector3d up = right.cross(forward);
 
-    const Eigen::Vector3d centre = box.center();
-    const double radius = std::max(0.5 * box.diagonal().norm(), 1e-12);
-    const double half_fov_y = 0.5 * camera.fov_y_degrees * std::numbers::pi / 180.0;
-    const double half_fov_x = std::atan(std::tan(half_fov_y) * aspect);
-    const double distance = camera.margin * radius / std::sin(std::min(half_fov_x, half_fov_y));
-
     CameraFrame frame;
-    frame.eye = centre - distance * forward;
+    frame.eye = target - distance * forward;
     frame.view.setIdentity();
     frame.view.block<1, 3>(0, 0) = right.transpose();
     frame.view.block<1, 3>(1, 0) = up.transpose();
@@ -260,6 +254,7 @@ CameraFrame frame_camera(const Eigen::AlignedBox3d& box, const CameraSettings& c
     frame.view.block<3, 1>(0, 3) = -frame.view.block<3, 3>(0, 0) * frame.eye;
 
     // The sphere lies within [distance - radius, distance + radius] in front of the eye.
+    const double half_fov_y = 0.5 * fov_y_degrees * std::numbers::pi / 180.0;
     const double near_plane = std::max(distance - 1.5 * radius, 1e-3 * distance);
     const double far_plane = distance + 1.5 * radius;
     const double f = 1.0 / std::tan(half_fov_y);
@@ -270,6 +265,30 @@ CameraFrame frame_camera(const Eigen::AlignedBox3d& box, const CameraSettings& c
     frame.projection(2, 3) = 2 * far_plane * near_plane / (near_plane - far_plane);
     frame.projection(3, 2) = -1;
     return frame;
+}
+
+double framing_distance(double radius, double fov_y_degrees, double aspect, double margin) {
+    const double half_fov_y = 0.5 * fov_y_degrees * std::numbers::pi / 180.0;
+    const double half_fov_x = std::atan(std::tan(half_fov_y) * aspect);
+    return margin * radius / std::sin(std::min(half_fov_x, half_fov_y));
+}
+
+double bounding_radius(const Eigen::AlignedBox3d& box) { return std::max(0.5 * box.diagonal().norm(), 1e-12); }
+
+CameraFrame frame_camera(const Eigen::AlignedBox3d& box, const CameraSettings& camera, double aspect) {
+    if (box.isEmpty() || !box.min().allFinite() || !box.max().allFinite()) {
+        throw InvalidArgumentError("camera: empty or non-finite bounding box");
+    }
+    if (!(camera.fov_y_degrees > 0 && camera.fov_y_degrees < 180)) {
+        throw InvalidArgumentError("camera: vertical field of view must be in (0, 180) degrees");
+    }
+    if (!(aspect > 0) || !std::isfinite(aspect) || !(camera.margin > 0)) {
+        throw InvalidArgumentError("camera: aspect ratio and margin must be positive");
+    }
+    const double radius = bounding_radius(box);
+    return look_at_frame(box.center(), camera.eye_direction, camera.up,
+                         framing_distance(radius, camera.fov_y_degrees, aspect, camera.margin), radius,
+                         camera.fov_y_degrees, aspect);
 }
 
 SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {
@@ -300,7 +319,33 @@ SurfaceRenderer::~SurfaceRenderer() {
     gl_.DeleteProgram(program_);
 }
 
-Image SurfaceRenderer::render(const SurfaceRenderInput& input) {
+Image read_framebuffer(const GlApi& gl, int width, int height) {
+    Image image;
+    image.width = width;
+    image.height = height;
+    image.rgba.resize(4 * static_cast<size_t>(width) * static_cast<size_t>(height));
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    gl.ReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
+    check_gl_error(gl, "reading back the framebuffer");
+
+    // OpenGL's first row is the bottom one; Image's is the top one.
+    const size_t row = 4 * static_cast<size_t>(width);
+    std::vector<uint8_t> swap(row);
+    for (int y = 0; y < height / 2; ++y) {
+        uint8_t* a = image.rgba.data() + y * row;
+        uint8_t* b = image.rgba.data() + (height - 1 - y) * row;
+        std::memcpy(swap.data(), a, row);
+        std::memcpy(a, b, row);
+        std::memcpy(b, swap.data(), row);
+    }
+    return image;
+}
+
+struct SurfaceRenderer::Frame : FrameResources {
+    using FrameResources::FrameResources;
+};
+
+void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const CameraFrame& frame, Frame& r) {
     validate_input(input);
     const GlApi& gl = gl_;
     GLint max_size = 0, max_samples = 0;
@@ -312,7 +357,6 @@ Image SurfaceRenderer::render(const SurfaceRenderInput& input) {
     }
     const int samples = std::clamp(input.samples, 1, std::max(max_samples, 1));
 
-    FrameResources r(gl);
     gl.GenFramebuffers(2, r.framebuffers);
     gl.GenRenderbuffers(3, r.renderbuffers);
     gl.BindRenderbuffer(GL_RENDERBUFFER, r.renderbuffers[0]);
@@ -356,9 +400,6 @@ Image SurfaceRenderer::render(const SurfaceRenderInput& input) {
         gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(input.triangles.size() * sizeof(input.triangles[0])),
                       input.triangles.data(), GL_STATIC_DRAW);
 
-        Eigen::AlignedBox3d box;
-        for (const Eigen::Vector3f& p : input.positions) box.extend(p.cast<double>());
-        const CameraFrame frame = frame_camera(box, input.camera, static_cast<double>(input.width) / input.height);
         const Eigen::Matrix4f view_projection = to_float(frame.projection * frame.view);
 
         gl.UseProgram(program_);
@@ -397,29 +438,40 @@ Image SurfaceRenderer::render(const SurfaceRenderInput& input) {
         gl.BindTexture(GL_TEXTURE_2D, 0);
     }
 
-    // Resolve the samples, then read back.
+    // Resolve the samples.
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[0]);
     gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, r.framebuffers[1]);
     gl.BlitFramebuffer(0, 0, input.width, input.height, 0, 0, input.width, input.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[1]);
-    Image image;
-    image.width = input.width;
-    image.height = input.height;
-    image.rgba.resize(4 * static_cast<size_t>(input.width) * static_cast<size_t>(input.height));
-    gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    gl.ReadPixels(0, 0, input.width, input.height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
-    check_gl_error(gl, "surface renderer: drawing");
+}
 
-    // OpenGL's first row is the bottom one; Image's is the top one.
-    const size_t row = 4 * static_cast<size_t>(input.width);
-    std::vector<uint8_t> swap(row);
-    for (int y = 0; y < input.height / 2; ++y) {
-        uint8_t* a = image.rgba.data() + y * row;
-        uint8_t* b = image.rgba.data() + (input.height - 1 - y) * row;
-        std::memcpy(swap.data(), a, row);
-        std::memcpy(a, b, row);
-        std::memcpy(b, swap.data(), row);
-    }
+void SurfaceRenderer::draw(const SurfaceRenderInput& input, const CameraFrame& camera, GLuint target_framebuffer, int x,
+                           int y) {
+    {
+        Frame r(gl_);
+        draw_resolved(input, camera, r);
+        // A multisampled source may only be blitted to the same rectangle, so the offset copy starts
+        // from the resolved image.
+        gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[1]);
+        gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, target_framebuffer);
+        gl_.BlitFramebuffer(0, 0, input.width, input.height, x, y, x + input.width, y + input.height,
+                            GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }  // the frame's objects are released (which unbinds them)
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, target_framebuffer);
+    check_gl_error(gl_, "surface renderer: drawing into the target framebuffer");
+}
+
+Image SurfaceRenderer::render(const SurfaceRenderInput& input) {
+    validate_input(input);
+    Eigen::AlignedBox3d box;
+    for (const Eigen::Vector3f& p : input.positions) box.extend(p.cast<double>());
+    const CameraFrame frame = box.isEmpty() ? CameraFrame{} :
+        frame_camera(box, input.camera, static_cast<double>(input.width) / input.height);
+    const GlApi& gl = gl_;
+    Frame r(gl);
+    draw_resolved(input, frame, r);
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[1]);
+    Image image = read_framebuffer(gl, input.width, input.height);
+    check_gl_error(gl, "surface renderer: drawing");
     return image;
 }
 

@@ -38,6 +38,20 @@ struct CameraFrame {
 // of view outside (0, 180) degrees, or an empty box.
 CameraFrame frame_camera(const Eigen::AlignedBox3d& box, const CameraSettings& camera, double aspect);
 
+// The eye at target + distance * eye_direction (normalised) looking at `target`, `up_hint` giving the
+// image's up; near and far planes enclose a sphere of `radius` around the target. frame_camera is this
+// with the box's centre and framing distance, and the editor's orbit camera calls it too, so both give
+// identical matrices for the same pose (the editor's first frame equals `waxwork render`'s image).
+// Throws InvalidArgumentError like frame_camera, and for a non-positive distance or radius.
+CameraFrame look_at_frame(const Eigen::Vector3d& target, const Eigen::Vector3d& eye_direction,
+                          const Eigen::Vector3d& up_hint, double distance, double radius, double fov_y_degrees,
+                          double aspect);
+
+// How far from the centre of a sphere of `radius` the eye stands so the sphere fits the narrower field
+// of view with `margin` to spare; and the radius frame_camera uses for a box (half its diagonal).
+double framing_distance(double radius, double fov_y_degrees, double aspect, double margin);
+double bounding_radius(const Eigen::AlignedBox3d& box);
+
 enum class ToneMap { Aces, Reinhard, Clamp };
 
 struct SurfaceRenderInput {
@@ -75,11 +89,24 @@ public:
     // sizes beyond the driver's limits, too many lights) and waxwork::Error for driver failures.
     Image render(const SurfaceRenderInput& input);
 
+    // Draws `input` seen from `frame` (input.camera is ignored) and copies the resolved image into
+    // `target_framebuffer` (0: the window's) with its lower-left corner at (x, y): exactly the pixels
+    // render() returns for the same frame. The editor's viewport. Leaves `target_framebuffer` bound.
+    void draw(const SurfaceRenderInput& input, const CameraFrame& frame, GLuint target_framebuffer, int x, int y);
+
 private:
+    struct Frame;
+    // Draws into the multisampled target of `frame` and resolves it into its single-sampled one.
+    void draw_resolved(const SurfaceRenderInput& input, const CameraFrame& camera, Frame& frame);
+
     const GlApi& gl_;
     GLuint program_ = 0;
     GLuint transmittance_lut_ = 0;
 };
+
+// Reads the bound read framebuffer's lower-left width x height pixels as an Image (top row first).
+// Throws waxwork::Error when the driver reports an error.
+Image read_framebuffer(const GlApi& gl, int width, int height);
 
 // One-shot headless render: creates an OSMesa context (gl_context.h) and a renderer, draws, returns.
 Image render_surface(const SurfaceRenderInput& input);

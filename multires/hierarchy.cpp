@@ -4,6 +4,7 @@
 #include "tetops/error.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -92,12 +93,10 @@ void build_coarse_matrix(const HierarchyLevel& fine, std::span<const int32_t> co
     coarse.columns.resize(nnz);
     coarse.diagonal.resize(m);
     for (auto& v : coarse.values) v.assign(nnz, 0.0);
-    const InterpolationOperator& p = fine.interpolation;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 256), [&](const tbb::blocked_range<size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 1024), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t c = r.begin(); c != r.end(); ++c) {
             // Pattern: the coarse graph row with the diagonal merged in, ascending.
-            const auto begin = static_cast<size_t>(coarse.offsets[c]);
-            size_t out = begin;
+            size_t out = static_cast<size_t>(coarse.offsets[c]);
             bool diagonal_placed = false;
             for (int32_t k : g.row(c)) {
                 if (!diagonal_placed && k > static_cast<int32_t>(c)) {
@@ -111,18 +110,42 @@ void build_coarse_matrix(const HierarchyLevel& fine, std::span<const int32_t> co
                 coarse.diagonal[c] = static_cast<int32_t>(out);
                 coarse.columns[out++] = static_cast<int32_t>(c);
             }
-            const int32_t* row_begin = coarse.columns.data() + begin;
-            const int32_t* row_end = coarse.columns.data() + out;
+        }
+    });
+    std::vector<int32_t> all(m);
+    for (size_t c = 0; c < m; ++c) all[c] = static_cast<int32_t>(c);
+    update_coarse_rows(fine, coarse_to_fine, coarse, all);
+}
+
+void update_coarse_rows(const HierarchyLevel& fine, std::span<const int32_t> coarse_to_fine, HierarchyLevel& coarse,
+                        std::span<const int32_t> rows) {
+    const size_t m = coarse_to_fine.size();
+    const InterpolationOperator& p = fine.interpolation;
+    // Per thread, the slot of each coarse column in the current row (replacing a binary search per
+    // product term). Stale entries from other rows are never read: every column a row's products reach
+    // is in its pattern (the coarse graph row plus the diagonal, see hierarchy.h).
+    tbb::enumerable_thread_specific<std::vector<int32_t>> slots([m] { return std::vector<int32_t>(m, -1); });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, rows.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<int32_t>& slot = slots.local();
+        for (size_t index = r.begin(); index != r.end(); ++index) {
+            const auto c = static_cast<size_t>(rows[index]);
+            const auto begin = static_cast<size_t>(coarse.offsets[c]), end = static_cast<size_t>(coarse.offsets[c + 1]);
+            for (size_t s = begin; s < end; ++s) slot[static_cast<size_t>(coarse.columns[s])] = static_cast<int32_t>(s);
+            for (auto& v : coarse.values)
+                std::fill(v.begin() + static_cast<std::ptrdiff_t>(begin), v.begin() + static_cast<std::ptrdiff_t>(end), 0.0);
             // Eq. 17: sum over the fine row of i of M_ij P_jk into coarse column k.
             const auto i = static_cast<size_t>(coarse_to_fine[c]);
             for (int32_t e = fine.offsets[i]; e < fine.offsets[i + 1]; ++e) {
                 const auto j = static_cast<size_t>(fine.columns[static_cast<size_t>(e)]);
+                const double m0 = fine.values[0][static_cast<size_t>(e)];
+                const double m1 = fine.values[1][static_cast<size_t>(e)];
+                const double m2 = fine.values[2][static_cast<size_t>(e)];
                 for (int32_t q = p.offsets[j]; q < p.offsets[j + 1]; ++q) {
-                    const int32_t k = p.columns[static_cast<size_t>(q)];
+                    const auto s = static_cast<size_t>(slot[static_cast<size_t>(p.columns[static_cast<size_t>(q)])]);
                     const double w = p.weights[static_cast<size_t>(q)];
-                    const size_t slot = begin + static_cast<size_t>(std::lower_bound(row_begin, row_end, k) - row_begin);
-                    for (size_t ch = 0; ch < 3; ++ch)
-                        coarse.values[ch][slot] += fine.values[ch][static_cast<size_t>(e)] * w;
+                    coarse.values[0][s] += m0 * w;
+                    coarse.values[1][s] += m1 * w;
+                    coarse.values[2][s] += m2 * w;
                 }
             }
         }

@@ -94,6 +94,12 @@ InterpolationOperator build_interpolation(const CompressedRows& graph, std::span
 // Eq. 17: the coarse level's matrix (all three channels) on the coarse graph's pattern.
 void build_coarse_matrix(const HierarchyLevel& fine, std::span<const int32_t> coarse_to_fine, HierarchyLevel& coarse);
 
+// Eq. 17 for the listed coarse rows only, on the existing pattern: row c depends on fine row
+// coarse_to_fine[c] alone, so after the fine rows R changed, the rows c with coarse_to_fine[c] in R are
+// all that change. Same arithmetic as build_coarse_matrix (bit-identical results).
+void update_coarse_rows(const HierarchyLevel& fine, std::span<const int32_t> coarse_to_fine, HierarchyLevel& coarse,
+                        std::span<const int32_t> rows);
+
 // fine = P coarse (Eq. 16).
 void interpolate(const InterpolationOperator& interpolation, std::span<const double> coarse, std::span<double> fine);
 

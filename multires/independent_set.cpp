@@ -1,6 +1,7 @@
 #include "multires/independent_set.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -149,6 +150,48 @@ std::vector<uint8_t> mark_lost_connections(const CompressedRows& graph, std::spa
     return marked;
 }
 
+namespace {
+
+// mark_lost_connections restricted to `candidates` (ascending), for the enhancement's later passes.
+// Retaining vertices never creates a lost connection (the retained set only grows, so a dropped pair
+// keeps every common retained neighbour it had), hence a vertex unmarked after one pass stays
+// unmarked and only the previous pass's marks need testing again. R(i) is marked in a per-thread tag
+// array instead of the full R lists: the candidates are few after the first pass.
+std::vector<int32_t> still_lost(const CompressedRows& graph, std::span<const uint8_t> retained,
+                                std::span<const int32_t> candidates) {
+    const size_t n = graph.row_count();
+    std::vector<uint8_t> lost(candidates.size(), 0);
+    tbb::enumerable_thread_specific<std::vector<int32_t>> tags([n] { return std::vector<int32_t>(n, -1); });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<int32_t>& tag = tags.local();
+        for (size_t a = r.begin(); a != r.end(); ++a) {
+            const int32_t i = candidates[a];
+            if (retained[static_cast<size_t>(i)]) continue;
+            for (int32_t k : graph.row(static_cast<size_t>(i)))
+                if (retained[static_cast<size_t>(k)]) tag[static_cast<size_t>(k)] = i;
+            for (int32_t j : graph.row(static_cast<size_t>(i))) {
+                if (retained[static_cast<size_t>(j)]) continue;
+                bool shared = false;
+                for (int32_t k : graph.row(static_cast<size_t>(j)))
+                    if (tag[static_cast<size_t>(k)] == i) {
+                        shared = true;
+                        break;
+                    }
+                if (!shared) {
+                    lost[a] = 1;
+                    break;
+                }
+            }
+        }
+    });
+    std::vector<int32_t> out;
+    for (size_t a = 0; a < candidates.size(); ++a)
+        if (lost[a]) out.push_back(candidates[a]);
+    return out;
+}
+
+}  // namespace
+
 VertexSelection select_coarse_vertices(const CompressedRows& graph, uint32_t seed, bool enhance) {
     const size_t n = graph.row_count();
     VertexSelection selection;
@@ -159,11 +202,15 @@ VertexSelection select_coarse_vertices(const CompressedRows& graph, uint32_t see
     if (!enhance) return selection;
     int64_t before = 0;
     for (uint8_t r : selection.retained) before += r;
-    while (true) {
-        std::vector<uint8_t> marked = mark_lost_connections(graph, selection.retained);
-        if (std::find(marked.begin(), marked.end(), uint8_t{1}) == marked.end()) break;
+    std::vector<uint8_t> marked = mark_lost_connections(graph, selection.retained);
+    std::vector<int32_t> candidates;
+    for (size_t v = 0; v < n; ++v)
+        if (marked[v]) candidates.push_back(static_cast<int32_t>(v));
+    while (!candidates.empty()) {
         ++selection.enhancement_passes;
-        run_independent_set_rounds(graph, codes, marked, selection.retained);
+        run_independent_set_rounds(graph, codes, marked, selection.retained);  // clears `marked`
+        candidates = still_lost(graph, selection.retained, candidates);
+        for (int32_t v : candidates) marked[static_cast<size_t>(v)] = 1;
     }
     int64_t after = 0;
     for (uint8_t r : selection.retained) after += r;
@@ -185,30 +232,51 @@ CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const u
     for (size_t v = 0; v < retained.size(); ++v)
         if (retained[v]) coarse_to_fine.push_back(static_cast<int32_t>(v));
     const size_t m = coarse_to_fine.size();
-    std::vector<std::vector<int32_t>> rows(m);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 256), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t c = r.begin(); c != r.end(); ++c) {
-            const int32_t i = coarse_to_fine[c];
-            std::vector<int32_t>& row = rows[c];
-            for (int32_t j : graph.row(i)) {
-                if (retained[j]) {
-                    row.push_back(coarse_index[j]);  // fine edge between retained vertices: kept
-                } else {
-                    for (int32_t k : graph.row(j))  // 2-ring through the dropped vertex j
-                        if (retained[k] && k != i) row.push_back(coarse_index[k]);
-                }
+    // Row c: retained neighbours of i, and retained neighbours of its dropped neighbours (2-ring),
+    // deduplicated with a per-thread tag array instead of a container per row: the 2-ring repeats each
+    // coarse neighbour several times, and allocating and sorting those duplicates was most of the
+    // hierarchy build (bench/multires_bench.cpp, BM_MultiresBuild).
+    tbb::enumerable_thread_specific<std::vector<int32_t>> tags([m] { return std::vector<int32_t>(m, -1); });
+    auto walk = [&](size_t c, std::vector<int32_t>& tag, int32_t key, auto&& emit) {
+        const int32_t i = coarse_to_fine[c];
+        auto visit = [&](int32_t fine_vertex) {
+            const int32_t k = coarse_index[static_cast<size_t>(fine_vertex)];
+            if (tag[static_cast<size_t>(k)] != key) {
+                tag[static_cast<size_t>(k)] = key;
+                emit(k);
             }
-            std::sort(row.begin(), row.end());
-            row.erase(std::unique(row.begin(), row.end()), row.end());
+        };
+        for (int32_t j : graph.row(static_cast<size_t>(i))) {
+            if (retained[static_cast<size_t>(j)]) {
+                visit(j);  // fine edge between retained vertices: kept
+            } else {
+                for (int32_t k : graph.row(static_cast<size_t>(j)))  // 2-ring through the dropped vertex j
+                    if (retained[static_cast<size_t>(k)] && k != i) visit(k);
+            }
         }
-    });
+    };
+    // One walk per row into per-chunk buffers (fixed chunks: the layout does not depend on the thread
+    // count), then the rows are copied into place once the offsets are known.
+    constexpr size_t kChunk = 512;
+    const size_t chunks = (m + kChunk - 1) / kChunk;
+    std::vector<std::vector<int32_t>> buffers(chunks);
     CompressedRows coarse;
     coarse.offsets.assign(m + 1, 0);
-    for (size_t c = 0; c < m; ++c) coarse.offsets[c + 1] = coarse.offsets[c] + static_cast<int32_t>(rows[c].size());
+    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
+        std::vector<int32_t>& tag = tags.local();
+        std::vector<int32_t>& buffer = buffers[chunk];
+        for (size_t c = chunk * kChunk; c < std::min(m, (chunk + 1) * kChunk); ++c) {
+            const size_t first = buffer.size();
+            walk(c, tag, static_cast<int32_t>(c), [&](int32_t k) { buffer.push_back(k); });
+            std::sort(buffer.begin() + static_cast<std::ptrdiff_t>(first), buffer.end());
+            coarse.offsets[c + 1] = static_cast<int32_t>(buffer.size() - first);
+        }
+    });
+    for (size_t c = 0; c < m; ++c) coarse.offsets[c + 1] += coarse.offsets[c];
     coarse.indices.resize(static_cast<size_t>(coarse.offsets[m]));
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t c = r.begin(); c != r.end(); ++c)
-            std::copy(rows[c].begin(), rows[c].end(), coarse.indices.begin() + coarse.offsets[c]);
+    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
+        std::copy(buffers[chunk].begin(), buffers[chunk].end(),
+                  coarse.indices.begin() + coarse.offsets[chunk * kChunk]);
     });
     return coarse;
 }

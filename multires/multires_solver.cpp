@@ -34,6 +34,38 @@ void MultiresSolver::update_values(const DiffusionMatrix& matrix) {
         build_coarse_matrix(hierarchy_.levels[l - 1], hierarchy_.levels[l].parent_vertex, hierarchy_.levels[l]);
 }
 
+void MultiresSolver::update_values(const DiffusionMatrix& matrix, std::span<const int32_t> changed_rows) {
+    HierarchyLevel& level0 = hierarchy_.levels[0];
+    if (matrix.offsets.size() != level0.offsets.size() || matrix.columns.size() != level0.columns.size())
+        throw InvalidArgumentError("multires update_values: the matrix pattern changed (rebuild the solver)");
+    std::vector<int32_t> changed(changed_rows.begin(), changed_rows.end());
+    std::sort(changed.begin(), changed.end());
+    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+    for (int32_t row : changed) {
+        if (row < 0 || static_cast<size_t>(row) >= level0.size())
+            throw InvalidArgumentError("multires update_values: row " + std::to_string(row) + " out of range");
+        const auto begin = static_cast<size_t>(level0.offsets[static_cast<size_t>(row)]);
+        const auto end = static_cast<size_t>(level0.offsets[static_cast<size_t>(row) + 1]);
+        for (size_t ch = 0; ch < 3; ++ch)
+            std::copy(matrix.values[ch].begin() + static_cast<std::ptrdiff_t>(begin),
+                      matrix.values[ch].begin() + static_cast<std::ptrdiff_t>(end),
+                      level0.values[ch].begin() + static_cast<std::ptrdiff_t>(begin));
+    }
+    std::vector<int32_t> rows;
+    for (size_t l = 1; l < hierarchy_.level_count() && !changed.empty(); ++l) {
+        HierarchyLevel& coarse = hierarchy_.levels[l];
+        // Coarse vertices keep their fine order, so parent_vertex is ascending: binary search per row.
+        rows.clear();
+        for (int32_t i : changed) {
+            const auto it = std::lower_bound(coarse.parent_vertex.begin(), coarse.parent_vertex.end(), i);
+            if (it != coarse.parent_vertex.end() && *it == i)
+                rows.push_back(static_cast<int32_t>(it - coarse.parent_vertex.begin()));
+        }
+        update_coarse_rows(hierarchy_.levels[l - 1], coarse.parent_vertex, coarse, rows);
+        changed.swap(rows);
+    }
+}
+
 void MultiresSolver::reset_warm_start() {
     for (auto& s : last_solution_) s.clear();
     eigenvalue_hint_ = {};

@@ -86,6 +86,12 @@ public:
     // the coarse matrices (Eq. 17) on the kept graphs and interpolation, without a new selection.
     // Throws InvalidArgumentError when the matrix pattern differs from the one the hierarchy was built on.
     void update_values(const DiffusionMatrix& matrix);
+    // The same after a local change (painting): only the level-0 rows `changed_rows` (ascending, e.g.
+    // from update_diffusion_matrix) differ from the hierarchy's. Copies those rows and recomputes the
+    // coarse rows that depend on them, level by level (Eq. 17 row c reads fine row parent_vertex[c]
+    // only), in time proportional to the change. Equals update_values(matrix) bit for bit.
+    // Throws InvalidArgumentError on a changed pattern or a row out of range.
+    void update_values(const DiffusionMatrix& matrix, std::span<const int32_t> changed_rows);
 
     // Forget the previous frames' solutions (after an edit that changes the solution a lot).
     void reset_warm_start();

@@ -1,5 +1,6 @@
 #include "solver/conjugate_gradient.h"
 
+#include "solver/cg_channel_state.h"
 #include "tetops/error.h"
 
 #include <tbb/blocked_range.h>
@@ -153,7 +154,7 @@ ConjugateGradientResult solve_jacobi_cg(const CsrMatrixView<Scalar>& m, std::spa
     if (bad_input) throw AlgorithmError("conjugate gradient: right-hand side or start vector is not finite");
 
     const double tol = options.relative_tolerance;
-    double rz = true_residual(m, b.data(), x.data(), inv_diag.data(), r.data(), z.data());
+    const double rz = true_residual(m, b.data(), x.data(), inv_diag.data(), r.data(), z.data());
     double bnorm2 = reduce_rows(n, [&](size_t begin, size_t end) {
         double acc = 0;
         for (size_t i = begin; i < end; ++i) acc += static_cast<double>(b[i]) * b[i] / diag[i];
@@ -164,43 +165,31 @@ ConjugateGradientResult solve_jacobi_cg(const CsrMatrixView<Scalar>& m, std::spa
         result.converged = true;
         return result;
     }
-    double xnorm2 = reduce_rows(n, [&](size_t begin, size_t end) {
+    CgChannelState st;
+    st.rz = rz;
+    st.xnorm2 = reduce_rows(n, [&](size_t begin, size_t end) {
         double acc = 0;
         for (size_t i = begin; i < end; ++i) acc += diag[i] * static_cast<double>(x[i]) * x[i];
         return acc;
     });
     std::copy(z.begin(), z.end(), p.begin());
 
-    const double hint = options.smallest_eigenvalue_hint > 0 ? options.smallest_eigenvalue_hint
-                                                             : std::numeric_limits<double>::infinity();
-    std::vector<double> t_diag, t_off;  // the Lanczos tridiagonal matrix of the current CG cycle
-    double ritz = std::numeric_limits<double>::infinity();  // its smallest eigenvalue (lazily updated)
-    bool ritz_stale = true;
-    double ritz_floor = std::numeric_limits<double>::infinity();  // from cycles before a restart
-    double alpha_prev = 0, beta_prev = 0;
-    double last_restart_estimate = std::numeric_limits<double>::infinity();
-    auto lambda = [&] {
-        if (ritz_stale && !t_diag.empty()) {
-            ritz = smallest_tridiagonal_eigenvalue(t_diag, t_off, std::isfinite(ritz) ? ritz : 0);
-            ritz_stale = false;
+    // A known lower bound of lambda_min acts as the Ritz floor from the start (an infinite "hint", e.g.
+    // the estimate of a run without iterations, says nothing).
+    if (options.smallest_eigenvalue_hint > 0 && std::isfinite(options.smallest_eigenvalue_hint)) {
+        st.ritz_floor = options.smallest_eigenvalue_hint;
+        // A warm start can already be good enough (only checkable with a known eigenvalue bound).
+        const double est = st.estimate(st.rz, st.ritz_floor);
+        if (est <= tol) {
+            result.converged = true;
+            result.estimated_relative_error = est;
+            result.smallest_eigenvalue_estimate = st.ritz_floor;
+            return result;
         }
-        return std::min({hint, ritz, ritz_floor});
-    };
-    auto estimate = [&](double rz_value, double lam) {
-        if (xnorm2 <= 0) return std::numeric_limits<double>::infinity();
-        return std::sqrt(std::max(rz_value, 0.0)) / lam / std::sqrt(xnorm2);
-    };
-
-    // A warm start can already be good enough (only checkable with a known eigenvalue bound).
-    if (std::isfinite(hint) && estimate(rz, hint) <= tol) {
-        result.converged = true;
-        result.estimated_relative_error = estimate(rz, hint);
-        result.smallest_eigenvalue_estimate = hint;
-        return result;
     }
 
     int k = 0;
-    for (; k < options.max_iterations; ++k) {
+    for (; k < options.max_iterations && st.active; ++k) {
         // q = M p and p . q in one pass.
         const double pq = reduce_rows(n, [&](size_t begin, size_t end) {
             double acc = 0;
@@ -213,7 +202,7 @@ ConjugateGradientResult solve_jacobi_cg(const CsrMatrixView<Scalar>& m, std::spa
         });
         if (!std::isfinite(pq)) breakdown(k, "p.Mp is not finite");
         if (!(pq > 0)) breakdown(k, "p.Mp = " + std::to_string(pq) + " is not positive");
-        const double alpha = rz / pq;
+        const double alpha = st.rz / pq;
         const Scalar a = static_cast<Scalar>(alpha);
         // x += alpha p, r -= alpha q, z = D^-1 r, and the two norms, in one pass.
         const Sums s = reduce_rows2(n, [&](size_t begin, size_t end) {
@@ -228,63 +217,26 @@ ConjugateGradientResult solve_jacobi_cg(const CsrMatrixView<Scalar>& m, std::spa
             return acc;
         });
         if (!std::isfinite(s.a) || !std::isfinite(s.b)) breakdown(k, "the iterate became non-finite");
-        const double rz_new = s.a;
-        xnorm2 = s.b;
-        const double beta = rz_new / rz;
-        // Lanczos coefficients (Saad, Iterative Methods, Sec. 6.7.3).
-        t_diag.push_back(1.0 / alpha + (t_diag.empty() ? 0.0 : beta_prev / alpha_prev));
-        if (t_diag.size() > 1) t_off.push_back(std::sqrt(beta_prev) / alpha_prev);
-        ritz_stale = true;
-        alpha_prev = alpha;
-        beta_prev = beta;
-        rz = rz_new;
-
-        // Cheap test with the last Ritz value (an over-estimate of lambda_min, so an under-estimate of
-        // the error); refresh the Ritz value only when the cheap test passes or a callback wants it.
-        double lam = std::min({hint, ritz, ritz_floor});
-        double est = estimate(rz, std::isfinite(lam) ? lam : t_diag.front());
-        if (est <= tol || options.on_iteration || k == 0) {
-            lam = lambda();
-            est = estimate(rz, lam);
-        }
+        const double beta = st.record_step(alpha, s.a, s.b);
+        double lam = 0;
+        const double est = st.current_estimate(k, tol, static_cast<bool>(options.on_iteration), lam);
         if (options.on_iteration) options.on_iteration(k + 1, est);
         if (est <= tol) {
             // Confirm with the true residual: the recursive one drifts (far, in float).
             const double rz_true = true_residual(m, b.data(), x.data(), inv_diag.data(), r.data(), z.data());
             if (!std::isfinite(rz_true)) breakdown(k, "the true residual is not finite");
-            const double est_true = estimate(rz_true, lam);
-            if (est_true <= tol) {
-                result.converged = true;
-                result.estimated_relative_error = est_true;
-                ++k;
-                break;
-            }
-            // Restart from the true residual; give up when restarts stop paying (precision floor).
-            ++result.residual_replacements;
-            const bool stagnating = est_true > 0.5 * last_restart_estimate;
-            last_restart_estimate = est_true;
-            result.estimated_relative_error = est_true;
-            if (stagnating || result.residual_replacements > 8) {
-                ++k;
-                break;
-            }
-            rz = rz_true;
-            std::copy(z.begin(), z.end(), p.begin());
-            ritz_floor = lam;
-            t_diag.clear();
-            t_off.clear();
-            ritz = std::numeric_limits<double>::infinity();
+            if (!st.confirm(k, rz_true, st.estimate(rz_true, lam), lam, tol))
+                std::copy(z.begin(), z.end(), p.begin());  // restart from the true residual
             continue;
         }
-        result.estimated_relative_error = est;
+        st.result.estimated_relative_error = est;
         tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& range) {
             const Scalar bt = static_cast<Scalar>(beta);
             for (size_t i = range.begin(); i != range.end(); ++i) p[i] = z[i] + bt * p[i];
         });
     }
-    result.iterations = k;
-    result.smallest_eigenvalue_estimate = lambda();
-    if (!result.converged && k == options.max_iterations) result.estimated_relative_error = estimate(rz, lambda());
+    result = st.finish(k);
+    result.smallest_eigenvalue_estimate = st.lambda();
     return result;
 }
 

@@ -283,7 +283,11 @@ void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std
             GpuCgOptions gpu;
             gpu.relative_tolerance = options.relative_tolerance;
             gpu.max_iterations = options.max_iterations;
-            results = solve_diffusion_gpu(*options.gl, matrix, q, gpu, solution.phi);
+            GpuDiffusionSolver gpu_solver(*options.gl, matrix);
+            gpu_solver.set_right_hand_side(b);
+            gpu_solver.set_solution(solution.phi);  // the warm start
+            results = gpu_solver.solve(gpu);
+            solution.phi = gpu_solver.solution();
             solution.backend = SolverBackend::Gpu;
             solved = true;
         } catch (const GpuError& e) {

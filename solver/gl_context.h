@@ -1,5 +1,6 @@
 // Headless OpenGL: an OSMesa (Mesa's off-screen interface, llvmpipe software rasteriser) OpenGL 4.5
-// core context, so `waxwork render`, the GPU solver and the tests run without a display or a GPU; and
+// core context, so `waxwork render`, the GPU solver and the tests run without a display or a GPU (or,
+// with WAXWORK_GL_DEVICE=egl, an EGL context on a real GPU without a display); and
 // the table of OpenGL entry points the renderers and the compute kernels call, loaded from whichever
 // context is current. Lives in solver/ because the GPU solver (solver/gpu_*) and the renderer
 // (editor/) share one device and one context.
@@ -12,9 +13,9 @@
 
 namespace waxwork {
 
-// Every OpenGL function the renderers and the compute kernels use. Loaded through the context's GetProcAddress instead of
-// linking gl* symbols directly: libOSMesa and libGL (GLFW windows) both export them, and whichever
-// the dynamic linker binds first would silently receive every call.
+// Every OpenGL function the renderers and the compute kernels use. Loaded through the context's
+// GetProcAddress instead of linking gl* symbols directly: libOSMesa and libGL (GLFW windows) both
+// export them, and whichever the dynamic linker binds first would silently receive every call.
 #define WAXWORK_GL_FUNCTIONS(X)                                                   \
     X(PFNGLGETSTRINGPROC, GetString)                                              \
     X(PFNGLGETINTEGERVPROC, GetIntegerv)                                          \

@@ -131,7 +131,7 @@ std::array<ConjugateGradientResult, 3> GpuDiffusionSolver::solve(const GpuCgOpti
             continue;
         }
         const double hint = options.use_eigenvalue_hints ? eigenvalue_hints_[c] : 0;
-        if (hint > 0) {
+        if (hint > 0 && std::isfinite(hint)) {
             ch[c].ritz_floor = hint;
             const double est = ch[c].estimate(ch[c].rz, hint);
             if (est <= tol) {  // the warm start is already good enough

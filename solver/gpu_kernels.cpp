@@ -247,6 +247,23 @@ void main() {
 }
 )";
 
+// E = max(a phi - c q, 0) per vertex and channel (Eq. 3 without F_t; a, c per vertex). n = rows.
+const char* kRadiance = R"(
+layout(std430, binding = 0) readonly buffer PhiWeight { float a[]; };
+layout(std430, binding = 1) readonly buffer QWeight { float c[]; };
+layout(std430, binding = 2) readonly buffer Phi { float phi[]; };
+layout(std430, binding = 3) readonly buffer Q { float q[]; };
+layout(std430, binding = 4) writeonly buffer E { float e[]; };
+uniform uint clamp_negative;
+void main() {
+    for (uint i = gl_GlobalInvocationID.x; i < n; i += STRIDE)
+        for (uint k = 0u; k < 3u; ++k) {
+            float v = a[i] * phi[3u * i + k] - c[i] * q[3u * i + k];
+            e[3u * i + k] = clamp_negative != 0u ? max(v, 0.0) : v;
+        }
+}
+)";
+
 // One workgroup adds the per-invocation sums of `groups` workgroups lane by lane: folded[lane * nsums + c].
 const char* kFold = R"(#version 430
 layout(local_size_x = 256) in;
@@ -291,6 +308,7 @@ GpuKernels::GpuKernels(const GlApi& gl, std::initializer_list<GpuMatrixFormat> f
     hadamard_ = ComputeProgram(gl, "hadamard", kernel(0, nullptr, nullptr, kHadamard));
     gather_ = ComputeProgram(gl, "gather", kernel(0, nullptr, nullptr, kGather));
     interpolate_ = ComputeProgram(gl, "interpolate", kernel(0, nullptr, nullptr, kInterpolate));
+    radiance_ = ComputeProgram(gl, "radiance", kernel(0, nullptr, nullptr, kRadiance));
     partials_ = GpuBuffer(gl, kMaxGroups * kGroupSize * kMaxSums * sizeof(float));
     folded_ = GpuBuffer(gl, kGroupSize * kMaxSums * sizeof(float));
     check_gpu_error(gl, "compiling the kernels");
@@ -411,6 +429,12 @@ GpuInterpolation::GpuInterpolation(const GlApi& gl, std::span<const int32_t> off
 
 void GpuKernels::interpolate(const GpuInterpolation& p, const GpuBuffer& coarse, GpuBuffer& fine) {
     launch(interpolate_, p.rows, p.rows, {{0, &p.offsets}, {1, &p.columns}, {2, &p.weights}, {3, &coarse}, {4, &fine}});
+}
+
+void GpuKernels::radiance(size_t rows, const GpuBuffer& phi_weight, const GpuBuffer& q_weight, const GpuBuffer& phi,
+                          const GpuBuffer& q, GpuBuffer& e, bool clamp_negative) {
+    launch(radiance_, rows, rows, {{0, &phi_weight}, {1, &q_weight}, {2, &phi}, {3, &q}, {4, &e}},
+           [&] { gl_->Uniform1ui(radiance_.uniform("clamp_negative"), clamp_negative ? 1u : 0u); });
 }
 
 }  // namespace waxwork

@@ -70,6 +70,9 @@ public:
     void gather(size_t rows, const GpuBuffer& index, const GpuBuffer& source, GpuBuffer& target);
     // fine = P coarse.
     void interpolate(const GpuInterpolation& p, const GpuBuffer& coarse, GpuBuffer& fine);
+    // e = max(a phi - c q, 0) (or unclamped) with per-vertex scalars a, c: gpu_radiance.h.
+    void radiance(size_t rows, const GpuBuffer& phi_weight, const GpuBuffer& q_weight, const GpuBuffer& phi,
+                  const GpuBuffer& q, GpuBuffer& e, bool clamp_negative);
     // values[3 * slot[k] + c] = source[3 * k + c] for k < count: row updates after painting.
     void scatter(size_t count, const GpuBuffer& slots, const GpuBuffer& source, GpuBuffer& values);
 
@@ -91,7 +94,8 @@ private:
 
     const GlApi* gl_;
     std::map<GpuMatrixFormat, ComputeProgram> multiply_dot_, residual_;
-    ComputeProgram dot_, axpby_, extract_diagonal_, cg_update_, scatter_, fold_, hadamard_, gather_, interpolate_;
+    ComputeProgram dot_, axpby_, extract_diagonal_, cg_update_, scatter_, fold_, hadamard_, gather_, interpolate_,
+        radiance_;
     GpuBuffer partials_, folded_;
 };
 

@@ -178,15 +178,24 @@ void label_components(const std::vector<std::array<int32_t, 4>>& neighbors, TetC
     }
 }
 
-}  // namespace
-
-TetConnectivity build_connectivity(const TetMesh& mesh) {
+void check_vertex_indices(const TetMesh& mesh) {
     const auto n_vertices = static_cast<int64_t>(mesh.vertex_count());
     for (size_t t = 0; t < mesh.tets.size(); ++t)
         for (int32_t v : mesh.tets[t])
             if (v < 0 || v >= n_vertices)
                 throw InvalidMeshError("tet " + std::to_string(t) + " references vertex " + std::to_string(v) +
                                        " out of range");
+}
+
+}  // namespace
+
+std::vector<std::array<int32_t, 4>> build_face_neighbors(const TetMesh& mesh) {
+    check_vertex_indices(mesh);
+    return build_tet_neighbors(mesh, build_vertex_tets(mesh));
+}
+
+TetConnectivity build_connectivity(const TetMesh& mesh) {
+    check_vertex_indices(mesh);
     TetConnectivity c;
     c.vertex_tets = build_vertex_tets(mesh);
     c.tet_neighbors = build_tet_neighbors(mesh, c.vertex_tets);

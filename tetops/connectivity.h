@@ -58,4 +58,7 @@ struct TetConnectivity {
 // Builds all derived data. Throws InvalidMeshError when a face is shared by more than two tets.
 TetConnectivity build_connectivity(const TetMesh& mesh);
 
+// Only TetConnectivity::tet_neighbors (what fracture needs), at a fraction of the full build's cost.
+std::vector<std::array<int32_t, 4>> build_face_neighbors(const TetMesh& mesh);
+
 }  // namespace waxwork

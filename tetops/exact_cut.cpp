@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
+#include <numeric>
 #include <string>
 #include <tuple>
 
@@ -100,49 +102,86 @@ void split_tet(const Tet& g, const std::array<int, 4>& s, const std::array<int32
     }
 }
 
-// The faces of v's star that contain v and lie on the boundary: every tet sharing such a face also
-// contains v, so a face met once within the star is a boundary face.
-std::vector<std::array<int32_t, 3>> boundary_faces_at(const TetMesh& mesh, const std::vector<int32_t>& star,
-                                                      int32_t v) {
-    std::vector<std::array<int32_t, 3>> faces;  // sorted triples, then oriented copies
-    std::vector<std::array<int32_t, 3>> oriented;
+// A face at a vertex that snapping must keep in its plane: on the boundary of the volume (met once in
+// the vertex's star) or between two regions (met twice, by tets of different labels).
+struct KeptFace {
+    std::array<int32_t, 3> vertices;
+    bool on_boundary;
+};
+
+// The kept faces of v's star that contain v. Every tet sharing a face through v also contains v, so
+// counting faces within the star is enough.
+std::vector<KeptFace> kept_faces_at(const TetMesh& mesh, const std::vector<int32_t>& star, int32_t v,
+                                    const std::vector<int64_t>* labels) {
+    std::vector<std::array<int32_t, 3>> sorted_faces, faces;
+    std::vector<int64_t> face_label;
     for (int32_t t : star) {
         const Tet& tet = mesh.tets[t];
         for (int k = 0; k < 4; ++k) {
             if (tet[k] == v) continue;  // the face opposite v does not contain it
             const auto& f = kTetFaces[k];
             std::array<int32_t, 3> key = {tet[f[0]], tet[f[1]], tet[f[2]]};
-            oriented.push_back(key);
-            std::sort(key.begin(), key.end());
             faces.push_back(key);
+            std::sort(key.begin(), key.end());
+            sorted_faces.push_back(key);
+            face_label.push_back(labels ? (*labels)[t] : 0);
         }
     }
-    std::vector<std::array<int32_t, 3>> sorted = faces;
-    std::sort(sorted.begin(), sorted.end());
-    std::vector<std::array<int32_t, 3>> boundary;
-    for (size_t i = 0; i < faces.size(); ++i)
-        if (std::upper_bound(sorted.begin(), sorted.end(), faces[i]) - std::lower_bound(sorted.begin(), sorted.end(), faces[i]) == 1)
-            boundary.push_back(oriented[i]);
-    return boundary;
+    std::vector<size_t> order(faces.size());
+    std::iota(order.begin(), order.end(), size_t{0});
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return sorted_faces[a] < sorted_faces[b]; });
+    std::vector<KeptFace> kept;
+    for (size_t i = 0; i < order.size();) {
+        size_t j = i + 1;
+        while (j < order.size() && sorted_faces[order[j]] == sorted_faces[order[i]]) ++j;
+        if (j - i == 1) kept.push_back({faces[order[i]], true});
+        if (j - i == 2 && face_label[order[i]] != face_label[order[i + 1]]) kept.push_back({faces[order[i]], false});
+        i = j;
+    }
+    return kept;
 }
 
-// True when the boundary faces all lie in one plane (v may then slide along a boundary edge without
-// changing the shape of the volume).
-bool flat_boundary(const TetMesh& mesh, const std::vector<std::array<int32_t, 3>>& faces) {
+// Whether v may slide towards w: the step must stay in the plane of every kept face at v (so every
+// wall, flat part and straight crease of the boundary keeps its shape) and run along an edge of a
+// boundary face (of a wall face when v is on walls only), never into the volume. Where the boundary faces at v
+// are all within max_bend_deg of each other (a smooth, curved surface rather than a crease), steps
+// up to max_bend_deg out of their planes are allowed: the outer surface then changes slightly.
+bool may_slide(const TetMesh& mesh, const std::vector<KeptFace>& faces, int32_t v, int32_t w, double max_bend_deg) {
+    const Eigen::Vector3d step = mesh.positions[w] - mesh.positions[v];
+    auto normal = [&](const KeptFace& face) -> Eigen::Vector3d {
+        const auto& f = face.vertices;
+        return (mesh.positions[f[1]] - mesh.positions[f[0]]).cross(mesh.positions[f[2]] - mesh.positions[f[0]]);
+    };
+    const double bend_sine = std::sin(max_bend_deg * std::numbers::pi / 180.0);
+    const double bend_cosine = std::cos(max_bend_deg * std::numbers::pi / 180.0);
+    bool smooth = max_bend_deg > 0;
     Eigen::Vector3d reference = Eigen::Vector3d::Zero();
-    for (const auto& f : faces) {
-        const Eigen::Vector3d n = (mesh.positions[f[1]] - mesh.positions[f[0]]).cross(mesh.positions[f[2]] - mesh.positions[f[0]]);
+    for (const KeptFace& face : faces) {
+        if (!face.on_boundary) continue;
+        const Eigen::Vector3d n = normal(face);
         if (reference.isZero()) reference = n;
-        if (n.cross(reference).norm() > 1e-12 * n.norm() * reference.norm() || n.dot(reference) <= 0) return false;
+        smooth = smooth && n.dot(reference) >= bend_cosine * n.norm() * reference.norm();
     }
-    return true;
+    // On the boundary the step runs along a boundary edge (else it could cut into the volume at up to
+    // the bend angle); on walls only, along a wall edge.
+    const bool on_boundary = std::any_of(faces.begin(), faces.end(), [](const KeptFace& f) { return f.on_boundary; });
+    bool along_a_face = false;
+    for (const KeptFace& face : faces) {
+        const auto& f = face.vertices;
+        if (face.on_boundary == on_boundary) along_a_face |= std::find(f.begin(), f.end(), w) != f.end();
+        const Eigen::Vector3d n = normal(face);
+        const double limit = face.on_boundary && smooth ? std::max(bend_sine, 1e-12) : 1e-12;
+        if (std::abs(n.dot(step)) > limit * n.norm() * step.norm()) return false;
+    }
+    return along_a_face;
 }
 
 // Moves vertices whose crossing is within snap_fraction of them onto the surface when the guard on
 // their star allows it. Sequential in vertex order (deterministic); only vertices next to the
-// surface are involved, a small fraction of the mesh. A vertex on the boundary of the volume moves
-// only along a boundary edge of a flat part of the boundary, so the volume keeps its shape exactly;
-// elsewhere on the boundary the edges are split instead.
+// surface are involved, a small fraction of the mesh. A vertex on the boundary of the volume or on a
+// wall between regions only slides along an edge of those faces that stays in their planes (may_slide),
+// so the volume and earlier walls keep their shape; where no such edge reaches the surface the edges
+// are split instead.
 size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::vector<double>& values,
                      const std::vector<int32_t>& crossed, const std::vector<int>& sign, const SplitField& field,
                      const SplitOptions& options, const std::vector<int32_t>& piece_of) {
@@ -205,21 +244,18 @@ size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::ve
         const int32_t v = candidates[begin].vertex;
         size_t end = begin;
         while (end < candidates.size() && candidates[end].vertex == v) ++end;
-        const auto boundary = boundary_faces_at(mesh, star[slot[v]], v);
+        const std::vector<KeptFace> kept = kept_faces_at(mesh, star[slot[v]], v, options.tet_labels);
         std::optional<Eigen::Vector3d> target_world;
-        if (boundary.empty()) {
+        if (kept.empty()) {
             target_world = field.project(world[v]);
             if (!target_world) target_world = candidates[begin].target;
-        } else if (flat_boundary(mesh, boundary)) {
+        } else {
             for (size_t i = begin; i < end && !target_world; ++i)
-                for (const auto& f : boundary)
-                    if (std::find(f.begin(), f.end(), candidates[i].other) != f.end()) {
-                        target_world = candidates[i].target;
-                        break;
-                    }
+                if (may_slide(mesh, kept, v, candidates[i].other, options.boundary_bend_deg))
+                    target_world = candidates[i].target;
         }
         begin = end;
-        if (!target_world || values[v] == 0 || (options.pinned && (*options.pinned)[v])) continue;
+        if (!target_world || values[v] == 0) continue;
         const Eigen::Vector3d target = to_rest(mesh, piece_of[v], *target_world);
         if (!guard_holds(v, target)) continue;
         mesh.positions[v] = target;
@@ -270,8 +306,10 @@ SplitReport split_along_field(TetMesh& mesh, std::vector<Eigen::Vector3d>& world
     if (!(options.min_dihedral_guard_deg >= 0) || !(options.min_dihedral_guard_deg < 60))
         throw InvalidArgumentError("split: the dihedral guard must be in [0, 60) degrees");
     if (!(options.zero_tolerance >= 0)) throw InvalidArgumentError("split: negative zero tolerance");
-    if (options.pinned && options.pinned->size() != mesh.vertex_count())
-        throw InvalidArgumentError("split: one pinned flag per vertex expected");
+    if (!(options.boundary_bend_deg >= 0) || !(options.boundary_bend_deg < 90))
+        throw InvalidArgumentError("split: the boundary bend must be in [0, 90) degrees");
+    if (options.tet_labels && options.tet_labels->size() != mesh.tet_count())
+        throw InvalidArgumentError("split: one label per tet expected");
     for (double v : values)
         if (!std::isfinite(v)) throw InvalidArgumentError("split: non-finite field value");
 

@@ -42,9 +42,16 @@ struct SplitOptions {
     // Field values within this absolute tolerance count as on the surface (e.g. vertices created on
     // the same surface by an earlier split, which rounding puts a few ulps off it).
     double zero_tolerance = 0;
-    // Vertices that must not be snapped (e.g. on a wall made by an earlier split), one flag per vertex;
-    // null: none.
-    const std::vector<uint8_t>* pinned = nullptr;
+    // A vertex on the boundary of the volume snaps only by sliding along a boundary edge, and only when
+    // that edge leaves the plane of every boundary face around the vertex by at most this angle
+    // (degrees): 0 keeps the shape of the volume exactly (vertices slide only within flat parts and
+    // along straight creases), more trades a change of the outer surface of at most
+    // sin(bend) x snap_fraction x edge length for fewer slivers where the surface is curved.
+    double boundary_bend_deg = 0;
+    // Per tet: a region label (e.g. the fracture cell). Faces between tets of different labels are
+    // kept in their planes like flat boundary faces (bend 0): a vertex on them snaps only by sliding
+    // along an edge that stays in all of them, so earlier walls stay where they are. Null: one region.
+    const std::vector<int64_t>* tet_labels = nullptr;
 };
 
 struct SplitReport {
@@ -81,7 +88,14 @@ private:
 };
 
 struct ExactCutOptions {
-    SplitOptions split;
+    // Boundary vertices slide onto the cut where the surface bends by up to 20 degrees around them:
+    // on spot (100K tets) this lifts the worst dihedral angle from 0.01 to 0.15 degrees for a relative
+    // volume change of 5e-6 (bench/editing_bench.cpp); 0 keeps the outer surface exactly.
+    SplitOptions split = [] {
+        SplitOptions o;
+        o.boundary_bend_deg = 20;
+        return o;
+    }();
 };
 
 struct ExactCutResult {

@@ -116,6 +116,8 @@ void check_options(const FractureOptions& options) {
     if (options.min_piece_tets < 0) throw InvalidArgumentError("fracture: min_piece_tets must be >= 0");
     if (!(options.snap_fraction >= 0 && options.snap_fraction < 0.5))
         throw InvalidArgumentError("fracture: the snap fraction must be in [0, 0.5)");
+    if (!(options.boundary_bend_deg >= 0 && options.boundary_bend_deg < 90))
+        throw InvalidArgumentError("fracture: the boundary bend must be in [0, 90) degrees");
 }
 
 // Turns per-tet cell labels into pieces: each face-connected part of one cell within one existing
@@ -125,11 +127,11 @@ void check_options(const FractureOptions& options) {
 void make_pieces(TetMesh& mesh, const std::vector<int64_t>& label, const FractureOptions& options,
                  FractureResult& result) {
     const size_t n = mesh.tet_count();
-    const TetConnectivity connectivity = build_connectivity(mesh);
+    const std::vector<std::array<int32_t, 4>> neighbors = build_face_neighbors(mesh);
     DisjointSets parts(n);
     for (size_t t = 0; t < n; ++t)
         for (int f = 0; f < 4; ++f) {
-            const int32_t u = connectivity.tet_neighbors[t][f];
+            const int32_t u = neighbors[t][f];
             if (u > static_cast<int32_t>(t) && label[u] == label[t] && mesh.piece_ids[u] == mesh.piece_ids[t])
                 parts.unite(static_cast<int32_t>(t), u);
         }
@@ -146,7 +148,7 @@ void make_pieces(TetMesh& mesh, const std::vector<int64_t>& label, const Fractur
             for (size_t t = 0; t < n; ++t) {
                 if (size[root[t]] >= options.min_piece_tets) continue;
                 for (int f = 0; f < 4; ++f) {
-                    const int32_t u = connectivity.tet_neighbors[t][f];
+                    const int32_t u = neighbors[t][f];
                     if (u >= 0 && root[u] != root[t]) ++shared[{root[t], root[u]}];
                 }
             }
@@ -200,9 +202,19 @@ void make_pieces(TetMesh& mesh, const std::vector<int64_t>& label, const Fractur
     result.min_dihedral_deg = mesh_min_dihedral_deg(mesh);
 }
 
-// Common start: checks and the world positions every field is evaluated at.
+// Common start: the checks the fracture relies on (a full validate() sorts every face, costlier than
+// the fracture itself) and the world positions every field is evaluated at.
 std::vector<Eigen::Vector3d> prepare(TetMesh& mesh, FractureResult& result) {
-    validate(mesh);
+    const size_t n = mesh.tet_count();
+    if (mesh.piece_ids.size() != n || mesh.original_ids.size() != n || (mesh.has_materials() && mesh.materials.size() != n))
+        throw InvalidMeshError("fracture: per-tet arrays do not match the tet count");
+    for (size_t t = 0; t < n; ++t) {
+        if (mesh.piece_ids[t] < 0 || static_cast<size_t>(mesh.piece_ids[t]) >= mesh.piece_transforms.size())
+            throw InvalidMeshError("fracture: tet " + std::to_string(t) + " has a piece without a transform");
+        for (int32_t v : mesh.tets[t])
+            if (v < 0 || static_cast<size_t>(v) >= mesh.vertex_count())
+                throw InvalidMeshError("fracture: tet " + std::to_string(t) + " has a vertex index out of range");
+    }
     result.pieces_before = static_cast<int>(mesh.piece_transforms.size());
     return world_positions(mesh);
 }
@@ -211,6 +223,7 @@ std::vector<Eigen::Vector3d> prepare(TetMesh& mesh, FractureResult& result) {
 SplitOptions wall_split_options(const std::vector<Eigen::Vector3d>& world, const FractureOptions& options) {
     SplitOptions split;
     split.snap_fraction = options.snap_fraction;
+    split.boundary_bend_deg = options.boundary_bend_deg;
     split.zero_tolerance = 1e-12 * extent_of(world);
     return split;
 }
@@ -273,12 +286,11 @@ FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> 
         // the part closer to k than to j. Every tet lies in one cell of the previous diagram, where the
         // wall field of k is sign-equivalent to the bisector of (j, k), a linear function, so the
         // vertex signs tell exactly which tets it crosses (a field that is only concave could bulge
-        // into a tet between its vertices). Vertices on earlier walls are pinned so snapping keeps
-        // those walls flat.
+        // into a tet between its vertices). Snapping treats earlier walls between cells like the
+        // boundary (split.tet_labels), so they stay flat.
         SplitOptions split = wall_split_options(world, options);
         std::vector<double> best(world.size());
         tbb::parallel_for(size_t{0}, world.size(), [&](size_t v) { best[v] = (world[v] - seeds[0]).squaredNorm(); });
-        std::vector<uint8_t> pinned(world.size(), 0);
         for (size_t k = 1; k < seeds.size(); ++k) {
             std::vector<uint8_t> closer(world.size());
             tbb::parallel_for(size_t{0}, world.size(),
@@ -294,7 +306,7 @@ FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> 
             tbb::parallel_for(size_t{0}, world.size(), [&](size_t v) {
                 values[v] = needs_value[v] ? field.value(world[v]) : (closer[v] ? 1.0 : -1.0);
             });
-            split.pinned = &pinned;
+            split.tet_labels = &label;
             const SplitReport report = split_along_field(mesh, world, values, field, split);
             result.tets_split += report.tets_split;
             for (int32_t parent : report.appended_parents) label.push_back(label[parent]);
@@ -302,7 +314,6 @@ FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> 
                 if (report.positive[t]) label[t] = static_cast<int64_t>(k);
             const size_t old_count = best.size();
             best.resize(world.size());
-            pinned.resize(world.size(), 0);
             tbb::parallel_for(size_t{0}, world.size(), [&](size_t v) {
                 if (v < old_count) {
                     best[v] = std::min(best[v], (world[v] - seeds[k]).squaredNorm());
@@ -310,7 +321,6 @@ FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> 
                     best[v] = std::numeric_limits<double>::infinity();
                     for (size_t j = 0; j <= k; ++j) best[v] = std::min(best[v], (world[v] - seeds[j]).squaredNorm());
                 }
-                if (values[v] == 0) pinned[v] = 1;
             });
         }
     } else {
@@ -332,18 +342,22 @@ FractureResult fracture_planes(TetMesh& mesh, std::span<const Eigen::Vector4d> p
     if (mesh.tets.empty()) return result;
 
     if (options.exact) {
-        // Vertices on earlier planes are pinned so snapping onto a later plane keeps those flat.
+        // Regions so far (sides of the earlier planes) label the tets, so snapping onto a later
+        // plane keeps the earlier ones flat (split.tet_labels).
         SplitOptions split = wall_split_options(world, options);
-        std::vector<uint8_t> pinned(world.size(), 0);
-        split.pinned = &pinned;
+        std::vector<int64_t> region(mesh.tet_count(), 0);
+        split.tet_labels = &region;
         for (const PlaneCut& cut : cuts) {
             const PlaneField field(cut);
             std::vector<double> values(world.size());
             tbb::parallel_for(size_t{0}, world.size(), [&](size_t v) { values[v] = cut.side(world[v]); });
-            result.tets_split += split_along_field(mesh, world, values, field, split).tets_split;
-            pinned.resize(world.size(), 0);
-            for (size_t v = 0; v < world.size(); ++v)
-                if (values[v] == 0) pinned[v] = 1;
+            const SplitReport report = split_along_field(mesh, world, values, field, split);
+            result.tets_split += report.tets_split;
+            for (int32_t parent : report.appended_parents) region.push_back(region[parent]);
+            std::map<std::pair<int64_t, uint8_t>, int64_t> renumber;
+            for (size_t t = 0; t < region.size(); ++t)
+                region[t] = renumber.try_emplace({region[t], report.positive[t]}, static_cast<int64_t>(renumber.size()))
+                                .first->second;
         }
     }
 

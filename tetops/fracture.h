@@ -27,6 +27,9 @@ struct FractureOptions {
     // of being cut off in a sliver (SplitOptions::snap_fraction); 0 splits every crossed edge, which
     // keeps every unsplit tet's shape but leaves thinner tets.
     double snap_fraction = 0.2;
+    // Exact mode: boundary vertices slide onto a wall where the surface bends by at most this angle
+    // (SplitOptions::boundary_bend_deg; 0 keeps the outer surface exactly).
+    double boundary_bend_deg = 20;
 };
 
 struct FractureResult {
@@ -37,13 +40,20 @@ struct FractureResult {
     double min_dihedral_deg = 0;     // of the whole mesh afterwards
 };
 
-// `count` seed points scattered inside the volume (world space), deterministic for `seed`.
-// Throws InvalidArgumentError for count < 1 or an empty mesh.
+// `count` seed points scattered inside the volume (world space), deterministic for `seed`: a tet drawn
+// with probability proportional to its volume, then a uniform point in it (std::mt19937).
+// Throws InvalidArgumentError for count < 1, count > tet count or an empty mesh.
 std::vector<Eigen::Vector3d> scatter_fracture_seeds(const TetMesh& mesh, int count, uint32_t seed);
 
 // Breaks every existing piece along the Voronoi cells of `seeds` (world space): each cell's part of
 // each piece becomes a piece (new pieces take their parent's transform). Original ids and materials
 // follow their tets (split tets keep their parent's original id and material).
+// Implementation notes (fracture.cpp): pieces are renumbered by their lowest tet and piece_transforms
+// holds exactly the pieces after (empty pieces are dropped). A cell can give fewer pieces than seeds
+// (a seed whose cell holds fewer than min_piece_tets tets is merged as dust) or more (a cell that meets
+// a concave volume in several parts gives one piece per part). Exact mode builds the diagram one seed
+// at a time, so walls of earlier seeds that a later cell swallows stay as (harmless) extra splits
+// inside that piece.
 FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> seeds,
                                 const FractureOptions& options = {});
 
@@ -64,6 +74,9 @@ struct WeldResult {
 // Merges pieces whose boundary faces coincide in world space (within `tolerance`, world units):
 // coincident vertices become one, the pieces become one piece (the lowest index's transform; the
 // others' rest positions are re-expressed in it). Pieces that do not touch stay apart.
+// Implementation notes (fracture.cpp): pieces join only when a whole boundary face matches (touching at
+// a point or an edge joins nothing); absorbed pieces are removed and the rest renumbered in order;
+// throws AlgorithmError (mesh unchanged) if merging would flatten a tet (tolerance too large).
 WeldResult weld_touching_pieces(TetMesh& mesh, double tolerance);
 
 }  // namespace waxwork

@@ -69,19 +69,51 @@ std::vector<double> min_dihedral_angles_deg(const TetMesh& mesh) {
     return result;
 }
 
+namespace {
+
+// Cosine of the smallest interior dihedral angle of a tet (the largest cosine over its six edges):
+// the same geometry as dihedral_angles_deg without the six arc cosines, so a whole-mesh minimum costs
+// one acos instead of six per tet. A degenerate face gives 1 (a zero angle).
+double max_dihedral_cosine(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
+                           const Eigen::Vector3d& p3) {
+    const std::array<const Eigen::Vector3d*, 4> p = {&p0, &p1, &p2, &p3};
+    std::array<Eigen::Vector3d, 4> normal;
+    std::array<double, 4> length;
+    for (int k = 0; k < 4; ++k) {
+        const auto& f = kTetFaces[k];
+        normal[k] = (*p[f[1]] - *p[f[0]]).cross(*p[f[2]] - *p[f[0]]);
+        length[k] = normal[k].norm();
+        if (!(length[k] > 0)) return 1.0;
+    }
+    double worst = -1.0;
+    // Edge (i, j) is between the faces opposite the other two vertices; interior cosine = -n_k.n_l.
+    for (int k = 0; k < 4; ++k)
+        for (int l = k + 1; l < 4; ++l) worst = std::max(worst, -normal[k].dot(normal[l]) / (length[k] * length[l]));
+    return std::min(worst, 1.0);
+}
+
+}  // namespace
+
 double mesh_min_dihedral_deg(const TetMesh& mesh) {
     if (mesh.tets.empty()) return 0;
-    return tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, mesh.tets.size(), 2048), std::numeric_limits<double>::infinity(),
-        [&](const tbb::blocked_range<size_t>& range, double worst) {
+    // Find the worst tet by cosine, then measure it with min_dihedral_angle_deg so the value is the
+    // one every other report of the same tet gives.
+    using Worst = std::pair<double, size_t>;  // (largest cosine, its tet)
+    const Worst worst = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, mesh.tets.size(), 2048), Worst{-2.0, 0},
+        [&](const tbb::blocked_range<size_t>& range, Worst w) {
             for (size_t t = range.begin(); t != range.end(); ++t) {
                 const Tet& tet = mesh.tets[t];
-                worst = std::min(worst, min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]],
-                                                               mesh.positions[tet[2]], mesh.positions[tet[3]]));
+                const double c = max_dihedral_cosine(mesh.positions[tet[0]], mesh.positions[tet[1]],
+                                                     mesh.positions[tet[2]], mesh.positions[tet[3]]);
+                if (c > w.first) w = {c, t};
             }
-            return worst;
+            return w;
         },
-        [](double a, double b) { return std::min(a, b); });
+        [](const Worst& a, const Worst& b) { return b.first > a.first || (b.first == a.first && b.second < a.second) ? b : a; });
+    const Tet& tet = mesh.tets[worst.second];
+    return min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]], mesh.positions[tet[2]],
+                                  mesh.positions[tet[3]]);
 }
 
 namespace {

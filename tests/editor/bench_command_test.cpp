@@ -52,11 +52,8 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
         EXPECT_LT(best_error, 1e-2) << name;
         ASSERT_TRUE(s["time_to_1pct_ms"].is_number()) << name;
         EXPECT_GT(s["time_to_1pct_ms"].get<double>(), 0.0) << name;
-        if (name != "direct") {
-            // The iterative curves start from the cold start (error 1, or multires' coarse pass) and fall.
-            EXPECT_GT(curve.front()[1].get<double>(), 1e-2) << name;
-            EXPECT_LT(curve.back()[1].get<double>(), 1e-2) << name;
-        }
+        // The last cap is always kept (noise only drops earlier points) and is below 1%.
+        EXPECT_LT(curve.back()[1].get<double>(), 1e-2) << name;
     }
     const std::string svg = testing::read_text(out / "solvers.svg");
     EXPECT_NE(svg.find("<svg"), std::string::npos);

@@ -25,13 +25,14 @@ inline std::string read_text(const std::filesystem::path& path) {
     return s.str();
 }
 
-// `arguments` is appended to the binary's path as-is (quote paths with spaces yourself).
-inline CommandResult run_waxwork(const std::string& arguments) {
+// `arguments` is appended to the binary's path as-is (quote paths with spaces yourself); `launcher`
+// (e.g. "xvfb-run -a ") is put before it.
+inline CommandResult run_waxwork(const std::string& arguments, const std::string& launcher = "") {
     static int counter = 0;
     const auto dir = std::filesystem::temp_directory_path();
     const std::string tag = std::to_string(::getpid()) + "_" + std::to_string(counter++);
     const auto out_path = dir / ("waxwork_out_" + tag), err_path = dir / ("waxwork_err_" + tag);
-    const std::string command = std::string(WAXWORK_BINARY) + " " + arguments + " >" + out_path.string() + " 2>" +
+    const std::string command = launcher + std::string(WAXWORK_BINARY) + " " + arguments + " >" + out_path.string() + " 2>" +
                                 err_path.string() + " </dev/null";
     const int status = std::system(command.c_str());
     CommandResult result;

@@ -1,6 +1,7 @@
 #include "multires/multigrid_cg.h"
 #include "multires/multigrid_preconditioner.h"
 #include "multires_test_systems.h"
+#include "solver/lighting.h"
 #include "tetops/error.h"
 
 #include <Eigen/Dense>
@@ -252,6 +253,49 @@ TEST(MultigridPreconditioner, PartialUpdateAfterPaintingEqualsARebuild) {
     updated.apply(0, s.b[0], xa);
     rebuilt.apply(0, s.b[0], xb);
     EXPECT_EQ(xa, xb);
+}
+
+}  // namespace
+}  // namespace waxwork
+
+namespace waxwork {
+namespace {
+
+// Per-frame relighting: after the light turns by 10 degrees, MG-CG warm-started from the previous
+// light's solution and stopped on its own estimate at 1e-2 is within 1% of the new solution in a few
+// iterations (bench/multires_bench.cpp, BM_LightTurn10Degrees, times it on spot).
+TEST(MultigridCg, LightTurnOfTenDegreesConvergesWithinAFewWarmIterations) {
+    const auto s = testing::make_test_system(12);
+    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(100));
+    MultigridPreconditioner mg(h);
+    const std::vector<TetMaterial> materials(s.mesh.tet_count(), TetMaterial{{0.01, 0.05, 0.2}, {1, 1, 1}, 1.3});
+    auto rhs = [&](double degrees, int channel) {
+        Lighting lighting;
+        Light light;
+        light.vector = Eigen::AngleAxisd(degrees * M_PI / 180, Eigen::Vector3d::UnitY()) *
+                       Eigen::Vector3d(1, -1, -1).normalized();
+        lighting.lights.push_back(light);
+        const std::vector<Rgb> q = incident_light(s.mesh, s.connectivity, materials, lighting);
+        std::vector<double> b(s.matrix.size());
+        diffusion_right_hand_side(s.matrix, q, channel, b);
+        return b;
+    };
+    for (int channel = 0; channel < 3; ++channel) {
+        const auto before = rhs(0, channel), after = rhs(10, channel);
+        std::vector<double> x(before.size(), 0.0);
+        ConjugateGradientOptions tight;
+        tight.relative_tolerance = 1e-8;
+        const ConjugateGradientResult previous = solve_multigrid_cg(mg, channel, before, x, tight);
+        const auto reference = reference_solution(s.matrix, after, channel);
+        ASSERT_GT(relative_error(x, reference), 1e-2) << "the turn must change the solution";
+        ConjugateGradientOptions frame;
+        frame.relative_tolerance = 1e-2;
+        frame.smallest_eigenvalue_hint = previous.smallest_eigenvalue_estimate;
+        const ConjugateGradientResult warm = solve_multigrid_cg(mg, channel, after, x, frame);
+        EXPECT_TRUE(warm.converged);
+        EXPECT_LE(warm.iterations, 4) << "channel " << channel;
+        EXPECT_LT(relative_error(x, reference), 1e-2) << "channel " << channel;
+    }
 }
 
 }  // namespace

@@ -250,3 +250,37 @@ TEST(MultiresSolver, SingleLevelMeshSolvesWithCgAlone) {
 
 }  // namespace
 }  // namespace waxwork
+
+namespace waxwork {
+namespace {
+
+TEST(MultiresSolver, UpdateOfChangedRowsEqualsARebuild) {
+    auto s = testing::make_test_system(8);
+    HierarchyOptions h;
+    h.min_coarse_vertices = 30;
+    MultiresSolver updated(s.matrix, s.mesh.positions, h);
+    ASSERT_GE(updated.hierarchy().level_count(), 3u);
+    std::vector<TetMaterial> materials(s.mesh.tet_count(), TetMaterial{{0.01, 0.05, 0.2}, {1, 1, 1}, 1.3});
+    std::vector<int32_t> painted;
+    for (int32_t t = 0; t < 30; ++t) {
+        painted.push_back(t * 11);
+        materials[static_cast<size_t>(t * 11)] = TetMaterial{{0.3, 0.02, 0.1}, {2, 1, 0.5}, 1.4};
+    }
+    const std::vector<int32_t> rows = update_diffusion_matrix(s.matrix, s.mesh, s.connectivity, materials, painted);
+    ASSERT_LT(rows.size(), s.matrix.size() / 2);
+    updated.update_values(s.matrix, rows);
+    const MultiresSolver rebuilt(s.matrix, s.mesh.positions, h);
+    ASSERT_EQ(updated.hierarchy().level_count(), rebuilt.hierarchy().level_count());
+    size_t changed_coarse = 0;
+    const MultiresSolver original(testing::make_test_system(8).matrix, s.mesh.positions, h);
+    for (size_t l = 0; l < rebuilt.hierarchy().level_count(); ++l) {
+        EXPECT_EQ(updated.hierarchy().levels[l].values, rebuilt.hierarchy().levels[l].values) << "level " << l;
+        if (l > 0 && original.hierarchy().levels[l].values != rebuilt.hierarchy().levels[l].values) ++changed_coarse;
+    }
+    EXPECT_GT(changed_coarse, 0u);  // the paint reached the coarse levels
+    const std::vector<int32_t> bad = {static_cast<int32_t>(s.matrix.size())};
+    EXPECT_THROW(updated.update_values(s.matrix, bad), InvalidArgumentError);
+}
+
+}  // namespace
+}  // namespace waxwork

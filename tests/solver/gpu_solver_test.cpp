@@ -10,6 +10,8 @@
 #include "solver/gpu_conjugate_gradient.h"
 #include "solver/gpu_kernels.h"
 #include "solver/gpu_matrix.h"
+#include "solver/gpu_radiance.h"
+#include "solver/radiance.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
 #include "solver/solver_test_meshes.h"
@@ -332,6 +334,33 @@ TEST(GpuDiffusionSolver, ShaderFailureFallsBackToTheCpuWithTheDriverLog) {
     solve_diffusion_system(s.matrix, s.q, options, solution);
     EXPECT_EQ(solution.backend, SolverBackend::Cpu);
     EXPECT_FALSE(solution.gpu_fallback_reason.empty());
+}
+
+TEST(GpuRadiance, ExitantRadianceFactorsMatchTheCpu) {
+    WAXWORK_REQUIRE_GL(context);
+    const System& s = spot_system();
+    GpuDiffusionSolver solver(context->gl(), s.matrix);
+    solver.set_light(s.matrix, s.q);
+    GpuCgOptions options;
+    options.relative_tolerance = 1e-4;
+    solver.solve(options);
+    const auto phi = solver.solution();
+    GpuRadiance radiance(solver.kernels(), s.mesh, s.conn, s.materials);
+    radiance.set_light(s.q);
+    for (const bool clamp : {true, false}) {
+        GpuBuffer e = solver.kernels().vector(s.matrix.size());
+        radiance.compute(solver.solution_buffer(), e, RadianceOptions{clamp});
+        const std::vector<float> gpu = e.download<float>();
+        const auto cpu = exitant_radiance_factors(s.mesh, s.conn, s.materials, phi, s.q, RadianceOptions{clamp});
+        double peak = 0, diff = 0;
+        for (size_t i = 0; i < cpu.size(); ++i)
+            for (int c = 0; c < 3; ++c) {
+                peak = std::max(peak, static_cast<double>(std::abs(cpu[i][c])));
+                diff = std::max(diff, static_cast<double>(std::abs(cpu[i][c] - gpu[3 * i + c])));
+            }
+        ASSERT_GT(peak, 0);
+        EXPECT_LT(diff, 1e-5 * peak) << (clamp ? "clamped" : "unclamped");
+    }
 }
 
 // WAXWORK_GL_DEVICE=egl: the path to a real GPU without a display. Here EGL finds llvmpipe again

@@ -17,6 +17,7 @@ namespace {
 
 using testing::expect_valid_conforming;
 using testing::make_cube_mesh;
+using testing::on_unit_cube_boundary;
 using testing::volume_by_original_id;
 
 // Volume of {x in [0,1]^3 : n.x <= d} for n with positive components: inclusion-exclusion over the
@@ -29,12 +30,6 @@ double kept_cube_volume(const Eigen::Vector3d& n, double d) {
         sum += ((corner & 1) + ((corner >> 1) & 1) + ((corner >> 2) & 1)) % 2 ? -s * s * s : s * s * s;
     }
     return sum / (6 * n.x() * n.y() * n.z());
-}
-
-bool on_unit_cube_boundary(const Eigen::Vector3d& p) {
-    for (int i = 0; i < 3; ++i)
-        if (std::abs(p[i]) < 1e-12 || std::abs(p[i] - 1) < 1e-12) return true;
-    return false;
 }
 
 // The largest |side| over vertices of boundary faces that are not on the cube's boundary (the
@@ -113,6 +108,31 @@ TEST(ExactCut, SnappingImprovesTheWorstAngle) {
     expect_valid_conforming(snapped);
     expect_valid_conforming(unsnapped);
     EXPECT_NEAR(total_volume(snapped), total_volume(unsnapped), 1e-13);
+}
+
+TEST(ExactCut, BoundaryBendZeroKeepsACurvedSurfaceExactly) {
+    // A cube whose top is a gentle bump: its boundary faces bend by a few degrees.
+    TetMesh before = make_cube_mesh(8);
+    for (auto& p : before.positions) p.z() *= 1 + 0.08 * std::sin(3 * p.x()) * std::cos(2 * p.y());
+    ASSERT_NO_THROW(validate(before));
+    const PlaneCut plane(Eigen::Vector3d(1, 0.1, 0.03), 0.515);
+    TetMesh reference = before, flat_only = before, bent = before;
+    ExactCutOptions options;
+    options.split.snap_fraction = 0;
+    cut_exact(reference, plane, options);  // no vertex moves: the exact kept volume
+    options.split.snap_fraction = 0.2;
+    options.split.boundary_bend_deg = 0;
+    const ExactCutResult a = cut_exact(flat_only, plane, options);
+    options.split.boundary_bend_deg = 20;
+    const ExactCutResult b = cut_exact(bent, plane, options);
+    EXPECT_NEAR(total_volume(flat_only), total_volume(reference), 1e-13);
+    EXPECT_GT(b.vertices_snapped, a.vertices_snapped);  // curved boundary vertices slide too
+    EXPECT_GE(b.min_dihedral_deg, a.min_dihedral_deg);
+    EXPECT_NEAR(total_volume(bent), total_volume(reference), 1e-3 * total_volume(reference));
+    expect_valid_conforming(flat_only);
+    expect_valid_conforming(bent);
+    options.split.boundary_bend_deg = 90;
+    EXPECT_THROW(cut_exact(bent, plane, options), InvalidArgumentError);
 }
 
 TEST(ExactCut, PlanesThroughVerticesAndEdges) {

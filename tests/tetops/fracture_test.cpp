@@ -21,6 +21,7 @@ using testing::boundary_area;
 using testing::expect_pieces_separate_and_connected;
 using testing::expect_valid_conforming;
 using testing::make_cube_mesh;
+using testing::on_unit_cube_boundary;
 using testing::volume_by_original_id;
 
 // The two nearest seeds of x: (nearest, second nearest).
@@ -33,12 +34,6 @@ std::pair<size_t, size_t> two_nearest(const std::vector<Eigen::Vector3d>& seeds,
         else if (d < (seeds[b] - x).norm()) b = i;
     }
     return {a, b};
-}
-
-bool on_unit_cube_boundary(const Eigen::Vector3d& p) {
-    for (int i = 0; i < 3; ++i)
-        if (std::abs(p[i]) < 1e-12 || std::abs(p[i] - 1) < 1e-12) return true;
-    return false;
 }
 
 TEST(FractureSeeds, DeterministicInsideAndValidated) {

@@ -8,10 +8,18 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <set>
 
 namespace waxwork::testing {
+
+// On a face of the unit cube [0, 1]^3 (to rounding).
+inline bool on_unit_cube_boundary(const Eigen::Vector3d& p) {
+    for (int i = 0; i < 3; ++i)
+        if (std::abs(p[i]) < 1e-12 || std::abs(p[i] - 1) < 1e-12) return true;
+    return false;
+}
 
 // Valid, every tet positively oriented (validate), no face shared by more than two tets
 // (build_connectivity throws otherwise) and the boundary closed: every edge of a boundary face is

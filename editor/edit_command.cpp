@@ -1,0 +1,98 @@
+// `waxwork edit [FILE]`: opens the interactive editor (editor/editor_app.h). With --screenshot it draws
+// --frames frames once loading and solving have finished, saves the window (UI included unless
+// --hide-ui) as a PNG and exits: for the docs and the tests, under xvfb-run on a server.
+#include "editor/commands.h"
+#include "editor/editor_app.h"
+#include "editor/material_options.h"
+#include "tetops/error.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <iostream>
+#include <memory>
+
+namespace waxwork {
+namespace {
+
+struct EditCommandOptions {
+    std::string file;
+    std::string screenshot;
+    int frames = 10;
+    bool hide_ui = false;
+    int width = 1280;
+    int height = 800;
+    std::optional<size_t> max_tets;
+    MaterialOptions material;
+    std::vector<std::string> lights;
+    double scale = 1.0;
+    std::vector<double> view;
+};
+
+void run_edit_command(const EditCommandOptions& o) {
+    if (o.width < 64 || o.height < 64 || o.width > kMaxImageSide || o.height > kMaxImageSide)
+        throw InvalidArgumentError("--width/--height must be between 64 and " + std::to_string(kMaxImageSide));
+    if (o.frames < 1 || o.frames > 100000) throw InvalidArgumentError("--frames must be between 1 and 100000");
+    if (!std::isfinite(o.scale) || o.scale < 1e-6 || o.scale > 1e6)
+        throw InvalidArgumentError("--scale must be a length in mm per model unit between 1e-6 and 1e6");
+    EditorOptions options;
+    options.file = o.file;
+    options.screenshot = o.screenshot;
+    options.frames = o.frames;
+    options.hide_ui = o.hide_ui;
+    options.width = o.width;
+    options.height = o.height;
+    options.max_tets = o.max_tets;
+    options.material = chosen_material(o.material);
+    options.scale = o.scale;
+    for (const std::string& spec : o.lights) options.lights.push_back(parse_light_spec(spec));
+    if (!o.view.empty()) {
+        const Eigen::Vector3d v(o.view[0], o.view[1], o.view[2]);
+        if (!v.allFinite() || v.norm() == 0) throw InvalidArgumentError("--view must be a finite, non-zero direction");
+        options.camera.eye_direction = v;
+        if (v.normalized().cross(options.camera.up).norm() < 1e-3) options.camera.up = Eigen::Vector3d(0, 0, -1);
+    }
+    const EditorRunStats stats = run_editor(options);
+    if (!o.screenshot.empty()) {
+        const nlohmann::ordered_json summary = {
+            {"screenshot", o.screenshot},  {"frames", stats.frames},
+            {"frame_ms", stats.mean_frame_ms}, {"view_ms", stats.mean_view_ms},
+            {"solve_ms", stats.solve_ms},  {"tets", stats.tets},
+            {"vertices", stats.vertices},  {"gl_version", stats.gl_version},
+            {"gl_renderer", stats.gl_renderer},
+        };
+        std::cout << summary.dump() << "\n";
+    }
+}
+
+}  // namespace
+
+void add_edit_command(CLI::App& app) {
+    auto options = std::make_shared<EditCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("edit", "Open the interactive editor (needs a display)");
+    cmd->add_option("file", options->file, "Surface (OBJ, OFF, PLY, STL) or volume (VTU, MSH, MESH, NODE) to open")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--screenshot", options->screenshot,
+                    "Draw --frames frames after loading and solving, save the window to this PNG and exit");
+    cmd->add_option("--frames", options->frames, "Frames drawn before the screenshot")->capture_default_str();
+    cmd->add_flag("--hide-ui", options->hide_ui, "Show the 3D view alone (Tab toggles it)");
+    cmd->add_option("--width", options->width, "Window width")->capture_default_str();
+    cmd->add_option("--height", options->height, "Window height")->capture_default_str();
+    cmd->add_option("--max-tets", options->max_tets, "Meshing a surface: about this many tets");
+    add_material_options(*cmd, options->material);
+    cmd->add_option("--light", options->lights, "dir:X,Y,Z[:R,G,B] or point:X,Y,Z[:R,G,B], as for render")
+        ->expected(1)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    cmd->add_option("--scale", options->scale, "Millimetres per model unit")->capture_default_str();
+    cmd->add_option("--view", options->view, "Direction from the object towards the camera, X,Y,Z")
+        ->delimiter(',')
+        ->expected(3);
+    cmd->footer(
+        "Mouse: right drag (or Alt+left) orbits, middle drag (or Shift+right) pans, the wheel zooms.\n"
+        "With --hide-ui the first frame shows exactly what `waxwork render` writes for the same volume,\n"
+        "materials, lights, --view and window size.");
+    cmd->callback([options] { run_edit_command(*options); });
+}
+
+}  // namespace waxwork

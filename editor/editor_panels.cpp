@@ -1,0 +1,403 @@
+// The ImGui side of EditorApp: theme, menus, tool palette, material, light, solver and view panels,
+// status bar, progress, overlays and dialogs. Everything here runs on the UI thread between
+// ImGui::NewFrame and ImGui::Render and only reads or edits EditorApp's state.
+#include "editor/editor_app.h"
+
+#include "editor/material_swatch.h"
+#include "solver/material.h"
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+namespace waxwork {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kDejaVuSans = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+
+const std::vector<std::string>& openable_extensions() {
+    static const std::vector<std::string> e = {".obj", ".off", ".ply", ".stl", ".vtu", ".msh", ".mesh", ".node"};
+    return e;
+}
+
+const char* tool_hint(Tool tool) {
+    switch (tool) {
+    case Tool::Orbit: return "Drag: orbit. Right drag: orbit, middle drag: pan, wheel: zoom.";
+    case Tool::Cut: return "Draw a stroke across the object: the left side is cut away.";
+    case Tool::ExactCut: return "Draw a stroke: cut exactly along it (tets split at the surface).";
+    case Tool::Relax: return "Relax the cross-sections of the last cut.";
+    case Tool::Fracture: return "Draw a stroke: the object breaks into pieces along it.";
+    case Tool::MovePiece: return "Drag a piece to move it.";
+    case Tool::Paint: return "Paint the selected material into the volume under the stroke.";
+    case Tool::Light: return "Drag: turn the selected directional light, or move the point light.";
+    }
+    return "";
+}
+
+ImVec4 swatch(const TetMaterial& m) {
+    const auto c = swatch_colour(m);
+    return ImVec4(c[0], c[1], c[2], 1.0f);
+}
+
+}  // namespace
+
+void EditorApp::apply_theme(float scale) {
+    ImGui::StyleColorsDark();
+    ImGuiStyle& style = ImGui::GetStyle();
+    style.WindowRounding = 4;
+    style.FrameRounding = 3;
+    style.GrabRounding = 3;
+    style.WindowBorderSize = 0;
+    style.FramePadding = ImVec2(6, 4);
+    style.ItemSpacing = ImVec2(8, 6);
+    ImVec4* c = style.Colors;
+    c[ImGuiCol_WindowBg] = ImVec4(0.11f, 0.11f, 0.13f, 0.97f);
+    c[ImGuiCol_MenuBarBg] = ImVec4(0.14f, 0.14f, 0.16f, 1.0f);
+    c[ImGuiCol_Header] = ImVec4(0.72f, 0.55f, 0.30f, 0.35f);  // warm wax accent
+    c[ImGuiCol_HeaderHovered] = ImVec4(0.72f, 0.55f, 0.30f, 0.55f);
+    c[ImGuiCol_HeaderActive] = ImVec4(0.72f, 0.55f, 0.30f, 0.75f);
+    c[ImGuiCol_Button] = ImVec4(0.24f, 0.24f, 0.28f, 1.0f);
+    c[ImGuiCol_ButtonHovered] = ImVec4(0.72f, 0.55f, 0.30f, 0.60f);
+    c[ImGuiCol_ButtonActive] = ImVec4(0.72f, 0.55f, 0.30f, 0.85f);
+    c[ImGuiCol_FrameBg] = ImVec4(0.20f, 0.20f, 0.23f, 1.0f);
+    c[ImGuiCol_SliderGrab] = ImVec4(0.85f, 0.66f, 0.38f, 1.0f);
+    c[ImGuiCol_CheckMark] = ImVec4(0.92f, 0.74f, 0.45f, 1.0f);
+    c[ImGuiCol_PlotHistogram] = ImVec4(0.85f, 0.66f, 0.38f, 1.0f);
+    style.ScaleAllSizes(scale);
+
+    // DejaVu Sans (fonts-dejavu-core, present on nearly every Debian desktop) scaled for HiDPI: the
+    // built-in bitmap font turns blurry when scaled. Fall back to it when DejaVu is missing.
+    ImGuiIO& io = ImGui::GetIO();
+    std::error_code error;
+    if (std::filesystem::exists(kDejaVuSans, error)) io.Fonts->AddFontFromFileTTF(kDejaVuSans, 15.0f * scale);
+    else io.FontGlobalScale = scale;
+}
+
+void EditorApp::open_dialog(FileDialog::Mode mode) {
+    const fs::path directory = current_file_.empty() ? fs::current_path() : current_file_.parent_path();
+    if (mode == FileDialog::Mode::Open) {
+        file_dialog_.open(mode, "Open", directory, openable_extensions());
+    } else {
+        const std::string name = current_file_.empty() ? "volume.vtu" : current_file_.stem().string() + ".vtu";
+        file_dialog_.open(mode, "Save volume", directory, {".vtu", ".msh", ".mesh", ".node"}, name);
+    }
+}
+
+void EditorApp::file_dialog_result() {
+    if (options_.hide_ui) return;
+    if (const auto chosen = file_dialog_.draw(ui_scale_)) {
+        if (file_dialog_.mode() == FileDialog::Mode::Open) open_file(*chosen);
+        else save_volume(*chosen);
+    }
+}
+
+void EditorApp::draw_ui() {
+    draw_menu_bar();
+    draw_tool_palette();
+    draw_side_panel();
+    draw_status_bar();
+    if (show_error_popup_) {
+        ImGui::OpenPopup("Error");
+        show_error_popup_ = false;
+    }
+    if (ImGui::BeginPopupModal("Error", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+        ImGui::PushTextWrapPos(ImGui::GetFontSize() * 36);
+        ImGui::TextUnformatted(error_message_.c_str());
+        ImGui::PopTextWrapPos();
+        if (ImGui::Button("OK", ImVec2(100 * ui_scale_, 0))) ImGui::CloseCurrentPopup();
+        ImGui::EndPopup();
+    }
+}
+
+void EditorApp::draw_menu_bar() {
+    if (!ImGui::BeginMainMenuBar()) return;
+    if (ImGui::BeginMenu("File")) {
+        if (ImGui::MenuItem("Open...", "Ctrl+O")) open_dialog(FileDialog::Mode::Open);
+        if (ImGui::MenuItem("Save volume...", "Ctrl+S", false, scene_->mesh != nullptr)) open_dialog(FileDialog::Mode::Save);
+        ImGui::Separator();
+        if (ImGui::MenuItem("Quit", "Ctrl+Q")) glfwSetWindowShouldClose(window_, GLFW_TRUE);
+        ImGui::EndMenu();
+    }
+    if (ImGui::BeginMenu("Edit")) {
+        if (ImGui::MenuItem("Undo", "Ctrl+Z", false, can_undo())) undo();
+        if (ImGui::MenuItem("Redo", "Ctrl+Shift+Z", false, can_redo())) redo();
+        ImGui::EndMenu();
+    }
+    if (ImGui::BeginMenu("Tools")) {
+        for (const ToolInfo& info : tool_infos()) {
+            if (ImGui::MenuItem(info.name, info.shortcut, tool_ == info.tool)) tool_ = info.tool;
+        }
+        ImGui::EndMenu();
+    }
+    if (ImGui::BeginMenu("View")) {
+        if (ImGui::MenuItem("Reset camera", "Home")) camera_.reset();
+        if (ImGui::MenuItem("Hide panels", "Tab", options_.hide_ui)) options_.hide_ui = !options_.hide_ui;
+        ImGui::EndMenu();
+    }
+    if (ImGui::BeginMenu("Help")) {
+        ImGui::TextUnformatted("Right drag or Alt+drag: orbit   Middle or Shift+right drag: pan   Wheel: zoom");
+        ImGui::TextUnformatted("Drop a mesh or volume file onto the window to open it.");
+        ImGui::EndMenu();
+    }
+    ImGui::EndMainMenuBar();
+}
+
+void EditorApp::draw_tool_palette() {
+    const float top = ImGui::GetFrameHeight();
+    const ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(0, top));
+    ImGui::SetNextWindowSize(ImVec2(kToolPaletteWidth * ui_scale_, io.DisplaySize.y - top - ImGui::GetFrameHeight() * 1.2f));
+    ImGui::Begin("Tools", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    const float width = ImGui::GetContentRegionAvail().x;
+    for (const ToolInfo& info : tool_infos()) {
+        const bool active = tool_ == info.tool;
+        if (active) ImGui::PushStyleColor(ImGuiCol_Button, ImGui::GetStyle().Colors[ImGuiCol_ButtonActive]);
+        char label[64];
+        std::snprintf(label, sizeof label, "%s", info.name);
+        if (ImGui::Button(label, ImVec2(width, 0))) tool_ = info.tool;
+        if (active) ImGui::PopStyleColor();
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s (%s)\n%s", info.name, info.shortcut, tool_hint(info.tool));
+    }
+    ImGui::End();
+}
+
+void EditorApp::draw_side_panel() {
+    const float top = ImGui::GetFrameHeight();
+    const ImGuiIO& io = ImGui::GetIO();
+    const float width = kSidePanelWidth * ui_scale_;
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - width, top));
+    ImGui::SetNextWindowSize(ImVec2(width, io.DisplaySize.y - top - ImGui::GetFrameHeight() * 1.2f));
+    ImGui::Begin("Scene", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) draw_material_panel();
+    if (ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) draw_light_panel();
+    if (ImGui::CollapsingHeader("Solver", ImGuiTreeNodeFlags_DefaultOpen)) draw_solver_panel();
+    if (ImGui::CollapsingHeader("View")) draw_view_panel();
+    ImGui::End();
+}
+
+void EditorApp::draw_material_panel() {
+    const std::vector<std::string> names = material_preset_names();
+    selected_preset_ = std::clamp(selected_preset_, 0, static_cast<int>(names.size()) - 1);
+    ImGui::TextDisabled("Jensen et al. 2001, per mm; swatch: diffuse reflectance");
+    const float swatch_size = ImGui::GetFrameHeight();
+    ImGui::BeginChild("presets", ImVec2(0, 5.3f * ImGui::GetFrameHeightWithSpacing()), true);
+    for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+        const TetMaterial m = material_preset(names[i]);
+        ImGui::PushID(i);
+        ImGui::ColorButton("##swatch", swatch(m), ImGuiColorEditFlags_NoTooltip, ImVec2(swatch_size, swatch_size * 0.8f));
+        ImGui::SameLine();
+        if (ImGui::Selectable(names[i].c_str(), selected_preset_ == i)) {
+            selected_preset_ = i;
+            custom_material_ = m;
+        }
+        if (ImGui::IsItemHovered()) {
+            ImGui::SetTooltip("mu_a  %.4f %.4f %.4f /mm\nmu_s' %.2f %.2f %.2f /mm\neta %.2f", m.mua[0], m.mua[1], m.mua[2],
+                              m.musp[0], m.musp[1], m.musp[2], m.eta);
+        }
+        ImGui::PopID();
+    }
+    ImGui::EndChild();
+    if (!custom_material_) custom_material_ = material_preset(names[selected_preset_]);
+    TetMaterial& m = *custom_material_;
+    float mua[3] = {static_cast<float>(m.mua[0]), static_cast<float>(m.mua[1]), static_cast<float>(m.mua[2])};
+    float musp[3] = {static_cast<float>(m.musp[0]), static_cast<float>(m.musp[1]), static_cast<float>(m.musp[2])};
+    float eta = static_cast<float>(m.eta);
+    bool changed = ImGui::DragFloat3("mu_a /mm", mua, 0.0005f, 0.0f, 100.0f, "%.4f");
+    changed |= ImGui::DragFloat3("mu_s' /mm", musp, 0.01f, 0.001f, 1000.0f, "%.3f");
+    changed |= ImGui::DragFloat("eta", &eta, 0.005f, 1.0f, 3.0f, "%.3f");
+    if (changed) {
+        for (int c = 0; c < 3; ++c) {
+            m.mua[c] = std::max(0.0f, mua[c]);
+            m.musp[c] = std::max(0.001f, musp[c]);
+        }
+        m.eta = std::clamp(static_cast<double>(eta), 1.0, 3.0);
+    }
+    ImGui::ColorButton("##custom", swatch(m), ImGuiColorEditFlags_NoTooltip, ImVec2(swatch_size * 2, swatch_size));
+    ImGui::SameLine();
+    const bool has_scene = scene_->mesh != nullptr;
+    if (ImGui::Button("Apply to the whole object") && has_scene) set_whole_material(m, names[selected_preset_]);
+    ImGui::TextDisabled("Object: %s; Paint (P) brushes it in locally", scene_->material_name.c_str());
+    ImGui::SliderFloat("brush radius", &brush_radius_, 0.005f, 0.3f, "%.3f x size");
+}
+
+void EditorApp::draw_light_panel() {
+    int remove = -1;
+    for (int i = 0; i < static_cast<int>(lighting_.lights.size()); ++i) {
+        Light& light = lighting_.lights[i];
+        ImGui::PushID(i);
+        bool changed = false;
+        const bool selected = selected_light_ == i;
+        char title[48];
+        std::snprintf(title, sizeof title, "%s light %d", light.type == LightType::Directional ? "Directional" : "Point", i + 1);
+        if (ImGui::RadioButton(title, selected)) selected_light_ = i;
+        ImGui::SameLine(ImGui::GetContentRegionAvail().x - 60 * ui_scale_);
+        if (ImGui::SmallButton("remove")) remove = i;
+        int type = light.type == LightType::Directional ? 0 : 1;
+        if (ImGui::Combo("type", &type, "directional\0point\0")) {
+            const bool to_point = type == 1;
+            if (to_point != (light.type == LightType::Point)) {
+                // A point light placed where the directional light comes from, outside the object.
+                const double reach = camera_ ? 2.5 * camera_->scene_radius() : 2.0;
+                const Eigen::Vector3d centre = camera_ ? camera_->target() : Eigen::Vector3d::Zero();
+                light.type = to_point ? LightType::Point : LightType::Directional;
+                light.vector = to_point ? Eigen::Vector3d(centre - reach * light.vector.normalized())
+                                        : Eigen::Vector3d((centre - light.vector).normalized());
+                changed = true;
+            }
+        }
+        float v[3] = {static_cast<float>(light.vector.x()), static_cast<float>(light.vector.y()), static_cast<float>(light.vector.z())};
+        if (ImGui::DragFloat3(light.type == LightType::Directional ? "travels along" : "position", v, 0.01f)) {
+            const Eigen::Vector3d next(v[0], v[1], v[2]);
+            if (next.allFinite() && (light.type == LightType::Point || next.norm() > 1e-6)) {
+                light.vector = next;
+                changed = true;
+            }
+        }
+        float colour[3] = {static_cast<float>(light.intensity[0]), static_cast<float>(light.intensity[1]),
+                           static_cast<float>(light.intensity[2])};
+        if (ImGui::ColorEdit3("intensity", colour, ImGuiColorEditFlags_HDR | ImGuiColorEditFlags_Float)) {
+            for (int c = 0; c < 3; ++c) light.intensity[c] = std::max(0.0f, colour[c]);
+            changed = true;
+        }
+        if (changed) request_solve();
+        ImGui::Separator();
+        ImGui::PopID();
+    }
+    if (remove >= 0) {
+        lighting_.lights.erase(lighting_.lights.begin() + remove);
+        request_solve();
+    }
+    if (lighting_.lights.size() < static_cast<size_t>(kMaxRenderLights) && ImGui::Button("Add light")) {
+        lighting_.lights.push_back(default_key_light());
+        selected_light_ = static_cast<int>(lighting_.lights.size()) - 1;
+        request_solve();
+    }
+    ImGui::SameLine();
+    ImGui::TextDisabled("drag in the view with L");
+    float ambient = static_cast<float>(lighting_.ambient[0]);
+    if (ImGui::DragFloat("ambient", &ambient, 0.002f, 0.0f, 10.0f, "%.3f")) {
+        lighting_.ambient = {std::max(0.0f, ambient), std::max(0.0f, ambient), std::max(0.0f, ambient)};
+        request_solve();
+    }
+    if (ImGui::Checkbox("shadows", &lighting_.shadows)) request_solve();
+}
+
+void EditorApp::draw_solver_panel() {
+    int method = diffusion_.discretization == Discretization::TransCut ? 0 : 1;
+    if (ImGui::Combo("method", &method, "TransCut (lumped)\0FEM (consistent mass)\0")) {
+        diffusion_.discretization = method == 0 ? Discretization::TransCut : Discretization::Fem;
+        request_solve();
+    }
+    int precision = diffusion_.precision == SolverPrecision::Double ? 0 : 1;
+    if (ImGui::Combo("backend", &precision, "CPU CG, double\0CPU CG, float\0")) {
+        diffusion_.precision = precision == 0 ? SolverPrecision::Double : SolverPrecision::Float;
+        request_solve();
+    }
+    float tolerance_exponent = static_cast<float>(std::log10(diffusion_.relative_tolerance));
+    if (ImGui::SliderFloat("tolerance", &tolerance_exponent, -6.0f, -1.0f, "1e%.1f")) {
+        diffusion_.relative_tolerance = std::pow(10.0, tolerance_exponent);
+        request_solve();
+    }
+    float scale = static_cast<float>(diffusion_.mm_per_unit);
+    if (ImGui::DragFloat("mm per unit", &scale, 0.1f, 0.01f, 10000.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) {
+        diffusion_.mm_per_unit = std::clamp(static_cast<double>(scale), 1e-3, 1e6);
+        request_solve();
+    }
+    ImGui::SliderFloat("exposure", &exposure_stops_, -4.0f, 4.0f, "%+.1f stops");
+
+    const Scene& s = *scene_;
+    if (s.solve_count > 0) {
+        const auto& st = s.stats;
+        ImGui::Text("iterations   %d %d %d", st.iterations[0], st.iterations[1], st.iterations[2]);
+        ImGui::Text("est. error   %.1e %.1e %.1e", st.estimated_relative_error[0], st.estimated_relative_error[1],
+                    st.estimated_relative_error[2]);
+        ImGui::Text("lighting %.0f ms  assembly %.0f ms  solve %.0f ms", s.lighting_ms, st.assembly_ms, st.solve_ms);
+    } else {
+        ImGui::TextDisabled("not solved yet");
+    }
+    const ImGuiIO& io = ImGui::GetIO();
+    ImGui::Text("frame %.1f ms (%.0f fps), view %.1f ms", 1000.0f / std::max(io.Framerate, 1e-3f), io.Framerate,
+                last_render_ms_);
+    if (s.mesh) ImGui::Text("%zu tets, %zu vertices", s.mesh->tet_count(), s.mesh->vertex_count());
+}
+
+void EditorApp::draw_view_panel() {
+    int msaa = msaa_samples_ >= 4 ? 2 : msaa_samples_ >= 2 ? 1 : 0;
+    if (ImGui::Combo("antialiasing", &msaa, "off\0" "2x MSAA\0" "4x MSAA\0")) msaa_samples_ = msaa == 2 ? 4 : msaa == 1 ? 2 : 1;
+    ImGui::Checkbox("show light gizmos", &show_light_gizmos_);
+    if (ImGui::Button("Reset camera (Home)")) camera_.reset();
+    if (camera_) {
+        const Eigen::Vector3d d = camera_->eye_direction();
+        ImGui::TextDisabled("view direction %.2f %.2f %.2f", d.x(), d.y(), d.z());
+    }
+}
+
+void EditorApp::draw_status_bar() {
+    const ImGuiIO& io = ImGui::GetIO();
+    const float height = ImGui::GetFrameHeight() * 1.2f;
+    ImGui::SetNextWindowPos(ImVec2(0, io.DisplaySize.y - height));
+    ImGui::SetNextWindowSize(ImVec2(io.DisplaySize.x, height));
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(8 * ui_scale_, 3 * ui_scale_));
+    ImGui::Begin("##status", nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings);
+    // Progress of anything that has run longer than 200 ms; the UI keeps drawing meanwhile.
+    const BackgroundTask* task = load_task_.busy() ? &load_task_ : solve_task_.busy() ? &solve_task_ : nullptr;
+    if (task && task->elapsed_seconds() > 0.2) {
+        const float fraction = task->progress()->fraction();
+        char overlay[160];
+        std::snprintf(overlay, sizeof overlay, "%s: %s (%.1f s)", task->label().c_str(), task->progress()->stage().c_str(),
+                      task->elapsed_seconds());
+        // Unknown fraction: a bar sweeping back and forth.
+        const float shown = fraction >= 0 ? fraction : 0.5f + 0.5f * std::sin(static_cast<float>(ImGui::GetTime()) * 3.0f);
+        ImGui::ProgressBar(shown, ImVec2(300 * ui_scale_, 0), overlay);
+        ImGui::SameLine();
+    }
+    ImGui::TextUnformatted(status_.c_str());
+    ImGui::End();
+    ImGui::PopStyleVar();
+}
+
+void EditorApp::draw_overlays() {
+    ImDrawList* draw = ImGui::GetBackgroundDrawList();
+    const double s = framebuffer_scale_;
+    auto to_screen = [&](float x, float y) {
+        return ImVec2(static_cast<float>((x + view_x_) / s), static_cast<float>((y + view_y_) / s));
+    };
+    // The stroke being drawn.
+    if (stroke_.size() > 1) {
+        const ImU32 colour = tool_ == Tool::Paint ? IM_COL32(120, 200, 255, 230) : IM_COL32(255, 190, 90, 230);
+        for (size_t i = 1; i < stroke_.size(); ++i) {
+            draw->AddLine(to_screen(stroke_[i - 1][0], stroke_[i - 1][1]), to_screen(stroke_[i][0], stroke_[i][1]), colour,
+                          2.0f * ui_scale_);
+        }
+    }
+    if (!camera_ || !show_light_gizmos_) return;
+    // Light gizmos: point lights as suns at their position, directional ones as an arrow towards the
+    // target from where the light comes.
+    for (int i = 0; i < static_cast<int>(lighting_.lights.size()); ++i) {
+        const Light& light = lighting_.lights[i];
+        const ImU32 colour = i == selected_light_ ? IM_COL32(255, 220, 120, 255) : IM_COL32(200, 200, 200, 180);
+        const Eigen::Vector3d from = light.type == LightType::Point
+                                         ? light.vector
+                                         : Eigen::Vector3d(camera_->target() - 1.3 * camera_->scene_radius() * light.vector.normalized());
+        const Eigen::Vector3d p = camera_->project(from, view_w_, view_h_);
+        if (!(p.z() > 0 && p.z() < 1)) continue;
+        const ImVec2 at = to_screen(static_cast<float>(p.x()), static_cast<float>(p.y()));
+        draw->AddCircleFilled(at, 6.0f * ui_scale_, colour);
+        if (light.type == LightType::Directional) {
+            const Eigen::Vector3d q = camera_->project(
+                Eigen::Vector3d(camera_->target() - 0.9 * camera_->scene_radius() * light.vector.normalized()), view_w_, view_h_);
+            draw->AddLine(at, to_screen(static_cast<float>(q.x()), static_cast<float>(q.y())), colour, 2.0f * ui_scale_);
+        }
+    }
+    const char* hint = tool_hint(tool_);
+    draw->AddText(to_screen(10, 8), IM_COL32(220, 220, 220, 200), hint);
+}
+
+}  // namespace waxwork

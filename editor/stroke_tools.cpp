@@ -1,0 +1,65 @@
+#include "editor/stroke_tools.h"
+
+#include <cmath>
+
+namespace waxwork {
+
+ScreenStroke simplify_stroke(const ScreenStroke& stroke, float min_spacing) {
+    ScreenStroke kept;
+    for (const auto& p : stroke) {
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1])) continue;
+        if (!kept.empty() && std::hypot(p[0] - kept.back()[0], p[1] - kept.back()[1]) < min_spacing) continue;
+        kept.push_back(p);
+    }
+    // The end point was dropped for being near the last kept one: let it replace that one (or follow
+    // the first point), so the stroke ends where the mouse was released.
+    const auto& last = stroke.empty() ? std::array<float, 2>{} : stroke.back();
+    if (!kept.empty() && std::isfinite(last[0]) && std::isfinite(last[1]) && last != kept.back()) {
+        if (kept.size() > 1) kept.back() = last;
+        else kept.push_back(last);
+    }
+    return kept;
+}
+
+std::vector<Eigen::Vector3d> stroke_on_target_plane(const OrbitCamera& camera, const ScreenStroke& stroke,
+                                                    double viewport_width, double viewport_height) {
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(stroke.size());
+    const Eigen::Vector3d forward = -camera.eye_direction();
+    for (const auto& p : stroke) {
+        const Ray ray = camera.unproject(Eigen::Vector2d(p[0], p[1]), viewport_width, viewport_height);
+        // The plane forward . x = forward . target, which the ray meets at distance / cos(angle).
+        const double cos_angle = ray.direction.dot(forward);
+        if (!(cos_angle > 1e-9)) continue;
+        points.push_back(ray.origin + (camera.distance() / cos_angle) * ray.direction);
+    }
+    return points;
+}
+
+std::optional<Eigen::Vector3d> first_hit(const TriangleBvh& bvh, const Ray& ray, double max_distance) {
+    const Eigen::Vector3f origin = ray.origin.cast<float>();
+    const Eigen::Vector3f direction = ray.direction.cast<float>();
+    float hi = static_cast<float>(max_distance);
+    if (bvh.empty() || !(hi > 0) || !bvh.occluded(origin, direction, 0.0f, hi)) return std::nullopt;
+    float lo = 0.0f;  // invariant: (0, lo) misses, (0, hi) hits
+    for (int i = 0; i < 24; ++i) {
+        const float mid = 0.5f * (lo + hi);
+        if (bvh.occluded(origin, direction, 0.0f, mid)) hi = mid;
+        else lo = mid;
+    }
+    return ray.origin + static_cast<double>(0.5f * (lo + hi)) * ray.direction;
+}
+
+std::vector<Eigen::Vector3d> stroke_on_surface(const OrbitCamera& camera, const TriangleBvh& bvh,
+                                               const ScreenStroke& stroke, double viewport_width,
+                                               double viewport_height) {
+    std::vector<Eigen::Vector3d> points;
+    const double reach = camera.distance() + 4 * camera.scene_radius();
+    for (const auto& p : stroke) {
+        const Ray ray = camera.unproject(Eigen::Vector2d(p[0], p[1]), viewport_width, viewport_height);
+        if (const auto hit = first_hit(bvh, ray, reach)) points.push_back(*hit);
+    }
+    return points;
+}
+
+}  // namespace waxwork

@@ -1,0 +1,114 @@
+// `waxwork cut --exact` and `waxwork fracture` end to end: a meshed cube in, a valid volume and a
+// one-line JSON summary out; bad input gives a one-line error and writes nothing.
+#include "editor/cli_run.h"
+#include "io/volume_file.h"
+#include "tetops/connectivity.h"
+#include "tetops/tet_mesh.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <set>
+
+namespace waxwork {
+namespace {
+
+using testing::line_count;
+using testing::run_waxwork;
+using testing::scratch_dir;
+namespace fs = std::filesystem;
+
+const std::string kAssets = WAXWORK_ASSET_DIR;
+
+// The embedded cube meshed once per test into `dir`.
+fs::path meshed_cube(const fs::path& dir) {
+    const auto volume = dir / "cube.vtu";
+    const auto r = run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + volume.string() + " --max-tets 3000");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return volume;
+}
+
+TEST(FractureCommand, BreaksIntoPiecesAndSummarises) {
+    const auto dir = scratch_dir("fracture_cli");
+    const auto in = meshed_cube(dir);
+    const TetMesh before = read_volume(in.string());
+    for (const std::string mode : {"--exact", "--no-exact"}) {
+        const auto out = dir / "pieces.vtu";
+        const auto r = run_waxwork("fracture " + in.string() + " -o " + out.string() + " --pieces 5 --seed 3 " + mode);
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        ASSERT_EQ(line_count(r.out), 1u) << r.out;
+        const auto summary = nlohmann::json::parse(r.out);
+        for (const char* key : {"tets_before", "vertices_before", "tets_after", "vertices_after", "pieces",
+                                "min_dihedral_deg", "milliseconds"})
+            EXPECT_TRUE(summary.contains(key)) << key;
+        EXPECT_EQ(summary["tets_before"], before.tet_count());
+        const TetMesh mesh = read_volume(out.string());
+        EXPECT_NO_THROW(validate(mesh));
+        EXPECT_EQ(summary["tets_after"], mesh.tet_count());
+        EXPECT_EQ(summary["vertices_after"], mesh.vertex_count());
+        EXPECT_EQ(summary["pieces"], mesh.piece_transforms.size());
+        EXPECT_GE(int(summary["pieces"]), 2);
+        EXPECT_LE(int(summary["pieces"]), 5);
+        EXPECT_GT(double(summary["min_dihedral_deg"]), 0.0);
+        EXPECT_NEAR(total_volume(mesh), total_volume(before), 1e-9 * total_volume(before));
+        // The pieces are apart: as many components as pieces.
+        EXPECT_EQ(build_connectivity(mesh).component_count, int(summary["pieces"])) << mode;
+        if (mode == "--no-exact") {
+            EXPECT_EQ(mesh.tet_count(), before.tet_count());
+        }
+    }
+    // The same seed gives the same file.
+    const auto a = dir / "a.vtu", b = dir / "b.vtu";
+    ASSERT_EQ(run_waxwork("fracture " + in.string() + " -o " + a.string() + " --pieces 4 --seed 9").exit_code, 0);
+    ASSERT_EQ(run_waxwork("fracture " + in.string() + " -o " + b.string() + " --pieces 4 --seed 9").exit_code, 0);
+    EXPECT_EQ(read_volume(a.string()), read_volume(b.string()));
+}
+
+TEST(FractureCommand, BadInputIsAOneLineError) {
+    const auto dir = scratch_dir("fracture_cli_bad");
+    const auto in = meshed_cube(dir);
+    const auto out = dir / "never.vtu";
+    for (const std::string& args : std::vector<std::string>{
+             in.string() + " -o " + out.string() + " --pieces 0", in.string() + " -o " + out.string() + " --pieces -4",
+          in.string() + " -o " + out.string() + " --pieces 100000000",
+          (dir / "missing.vtu").string() + " -o " + out.string() + " --pieces 3",
+          in.string() + " -o " + out.string() + " --pieces x", in.string() + " -o " + out.string()}) {
+        const auto r = run_waxwork("fracture " + args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_EQ(line_count(r.err), 1u) << args << ": " << r.err;
+    }
+    EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(CutCommand, ExactCutLeavesTheCrossSectionOnThePlane) {
+    const auto dir = scratch_dir("cut_exact_cli");
+    const auto in = meshed_cube(dir);
+    const TetMesh before = read_volume(in.string());
+    const auto box = bounding_box(before);
+    const double mid = 0.5 * (box[0].x() + box[1].x()) + 0.0123;
+    const auto out = dir / "cut.vtu";
+    const auto r = run_waxwork("cut " + in.string() + " -o " + out.string() + " --plane=1,0,0," + std::to_string(mid) +
+                               " --exact");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    ASSERT_EQ(line_count(r.out), 1u);
+    const auto summary = nlohmann::json::parse(r.out);
+    EXPECT_EQ(summary["mode"], "exact");
+    EXPECT_GT(int(summary["tets_split"]), 0);
+    const TetMesh mesh = read_volume(out.string());
+    EXPECT_NO_THROW(validate(mesh));
+    EXPECT_EQ(summary["tets_after"], mesh.tet_count());
+    const double mid_written = std::stod(std::to_string(mid));
+    double max_x = -1e300;
+    for (const auto& p : mesh.positions) max_x = std::max(max_x, p.x());
+    EXPECT_NEAR(max_x, mid_written, 1e-12);
+    // The cube is a box: the kept volume is exact.
+    const Eigen::Vector3d extent = box[1] - box[0];
+    EXPECT_NEAR(total_volume(mesh), (mid_written - box[0].x()) * extent.y() * extent.z(), 1e-9);
+    const auto bad = run_waxwork("cut " + in.string() + " -o " + (dir / "x.vtu").string() + " --plane=0,0,0,1 --exact");
+    EXPECT_NE(bad.exit_code, 0);
+    EXPECT_EQ(line_count(bad.err), 1u);
+}
+
+}  // namespace
+}  // namespace waxwork
