@@ -223,9 +223,8 @@ void run_demo_command(const DemoCommandOptions& o) {
     // Hook for the interactive editor: when a window can open, this is where the demo hands over
     // (the example sessions in assets/sessions/ are the scenes to offer).
     if (std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY")) {
-        std::cout << "a display is available, but the interactive editor is not built yet: open the images above, "
-                     "or render your own with `waxwork render "
-                  << volume_path.string() << " -o IMAGE.png`\n";
+        std::cout << "a display is available: open the volume in the interactive editor with `waxwork edit "
+                  << volume_path.string() << "`\n";
     }
 }
 

@@ -15,6 +15,9 @@
 // exceed it the oldest entries are dropped (counted in evicted_undo_count()). An entry larger than the
 // whole budget is not kept at all (the edit then cannot be undone; the report says so).
 //
+// Not synchronised: one thread (or one lock) applies, undoes and redoes (see live_scene.h for the
+// window's threading).
+//
 // The document always stores materials: a volume loaded without them gets the default material on
 // every tet, so paint, undo and the solver all see one material per tet.
 #pragma once

@@ -26,7 +26,11 @@
 // running step() to finish (one frame). The TetMesh passed to the constructor and apply_change() is
 // borrowed: it must outlive the scene and must not be modified while any member runs (the document
 // changes it only inside Document::apply/undo/redo: call those and apply_change() under the same
-// external lock or on the same thread, and never concurrently with solved_scene()).
+// external lock or on the same thread, and never concurrently with solved_scene() or
+// radiance_factors(), which read it). step(), step_for(), converge() and phi() never read the mesh.
+// A window's loop, for example:
+//   UI thread:     { lock edit_mutex; report = document.apply(op); scene.apply_change(document.mesh(), report); }
+//   solver thread: scene.step_for(12 /* ms */); { lock edit_mutex; E = scene.radiance_factors(); } upload E
 #pragma once
 
 #include "editor/document.h"
