@@ -641,25 +641,18 @@ void EditorApp::finish_stroke() {
     if (!camera_ || !scene_->core) return;
     try {
         if (tool_ == Tool::Cut || tool_ == Tool::ExactCut) {
-            if (stroke.size() < 2) return;
-            StrokeSurface surface;
-            surface.eye = camera_->eye();
-            surface.view_direction = -camera_->eye_direction();
-            surface.points = stroke_on_target_plane(*camera_, stroke, view_w_, view_h_);
-            surface.flip = ImGui::GetIO().KeyShift;  // Shift keeps the left side instead
-            StrokeCutOp op;
-            op.stroke = surface;
-            op.exact = tool_ == Tool::ExactCut;
-            last_cut_ = surface;
-            queue_edit(op);
+            // Shift keeps the left side instead.
+            const auto op = stroke_cut_op(*camera_, stroke, view_w_, view_h_, tool_ == Tool::ExactCut,
+                                          ImGui::GetIO().KeyShift);
+            if (!op) return;
+            last_cut_ = op->stroke;
+            queue_edit(*op);
         } else if (tool_ == Tool::Paint) {
             if (!scene_->surface_bvh) return;
-            PaintOp op;
-            op.points = stroke_on_surface(*camera_, *scene_->surface_bvh, stroke, view_w_, view_h_);
-            if (op.points.empty()) return;  // the stroke missed the object
-            op.material = custom_material_.value_or(material_preset("marble"));
-            op.sigma = brush_radius_ * camera_->scene_radius();
-            queue_edit(op);
+            const auto op = paint_op(*camera_, *scene_->surface_bvh, stroke, view_w_, view_h_,
+                                     custom_material_.value_or(material_preset("marble")),
+                                     brush_radius_ * camera_->scene_radius());
+            if (op) queue_edit(*op);  // else the stroke missed the object
         } else if (tool_ == Tool::Fracture) {
             FractureOp op;
             if (scene_->surface_bvh && stroke.size() >= 2) {
