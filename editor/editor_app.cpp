@@ -612,19 +612,13 @@ void EditorApp::drag_light(double dx, double dy) {
 bool EditorApp::can_undo() const { return scene_->can_undo || !pending_jobs_.empty(); }
 bool EditorApp::can_redo() const { return scene_->can_redo; }
 
-void EditorApp::undo() {
-    queue_job("undo", [](SceneCore& core) {
-        const auto report = core.document->undo();
-        if (!report) return std::string("Nothing to undo");
-        core.live->apply_change(core.document->mesh(), *report);
-        return report->name;
-    });
-}
+void EditorApp::undo() { queue_history_step(false); }
+void EditorApp::redo() { queue_history_step(true); }
 
-void EditorApp::redo() {
-    queue_job("redo", [](SceneCore& core) {
-        const auto report = core.document->redo();
-        if (!report) return std::string("Nothing to redo");
+void EditorApp::queue_history_step(bool redo) {
+    queue_job(redo ? "redo" : "undo", [redo](SceneCore& core) {
+        const auto report = redo ? core.document->redo() : core.document->undo();
+        if (!report) return std::string(redo ? "Nothing to redo" : "Nothing to undo");
         core.live->apply_change(core.document->mesh(), *report);
         return report->name;
     });

@@ -13,22 +13,22 @@
 
 #include "editor/background_task.h"
 #include "editor/document.h"
-#include "editor/live_scene.h"
-#include "editor/session.h"
 #include "editor/file_dialog.h"
+#include "editor/live_scene.h"
 #include "editor/orbit_camera.h"
 #include "editor/render_pipeline.h"
+#include "editor/session.h"
 #include "editor/surface_renderer.h"
 #include "editor/view_cache.h"
 #include "solver/ray_caster.h"
 
 #include <deque>
-#include <functional>
-
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 struct GLFWwindow;
@@ -172,6 +172,7 @@ private:
     void file_dialog_result();
     void undo();
     void redo();
+    void queue_history_step(bool redo);
     bool can_undo() const;
     bool can_redo() const;
     void set_whole_material(const TetMaterial& material, const std::string& name);
