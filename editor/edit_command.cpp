@@ -18,6 +18,7 @@ namespace {
 
 struct EditCommandOptions {
     std::string file;
+    std::string session;
     std::string screenshot;
     int frames = 10;
     bool hide_ui = false;
@@ -38,6 +39,7 @@ void run_edit_command(const EditCommandOptions& o) {
         throw InvalidArgumentError("--scale must be a length in mm per model unit between 1e-6 and 1e6");
     EditorOptions options;
     options.file = o.file;
+    options.session = o.session;
     options.screenshot = o.screenshot;
     options.frames = o.frames;
     options.hide_ui = o.hide_ui;
@@ -58,7 +60,7 @@ void run_edit_command(const EditCommandOptions& o) {
         const nlohmann::ordered_json summary = {
             {"screenshot", o.screenshot},  {"frames", stats.frames},
             {"frame_ms", stats.mean_frame_ms}, {"view_ms", stats.mean_view_ms},
-            {"solve_ms", stats.solve_ms},  {"tets", stats.tets},
+            {"solver_ticks", stats.ticks}, {"tick_ms", stats.tick_ms}, {"tets", stats.tets},
             {"vertices", stats.vertices},  {"gl_version", stats.gl_version},
             {"gl_renderer", stats.gl_renderer},
         };
@@ -72,6 +74,10 @@ void add_edit_command(CLI::App& app) {
     auto options = std::make_shared<EditCommandOptions>();
     CLI::App* cmd = app.add_subcommand("edit", "Open the interactive editor (needs a display)");
     cmd->add_option("file", options->file, "Surface (OBJ, OFF, PLY, STL) or volume (VTU, MSH, MESH, NODE) to open")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--session", options->session,
+                    "Open a session file (as `waxwork run` takes): its input, material, lights and camera, with "
+                    "its edits replayed (undoable); File > Save session records yours")
         ->check(CLI::ExistingFile);
     cmd->add_option("--screenshot", options->screenshot,
                     "Draw --frames frames after loading and solving, save the window to this PNG and exit");

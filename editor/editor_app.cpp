@@ -7,6 +7,7 @@
 #include "tetops/connectivity.h"
 #include "tetops/error.h"
 #include "tetops/tetrahedralize.h"
+#include "editor/stroke_tools.h"
 
 #include <GLFW/glfw3.h>
 #include <imgui.h>
@@ -18,6 +19,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
+#include <numbers>
+#include <sstream>
 #include <thread>
 
 namespace waxwork {
@@ -81,7 +85,7 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
 
     lighting_.lights = options.lights.empty() ? std::vector<Light>{default_key_light()} : options.lights;
     lighting_.ambient = {0.02, 0.02, 0.02};  // `waxwork render`'s default --ambient
-    diffusion_.mm_per_unit = options.scale;
+    live_options_.mm_per_unit = options.scale;
     const std::vector<std::string> presets = material_preset_names();
     selected_preset_ = static_cast<int>(std::find(presets.begin(), presets.end(), "marble") - presets.begin());
 
@@ -106,15 +110,16 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
     ImGui_ImplGlfw_InitForOpenGL(window_, true);
     if (!ImGui_ImplOpenGL3_Init("#version 430 core")) throw Error("editor: ImGui's OpenGL 3 backend failed to start");
 
-    if (!options.file.empty()) open_file(options.file);
+    if (!options.session.empty()) open_session(options.session);
+    else if (!options.file.empty()) open_file(options.file);
     else status_ = "Open a surface (OBJ, OFF, PLY, STL) or a volume (VTU, MSH, MESH) with Ctrl+O or drop it here";
 }
 
 EditorApp::~EditorApp() {
     load_task_.cancel();
-    solve_task_.cancel();
+    tick_task_.cancel();
     load_task_.wait();
-    solve_task_.wait();
+    tick_task_.wait();
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();
@@ -129,65 +134,144 @@ void EditorApp::set_error(const std::string& message) {
     show_error_popup_ = true;
 }
 
+namespace {
+
+// Installs a freshly loaded volume: a document (stored materials kept, else `material` on every
+// tet) and its live scene. Runs on the load worker.
+std::shared_ptr<SceneCore> make_core(TetMesh mesh, Session setup) {
+    if (mesh.tet_count() == 0) throw InvalidArgumentError(setup.name + ": the volume has no tets");
+    auto core = std::make_shared<SceneCore>();
+    core->document = std::make_shared<Document>(std::move(mesh), setup.material);
+    LiveSceneOptions live;
+    live.mm_per_unit = setup.scale;
+    live.relative_tolerance = setup.tolerance;
+    core->live = std::make_shared<LiveScene>(core->document->mesh(), setup.lighting, live);
+    core->setup = std::move(setup);
+    return core;
+}
+
+}  // namespace
+
 void EditorApp::open_file(const fs::path& path) {
     if (load_task_.busy()) {
         set_error("still loading " + load_task_.label() + "; try again when it finishes");
         return;
     }
-    const std::optional<size_t> max_tets = options_.max_tets;
-    const std::optional<TetMaterial> chosen = options_.material;
-    const double mm_per_unit = diffusion_.mm_per_unit;
+    if (path.extension() == ".json") {
+        open_session(path);
+        return;
+    }
+    Session setup;
+    setup.name = path.filename().string();
+    (is_volume_file(path) ? setup.input.volume : setup.input.surface) = fs::absolute(path);
+    setup.input.max_tets = options_.max_tets;
+    setup.material = options_.material.value_or(material_preset("marble"));
+    setup.scale = live_options_.mm_per_unit;
+    setup.tolerance = live_options_.relative_tolerance;
+    setup.lighting = lighting_;
+    setup.camera = options_.camera;
+    setup.frame_iterations = frame_iterations_;
+    const std::string material_name = options_.material ? "custom" : "marble (or stored)";
     status_ = "Loading " + path.string();
-    load_task_.start(path.filename().string(), [this, path, max_tets, chosen, mm_per_unit](TaskProgress& progress) {
-        auto mesh = std::make_shared<TetMesh>();
-        if (is_volume_file(path)) {
-            progress.set_stage("reading the volume");
-            *mesh = read_volume(path);
-        } else {
-            progress.set_stage("reading and checking the surface");
-            const LoadedSurface loaded = load_closed_surface(path);
-            progress.set_stage("filling it with tetrahedra");
-            MeshingOptions meshing;
-            if (max_tets) meshing.sizing.target_tets = max_tets;
-            else meshing.sizing = default_mesh_sizing(loaded.surface, chosen.value_or(material_preset("marble")), mm_per_unit);
-            *mesh = tetrahedralize(loaded.surface, meshing).mesh;
+    load_task_.start(path.filename().string(), [this, path, setup, material_name](TaskProgress& progress) {
+        progress.set_stage(setup.input.volume.empty() ? "meshing the surface" : "reading the volume");
+        TetMesh mesh = load_session_input(setup);
+        progress.set_stage("building the document and the live scene");
+        auto core = make_core(std::move(mesh), setup);
+        return BackgroundTask::Apply([this, path, core, material_name] { install_core(core, path, material_name, {}); });
+    });
+}
+
+void EditorApp::open_session(const fs::path& path) {
+    status_ = "Loading session " + path.string();
+    load_task_.start(path.filename().string(), [this, path](TaskProgress& progress) {
+        progress.set_stage("reading the session");
+        Session session = read_session(path);
+        progress.set_stage(session.input.volume.empty() ? "meshing the surface" : "reading the volume");
+        TetMesh mesh = load_session_input(session);
+        // Edits are replayed (and become undoable); the last light and camera steps set the scene's.
+        std::vector<EditOperation> edits;
+        for (const SessionStep& step : session.steps) {
+            if (const auto* op = std::get_if<EditOperation>(&step)) edits.push_back(*op);
+            if (const auto* light = std::get_if<LightStep>(&step)) session.lighting = light->lighting;
+            if (const auto* camera = std::get_if<CameraStep>(&step)) session.camera = camera->camera;
         }
-        if (mesh->tet_count() == 0) throw InvalidArgumentError(path.string() + ": the volume has no tets");
-        progress.set_stage("connectivity");
-        auto connectivity = std::make_shared<TetConnectivity>(build_connectivity(*mesh));
-        std::vector<TetMaterial> materials = resolve_materials(*mesh, chosen);
-        const std::string material_name = chosen ? "custom" : mesh->has_materials() ? "stored" : "marble";
-        // Installed on the UI thread.
-        return [this, path, mesh, connectivity, materials = std::move(materials), material_name]() mutable {
-            scene_ = std::make_unique<Scene>();
-            scene_->mesh = mesh;
-            scene_->connectivity = connectivity;
-            scene_->materials = std::move(materials);
-            scene_->material_name = material_name;
-            camera_.reset();
-            current_file_ = path;
-            status_ = "Loaded " + path.filename().string() + ": " + std::to_string(mesh->tet_count()) + " tets, " +
-                      std::to_string(mesh->vertex_count()) + " vertices";
-            glfwSetWindowTitle(window_, ("Waxwork - " + path.filename().string()).c_str());
-            request_solve();
-        };
+        Session setup = session;
+        setup.steps.clear();
+        progress.set_stage("building the document and the live scene");
+        auto core = make_core(std::move(mesh), setup);
+        return BackgroundTask::Apply([this, path, core, edits] { install_core(core, path, "session", edits); });
+    });
+}
+
+void EditorApp::install_core(std::shared_ptr<SceneCore> core, const fs::path& path, const std::string& material_name,
+                             const std::vector<EditOperation>& replay) {
+    pending_jobs_.clear();
+    scene_ = std::make_unique<Scene>();
+    scene_->core = core;
+    scene_->tets = core->document->mesh().tet_count();
+    scene_->vertices = core->document->mesh().vertex_count();
+    scene_->material_name = material_name;
+    lighting_ = core->setup.lighting;
+    live_options_.mm_per_unit = core->setup.scale;
+    live_options_.relative_tolerance = core->setup.tolerance;
+    options_.camera = core->setup.camera;
+    camera_.reset();
+    current_file_ = path;
+    for (const EditOperation& op : replay) queue_edit(op);
+    status_ = "Loaded " + path.filename().string() + ": " + std::to_string(scene_->tets) + " tets, " +
+              std::to_string(scene_->vertices) + " vertices";
+    glfwSetWindowTitle(window_, ("Waxwork - " + path.filename().string()).c_str());
+    lighting_dirty_ = false;
+}
+
+void EditorApp::queue_job(std::string label, SceneJob job) {
+    if (!scene_->core) {
+        set_error("open a file first");
+        return;
+    }
+    pending_jobs_.emplace_back(std::move(label), std::move(job));
+}
+
+void EditorApp::queue_edit(const EditOperation& op) {
+    queue_job(operation_name(op), [op](SceneCore& core) {
+        const ChangeReport report = core.document->apply(op);
+        core.live->apply_change(core.document->mesh(), report);
+        std::ostringstream line;
+        line << report.name << ": " << report.details << " (" << std::lround(report.milliseconds) << " ms)";
+        if (!report.undoable) line << "; too large to undo";
+        return line.str();
     });
 }
 
 void EditorApp::save_volume(const fs::path& path) {
-    if (!scene_->mesh) {
-        set_error("nothing to save: open a file first");
-        return;
-    }
-    try {
-        TetMesh copy = *scene_->mesh;
-        copy.materials = scene_->materials;
-        write_volume(copy, path);
-        current_file_ = path;
-        status_ = "Saved " + path.string();
-    } catch (const std::exception& e) {
-        set_error(e.what());
-    }
+    queue_job("save", [path](SceneCore& core) {
+        write_volume(core.document->mesh(), path);
+        return "Saved " + path.string();
+    });
+    current_file_ = path;
+}
+
+void EditorApp::save_session(const fs::path& path) {
+    queue_job("save session", [path](SceneCore& core) {
+        Session setup = core.setup;
+        setup.lighting = core.live->lighting();
+        write_session(path, record_session(setup, *core.document));
+        return "Saved the session (" + std::to_string(core.document->history().size()) + " edits) to " + path.string();
+    });
+}
+
+void EditorApp::rebuild_live_scene() {
+    const LiveSceneOptions options = live_options_;
+    queue_job("solver settings", [options](SceneCore& core) {
+        const Lighting lighting = core.live->lighting();
+        core.live.reset();  // it borrows the document's mesh: release before building the next one
+        core.live = std::make_shared<LiveScene>(core.document->mesh(), lighting, options);
+        core.setup.scale = options.mm_per_unit;
+        core.setup.tolerance = options.relative_tolerance;
+        return std::string("Solver settings changed: solving again");
+    });
+    if (scene_->core) scene_->exposure_locked = false;
 }
 
 void EditorApp::on_drop(const std::vector<fs::path>& paths) {
@@ -211,14 +295,14 @@ void EditorApp::on_key(int key, int mods) {
         return;
     }
     switch (key) {
-    case GLFW_KEY_ESCAPE: tool_ = Tool::Orbit; stroke_.clear(); break;
-    case GLFW_KEY_C: tool_ = Tool::Cut; break;
-    case GLFW_KEY_X: tool_ = Tool::ExactCut; break;
-    case GLFW_KEY_R: tool_ = Tool::Relax; break;
-    case GLFW_KEY_F: tool_ = Tool::Fracture; break;
-    case GLFW_KEY_M: tool_ = Tool::MovePiece; break;
-    case GLFW_KEY_P: tool_ = Tool::Paint; break;
-    case GLFW_KEY_L: tool_ = Tool::Light; break;
+    case GLFW_KEY_ESCAPE: select_tool(Tool::Orbit); break;
+    case GLFW_KEY_C: select_tool(Tool::Cut); break;
+    case GLFW_KEY_X: select_tool(Tool::ExactCut); break;
+    case GLFW_KEY_R: select_tool(Tool::Relax); break;
+    case GLFW_KEY_F: select_tool(Tool::Fracture); break;
+    case GLFW_KEY_M: select_tool(Tool::MovePiece); break;
+    case GLFW_KEY_P: select_tool(Tool::Paint); break;
+    case GLFW_KEY_L: select_tool(Tool::Light); break;
     case GLFW_KEY_HOME: camera_.reset(); break;
     case GLFW_KEY_TAB: options_.hide_ui = !options_.hide_ui; break;
     default: break;
@@ -226,20 +310,25 @@ void EditorApp::on_key(int key, int mods) {
 }
 
 void EditorApp::request_solve() {
-    if (!scene_->mesh) return;
-    if (solve_task_.busy()) solve_pending_ = true;
-    else start_solve();
+    if (scene_->core) lighting_dirty_ = true;
 }
 
-void EditorApp::start_solve() {
-    solve_pending_ = false;
-    // The worker gets its own copies (or shared, immutable pointers): the UI may edit lights and
-    // materials while it runs.
-    auto mesh = scene_->mesh;
-    auto connectivity = scene_->connectivity;
-    auto materials = std::make_shared<const std::vector<TetMaterial>>(scene_->materials);
-    const Lighting lighting = lighting_;
-    const DiffusionOptions diffusion = diffusion_;
+bool EditorApp::idle() const {
+    if (load_task_.busy() || tick_task_.busy() || !pending_jobs_.empty() || lighting_dirty_) return false;
+    return !scene_->core || (scene_->converged && scene_->render_input && scene_->exposure_locked);
+}
+
+void EditorApp::start_tick() {
+    // What this tick does, handed over whole: the UI thread queues the next batch meanwhile.
+    std::shared_ptr<SceneCore> core = scene_->core;
+    auto jobs = std::make_shared<std::vector<std::pair<std::string, SceneJob>>>(pending_jobs_.begin(), pending_jobs_.end());
+    pending_jobs_.clear();
+    std::optional<Lighting> lighting;
+    if (lighting_dirty_) lighting = lighting_;
+    lighting_dirty_ = false;
+    const int budget = frame_iterations_;
+    const bool first = !scene_->render_input;
+    const bool need_bvh = !scene_->surface_bvh;
     ImageSettings settings;
     settings.width = std::max(view_w_, 1);
     settings.height = std::max(view_h_, 1);
@@ -249,30 +338,96 @@ void EditorApp::start_solve() {
     } else {
         settings.camera = options_.camera;
     }
+    const std::string label = jobs->empty() ? "solve" : jobs->front().first;
     Scene* target = scene_.get();
-    solve_task_.start("solve", [this, target, mesh, connectivity, materials, lighting, diffusion,
-                                settings](TaskProgress& progress) {
-        progress.set_stage("lighting and diffusion");
-        SolvedScene solved = solve_scene(*mesh, *connectivity, *materials, lighting, diffusion);
-        progress.set_stage("radiance");
+
+    struct Result {
+        std::vector<std::string> messages, errors;
+        bool geometry_changed = false;
+        std::optional<SurfaceRenderInput> input;
+        std::shared_ptr<const TriangleBvh> bvh;
+        std::vector<int32_t> surface_piece;
+        std::vector<RigidTransform> piece_transforms;
+        FrameReport frame;
+        bool converged = false;
+        std::optional<double> error;
+        bool can_undo = false, can_redo = false;
+        size_t history = 0, tets = 0, vertices = 0;
+        double min_dihedral = 0;
+        double ms = 0;
+    };
+    tick_task_.start(label, [this, target, core, jobs, lighting, budget, first, need_bvh, settings](TaskProgress& progress) {
         const auto start = std::chrono::steady_clock::now();
-        auto input = std::make_shared<SurfaceRenderInput>(make_render_input(*mesh, solved, lighting, settings));
-        auto bvh = std::make_shared<const TriangleBvh>(input->positions, input->triangles);
-        const double radiance_ms = ms_since(start);
-        solved.diffusion.phi.clear();
-        auto stats = std::make_shared<DiffusionSolution>(std::move(solved.diffusion));
-        const double lighting_ms = solved.lighting_ms;
-        return [this, target, input, bvh, stats, lighting_ms, radiance_ms] {
-            if (scene_.get() != target) return;  // a different file was opened meanwhile
-            scene_->automatic_exposure = input->exposure;
-            scene_->render_input = std::move(*input);
-            scene_->surface_bvh = bvh;
-            scene_->stats = *stats;
-            scene_->lighting_ms = lighting_ms;
-            scene_->radiance_ms = radiance_ms;
-            ++scene_->solve_count;
-            ++scene_version_;
-        };
+        auto r = std::make_shared<Result>();
+        for (auto& [name, job] : *jobs) {
+            progress.set_stage(name);
+            try {
+                r->messages.push_back(job(*core));
+                r->geometry_changed = true;
+            } catch (const std::exception& e) {
+                r->errors.push_back(name + ": " + e.what());
+            }
+        }
+        if (lighting) core->live->set_lighting(*lighting);
+        progress.set_stage("solving");
+        r->frame = core->live->step(budget);
+        r->converged = core->live->converged();
+        r->error = core->live->estimated_error();
+        const TetMesh& mesh = core->document->mesh();
+        if (first || r->geometry_changed || lighting || r->frame.total_iterations() > 0) {
+            progress.set_stage("radiance");
+            const SolvedScene solved = core->live->solved_scene();
+            r->input = make_render_input(mesh, solved, core->live->lighting(), settings);
+            if (need_bvh || r->geometry_changed) {
+                r->bvh = std::make_shared<const TriangleBvh>(r->input->positions, r->input->triangles);
+                // Each surface vertex's piece, for picking pieces to move.
+                std::vector<int32_t> vertex_piece(mesh.vertex_count(), 0);
+                for (size_t t = 0; t < mesh.tet_count(); ++t)
+                    for (int32_t v : mesh.tets[t]) vertex_piece[v] = mesh.piece_ids[t];
+                r->surface_piece.resize(solved.surface.vertices.size());
+                for (size_t i = 0; i < solved.surface.vertices.size(); ++i)
+                    r->surface_piece[i] = vertex_piece[solved.surface.vertices[i]];
+            }
+        }
+        r->piece_transforms = mesh.piece_transforms;
+        r->can_undo = core->document->can_undo();
+        r->can_redo = core->document->can_redo();
+        r->history = core->document->history().size();
+        r->tets = mesh.tet_count();
+        r->vertices = mesh.vertex_count();
+        r->min_dihedral = core->document->min_dihedral_deg();
+        r->ms = ms_since(start);
+        return BackgroundTask::Apply([this, target, r] {
+            if (scene_.get() != target) return;  // another file was opened meanwhile
+            Scene& s = *scene_;
+            for (const std::string& m : r->messages) status_ = m;
+            for (const std::string& e : r->errors) set_error(e);
+            if (r->input) {
+                if (!s.exposure_locked) s.automatic_exposure = r->input->exposure;
+                s.render_input = std::move(r->input);
+                ++scene_version_;
+            }
+            if (r->bvh) {
+                s.surface_bvh = r->bvh;
+                s.surface_piece = std::move(r->surface_piece);
+            }
+            s.piece_transforms = std::move(r->piece_transforms);
+            s.last_frame = r->frame;
+            s.converged = r->converged;
+            s.estimated_error = r->error;
+            if (s.converged && s.render_input) s.exposure_locked = true;
+            s.can_undo = r->can_undo;
+            s.can_redo = r->can_redo;
+            s.history_size = r->history;
+            s.tets = r->tets;
+            s.vertices = r->vertices;
+            s.min_dihedral_deg = r->min_dihedral;
+            s.tick_ms = r->ms;
+            if (!s.converged || r->frame.total_iterations() > 0) {
+                s.tick_ms_sum += r->ms;
+                ++s.ticks;
+            }
+        });
     });
 }
 
@@ -283,16 +438,21 @@ void EditorApp::poll_tasks() {
         set_error(e.what());
     }
     try {
-        if (solve_task_.poll() && solve_pending_) start_solve();
+        tick_task_.poll();
     } catch (const std::exception& e) {
-        solve_pending_ = false;
-        set_error(std::string("solve: ") + e.what());
+        set_error(std::string("solver: ") + e.what());
+        scene_->converged = true;  // do not retry a failing step every frame
+        scene_->exposure_locked = true;
     }
+    // Keep one tick running while there is anything to do.
+    if (scene_->core && !tick_task_.busy() && !load_task_.busy() &&
+        (!pending_jobs_.empty() || lighting_dirty_ || !scene_->converged || !scene_->render_input))
+        start_tick();
 }
 
 void EditorApp::wait_for_tasks() {
     load_task_.wait();
-    solve_task_.wait();
+    tick_task_.wait();
 }
 
 void EditorApp::frame() {
@@ -400,6 +560,26 @@ void EditorApp::handle_viewport_input() {
         if (free && io.MouseDown[0] && !io.MouseClicked[0] && (dx != 0 || dy != 0) && !lighting_.lights.empty()) {
             drag_light(dx, dy);
         }
+    } else if (tool_ == Tool::MovePiece) {
+        if (free && inside && io.MouseClicked[0]) {
+            dragged_piece_ = piece_under(mx, my).value_or(-1);
+            drag_translation_.setZero();
+        }
+        if (dragged_piece_ >= 0 && io.MouseDown[0]) {
+            const double half_fov = 0.5 * camera_->fov_y_degrees() * std::numbers::pi / 180.0;
+            const double units = 2 * camera_->distance() * std::tan(half_fov) / view_h_;
+            drag_translation_ += units * (dx * camera_->right_axis() - dy * camera_->up_axis());
+        }
+        if (dragged_piece_ >= 0 && io.MouseReleased[0]) {
+            if (drag_translation_.norm() > 0 && dragged_piece_ < static_cast<int>(scene_->piece_transforms.size())) {
+                MovePieceOp op;
+                op.piece = dragged_piece_;
+                op.transform = scene_->piece_transforms[dragged_piece_];
+                op.transform.translation += drag_translation_;
+                queue_edit(op);
+            }
+            dragged_piece_ = -1;
+        }
     } else if (stroke_tool) {
         if (free && inside && io.MouseClicked[0]) stroke_.clear(), stroke_active_ = true;
         if (stroke_active_ && io.MouseDown[0]) stroke_.push_back({static_cast<float>(mx), static_cast<float>(my)});
@@ -422,30 +602,103 @@ void EditorApp::drag_light(double dx, double dy) {
         light.vector = rotation * d;
     } else {
         // Move the point light in the view plane, a point at the target's depth following the cursor.
-        const double half_fov = 0.5 * camera_->fov_y_degrees() * 3.14159265358979 / 180.0;
+        const double half_fov = 0.5 * camera_->fov_y_degrees() * std::numbers::pi / 180.0;
         const double units = 2 * camera_->distance() * std::tan(half_fov) / view_h_;
         light.vector += units * (dx * camera_->right_axis() - dy * camera_->up_axis());
     }
     request_solve();
 }
 
-// Until the document (editor/document.h) provides the edit history, only whole-object materials and
-// lights change, and there is nothing to undo.
-bool EditorApp::can_undo() const { return false; }
-bool EditorApp::can_redo() const { return false; }
-void EditorApp::undo() { status_ = "Nothing to undo"; }
-void EditorApp::redo() { status_ = "Nothing to redo"; }
+bool EditorApp::can_undo() const { return scene_->can_undo || !pending_jobs_.empty(); }
+bool EditorApp::can_redo() const { return scene_->can_redo; }
+
+void EditorApp::undo() { queue_history_step(false); }
+void EditorApp::redo() { queue_history_step(true); }
+
+void EditorApp::queue_history_step(bool redo) {
+    queue_job(redo ? "redo" : "undo", [redo](SceneCore& core) {
+        const auto report = redo ? core.document->redo() : core.document->undo();
+        if (!report) return std::string(redo ? "Nothing to redo" : "Nothing to undo");
+        core.live->apply_change(core.document->mesh(), *report);
+        return report->name;
+    });
+}
 
 void EditorApp::set_whole_material(const TetMaterial& material, const std::string& name) {
-    if (!scene_->mesh) return;
-    scene_->materials.assign(scene_->mesh->tet_count(), material);
+    queue_edit(SetMaterialOp{material, std::nullopt});
     scene_->material_name = name;
-    request_solve();
 }
 
 void EditorApp::finish_stroke() {
+    const ScreenStroke stroke = simplify_stroke(stroke_, 3.0f);
     stroke_.clear();
-    status_ = "This tool needs the edit document (not built yet)";
+    if (!camera_ || !scene_->core) return;
+    try {
+        if (tool_ == Tool::Cut || tool_ == Tool::ExactCut) {
+            // Shift keeps the left side instead.
+            const auto op = stroke_cut_op(*camera_, stroke, view_w_, view_h_, tool_ == Tool::ExactCut,
+                                          ImGui::GetIO().KeyShift);
+            if (!op) return;
+            last_cut_ = op->stroke;
+            queue_edit(*op);
+        } else if (tool_ == Tool::Paint) {
+            if (!scene_->surface_bvh) return;
+            const auto op = paint_op(*camera_, *scene_->surface_bvh, stroke, view_w_, view_h_,
+                                     custom_material_.value_or(material_preset("marble")),
+                                     brush_radius_ * camera_->scene_radius());
+            if (op) queue_edit(*op);  // else the stroke missed the object
+        } else if (tool_ == Tool::Fracture) {
+            FractureOp op;
+            if (scene_->surface_bvh && stroke.size() >= 2) {
+                // Seeds along the stroke, on the surface under it: the object breaks where drawn.
+                const auto points = stroke_on_surface(*camera_, *scene_->surface_bvh, stroke, view_w_, view_h_);
+                const size_t step = std::max<size_t>(1, points.size() / static_cast<size_t>(fracture_pieces_));
+                for (size_t i = 0; i < points.size(); i += step) op.seeds.push_back(points[i]);
+            }
+            if (op.seeds.size() < 2) {
+                op.seeds.clear();
+                op.pieces = fracture_pieces_;
+                op.seed = fracture_seed_++;
+            }
+            queue_edit(op);
+        }
+    } catch (const std::exception& e) {
+        set_error(e.what());
+    }
+}
+
+void EditorApp::select_tool(Tool tool) {
+    stroke_.clear();
+    stroke_active_ = false;
+    // Relax is an action on the last cut, not a mode.
+    if (tool == Tool::Relax) relax_last_cut();
+    else tool_ = tool;
+}
+
+std::optional<int> EditorApp::piece_under(double x, double y) const {
+    if (!camera_ || !scene_->surface_bvh || !scene_->render_input) return std::nullopt;
+    const auto hit = first_hit(*scene_->surface_bvh, camera_->unproject(Eigen::Vector2d(x, y), view_w_, view_h_),
+                               camera_->distance() + 4 * camera_->scene_radius());
+    if (!hit) return std::nullopt;
+    const auto& positions = scene_->render_input->positions;
+    if (positions.size() != scene_->surface_piece.size()) return std::nullopt;
+    size_t nearest = 0;
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < positions.size(); ++i) {
+        const double d = (positions[i].cast<double>() - *hit).squaredNorm();
+        if (d < best) best = d, nearest = i;
+    }
+    return scene_->surface_piece[nearest];
+}
+
+void EditorApp::relax_last_cut() {
+    if (!last_cut_) {
+        set_error("relax: cut first (C), then relax its cross-section");
+        return;
+    }
+    RelaxOp op;
+    op.surface = *last_cut_;
+    queue_edit(op);
 }
 
 Image EditorApp::read_window() const {
@@ -483,6 +736,12 @@ bool display_available() {
     if (probe) glfwDestroyWindow(probe);
     glfwTerminate();
     return ok;
+}
+
+bool try_open_editor(const EditorOptions& options) {
+    if (!display_available()) return false;
+    run_editor(options);
+    return true;
 }
 
 EditorRunStats run_editor(const EditorOptions& options) {
@@ -529,11 +788,11 @@ EditorRunStats run_editor(const EditorOptions& options) {
         }
         stats.mean_frame_ms = stats.frames ? frame_ms_sum / stats.frames : 0;
         stats.mean_view_ms = stats.frames ? view_ms_sum / stats.frames : 0;
-        if (const EditorScene& scene = app.scene(); scene.mesh) {
-            stats.tets = scene.mesh->tet_count();
-            stats.vertices = scene.mesh->vertex_count();
-            stats.solve_ms = scene.lighting_ms + scene.stats.assembly_ms + scene.stats.solve_ms + scene.radiance_ms;
-        }
+        const EditorScene& scene = app.scene();
+        stats.tets = scene.tets;
+        stats.vertices = scene.vertices;
+        stats.ticks = scene.ticks;
+        stats.tick_ms = scene.ticks ? scene.tick_ms_sum / scene.ticks : 0;
     }
     glfwDestroyWindow(window);
     return stats;

@@ -1,24 +1,34 @@
 // The interactive editor: a GLFW window with an OpenGL 4.5 core context, Dear ImGui panels around a
 // 3D viewport drawn by SurfaceRenderer (the renderer `waxwork render` uses, so both show the same
-// image), an orbit camera, and background tasks for everything slow. Threading: the UI thread owns
-// every piece of editor state; loading/meshing and solving run as BackgroundTasks on worker threads
-// with their own copies of the inputs, and the UI thread installs their results when it polls them.
+// image), an orbit camera, and background tasks for everything slow.
+//
+// Threading: the UI thread owns every piece of editor state and never waits. Loading (reading,
+// meshing, building the Document and LiveScene) runs as one BackgroundTask; after that a second task
+// runs "ticks" one after another on a worker: each applies the queued edits (Document::apply, undo,
+// redo, saves) and lighting changes to the document and live scene, advances the solve by the
+// per-frame iteration budget (LiveScene::step) and prepares the next image input. Only the worker
+// touches the Document and LiveScene while a tick runs; the UI thread sees copies (EditorScene) that
+// it installs when it polls the finished tick, and queues new work for the next one.
 #pragma once
 
 #include "editor/background_task.h"
+#include "editor/document.h"
 #include "editor/file_dialog.h"
+#include "editor/live_scene.h"
 #include "editor/orbit_camera.h"
 #include "editor/render_pipeline.h"
+#include "editor/session.h"
 #include "editor/surface_renderer.h"
 #include "editor/view_cache.h"
-#include "solver/diffusion_solve.h"
 #include "solver/ray_caster.h"
-#include "tetops/connectivity.h"
 
+#include <deque>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 struct GLFWwindow;
@@ -27,6 +37,8 @@ namespace waxwork {
 
 struct EditorOptions {
     std::filesystem::path file;          // surface or volume to open; empty: start empty
+    std::filesystem::path session;       // a session (session.h) to open instead: its input, material,
+                                         // lights and camera, with its edit steps replayed
     std::optional<size_t> max_tets;      // meshing a surface: about this many tets (default by material)
     std::optional<TetMaterial> material; // applied to the whole volume after loading
     std::filesystem::path screenshot;    // non-empty: render `frames` frames, save the window, exit
@@ -46,7 +58,8 @@ struct EditorRunStats {
     int frames = 0;              // frames drawn after loading and solving finished
     double mean_frame_ms = 0;    // per frame, UI + 3D view, GPU finished (screenshot mode)
     double mean_view_ms = 0;     // drawing the 3D view (only when it changed; else a cached copy)
-    double solve_ms = 0;         // the last solve: lighting + assembly + CG + radiance
+    double tick_ms = 0;          // mean worker tick (edits, solver step, image input) while converging
+    int ticks = 0;
     size_t tets = 0, vertices = 0;
     std::string gl_version, gl_renderer;
 };
@@ -55,6 +68,10 @@ EditorRunStats run_editor(const EditorOptions& options);
 // True when a window can be opened here (a display is set and GLFW initialises). `waxwork demo` asks
 // before opening the editor so it stays headless on servers.
 bool display_available();
+
+// For `waxwork demo`: opens the editor on `options` when display_available(), returns whether it did
+// (false on a server: the caller carries on headless). Errors after the window opened propagate.
+bool try_open_editor(const EditorOptions& options);
 
 enum class Tool { Orbit, Cut, ExactCut, Relax, Fracture, MovePiece, Paint, Light };
 
@@ -65,21 +82,39 @@ struct ToolInfo {
 };
 const std::vector<ToolInfo>& tool_infos();
 
-// The loaded volume and what was last solved on it. Shared pointers: a running solve keeps its own
-// references, so replacing the scene on the UI thread never pulls data from under a worker.
-struct EditorScene {
-    std::shared_ptr<const TetMesh> mesh;
-    std::shared_ptr<const TetConnectivity> connectivity;
-    std::vector<TetMaterial> materials;  // per tet
-    std::string material_name;           // preset applied to the whole volume, or "stored"/"custom"
+// The document and its live scene, used by one worker tick at a time (never by the UI thread while a
+// tick runs). LiveScene borrows the document's mesh: `live` is declared last so it is destroyed first.
+struct SceneCore {
+    std::shared_ptr<Document> document;
+    std::shared_ptr<LiveScene> live;
+    Session setup;  // input, material, scale, lights, camera: the recorded session's head
+};
 
-    std::optional<SurfaceRenderInput> render_input;  // the latest solved image input
+// One queued piece of work for the next tick; returns a status line. Throws to report a failure
+// (the document is then unchanged, Document::apply's guarantee).
+using SceneJob = std::function<std::string(SceneCore&)>;
+
+// What the UI thread knows about the scene: copies refreshed after every tick.
+struct EditorScene {
+    std::shared_ptr<SceneCore> core;
+    size_t tets = 0, vertices = 0;
+    bool can_undo = false, can_redo = false;
+    size_t history_size = 0;
+    std::string material_name;
+
+    std::optional<SurfaceRenderInput> render_input;  // the latest image input
     std::shared_ptr<const TriangleBvh> surface_bvh;  // of render_input's triangles (paint picking)
+    std::vector<int32_t> surface_piece;              // per render_input vertex: its piece
+    std::vector<RigidTransform> piece_transforms;
     float automatic_exposure = 1.0f;
-    DiffusionSolution stats;                         // phi dropped: iterations, errors, times
-    double lighting_ms = 0;
-    double radiance_ms = 0;
-    int solve_count = 0;
+    bool exposure_locked = false;  // set at the first convergence: relighting then changes brightness
+    FrameReport last_frame;        // the latest solver step
+    bool converged = false;
+    std::optional<double> estimated_error;
+    double tick_ms = 0;
+    double tick_ms_sum = 0;
+    int ticks = 0;
+    double min_dihedral_deg = 0;
 };
 
 // Everything the window shows and edits. UI-thread only.
@@ -92,7 +127,8 @@ public:
 
     // One frame: events already polled; polls tasks, handles input, draws the view and the UI.
     void frame();
-    bool idle() const { return !load_task_.busy() && !solve_task_.busy() && !solve_pending_; }
+    // Nothing loading, queued or running, and the solve converged (screenshot mode waits for this).
+    bool idle() const;
     // Screenshot mode: blocks until the running task finishes (the frame loop then installs it).
     void wait_for_tasks();
     Image read_window() const;
@@ -127,19 +163,30 @@ private:
     void draw_overlays();
     void apply_theme(float scale);
 
-    void open_dialog(FileDialog::Mode mode);
+    void open_dialog(FileDialog::Mode mode, bool session = false);
+    void select_tool(Tool tool);
+    void relax_last_cut();
+    void install_core(std::shared_ptr<SceneCore> core, const std::filesystem::path& path,
+                      const std::string& material_name, const std::vector<EditOperation>& replay);
+    std::optional<int> piece_under(double x, double y) const;
     void file_dialog_result();
     void undo();
     void redo();
+    void queue_history_step(bool redo);
     bool can_undo() const;
     bool can_redo() const;
     void set_whole_material(const TetMaterial& material, const std::string& name);
+    void queue_edit(const EditOperation& op);
+    void queue_job(std::string label, SceneJob job);
+    void rebuild_live_scene();
+    void save_session(const std::filesystem::path& path);
+    void open_session(const std::filesystem::path& path);
     void finish_stroke();
     void drag_light(double dx, double dy);
     void layout_viewport(int fb_w, int fb_h);
     void poll_tasks();
-    void request_solve();
-    void start_solve();
+    void request_solve();  // the lights changed
+    void start_tick();
     void handle_viewport_input();
     void draw_viewport(int fb_h);
     void set_error(const std::string& message);
@@ -159,14 +206,21 @@ private:
     // The scene: the volume, its materials and lights, the latest solved image input.
     std::unique_ptr<Scene> scene_;
     Lighting lighting_;
-    DiffusionOptions diffusion_;
+    LiveSceneOptions live_options_;
+    int frame_iterations_ = 10;                // CG iterations per channel and tick
     float exposure_stops_ = 0;                 // added to the automatic exposure
     std::optional<OrbitCamera> camera_;
     std::filesystem::path current_file_;
 
     BackgroundTask load_task_;
-    BackgroundTask solve_task_;
-    bool solve_pending_ = false;  // inputs changed while a solve ran: solve again when it ends
+    BackgroundTask tick_task_;
+    std::deque<std::pair<std::string, SceneJob>> pending_jobs_;  // for the next tick, in order
+    bool lighting_dirty_ = false;                                // send lighting_ with the next tick
+    std::optional<std::variant<PlaneSurface, StrokeSurface>> last_cut_;  // what Relax relaxes towards
+    int fracture_pieces_ = 5;
+    uint32_t fracture_seed_ = 1;
+    int dragged_piece_ = -1;
+    Eigen::Vector3d drag_translation_ = Eigen::Vector3d::Zero();
 
     Tool tool_ = Tool::Orbit;
     int selected_light_ = 0;
@@ -183,6 +237,7 @@ private:
     double framebuffer_scale_ = 1.0;
 
     FileDialog file_dialog_;
+    bool saving_session_ = false;
     std::string status_;
     std::string last_error_;
     std::string error_message_;

@@ -22,7 +22,7 @@ namespace {
 constexpr const char* kDejaVuSans = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
 const std::vector<std::string>& openable_extensions() {
-    static const std::vector<std::string> e = {".obj", ".off", ".ply", ".stl", ".vtu", ".msh", ".mesh", ".node"};
+    static const std::vector<std::string> e = {".obj", ".off", ".ply", ".stl", ".vtu", ".msh", ".mesh", ".node", ".json"};
     return e;
 }
 
@@ -79,10 +79,13 @@ void EditorApp::apply_theme(float scale) {
     else io.FontGlobalScale = scale;
 }
 
-void EditorApp::open_dialog(FileDialog::Mode mode) {
+void EditorApp::open_dialog(FileDialog::Mode mode, bool session) {
     const fs::path directory = current_file_.empty() ? fs::current_path() : current_file_.parent_path();
+    saving_session_ = session;
     if (mode == FileDialog::Mode::Open) {
         file_dialog_.open(mode, "Open", directory, openable_extensions());
+    } else if (session) {
+        file_dialog_.open(mode, "Save session", directory, {".json"}, "session.json");
     } else {
         const std::string name = current_file_.empty() ? "volume.vtu" : current_file_.stem().string() + ".vtu";
         file_dialog_.open(mode, "Save volume", directory, {".vtu", ".msh", ".mesh", ".node"}, name);
@@ -93,6 +96,7 @@ void EditorApp::file_dialog_result() {
     if (options_.hide_ui) return;
     if (const auto chosen = file_dialog_.draw(ui_scale_)) {
         if (file_dialog_.mode() == FileDialog::Mode::Open) open_file(*chosen);
+        else if (saving_session_) save_session(*chosen);
         else save_volume(*chosen);
     }
 }
@@ -119,7 +123,8 @@ void EditorApp::draw_menu_bar() {
     if (!ImGui::BeginMainMenuBar()) return;
     if (ImGui::BeginMenu("File")) {
         if (ImGui::MenuItem("Open...", "Ctrl+O")) open_dialog(FileDialog::Mode::Open);
-        if (ImGui::MenuItem("Save volume...", "Ctrl+S", false, scene_->mesh != nullptr)) open_dialog(FileDialog::Mode::Save);
+        if (ImGui::MenuItem("Save volume...", "Ctrl+S", false, scene_->core != nullptr)) open_dialog(FileDialog::Mode::Save);
+        if (ImGui::MenuItem("Save session...", nullptr, false, scene_->core != nullptr)) open_dialog(FileDialog::Mode::Save, true);
         ImGui::Separator();
         if (ImGui::MenuItem("Quit", "Ctrl+Q")) glfwSetWindowShouldClose(window_, GLFW_TRUE);
         ImGui::EndMenu();
@@ -131,7 +136,7 @@ void EditorApp::draw_menu_bar() {
     }
     if (ImGui::BeginMenu("Tools")) {
         for (const ToolInfo& info : tool_infos()) {
-            if (ImGui::MenuItem(info.name, info.shortcut, tool_ == info.tool)) tool_ = info.tool;
+            if (ImGui::MenuItem(info.name, info.shortcut, tool_ == info.tool)) select_tool(info.tool);
         }
         ImGui::EndMenu();
     }
@@ -160,10 +165,14 @@ void EditorApp::draw_tool_palette() {
         if (active) ImGui::PushStyleColor(ImGuiCol_Button, ImGui::GetStyle().Colors[ImGuiCol_ButtonActive]);
         char label[64];
         std::snprintf(label, sizeof label, "%s", info.name);
-        if (ImGui::Button(label, ImVec2(width, 0))) tool_ = info.tool;
+        if (ImGui::Button(label, ImVec2(width, 0))) select_tool(info.tool);
         if (active) ImGui::PopStyleColor();
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s (%s)\n%s", info.name, info.shortcut, tool_hint(info.tool));
     }
+    ImGui::Separator();
+    ImGui::TextDisabled("pieces");
+    ImGui::SetNextItemWidth(width);
+    ImGui::SliderInt("##pieces", &fracture_pieces_, 2, 12);
     ImGui::End();
 }
 
@@ -220,7 +229,7 @@ void EditorApp::draw_material_panel() {
     }
     ImGui::ColorButton("##custom", swatch(m), ImGuiColorEditFlags_NoTooltip, ImVec2(swatch_size * 2, swatch_size));
     ImGui::SameLine();
-    const bool has_scene = scene_->mesh != nullptr;
+    const bool has_scene = scene_->core != nullptr;
     if (ImGui::Button("Apply to the whole object") && has_scene) set_whole_material(m, names[selected_preset_]);
     ImGui::TextDisabled("Object: %s; Paint (P) brushes it in locally", scene_->material_name.c_str());
     ImGui::SliderFloat("brush radius", &brush_radius_, 0.005f, 0.3f, "%.3f x size");
@@ -289,42 +298,41 @@ void EditorApp::draw_light_panel() {
 }
 
 void EditorApp::draw_solver_panel() {
-    int method = diffusion_.discretization == Discretization::TransCut ? 0 : 1;
-    if (ImGui::Combo("method", &method, "TransCut (lumped)\0FEM (consistent mass)\0")) {
-        diffusion_.discretization = method == 0 ? Discretization::TransCut : Discretization::Fem;
-        request_solve();
-    }
-    int precision = diffusion_.precision == SolverPrecision::Double ? 0 : 1;
-    if (ImGui::Combo("backend", &precision, "CPU CG, double\0CPU CG, float\0")) {
-        diffusion_.precision = precision == 0 ? SolverPrecision::Double : SolverPrecision::Float;
-        request_solve();
-    }
-    float tolerance_exponent = static_cast<float>(std::log10(diffusion_.relative_tolerance));
-    if (ImGui::SliderFloat("tolerance", &tolerance_exponent, -6.0f, -1.0f, "1e%.1f")) {
-        diffusion_.relative_tolerance = std::pow(10.0, tolerance_exponent);
-        request_solve();
-    }
-    float scale = static_cast<float>(diffusion_.mm_per_unit);
-    if (ImGui::DragFloat("mm per unit", &scale, 0.1f, 0.01f, 10000.0f, "%.2f", ImGuiSliderFlags_Logarithmic)) {
-        diffusion_.mm_per_unit = std::clamp(static_cast<double>(scale), 1e-3, 1e6);
-        request_solve();
-    }
+    ImGui::TextDisabled("TransCut matrix, Jacobi CG (double), warm-started");
+    int backend = 0;
+    ImGui::Combo("backend", &backend, "CPU, per frame\0");
+    ImGui::SliderInt("iterations / frame", &frame_iterations_, 1, 200);
+    float tolerance_exponent = static_cast<float>(std::log10(live_options_.relative_tolerance));
+    // Solver settings rebuild the live scene: only when the user lets go of the slider.
+    if (ImGui::SliderFloat("tolerance", &tolerance_exponent, -6.0f, -1.0f, "1e%.1f"))
+        live_options_.relative_tolerance = std::pow(10.0, tolerance_exponent);
+    if (ImGui::IsItemDeactivatedAfterEdit()) rebuild_live_scene();
+    float scale = static_cast<float>(live_options_.mm_per_unit);
+    if (ImGui::DragFloat("mm per unit", &scale, 0.1f, 0.01f, 10000.0f, "%.2f", ImGuiSliderFlags_Logarithmic))
+        live_options_.mm_per_unit = std::clamp(static_cast<double>(scale), 1e-3, 1e6);
+    if (ImGui::IsItemDeactivatedAfterEdit()) rebuild_live_scene();
     ImGui::SliderFloat("exposure", &exposure_stops_, -4.0f, 4.0f, "%+.1f stops");
+    ImGui::SameLine();
+    if (ImGui::SmallButton("auto")) {
+        exposure_stops_ = 0;
+        scene_->exposure_locked = false;
+        request_solve();
+    }
 
     const Scene& s = *scene_;
-    if (s.solve_count > 0) {
-        const auto& st = s.stats;
-        ImGui::Text("iterations   %d %d %d", st.iterations[0], st.iterations[1], st.iterations[2]);
-        ImGui::Text("est. error   %.1e %.1e %.1e", st.estimated_relative_error[0], st.estimated_relative_error[1],
-                    st.estimated_relative_error[2]);
-        ImGui::Text("lighting %.0f ms  assembly %.0f ms  solve %.0f ms", s.lighting_ms, st.assembly_ms, st.solve_ms);
-    } else {
-        ImGui::TextDisabled("not solved yet");
+    if (s.core) {
+        const FrameReport& f = s.last_frame;
+        ImGui::Text("%s", s.converged ? "converged" : "refining...");
+        ImGui::Text("iterations   %d %d %d (last frame)", f.iterations[0], f.iterations[1], f.iterations[2]);
+        if (s.estimated_error)
+            ImGui::Text("est. error   %.1e (tolerance %.0e)", *s.estimated_error, live_options_.relative_tolerance);
+        ImGui::Text("solver tick  %.1f ms", s.tick_ms);
+        ImGui::Text("%zu tets, %zu vertices, min dihedral %.1f deg", s.tets, s.vertices, s.min_dihedral_deg);
+        ImGui::Text("%zu edits in the history", s.history_size);
     }
     const ImGuiIO& io = ImGui::GetIO();
-    ImGui::Text("frame %.1f ms (%.0f fps), view %.1f ms", 1000.0f / std::max(io.Framerate, 1e-3f), io.Framerate,
+    ImGui::Text("frame %.1f ms (%.0f fps), 3D view %.1f ms", 1000.0f / std::max(io.Framerate, 1e-3f), io.Framerate,
                 last_render_ms_);
-    if (s.mesh) ImGui::Text("%zu tets, %zu vertices", s.mesh->tet_count(), s.mesh->vertex_count());
 }
 
 void EditorApp::draw_view_panel() {
@@ -347,7 +355,7 @@ void EditorApp::draw_status_bar() {
     ImGui::Begin("##status", nullptr,
                  ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings);
     // Progress of anything that has run longer than 200 ms; the UI keeps drawing meanwhile.
-    const BackgroundTask* task = load_task_.busy() ? &load_task_ : solve_task_.busy() ? &solve_task_ : nullptr;
+    const BackgroundTask* task = load_task_.busy() ? &load_task_ : tick_task_.busy() ? &tick_task_ : nullptr;
     if (task && task->elapsed_seconds() > 0.2) {
         const float fraction = task->progress()->fraction();
         char overlay[160];

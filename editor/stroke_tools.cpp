@@ -1,5 +1,6 @@
 #include "editor/stroke_tools.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace waxwork {
@@ -60,6 +61,33 @@ std::vector<Eigen::Vector3d> stroke_on_surface(const OrbitCamera& camera, const 
         if (const auto hit = first_hit(bvh, ray, reach)) points.push_back(*hit);
     }
     return points;
+}
+
+std::optional<StrokeCutOp> stroke_cut_op(const OrbitCamera& camera, const ScreenStroke& stroke,
+                                         double viewport_width, double viewport_height, bool exact, bool flip) {
+    StrokeCutOp op;
+    op.stroke.eye = camera.eye();
+    op.stroke.view_direction = -camera.eye_direction();
+    op.stroke.points = stroke_on_target_plane(camera, stroke, viewport_width, viewport_height);
+    op.stroke.flip = flip;
+    op.exact = exact;
+    const auto& p = op.stroke.points;
+    const bool distinct = p.size() >= 2 && std::any_of(p.begin() + 1, p.end(), [&](const Eigen::Vector3d& q) {
+        return (q - p.front()).norm() > 1e-9 * camera.scene_radius();
+    });
+    if (!distinct) return std::nullopt;
+    return op;
+}
+
+std::optional<PaintOp> paint_op(const OrbitCamera& camera, const TriangleBvh& surface, const ScreenStroke& stroke,
+                                double viewport_width, double viewport_height, const TetMaterial& material,
+                                double sigma) {
+    PaintOp op;
+    op.points = stroke_on_surface(camera, surface, stroke, viewport_width, viewport_height);
+    if (op.points.empty()) return std::nullopt;
+    op.material = material;
+    op.sigma = sigma;
+    return op;
 }
 
 }  // namespace waxwork

@@ -3,6 +3,7 @@
 // the surface points under a paint stroke (found by casting view rays at the boundary surface).
 #pragma once
 
+#include "editor/edit_operation.h"
 #include "editor/orbit_camera.h"
 #include "solver/ray_caster.h"
 
@@ -34,5 +35,17 @@ std::optional<Eigen::Vector3d> first_hit(const TriangleBvh& bvh, const Ray& ray,
 std::vector<Eigen::Vector3d> stroke_on_surface(const OrbitCamera& camera, const TriangleBvh& bvh,
                                                const ScreenStroke& stroke, double viewport_width,
                                                double viewport_height);
+
+// The cut a stroke draws: swept from the camera's eye along its view rays; the left side of the
+// stroke as drawn is cut away, the right with `flip` (Shift in the editor). nullopt for a stroke of
+// fewer than two distinct points.
+std::optional<StrokeCutOp> stroke_cut_op(const OrbitCamera& camera, const ScreenStroke& stroke,
+                                         double viewport_width, double viewport_height, bool exact, bool flip);
+
+// A paint stroke of `material` with Gaussian width `sigma` (world units) through the surface points
+// under the stroke; nullopt when the stroke misses the object.
+std::optional<PaintOp> paint_op(const OrbitCamera& camera, const TriangleBvh& surface, const ScreenStroke& stroke,
+                                double viewport_width, double viewport_height, const TetMaterial& material,
+                                double sigma);
 
 }  // namespace waxwork

@@ -88,5 +88,44 @@ TEST(StrokeTools, PaintStrokeLandsOnTheVisibleSurface) {
     EXPECT_NEAR(on_surface[0].y(), 0, 1e-5);
 }
 
+TEST(StrokeTools, CutStrokeBecomesAStrokeCutOpFromTheEye) {
+    OrbitCamera camera = front_camera();
+    camera.orbit(0.2, -0.1);
+    const ScreenStroke stroke = {{50, 20}, {120, 180}};
+    const auto op = stroke_cut_op(camera, stroke, 200, 200, true, true);
+    ASSERT_TRUE(op.has_value());
+    EXPECT_TRUE(op->exact);
+    EXPECT_TRUE(op->stroke.flip);
+    EXPECT_LT((op->stroke.eye - camera.eye()).norm(), 1e-12);
+    EXPECT_LT((op->stroke.view_direction + camera.eye_direction()).norm(), 1e-12);
+    ASSERT_EQ(op->stroke.points.size(), 2u);
+    // The op's surface, built the way Document builds it, splits the object along the stroke: points
+    // projecting to either side of it land on opposite sides.
+    const StrokeCut cut(op->stroke.eye, op->stroke.view_direction, op->stroke.points, op->stroke.flip);
+    const Ray left = camera.unproject(Eigen::Vector2d(40, 150), 200, 200);
+    const Ray right = camera.unproject(Eigen::Vector2d(160, 50), 200, 200);
+    const double depth = camera.distance();
+    EXPECT_LT(cut.side(left.origin + depth * left.direction) * cut.side(right.origin + depth * right.direction), 0);
+    // A click is no cut.
+    EXPECT_FALSE(stroke_cut_op(camera, {{50, 20}, {50, 20}}, 200, 200, false, false).has_value());
+}
+
+TEST(StrokeTools, PaintStrokeBecomesAPaintOpOnTheSurface) {
+    const std::vector<Eigen::Vector3f> points = {{-1, -1, 0.25f}, {1, -1, 0.25f}, {1, 1, 0.25f}, {-1, 1, 0.25f}};
+    const std::vector<std::array<int32_t, 3>> triangles = {{0, 1, 2}, {0, 2, 3}};
+    const TriangleBvh bvh(points, triangles);
+    TetMaterial material;
+    material.mua = {0.1, 0.2, 0.3};
+    material.musp = {1, 1, 1};
+    material.eta = 1.4;
+    const auto op = paint_op(front_camera(), bvh, {{100, 100}, {105, 100}}, 200, 200, material, 0.07);
+    ASSERT_TRUE(op.has_value());
+    EXPECT_EQ(op->material, material);
+    EXPECT_EQ(op->sigma, 0.07);
+    ASSERT_EQ(op->points.size(), 2u);
+    EXPECT_NEAR(op->points[0].z(), 0.25, 1e-5);
+    EXPECT_FALSE(paint_op(front_camera(), bvh, {{0, 0}}, 200, 200, material, 0.07).has_value());
+}
+
 }  // namespace
 }  // namespace waxwork
