@@ -2,6 +2,7 @@
 // save the volume, render it in a few materials and lights, a cut and a painted variant, then replay
 // the example editing sessions of assets/sessions/.
 #include "editor/commands.h"
+#include "editor/editor_app.h"
 #include "editor/render_pipeline.h"
 #include "editor/session.h"
 #include "io/surface_reader.h"
@@ -42,6 +43,7 @@ struct DemoCommandOptions {
     std::optional<size_t> max_tets;
     int width = 800;
     int height = 600;
+    bool no_editor = false;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -220,12 +222,17 @@ void run_demo_command(const DemoCommandOptions& o) {
 
     run_example_sessions(dir, volume_path, o);
 
-    // Hook for the interactive editor: when a window can open, this is where the demo hands over
-    // (the example sessions in assets/sessions/ are the scenes to offer).
-    if (std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY")) {
-        std::cout << "a display is available: open the volume in the interactive editor with `waxwork edit "
-                  << volume_path.string() << "`\n";
+    // The interactive editor on the demo's volume when a window can open (a desktop); on a server, or
+    // with --no-editor, the demo ends here with its images written.
+    if (!o.no_editor) {
+        EditorOptions editor;
+        editor.file = volume_path;
+        editor.scale = o.scale;
+        editor.camera.eye_direction = kCameraDirection;
+        editor.lights = {key_light()};
+        if (try_open_editor(editor)) return;
     }
+    std::cout << "no display: not opening the editor (see `waxwork edit --help`)\n";
 }
 
 }  // namespace
@@ -238,6 +245,7 @@ void add_demo_command(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--max-tets", options->max_tets, "About this many tets (default: sized by marble's diffusion length)");
     cmd->add_option("--width", options->width, "Image width in pixels")->capture_default_str();
+    cmd->add_flag("--no-editor", options->no_editor, "Do not open the interactive editor even when a display is present");
     cmd->add_option("--height", options->height, "Image height in pixels")->capture_default_str();
     cmd->callback([options] { run_demo_command(*options); });
 }

@@ -283,7 +283,7 @@ TEST_F(Render, BadInputIsAOneLineError) {
 TEST(Demo, WritesTheVolumeAndImages) {
     const fs::path dir = scratch_dir("demo");
     // Small images keep it quick; the mesh is the default marble-driven one the README demo uses.
-    const auto r = run_waxwork("demo -o " + dir.string() + " --width 96 --height 72");
+    const auto r = run_waxwork("demo -o " + dir.string() + " --width 96 --height 72 --no-editor");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_TRUE(fs::exists(dir / "spot.vtu"));
     size_t images = 0;
