@@ -79,7 +79,10 @@ public:
             const Run r = run(solve, cap);
             runs.emplace_back(cap, r);
             points.emplace_back(r.ms, r.error);
-            stalled = r.error < 0.95 * best_error ? 0 : stalled + 1;
+            // CG minimises the energy norm, not the L2 error this curve measures: from a good start
+            // (multires' coarse pass) the first few iterations can leave the L2 error flat or higher,
+            // so a stall only counts once the run is past the first 16 iterations.
+            stalled = r.error < 0.95 * best_error || cap < 16 ? 0 : stalled + 1;
             best_error = std::min(best_error, r.error);
             if (r.error <= options_.floor_error || stalled >= 4 || cap >= 200000 ||
                 elapsed_ms(start) > 1000 * options_.max_seconds)

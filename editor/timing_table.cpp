@@ -6,6 +6,7 @@
 #include "solver/diffusion_matrix.h"
 #include "solver/material.h"
 #include "tetops/connectivity.h"
+#include "tetops/error.h"
 #include "tetops/cut.h"
 #include "tetops/paint.h"
 #include "tetops/relaxation.h"
@@ -37,10 +38,18 @@ TimingRow measure_timing_row(const std::filesystem::path& surface_path, const Ti
     const TriangleSurface surface = load_closed_surface(surface_path).surface;
     MeshingOptions meshing;
     meshing.sizing.target_tets = options.target_tets;
-    MeshingResult meshed = tetrahedralize(surface, meshing);
+    TimingRow row;
+    row.mesher = "tetgen";
+    MeshingResult meshed;
+    try {
+        meshed = tetrahedralize(surface, meshing);
+    } catch (const InvalidArgumentError&) {  // TetGen's floor on the count for this surface
+        meshing.mesher = Mesher::Cgal;
+        row.mesher = "cgal";
+        meshed = tetrahedralize(surface, meshing);
+    }
     TetMesh mesh = std::move(meshed.mesh);
 
-    TimingRow row;
     row.model = surface_path.stem().string();
     row.tets = mesh.tet_count();
     row.vertices = mesh.vertex_count();
@@ -120,6 +129,7 @@ nlohmann::ordered_json to_json(const std::vector<TimingRow>& rows) {
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
     for (const TimingRow& r : rows)
         out.push_back({{"model", r.model},
+                       {"mesher", r.mesher},
                        {"tets", r.tets},
                        {"vertices", r.vertices},
                        {"levels", r.levels},
@@ -140,7 +150,8 @@ std::string timing_table_markdown(const std::vector<TimingRow>& rows) {
        << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     char line[256];
     for (const TimingRow& r : rows) {
-        std::snprintf(line, sizeof line, "| %s | %zu | %d | %.0f | %.0f | %.0f | %.0f | %.1f |\n", r.model.c_str(), r.tets,
+        const std::string model = r.model + (r.mesher == "tetgen" ? "" : " (" + r.mesher + ")");
+        std::snprintf(line, sizeof line, "| %s | %zu | %d | %.0f | %.0f | %.0f | %.0f | %.1f |\n", model.c_str(), r.tets,
                       r.levels, r.build_ms, r.matrix_ms, r.solve_ms, r.cut_ms, r.paint_ms);
         md << line;
     }

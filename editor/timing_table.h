@@ -30,6 +30,7 @@ inline constexpr PaperTimingRow kTransCutTable1[] = {
 
 struct TimingRow {
     std::string model;
+    std::string mesher;            // "tetgen", or "cgal" when TetGen cannot reach the tet count
     size_t tets = 0;
     size_t vertices = 0;
     int levels = 0;
@@ -49,8 +50,9 @@ struct TimingOptions {
     size_t target_tets = 500'000;
 };
 
-// Meshes `surface` with TetGen to about target_tets and times each stage once (first run, as an
-// interactive user would see it). Throws what meshing and solving throw.
+// Meshes `surface` with TetGen to about target_tets (with CGAL Mesh_3 when TetGen cannot: it keeps every
+// input triangle, so a detailed surface such as the skull needs more tets) and times each stage once
+// (first run, as an interactive user would see it). Throws what meshing and solving throw.
 TimingRow measure_timing_row(const std::filesystem::path& surface, const TimingOptions& options);
 
 nlohmann::ordered_json to_json(const std::vector<TimingRow>& rows);
