@@ -7,6 +7,7 @@
 //   ./build/bench/editing_bench
 //   ./build/bench/editing_bench --benchmark_filter=CrossSection --benchmark_format=json
 #include "bench_meshes.h"
+#include "editor/cut_study.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
 #include "tetops/exact_cut.h"
@@ -98,64 +99,21 @@ void BM_ExactCutConnectivity(benchmark::State& state) {
 }
 BENCHMARK(BM_ExactCutConnectivity)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// Cross-section accuracy of both cut modes on spot. Cross-section vertices: boundary vertices after
-// the cut that are not on the original boundary (an original vertex that was not a boundary vertex,
-// or a vertex the exact cut created on an interior edge). Their distance to the plane (max and RMS,
-// also relative to the mean edge length) and the worst dihedral angle of the whole mesh.
-// Arg 0: 0 = remove + 10 relaxation sweeps with the 0.5 degree guard (TransCut Sec. 5), 1 = exact.
+// Cross-section accuracy of both cut modes on spot (editor/cut_study.h; `waxwork bench --only cut_modes`
+// charts the distributions). Arg 0: 0 = remove + 10 relaxation sweeps with the 0.5 degree guard
+// (TransCut Sec. 5), 1 = exact.
 void BM_CrossSectionAccuracy(benchmark::State& state) {
     const TetMesh& source = bench::spot_volume(kTets);
-    const PlaneCut plane = middle_plane(source);
-    const TetConnectivity before = build_connectivity(source);
-    std::set<std::pair<int32_t, int32_t>> boundary_edges;
-    for (const BoundaryFace& f : before.boundary_faces)
-        for (int k = 0; k < 3; ++k) {
-            const int32_t a = f.vertices[k], b = f.vertices[(k + 1) % 3];
-            boundary_edges.insert({std::min(a, b), std::max(a, b)});
-        }
-    const bool exact = state.range(0) == 1;
-    TetMesh mesh;
-    std::vector<uint8_t> on_original_boundary;
-    for (auto _ : state) {
-        mesh = source;
-        if (exact) {
-            const ExactCutResult r = cut_exact(mesh, plane);
-            on_original_boundary.resize(mesh.vertex_count());
-            for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-                const auto [a, b] = r.vertex_origins[v];
-                on_original_boundary[v] = a == b ? before.is_boundary_vertex[a]
-                                                 : boundary_edges.count({std::min(a, b), std::max(a, b)}) > 0;
-            }
-        } else {
-            const CutResult r = remove_cut_away_tets(mesh, plane);
-            relax_cut_vertices(mesh, build_connectivity(mesh), plane);
-            on_original_boundary.resize(mesh.vertex_count());
-            for (size_t v = 0; v < r.old_to_new_vertex.size(); ++v)
-                if (r.old_to_new_vertex[v] >= 0) on_original_boundary[r.old_to_new_vertex[v]] = before.is_boundary_vertex[v];
-        }
-    }
-    const TetConnectivity after = build_connectivity(mesh);
-    double max_distance = 0, sum_squares = 0;
-    size_t count = 0;
-    for (int32_t v : after.boundary_vertices) {
-        if (on_original_boundary[v]) continue;
-        const double d = std::abs(plane.side(mesh.positions[v]));
-        max_distance = std::max(max_distance, d);
-        sum_squares += d * d;
-        ++count;
-    }
-    const QualityReport quality = measure_quality(mesh);
-    const double h = measure_quality(source).mean_edge_length;
-    const double rms = count ? std::sqrt(sum_squares / static_cast<double>(count)) : 0.0;
-    state.counters["cross_section_vertices"] = static_cast<double>(count);
-    state.counters["max_distance"] = max_distance;
-    state.counters["rms_distance"] = rms;
-    state.counters["max_distance_per_edge"] = max_distance / h;
-    state.counters["rms_distance_per_edge"] = rms / h;
-    state.counters["min_dihedral_deg"] = quality.min_dihedral_deg;
-    state.counters["tets_below_5_deg"] = static_cast<double>(quality.tets_below_5_deg);
-    state.counters["tets_after"] = static_cast<double>(mesh.tet_count());
-    state.SetLabel(exact ? "exact" : "remove+relax");
+    const size_t mode = static_cast<size_t>(state.range(0));
+    CutModeResult result;
+    for (auto _ : state) result = compare_cut_modes(source, middle_plane(source))[mode];
+    state.counters["cross_section_vertices"] = static_cast<double>(result.distances_per_edge.size());
+    state.counters["max_distance_per_edge"] = result.max_distance_per_edge();
+    state.counters["rms_distance_per_edge"] = result.rms_distance_per_edge();
+    state.counters["min_dihedral_deg"] = result.worst_dihedral_deg();
+    state.counters["tets_below_5_deg"] = static_cast<double>(result.tets_below(5.0));
+    state.counters["tets_after"] = static_cast<double>(result.tets_after);
+    state.SetLabel(result.mode);
 }
 BENCHMARK(BM_CrossSectionAccuracy)->Arg(0)->Arg(1)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 

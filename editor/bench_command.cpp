@@ -81,14 +81,7 @@ void run_solvers_command(const SolversCommandOptions& o) {
     // --backend gpu adds the GPU curves (OpenGL compute shaders; OSMesa's llvmpipe unless
     // WAXWORK_GL_DEVICE=egl finds a GPU); the CPU curves stay for comparison.
     std::unique_ptr<HeadlessGlContext> context;
-    if (o.backend == "gpu") {
-        try {
-            context = std::make_unique<HeadlessGlContext>();
-            options.gl = &context->gl();
-        } catch (const Error& e) {
-            std::cerr << "warning: no GPU curves: " << e.what() << "\n";
-        }
-    }
+    if (o.backend == "gpu") context = open_gpu_for_comparison(options);
     const SolverComparison comparison = compare_solvers(mesh, connectivity, materials, lighting, options);
     if (!comparison.gpu_fallback_reason.empty())
         std::cerr << "warning: no GPU curves: " << comparison.gpu_fallback_reason << "\n";
@@ -125,7 +118,7 @@ void add_bench_command(CLI::App& app) {
     bench->require_subcommand(0, 1);
     bench->add_option("-o,--output", *suite_output, "Output directory of the whole suite");
     bench->add_flag("--quick", suite->quick, "Smaller meshes and fewer samples (under 2 minutes)");
-    bench->add_option("--only", suite->only, "Run only these parts (solvers_50k, solvers_500k, accuracy, table1, "
+    bench->add_option("--only", suite->only, "Run only these parts (solvers_50k, solvers_500k, accuracy, cut_modes, table1, "
                                              "stability, resolution)")
         ->delimiter(',');
     bench->footer("Without a subcommand runs every part (editor/bench_suite.h) and writes JSON, SVG charts and\n"

@@ -1,6 +1,7 @@
 #include "editor/bench_suite.h"
 
 #include "editor/accuracy_study.h"
+#include "editor/cut_study.h"
 #include "editor/render_pipeline.h"
 #include "editor/resolution_study.h"
 #include "editor/solver_comparison.h"
@@ -8,9 +9,11 @@
 #include "editor/svg_chart.h"
 #include "editor/timing_table.h"
 #include "io/atomic_file.h"
+#include "io/file_contents.h"
 #include "io/surface_reader.h"
 #include "solver/material.h"
 #include "tetops/connectivity.h"
+#include "tetops/cut.h"
 #include "tetops/error.h"
 #include "tetops/tetrahedralize.h"
 
@@ -20,6 +23,7 @@
 #include <chrono>
 #include <ctime>
 #include <exception>
+#include <iostream>
 #include <map>
 #include <thread>
 
@@ -48,10 +52,66 @@ void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index
     SolverComparisonOptions options;
     options.mm_per_unit = 30;
     options.max_seconds = o.quick ? 8.0 : 60.0;
+    // Every path, the GPU one included (llvmpipe here: a CPU, so its times are not GPU times).
+    const std::unique_ptr<HeadlessGlContext> context = open_gpu_for_comparison(options);
     const SolverComparison comparison = compare_solvers(mesh, connectivity, materials, lighting, options);
+    if (!comparison.gpu_fallback_reason.empty())
+        std::cerr << "warning: no GPU curves: " << comparison.gpu_fallback_reason << "\n";
     const std::string stem = "solvers_spot_" + std::to_string((target_tets + 500) / 1000) + "k";
     write_solver_comparison(o.output_dir, stem, "assets/meshes/spot.obj", comparison);
-    index["solvers"].push_back(stem + ".json");
+    Json& listed = index["solvers"];
+    if (!listed.is_array()) listed = Json::array();
+    if (std::find(listed.begin(), listed.end(), Json(stem + ".json")) == listed.end()) listed.push_back(stem + ".json");
+}
+
+// Cross-section distance and dihedral distributions of both cut modes (issue 6, part 2).
+void run_cut_modes_part(const BenchSuiteOptions& o, Json& index) {
+    const TriangleSurface surface = load_closed_surface(o.asset_dir / "meshes/spot.obj").surface;
+    MeshingOptions meshing;
+    meshing.sizing.target_tets = o.quick ? 50'000 : 500'000;
+    const TetMesh mesh = tetrahedralize(surface, meshing).mesh;
+    const auto box = bounding_box(mesh);
+    const Eigen::Vector3d normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
+    const std::vector<CutModeResult> results =
+        compare_cut_modes(mesh, PlaneCut(normal, normal.dot(0.5 * (box[0] + box[1]))));
+    Json json = {{"tets_before", mesh.tet_count()}, {"modes", to_json(results)}};
+    write_json(o.output_dir / "cut_modes.json", json);
+
+    // At most ~200 points per line: every k-th sample of a sorted distribution, the last one always.
+    auto thin = [](size_t n, auto&& point) {
+        std::vector<std::pair<double, double>> points;
+        const size_t step = std::max<size_t>(1, n / 200);
+        for (size_t i = 0; i < n; i += step) points.push_back(point(i));
+        if (n > 0 && (n - 1) % step != 0) points.push_back(point(n - 1));
+        return points;
+    };
+    std::vector<ChartSeries> distance_lines, quality_lines;
+    for (const CutModeResult& r : results) {
+        const size_t n = r.distances_per_edge.size();
+        // Exact cuts put vertices on the plane to rounding (often exactly 0): drawn at 1e-17.
+        distance_lines.push_back({r.mode, thin(n, [&](size_t i) {
+                                      return std::pair{static_cast<double>(i + 1) / static_cast<double>(n),
+                                                       std::max(r.distances_per_edge[i], 1e-17)};
+                                  }), false});
+        const size_t below_10 = r.tets_below(10.0);
+        char name[96];
+        std::snprintf(name, sizeof name, "%s (worst %.2f deg)", r.mode.c_str(), r.worst_dihedral_deg());
+        quality_lines.push_back({name, thin(below_10, [&](size_t i) {
+                                     return std::pair{r.min_dihedral_deg[i], static_cast<double>(i + 1)};
+                                 }), false});
+    }
+    ChartOptions distance_chart;
+    distance_chart.title = "Cross-section vertices' distance to the cutting plane (spot, " +
+                           std::to_string(mesh.tet_count()) + " tets)";
+    distance_chart.x = {"fraction of cross-section vertices (sorted)", AxisScale::Linear, 0, 1};
+    distance_chart.y = {"distance / mean edge length", AxisScale::Log};
+    write_svg_chart(o.output_dir / "cut_modes.svg", distance_lines, distance_chart);
+    ChartOptions quality_chart;
+    quality_chart.title = "Tets under a minimum dihedral angle after the cut";
+    quality_chart.x = {"minimum dihedral angle (degrees)", AxisScale::Log, 0.1, 10};
+    quality_chart.y = {"tets below", AxisScale::Log};
+    write_svg_chart(o.output_dir / "cut_quality.svg", quality_lines, quality_chart);
+    index["cut_modes"] = "cut_modes.json";
 }
 
 void run_accuracy_part(const BenchSuiteOptions& o, Json& index) {
@@ -156,14 +216,22 @@ void run_bench_suite(const BenchSuiteOptions& o) {
     std::filesystem::create_directories(o.output_dir, ec);
     if (ec) throw FileError(o.output_dir.string(), "cannot create the output directory: " + ec.message());
 
-    Json index;
+    // With --only, the parts not run keep their entries from an earlier run of the suite in DIR.
+    Json index = Json::object();
+    if (!o.only.empty() && std::filesystem::exists(o.output_dir / "bench.json")) {
+        try {
+            index = Json::parse(read_file_contents(o.output_dir / "bench.json"));
+        } catch (const std::exception&) {
+            index = Json::object();  // unreadable: start afresh
+        }
+    }
     index["quick"] = o.quick;
     index["hardware_threads"] = std::thread::hardware_concurrency();
     const std::time_t now = std::time(nullptr);
     char date[32];
     std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
     index["date"] = date;
-    index["parts"] = Json::object();
+    if (!index.contains("parts") || !index["parts"].is_object()) index["parts"] = Json::object();
 
     using Part = std::function<void(Json&)>;
     std::vector<std::pair<std::string, Part>> parts = {
@@ -171,6 +239,7 @@ void run_bench_suite(const BenchSuiteOptions& o) {
     };
     if (!o.quick) parts.emplace_back("solvers_500k", [&](Json& i) { run_solver_part(o, 500'000, i); });
     parts.emplace_back("accuracy", [&](Json& i) { run_accuracy_part(o, i); });
+    parts.emplace_back("cut_modes", [&](Json& i) { run_cut_modes_part(o, i); });
     parts.emplace_back("table1", [&](Json& i) { run_table1_part(o, i); });
     parts.emplace_back("stability", [&](Json& i) { run_stability_part(o, i); });
     parts.emplace_back("resolution", [&](Json& i) { run_resolution_part(o, i); });

@@ -3,6 +3,8 @@
 //   solvers_*.json/.svg   error of phi against time for every solver path (paper Fig. 7), per mesh size
 //   accuracy.json, accuracy_ball.svg, accuracy_spot.svg
 //                         error against tet size: the analytic ball, spot against a fine reference
+//   cut_modes.json, cut_modes.svg, cut_quality.svg
+//                         cross-section distance and dihedral angles of remove+relax and exact cuts
 //   table1.json/.md       T_b, T_m, T_s, cut and paint per shipped model beside the paper's Table 1
 //   stability.json/.md    where the methods fail and what Waxwork does (editor/stability_study.h)
 //   resolution.json/.svg  image error against per-frame cost over mesh size x tolerance
@@ -22,7 +24,7 @@ struct BenchSuiteOptions {
     bool quick = false;
     std::filesystem::path asset_dir;                    // holds meshes/spot.obj, torus.obj, skull.obj
     std::function<void(const std::string&)> progress;   // one line per part started; may be empty
-    // Run only these parts (names as in bench.json: solvers_50k, solvers_500k, accuracy, table1,
+    // Run only these parts (names as in bench.json: solvers_50k, solvers_500k, accuracy, cut_modes, table1,
     // stability, resolution); empty: all. An unknown name is an InvalidArgumentError.
     std::vector<std::string> only;
 };

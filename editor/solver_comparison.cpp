@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <iostream>
 #include <limits>
 
 namespace waxwork {
@@ -303,6 +304,17 @@ void write_solver_comparison(const std::filesystem::path& dir, const std::string
     chart.x = {"solve time (ms, log scale)", AxisScale::Log, 0, 0};  // direct is orders of magnitude slower
     chart.y = {"relative L2 error of phi vs direct reference", AxisScale::Log, 0, 0};
     write_svg_chart(dir / (stem + ".svg"), series, chart);
+}
+
+std::unique_ptr<HeadlessGlContext> open_gpu_for_comparison(SolverComparisonOptions& options) {
+    try {
+        auto context = std::make_unique<HeadlessGlContext>();
+        options.gl = &context->gl();
+        return context;
+    } catch (const Error& e) {
+        std::cerr << "warning: no GPU curves: " << e.what() << "\n";
+        return nullptr;
+    }
 }
 
 }  // namespace waxwork

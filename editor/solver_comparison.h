@@ -29,6 +29,7 @@
 #include "tetops/tet_mesh.h"
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -73,5 +74,10 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
 // against time, one line per solver), atomically. `mesh_name` is recorded as given.
 void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const std::string& mesh_name,
                              const SolverComparison& comparison);
+
+// For the GPU curves: a headless OpenGL context (OSMesa's llvmpipe unless WAXWORK_GL_DEVICE=egl finds a
+// GPU) set as options.gl. Returns null, with one warning line on stderr, when none can be created; the
+// CPU curves are measured either way.
+std::unique_ptr<HeadlessGlContext> open_gpu_for_comparison(SolverComparisonOptions& options);
 
 }  // namespace waxwork

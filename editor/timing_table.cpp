@@ -101,8 +101,9 @@ TimingRow measure_timing_row(const std::filesystem::path& surface_path, const Ti
         mesh.materials = materials;
         start = Clock::now();
         const PaintResult painted = paint_stroke(mesh, index, stroke, brush);
-        update_diffusion_matrix(matrix, mesh, connectivity, mesh.materials, painted.changed_tets);
-        solver.update_values(matrix);
+        const std::vector<int32_t> rows =
+            update_diffusion_matrix(matrix, mesh, connectivity, mesh.materials, painted.changed_tets);
+        solver.update_values(matrix, rows);  // only the coarse rows that depend on the painted ones
         row.paint_ms = ms_since(start);
         materials = mesh.materials;
     }
