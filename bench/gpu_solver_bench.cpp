@@ -26,18 +26,13 @@
 
 #include <cstdio>
 #include <map>
+#include <set>
 #include <memory>
 
 namespace waxwork {
 namespace {
 
-struct Scene {
-    TetMesh mesh;
-    TetConnectivity conn;
-    std::vector<TetMaterial> materials;
-    DiffusionMatrix matrix;
-    std::vector<std::array<double, 3>> q;
-};
+using Scene = bench::LitSpot;
 
 HeadlessGlContext& context() {
     static std::unique_ptr<HeadlessGlContext> c;
@@ -50,24 +45,11 @@ HeadlessGlContext& context() {
 }
 
 const Scene& scene(size_t target_tets) {
-    static std::map<size_t, std::unique_ptr<Scene>> cache;
-    auto& slot = cache[target_tets];
-    if (slot) return *slot;
-    slot = std::make_unique<Scene>();
-    Scene& s = *slot;
-    s.mesh = bench::spot_volume(target_tets);
-    s.conn = build_connectivity(s.mesh);
-    const auto box = bounding_box(s.mesh);
-    s.materials.assign(s.mesh.tet_count(), material_preset("marble"));
-    AssemblyOptions assembly;
-    assembly.mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();
-    s.matrix = assemble_diffusion_matrix(s.mesh, s.conn, s.materials, assembly);
-    Lighting lighting;
-    lighting.lights.push_back(Light{LightType::Directional, Eigen::Vector3d(0, 0, -1), {1, 1, 1}});
-    lighting.shadows = false;
-    s.q = incident_light(s.mesh, s.conn, s.materials, lighting);
-    std::fprintf(stderr, "spot: %zu tets, %zu vertices, %zu nonzeros\n", s.mesh.tet_count(), s.mesh.vertex_count(),
-                 s.matrix.nonzeros());
+    static std::set<size_t> reported;
+    const Scene& s = bench::lit_spot(target_tets);
+    if (reported.insert(target_tets).second)
+        std::fprintf(stderr, "spot: %zu tets, %zu vertices, %zu nonzeros\n", s.mesh.tet_count(), s.mesh.vertex_count(),
+                     s.matrix.nonzeros());
     return s;
 }
 

@@ -108,25 +108,11 @@ const Scene& scene(size_t target_tets) {
     if (slot) return *slot;
     slot = std::make_unique<Scene>();
     Scene& s = *slot;
-    s.mesh = &bench::spot_volume(target_tets);
-    s.conn = build_connectivity(*s.mesh);
-    const auto box = bounding_box(*s.mesh);
-    AssemblyOptions assembly;
-    assembly.mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();
-    const std::vector<TetMaterial> materials(s.mesh->tet_count(), material_preset("marble"));
-    s.matrix = assemble_diffusion_matrix(*s.mesh, s.conn, materials, assembly);
-    std::vector<Eigen::Vector3d> normals(s.mesh->vertex_count(), Eigen::Vector3d::Zero());
-    for (const auto& f : s.conn.boundary_faces) {
-        const auto& p = s.mesh->positions;
-        const Eigen::Vector3d n = (p[f.vertices[1]] - p[f.vertices[0]]).cross(p[f.vertices[2]] - p[f.vertices[0]]);
-        for (int32_t v : f.vertices) normals[static_cast<size_t>(v)] += n;
-    }
-    std::vector<std::array<double, 3>> q(s.mesh->vertex_count(), {0, 0, 0});
-    for (int32_t v : s.conn.boundary_vertices) {
-        const double c = normals[static_cast<size_t>(v)].normalized().z();
-        const double value = c > 0 ? c * fresnel_transmittance(c, 1.5) : 0.0;
-        q[static_cast<size_t>(v)] = {value, value, value};
-    }
+    const bench::LitSpot& lit = bench::lit_spot(target_tets);
+    s.mesh = &lit.mesh;
+    s.conn = lit.conn;
+    s.matrix = lit.matrix;
+    const std::vector<std::array<double, 3>>& q = lit.q;
     s.b.resize(s.matrix.size());
     diffusion_right_hand_side(s.matrix, q, 1, s.b);
     const Eigen::Map<const Eigen::VectorXd> bm(s.b.data(), static_cast<Eigen::Index>(s.b.size()));

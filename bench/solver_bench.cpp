@@ -28,13 +28,8 @@
 namespace waxwork {
 namespace {
 
-struct Scene {
-    TetMesh mesh;
-    TetConnectivity conn;
-    std::vector<TetMaterial> materials;
-    DiffusionMatrix matrix;
-    std::vector<std::array<double, 3>> q;
-    double mm_per_unit = 1;
+// The lit spot system plus its direct solution and the Eigen tolerance that reaches 1%.
+struct Scene : bench::LitSpot {
     Eigen::VectorXd exact_g;  // direct solution, green channel
     double eigen_tolerance = 1e-2;
 };
@@ -45,22 +40,8 @@ const Scene& scene(size_t target_tets) {
     static std::map<size_t, std::unique_ptr<Scene>> cache;
     auto& slot = cache[target_tets];
     if (slot) return *slot;
-    slot = std::make_unique<Scene>();
+    slot = std::make_unique<Scene>(Scene{bench::lit_spot(target_tets), {}, 1e-2});
     Scene& s = *slot;
-    s.mesh = bench::spot_volume(target_tets);
-    s.conn = build_connectivity(s.mesh);
-    const auto box = bounding_box(s.mesh);
-    s.mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();
-    s.materials.assign(s.mesh.tet_count(), material_preset("marble"));
-    AssemblyOptions assembly;
-    assembly.mm_per_unit = s.mm_per_unit;
-    s.matrix = assemble_diffusion_matrix(s.mesh, s.conn, s.materials, assembly);
-    // One white directional light travelling along -z, without shadows: q = n.z F_t(n.z) on the
-    // boundary (the solve's cost does not depend on the light, only its right-hand side does).
-    Lighting lighting;
-    lighting.lights.push_back(Light{LightType::Directional, Eigen::Vector3d(0, 0, -1), {1, 1, 1}});
-    lighting.shadows = false;
-    s.q = incident_light(s.mesh, s.conn, s.materials, lighting);
     std::vector<double> b(s.matrix.size());
     diffusion_right_hand_side(s.matrix, s.q, 1, b);
     const Eigen::SparseMatrix<double> a = to_eigen_sparse(s.matrix, 1);

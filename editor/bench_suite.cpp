@@ -40,11 +40,15 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
     write_file_atomically(path, [&](std::ostream& out) { out << text; });
 }
 
-void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index) {
-    const TriangleSurface surface = load_closed_surface(o.asset_dir / "meshes/spot.obj").surface;
+// The shipped spot meshed by TetGen to about target_tets.
+TetMesh spot_volume(const BenchSuiteOptions& o, size_t target_tets) {
     MeshingOptions meshing;
     meshing.sizing.target_tets = target_tets;
-    const TetMesh mesh = tetrahedralize(surface, meshing).mesh;
+    return tetrahedralize(load_closed_surface(o.asset_dir / "meshes/spot.obj").surface, meshing).mesh;
+}
+
+void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index) {
+    const TetMesh mesh = spot_volume(o, target_tets);
     const TetConnectivity connectivity = build_connectivity(mesh);
     const std::vector<TetMaterial> materials(mesh.tet_count(), material_preset("marble"));
     Lighting lighting;
@@ -66,10 +70,7 @@ void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index
 
 // Cross-section distance and dihedral distributions of both cut modes (issue 6, part 2).
 void run_cut_modes_part(const BenchSuiteOptions& o, Json& index) {
-    const TriangleSurface surface = load_closed_surface(o.asset_dir / "meshes/spot.obj").surface;
-    MeshingOptions meshing;
-    meshing.sizing.target_tets = o.quick ? 50'000 : 500'000;
-    const TetMesh mesh = tetrahedralize(surface, meshing).mesh;
+    const TetMesh mesh = spot_volume(o, o.quick ? 50'000 : 500'000);
     const auto box = bounding_box(mesh);
     const Eigen::Vector3d normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
     const std::vector<CutModeResult> results =

@@ -128,12 +128,9 @@ GLuint compile_shader(const GlApi& gl, GLenum type, const char* source, const ch
     GLint ok = GL_FALSE;
     gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
     if (ok != GL_TRUE) {
-        GLint length = 0;
-        gl.GetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
-        std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
-        gl.GetShaderInfoLog(shader, length, nullptr, log.data());
+        const std::string log = shader_info_log(gl, shader);
         gl.DeleteShader(shader);
-        throw Error(std::string("surface renderer: the ") + name + " shader failed to compile: " + log.c_str());
+        throw Error(std::string("surface renderer: the ") + name + " shader failed to compile: " + log);
     }
     return shader;
 }
@@ -156,12 +153,9 @@ GLuint link_program(const GlApi& gl) {
     GLint ok = GL_FALSE;
     gl.GetProgramiv(program, GL_LINK_STATUS, &ok);
     if (ok != GL_TRUE) {
-        GLint length = 0;
-        gl.GetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
-        std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
-        gl.GetProgramInfoLog(program, length, nullptr, log.data());
+        const std::string log = program_info_log(gl, program);
         gl.DeleteProgram(program);
-        throw Error(std::string("surface renderer: the shader program failed to link: ") + log.c_str());
+        throw Error(std::string("surface renderer: the shader program failed to link: ") + log);
     }
     return program;
 }

@@ -34,6 +34,28 @@ void check_gl_error(const GlApi& gl, const char* what) {
 
 namespace {
 
+template <typename GetIv, typename GetLog>
+std::string info_log(GLuint object, GetIv get_iv, GetLog get_log) {
+    GLint length = 0;
+    get_iv(object, GL_INFO_LOG_LENGTH, &length);
+    std::string log(static_cast<size_t>(length > 0 ? length : 0), '\0');
+    if (length > 0) get_log(object, length, nullptr, log.data());
+    while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
+    return log.empty() ? "(the driver gave no log)" : log;
+}
+
+}  // namespace
+
+std::string shader_info_log(const GlApi& gl, GLuint shader) {
+    return info_log(shader, gl.GetShaderiv, gl.GetShaderInfoLog);
+}
+
+std::string program_info_log(const GlApi& gl, GLuint program) {
+    return info_log(program, gl.GetProgramiv, gl.GetProgramInfoLog);
+}
+
+namespace {
+
 // OSMesa wants a colour buffer to make a context current even when all drawing goes to FBOs.
 constexpr int kDefaultBufferSize = 16;
 

@@ -101,6 +101,11 @@ GlApi load_gl_api(GlProcLoader loader);
 // Throws waxwork::Error("WHAT: OpenGL error 0x...") when glGetError reports one.
 void check_gl_error(const GlApi& gl, const char* what);
 
+// The driver's info log of a shader or a program (after a failed compile or link), without trailing
+// newlines; "(the driver gave no log)" when it is empty.
+std::string shader_info_log(const GlApi& gl, GLuint shader);
+std::string program_info_log(const GlApi& gl, GLuint program);
+
 // Where a HeadlessGlContext comes from.
 enum class GlDevice {
     // Mesa's OSMesa: always software (llvmpipe), needs no display, no GPU and no driver setup. The

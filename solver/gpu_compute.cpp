@@ -91,17 +91,6 @@ void GpuBuffer::bind(GLuint binding) const { gl_->BindBufferBase(GL_SHADER_STORA
 
 namespace {
 
-// The info log of a shader (GetShaderiv, GetShaderInfoLog) or a program (GetProgramiv, ...).
-template <typename GetIv, typename GetLog>
-std::string info_log(GLuint object, GetIv get_iv, GetLog get_log) {
-    GLint length = 0;
-    get_iv(object, GL_INFO_LOG_LENGTH, &length);
-    std::string log(static_cast<size_t>(length > 0 ? length : 0), '\0');
-    if (length > 0) get_log(object, length, nullptr, log.data());
-    while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
-    return log.empty() ? "(the driver gave no log)" : log;
-}
-
 // Driver logs span lines; the caller prints one line.
 std::string one_line(std::string text) {
     for (char& c : text)
@@ -123,7 +112,7 @@ ComputeProgram::ComputeProgram(const GlApi& gl, std::string name, const std::str
     GLint ok = 0;
     gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
     if (!ok) {
-        const std::string log = info_log(shader, gl.GetShaderiv, gl.GetShaderInfoLog);
+        const std::string log = shader_info_log(gl, shader);
         gl.DeleteShader(shader);
         throw GpuError("GPU solver: compute shader " + name_ + " failed to compile: " + one_line(log));
     }
@@ -133,7 +122,7 @@ ComputeProgram::ComputeProgram(const GlApi& gl, std::string name, const std::str
     gl.DeleteShader(shader);  // flagged; freed with the program
     gl.GetProgramiv(id_, GL_LINK_STATUS, &ok);
     if (!ok) {
-        const std::string log = info_log(id_, gl.GetProgramiv, gl.GetProgramInfoLog);
+        const std::string log = program_info_log(gl, id_);
         gl.DeleteProgram(std::exchange(id_, 0));
         throw GpuError("GPU solver: compute shader " + name_ + " failed to link: " + one_line(log));
     }
