@@ -95,9 +95,7 @@ ConvergenceSeries study_surface_convergence(const SurfaceConvergenceOptions& opt
     using Key = std::tuple<double, double, double>;
     auto solve_at_surface = [&](double factor, ConvergencePoint* point) {
         MeshingOptions meshing;
-        meshing.sizing = default_mesh_sizing(surface, material, options.mm_per_unit);
-        meshing.sizing.surface_edge *= factor;
-        meshing.sizing.max_edge *= factor;
+        meshing.sizing = default_mesh_sizing(surface, material, options.mm_per_unit, {.size_factor = factor});
         const TetMesh mesh = tetrahedralize(surface, meshing).mesh;
         const TetConnectivity connectivity = build_connectivity(mesh);
         const std::vector<TetMaterial> materials(mesh.tet_count(), material);

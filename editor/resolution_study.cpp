@@ -30,9 +30,7 @@ struct Scene {
 
 Scene mesh_scene(const TriangleSurface& surface, const TetMaterial& material, double mm_per_unit, double factor) {
     MeshingOptions meshing;
-    meshing.sizing = default_mesh_sizing(surface, material, mm_per_unit);
-    meshing.sizing.surface_edge *= factor;
-    meshing.sizing.max_edge *= factor;
+    meshing.sizing = default_mesh_sizing(surface, material, mm_per_unit, {.size_factor = factor});
     MeshingResult result = tetrahedralize(surface, meshing);
     Scene scene;
     scene.mesh = std::move(result.mesh);

@@ -22,6 +22,8 @@ MeshSizing default_mesh_sizing(const TriangleSurface& surface, const TetMaterial
                                    std::to_string(mm_per_unit) + ")");
     validate_material(material);
     if (surface.points.empty()) throw InvalidArgumentError("cannot size an empty surface");
+    if (!(rule.size_factor > 0) || !std::isfinite(rule.size_factor))
+        throw InvalidArgumentError("mesh size factor must be a positive number");
     Eigen::Vector3d lo = surface.points.front(), hi = lo;
     for (const auto& p : surface.points) {
         lo = lo.cwiseMin(p);
@@ -37,6 +39,8 @@ MeshSizing default_mesh_sizing(const TriangleSurface& surface, const TetMaterial
                                      rule.coarsest_surface_fraction_of_diagonal * diagonal);
     sizing.grading = rule.grading;
     sizing.max_edge = std::max(sizing.surface_edge, rule.interior_fraction_of_diagonal * diagonal);
+    sizing.surface_edge *= rule.size_factor;
+    sizing.max_edge *= rule.size_factor;
     return sizing;
 }
 

@@ -27,6 +27,9 @@ struct MeshResolutionRule {
     double coarsest_surface_fraction_of_diagonal = 1.0 / 25.0;
     double interior_fraction_of_diagonal = 1.0 / 8.0;
     double grading = 0.5;
+    // Multiplies the rule's edge lengths (surface and largest): the mesh-size studies' knob
+    // (editor/resolution_study.h, accuracy_study.h). 1 is the rule above.
+    double size_factor = 1.0;
 };
 
 // The smallest diffusion length over the rgb channels, in mm (infinite when every mu_a is 0).
