@@ -16,6 +16,7 @@
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
+#include "solver/gpu_assembly.h"
 #include "solver/gl_context.h"
 #include "solver/gpu_conjugate_gradient.h"
 #include "solver/lighting.h"
@@ -176,6 +177,34 @@ void BM_GpuPaintRowUpdate(benchmark::State& state) {
     state.counters["rows"] = static_cast<double>(rows);
 }
 
+// The matrix values assembled on the device (gpu_assembly.h): every row from the positions and the
+// materials (what a wholesale material change or a relaxation costs; the host only computes and
+// uploads the per-tet coefficients), and a paint stroke of ~1% of the tets (the rows of their vertices).
+// Compare with solver_bench's BM_AssembleValues (host, from cached geometry) and BM_GpuPaintRowUpdate.
+void BM_GpuAssembleValues(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    GpuMatrix m(context().gl(), rgb_csr_view(s.matrix), GpuMatrixFormat::SellCSigma);
+    GpuMatrixAssembly assembly(context().gl(), s.mesh, s.conn, s.matrix, m.layout);
+    for (auto _ : state) assembly.assemble(s.materials, m);  // ends with a read-back: synchronous
+}
+
+void BM_GpuAssemblePaintUpdate(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    GpuMatrix m(context().gl(), rgb_csr_view(s.matrix), GpuMatrixFormat::SellCSigma);
+    GpuMatrixAssembly assembly(context().gl(), s.mesh, s.conn, s.matrix, m.layout);
+    std::vector<TetMaterial> materials = s.materials;
+    std::vector<int32_t> stroke;
+    for (size_t t = 0; t < s.mesh.tet_count() / 100; ++t) stroke.push_back(static_cast<int32_t>(t));
+    bool ketchup = false;
+    size_t rows = 0;
+    for (auto _ : state) {
+        ketchup = !ketchup;
+        for (int32_t t : stroke) materials[t] = material_preset(ketchup ? "ketchup" : "marble");
+        rows = assembly.update(s.mesh, materials, stroke, m).size();
+    }
+    state.counters["rows"] = static_cast<double>(rows);
+}
+
 #define WAXWORK_SIZES Arg(50000)->Arg(500000)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime()
 BENCHMARK(BM_GpuProduct<GpuMatrixFormat::Csr>)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuProduct<GpuMatrixFormat::Ell>)->WAXWORK_SIZES;
@@ -188,6 +217,8 @@ BENCHMARK(BM_GpuCgWarm)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuMultires)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuSetup)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuPaintRowUpdate)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuAssembleValues)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuAssemblePaintUpdate)->WAXWORK_SIZES;
 
 }  // namespace
 }  // namespace waxwork

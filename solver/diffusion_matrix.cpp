@@ -31,7 +31,9 @@ int32_t find_slot(const std::vector<int32_t>& offsets, const std::vector<int32_t
     return static_cast<int32_t>(it - columns.begin());
 }
 
-DiffusionMatrix::TetCoefficients tet_coefficients_of(const TetMaterial& m) {
+}  // namespace
+
+DiffusionMatrix::TetCoefficients tet_diffusion_coefficients(const TetMaterial& m) {
     DiffusionMatrix::TetCoefficients c{};
     for (int ch = 0; ch < 3; ++ch) {
         c.kappa[ch] = diffusion_coefficient(m.mua[ch], m.musp[ch]);
@@ -44,14 +46,17 @@ DiffusionMatrix::TetCoefficients tet_coefficients_of(const TetMaterial& m) {
     return c;
 }
 
+namespace {
+
 void check_materials(const TetMesh& mesh, const std::vector<TetMaterial>& materials) {
     if (materials.size() != mesh.tet_count())
         throw InvalidArgumentError("diffusion matrix: " + std::to_string(materials.size()) + " materials for " +
                                    std::to_string(mesh.tet_count()) + " tets");
 }
 
-// Validates in parallel and reports the lowest bad tet, so the message is deterministic.
-void validate_materials(const std::vector<TetMaterial>& materials, std::span<const int32_t> which) {
+}  // namespace
+
+void validate_tet_materials(const std::vector<TetMaterial>& materials, std::span<const int32_t> which) {
     std::atomic<int64_t> first_bad{-1};
     auto check = [&](int64_t t) {
         try {
@@ -68,6 +73,8 @@ void validate_materials(const std::vector<TetMaterial>& materials, std::span<con
     });
     if (first_bad >= 0) validate_material(materials[first_bad], "material of tet " + std::to_string(first_bad.load()));
 }
+
+namespace {
 
 // Writes row i of all three matrices and of the source operator from the cached geometry and
 // coefficients. Only row i is written, so rows can be assembled in parallel without races.
@@ -202,17 +209,15 @@ template std::array<long double, 6> tet_edge_stiffness<long double>(
     const Eigen::Matrix<long double, 3, 1>&, const Eigen::Matrix<long double, 3, 1>&,
     const Eigen::Matrix<long double, 3, 1>&, const Eigen::Matrix<long double, 3, 1>&, StiffnessForm);
 
-DiffusionMatrix assemble_diffusion_matrix(const TetMesh& mesh, const TetConnectivity& conn,
-                                          const std::vector<TetMaterial>& materials, const AssemblyOptions& options) {
+DiffusionMatrix assemble_diffusion_pattern(const TetMesh& mesh, const TetConnectivity& conn,
+                                           const AssemblyOptions& options) {
     if (!std::isfinite(options.mm_per_unit) || options.mm_per_unit <= 0)
         throw InvalidArgumentError("diffusion matrix: mm_per_unit = " + std::to_string(options.mm_per_unit) +
                                    " must be positive and finite");
-    check_materials(mesh, materials);
     if (conn.vertex_tets.row_count() != mesh.vertex_count() || conn.vertex_vertices.row_count() != mesh.vertex_count())
         throw InvalidArgumentError("diffusion matrix: connectivity does not match the mesh (rebuild it after edits)");
 
     const size_t n = mesh.vertex_count();
-    const size_t tet_count = mesh.tet_count();
     DiffusionMatrix m;
     m.options = options;
 
@@ -234,28 +239,8 @@ DiffusionMatrix assemble_diffusion_matrix(const TetMesh& mesh, const TetConnecti
         }
     });
 
-    // Per tet: geometry in mm, and the slots of its vertices' rows.
-    m.tet_geometry.resize(tet_count);
+    // Per tet incidence: the slots of the tet's other vertices in the row of each of its vertices.
     m.tet_incidences.resize(conn.vertex_tets.indices.size());
-    std::atomic<int64_t> bad_tet{-1};
-    const double scale = options.mm_per_unit;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, tet_count, 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t t = r.begin(); t != r.end(); ++t) {
-            const Tet& tet = mesh.tets[t];
-            // Relative to the first vertex before scaling: keeps the rounding of large coordinates out.
-            const Eigen::Vector3d o = mesh.positions[tet[0]];
-            const Eigen::Vector3d p1 = (mesh.positions[tet[1]] - o) * scale;
-            const Eigen::Vector3d p2 = (mesh.positions[tet[2]] - o) * scale;
-            const Eigen::Vector3d p3 = (mesh.positions[tet[3]] - o) * scale;
-            const double volume = p1.dot(p2.cross(p3)) / 6.0;
-            if (!(volume > 0)) bad_tet = static_cast<int64_t>(t);
-            m.tet_geometry[t] = {tet_edge_stiffness<double>(Eigen::Vector3d::Zero(), p1, p2, p3, options.stiffness_form),
-                                 volume};
-        }
-    });
-    if (bad_tet >= 0)
-        throw InvalidMeshError("diffusion matrix: tet " + std::to_string(bad_tet.load()) +
-                               " has non-positive volume (inverted or degenerate)");
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kRowGrain), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) {
             for (int32_t k = conn.vertex_tets.offsets[i]; k < conn.vertex_tets.offsets[i + 1]; ++k) {
@@ -276,21 +261,53 @@ DiffusionMatrix assemble_diffusion_matrix(const TetMesh& mesh, const TetConnecti
     for (size_t i = 0; i < n; ++i) m.vertex_face_offsets[i + 1] += m.vertex_face_offsets[i];
     m.vertex_faces.resize(m.vertex_face_offsets.back());
     m.vertex_face_slots.resize(m.vertex_faces.size());
-    m.boundary_face_area.resize(faces.size());
-    {
-        std::vector<int32_t> cursor(m.vertex_face_offsets.begin(), m.vertex_face_offsets.end() - 1);
-        for (size_t f = 0; f < faces.size(); ++f) {
-            const auto& v = faces[f].vertices;
-            m.boundary_face_area[f] =
-                0.5 * scale * scale *
-                (mesh.positions[v[1]] - mesh.positions[v[0]]).cross(mesh.positions[v[2]] - mesh.positions[v[0]]).norm();
-            for (int a = 0; a < 3; ++a) {
-                const int32_t k = cursor[v[a]]++;
-                m.vertex_faces[k] = static_cast<int32_t>(f);
-                m.vertex_face_slots[k] = {find_slot(m.offsets, m.columns, v[a], v[(a + 1) % 3]),
-                                          find_slot(m.offsets, m.columns, v[a], v[(a + 2) % 3])};
-            }
+    std::vector<int32_t> cursor(m.vertex_face_offsets.begin(), m.vertex_face_offsets.end() - 1);
+    for (size_t f = 0; f < faces.size(); ++f) {
+        const auto& v = faces[f].vertices;
+        for (int a = 0; a < 3; ++a) {
+            const int32_t k = cursor[v[a]]++;
+            m.vertex_faces[k] = static_cast<int32_t>(f);
+            m.vertex_face_slots[k] = {find_slot(m.offsets, m.columns, v[a], v[(a + 1) % 3]),
+                                      find_slot(m.offsets, m.columns, v[a], v[(a + 2) % 3])};
         }
+    }
+    return m;
+}
+
+DiffusionMatrix assemble_diffusion_matrix(const TetMesh& mesh, const TetConnectivity& conn,
+                                          const std::vector<TetMaterial>& materials, const AssemblyOptions& options) {
+    check_materials(mesh, materials);
+    DiffusionMatrix m = assemble_diffusion_pattern(mesh, conn, options);
+
+    // Per tet: geometry in mm.
+    const size_t tet_count = mesh.tet_count();
+    m.tet_geometry.resize(tet_count);
+    std::atomic<int64_t> bad_tet{-1};
+    const double scale = options.mm_per_unit;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, tet_count, 1024), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t t = r.begin(); t != r.end(); ++t) {
+            const Tet& tet = mesh.tets[t];
+            // Relative to the first vertex before scaling: keeps the rounding of large coordinates out.
+            const Eigen::Vector3d o = mesh.positions[tet[0]];
+            const Eigen::Vector3d p1 = (mesh.positions[tet[1]] - o) * scale;
+            const Eigen::Vector3d p2 = (mesh.positions[tet[2]] - o) * scale;
+            const Eigen::Vector3d p3 = (mesh.positions[tet[3]] - o) * scale;
+            const double volume = p1.dot(p2.cross(p3)) / 6.0;
+            if (!(volume > 0)) bad_tet = static_cast<int64_t>(t);
+            m.tet_geometry[t] = {tet_edge_stiffness<double>(Eigen::Vector3d::Zero(), p1, p2, p3, options.stiffness_form),
+                                 volume};
+        }
+    });
+    if (bad_tet >= 0)
+        throw InvalidMeshError("diffusion matrix: tet " + std::to_string(bad_tet.load()) +
+                               " has non-positive volume (inverted or degenerate)");
+    const auto& faces = conn.boundary_faces;
+    m.boundary_face_area.resize(faces.size());
+    for (size_t f = 0; f < faces.size(); ++f) {
+        const auto& v = faces[f].vertices;
+        m.boundary_face_area[f] =
+            0.5 * scale * scale *
+            (mesh.positions[v[1]] - mesh.positions[v[0]]).cross(mesh.positions[v[2]] - mesh.positions[v[0]]).norm();
     }
 
     assemble_diffusion_values(m, conn, materials);
@@ -302,7 +319,7 @@ void assemble_diffusion_values(DiffusionMatrix& m, const TetConnectivity& conn, 
     if (materials.size() != tet_count)
         throw InvalidArgumentError("diffusion matrix: " + std::to_string(materials.size()) + " materials for " +
                                    std::to_string(tet_count) + " tets");
-    validate_materials(materials, {});
+    validate_tet_materials(materials, {});
     m.tet_coefficients.resize(tet_count);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tet_count, 4096), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t t = r.begin(); t != r.end(); ++t) {
@@ -311,7 +328,7 @@ void assemble_diffusion_values(DiffusionMatrix& m, const TetConnectivity& conn, 
             if (t > r.begin() && std::memcmp(&materials[t], &materials[t - 1], sizeof(TetMaterial)) == 0)
                 m.tet_coefficients[t] = m.tet_coefficients[t - 1];
             else
-                m.tet_coefficients[t] = tet_coefficients_of(materials[t]);
+                m.tet_coefficients[t] = tet_diffusion_coefficients(materials[t]);
         }
     });
     for (auto& v : m.values) v.resize(m.columns.size());
@@ -332,13 +349,13 @@ std::vector<int32_t> update_diffusion_matrix(DiffusionMatrix& m, const TetMesh& 
         if (t < 0 || static_cast<size_t>(t) >= materials.size())
             throw InvalidArgumentError("diffusion matrix update: tet index " + std::to_string(t) + " out of range");
     if (changed_tets.empty()) return {};
-    validate_materials(materials, changed_tets);
+    validate_tet_materials(materials, changed_tets);
     // A tet's material enters exactly the rows of its four vertices (its edges, its mass and, through
     // eta, its boundary faces all lie in those rows), so rewriting them reproduces a full assembly.
     std::vector<int32_t> rows;
     rows.reserve(4 * changed_tets.size());
     for (int32_t t : changed_tets) {
-        m.tet_coefficients[t] = tet_coefficients_of(materials[t]);
+        m.tet_coefficients[t] = tet_diffusion_coefficients(materials[t]);
         rows.insert(rows.end(), mesh.tets[t].begin(), mesh.tets[t].end());
     }
     std::sort(rows.begin(), rows.end());

@@ -115,6 +115,20 @@ struct DiffusionMatrix {
     std::vector<TetCoefficients> tet_coefficients;
 };
 
+// The topology-only part: options, pattern (offsets, columns, diagonal), tet_incidences and the
+// boundary-face incidences (vertex_face_offsets/faces/slots). No geometry, coefficients or values:
+// what a device assembly (gpu_assembly.h) needs from the host after a topology change. Throws
+// InvalidArgumentError on a bad mm_per_unit or a connectivity that does not match the mesh.
+DiffusionMatrix assemble_diffusion_pattern(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                           const AssemblyOptions& options = {});
+
+// A tet's material as the assembly uses it: kappa and mu_a per channel, 1/A and 1/(A (1 - F_dr)).
+DiffusionMatrix::TetCoefficients tet_diffusion_coefficients(const TetMaterial& material);
+
+// Validates the materials of `which` (all when empty) in parallel; InvalidArgumentError names the
+// lowest bad tet, so the message does not depend on scheduling.
+void validate_tet_materials(const std::vector<TetMaterial>& materials, std::span<const int32_t> which = {});
+
 // Builds pattern, geometry and values. materials: one per tet (validated: InvalidArgumentError names
 // the first bad tet). Throws InvalidArgumentError on a non-positive or non-finite mm_per_unit or
 // mismatched sizes, InvalidMeshError on a tet of non-positive volume.

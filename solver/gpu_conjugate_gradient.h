@@ -50,6 +50,9 @@ public:
     void update_values(const DiffusionMatrix& matrix);
     // After update_diffusion_matrix: uploads only `rows` (its return value), O(their entries).
     void update_rows(const DiffusionMatrix& matrix, std::span<const int32_t> rows);
+    // After the values were rewritten on the device (gpu_assembly.h writes into matrix()): refreshes
+    // the Jacobi preconditioner from the new diagonal.
+    void values_changed_on_device() { kernels_.extract_diagonal(matrix_, diag_, inv_diag_); }
     // b = source q (Eq. 12) for the three channels, uploaded.
     void set_light(const DiffusionMatrix& matrix, const std::vector<std::array<double, 3>>& q);
     // b per channel, directly.
@@ -71,6 +74,8 @@ public:
     GpuBuffer& solution_buffer() { return x_; }
     const GpuBuffer& right_hand_side_buffer() const { return b_; }
     const GpuMatrix& matrix() const { return matrix_; }
+    // Writable values for a device assembly; call values_changed_on_device() afterwards.
+    GpuMatrix& matrix() { return matrix_; }
     GpuKernels& kernels() { return kernels_; }
 
 private:
