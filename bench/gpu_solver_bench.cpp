@@ -11,6 +11,7 @@
 //
 // Run: build/bench/gpu_solver_bench [--benchmark_filter=...]
 #include "bench_meshes.h"
+#include "multires/gpu_independent_set.h"
 #include "multires/gpu_multires_solver.h"
 #include "multires/hierarchy.h"
 #include "solver/conjugate_gradient.h"
@@ -25,6 +26,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <set>
@@ -205,6 +207,23 @@ void BM_GpuAssemblePaintUpdate(benchmark::State& state) {
     state.counters["rows"] = static_cast<double>(rows);
 }
 
+// The hierarchy's first vertex selection (independent set + enhancement, Sec. 4.1) on level 0's graph:
+// on the device (gpu_independent_set.h, graph upload and read-back included) and on the CPU (TBB), same
+// result. Argument 2: 0 = device, 1 = CPU.
+void BM_SelectCoarseVertices(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    const bool on_device = state.range(1) == 0;
+    std::unique_ptr<GpuVertexSelector> gpu;
+    if (on_device) gpu = std::make_unique<GpuVertexSelector>(context().gl());
+    size_t retained = 0;
+    for (auto _ : state) {
+        const VertexSelection selection = on_device ? gpu->select(s.conn.vertex_vertices, 1)
+                                                    : select_coarse_vertices(s.conn.vertex_vertices, 1);
+        retained = static_cast<size_t>(std::count(selection.retained.begin(), selection.retained.end(), 1));
+    }
+    state.counters["retained"] = static_cast<double>(retained);
+}
+
 #define WAXWORK_SIZES Arg(50000)->Arg(500000)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime()
 BENCHMARK(BM_GpuProduct<GpuMatrixFormat::Csr>)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuProduct<GpuMatrixFormat::Ell>)->WAXWORK_SIZES;
@@ -219,6 +238,7 @@ BENCHMARK(BM_GpuSetup)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuPaintRowUpdate)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuAssembleValues)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuAssemblePaintUpdate)->WAXWORK_SIZES;
+BENCHMARK(BM_SelectCoarseVertices)->ArgsProduct({{50000, 500000}, {0, 1}})->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 }  // namespace
 }  // namespace waxwork
