@@ -157,13 +157,11 @@ void BM_GpuSetup(benchmark::State& state) {
     }
 }
 
-// A paint stroke: ~1% of the tets change material; the CPU rewrites their rows (update_diffusion_matrix)
-// and the GPU receives only those rows.
-void BM_GpuPaintRowUpdate(benchmark::State& state) {
-    const Scene& s = scene(state.range(0));
-    DiffusionMatrix matrix = s.matrix;
+// Paint strokes over the first ~1% of the tets, alternately ketchup and marble; `update` applies one
+// (its materials and tets) and returns the rows it rewrote.
+template <typename Update>
+void run_paint_strokes(benchmark::State& state, const Scene& s, Update&& update) {
     std::vector<TetMaterial> materials = s.materials;
-    GpuDiffusionSolver solver(context().gl(), matrix);
     std::vector<int32_t> stroke;
     for (size_t t = 0; t < s.mesh.tet_count() / 100; ++t) stroke.push_back(static_cast<int32_t>(t));
     bool ketchup = false;
@@ -171,12 +169,23 @@ void BM_GpuPaintRowUpdate(benchmark::State& state) {
     for (auto _ : state) {
         ketchup = !ketchup;
         for (int32_t t : stroke) materials[t] = material_preset(ketchup ? "ketchup" : "marble");
+        rows = update(materials, stroke);
+    }
+    state.counters["rows"] = static_cast<double>(rows);
+}
+
+// A paint stroke: ~1% of the tets change material; the CPU rewrites their rows (update_diffusion_matrix)
+// and the GPU receives only those rows.
+void BM_GpuPaintRowUpdate(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    DiffusionMatrix matrix = s.matrix;
+    GpuDiffusionSolver solver(context().gl(), matrix);
+    run_paint_strokes(state, s, [&](const std::vector<TetMaterial>& materials, const std::vector<int32_t>& stroke) {
         const std::vector<int32_t> changed = update_diffusion_matrix(matrix, s.mesh, s.conn, materials, stroke);
         solver.update_rows(matrix, changed);
         context().gl().Finish();
-        rows = changed.size();
-    }
-    state.counters["rows"] = static_cast<double>(rows);
+        return changed.size();
+    });
 }
 
 // The matrix values assembled on the device (gpu_assembly.h): every row from the positions and the
@@ -194,17 +203,9 @@ void BM_GpuAssemblePaintUpdate(benchmark::State& state) {
     const Scene& s = scene(state.range(0));
     GpuMatrix m(context().gl(), rgb_csr_view(s.matrix), GpuMatrixFormat::SellCSigma);
     GpuMatrixAssembly assembly(context().gl(), s.mesh, s.conn, s.matrix, m.layout);
-    std::vector<TetMaterial> materials = s.materials;
-    std::vector<int32_t> stroke;
-    for (size_t t = 0; t < s.mesh.tet_count() / 100; ++t) stroke.push_back(static_cast<int32_t>(t));
-    bool ketchup = false;
-    size_t rows = 0;
-    for (auto _ : state) {
-        ketchup = !ketchup;
-        for (int32_t t : stroke) materials[t] = material_preset(ketchup ? "ketchup" : "marble");
-        rows = assembly.update(s.mesh, materials, stroke, m).size();
-    }
-    state.counters["rows"] = static_cast<double>(rows);
+    run_paint_strokes(state, s, [&](const std::vector<TetMaterial>& materials, const std::vector<int32_t>& stroke) {
+        return assembly.update(s.mesh, materials, stroke, m).size();  // ends with a read-back
+    });
 }
 
 // The hierarchy's first vertex selection (independent set + enhancement, Sec. 4.1) on level 0's graph:

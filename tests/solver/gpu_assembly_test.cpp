@@ -114,12 +114,25 @@ TEST(GpuMatrixAssembly, UpdateAfterPaintingRewritesExactlyTheHostRows) {
     EXPECT_LT(worst_relative_difference(device, host), 1e-6);
 }
 
+// The host assembly of a scene and a device matrix + assembly for it (values from the host).
+struct DeviceScene {
+    DiffusionMatrix host;
+    GpuMatrix device;
+    GpuMatrixAssembly assembly;
+
+    DeviceScene(const GlApi& gl, const Scene& s)
+        : host(assemble_diffusion_matrix(s.mesh, s.conn, s.materials)),
+          device(gl, rgb_csr_view(host), GpuMatrixFormat::SellCSigma),
+          assembly(gl, s.mesh, s.conn, host, device.layout) {}
+};
+
 TEST(GpuMatrixAssembly, MovedVerticesAreAssembledFromTheNewPositions) {
     WAXWORK_REQUIRE_GL(context);
     Scene s = jittered_cube();
-    const DiffusionMatrix before = assemble_diffusion_matrix(s.mesh, s.conn, s.materials);
-    GpuMatrix device(context->gl(), rgb_csr_view(before), GpuMatrixFormat::SellCSigma);
-    GpuMatrixAssembly assembly(context->gl(), s.mesh, s.conn, before, device.layout);
+    DeviceScene d(context->gl(), s);
+    const DiffusionMatrix& before = d.host;
+    GpuMatrix& device = d.device;
+    GpuMatrixAssembly& assembly = d.assembly;
     for (auto& p : s.mesh.positions) p = Eigen::Vector3d(1.3 * p.x(), p.y() + 0.1 * p.x() * p.x(), 0.8 * p.z());
     assembly.set_positions(s.mesh);
     assembly.assemble(s.materials, device);
@@ -139,9 +152,9 @@ TEST(GpuMatrixAssembly, UnreferencedVerticesGetIdentityRows) {
 TEST(GpuMatrixAssembly, AnInvertedTetIsNamed) {
     WAXWORK_REQUIRE_GL(context);
     Scene s = jittered_cube();
-    const DiffusionMatrix host = assemble_diffusion_matrix(s.mesh, s.conn, s.materials);
-    GpuMatrix device(context->gl(), rgb_csr_view(host), GpuMatrixFormat::SellCSigma);
-    GpuMatrixAssembly assembly(context->gl(), s.mesh, s.conn, host, device.layout);
+    DeviceScene d(context->gl(), s);
+    GpuMatrix& device = d.device;
+    GpuMatrixAssembly& assembly = d.assembly;
     // Collapse tet 17 by moving its first vertex onto the plane of its other three... and beyond.
     TetMesh moved = s.mesh;
     const Tet& t = moved.tets[17];
@@ -159,14 +172,14 @@ TEST(GpuMatrixAssembly, AnInvertedTetIsNamed) {
 TEST(GpuMatrixAssembly, RejectsBadInput) {
     WAXWORK_REQUIRE_GL(context);
     Scene s = jittered_cube();
-    const DiffusionMatrix host = assemble_diffusion_matrix(s.mesh, s.conn, s.materials);
-    GpuMatrix device(context->gl(), rgb_csr_view(host), GpuMatrixFormat::SellCSigma);
+    DeviceScene d(context->gl(), s);
+    GpuMatrix& device = d.device;
+    GpuMatrixAssembly& assembly = d.assembly;
     AssemblyOptions cotangent;
     cotangent.stiffness_form = StiffnessForm::Cotangent;
     EXPECT_THROW(GpuMatrixAssembly(context->gl(), s.mesh, s.conn, assemble_diffusion_pattern(s.mesh, s.conn, cotangent),
                                    device.layout),
                  InvalidArgumentError);
-    GpuMatrixAssembly assembly(context->gl(), s.mesh, s.conn, host, device.layout);
     std::vector<TetMaterial> bad = s.materials;
     bad[5].mua[1] = std::nan("");
     try {
