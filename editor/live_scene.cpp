@@ -56,7 +56,7 @@ void LiveScene::rebuild_surface(SceneUpdate& update) {
 }
 
 void LiveScene::relight(SceneUpdate& update) {
-    surface_q_ = incident_light(surface_, shadow_bvh_, lighting_);
+    surface_q_ = incident_light(surface_, shadow_bvh_, lighting_, &surface_visibility_);
     q_ = to_volume_vertices(surface_, surface_q_, mesh_->vertex_count());
     update.recomputed_light = true;
     refresh_right_hand_sides();
@@ -292,6 +292,7 @@ SolvedScene LiveScene::solved_scene() const {
     const std::lock_guard lock(mutex_);
     scene.surface = surface_;
     scene.q = q_;
+    scene.light_visibility = surface_visibility_;
     for (int c = 0; c < 3; ++c) scene.diffusion.estimated_relative_error[c] = error_[c];
     scene.radiance_factor =
         exitant_radiance_factors(*mesh_, *connectivity_, mesh_->materials, scene.diffusion.phi, scene.q);

@@ -136,6 +136,7 @@ private:
     BoundarySurface surface_;
     TriangleBvh shadow_bvh_;
     std::vector<Rgb> surface_q_;                // per surface vertex
+    std::vector<float> surface_visibility_;     // per surface vertex and light (SolvedScene::light_visibility)
     std::vector<Rgb> q_;                        // per volume vertex
     std::array<std::vector<double>, 3> b_;      // right-hand side per channel
     std::array<std::vector<double>, 3> phi_;    // current fluence per channel

@@ -2,6 +2,7 @@
 #include "editor/commands.h"
 #include "editor/material_options.h"
 #include "editor/render_pipeline.h"
+#include "editor/view_modes.h"
 #include "io/volume_file.h"
 #include "tetops/connectivity.h"
 #include "tetops/error.h"
@@ -37,7 +38,20 @@ struct RenderCommandOptions {
     std::vector<double> view;
     std::optional<double> exposure;
     std::string backend = "cpu";
+    std::string show = "radiance";
+    std::string slice_normal;
+    double slice_offset = 0;
 };
+
+// The view --show asks for, checked before any work.
+ViewOptions view_options(const RenderCommandOptions& o) {
+    ViewOptions view;
+    view.mode = parse_view_mode(o.show);
+    if (!o.slice_normal.empty()) view.slice_normal = parse_slice_normal(o.slice_normal);
+    view.slice_offset = o.slice_offset;
+    validate(view);
+    return view;
+}
 
 // Physically meaningless values are refused before any work: a scale beyond these bounds is a unit
 // error (a nanometre or a kilometre per model unit), not a scene.
@@ -74,6 +88,7 @@ CameraSettings camera_for_view(const std::vector<double>& view) {
 
 void run_render_command(const RenderCommandOptions& o) {
     check_options(o);
+    const ViewOptions view = view_options(o);
     Lighting lighting;
     for (const std::string& spec : o.lights) lighting.lights.push_back(parse_light_spec(spec));
     if (lighting.lights.empty()) lighting.lights.push_back(default_key_light());
@@ -105,7 +120,9 @@ void run_render_command(const RenderCommandOptions& o) {
     settings.height = o.height;
     settings.camera = camera_for_view(o.view);
     if (o.exposure) settings.exposure = static_cast<float>(*o.exposure);
-    const SurfaceRenderInput input = make_render_input(mesh, scene, lighting, settings);
+    SurfaceRenderInput input = make_render_input(mesh, scene, lighting, settings);
+    const ViewGeometry view_geometry = build_view_geometry(mesh, connectivity, materials, scene, view);
+    apply_view(view_geometry, input);
     SurfaceRenderer renderer(context.gl());
     const Image image = render_scene(renderer, input);
     const double render_ms =
@@ -134,7 +151,9 @@ void run_render_command(const RenderCommandOptions& o) {
         {"assembly_ms", s.assembly_ms},
         {"solve_ms", s.solve_ms},
         {"render_ms", render_ms},
+        {"view", view_mode_name(view.mode)},
     };
+    if (view.mode != ViewMode::Radiance) summary["legend"] = view_geometry.legend.title;
     if (!o.fields.empty()) summary["fields"] = o.fields;
     std::cout << summary.dump() << "\n";
 }
@@ -172,6 +191,15 @@ void add_render_command(CLI::App& app) {
         ->delimiter(',')
         ->expected(3);
     cmd->add_option("--exposure", options->exposure, "Fixed exposure (default: automatic)");
+    cmd->add_option("--show", options->show,
+                    "What to draw: radiance (the image), materials, quality (min dihedral angle), wireframe (tet "
+                    "edges), slice (fluence on a plane), levels (multires hierarchy)")
+        ->capture_default_str();
+    cmd->add_option("--slice-normal", options->slice_normal,
+                    "--show slice: X,Y,Z, the plane's normal, pointing at the half cut away (default 0,0,1)");
+    cmd->add_option("--slice-offset", options->slice_offset,
+                    "--show slice: the plane's offset from the centre, in [-1, 1] half extents along the normal")
+        ->capture_default_str();
     cmd->footer(
         "Without --light a white key light shines from the upper front-left: dir:1,-1,-1 (y up, front +z).\n"
         "Without a material option the volume's stored per-tet materials are used, else marble.\n"

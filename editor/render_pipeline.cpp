@@ -124,7 +124,8 @@ SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity
     // The surface is extracted once and shared by the lighting and the renderer (the 4-argument
     // incident_light would extract it again).
     scene.surface = extract_boundary_surface(mesh, connectivity, materials);
-    scene.q = to_volume_vertices(scene.surface, incident_light(scene.surface, lighting), mesh.vertex_count());
+    scene.q = to_volume_vertices(scene.surface, incident_light(scene.surface, lighting, &scene.light_visibility),
+                                 mesh.vertex_count());
     scene.lighting_ms = milliseconds_since(lighting_start);
 
     scene.diffusion = solve_diffusion(mesh, connectivity, materials, scene.q, options);
@@ -187,13 +188,23 @@ SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& sce
     }
     input.triangles = surface.triangles;
     // Highlights: the same lights as the subsurface term, minus point lights inside the volume (they
-    // reach no surface from outside, and the shader's highlight has no shadow test to know that).
+    // reach no surface from outside), each shadowed by the visibility its shadow rays found.
     input.lighting.ambient = lighting.ambient;
     input.lighting.shadows = lighting.shadows;
-    for (const Light& light : lighting.lights) {
+    std::vector<size_t> kept;  // index into lighting.lights of each drawn light
+    for (size_t l = 0; l < lighting.lights.size(); ++l) {
+        const Light& light = lighting.lights[l];
         if (input.lighting.lights.size() == static_cast<size_t>(kMaxRenderLights)) break;
         if (light.type == LightType::Point && point_inside_volume(mesh, light.vector)) continue;
         input.lighting.lights.push_back(light);
+        kept.push_back(l);
+    }
+    const size_t solved_lights = lighting.lights.size();
+    if (!kept.empty() && scene.light_visibility.size() == n * solved_lights) {
+        input.light_visibility.resize(n * kept.size());
+        for (size_t s = 0; s < n; ++s)
+            for (size_t k = 0; k < kept.size(); ++k)
+                input.light_visibility[s * kept.size() + k] = scene.light_visibility[s * solved_lights + kept[k]];
     }
     input.width = settings.width;
     input.height = settings.height;

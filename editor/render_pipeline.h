@@ -50,6 +50,9 @@ struct SolvedScene {
     std::vector<Rgb> q;                                // incident diffuse light (0 inside)
     DiffusionSolution diffusion;                       // phi and solver statistics
     std::vector<std::array<float, 3>> radiance_factor; // E (0 inside)
+    // Per surface vertex and light of the lighting solved with, vertex-major: the shadow rays'
+    // visibility (incident_light), so the renderer can shadow the highlights. Empty: all visible.
+    std::vector<float> light_visibility;
     double lighting_ms = 0;                            // surface extraction, shadow BVH and q
 };
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <utility>
 #include <string>
 
 namespace waxwork {
@@ -27,16 +28,22 @@ layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec3 radiance_factor;
 layout(location = 3) in float eta;
+layout(location = 4) in vec4 visibility_a;  // lights 0-3
+layout(location = 5) in vec4 visibility_b;  // lights 4-7
 uniform mat4 view_projection;
 out vec3 v_position;
 out vec3 v_normal;
 out vec3 v_factor;
 out float v_eta;
+out vec4 v_visibility_a;
+out vec4 v_visibility_b;
 void main() {
     v_position = position;
     v_normal = normal;
     v_factor = radiance_factor;
     v_eta = eta;
+    v_visibility_a = visibility_a;
+    v_visibility_b = visibility_b;
     gl_Position = view_projection * vec4(position, 1.0);
 }
 )glsl";
@@ -49,7 +56,13 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec3 v_factor;
 in float v_eta;
+in vec4 v_visibility_a;
+in vec4 v_visibility_b;
 out vec4 color;
+layout(std430, binding = 0) readonly buffer TriangleColours { float triangle_colour[]; };
+uniform int shading;                       // 0 radiance, 1 vertex colour, 2 triangle colour
+uniform int clip_enabled;
+uniform vec4 clip_plane;
 uniform vec3 eye;
 uniform sampler2D transmittance_lut;  // x: cos(theta) in [0, 1], y: eta over lut_eta_range
 uniform vec2 lut_eta_range;
@@ -78,10 +91,21 @@ vec3 srgb_encode(vec3 c) {
 }
 
 void main() {
+    if (clip_enabled != 0 && dot(clip_plane.xyz, v_position) + clip_plane.w < 0.0) discard;
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;  // inside of an open cut: shade the side we see
     vec3 v = normalize(eye - v_position);
     float nv = max(dot(n, v), 1e-4);
+    if (shading != 0) {
+        // A headlight keeps the shape readable without changing the hue the view encodes.
+        vec3 albedo = v_factor;
+        if (shading == 2) {
+            int t = 3 * gl_PrimitiveID;
+            albedo = vec3(triangle_colour[t], triangle_colour[t + 1], triangle_colour[t + 2]);
+        }
+        color = vec4(srgb_encode(clamp(albedo * (0.35 + 0.65 * nv), 0.0, 1.0)), 1.0);
+        return;
+    }
     // Subsurface part: L_o = F_t(theta_o) E (Li et al. 2013, Eq. 3).
     vec3 radiance = transmittance(nv, v_eta) * max(v_factor, vec3(0.0));
 
@@ -103,6 +127,10 @@ void main() {
         }
         float nl = dot(n, l);
         if (nl <= 0.0) continue;
+        // The shadow rays' visibility of this light, interpolated over the triangle.
+        float visible = i < 4 ? v_visibility_a[i] : v_visibility_b[i - 4];
+        if (visible <= 0.0) continue;
+        irradiance *= visible;
         vec3 h = normalize(l + v);
         float nh = max(dot(n, h), 0.0);
         float vh = max(dot(v, h), 0.0);
@@ -121,6 +149,33 @@ void main() {
 }
 )glsl";
 
+// The overlay: unlit, coloured lines, triangles and points.
+constexpr const char* kOverlayVertexShader = R"glsl(
+#version 430 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 colour;
+uniform mat4 view_projection;
+uniform float depth_pull;  // fraction of w subtracted from the clip-space depth
+uniform float point_size;
+out vec3 v_colour;
+void main() {
+    v_colour = colour;
+    gl_Position = view_projection * vec4(position, 1.0);
+    gl_Position.z -= depth_pull * gl_Position.w;
+    gl_PointSize = point_size;
+}
+)glsl";
+
+constexpr const char* kOverlayFragmentShader = R"glsl(
+#version 430 core
+in vec3 v_colour;
+out vec4 color;
+vec3 srgb_encode(vec3 c) {
+    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+void main() { color = vec4(srgb_encode(clamp(v_colour, 0.0, 1.0)), 1.0); }
+)glsl";
+
 GLuint compile_shader(const GlApi& gl, GLenum type, const char* source, const char* name) {
     const GLuint shader = gl.CreateShader(type);
     gl.ShaderSource(shader, 1, &source, nullptr);
@@ -135,11 +190,12 @@ GLuint compile_shader(const GlApi& gl, GLenum type, const char* source, const ch
     return shader;
 }
 
-GLuint link_program(const GlApi& gl) {
-    const GLuint vertex = compile_shader(gl, GL_VERTEX_SHADER, kVertexShader, "vertex");
+GLuint link_program(const GlApi& gl, const char* vertex_source = kVertexShader,
+                    const char* fragment_source = kFragmentShader) {
+    const GLuint vertex = compile_shader(gl, GL_VERTEX_SHADER, vertex_source, "vertex");
     GLuint fragment = 0;
     try {
-        fragment = compile_shader(gl, GL_FRAGMENT_SHADER, kFragmentShader, "fragment");
+        fragment = compile_shader(gl, GL_FRAGMENT_SHADER, fragment_source, "fragment");
     } catch (...) {
         gl.DeleteShader(vertex);
         throw;
@@ -166,7 +222,11 @@ struct FrameResources {
     GLuint framebuffers[2] = {0, 0};   // multisampled, resolved
     GLuint renderbuffers[3] = {0, 0, 0};  // msaa colour, msaa depth, resolved colour
     GLuint vertex_array = 0;
-    GLuint buffers[5] = {0, 0, 0, 0, 0};  // positions, normals, factors, eta, indices
+    GLuint overlay_array = 0;
+    // positions, normals, factors, eta, indices, visibility, triangle colours, overlay positions,
+    // overlay colours, overlay indices
+    static constexpr int kBuffers = 10;
+    GLuint buffers[kBuffers] = {};
 
     explicit FrameResources(const GlApi& g) : gl(g) {}
     ~FrameResources() {
@@ -175,7 +235,8 @@ struct FrameResources {
         gl.DeleteFramebuffers(2, framebuffers);
         gl.DeleteRenderbuffers(3, renderbuffers);
         gl.DeleteVertexArrays(1, &vertex_array);
-        gl.DeleteBuffers(5, buffers);
+        gl.DeleteVertexArrays(1, &overlay_array);
+        gl.DeleteBuffers(kBuffers, buffers);
     }
 };
 
@@ -213,6 +274,26 @@ void validate_input(const SurfaceRenderInput& input) {
     if (input.lighting.lights.size() > static_cast<size_t>(kMaxRenderLights)) {
         fail(std::to_string(input.lighting.lights.size()) + " lights; at most " + std::to_string(kMaxRenderLights) + " are drawn");
     }
+    if (!input.light_visibility.empty() && input.light_visibility.size() != n * input.lighting.lights.size())
+        fail(std::to_string(input.light_visibility.size()) + " visibility values for " + std::to_string(n) +
+             " vertices and " + std::to_string(input.lighting.lights.size()) + " lights");
+    if (input.shading == SurfaceShading::VertexColour && input.colours.size() != n)
+        fail(std::to_string(input.colours.size()) + " vertex colours for " + std::to_string(n) + " vertices");
+    if (input.shading == SurfaceShading::TriangleColour && input.colours.size() != input.triangles.size())
+        fail(std::to_string(input.colours.size()) + " triangle colours for " + std::to_string(input.triangles.size()) +
+             " triangles");
+    const RenderOverlay& o = input.overlay;
+    if (o.line_vertices.size() % 2 != 0 || o.line_colours.size() != o.line_vertices.size())
+        fail("overlay lines need two vertices per segment and one colour per vertex");
+    if (o.triangle_vertices.size() % 3 != 0 || o.triangle_colours.size() != o.triangle_vertices.size())
+        fail("overlay triangles need three vertices each and one colour per vertex");
+    if (o.point_colours.size() != o.points.size()) fail("overlay points need one colour each");
+    if (!std::isfinite(o.point_size) || o.point_size <= 0) fail("overlay point size must be positive");
+    for (const auto* list : {&o.line_vertices, &o.triangle_vertices, &o.points})
+        for (const Eigen::Vector3f& p : *list)
+            if (!p.allFinite()) fail("non-finite overlay vertex");
+    if (input.clip_plane && (!input.clip_plane->allFinite() || input.clip_plane->head<3>().norm() == 0))
+        fail("the clip plane needs a finite, non-zero normal");
     validate(input.lighting);
 }
 
@@ -287,6 +368,12 @@ CameraFrame frame_camera(const Eigen::AlignedBox3d& box, const CameraSettings& c
 
 SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {
     program_ = link_program(gl_);
+    try {
+        overlay_program_ = link_program(gl_, kOverlayVertexShader, kOverlayFragmentShader);
+    } catch (...) {
+        gl_.DeleteProgram(program_);
+        throw;
+    }
 
     std::vector<float> table(kLutCosSamples * kLutEtaSamples);
     for (int j = 0; j < kLutEtaSamples; ++j) {
@@ -310,6 +397,7 @@ SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {
 
 SurfaceRenderer::~SurfaceRenderer() {
     gl_.DeleteTextures(1, &transmittance_lut_);
+    gl_.DeleteProgram(overlay_program_);
     gl_.DeleteProgram(program_);
 }
 
@@ -334,6 +422,65 @@ Image read_framebuffer(const GlApi& gl, int width, int height) {
     }
     return image;
 }
+
+namespace {
+
+// Lines, then triangles, then points from one vertex buffer, each with its own index range.
+void draw_overlay(const GlApi& gl, GLuint program, const RenderOverlay& o, const CameraFrame& frame, FrameResources& r) {
+    std::vector<Eigen::Vector3f> positions;
+    std::vector<std::array<float, 3>> colours;
+    positions.reserve(o.line_vertices.size() + o.triangle_vertices.size() + o.points.size());
+    colours.reserve(positions.capacity());
+    for (const auto& [p, c] : {std::pair{&o.line_vertices, &o.line_colours}, std::pair{&o.triangle_vertices, &o.triangle_colours},
+                               std::pair{&o.points, &o.point_colours}}) {
+        positions.insert(positions.end(), p->begin(), p->end());
+        colours.insert(colours.end(), c->begin(), c->end());
+    }
+    std::vector<uint32_t> indices(positions.size());
+    for (size_t i = 0; i < indices.size(); ++i) indices[i] = static_cast<uint32_t>(i);
+
+    gl.GenVertexArrays(1, &r.overlay_array);
+    gl.BindVertexArray(r.overlay_array);
+    gl.BindBuffer(GL_ARRAY_BUFFER, r.buffers[7]);
+    gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(positions.size() * sizeof(Eigen::Vector3f)), positions.data(),
+                  GL_STATIC_DRAW);
+    gl.EnableVertexAttribArray(0);
+    gl.VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+    gl.BindBuffer(GL_ARRAY_BUFFER, r.buffers[8]);
+    gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(colours.size() * sizeof(std::array<float, 3>)), colours.data(),
+                  GL_STATIC_DRAW);
+    gl.EnableVertexAttribArray(1);
+    gl.VertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+    gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, r.buffers[9]);
+    gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(uint32_t)), indices.data(),
+                  GL_STATIC_DRAW);
+
+    gl.UseProgram(program);
+    const Eigen::Matrix4f view_projection = to_float(frame.projection * frame.view);
+    gl.UniformMatrix4fv(gl.GetUniformLocation(program, "view_projection"), 1, GL_FALSE, view_projection.data());
+    gl.Uniform1f(gl.GetUniformLocation(program, "point_size"), o.point_size);
+    const GLint pull = gl.GetUniformLocation(program, "depth_pull");
+    gl.Enable(GL_DEPTH_TEST);
+    gl.DepthFunc(GL_LEQUAL);
+    gl.Enable(GL_PROGRAM_POINT_SIZE);
+    auto draw = [&](GLenum mode, size_t first, size_t count, float depth_pull) {
+        if (count == 0) return;
+        gl.Uniform1f(pull, depth_pull);
+        gl.DrawElements(mode, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
+                        reinterpret_cast<const void*>(static_cast<uintptr_t>(first * sizeof(uint32_t))));
+    };
+    // Lines and points on the surface would fight its depth: pull them a little towards the eye.
+    // Triangles (slice polygons) lie where the clipped surface ends and need no pull.
+    const size_t lines = o.line_vertices.size(), triangles = o.triangle_vertices.size();
+    draw(GL_TRIANGLES, lines, triangles, 0.0f);
+    draw(GL_LINES, 0, lines, 2e-4f);
+    draw(GL_POINTS, lines + triangles, o.points.size(), 4e-4f);
+    gl.Disable(GL_PROGRAM_POINT_SIZE);
+    gl.DepthFunc(GL_LESS);
+    gl.UseProgram(0);
+}
+
+}  // namespace
 
 struct SurfaceRenderer::Frame : FrameResources {
     using FrameResources::FrameResources;
@@ -377,7 +524,7 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         std::vector<float> eta = input.eta.empty() ? std::vector<float>(n, input.uniform_eta) : input.eta;
         gl.GenVertexArrays(1, &r.vertex_array);
         gl.BindVertexArray(r.vertex_array);
-        gl.GenBuffers(5, r.buffers);
+        gl.GenBuffers(FrameResources::kBuffers, r.buffers);
         auto attribute = [&](GLuint index, GLuint buffer, const void* data, size_t bytes, GLint components) {
             gl.BindBuffer(GL_ARRAY_BUFFER, buffer);
             gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(bytes), data, GL_STATIC_DRAW);
@@ -388,8 +535,35 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float) && sizeof(std::array<float, 3>) == 3 * sizeof(float));
         attribute(0, r.buffers[0], input.positions.data(), n * sizeof(Eigen::Vector3f), 3);
         attribute(1, r.buffers[1], input.normals.data(), n * sizeof(Eigen::Vector3f), 3);
-        attribute(2, r.buffers[2], input.radiance_factor.data(), n * sizeof(std::array<float, 3>), 3);
+        // The colour modes pass their per-vertex colours where the radiance factors go.
+        const auto& factors = input.shading == SurfaceShading::VertexColour ? input.colours : input.radiance_factor;
+        attribute(2, r.buffers[2], factors.data(), n * sizeof(std::array<float, 3>), 3);
         attribute(3, r.buffers[3], eta.data(), n * sizeof(float), 1);
+        // Visibility as two vec4 attributes of eight lights each (1 where not given).
+        const size_t light_count_in = input.lighting.lights.size();
+        std::vector<float> visibility(8 * n, 1.0f);
+        if (!input.light_visibility.empty())
+            for (size_t v = 0; v < n; ++v)
+                for (size_t l = 0; l < light_count_in; ++l) visibility[8 * v + l] = input.light_visibility[v * light_count_in + l];
+        gl.BindBuffer(GL_ARRAY_BUFFER, r.buffers[5]);
+        gl.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(visibility.size() * sizeof(float)), visibility.data(),
+                      GL_STATIC_DRAW);
+        for (GLuint k = 0; k < 2; ++k) {
+            gl.EnableVertexAttribArray(4 + k);
+            gl.VertexAttribPointer(4 + k, 4, GL_FLOAT, GL_FALSE, 8 * sizeof(float),
+                                   reinterpret_cast<const void*>(static_cast<uintptr_t>(4 * k * sizeof(float))));
+        }
+        // Per-triangle colours as a storage buffer read with gl_PrimitiveID (one entry when unused:
+        // the binding must exist).
+        std::vector<float> triangle_colours(3, 0.0f);
+        if (input.shading == SurfaceShading::TriangleColour && !input.colours.empty()) {
+            triangle_colours.resize(3 * input.colours.size());
+            std::memcpy(triangle_colours.data(), input.colours.data(), triangle_colours.size() * sizeof(float));
+        }
+        gl.BindBuffer(GL_SHADER_STORAGE_BUFFER, r.buffers[6]);
+        gl.BufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(triangle_colours.size() * sizeof(float)),
+                      triangle_colours.data(), GL_STATIC_DRAW);
+        gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r.buffers[6]);
         gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, r.buffers[4]);
         gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(input.triangles.size() * sizeof(input.triangles[0])),
                       input.triangles.data(), GL_STATIC_DRAW);
@@ -407,6 +581,10 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.Uniform1f(location("specular_scale"), input.specular_scale);
         gl.Uniform1f(location("exposure"), input.exposure);
         gl.Uniform1i(location("tone_map"), static_cast<int>(input.tone_map));
+        gl.Uniform1i(location("shading"), static_cast<int>(input.shading));
+        gl.Uniform1i(location("clip_enabled"), input.clip_plane ? 1 : 0);
+        const Eigen::Vector4f plane = input.clip_plane.value_or(Eigen::Vector4f::Zero());
+        gl.Uniform4fv(location("clip_plane"), 1, plane.data());
         const auto light_count = static_cast<int>(input.lighting.lights.size());
         gl.Uniform1i(location("light_count"), light_count);
         for (int i = 0; i < light_count; ++i) {
@@ -430,7 +608,9 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * input.triangles.size()), GL_UNSIGNED_INT, nullptr);
         gl.UseProgram(0);
         gl.BindTexture(GL_TEXTURE_2D, 0);
+        gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
     }
+    if (!input.overlay.empty()) draw_overlay(gl, overlay_program_, input.overlay, frame, r);
 
     // Resolve the samples.
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[0]);

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace waxwork {
@@ -54,6 +55,28 @@ double bounding_radius(const Eigen::AlignedBox3d& box);
 
 enum class ToneMap { Aces, Reinhard, Clamp };
 
+// What colours the surface (the optional views of editor/view_modes.h use the colour modes).
+enum class SurfaceShading {
+    Radiance,        // F_t E plus the highlights, exposed and tone-mapped (the physical image)
+    VertexColour,    // `colours` per vertex, interpolated
+    TriangleColour,  // `colours` per triangle (flat)
+};
+
+// Unlit geometry drawn after the surface into the same depth buffer (so the surface hides what lies
+// behind it): tet edges, slice polygons, marker points. Colours are linear rgb in [0, 1], shown as
+// they are (no exposure, no tone mapping); lines and points are pulled slightly towards the camera
+// so that edges lying on the surface are not lost to depth fighting.
+struct RenderOverlay {
+    std::vector<Eigen::Vector3f> line_vertices;          // two per segment
+    std::vector<std::array<float, 3>> line_colours;      // per line vertex
+    std::vector<Eigen::Vector3f> triangle_vertices;      // three per triangle
+    std::vector<std::array<float, 3>> triangle_colours;  // per triangle vertex
+    std::vector<Eigen::Vector3f> points;
+    std::vector<std::array<float, 3>> point_colours;     // per point
+    float point_size = 4.0f;                             // pixels
+    bool empty() const { return line_vertices.empty() && triangle_vertices.empty() && points.empty(); }
+};
+
 struct SurfaceRenderInput {
     std::vector<Eigen::Vector3f> positions;            // world space
     std::vector<std::array<int32_t, 3>> triangles;     // counter-clockwise seen from outside
@@ -71,6 +94,17 @@ struct SurfaceRenderInput {
     float exposure = 1.0f;
     ToneMap tone_map = ToneMap::Aces;
     std::array<uint8_t, 3> background = {38, 40, 46}; // sRGB
+    // Per vertex and light (lighting.lights.size() per vertex, vertex-major), multiplies that light's
+    // highlight: the shadow rays' visibility (SolvedScene::light_visibility). Empty: all visible.
+    std::vector<float> light_visibility;
+    SurfaceShading shading = SurfaceShading::Radiance;
+    // Linear rgb in [0, 1]: per vertex (VertexColour) or per triangle (TriangleColour), lit by a
+    // headlight so the shape stays readable; unused for Radiance.
+    std::vector<std::array<float, 3>> colours;
+    RenderOverlay overlay;
+    // (n, d): surface fragments at points p with n.p + d < 0 are not drawn (the slice view's cut-away
+    // half). The overlay is never clipped.
+    std::optional<Eigen::Vector4f> clip_plane;
 };
 
 inline constexpr int kMaxRenderLights = 8;
@@ -101,6 +135,7 @@ private:
 
     const GlApi& gl_;
     GLuint program_ = 0;
+    GLuint overlay_program_ = 0;
     GLuint transmittance_lut_ = 0;
 };
 

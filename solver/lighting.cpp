@@ -161,13 +161,16 @@ std::vector<double> shadow_ray_offsets(const BoundarySurface& surface, const Lig
 }
 
 // q at surface vertex s.
+// `visibility`, when not null, receives V_il for each light (lights.size() entries).
 Rgb incident_light_at(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
-                      double offset, size_t s) {
+                      double offset, size_t s, float* visibility = nullptr) {
     Rgb sum = lighting.ambient;
     const Eigen::Vector3d& p = surface.positions[s];
     const Eigen::Vector3d& normal = surface.normals[s];
     const Eigen::Vector3f origin = (p + offset * normal).cast<float>();
-    for (const Light& light : lighting.lights) {
+    for (size_t l = 0; l < lighting.lights.size(); ++l) {
+        const Light& light = lighting.lights[l];
+        if (visibility) visibility[l] = 1.0f;
         Eigen::Vector3d to_light;
         double scale = 1.0;
         double distance = std::numeric_limits<double>::infinity();
@@ -187,7 +190,10 @@ Rgb incident_light_at(const BoundarySurface& surface, const TriangleBvh& bvh, co
             // does not shadow itself.
             const float t_max = std::isinf(distance) ? std::numeric_limits<float>::infinity()
                                                      : static_cast<float>(distance * (1.0 - 1e-6));
-            if (bvh.occluded(origin, to_light.cast<float>(), 0.0f, t_max)) continue;
+            if (bvh.occluded(origin, to_light.cast<float>(), 0.0f, t_max)) {
+                if (visibility) visibility[l] = 0.0f;
+                continue;
+            }
         }
         const double factor = scale * cos_theta * fresnel_transmittance(cos_theta, surface.eta[s]);
         for (int c = 0; c < 3; ++c) sum[c] += light.intensity[c] * factor;
@@ -197,13 +203,19 @@ Rgb incident_light_at(const BoundarySurface& surface, const TriangleBvh& bvh, co
 
 }  // namespace
 
-std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting) {
+std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
+                                std::vector<float>* visibility) {
     check_lighting_inputs(surface, bvh, lighting);
     const size_t n = surface.positions.size();
+    const size_t lights = lighting.lights.size();
     const std::vector<double> offset = shadow_ray_offsets(surface, lighting);
     std::vector<Rgb> q(n);
+    if (visibility) visibility->assign(n * lights, 1.0f);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t s = range.begin(); s != range.end(); ++s) q[s] = incident_light_at(surface, bvh, lighting, offset[s], s);
+        for (size_t s = range.begin(); s != range.end(); ++s) {
+            float* v = visibility ? visibility->data() + s * lights : nullptr;
+            q[s] = incident_light_at(surface, bvh, lighting, offset[s], s, v);
+        }
     });
     return q;
 }
@@ -227,10 +239,11 @@ void update_incident_light(const BoundarySurface& surface, const TriangleBvh& bv
                       });
 }
 
-std::vector<Rgb> incident_light(const BoundarySurface& surface, const Lighting& lighting) {
+std::vector<Rgb> incident_light(const BoundarySurface& surface, const Lighting& lighting,
+                                std::vector<float>* visibility) {
     validate(lighting);
     const TriangleBvh bvh = lighting.shadows ? build_shadow_bvh(surface) : TriangleBvh();
-    return incident_light(surface, bvh, lighting);
+    return incident_light(surface, bvh, lighting, visibility);
 }
 
 std::vector<Rgb> incident_light(const TetMesh& mesh, const TetConnectivity& connectivity,

@@ -82,13 +82,20 @@ TriangleBvh build_shadow_bvh(const BoundarySurface& surface);
 
 // q per surface vertex and channel. `bvh` must have been built from `surface` (only used with
 // lighting.shadows). Parallel over vertices (TBB).
-std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting);
+// `visibility`, when given, receives V_il from the shadow rays already cast for q, vertex-major
+// (visibility[s * lights + l]): 0 where light l is occluded at surface vertex s, else 1 (also where the
+// vertex faces away from the light, which the renderer's n.l test handles, so that interpolation
+// across a triangle does not darken the terminator). The renderer multiplies each light's specular
+// highlight by it, so highlights vanish in shadow as the diffuse light q does.
+std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
+                                std::vector<float>* visibility = nullptr);
 // Recomputes q (per surface vertex, as above) at `surface_vertices` only, e.g. after their eta
 // changed (painting): equal to the full computation at those vertices, other entries untouched.
 void update_incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
                            std::span<const int32_t> surface_vertices, std::vector<Rgb>& q);
 // Same, building the BVH when lighting.shadows is set.
-std::vector<Rgb> incident_light(const BoundarySurface& surface, const Lighting& lighting);
+std::vector<Rgb> incident_light(const BoundarySurface& surface, const Lighting& lighting,
+                                std::vector<float>* visibility = nullptr);
 
 // q per volume vertex (zero at interior vertices): the form solve_diffusion takes.
 std::vector<Rgb> incident_light(const TetMesh& mesh, const TetConnectivity& connectivity,
