@@ -29,6 +29,9 @@ struct EditCommandOptions {
     std::vector<std::string> lights;
     double scale = 1.0;
     std::vector<double> view;
+    std::string show = "radiance";
+    std::string slice_normal;
+    double slice_offset = 0;
 };
 
 void run_edit_command(const EditCommandOptions& o) {
@@ -38,6 +41,10 @@ void run_edit_command(const EditCommandOptions& o) {
     if (!std::isfinite(o.scale) || o.scale < 1e-6 || o.scale > 1e6)
         throw InvalidArgumentError("--scale must be a length in mm per model unit between 1e-6 and 1e6");
     EditorOptions options;
+    options.view.mode = parse_view_mode(o.show);
+    if (!o.slice_normal.empty()) options.view.slice_normal = parse_slice_normal(o.slice_normal);
+    options.view.slice_offset = o.slice_offset;
+    validate(options.view);
     options.file = o.file;
     options.session = o.session;
     options.screenshot = o.screenshot;
@@ -94,6 +101,12 @@ void add_edit_command(CLI::App& app) {
     cmd->add_option("--view", options->view, "Direction from the object towards the camera, X,Y,Z")
         ->delimiter(',')
         ->expected(3);
+    cmd->add_option("--show", options->show,
+                    "What the view shows, as for render: radiance, materials, quality, wireframe, slice, levels")
+        ->capture_default_str();
+    cmd->add_option("--slice-normal", options->slice_normal, "--show slice: X,Y,Z, pointing at the half cut away");
+    cmd->add_option("--slice-offset", options->slice_offset, "--show slice: offset in [-1, 1] half extents")
+        ->capture_default_str();
     cmd->footer(
         "Mouse: right drag (or Alt+left) orbits, middle drag (or Shift+right) pans, the wheel zooms.\n"
         "With --hide-ui the first frame shows exactly what `waxwork render` writes for the same volume,\n"

@@ -315,7 +315,7 @@ void EditorApp::request_solve() {
 
 bool EditorApp::idle() const {
     if (load_task_.busy() || tick_task_.busy() || !pending_jobs_.empty() || lighting_dirty_) return false;
-    return !scene_->core || (scene_->converged && scene_->render_input && scene_->exposure_locked);
+    return !scene_->core || (scene_->converged && scene_->render_input && scene_->exposure_locked && !view_dirty_);
 }
 
 void EditorApp::start_tick() {
@@ -340,6 +340,10 @@ void EditorApp::start_tick() {
     }
     const std::string label = jobs->empty() ? "solve" : jobs->front().first;
     Scene* target = scene_.get();
+    const ViewOptions view = view_options_;
+    const bool view_changed = view_dirty_;
+    view_dirty_ = false;
+    std::shared_ptr<ViewWorkerState> view_worker = view_worker_;
 
     struct Result {
         std::vector<std::string> messages, errors;
@@ -355,8 +359,10 @@ void EditorApp::start_tick() {
         size_t history = 0, tets = 0, vertices = 0;
         double min_dihedral = 0;
         double ms = 0;
+        std::shared_ptr<const ViewGeometry> view;
     };
-    tick_task_.start(label, [this, target, core, jobs, lighting, budget, first, need_bvh, settings](TaskProgress& progress) {
+    tick_task_.start(label, [this, target, core, jobs, lighting, budget, first, need_bvh, settings, view, view_changed,
+                             view_worker](TaskProgress& progress) {
         const auto start = std::chrono::steady_clock::now();
         auto r = std::make_shared<Result>();
         for (auto& [name, job] : *jobs) {
@@ -374,10 +380,18 @@ void EditorApp::start_tick() {
         r->converged = core->live->converged();
         r->error = core->live->estimated_error();
         const TetMesh& mesh = core->document->mesh();
-        if (first || r->geometry_changed || lighting || r->frame.total_iterations() > 0) {
+        if (first || r->geometry_changed) ++view_worker->geometry_version;
+        if (lighting || r->frame.total_iterations() > 0) ++view_worker->solution_version;
+        if (first || r->geometry_changed || lighting || r->frame.total_iterations() > 0 || view_changed) {
             progress.set_stage("radiance");
             const SolvedScene solved = core->live->solved_scene();
             r->input = make_render_input(mesh, solved, core->live->lighting(), settings);
+            if (view.mode != ViewMode::Radiance) {
+                progress.set_stage("view");
+                r->view = view_worker->cache.get(mesh, core->live->connectivity(), mesh.materials, solved, view,
+                                                 view_worker->geometry_version, view_worker->solution_version);
+                apply_view(*r->view, *r->input);
+            }
             if (need_bvh || r->geometry_changed) {
                 r->bvh = std::make_shared<const TriangleBvh>(r->input->positions, r->input->triangles);
                 // Each surface vertex's piece, for picking pieces to move.
@@ -405,6 +419,7 @@ void EditorApp::start_tick() {
             if (r->input) {
                 if (!s.exposure_locked) s.automatic_exposure = r->input->exposure;
                 s.render_input = std::move(r->input);
+                view_geometry_ = r->view;
                 ++scene_version_;
             }
             if (r->bvh) {
@@ -446,7 +461,7 @@ void EditorApp::poll_tasks() {
     }
     // Keep one tick running while there is anything to do.
     if (scene_->core && !tick_task_.busy() && !load_task_.busy() &&
-        (!pending_jobs_.empty() || lighting_dirty_ || !scene_->converged || !scene_->render_input))
+        (!pending_jobs_.empty() || lighting_dirty_ || !scene_->converged || !scene_->render_input || view_dirty_))
         start_tick();
 }
 

@@ -20,6 +20,7 @@
 #include "editor/session.h"
 #include "editor/surface_renderer.h"
 #include "editor/view_cache.h"
+#include "editor/view_modes.h"
 #include "solver/ray_caster.h"
 
 #include <deque>
@@ -49,6 +50,7 @@ struct EditorOptions {
     std::vector<Light> lights;           // empty: default_key_light
     double scale = 1.0;                  // millimetres per model unit
     CameraSettings camera;               // the first view (as `waxwork render --view`)
+    ViewOptions view;                    // what the 3D view shows (as `waxwork render --show`)
 };
 
 // Opens the window and runs until it is closed (or, with a screenshot, until it is saved). Throws
@@ -159,6 +161,7 @@ private:
     void draw_light_panel();
     void draw_solver_panel();
     void draw_view_panel();
+    void draw_view_mode_panel();  // view_mode_panel.cpp: the optional views and their legend
     void draw_status_bar();
     void draw_overlays();
     void apply_theme(float scale);
@@ -243,6 +246,16 @@ private:
     std::string error_message_;
     bool show_error_popup_ = false;
     double last_render_ms_ = 0;
+
+    // The optional views (view_modes.h): the UI's choice, and the worker's cache of the geometry.
+    struct ViewWorkerState {
+        ViewGeometryCache cache;
+        long long geometry_version = 0, solution_version = 0;
+    };
+    ViewOptions view_options_ = options_.view;
+    bool view_dirty_ = false;  // the choice changed: the next tick rebuilds the image input
+    std::shared_ptr<ViewWorkerState> view_worker_ = std::make_shared<ViewWorkerState>();
+    std::shared_ptr<const ViewGeometry> view_geometry_;  // of the installed image input (the legend)
 };
 
 }  // namespace waxwork

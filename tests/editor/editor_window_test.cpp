@@ -86,6 +86,41 @@ TEST_F(EditorWindow, ViewWithoutPanelsEqualsWaxworkRender) {
     EXPECT_GT(mean_brightness(a, 0, 0, a.width, a.height), mean_brightness(a, 0, 0, 20, 20) + 5);  // not empty
 }
 
+TEST_F(EditorWindow, EveryOptionalViewEqualsWaxworkRenderShow) {
+    // The optional views (view_modes.h) are built by the same functions in both commands; the editor
+    // builds them on its worker from the live scene. Same tolerance argument as above (the slice's
+    // colours follow phi on a log scale, which moves them less than the radiance).
+    const fs::path dir = scratch_dir("editor_views_equal_render");
+    const fs::path volume = dir / "torus.vtu";
+    ASSERT_EQ(run_waxwork("mesh " + kAssets + "/meshes/torus.obj -o " + volume.string() + " --max-tets 12000").exit_code, 0);
+    for (const std::string show : {"materials", "quality", "wireframe", "slice --slice-normal 1,0,0.3 --slice-offset 0.2",
+                                   "levels"}) {
+        const std::string name = show.substr(0, show.find(' '));
+        const fs::path rendered = dir / (name + "_render.png"), edited = dir / (name + "_edit.png");
+        const std::string scene = volume.string() + " --width 320 --height 240 --view 0.3,0.8,0.6 --show " + show;
+        const auto render = run_waxwork("render " + scene + " -o " + rendered.string());
+        ASSERT_EQ(render.exit_code, 0) << render.err;
+        const auto edit = run_under_xvfb("edit " + scene + " --hide-ui --frames 2 --screenshot " + edited.string());
+        ASSERT_EQ(edit.exit_code, 0) << edit.err;
+        const Image a = read_png(rendered), b = read_png(edited);
+        ASSERT_EQ(a.width, b.width);
+        ASSERT_EQ(a.height, b.height);
+        int max_difference = 0;
+        for (size_t i = 0; i < a.rgba.size(); ++i) max_difference = std::max(max_difference, std::abs(a.rgba[i] - b.rgba[i]));
+        EXPECT_LE(max_difference, 2) << name;
+        EXPECT_GT(mean_brightness(a, 0, 0, a.width, a.height), mean_brightness(a, 0, 0, 20, 20) + 5) << name;
+    }
+}
+
+TEST(EditorWithoutDisplay, BadViewOptionsAreRefusedWithOneLine) {
+    for (const std::string bad : {"--show normals", "--show slice --slice-offset -3", "--show slice --slice-normal 1,2"}) {
+        const auto r = run_waxwork("edit " + kAssets + "/meshes/cube.obj --screenshot /dev/null " + bad);
+        EXPECT_NE(r.exit_code, 0) << bad;
+        EXPECT_EQ(testing::line_count(r.err), 1u) << bad << ": " << r.err;
+        EXPECT_NE(r.err.find("slice"), std::string::npos) << r.err;  // names the option's domain
+    }
+}
+
 TEST_F(EditorWindow, ReplayedSessionEqualsWaxworkRun) {
     // The editor replays a session's edits through Document and LiveScene on its worker; its converged
     // view must show what the headless `waxwork run` renders for the same session.
