@@ -474,7 +474,7 @@ void draw_overlay(const GlApi& gl, GLuint program, const RenderOverlay& o, const
     const size_t lines = o.line_vertices.size(), triangles = o.triangle_vertices.size();
     draw(GL_TRIANGLES, lines, triangles, 0.0f);
     draw(GL_LINES, 0, lines, 2e-4f);
-    draw(GL_POINTS, lines + triangles, o.points.size(), 4e-4f);
+    draw(GL_POINTS, lines + triangles, o.points.size(), 2e-3f);
     gl.Disable(GL_PROGRAM_POINT_SIZE);
     gl.DepthFunc(GL_LESS);
     gl.UseProgram(0);

@@ -315,7 +315,7 @@ ViewGeometry levels_view(const BoundarySurface& surface, const std::vector<int32
         view.overlay.points.push_back(surface.positions[s].cast<float>());
         view.overlay.point_colours.push_back(palette[static_cast<size_t>(level - 1) % palette.size()]);
     }
-    view.overlay.point_size = 4.0f;
+    view.overlay.point_size = 5.0f;
     for (int32_t l = 1; l <= deepest; ++l)
         view.legend.swatches.emplace_back("level " + std::to_string(l) + ": " + std::to_string(counts[l]) + " boundary vertices",
                                           palette[static_cast<size_t>(l - 1) % palette.size()]);
