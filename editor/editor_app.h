@@ -162,6 +162,7 @@ private:
     void draw_solver_panel();
     void draw_view_panel();
     void draw_view_mode_panel();  // view_mode_panel.cpp: the optional views and their legend
+    void draw_view_mode_menu();   // view_mode_panel.cpp: View > Show
     void draw_status_bar();
     void draw_overlays();
     void apply_theme(float scale);

@@ -143,6 +143,7 @@ void EditorApp::draw_menu_bar() {
     if (ImGui::BeginMenu("View")) {
         if (ImGui::MenuItem("Reset camera", "Home")) camera_.reset();
         if (ImGui::MenuItem("Hide panels", "Tab", options_.hide_ui)) options_.hide_ui = !options_.hide_ui;
+        draw_view_mode_menu();
         ImGui::EndMenu();
     }
     if (ImGui::BeginMenu("Help")) {

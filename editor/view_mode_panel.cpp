@@ -58,6 +58,17 @@ void draw_legend(const ViewLegend& legend) {
 
 }  // namespace
 
+void EditorApp::draw_view_mode_menu() {
+    if (!ImGui::BeginMenu("Show")) return;
+    for (ViewMode mode : all_view_modes()) {
+        if (ImGui::MenuItem(view_mode_name(mode), nullptr, view_options_.mode == mode) && view_options_.mode != mode) {
+            view_options_.mode = mode;
+            view_dirty_ = true;
+        }
+    }
+    ImGui::EndMenu();
+}
+
 void EditorApp::draw_view_mode_panel() {
     int current = 0;
     std::string items;

@@ -2,6 +2,7 @@
 // must say what it claims (hues where the materials are, red where a tet is bad, lines, a slice that
 // is brighter towards the light with the cut-away half gone, several hierarchy levels), and a
 // highlight must not shine where the surface is in shadow.
+#include "editor/live_scene.h"
 #include "editor/render_pipeline.h"
 #include "editor/surface_renderer.h"
 #include "editor/view_modes.h"
@@ -184,6 +185,24 @@ TEST(ShadowedHighlights, NoHighlightInTheShadowAndUnshadowedScenesUnchanged) {
     const Image shadowed_box = renderer.render(box_input);
     box_input.light_visibility.clear();
     EXPECT_EQ(renderer.render(box_input).rgba, shadowed_box.rgba);
+}
+
+TEST(ShadowedHighlights, LiveSceneCarriesTheVisibilityThroughRelighting) {
+    ShadowScene s;
+    s.mesh.materials = s.materials;
+    LiveScene live(s.mesh, s.lighting);
+    const auto expected = [&](const Lighting& lighting) {
+        return solve_scene(s.mesh, s.connectivity, s.materials, lighting, quick_solve()).light_visibility;
+    };
+    EXPECT_EQ(live.solved_scene().light_visibility, expected(s.lighting));
+    // A second light from straight above: the cube shadows the slab's centre for it as well.
+    Lighting two = s.lighting;
+    two.lights.push_back({LightType::Directional, Eigen::Vector3d(0, -1, 0), {1, 1, 1}});
+    live.set_lighting(two);
+    const std::vector<float> visibility = live.solved_scene().light_visibility;
+    EXPECT_EQ(visibility, expected(two));
+    EXPECT_EQ(visibility.size(), 2 * live.solved_scene().surface.positions.size());
+    EXPECT_NE(std::count(visibility.begin(), visibility.end(), 0.0f), 0);
 }
 
 // A box of two materials: ketchup (red) for x < 0, apple (yellow-green) for x > 0.

@@ -127,6 +127,44 @@ TEST(Lighting, PieceBetweenLightAndCubeCastsAShadow) {
     EXPECT_EQ(slab_top, 9);
 }
 
+TEST(Lighting, VisibilityOutputIsWhatTheShadowRaysFound) {
+    // The same scene with two lights: one from above (the slab shadows the cube's top), one from the
+    // side (+x travelling -x: nothing in its way for the cube's +x face).
+    TetMesh mesh = testing::make_box_mesh(4, {0, 0, 0}, {1, 1, 1});
+    const TetMesh slab = testing::make_box_mesh(2, {-0.5, -0.5, 0}, {1.5, 1.5, 0.3});
+    RigidTransform lift;
+    lift.translation = {0, 0, 2};
+    append_piece(mesh, slab, lift);
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    Lighting lighting;
+    lighting.lights.push_back({LightType::Directional, {0, 0, -1}, {1, 1, 1}});
+    lighting.lights.push_back({LightType::Directional, {-1, 0, 0}, {1, 1, 1}});
+    const BoundarySurface surface = extract_boundary_surface(mesh, connectivity, materials_with_eta(mesh, 1.3));
+    std::vector<float> visibility;
+    const std::vector<Rgb> q = incident_light(surface, lighting, &visibility);
+    ASSERT_EQ(visibility.size(), 2 * surface.positions.size());
+    EXPECT_EQ(q, incident_light(surface, lighting));  // asking for it changes nothing else
+    int shadowed_top = 0, lit_side = 0;
+    for (size_t s = 0; s < surface.positions.size(); ++s) {
+        const Eigen::Vector3d& p = surface.positions[s];
+        if (on_top_face_interior(p, 1.0)) {
+            ++shadowed_top;
+            EXPECT_EQ(visibility[2 * s], 0.0f) << p.transpose();
+        }
+        if (std::abs(p.x() - 1.0) < 1e-12 && p.z() > 1e-9 && p.z() < 1 - 1e-9 && p.y() > 1e-9 && p.y() < 1 - 1e-9) {
+            ++lit_side;
+            EXPECT_EQ(visibility[2 * s + 1], 1.0f) << p.transpose();
+        }
+        for (int l = 0; l < 2; ++l) EXPECT_TRUE(visibility[2 * s + l] == 0.0f || visibility[2 * s + l] == 1.0f);
+    }
+    EXPECT_GT(shadowed_top, 0);
+    EXPECT_GT(lit_side, 0);
+    // Without shadows nothing is occluded.
+    lighting.shadows = false;
+    incident_light(surface, lighting, &visibility);
+    for (float v : visibility) EXPECT_EQ(v, 1.0f);
+}
+
 TEST(Lighting, PointLightFallsOffWithInverseSquareDistance) {
     const TetMesh mesh = testing::make_box_mesh(4, {0, 0, 0}, {1, 1, 1});
     const TetConnectivity connectivity = build_connectivity(mesh);
