@@ -32,6 +32,7 @@ struct EditCommandOptions {
     std::string show = "radiance";
     std::string slice_normal;
     double slice_offset = 0;
+    bool quality_interior = false;
 };
 
 void run_edit_command(const EditCommandOptions& o) {
@@ -44,6 +45,7 @@ void run_edit_command(const EditCommandOptions& o) {
     options.view.mode = parse_view_mode(o.show);
     if (!o.slice_normal.empty()) options.view.slice_normal = parse_slice_normal(o.slice_normal);
     options.view.slice_offset = o.slice_offset;
+    options.view.quality_interior = o.quality_interior;
     validate(options.view);
     options.file = o.file;
     options.session = o.session;
@@ -107,6 +109,8 @@ void add_edit_command(CLI::App& app) {
     cmd->add_option("--slice-normal", options->slice_normal, "--show slice: X,Y,Z, pointing at the half cut away");
     cmd->add_option("--slice-offset", options->slice_offset, "--show slice: offset in [-1, 1] half extents")
         ->capture_default_str();
+    cmd->add_flag("--quality-interior", options->quality_interior,
+                  "--show quality: also cut at the slice plane and colour the cross-section's tets");
     cmd->footer(
         "Mouse: right drag (or Alt+left) orbits, middle drag (or Shift+right) pans, the wheel zooms.\n"
         "With --hide-ui the first frame shows exactly what `waxwork render` writes for the same volume,\n"

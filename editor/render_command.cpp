@@ -41,6 +41,7 @@ struct RenderCommandOptions {
     std::string show = "radiance";
     std::string slice_normal;
     double slice_offset = 0;
+    bool quality_interior = false;
 };
 
 // The view --show asks for, checked before any work.
@@ -49,6 +50,7 @@ ViewOptions view_options(const RenderCommandOptions& o) {
     view.mode = parse_view_mode(o.show);
     if (!o.slice_normal.empty()) view.slice_normal = parse_slice_normal(o.slice_normal);
     view.slice_offset = o.slice_offset;
+    view.quality_interior = o.quality_interior;
     validate(view);
     return view;
 }
@@ -200,6 +202,8 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--slice-offset", options->slice_offset,
                     "--show slice: the plane's offset from the centre, in [-1, 1] half extents along the normal")
         ->capture_default_str();
+    cmd->add_flag("--quality-interior", options->quality_interior,
+                  "--show quality: also cut at the slice plane and colour the cross-section's tets");
     cmd->footer(
         "Without --light a white key light shines from the upper front-left: dir:1,-1,-1 (y up, front +z).\n"
         "Without a material option the volume's stored per-tet materials are used, else marble.\n"

@@ -82,7 +82,10 @@ void EditorApp::draw_view_mode_panel() {
         view_options_.mode = modes[static_cast<size_t>(current)];
         view_dirty_ = true;
     }
-    if (view_options_.mode == ViewMode::Slice) {
+    if (view_options_.mode == ViewMode::Quality &&
+        ImGui::Checkbox("interior (cross-section)", &view_options_.quality_interior))
+        view_dirty_ = true;
+    if (view_options_.mode == ViewMode::Slice || (view_options_.mode == ViewMode::Quality && view_options_.quality_interior)) {
         float offset = static_cast<float>(view_options_.slice_offset);
         if (ImGui::SliderFloat("slice offset", &offset, -1.0f, 1.0f, "%.2f")) {
             view_options_.slice_offset = offset;

@@ -200,6 +200,82 @@ ViewGeometry wireframe_view(const TetMesh& mesh, const TetConnectivity& connecti
     return view;
 }
 
+namespace {
+
+// The slice plane of `options` for the volume's world-space box: n.p = c with n unit.
+struct Plane {
+    Eigen::Vector3d normal;
+    double offset = 0;
+};
+
+Plane slice_plane(const std::vector<Eigen::Vector3d>& world, const ViewOptions& options) {
+    Eigen::AlignedBox3d box;
+    for (const Eigen::Vector3d& p : world) box.extend(p);
+    Plane plane;
+    plane.normal = options.slice_normal.normalized();
+    // The box's half extent along n: the support function of the box minus its centre.
+    const double half_extent = 0.5 * (box.max() - box.min()).cwiseAbs().dot(plane.normal.cwiseAbs());
+    plane.offset = plane.normal.dot(box.center()) + options.slice_offset * half_extent;
+    return plane;
+}
+
+// Keep n.p - c <= 0; the renderer keeps plane.xyz . p + plane.w >= 0.
+Eigen::Vector4f clip_plane_of(const Plane& plane) {
+    return Eigen::Vector4f(static_cast<float>(-plane.normal.x()), static_cast<float>(-plane.normal.y()),
+                           static_cast<float>(-plane.normal.z()), static_cast<float>(plane.offset));
+}
+
+// The plane's intersection with the tets, as triangles: per corner its position, the weights of
+// its two tet vertices (value = (1 - t) f(a) + t f(b)) and the tet it lies in. A crossed tet gives a
+// triangle (one vertex on one side) or a quadrilateral (two on each side) split in two.
+struct Section {
+    std::vector<Eigen::Vector3f> points;
+    std::vector<std::array<int32_t, 2>> ends;
+    std::vector<double> t;
+    std::vector<int32_t> tets;
+};
+
+Section cross_section(const TetMesh& mesh, const std::vector<Eigen::Vector3d>& world, const Plane& plane) {
+    Section section;
+    const Eigen::Vector3d& n = plane.normal;
+    const double c = plane.offset;
+    for (size_t tet_index = 0; tet_index < mesh.tets.size(); ++tet_index) {
+        const Tet& tet = mesh.tets[tet_index];
+        std::array<double, 4> d;
+        int below = 0;
+        for (int k = 0; k < 4; ++k) {
+            d[k] = n.dot(world[tet[k]]) - c;
+            below += d[k] < 0;
+        }
+        if (below == 0 || below == 4) continue;
+        std::vector<std::pair<int, int>> edges;  // crossed edges, in polygon order
+        std::array<int, 4> lo{}, hi{};
+        int nl = 0, nh = 0;
+        for (int k = 0; k < 4; ++k) (d[k] < 0 ? lo[nl++] : hi[nh++]) = k;
+        if (nl == 1 || nh == 1) {
+            const int apex = nl == 1 ? lo[0] : hi[0];
+            const std::array<int, 4>& others = nl == 1 ? hi : lo;
+            edges = {{apex, others[0]}, {apex, others[1]}, {apex, others[2]}};
+        } else {
+            // Edges a-c, a-d, b-d, b-c: consecutive ones share a vertex, so they bound a convex
+            // quadrilateral, split into (0, 1, 2) and (0, 2, 3).
+            const std::array<std::pair<int, int>, 4> quad = {
+                {{lo[0], hi[0]}, {lo[0], hi[1]}, {lo[1], hi[1]}, {lo[1], hi[0]}}};
+            edges = {quad[0], quad[1], quad[2], quad[0], quad[2], quad[3]};
+        }
+        for (const auto& [a, b] : edges) {
+            const double t = d[a] / (d[a] - d[b]);
+            section.points.push_back((world[tet[a]] + t * (world[tet[b]] - world[tet[a]])).cast<float>());
+            section.ends.push_back({tet[a], tet[b]});
+            section.t.push_back(t);
+            section.tets.push_back(static_cast<int32_t>(tet_index));
+        }
+    }
+    return section;
+}
+
+}  // namespace
+
 ViewGeometry slice_view(const TetMesh& mesh, const std::vector<std::array<double, 3>>& phi, const ViewOptions& options) {
     validate(options);
     if (phi.size() != mesh.vertex_count())
@@ -208,66 +284,20 @@ ViewGeometry slice_view(const TetMesh& mesh, const std::vector<std::array<double
     ViewGeometry view;
     view.mode = ViewMode::Slice;
     const std::vector<Eigen::Vector3d> world = world_positions(mesh);
-    Eigen::AlignedBox3d box;
-    for (const Eigen::Vector3d& p : world) box.extend(p);
-    const Eigen::Vector3d n = options.slice_normal.normalized();
-    // The box's half extent along n: the support function of the box minus its centre.
-    const double half_extent = 0.5 * (box.max() - box.min()).cwiseAbs().dot(n.cwiseAbs());
-    const double c = n.dot(box.center()) + options.slice_offset * half_extent;
-    // Keep n.p - c <= 0; the renderer keeps plane.xyz . p + plane.w >= 0.
-    view.clip_plane = Eigen::Vector4f(static_cast<float>(-n.x()), static_cast<float>(-n.y()), static_cast<float>(-n.z()),
-                                      static_cast<float>(c));
-
-    // The plane's intersection with each crossed tet: a triangle (one vertex on one side) or a
-    // quadrilateral (two on each side), phi interpolated linearly along the crossed edges, as the
-    // solve's piecewise-linear fluence is.
-    std::vector<Eigen::Vector3f> points;
-    std::vector<double> values;
-    for (const Tet& tet : mesh.tets) {
-        std::array<double, 4> d;
-        int below = 0;
-        for (int k = 0; k < 4; ++k) {
-            d[k] = n.dot(world[tet[k]]) - c;
-            below += d[k] < 0;
-        }
-        if (below == 0 || below == 4) continue;
-        auto crossing = [&](int a, int b) {
-            const double t = d[a] / (d[a] - d[b]);
-            points.push_back((world[tet[a]] + t * (world[tet[b]] - world[tet[a]])).cast<float>());
-            values.push_back((1 - t) * luminance(phi[tet[a]]) + t * luminance(phi[tet[b]]));
-        };
-        std::array<int, 4> lo{}, hi{};
-        int nl = 0, nh = 0;
-        for (int k = 0; k < 4; ++k) (d[k] < 0 ? lo[nl++] : hi[nh++]) = k;
-        if (nl == 1 || nh == 1) {
-            const int apex = nl == 1 ? lo[0] : hi[0];
-            const std::array<int, 4>& others = nl == 1 ? hi : lo;
-            for (int k = 0; k < 3; ++k) crossing(apex, others[k]);
-        } else {
-            // Edges a-c, a-d, b-d, b-c: consecutive ones share a vertex, so they bound a convex quad.
-            const size_t first = points.size();
-            crossing(lo[0], hi[0]);
-            crossing(lo[0], hi[1]);
-            crossing(lo[1], hi[1]);
-            crossing(lo[1], hi[0]);
-            // Fan (0, 1, 2), (0, 2, 3): append the repeated corners.
-            const Eigen::Vector3f p0 = points[first], p2 = points[first + 2], p3 = points[first + 3];
-            const double v0 = values[first], v2 = values[first + 2], v3 = values[first + 3];
-            points.resize(first + 2);
-            values.resize(first + 2);
-            points.push_back(p2);
-            values.push_back(v2);
-            points.insert(points.end(), {p0, p2, p3});
-            values.insert(values.end(), {v0, v2, v3});
-        }
-    }
+    const Plane plane = slice_plane(world, options);
+    view.clip_plane = clip_plane_of(plane);
+    Section section = cross_section(mesh, world, plane);
+    // phi interpolated linearly along the crossed edges, as the solve's piecewise-linear fluence is.
+    std::vector<double> values(section.points.size());
+    for (size_t i = 0; i < values.size(); ++i)
+        values[i] = (1 - section.t[i]) * luminance(phi[section.ends[i][0]]) + section.t[i] * luminance(phi[section.ends[i][1]]);
     // Log scale over three decades below the brightest point of the slice.
     constexpr double kDecades = 3;
     double peak = 0;
     for (double v : values)
         if (std::isfinite(v)) peak = std::max(peak, v);
     const double low = peak > 0 ? peak * std::pow(10.0, -kDecades) : 0;
-    view.overlay.triangle_vertices = std::move(points);
+    view.overlay.triangle_vertices = std::move(section.points);
     view.overlay.triangle_colours.resize(values.size());
     for (size_t i = 0; i < values.size(); ++i) {
         const double t = low > 0 && values[i] > 0 ? std::log10(values[i] / low) / kDecades : 0.0;
@@ -279,6 +309,32 @@ ViewGeometry slice_view(const TetMesh& mesh, const std::vector<std::array<double
     view.legend.low = peak > 0 ? std::pow(10.0, -kDecades) : 0;
     view.legend.high = 1;
     for (int i = 0; i <= 8; ++i) view.legend.stops.push_back(fluence_colour(i / 8.0));
+    return view;
+}
+
+ViewGeometry interior_quality_view(const TetMesh& mesh, const BoundarySurface& surface, const ViewOptions& options) {
+    validate(options);
+    ViewGeometry view = quality_view(mesh, surface);
+    view.legend.title = "minimum dihedral angle of the tet (surface and slice)";
+    const std::vector<Eigen::Vector3d> world = world_positions(mesh);
+    const Plane plane = slice_plane(world, options);
+    view.clip_plane = clip_plane_of(plane);
+    Section section = cross_section(mesh, world, plane);
+    // One colour per crossed tet, flat over its polygon.
+    std::vector<Colour> tet_colour(mesh.tet_count());
+    std::vector<uint8_t> done(mesh.tet_count(), 0);
+    view.overlay.triangle_colours.resize(section.points.size());
+    for (size_t i = 0; i < section.points.size(); ++i) {
+        const auto t = static_cast<size_t>(section.tets[i]);
+        if (!done[t]) {
+            const Tet& tet = mesh.tets[t];
+            tet_colour[t] = quality_colour(min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]],
+                                                                  mesh.positions[tet[2]], mesh.positions[tet[3]]));
+            done[t] = 1;
+        }
+        view.overlay.triangle_colours[i] = tet_colour[t];
+    }
+    view.overlay.triangle_vertices = std::move(section.points);
     return view;
 }
 
@@ -329,7 +385,9 @@ ViewGeometry build_view_geometry(const TetMesh& mesh, const TetConnectivity& con
     switch (options.mode) {
         case ViewMode::Radiance: return ViewGeometry{};
         case ViewMode::Materials: return materials_view(scene.surface, materials);
-        case ViewMode::Quality: return quality_view(mesh, scene.surface);
+        case ViewMode::Quality:
+            return options.quality_interior ? interior_quality_view(mesh, scene.surface, options)
+                                            : quality_view(mesh, scene.surface);
         case ViewMode::Wireframe: return wireframe_view(mesh, connectivity);
         case ViewMode::Slice: return slice_view(mesh, scene.diffusion.phi, options);
         case ViewMode::Levels: return levels_view(scene.surface, hierarchy_vertex_levels(mesh, connectivity, materials));
@@ -354,7 +412,8 @@ std::shared_ptr<const ViewGeometry> ViewGeometryCache::get(const TetMesh& mesh, 
                                                            long long geometry_version, long long solution_version) {
     const bool same_options = options_ && options_->mode == options.mode &&
                               options_->slice_normal == options.slice_normal &&
-                              options_->slice_offset == options.slice_offset;
+                              options_->slice_offset == options.slice_offset &&
+                              options_->quality_interior == options.quality_interior;
     const bool stale = !view_ || !same_options || geometry_version != geometry_version_ ||
                        (options.mode == ViewMode::Slice && solution_version != solution_version_);
     if (!stale) return view_;

@@ -8,7 +8,8 @@
 //   radiance    the physical image: F_t E plus shadowed Cook-Torrance highlights, tone-mapped
 //   materials   each surface triangle in the colour of its tet's material (its single-scattering
 //               albedo mu_s' / (mu_s' + mu_a) per channel, brightened to a hue)
-//   quality     each surface triangle coloured by its tet's minimum dihedral angle (red: sliver)
+//   quality     each surface triangle coloured by its tet's minimum dihedral angle (red: sliver);
+//               optionally also the slice plane's cross-section of the interior tets
 //   wireframe   the radiance image with every tet edge drawn over it (edges behind the surface hidden)
 //   slice       a plane through the volume: the plane's intersection with the tets coloured by the
 //               interpolated fluence phi (log scale), the surface on the normal's side cut away
@@ -49,6 +50,9 @@ struct ViewOptions {
     // (so -1 and 1 touch the box, 0 halves it).
     Eigen::Vector3d slice_normal = Eigen::Vector3d(0, 0, 1);
     double slice_offset = 0;
+    // Quality: also cut the volume with the slice plane and colour the cross-section by the quality
+    // of the tets it crosses (slivers inside the volume, not only at its surface).
+    bool quality_interior = false;
 };
 
 // Throws InvalidArgumentError for a zero or non-finite normal or an offset outside [-1, 1].
@@ -89,6 +93,9 @@ std::array<float, 3> material_colour(const TetMaterial& material);
 // with make_render_input's vertices and triangles.
 ViewGeometry materials_view(const BoundarySurface& surface, const std::vector<TetMaterial>& materials);
 ViewGeometry quality_view(const TetMesh& mesh, const BoundarySurface& surface);
+// quality_view plus the slice plane's cross-section coloured per tet, the surface clipped as for the
+// slice view.
+ViewGeometry interior_quality_view(const TetMesh& mesh, const BoundarySurface& surface, const ViewOptions& options);
 ViewGeometry wireframe_view(const TetMesh& mesh, const TetConnectivity& connectivity);
 // phi: per volume vertex (SolvedScene::diffusion.phi).
 ViewGeometry slice_view(const TetMesh& mesh, const std::vector<std::array<double, 3>>& phi, const ViewOptions& options);

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -93,9 +94,10 @@ TEST_F(EditorWindow, EveryOptionalViewEqualsWaxworkRenderShow) {
     const fs::path dir = scratch_dir("editor_views_equal_render");
     const fs::path volume = dir / "torus.vtu";
     ASSERT_EQ(run_waxwork("mesh " + kAssets + "/meshes/torus.obj -o " + volume.string() + " --max-tets 12000").exit_code, 0);
-    for (const std::string show : {"materials", "quality", "wireframe", "slice --slice-normal 1,0,0.3 --slice-offset 0.2",
-                                   "levels"}) {
-        const std::string name = show.substr(0, show.find(' '));
+    for (const std::string show : {"materials", "quality", "quality --quality-interior --slice-normal 0,1,0", "wireframe",
+                                   "slice --slice-normal 1,0,0.3 --slice-offset 0.2", "levels"}) {
+        std::string name = show;
+        for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
         const fs::path rendered = dir / (name + "_render.png"), edited = dir / (name + "_edit.png");
         const std::string scene = volume.string() + " --width 320 --height 240 --view 0.3,0.8,0.6 --show " + show;
         const auto render = run_waxwork("render " + scene + " -o " + rendered.string());

@@ -12,6 +12,8 @@
 #include "tetops/box_mesh.h"
 #include "tetops/connectivity.h"
 #include "tetops/error.h"
+#include "tetops/quality.h"
+#include "tetops/sliver_maker.h"
 
 #include <gtest/gtest.h>
 
@@ -299,6 +301,53 @@ TEST(ViewModes, QualityViewColoursABadTetRed) {
         }
     EXPECT_GT(red, 50u);
     EXPECT_GT(green, 50u);
+}
+
+TEST(ViewModes, InteriorQualityColoursTheCrossSectionsSliversRed) {
+    TetMesh mesh = make_box_mesh({6, 6, 6}, {-1, -1, -1}, {1, 1, 1});
+    const std::vector<int32_t> slivers = flatten_into_slivers(mesh, build_connectivity(mesh), 3, 0.02);
+    ASSERT_FALSE(slivers.empty());
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    const std::vector<TetMaterial> materials(mesh.tet_count(), material_preset("marble"));
+    const SolvedScene scene = solve_scene(mesh, connectivity, materials, key_light(), quick_solve());
+    // The plane z = the first sliver's centroid, so the section crosses it.
+    const Tet& bad = mesh.tets[static_cast<size_t>(slivers.front())];
+    const double z = 0.25 * (mesh.positions[bad[0]] + mesh.positions[bad[1]] + mesh.positions[bad[2]] + mesh.positions[bad[3]]).z();
+    ViewOptions options;
+    options.mode = ViewMode::Quality;
+    options.quality_interior = true;
+    options.slice_offset = z;  // the box's half extent along z is 1
+    const ViewGeometry view = build_view_geometry(mesh, connectivity, materials, scene, options);
+    ASSERT_TRUE(view.clip_plane);
+    ASSERT_FALSE(view.overlay.triangle_vertices.empty());
+    size_t red = 0;
+    for (size_t i = 0; i < view.overlay.triangle_colours.size(); ++i) {
+        EXPECT_NEAR(view.overlay.triangle_vertices[i].z(), z, 1e-5);
+        red += view.overlay.triangle_colours[i] == quality_colour(0.0);
+    }
+    EXPECT_GT(red, 0u);
+    // Only bad tets are red: every red corner lies in (the box of) a tet of at most 5 degrees, and the
+    // box mesh had none before the flattening (its Kuhn tets have 45-90 degrees).
+    EXPECT_GT(mesh_min_dihedral_deg(make_box_mesh({6, 6, 6}, {-1, -1, -1}, {1, 1, 1})), kQualityRedDeg);
+    const std::vector<double> angles = min_dihedral_angles_deg(mesh);
+    std::vector<Eigen::AlignedBox3d> bad_boxes;
+    for (size_t t = 0; t < mesh.tet_count(); ++t) {
+        if (angles[t] > kQualityRedDeg) continue;
+        Eigen::AlignedBox3d box;
+        for (const int32_t v : mesh.tets[t]) box.extend(mesh.positions[v]);
+        bad_boxes.emplace_back(box.min() - Eigen::Vector3d::Constant(1e-6), box.max() + Eigen::Vector3d::Constant(1e-6));
+    }
+    for (size_t i = 0; i < view.overlay.triangle_colours.size(); ++i) {
+        if (view.overlay.triangle_colours[i] != quality_colour(0.0)) continue;
+        const Eigen::Vector3d p = view.overlay.triangle_vertices[i].cast<double>();
+        EXPECT_TRUE(std::any_of(bad_boxes.begin(), bad_boxes.end(), [&](const auto& box) { return box.contains(p); }))
+            << p.transpose();
+    }
+    // Without the option the quality view is the surface alone.
+    options.quality_interior = false;
+    const ViewGeometry surface_only = build_view_geometry(mesh, connectivity, materials, scene, options);
+    EXPECT_FALSE(surface_only.clip_plane);
+    EXPECT_TRUE(surface_only.overlay.empty());
 }
 
 TEST(ViewModes, WireframeDrawsEveryTetEdgeOverTheRadiance) {
