@@ -7,6 +7,7 @@
 #include "io/volume_file.h"
 #include "solver/material.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -242,6 +243,39 @@ TEST_F(EditorWindow, PieceDragAfterFractureMovesThatPiece) {
         EXPECT_NEAR(shift.z(), 0, 1e-6);
     }
     EXPECT_EQ(moved_pieces, 1);
+}
+
+TEST_F(EditorWindow, LightDragZoomAndPanAreWhatASavedSessionRecords) {
+    const fs::path dir = scratch_dir("editor_light_view");
+    // The default key light turned by a trackball drag 60 px right of the centre, then two wheel
+    // steps in and a 30 px pan to the right; the session saved afterwards holds that light and view.
+    const auto r = run_script(dir, R"([
+        {"event": "tool", "tool": "light"},
+        {"frame": 2, "event": "drag", "from": [200, 150], "to": [260, 150], "steps": 6},
+        {"event": "scroll", "x": 200, "y": 150, "dy": 2},
+        {"event": "drag", "from": [200, 150], "to": [230, 150], "steps": 3, "button": "middle"},
+        {"event": "idle"},
+        {"event": "save_session", "file": "view.json"},
+        {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json session = nlohmann::json::parse(testing::read_text(dir / "view.json"));
+    // Trackball: the sphere point under the centre, +z, goes to the one under (260, 150): a turn of
+    // asin(60 / 150) about +y (the sphere's radius is half the view's height).
+    const double angle = std::asin(60.0 / 150.0);
+    const Eigen::Vector3d key = Eigen::Vector3d(1, -1, -1).normalized();  // default_key_light
+    const Eigen::Vector3d expected = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()) * key;
+    ASSERT_EQ(session["lights"].size(), 1u);
+    const auto& direction = session["lights"][0]["direction"];
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(direction[i].get<double>(), expected[i], 1e-9) << i;
+    // Zoom: the framing distance times 0.85 per step, recorded as the margin.
+    EXPECT_NEAR(session["camera"]["margin"].get<double>(), 1.1 * 0.85 * 0.85, 1e-9);
+    // Pan: the target moves left by 30 px at the target's depth (the point under the cursor follows it).
+    const double distance = 1.1 * 0.85 * 0.85 * std::sqrt(3.0) / std::sin(15 * std::numbers::pi / 180);
+    const double shift = 30 * 2 * distance * std::tan(15 * std::numbers::pi / 180) / 300;
+    const auto& offset = session["camera"]["target_offset"];
+    EXPECT_NEAR(offset[0].get<double>(), -shift, 1e-9);
+    EXPECT_NEAR(offset[1].get<double>(), 0, 1e-9);
+    EXPECT_NEAR(offset[2].get<double>(), 0, 1e-9);
 }
 
 TEST(EditorWithoutDisplay, BadInputScriptsAreOneLineErrorsNamingTheEntry) {
