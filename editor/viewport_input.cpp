@@ -29,11 +29,12 @@ ViewportContext EditorApp::viewport_context() {
 bool EditorApp::ui_has_pointer() const {
     if (options_.hide_ui) return false;
     if (file_dialog_.is_open()) return true;
-    // ImGui decides capture for the position it polled from the window. When the event comes from
-    // elsewhere (an input script), that decision is about another position and does not apply.
-    const ImGuiIO& io = ImGui::GetIO();
-    const bool same_position = std::abs(io.MousePos.x - cursor_.x()) < 0.5 && std::abs(io.MousePos.y - cursor_.y()) < 0.5;
-    return io.WantCaptureMouse && same_position;
+    // ImGui decides capture for where the window's pointer is (it polls it every frame). An event
+    // somewhere else came from an input script: ImGui's decision is about another position then.
+    double x = 0, y = 0;
+    glfwGetCursorPos(window_, &x, &y);
+    const bool at_pointer = std::abs(x - cursor_.x()) < 0.5 && std::abs(y - cursor_.y()) < 0.5;
+    return ImGui::GetIO().WantCaptureMouse && at_pointer;
 }
 
 void EditorApp::on_cursor(double x, double y) {

@@ -163,6 +163,17 @@ TEST(InputScriptPlayer, FiresInOrderOnePerFrameFromTheFirstReadyFrame) {
     EXPECT_EQ(target.log, expected);
 }
 
+TEST(InputScript, ExampleScriptsParse) {
+    int count = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(WAXWORK_ASSET_DIR) / "input")) {
+        if (entry.path().extension() != ".json") continue;
+        ++count;
+        const InputScript script = read_input_script(entry.path());
+        EXPECT_FALSE(script.events.empty()) << entry.path();
+    }
+    EXPECT_GE(count, 1);
+}
+
 TEST(InputScript, KeyNames) {
     EXPECT_EQ(key_from_name("c"), GLFW_KEY_C);
     EXPECT_EQ(key_from_name("Z"), GLFW_KEY_Z);
