@@ -245,6 +245,40 @@ TEST_F(EditorWindow, PieceDragAfterFractureMovesThatPiece) {
     EXPECT_EQ(moved_pieces, 1);
 }
 
+TEST_F(EditorWindow, DraggedPieceIsShownMovedBeforeTheDocumentMovesIt) {
+    // The screenshot of a drag still in progress (pressed, moved, not released) shows the piece where
+    // the finished drag puts it: the same silhouette as after the release, out beyond the cube.
+    const std::string fracture = R"([{"event": "tool", "tool": "fracture"},
+        {"frame": 2, "event": "press", "x": 200, "y": 150}, {"event": "release", "x": 200, "y": 150},
+        {"event": "idle"}, {"event": "tool", "tool": "move_piece"}, )";
+    const fs::path dragging = scratch_dir("editor_piece_preview"), released = scratch_dir("editor_piece_released");
+    auto r = run_script(dragging, fracture + R"({"event": "press", "x": 200, "y": 150},
+        {"event": "move", "x": 250, "y": 150}, {"event": "move", "x": 300, "y": 150}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_script(released, fracture + R"({"event": "drag", "from": [200, 150], "to": [300, 150], "steps": 2},
+        {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Image preview = read_png(dragging / "shot.png"), done = read_png(released / "shot.png");
+    ASSERT_EQ(preview.width, done.width);
+    ASSERT_EQ(preview.height, done.height);
+    // Background: the corner's colour. The radiance differs (the document's move is solved again), the
+    // coverage must not, but for antialiased edge pixels.
+    const auto is_object = [](const Image& image, int x, int y) {
+        for (int c = 0; c < 3; ++c)
+            if (std::abs(image.pixel(x, y)[c] - image.pixel(0, 0)[c]) > 2) return true;
+        return false;
+    };
+    int disagree = 0;
+    for (int y = 0; y < preview.height; ++y)
+        for (int x = 0; x < preview.width; ++x) disagree += is_object(preview, x, y) != is_object(done, x, y);
+    EXPECT_LT(disagree, preview.width * preview.height / 100);
+    // The cube spans 200 +- 1 / units_per_pixel pixels; the dragged piece reaches beyond.
+    const int cube_edge = 200 + static_cast<int>(std::ceil(1 / units_per_pixel_at_front_face()));
+    int beyond = 0;
+    for (int x = cube_edge + 5; x < preview.width; ++x) beyond += is_object(preview, x, 150);
+    EXPECT_GT(beyond, 20);
+}
+
 TEST_F(EditorWindow, LightDragZoomAndPanAreWhatASavedSessionRecords) {
     const fs::path dir = scratch_dir("editor_light_view");
     // The default key light turned by a trackball drag 60 px right of the centre, then two wheel
