@@ -153,6 +153,7 @@ public:
     void on_scroll(double steps);
     void select_tool(Tool tool);
     void save_session(const std::filesystem::path& path);
+
 private:
     using Scene = EditorScene;
     // editor_panels.cpp: the ImGui parts.
