@@ -279,6 +279,25 @@ TEST_F(EditorWindow, DraggedPieceIsShownMovedBeforeTheDocumentMovesIt) {
     EXPECT_GT(beyond, 20);
 }
 
+TEST_F(EditorWindow, ShortcutKeysSelectToolsAndUndo) {
+    const fs::path dir = scratch_dir("editor_keys");
+    // C selects the cut tool by its shortcut, Ctrl+Z undoes the cut: the volume is as loaded again.
+    const auto r = run_script(dir, R"([
+        {"frame": 2, "event": "save_volume", "file": "loaded.vtu"},
+        {"event": "key", "key": "C"},
+        {"event": "drag", "from": [200, 20], "to": [200, 280], "steps": 6},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "cut.vtu"},
+        {"event": "key", "key": "Z", "mods": ["ctrl"]},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "undone.vtu"},
+        {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const TetMesh loaded = read_volume(dir / "loaded.vtu");
+    EXPECT_LT(read_volume(dir / "cut.vtu").tet_count(), loaded.tet_count());
+    EXPECT_TRUE(read_volume(dir / "undone.vtu") == loaded);
+}
+
 TEST_F(EditorWindow, LightDragZoomAndPanAreWhatASavedSessionRecords) {
     const fs::path dir = scratch_dir("editor_light_view");
     // The default key light turned by a trackball drag 60 px right of the centre, then two wheel
