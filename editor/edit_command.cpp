@@ -20,6 +20,7 @@ struct EditCommandOptions {
     std::string file;
     std::string session;
     std::string screenshot;
+    std::string input;
     int frames = 10;
     bool hide_ui = false;
     int width = 1280;
@@ -58,6 +59,8 @@ void run_edit_command(const EditCommandOptions& o) {
     options.material = chosen_material(o.material);
     options.scale = o.scale;
     for (const std::string& spec : o.lights) options.lights.push_back(parse_light_spec(spec));
+    // Read before the window opens: a bad script is a one-line error, with or without a display.
+    if (!o.input.empty()) options.input = read_input_script(o.input);
     if (!o.view.empty()) {
         const Eigen::Vector3d v(o.view[0], o.view[1], o.view[2]);
         if (!v.allFinite() || v.norm() == 0) throw InvalidArgumentError("--view must be a finite, non-zero direction");
@@ -90,6 +93,9 @@ void add_edit_command(CLI::App& app) {
         ->check(CLI::ExistingFile);
     cmd->add_option("--screenshot", options->screenshot,
                     "Draw --frames frames after loading and solving, save the window to this PNG and exit");
+    cmd->add_option("--input", options->input,
+                    "Replay this JSON list of timed mouse and key events into the window (editor/input_script.h)")
+        ->check(CLI::ExistingFile);
     cmd->add_option("--frames", options->frames, "Frames drawn before the screenshot")->capture_default_str();
     cmd->add_flag("--hide-ui", options->hide_ui, "Show the 3D view alone (Tab toggles it)");
     cmd->add_option("--width", options->width, "Window width")->capture_default_str();
@@ -112,7 +118,8 @@ void add_edit_command(CLI::App& app) {
     cmd->add_flag("--quality-interior", options->quality_interior,
                   "--show quality: also cut at the slice plane and colour the cross-section's tets");
     cmd->footer(
-        "Mouse: right drag (or Alt+left) orbits, middle drag (or Shift+right) pans, the wheel zooms.\n"
+        "Mouse: left drag uses the current tool; right drag (or Alt+left) orbits, middle drag (or Shift+right)\n"
+        "pans, the wheel zooms, Home resets the view, Esc cancels a stroke or drag.\n"
         "With --hide-ui the first frame shows exactly what `waxwork render` writes for the same volume,\n"
         "materials, lights, --view and window size.");
     cmd->callback([options] { run_edit_command(*options); });

@@ -67,16 +67,6 @@ GLFWwindow* create_window(int width, int height, bool visible) {
 
 }  // namespace
 
-const std::vector<ToolInfo>& tool_infos() {
-    static const std::vector<ToolInfo> tools = {
-        {Tool::Orbit, "Orbit", "Esc"},        {Tool::Cut, "Cut", "C"},
-        {Tool::ExactCut, "Exact cut", "X"},   {Tool::Relax, "Relax", "R"},
-        {Tool::Fracture, "Fracture", "F"},    {Tool::MovePiece, "Move piece", "M"},
-        {Tool::Paint, "Paint", "P"},          {Tool::Light, "Light", "L"},
-    };
-    return tools;
-}
-
 EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
     : window_(window), options_(options), scene_(std::make_unique<Scene>()) {
     gl_ = load_gl_api(gl_proc_address);
@@ -98,6 +88,11 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
     glfwSetKeyCallback(window_, [](GLFWwindow* w, int key, int, int action, int mods) {
         if (action == GLFW_PRESS) app_of(w)->on_key(key, mods);
     });
+    glfwSetCursorPosCallback(window_, [](GLFWwindow* w, double x, double y) { app_of(w)->on_cursor(x, y); });
+    glfwSetMouseButtonCallback(window_, [](GLFWwindow* w, int button, int action, int mods) {
+        app_of(w)->on_mouse_button(button, action, mods);
+    });
+    glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double dy) { app_of(w)->on_scroll(dy); });
 
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
@@ -253,9 +248,18 @@ void EditorApp::save_volume(const fs::path& path) {
 }
 
 void EditorApp::save_session(const fs::path& path) {
-    queue_job("save session", [path](SceneCore& core) {
+    // The view and lights as they are now, not as the session started.
+    Session current;
+    current.lighting = lighting_;
+    current.camera = camera_ ? camera_->settings(static_cast<double>(view_w_) / view_h_) : options_.camera;
+    current.width = view_w_;
+    current.height = view_h_;
+    queue_job("save session", [path, current](SceneCore& core) {
         Session setup = core.setup;
-        setup.lighting = core.live->lighting();
+        setup.lighting = current.lighting;
+        setup.camera = current.camera;
+        setup.width = current.width;
+        setup.height = current.height;
         write_session(path, record_session(setup, *core.document));
         return "Saved the session (" + std::to_string(core.document->history().size()) + " edits) to " + path.string();
     });
@@ -295,7 +299,9 @@ void EditorApp::on_key(int key, int mods) {
         return;
     }
     switch (key) {
-    case GLFW_KEY_ESCAPE: select_tool(Tool::Orbit); break;
+    case GLFW_KEY_ESCAPE:
+        if (!tools_.cancel(viewport_context())) select_tool(Tool::Orbit);
+        break;
     case GLFW_KEY_C: select_tool(Tool::Cut); break;
     case GLFW_KEY_X: select_tool(Tool::ExactCut); break;
     case GLFW_KEY_R: select_tool(Tool::Relax); break;
@@ -535,7 +541,8 @@ void EditorApp::draw_viewport(int fb_h) {
     if (!view_cache_->holds(key)) {
         const auto start = std::chrono::steady_clock::now();
         try {
-            renderer_->draw(input, frame, view_cache_->begin_update(key), 0, 0);
+            if (shown_preview_) renderer_->draw(with_piece_preview(input), frame, view_cache_->begin_update(key), 0, 0);
+            else renderer_->draw(input, frame, view_cache_->begin_update(key), 0, 0);
         } catch (const std::exception& e) {
             view_cache_->invalidate();
             scene_->render_input.reset();
@@ -545,83 +552,6 @@ void EditorApp::draw_viewport(int fb_h) {
         last_render_ms_ = ms_since(start);
     }
     view_cache_->blit(0, view_x_, y);
-}
-
-void EditorApp::handle_viewport_input() {
-    const ImGuiIO& io = ImGui::GetIO();
-    if (!camera_) return;
-    // Mouse in viewport pixels (framebuffer units, origin at the viewport's top-left).
-    const double s = framebuffer_scale_;
-    const double mx = io.MousePos.x * s - view_x_, my = io.MousePos.y * s - view_y_;
-    const bool inside = mx >= 0 && my >= 0 && mx < view_w_ && my < view_h_;
-    const double dx = io.MouseDelta.x * s, dy = io.MouseDelta.y * s;
-    const bool free = !io.WantCaptureMouse || options_.hide_ui;
-
-    if (free && inside && io.MouseWheel != 0) camera_->zoom(std::pow(0.85, io.MouseWheel));
-    // Right drag (or Alt + left) orbits and middle drag (or Shift + right) pans, whatever the tool.
-    const bool alt_left = io.KeyAlt && io.MouseDown[0];
-    if (free && (io.MouseDown[1] || alt_left) && !io.KeyShift && (dx != 0 || dy != 0)) {
-        camera_->orbit(-dx * 0.008, dy * 0.008);
-    }
-    if (free && (io.MouseDown[2] || (io.MouseDown[1] && io.KeyShift))) camera_->pan(dx, dy, view_h_);
-    if (alt_left) return;
-
-    const bool stroke_tool = tool_ == Tool::Cut || tool_ == Tool::ExactCut || tool_ == Tool::Paint ||
-                             tool_ == Tool::Fracture;
-    if (tool_ == Tool::Orbit) {
-        if (free && io.MouseDown[0] && !io.MouseClicked[0] && (dx != 0 || dy != 0))
-            camera_->orbit(-dx * 0.008, dy * 0.008);
-    } else if (tool_ == Tool::Light) {
-        if (free && io.MouseDown[0] && !io.MouseClicked[0] && (dx != 0 || dy != 0) && !lighting_.lights.empty()) {
-            drag_light(dx, dy);
-        }
-    } else if (tool_ == Tool::MovePiece) {
-        if (free && inside && io.MouseClicked[0]) {
-            dragged_piece_ = piece_under(mx, my).value_or(-1);
-            drag_translation_.setZero();
-        }
-        if (dragged_piece_ >= 0 && io.MouseDown[0]) {
-            const double half_fov = 0.5 * camera_->fov_y_degrees() * std::numbers::pi / 180.0;
-            const double units = 2 * camera_->distance() * std::tan(half_fov) / view_h_;
-            drag_translation_ += units * (dx * camera_->right_axis() - dy * camera_->up_axis());
-        }
-        if (dragged_piece_ >= 0 && io.MouseReleased[0]) {
-            if (drag_translation_.norm() > 0 && dragged_piece_ < static_cast<int>(scene_->piece_transforms.size())) {
-                MovePieceOp op;
-                op.piece = dragged_piece_;
-                op.transform = scene_->piece_transforms[dragged_piece_];
-                op.transform.translation += drag_translation_;
-                queue_edit(op);
-            }
-            dragged_piece_ = -1;
-        }
-    } else if (stroke_tool) {
-        if (free && inside && io.MouseClicked[0]) stroke_.clear(), stroke_active_ = true;
-        if (stroke_active_ && io.MouseDown[0]) stroke_.push_back({static_cast<float>(mx), static_cast<float>(my)});
-        if (stroke_active_ && io.MouseReleased[0]) {
-            stroke_active_ = false;
-            finish_stroke();
-        }
-    }
-}
-
-void EditorApp::drag_light(double dx, double dy) {
-    selected_light_ = std::clamp(selected_light_, 0, static_cast<int>(lighting_.lights.size()) - 1);
-    Light& light = lighting_.lights[selected_light_];
-    if (light.type == LightType::Directional) {
-        // Turn the direction of travel with the mouse, like an arcball about the view axes.
-        const Eigen::Vector3d d = light.vector.normalized();
-        const Eigen::Matrix3d rotation =
-            (Eigen::AngleAxisd(dx * 0.01, camera_->up_axis()) * Eigen::AngleAxisd(dy * 0.01, camera_->right_axis()))
-                .toRotationMatrix();
-        light.vector = rotation * d;
-    } else {
-        // Move the point light in the view plane, a point at the target's depth following the cursor.
-        const double half_fov = 0.5 * camera_->fov_y_degrees() * std::numbers::pi / 180.0;
-        const double units = 2 * camera_->distance() * std::tan(half_fov) / view_h_;
-        light.vector += units * (dx * camera_->right_axis() - dy * camera_->up_axis());
-    }
-    request_solve();
 }
 
 bool EditorApp::can_undo() const { return scene_->can_undo || !pending_jobs_.empty(); }
@@ -642,68 +572,6 @@ void EditorApp::queue_history_step(bool redo) {
 void EditorApp::set_whole_material(const TetMaterial& material, const std::string& name) {
     queue_edit(SetMaterialOp{material, std::nullopt});
     scene_->material_name = name;
-}
-
-void EditorApp::finish_stroke() {
-    const ScreenStroke stroke = simplify_stroke(stroke_, 3.0f);
-    stroke_.clear();
-    if (!camera_ || !scene_->core) return;
-    try {
-        if (tool_ == Tool::Cut || tool_ == Tool::ExactCut) {
-            // Shift keeps the left side instead.
-            const auto op = stroke_cut_op(*camera_, stroke, view_w_, view_h_, tool_ == Tool::ExactCut,
-                                          ImGui::GetIO().KeyShift);
-            if (!op) return;
-            last_cut_ = op->stroke;
-            queue_edit(*op);
-        } else if (tool_ == Tool::Paint) {
-            if (!scene_->surface_bvh) return;
-            const auto op = paint_op(*camera_, *scene_->surface_bvh, stroke, view_w_, view_h_,
-                                     custom_material_.value_or(material_preset("marble")),
-                                     brush_radius_ * camera_->scene_radius());
-            if (op) queue_edit(*op);  // else the stroke missed the object
-        } else if (tool_ == Tool::Fracture) {
-            FractureOp op;
-            if (scene_->surface_bvh && stroke.size() >= 2) {
-                // Seeds along the stroke, on the surface under it: the object breaks where drawn.
-                const auto points = stroke_on_surface(*camera_, *scene_->surface_bvh, stroke, view_w_, view_h_);
-                const size_t step = std::max<size_t>(1, points.size() / static_cast<size_t>(fracture_pieces_));
-                for (size_t i = 0; i < points.size(); i += step) op.seeds.push_back(points[i]);
-            }
-            if (op.seeds.size() < 2) {
-                op.seeds.clear();
-                op.pieces = fracture_pieces_;
-                op.seed = fracture_seed_++;
-            }
-            queue_edit(op);
-        }
-    } catch (const std::exception& e) {
-        set_error(e.what());
-    }
-}
-
-void EditorApp::select_tool(Tool tool) {
-    stroke_.clear();
-    stroke_active_ = false;
-    // Relax is an action on the last cut, not a mode.
-    if (tool == Tool::Relax) relax_last_cut();
-    else tool_ = tool;
-}
-
-std::optional<int> EditorApp::piece_under(double x, double y) const {
-    if (!camera_ || !scene_->surface_bvh || !scene_->render_input) return std::nullopt;
-    const auto hit = first_hit(*scene_->surface_bvh, camera_->unproject(Eigen::Vector2d(x, y), view_w_, view_h_),
-                               camera_->distance() + 4 * camera_->scene_radius());
-    if (!hit) return std::nullopt;
-    const auto& positions = scene_->render_input->positions;
-    if (positions.size() != scene_->surface_piece.size()) return std::nullopt;
-    size_t nearest = 0;
-    double best = std::numeric_limits<double>::infinity();
-    for (size_t i = 0; i < positions.size(); ++i) {
-        const double d = (positions[i].cast<double>() - *hit).squaredNorm();
-        if (d < best) best = d, nearest = i;
-    }
-    return scene_->surface_piece[nearest];
 }
 
 void EditorApp::relax_last_cut() {
@@ -774,17 +642,25 @@ EditorRunStats run_editor(const EditorOptions& options) {
     EditorRunStats stats;
     {
         EditorApp app(window, options);
+        std::optional<InputScriptPlayer> player;
+        std::unique_ptr<ScriptTarget> script_target;
+        if (options.input) {
+            player.emplace(*options.input);
+            script_target = make_window_script_target(window, app);
+        }
+        const auto script_running = [&] { return player && !player->done(); };
         stats.gl_version = reinterpret_cast<const char*>(app.gl().GetString(GL_VERSION));
         stats.gl_renderer = reinterpret_cast<const char*>(app.gl().GetString(GL_RENDERER));
         double frame_ms_sum = 0, view_ms_sum = 0;
         while (!glfwWindowShouldClose(window)) {
-            if (screenshot || !app.idle() || app.animating()) glfwPollEvents();
+            if (screenshot || !app.idle() || app.animating() || script_running()) glfwPollEvents();
             else glfwWaitEventsTimeout(0.5);  // nothing moves: sleep until input arrives
             const auto start = std::chrono::steady_clock::now();
+            if (player) player->advance(*script_target);
             app.frame();
             if (screenshot) {
                 if (!app.last_error().empty()) throw Error(app.last_error());
-                if (!app.idle()) {
+                if (!app.idle() || script_running()) {
                     stats.frames = 0;
                     frame_ms_sum = view_ms_sum = 0;
                     // Not interactive: no point drawing hundreds of progress frames meanwhile.

@@ -14,6 +14,7 @@
 #include "editor/background_task.h"
 #include "editor/document.h"
 #include "editor/file_dialog.h"
+#include "editor/input_script.h"
 #include "editor/live_scene.h"
 #include "editor/orbit_camera.h"
 #include "editor/render_pipeline.h"
@@ -21,6 +22,7 @@
 #include "editor/surface_renderer.h"
 #include "editor/view_cache.h"
 #include "editor/view_modes.h"
+#include "editor/viewport_tools.h"
 #include "solver/ray_caster.h"
 
 #include <deque>
@@ -51,6 +53,7 @@ struct EditorOptions {
     double scale = 1.0;                  // millimetres per model unit
     CameraSettings camera;               // the first view (as `waxwork render --view`)
     ViewOptions view;                    // what the 3D view shows (as `waxwork render --show`)
+    std::optional<InputScript> input;    // replayed into the window once the object shows (--input)
 };
 
 // Opens the window and runs until it is closed (or, with a screenshot, until it is saved). Throws
@@ -75,14 +78,9 @@ bool display_available();
 // (false on a server: the caller carries on headless). Errors after the window opened propagate.
 bool try_open_editor(const EditorOptions& options);
 
-enum class Tool { Orbit, Cut, ExactCut, Relax, Fracture, MovePiece, Paint, Light };
-
-struct ToolInfo {
-    Tool tool;
-    const char* name;
-    const char* shortcut;  // shown in the menus; empty: none
-};
-const std::vector<ToolInfo>& tool_infos();
+class EditorApp;
+// Drives `app` in `window` through GLFW's installed callbacks (viewport_input.cpp), for --input.
+std::unique_ptr<ScriptTarget> make_window_script_target(GLFWwindow* window, EditorApp& app);
 
 // The document and its live scene, used by one worker tick at a time (never by the UI thread while a
 // tick runs). LiveScene borrows the document's mesh: `live` is declared last so it is destroyed first.
@@ -137,7 +135,9 @@ public:
     // The 3D view's pixels alone (what `waxwork render` would write for the same scene and size).
     Image read_viewport() const;
     // True while something on screen changes without input (a stroke, a drag).
-    bool animating() const { return stroke_active_; }
+    bool animating() const { return tools_.active(); }
+    // The loaded object is on screen (its camera exists): scripted input starts here.
+    bool viewport_ready() const { return camera_.has_value() && scene_->render_input.has_value(); }
     // The first error of a failed load or solve (screenshot mode turns it into the exit status).
     const std::string& last_error() const { return last_error_; }
     const GlApi& gl() const { return gl_; }
@@ -149,6 +149,12 @@ public:
     void save_volume(const std::filesystem::path& path);
     void on_drop(const std::vector<std::filesystem::path>& paths);
     void on_key(int key, int mods);
+    // Pointer input in window coordinates, from GLFW's callbacks (real or scripted input alike).
+    void on_cursor(double x, double y);
+    void on_mouse_button(int button, int action, int mods);
+    void on_scroll(double steps);
+    void select_tool(Tool tool);
+    void save_session(const std::filesystem::path& path);
 
 private:
     using Scene = EditorScene;
@@ -168,11 +174,10 @@ private:
     void apply_theme(float scale);
 
     void open_dialog(FileDialog::Mode mode, bool session = false);
-    void select_tool(Tool tool);
     void relax_last_cut();
     void install_core(std::shared_ptr<SceneCore> core, const std::filesystem::path& path,
                       const std::string& material_name, const std::vector<EditOperation>& replay);
-    std::optional<int> piece_under(double x, double y) const;
+    std::optional<PieceHit> piece_under(const Eigen::Vector2d& pixel) const;
     void file_dialog_result();
     void undo();
     void redo();
@@ -183,10 +188,15 @@ private:
     void queue_edit(const EditOperation& op);
     void queue_job(std::string label, SceneJob job);
     void rebuild_live_scene();
-    void save_session(const std::filesystem::path& path);
     void open_session(const std::filesystem::path& path);
-    void finish_stroke();
-    void drag_light(double dx, double dy);
+    // viewport_input.cpp: pointer events to ViewportTools and its outcome to edits.
+    ViewportContext viewport_context();
+    void pointer_event(PointerAction action, PointerButton button, int mods, double scroll = 0);
+    bool ui_has_pointer() const;
+    void apply_tool_outcome(const ToolOutcome& outcome);
+    void draw_tool_overlay();
+    void update_piece_preview();
+    SurfaceRenderInput with_piece_preview(const SurfaceRenderInput& input) const;
     void layout_viewport(int fb_w, int fb_h);
     void poll_tasks();
     void request_solve();  // the lights changed
@@ -223,14 +233,13 @@ private:
     std::optional<std::variant<PlaneSurface, StrokeSurface>> last_cut_;  // what Relax relaxes towards
     int fracture_pieces_ = 5;
     uint32_t fracture_seed_ = 1;
-    int dragged_piece_ = -1;
-    Eigen::Vector3d drag_translation_ = Eigen::Vector3d::Zero();
 
-    Tool tool_ = Tool::Orbit;
+    ViewportTools tools_;
+    Eigen::Vector2d cursor_ = Eigen::Vector2d::Zero();  // window coordinates
+    int mods_ = 0;                                       // of the latest button event
+    std::optional<Eigen::Vector3d> shown_preview_;       // the piece translation the view shows
     int selected_light_ = 0;
     int selected_preset_ = 0;
-    std::vector<std::array<float, 2>> stroke_;  // the stroke being drawn (viewport pixels)
-    bool stroke_active_ = false;
     std::optional<TetMaterial> custom_material_;  // the material panel's current material
     float brush_radius_ = 0.05f;                  // paint brush sigma, fraction of the scene radius
     bool show_light_gizmos_ = true;

@@ -26,20 +26,6 @@ const std::vector<std::string>& openable_extensions() {
     return e;
 }
 
-const char* tool_hint(Tool tool) {
-    switch (tool) {
-    case Tool::Orbit: return "Drag: orbit. Right drag: orbit, middle drag: pan, wheel: zoom.";
-    case Tool::Cut: return "Draw a stroke across the object: the left side is cut away.";
-    case Tool::ExactCut: return "Draw a stroke: cut exactly along it (tets split at the surface).";
-    case Tool::Relax: return "Relax the cross-sections of the last cut.";
-    case Tool::Fracture: return "Draw a stroke: the object breaks into pieces along it.";
-    case Tool::MovePiece: return "Drag a piece to move it.";
-    case Tool::Paint: return "Paint the selected material into the volume under the stroke.";
-    case Tool::Light: return "Drag: turn the selected directional light, or move the point light.";
-    }
-    return "";
-}
-
 ImVec4 swatch(const TetMaterial& m) {
     const auto c = swatch_colour(m);
     return ImVec4(c[0], c[1], c[2], 1.0f);
@@ -136,7 +122,7 @@ void EditorApp::draw_menu_bar() {
     }
     if (ImGui::BeginMenu("Tools")) {
         for (const ToolInfo& info : tool_infos()) {
-            if (ImGui::MenuItem(info.name, info.shortcut, tool_ == info.tool)) select_tool(info.tool);
+            if (ImGui::MenuItem(info.name, info.shortcut, tools_.tool() == info.tool)) select_tool(info.tool);
         }
         ImGui::EndMenu();
     }
@@ -147,7 +133,7 @@ void EditorApp::draw_menu_bar() {
         ImGui::EndMenu();
     }
     if (ImGui::BeginMenu("Help")) {
-        ImGui::TextUnformatted("Right drag or Alt+drag: orbit   Middle or Shift+right drag: pan   Wheel: zoom");
+        for (const std::string& line : control_lines()) ImGui::TextUnformatted(line.c_str());
         ImGui::TextUnformatted("Drop a mesh or volume file onto the window to open it.");
         ImGui::EndMenu();
     }
@@ -162,7 +148,7 @@ void EditorApp::draw_tool_palette() {
     ImGui::Begin("Tools", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
     const float width = ImGui::GetContentRegionAvail().x;
     for (const ToolInfo& info : tool_infos()) {
-        const bool active = tool_ == info.tool;
+        const bool active = tools_.tool() == info.tool;
         if (active) ImGui::PushStyleColor(ImGuiCol_Button, ImGui::GetStyle().Colors[ImGuiCol_ButtonActive]);
         char label[64];
         std::snprintf(label, sizeof label, "%s", info.name);
@@ -234,68 +220,6 @@ void EditorApp::draw_material_panel() {
     if (ImGui::Button("Apply to the whole object") && has_scene) set_whole_material(m, names[selected_preset_]);
     ImGui::TextDisabled("Object: %s; Paint (P) brushes it in locally", scene_->material_name.c_str());
     ImGui::SliderFloat("brush radius", &brush_radius_, 0.005f, 0.3f, "%.3f x size");
-}
-
-void EditorApp::draw_light_panel() {
-    int remove = -1;
-    for (int i = 0; i < static_cast<int>(lighting_.lights.size()); ++i) {
-        Light& light = lighting_.lights[i];
-        ImGui::PushID(i);
-        bool changed = false;
-        const bool selected = selected_light_ == i;
-        char title[48];
-        std::snprintf(title, sizeof title, "%s light %d", light.type == LightType::Directional ? "Directional" : "Point", i + 1);
-        if (ImGui::RadioButton(title, selected)) selected_light_ = i;
-        ImGui::SameLine(ImGui::GetContentRegionAvail().x - 60 * ui_scale_);
-        if (ImGui::SmallButton("remove")) remove = i;
-        int type = light.type == LightType::Directional ? 0 : 1;
-        if (ImGui::Combo("type", &type, "directional\0point\0")) {
-            const bool to_point = type == 1;
-            if (to_point != (light.type == LightType::Point)) {
-                // A point light placed where the directional light comes from, outside the object.
-                const double reach = camera_ ? 2.5 * camera_->scene_radius() : 2.0;
-                const Eigen::Vector3d centre = camera_ ? camera_->target() : Eigen::Vector3d::Zero();
-                light.type = to_point ? LightType::Point : LightType::Directional;
-                light.vector = to_point ? Eigen::Vector3d(centre - reach * light.vector.normalized())
-                                        : Eigen::Vector3d((centre - light.vector).normalized());
-                changed = true;
-            }
-        }
-        float v[3] = {static_cast<float>(light.vector.x()), static_cast<float>(light.vector.y()), static_cast<float>(light.vector.z())};
-        if (ImGui::DragFloat3(light.type == LightType::Directional ? "travels along" : "position", v, 0.01f)) {
-            const Eigen::Vector3d next(v[0], v[1], v[2]);
-            if (next.allFinite() && (light.type == LightType::Point || next.norm() > 1e-6)) {
-                light.vector = next;
-                changed = true;
-            }
-        }
-        float colour[3] = {static_cast<float>(light.intensity[0]), static_cast<float>(light.intensity[1]),
-                           static_cast<float>(light.intensity[2])};
-        if (ImGui::ColorEdit3("intensity", colour, ImGuiColorEditFlags_HDR | ImGuiColorEditFlags_Float)) {
-            for (int c = 0; c < 3; ++c) light.intensity[c] = std::max(0.0f, colour[c]);
-            changed = true;
-        }
-        if (changed) request_solve();
-        ImGui::Separator();
-        ImGui::PopID();
-    }
-    if (remove >= 0) {
-        lighting_.lights.erase(lighting_.lights.begin() + remove);
-        request_solve();
-    }
-    if (lighting_.lights.size() < static_cast<size_t>(kMaxRenderLights) && ImGui::Button("Add light")) {
-        lighting_.lights.push_back(default_key_light());
-        selected_light_ = static_cast<int>(lighting_.lights.size()) - 1;
-        request_solve();
-    }
-    ImGui::SameLine();
-    ImGui::TextDisabled("drag in the view with L");
-    float ambient = static_cast<float>(lighting_.ambient[0]);
-    if (ImGui::DragFloat("ambient", &ambient, 0.002f, 0.0f, 10.0f, "%.3f")) {
-        lighting_.ambient = {std::max(0.0f, ambient), std::max(0.0f, ambient), std::max(0.0f, ambient)};
-        request_solve();
-    }
-    if (ImGui::Checkbox("shadows", &lighting_.shadows)) request_solve();
 }
 
 void EditorApp::draw_solver_panel() {
@@ -379,14 +303,7 @@ void EditorApp::draw_overlays() {
     auto to_screen = [&](float x, float y) {
         return ImVec2(static_cast<float>((x + view_x_) / s), static_cast<float>((y + view_y_) / s));
     };
-    // The stroke being drawn.
-    if (stroke_.size() > 1) {
-        const ImU32 colour = tool_ == Tool::Paint ? IM_COL32(120, 200, 255, 230) : IM_COL32(255, 190, 90, 230);
-        for (size_t i = 1; i < stroke_.size(); ++i) {
-            draw->AddLine(to_screen(stroke_[i - 1][0], stroke_[i - 1][1]), to_screen(stroke_[i][0], stroke_[i][1]), colour,
-                          2.0f * ui_scale_);
-        }
-    }
+    draw_tool_overlay();  // the stroke being drawn and the side a cut takes away
     if (!camera_ || !show_light_gizmos_) return;
     // Light gizmos: point lights as suns at their position, directional ones as an arrow towards the
     // target from where the light comes.
@@ -406,7 +323,7 @@ void EditorApp::draw_overlays() {
             draw->AddLine(at, to_screen(static_cast<float>(q.x()), static_cast<float>(q.y())), colour, 2.0f * ui_scale_);
         }
     }
-    const char* hint = tool_hint(tool_);
+    const char* hint = tool_hint(tools_.tool());
     draw->AddText(to_screen(10, 8), IM_COL32(220, 220, 220, 200), hint);
 }
 

@@ -11,7 +11,8 @@ namespace waxwork {
 OrbitCamera::OrbitCamera(const Eigen::AlignedBox3d& box, const CameraSettings& settings, double aspect) {
     // frame_camera validates the box, direction, up vector, field of view, aspect and margin.
     const CameraFrame check = frame_camera(box, settings, aspect);
-    target_ = box.center();
+    centre_ = box.center();
+    target_ = centre_ + settings.target_offset;
     radius_ = bounding_radius(box);
     eye_direction_ = settings.eye_direction.normalized();
     up_ = settings.up.normalized();
@@ -20,7 +21,19 @@ OrbitCamera::OrbitCamera(const Eigen::AlignedBox3d& box, const CameraSettings& s
 }
 
 CameraFrame OrbitCamera::frame(double aspect) const {
-    return look_at_frame(target_, eye_direction_, up_, distance_, radius_, fov_y_degrees_, aspect);
+    return look_at_frame(target_, eye_direction_, up_, distance_, radius_ + (target_ - centre_).norm(), fov_y_degrees_,
+                         aspect);
+}
+
+CameraSettings OrbitCamera::settings(double aspect) const {
+    CameraSettings s;
+    s.eye_direction = eye_direction_;
+    s.up = up_;
+    s.fov_y_degrees = fov_y_degrees_;
+    // framing_distance is proportional to the margin.
+    s.margin = distance_ / framing_distance(radius_, fov_y_degrees_, aspect, 1.0);
+    s.target_offset = target_ - centre_;
+    return s;
 }
 
 Eigen::Vector3d OrbitCamera::right_axis() const { return (-eye_direction_).cross(up_).normalized(); }

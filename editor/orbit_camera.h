@@ -22,8 +22,12 @@ public:
     // Throws InvalidArgumentError for what frame_camera refuses.
     OrbitCamera(const Eigen::AlignedBox3d& box, const CameraSettings& settings, double aspect);
 
-    // View and projection for a viewport of this aspect (width / height).
+    // View and projection for a viewport of this aspect (width / height). The depth range encloses
+    // the scene's bounding sphere wherever panning moved the target.
     CameraFrame frame(double aspect) const;
+    // The settings that give this view through frame_camera (`waxwork render`, sessions) for a
+    // viewport of this aspect: the zoom as the margin, the pan as the target offset.
+    CameraSettings settings(double aspect) const;
 
     // Turns the eye around the target: `yaw` radians about the up vector, then `pitch` radians about
     // the image's right axis (positive: the eye moves up). The pitch stops kMinPoleAngle short of the
@@ -57,6 +61,7 @@ public:
     static constexpr double kMinPoleAngle = 0.02;  // radians
 
 private:
+    Eigen::Vector3d centre_;  // of the scene's box
     Eigen::Vector3d target_;
     Eigen::Vector3d eye_direction_;  // unit, target -> eye
     Eigen::Vector3d up_;             // unit

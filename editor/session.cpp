@@ -94,15 +94,18 @@ CameraSettings camera_from_json(const Json& json, const std::string& context, Ca
     if (!(camera.fov_y_degrees > 1 && camera.fov_y_degrees < 170)) fail_json(in.field("fov_y_deg"), "must be in (1, 170)");
     camera.margin = in.number("margin", camera.margin);
     if (!(camera.margin > 0)) fail_json(in.field("margin"), "must be positive");
+    if (in.has("target_offset")) camera.target_offset = in.vector("target_offset");
     in.finish();
     return camera;
 }
 
 Json camera_to_json(const CameraSettings& c) {
-    return Json{{"eye_direction", vector_to_json(c.eye_direction)},
-                {"up", vector_to_json(c.up)},
-                {"fov_y_deg", c.fov_y_degrees},
-                {"margin", c.margin}};
+    Json j{{"eye_direction", vector_to_json(c.eye_direction)},
+           {"up", vector_to_json(c.up)},
+           {"fov_y_deg", c.fov_y_degrees},
+           {"margin", c.margin}};
+    if (c.target_offset != Eigen::Vector3d::Zero()) j["target_offset"] = vector_to_json(c.target_offset);
+    return j;
 }
 
 std::string output_name(FieldReader& in, const std::string& key) {

@@ -9,7 +9,8 @@
 //     "scale": 30,                         millimetres per model unit
 //     "lights": [{"direction": [1,-1,-1], "intensity": [1,1,1]}, {"position": [0,2,0]}],
 //     "ambient": [0.02, 0.02, 0.02], "shadows": true,
-//     "camera": {"eye_direction": [0.75,0.5,-1], "up": [0,1,0], "fov_y_deg": 30},
+//     "camera": {"eye_direction": [0.75,0.5,-1], "up": [0,1,0], "fov_y_deg": 30, "margin": 1.1,
+//                "target_offset": [0,0,0]},    margin: framing distance factor (zoom); offset: pan
 //     "image": {"width": 640, "height": 480},
 //     "tolerance": 0.001,                  relative error a converged frame reaches
 //     "frame_iterations": 10,              CG iterations per channel of one live frame

@@ -361,9 +361,10 @@ CameraFrame frame_camera(const Eigen::AlignedBox3d& box, const CameraSettings& c
         throw InvalidArgumentError("camera: aspect ratio and margin must be positive");
     }
     const double radius = bounding_radius(box);
-    return look_at_frame(box.center(), camera.eye_direction, camera.up,
-                         framing_distance(radius, camera.fov_y_degrees, aspect, camera.margin), radius,
-                         camera.fov_y_degrees, aspect);
+    if (!camera.target_offset.allFinite()) throw InvalidArgumentError("camera: target offset must be finite");
+    return look_at_frame(box.center() + camera.target_offset, camera.eye_direction, camera.up,
+                         framing_distance(radius, camera.fov_y_degrees, aspect, camera.margin),
+                         radius + camera.target_offset.norm(), camera.fov_y_degrees, aspect);
 }
 
 SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {

@@ -27,6 +27,9 @@ struct CameraSettings {
     Eigen::Vector3d up = Eigen::Vector3d(0, 1, 0);
     double fov_y_degrees = 30;
     double margin = 1.1;
+    // The point looked at, relative to the box's centre (the editor's pan); world units. The depth
+    // range grows by its length so the whole box stays between the near and far planes.
+    Eigen::Vector3d target_offset = Eigen::Vector3d::Zero();
 };
 
 struct CameraFrame {

@@ -4,14 +4,20 @@
 // (OSMesa) writes for the same scene.
 #include "editor/cli_run.h"
 #include "io/image_io.h"
+#include "io/volume_file.h"
+#include "solver/material.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 
 namespace waxwork {
 namespace {
@@ -145,6 +151,231 @@ TEST_F(EditorWindow, ReplayedSessionEqualsWaxworkRun) {
     int max_difference = 0;
     for (size_t i = 0; i < a.rgba.size(); ++i) max_difference = std::max(max_difference, std::abs(a.rgba[i] - b.rgba[i]));
     EXPECT_LE(max_difference, 2);
+}
+
+// The mouse tools driven by scripted input (`--input`): a 400x300 view without panels looking at the
+// cube [-1, 1]^3 from +z, so screen right is +x and screen up is +y, the centre pixel (200, 150)
+// looks at the origin.
+const std::string kCubeView = " --max-tets 6000 --view 0,0,1 --hide-ui --width 400 --height 300 ";
+
+// World units per viewport pixel on the cube's front face (z = 1): the eye stands at frame_camera's
+// framing distance (margin 1.1, bounding radius sqrt(3), vertical field of view 30 degrees, the
+// narrower one at this aspect) and the view is 300 pixels high.
+double units_per_pixel_at_front_face() {
+    const double half_fov = 15 * std::numbers::pi / 180;
+    const double distance = 1.1 * std::sqrt(3.0) / std::sin(half_fov);
+    return 2 * (distance - 1) * std::tan(half_fov) / 300;
+}
+
+testing::CommandResult run_script(const fs::path& dir, const std::string& script, const std::string& extra = "") {
+    const fs::path path = dir / "input.json";
+    std::ofstream(path) << script;
+    return run_under_xvfb("edit " + kAssets + "/meshes/cube.obj" + kCubeView + extra + " --input " + path.string() +
+                          " --frames 2 --screenshot " + (dir / "shot.png").string());
+}
+
+TEST_F(EditorWindow, CutStrokeCutsTheSideDrawnAndTheSessionReplaysIt) {
+    const fs::path dir = scratch_dir("editor_cut_stroke");
+    // A stroke cancelled with Esc first (it must cut nothing), then a stroke down the middle: going
+    // down the screen its left is the screen's right, +x.
+    const auto r = run_script(dir, R"([
+        {"event": "tool", "tool": "cut"},
+        {"frame": 2, "event": "press", "x": 200, "y": 20},
+        {"event": "move", "x": 200, "y": 150},
+        {"event": "key", "key": "Escape"},
+        {"event": "release", "x": 200, "y": 280},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "before.vtu"},
+        {"event": "drag", "from": [200, 20], "to": [200, 280], "steps": 10},
+        {"event": "idle"},
+        {"event": "save_session", "file": "session.json"},
+        {"event": "save_volume", "file": "after.vtu"},
+        {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const TetMesh before = read_volume(dir / "before.vtu"), after = read_volume(dir / "after.vtu");
+    EXPECT_LT(after.tet_count(), 0.7 * before.tet_count());
+    EXPECT_GT(after.tet_count(), 0.3 * before.tet_count());
+    double before_max_x = -1e9, after_max_x = -1e9, after_min_x = 1e9;
+    for (const auto& p : before.positions) before_max_x = std::max(before_max_x, p.x());
+    for (const auto& p : after.positions) after_max_x = std::max(after_max_x, p.x()), after_min_x = std::min(after_min_x, p.x());
+    EXPECT_GT(before_max_x, 0.99);
+    EXPECT_LT(after_max_x, 0.2) << "the +x half (right of the screen) should be gone";
+    EXPECT_LT(after_min_x, -0.99);
+
+    // The recorded session holds the current view and the stroke; `waxwork run` replays it to the
+    // identical volume.
+    nlohmann::json session = nlohmann::json::parse(testing::read_text(dir / "session.json"));
+    ASSERT_EQ(session["steps"].size(), 1u);
+    EXPECT_EQ(session["steps"][0]["op"], "stroke_cut");
+    EXPECT_NEAR(session["camera"]["eye_direction"][2].get<double>(), 1.0, 1e-9);
+    EXPECT_EQ(session["image"]["width"], 400);
+    session["steps"].push_back({{"save", "replay.vtu"}});
+    std::ofstream(dir / "replay.json") << session.dump(2);
+    const auto run = run_waxwork("run " + (dir / "replay.json").string() + " -o " + (dir / "run").string());
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_TRUE(read_volume(dir / "run" / "replay.vtu") == after);
+}
+
+TEST_F(EditorWindow, PaintStrokeChangesTheMaterialWhereDrawn) {
+    const fs::path dir = scratch_dir("editor_paint_stroke");
+    // The object is skin; the brush paints marble (the material panel's default) along the upper
+    // part of the front face.
+    const auto r = run_script(dir, R"([
+        {"event": "tool", "tool": "paint"},
+        {"frame": 2, "event": "drag", "from": [150, 90], "to": [250, 90], "steps": 10},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "painted.vtu"},
+        {"event": "idle"}])", "--material skin1");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const TetMesh painted = read_volume(dir / "painted.vtu");
+    ASSERT_TRUE(painted.has_materials());
+    const TetMaterial skin = material_preset("skin1");
+    // The stroke on the front face: from x = -50 px to +50 px of the centre, 60 px above it.
+    const double u = units_per_pixel_at_front_face();
+    const Eigen::Vector3d a(-50 * u, 60 * u, 1), b(50 * u, 60 * u, 1);
+    // The brush's Gaussian (sigma 0.05 x the bounding radius) drops below PaintOp's cutoff weight 1e-3
+    // at sqrt(2 ln 1000) sigma; tet centroids lie up to about an edge (0.25 here) from a painted point.
+    const double reach = std::sqrt(2 * std::log(1000.0)) * 0.05 * std::sqrt(3.0) + 0.25;
+    size_t changed = 0;
+    for (size_t t = 0; t < painted.tet_count(); ++t) {
+        if (painted.materials[t] == skin) continue;
+        ++changed;
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+        for (const int32_t v : painted.tets[t]) centroid += 0.25 * painted.positions[v];
+        const double s = std::clamp((centroid - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+        EXPECT_LT((centroid - (a + s * (b - a))).norm(), reach) << "tet " << t << " painted away from the stroke";
+    }
+    EXPECT_GT(changed, 0u);
+    EXPECT_LT(changed, painted.tet_count() / 4);
+}
+
+TEST_F(EditorWindow, PieceDragAfterFractureMovesThatPiece) {
+    const fs::path dir = scratch_dir("editor_piece_drag");
+    // A click with the Fracture tool breaks the cube into random pieces; dragging the piece under the
+    // centre 100 px to the right moves it along +x.
+    const auto r = run_script(dir, R"([
+        {"event": "tool", "tool": "fracture"},
+        {"frame": 2, "event": "press", "x": 200, "y": 150},
+        {"event": "release", "x": 200, "y": 150},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "fractured.vtu"},
+        {"event": "tool", "tool": "move_piece"},
+        {"event": "drag", "from": [200, 150], "to": [300, 150], "steps": 10},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "moved.vtu"},
+        {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const TetMesh fractured = read_volume(dir / "fractured.vtu"), moved = read_volume(dir / "moved.vtu");
+    ASSERT_GT(fractured.piece_transforms.size(), 1u);
+    ASSERT_EQ(moved.piece_transforms.size(), fractured.piece_transforms.size());
+    EXPECT_EQ(moved.positions, fractured.positions);  // pieces move by their transforms
+    int moved_pieces = 0;
+    for (size_t i = 0; i < moved.piece_transforms.size(); ++i) {
+        const Eigen::Vector3d shift = moved.piece_transforms[i].translation - fractured.piece_transforms[i].translation;
+        if (shift.norm() == 0) continue;
+        ++moved_pieces;
+        // The grabbed point on the front face follows the cursor 100 px right, at its depth.
+        EXPECT_NEAR(shift.x(), 100 * units_per_pixel_at_front_face(), 1e-3);
+        EXPECT_NEAR(shift.y(), 0, 1e-6);
+        EXPECT_NEAR(shift.z(), 0, 1e-6);
+    }
+    EXPECT_EQ(moved_pieces, 1);
+}
+
+TEST_F(EditorWindow, DraggedPieceIsShownMovedBeforeTheDocumentMovesIt) {
+    // The screenshot of a drag still in progress (pressed, moved, not released) shows the piece where
+    // the finished drag puts it: the same silhouette as after the release, out beyond the cube.
+    const std::string fracture = R"([{"event": "tool", "tool": "fracture"},
+        {"frame": 2, "event": "press", "x": 200, "y": 150}, {"event": "release", "x": 200, "y": 150},
+        {"event": "idle"}, {"event": "tool", "tool": "move_piece"}, )";
+    const fs::path dragging = scratch_dir("editor_piece_preview"), released = scratch_dir("editor_piece_released");
+    auto r = run_script(dragging, fracture + R"({"event": "press", "x": 200, "y": 150},
+        {"event": "move", "x": 250, "y": 150}, {"event": "move", "x": 300, "y": 150}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_script(released, fracture + R"({"event": "drag", "from": [200, 150], "to": [300, 150], "steps": 2},
+        {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Image preview = read_png(dragging / "shot.png"), done = read_png(released / "shot.png");
+    ASSERT_EQ(preview.width, done.width);
+    ASSERT_EQ(preview.height, done.height);
+    // Background: the corner's colour. The radiance differs (the document's move is solved again), the
+    // coverage must not, but for antialiased edge pixels.
+    const auto is_object = [](const Image& image, int x, int y) {
+        for (int c = 0; c < 3; ++c)
+            if (std::abs(image.pixel(x, y)[c] - image.pixel(0, 0)[c]) > 2) return true;
+        return false;
+    };
+    int disagree = 0;
+    for (int y = 0; y < preview.height; ++y)
+        for (int x = 0; x < preview.width; ++x) disagree += is_object(preview, x, y) != is_object(done, x, y);
+    EXPECT_LT(disagree, preview.width * preview.height / 100);
+    // The cube spans 200 +- 1 / units_per_pixel pixels; the dragged piece reaches beyond.
+    const int cube_edge = 200 + static_cast<int>(std::ceil(1 / units_per_pixel_at_front_face()));
+    int beyond = 0;
+    for (int x = cube_edge + 5; x < preview.width; ++x) beyond += is_object(preview, x, 150);
+    EXPECT_GT(beyond, 20);
+}
+
+TEST_F(EditorWindow, ShortcutKeysSelectToolsAndUndo) {
+    const fs::path dir = scratch_dir("editor_keys");
+    // C selects the cut tool by its shortcut, Ctrl+Z undoes the cut: the volume is as loaded again.
+    const auto r = run_script(dir, R"([
+        {"frame": 2, "event": "save_volume", "file": "loaded.vtu"},
+        {"event": "key", "key": "C"},
+        {"event": "drag", "from": [200, 20], "to": [200, 280], "steps": 6},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "cut.vtu"},
+        {"event": "key", "key": "Z", "mods": ["ctrl"]},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "undone.vtu"},
+        {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const TetMesh loaded = read_volume(dir / "loaded.vtu");
+    EXPECT_LT(read_volume(dir / "cut.vtu").tet_count(), loaded.tet_count());
+    EXPECT_TRUE(read_volume(dir / "undone.vtu") == loaded);
+}
+
+TEST_F(EditorWindow, LightDragZoomAndPanAreWhatASavedSessionRecords) {
+    const fs::path dir = scratch_dir("editor_light_view");
+    // The default key light turned by a trackball drag 60 px right of the centre, then two wheel
+    // steps in and a 30 px pan to the right; the session saved afterwards holds that light and view.
+    const auto r = run_script(dir, R"([
+        {"event": "tool", "tool": "light"},
+        {"frame": 2, "event": "drag", "from": [200, 150], "to": [260, 150], "steps": 6},
+        {"event": "scroll", "x": 200, "y": 150, "dy": 2},
+        {"event": "drag", "from": [200, 150], "to": [230, 150], "steps": 3, "button": "middle"},
+        {"event": "idle"},
+        {"event": "save_session", "file": "view.json"},
+        {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json session = nlohmann::json::parse(testing::read_text(dir / "view.json"));
+    // Trackball: the sphere point under the centre, +z, goes to the one under (260, 150): a turn of
+    // asin(60 / 150) about +y (the sphere's radius is half the view's height).
+    const double angle = std::asin(60.0 / 150.0);
+    const Eigen::Vector3d key = Eigen::Vector3d(1, -1, -1).normalized();  // default_key_light
+    const Eigen::Vector3d expected = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()) * key;
+    ASSERT_EQ(session["lights"].size(), 1u);
+    const auto& direction = session["lights"][0]["direction"];
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(direction[i].get<double>(), expected[i], 1e-9) << i;
+    // Zoom: the framing distance times 0.85 per step, recorded as the margin.
+    EXPECT_NEAR(session["camera"]["margin"].get<double>(), 1.1 * 0.85 * 0.85, 1e-9);
+    // Pan: the target moves left by 30 px at the target's depth (the point under the cursor follows it).
+    const double distance = 1.1 * 0.85 * 0.85 * std::sqrt(3.0) / std::sin(15 * std::numbers::pi / 180);
+    const double shift = 30 * 2 * distance * std::tan(15 * std::numbers::pi / 180) / 300;
+    const auto& offset = session["camera"]["target_offset"];
+    EXPECT_NEAR(offset[0].get<double>(), -shift, 1e-9);
+    EXPECT_NEAR(offset[1].get<double>(), 0, 1e-9);
+    EXPECT_NEAR(offset[2].get<double>(), 0, 1e-9);
+}
+
+TEST(EditorWithoutDisplay, BadInputScriptsAreOneLineErrorsNamingTheEntry) {
+    const fs::path dir = scratch_dir("editor_bad_script");
+    const fs::path script = dir / "bad.json";
+    std::ofstream(script) << R"([{"event": "tool", "tool": "cut"}, {"event": "press", "x": 3}])";
+    const auto r = run_waxwork("edit " + kAssets + "/meshes/cube.obj --input " + script.string());
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_EQ(testing::line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(script.string() + ": entry 1 (press): missing field 'y'"), std::string::npos) << r.err;
 }
 
 TEST(EditorWithoutDisplay, FailsWithAOneLineError) {

@@ -110,6 +110,47 @@ TEST(OrbitCamera, UnprojectedRayPassesThroughTheProjectedPoint) {
     EXPECT_LT((centre.direction + camera.eye_direction()).norm(), 1e-9);
 }
 
+TEST(OrbitCamera, SettingsReproduceThePannedZoomedView) {
+    // What a saved session records: frame_camera on those settings must give the editor's current view.
+    OrbitCamera camera(test_box(), CameraSettings{}, 1.5);
+    camera.orbit(0.6, -0.2);
+    camera.pan(40, -25, 400);
+    camera.zoom(0.7);
+    for (const double aspect : {1.5, 0.8}) {
+        const CameraSettings settings = camera.settings(aspect);
+        EXPECT_GT(settings.target_offset.norm(), 0);
+        const CameraFrame expected = camera.frame(aspect);
+        const CameraFrame actual = frame_camera(test_box(), settings, aspect);
+        EXPECT_LT((actual.view - expected.view).cwiseAbs().maxCoeff(), 1e-9) << aspect;
+        EXPECT_LT((actual.projection - expected.projection).cwiseAbs().maxCoeff(), 1e-9) << aspect;
+        // And a camera built from them starts there.
+        const OrbitCamera rebuilt(test_box(), settings, aspect);
+        EXPECT_LT((rebuilt.eye() - camera.eye()).norm(), 1e-9);
+        EXPECT_LT((rebuilt.target() - camera.target()).norm(), 1e-9);
+    }
+    // Unpanned and unzoomed: the default settings come back.
+    const OrbitCamera fresh(test_box(), CameraSettings{}, 1.5);
+    EXPECT_NEAR(fresh.settings(1.5).margin, CameraSettings{}.margin, 1e-12);
+    EXPECT_EQ(fresh.settings(1.5).target_offset, Eigen::Vector3d::Zero());
+}
+
+TEST(OrbitCamera, DepthRangeKeepsTheSceneAfterPanning) {
+    // Panned far to the side, every corner of the box must still lie between the near and far planes.
+    OrbitCamera camera(test_box(), CameraSettings{}, 1.0);
+    camera.pan(-900, 0, 300);  // three viewport heights: the target far outside the box
+    camera.orbit(1.2, 0);      // now the box lies behind or in front of the target along the view
+    const Eigen::Vector3d lo = test_box().min(), hi = test_box().max();
+    for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector3d p((corner & 1) ? hi.x() : lo.x(), (corner & 2) ? hi.y() : lo.y(), (corner & 4) ? hi.z() : lo.z());
+        const CameraFrame frame = camera.frame(1.0);
+        const Eigen::Vector4d clip = frame.projection * frame.view * p.homogeneous();
+        const double depth = clip.z() / clip.w();
+        EXPECT_GT(clip.w(), 0) << corner;  // in front of the eye
+        EXPECT_GT(depth, -1) << corner;
+        EXPECT_LT(depth, 1) << corner;
+    }
+}
+
 TEST(OrbitCamera, RefusesWhatFrameCameraRefuses) {
     CameraSettings bad;
     bad.eye_direction = Eigen::Vector3d::Zero();

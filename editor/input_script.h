@@ -1,0 +1,100 @@
+// Scripted mouse and keyboard input for the editor (`waxwork edit --input SCRIPT.json`): a JSON list
+// of timed events replayed into the window through the callbacks GLFW calls for real input, so tests
+// and docs drive the real mouse tools headless under xvfb.
+//
+//   [
+//     {"event": "tool", "tool": "cut"},                       select a tool (ids: tool_infos())
+//     {"frame": 3, "event": "press", "x": 200, "y": 300, "button": "left", "mods": ["shift"]},
+//     {"event": "move", "x": 260, "y": 310},
+//     {"event": "release", "x": 420, "y": 320, "button": "left"},
+//     {"event": "drag", "from": [200, 300], "to": [420, 320], "steps": 12, "button": "left"},
+//                                 press, `steps` moves on successive frames, release ("points":
+//                                 [[x, y], ...] instead of from/to: through those points)
+//     {"event": "scroll", "x": 400, "y": 300, "dy": 2},       wheel steps (positive zooms in)
+//     {"event": "key", "key": "Home", "mods": ["ctrl"]},      press and release a key
+//     {"event": "idle"},                                      wait until edits are applied and solved
+//     {"event": "save_session", "file": "s.json"},            as File > Save session / Save volume
+//     {"event": "save_volume", "file": "v.vtu"}
+//   ]
+//
+// Positions are window coordinates (GLFW's: screen units, origin top-left; with --hide-ui the view
+// fills the window). "frame" is the earliest frame an event fires, counted from the first frame that
+// shows the loaded object; events fire in order, each at the earliest one frame after the previous
+// (several per frame would pile a whole drag into one frame). Output files are relative to the
+// script's directory. Errors name the file and the entry ("s.json: entry 3 (press): field 'x': ...").
+#pragma once
+
+#include "editor/viewport_tools.h"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace waxwork {
+
+enum class ScriptAction { Move, Press, Release, Scroll, Key, SelectTool, WaitIdle, SaveSession, SaveVolume };
+
+struct ScriptEvent {
+    ScriptAction action = ScriptAction::Move;
+    std::optional<int> frame;  // earliest frame; nullopt: one frame after the previous event
+    double x = 0, y = 0;       // window coordinates (Move, Press, Release, Scroll)
+    int button = 0;            // GLFW_MOUSE_BUTTON_LEFT / RIGHT / MIDDLE
+    int mods = 0;              // GLFW_MOD_SHIFT | GLFW_MOD_CONTROL | GLFW_MOD_ALT
+    double scroll = 0;         // wheel steps
+    int key = 0;               // GLFW_KEY_*
+    Tool tool = Tool::Orbit;
+    std::filesystem::path file;  // SaveSession, SaveVolume (absolute after parsing)
+    std::string context;         // "SCRIPT: entry N (kind)" for messages
+};
+
+struct InputScript {
+    std::string name;
+    std::vector<ScriptEvent> events;  // drags expanded into press, moves, release
+};
+
+// Throws InvalidArgumentError "NAME: entry N (kind): problem"; relative files resolve against
+// `base_directory`.
+InputScript parse_input_script(const nlohmann::ordered_json& json, const std::filesystem::path& base_directory,
+                               const std::string& name);
+// Reads and parses; FileError for unreadable files or malformed JSON.
+InputScript read_input_script(const std::filesystem::path& path);
+
+// The key for a name: "A".."Z", "0".."9", "Escape" (or "Esc"), "Home", "Tab", "Delete", "Enter",
+// "Space" (case-insensitive); nullopt for others.
+std::optional<int> key_from_name(const std::string& name);
+
+// What the player drives: EditorApp through GLFW's callbacks in the window, a fake in the tests.
+class ScriptTarget {
+public:
+    virtual ~ScriptTarget() = default;
+    virtual bool ready() const = 0;  // the loaded object is on screen (frames count from here)
+    virtual bool idle() const = 0;   // edits applied and the solve converged
+    virtual void cursor(double x, double y) = 0;
+    virtual void button(int button, bool press, int mods) = 0;
+    virtual void scroll(double steps) = 0;
+    virtual void key(int key, int mods) = 0;  // press and release
+    virtual void select_tool(Tool tool) = 0;
+    virtual void save_session(const std::filesystem::path& file) = 0;
+    virtual void save_volume(const std::filesystem::path& file) = 0;
+};
+
+// Replays a script, a frame at a time.
+class InputScriptPlayer {
+public:
+    explicit InputScriptPlayer(InputScript script) : script_(std::move(script)) {}
+    // Called once per frame before the frame is drawn: fires the events due.
+    void advance(ScriptTarget& target);
+    bool done() const { return next_ >= script_.events.size(); }
+    const InputScript& script() const { return script_; }
+
+private:
+    InputScript script_;
+    size_t next_ = 0;
+    int frame_ = -1;       // frames since the target became ready
+    int last_fired_ = -1;  // the frame the previous event fired in
+};
+
+}  // namespace waxwork

@@ -1,0 +1,115 @@
+// The Lights panel of EditorApp: add and remove directional and point lights, pick the one the Light
+// tool drags in the view, and set each light's colour and intensity separately (the solver takes
+// their product per channel, solver/lighting.h).
+#include "editor/editor_app.h"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cstdio>
+
+namespace waxwork {
+
+namespace {
+
+// A new point light: above and in front of the view's target, outside the object.
+Light new_point_light(const std::optional<OrbitCamera>& camera) {
+    Light light;
+    light.type = LightType::Point;
+    const Eigen::Vector3d centre = camera ? camera->target() : Eigen::Vector3d::Zero();
+    const double reach = camera ? 2.5 * camera->scene_radius() : 2.0;
+    const Eigen::Vector3d towards = camera ? Eigen::Vector3d(camera->eye_direction() + camera->up_axis()).normalized()
+                                           : Eigen::Vector3d(0, 1, 1).normalized();
+    light.vector = centre + reach * towards;
+    // Point intensity is radiant intensity: at the reach it lights like a unit directional light.
+    light.intensity = {reach * reach, reach * reach, reach * reach};
+    return light;
+}
+
+}  // namespace
+
+void EditorApp::draw_light_panel() {
+    int remove = -1;
+    for (int i = 0; i < static_cast<int>(lighting_.lights.size()); ++i) {
+        Light& light = lighting_.lights[i];
+        ImGui::PushID(i);
+        bool changed = false;
+        char title[48];
+        std::snprintf(title, sizeof title, "%s light %d", light.type == LightType::Directional ? "Directional" : "Point",
+                      i + 1);
+        if (ImGui::RadioButton(title, selected_light_ == i)) selected_light_ = i;
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("The Light tool (L) drags the selected light in the view");
+        ImGui::SameLine(ImGui::GetContentRegionAvail().x - 60 * ui_scale_);
+        if (ImGui::SmallButton("remove")) remove = i;
+        int type = light.type == LightType::Directional ? 0 : 1;
+        if (ImGui::Combo("type", &type, "directional\0point\0")) {
+            const bool to_point = type == 1;
+            if (to_point != (light.type == LightType::Point)) {
+                // A point light placed where the directional light comes from, outside the object.
+                const double reach = camera_ ? 2.5 * camera_->scene_radius() : 2.0;
+                const Eigen::Vector3d centre = camera_ ? camera_->target() : Eigen::Vector3d::Zero();
+                light.type = to_point ? LightType::Point : LightType::Directional;
+                light.vector = to_point ? Eigen::Vector3d(centre - reach * light.vector.normalized())
+                                        : Eigen::Vector3d((centre - light.vector).normalized());
+                changed = true;
+            }
+        }
+        float v[3] = {static_cast<float>(light.vector.x()), static_cast<float>(light.vector.y()),
+                      static_cast<float>(light.vector.z())};
+        if (ImGui::DragFloat3(light.type == LightType::Directional ? "travels along" : "position", v, 0.01f)) {
+            const Eigen::Vector3d next(v[0], v[1], v[2]);
+            if (next.allFinite() && (light.type == LightType::Point || next.norm() > 1e-6)) {
+                light.vector = next;
+                changed = true;
+            }
+        }
+        // Colour (brightest channel 1) times intensity: the two edited apart.
+        const double strength = std::max({light.intensity[0], light.intensity[1], light.intensity[2]});
+        float colour[3] = {1, 1, 1};
+        if (strength > 0)
+            for (int c = 0; c < 3; ++c) colour[c] = static_cast<float>(light.intensity[c] / strength);
+        float intensity = static_cast<float>(strength);
+        const bool colour_changed = ImGui::ColorEdit3("colour", colour, ImGuiColorEditFlags_Float);
+        const bool intensity_changed = ImGui::DragFloat("intensity", &intensity, 0.01f * std::max(intensity, 0.1f), 0.0f,
+                                                        1e6f, "%.3f", ImGuiSliderFlags_Logarithmic);
+        if (colour_changed || intensity_changed) {
+            const float peak = std::max({colour[0], colour[1], colour[2]});
+            for (int c = 0; c < 3; ++c) {
+                const double normalised = peak > 0 ? std::clamp(colour[c] / peak, 0.0f, 1.0f) : 1.0;
+                light.intensity[c] = std::max(0.0f, intensity) * normalised;
+            }
+            changed = true;
+        }
+        if (changed) request_solve();
+        ImGui::Separator();
+        ImGui::PopID();
+    }
+    if (remove >= 0) {
+        lighting_.lights.erase(lighting_.lights.begin() + remove);
+        selected_light_ = std::clamp(selected_light_, 0, std::max(0, static_cast<int>(lighting_.lights.size()) - 1));
+        request_solve();
+    }
+    const bool room = lighting_.lights.size() < static_cast<size_t>(kMaxRenderLights);
+    if (!room) ImGui::BeginDisabled();
+    if (ImGui::Button("Add directional")) {
+        lighting_.lights.push_back(default_key_light());
+        selected_light_ = static_cast<int>(lighting_.lights.size()) - 1;
+        request_solve();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Add point")) {
+        lighting_.lights.push_back(new_point_light(camera_));
+        selected_light_ = static_cast<int>(lighting_.lights.size()) - 1;
+        request_solve();
+    }
+    if (!room) ImGui::EndDisabled();
+    ImGui::TextDisabled("Light tool (L): drag in the view to turn or move the selected light");
+    float ambient = static_cast<float>(lighting_.ambient[0]);
+    if (ImGui::DragFloat("ambient", &ambient, 0.002f, 0.0f, 10.0f, "%.3f")) {
+        lighting_.ambient = {std::max(0.0f, ambient), std::max(0.0f, ambient), std::max(0.0f, ambient)};
+        request_solve();
+    }
+    if (ImGui::Checkbox("shadows", &lighting_.shadows)) request_solve();
+}
+
+}  // namespace waxwork

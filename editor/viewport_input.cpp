@@ -1,0 +1,236 @@
+// EditorApp's pointer input: GLFW's cursor, button and scroll callbacks (or an input script calling
+// the same callbacks) become PointerEvents for ViewportTools, and its outcome becomes camera changes,
+// light changes and queued edits. The tool logic itself lives in viewport_tools.cpp.
+#include "editor/editor_app.h"
+
+#include "editor/stroke_tools.h"
+#include "solver/material.h"
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+
+#include <algorithm>
+#include <limits>
+
+namespace waxwork {
+
+ViewportContext EditorApp::viewport_context() {
+    ViewportContext context;
+    context.camera = camera_ ? &*camera_ : nullptr;
+    context.width = view_w_;
+    context.height = view_h_;
+    context.pick_piece = [this](const Eigen::Vector2d& pixel) { return piece_under(pixel); };
+    context.piece_transforms = &scene_->piece_transforms;
+    context.lights = &lighting_.lights;
+    context.selected_light = selected_light_;
+    return context;
+}
+
+bool EditorApp::ui_has_pointer() const {
+    if (options_.hide_ui) return false;
+    if (file_dialog_.is_open()) return true;
+    // ImGui decides capture for where the window's pointer is (it polls it every frame). An event
+    // somewhere else came from an input script: ImGui's decision is about another position then.
+    double x = 0, y = 0;
+    glfwGetCursorPos(window_, &x, &y);
+    const bool at_pointer = std::abs(x - cursor_.x()) < 0.5 && std::abs(y - cursor_.y()) < 0.5;
+    return ImGui::GetIO().WantCaptureMouse && at_pointer;
+}
+
+void EditorApp::on_cursor(double x, double y) {
+    cursor_ = Eigen::Vector2d(x, y);
+    int mods = mods_;
+    if (glfwGetKey(window_, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS || glfwGetKey(window_, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS)
+        mods |= GLFW_MOD_SHIFT;
+    pointer_event(PointerAction::Move, PointerButton::None, mods);
+}
+
+void EditorApp::on_mouse_button(int button, int action, int mods) {
+    mods_ = mods;
+    const PointerButton b = button == GLFW_MOUSE_BUTTON_LEFT     ? PointerButton::Left
+                            : button == GLFW_MOUSE_BUTTON_RIGHT  ? PointerButton::Right
+                            : button == GLFW_MOUSE_BUTTON_MIDDLE ? PointerButton::Middle
+                                                                 : PointerButton::None;
+    if (b == PointerButton::None || (action != GLFW_PRESS && action != GLFW_RELEASE)) return;
+    pointer_event(action == GLFW_PRESS ? PointerAction::Press : PointerAction::Release, b, mods);
+}
+
+void EditorApp::on_scroll(double steps) { pointer_event(PointerAction::Scroll, PointerButton::None, mods_, steps); }
+
+void EditorApp::pointer_event(PointerAction action, PointerButton button, int mods, double scroll) {
+    PointerEvent event;
+    event.action = action;
+    event.button = button;
+    event.scroll = scroll;
+    event.modifiers.shift = (mods & GLFW_MOD_SHIFT) != 0;
+    event.modifiers.ctrl = (mods & GLFW_MOD_CONTROL) != 0;
+    event.modifiers.alt = (mods & GLFW_MOD_ALT) != 0;
+    // Viewport pixels: framebuffer units from the viewport's top-left corner.
+    event.position = cursor_ * framebuffer_scale_ - Eigen::Vector2d(view_x_, view_y_);
+    if (action == PointerAction::Press || action == PointerAction::Scroll) {
+        // Drags and the wheel start only in the 3D view, not over a panel or menu.
+        const bool inside = event.position.x() >= 0 && event.position.y() >= 0 && event.position.x() < view_w_ &&
+                            event.position.y() < view_h_;
+        if (!inside || ui_has_pointer()) return;
+    }
+    const ToolOutcome outcome = tools_.pointer(event, viewport_context());
+    apply_tool_outcome(outcome);
+}
+
+void EditorApp::apply_tool_outcome(const ToolOutcome& outcome) {
+    if (outcome.light_changed) request_solve();
+    if (!camera_ || !scene_->core) return;
+    try {
+        if (outcome.cut) {
+            last_cut_ = outcome.cut->stroke;
+            queue_edit(*outcome.cut);
+        }
+        if (outcome.paint) {
+            if (!scene_->surface_bvh) return;
+            const auto op = paint_op(*camera_, *scene_->surface_bvh, *outcome.paint, view_w_, view_h_,
+                                     custom_material_.value_or(material_preset("marble")),
+                                     brush_radius_ * camera_->scene_radius());
+            if (op) queue_edit(*op);
+            else status_ = "Paint: the stroke missed the object";
+        }
+        if (outcome.fracture) {
+            FractureOp op;
+            if (scene_->surface_bvh && outcome.fracture->size() >= 2) {
+                // Seeds along the stroke, on the surface under it: the object breaks where drawn.
+                const auto points = stroke_on_surface(*camera_, *scene_->surface_bvh, *outcome.fracture, view_w_, view_h_);
+                const size_t step = std::max<size_t>(1, points.size() / static_cast<size_t>(fracture_pieces_));
+                for (size_t i = 0; i < points.size(); i += step) op.seeds.push_back(points[i]);
+            }
+            if (op.seeds.size() < 2) {  // a click, or a stroke that missed: random pieces
+                op.seeds.clear();
+                op.pieces = fracture_pieces_;
+                op.seed = fracture_seed_++;
+            }
+            queue_edit(op);
+        }
+        if (outcome.move) queue_edit(*outcome.move);
+    } catch (const std::exception& e) {
+        set_error(e.what());
+    }
+}
+
+void EditorApp::select_tool(Tool tool) {
+    // Relax is an action on the last cut, not a mode.
+    if (tool == Tool::Relax) relax_last_cut();
+    else tools_.set_tool(tool, viewport_context());
+}
+
+std::optional<PieceHit> EditorApp::piece_under(const Eigen::Vector2d& pixel) const {
+    if (!camera_ || !scene_->surface_bvh || !scene_->render_input) return std::nullopt;
+    const auto hit = first_hit(*scene_->surface_bvh, camera_->unproject(pixel, view_w_, view_h_),
+                               camera_->distance() + 4 * camera_->scene_radius());
+    if (!hit) return std::nullopt;
+    const auto& positions = scene_->render_input->positions;
+    if (positions.size() != scene_->surface_piece.size()) return std::nullopt;
+    size_t nearest = 0;
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < positions.size(); ++i) {
+        const double d = (positions[i].cast<double>() - *hit).squaredNorm();
+        if (d < best) best = d, nearest = i;
+    }
+    return PieceHit{scene_->surface_piece[nearest], *hit};
+}
+
+void EditorApp::handle_viewport_input() { update_piece_preview(); }
+
+void EditorApp::update_piece_preview() {
+    const std::optional<PiecePreview>& preview = tools_.piece_preview();
+    std::optional<Eigen::Vector3d> shown;
+    if (preview) {
+        const auto& transforms = scene_->piece_transforms;
+        const bool landed = !tools_.active() && preview->piece < static_cast<int>(transforms.size()) &&
+                            (transforms[preview->piece].translation - preview->transform.translation -
+                             preview->translation).norm() <= 1e-9 * (1 + preview->translation.norm());
+        // The document applied the move, or nothing queued or running is left that could (it
+        // failed): show the document's mesh instead.
+        const bool settled = !tools_.active() && pending_jobs_.empty() && !tick_task_.busy();
+        if (landed || settled) tools_.clear_preview();
+        else
+            shown = preview->translation;
+    }
+    if (shown != shown_preview_) {
+        shown_preview_ = shown;
+        ++scene_version_;  // the view cache must draw again
+    }
+}
+
+SurfaceRenderInput EditorApp::with_piece_preview(const SurfaceRenderInput& input) const {
+    SurfaceRenderInput moved = input;
+    const std::optional<PiecePreview>& preview = tools_.piece_preview();
+    if (!preview || !shown_preview_ || scene_->surface_piece.size() != moved.positions.size()) return moved;
+    const Eigen::Vector3f delta = shown_preview_->cast<float>();
+    for (size_t i = 0; i < moved.positions.size(); ++i)
+        if (scene_->surface_piece[i] == preview->piece) moved.positions[i] += delta;
+    return moved;
+}
+
+void EditorApp::draw_tool_overlay() {
+    const ToolOverlay overlay = tools_.overlay();
+    if (overlay.stroke.size() < 2) return;
+    ImDrawList* draw = ImGui::GetForegroundDrawList();
+    const double s = framebuffer_scale_;
+    auto to_screen = [&](double x, double y) {
+        return ImVec2(static_cast<float>((x + view_x_) / s), static_cast<float>((y + view_y_) / s));
+    };
+    const ImU32 colour = tools_.tool() == Tool::Paint ? IM_COL32(120, 200, 255, 230) : IM_COL32(255, 190, 90, 230);
+    const auto& p = overlay.stroke;
+    for (size_t i = 1; i < p.size(); ++i)
+        draw->AddLine(to_screen(p[i - 1][0], p[i - 1][1]), to_screen(p[i][0], p[i][1]), colour, 2.0f * ui_scale_);
+    for (const auto& tick : overlay.cut_side_ticks)
+        draw->AddLine(to_screen(tick[0].x(), tick[0].y()), to_screen(tick[1].x(), tick[1].y()),
+                      IM_COL32(255, 110, 80, 230), 1.5f * ui_scale_);
+}
+
+namespace {
+
+// Calls the callbacks GLFW would call for real input, so scripted events take the same path:
+// ImGui's backend callbacks first (installed after ours), which chain to EditorApp's.
+class WindowScriptTarget final : public ScriptTarget {
+public:
+    WindowScriptTarget(GLFWwindow* window, EditorApp& app) : window_(window), app_(app) {}
+    bool ready() const override { return app_.viewport_ready(); }
+    bool idle() const override { return app_.idle(); }
+    void cursor(double x, double y) override {
+        const GLFWcursorposfun f = glfwSetCursorPosCallback(window_, nullptr);
+        glfwSetCursorPosCallback(window_, f);
+        if (f) f(window_, x, y);
+    }
+    void button(int button, bool press, int mods) override {
+        const GLFWmousebuttonfun f = glfwSetMouseButtonCallback(window_, nullptr);
+        glfwSetMouseButtonCallback(window_, f);
+        if (f) f(window_, button, press ? GLFW_PRESS : GLFW_RELEASE, mods);
+    }
+    void scroll(double steps) override {
+        const GLFWscrollfun f = glfwSetScrollCallback(window_, nullptr);
+        glfwSetScrollCallback(window_, f);
+        if (f) f(window_, 0.0, steps);
+    }
+    void key(int key, int mods) override {
+        const GLFWkeyfun f = glfwSetKeyCallback(window_, nullptr);
+        glfwSetKeyCallback(window_, f);
+        if (!f) return;
+        const int scancode = glfwGetKeyScancode(key);
+        f(window_, key, scancode, GLFW_PRESS, mods);
+        f(window_, key, scancode, GLFW_RELEASE, mods);
+    }
+    void select_tool(Tool tool) override { app_.select_tool(tool); }
+    void save_session(const std::filesystem::path& file) override { app_.save_session(file); }
+    void save_volume(const std::filesystem::path& file) override { app_.save_volume(file); }
+
+private:
+    GLFWwindow* window_;
+    EditorApp& app_;
+};
+
+}  // namespace
+
+std::unique_ptr<ScriptTarget> make_window_script_target(GLFWwindow* window, EditorApp& app) {
+    return std::make_unique<WindowScriptTarget>(window, app);
+}
+
+}  // namespace waxwork

@@ -1,0 +1,188 @@
+#include "editor/input_script.h"
+
+#include "tetops/error.h"
+
+#include <GLFW/glfw3.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+namespace waxwork {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+InputScript parse(const std::string& text) { return parse_input_script(Json::parse(text), "/scripts", "s.json"); }
+
+// The one-line message parsing `text` fails with.
+std::string parse_error(const std::string& text) {
+    try {
+        parse(text);
+    } catch (const InvalidArgumentError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(InputScript, ParsesEveryEventKind) {
+    const InputScript s = parse(R"([
+        {"event": "tool", "tool": "exact_cut"},
+        {"frame": 3, "event": "press", "x": 10, "y": 20.5, "button": "right", "mods": ["shift", "alt"]},
+        {"event": "move", "x": 15, "y": 25},
+        {"event": "release", "x": 16, "y": 26, "button": "right"},
+        {"event": "scroll", "x": 5, "y": 6, "dy": -2},
+        {"event": "key", "key": "home", "mods": ["ctrl"]},
+        {"event": "idle"},
+        {"event": "save_session", "file": "out/s.json"},
+        {"event": "save_volume", "file": "/tmp/v.vtu"}])");
+    ASSERT_EQ(s.events.size(), 9u);
+    EXPECT_EQ(s.events[0].action, ScriptAction::SelectTool);
+    EXPECT_EQ(s.events[0].tool, Tool::ExactCut);
+    EXPECT_FALSE(s.events[0].frame);
+    EXPECT_EQ(s.events[1].action, ScriptAction::Press);
+    EXPECT_EQ(s.events[1].frame, 3);
+    EXPECT_EQ(s.events[1].x, 10);
+    EXPECT_EQ(s.events[1].y, 20.5);
+    EXPECT_EQ(s.events[1].button, GLFW_MOUSE_BUTTON_RIGHT);
+    EXPECT_EQ(s.events[1].mods, GLFW_MOD_SHIFT | GLFW_MOD_ALT);
+    EXPECT_EQ(s.events[2].action, ScriptAction::Move);
+    EXPECT_EQ(s.events[3].action, ScriptAction::Release);
+    EXPECT_EQ(s.events[4].action, ScriptAction::Scroll);
+    EXPECT_EQ(s.events[4].scroll, -2);
+    EXPECT_EQ(s.events[5].key, GLFW_KEY_HOME);
+    EXPECT_EQ(s.events[5].mods, GLFW_MOD_CONTROL);
+    EXPECT_EQ(s.events[6].action, ScriptAction::WaitIdle);
+    EXPECT_EQ(s.events[7].file, std::filesystem::path("/scripts/out/s.json"));
+    EXPECT_EQ(s.events[8].file, std::filesystem::path("/tmp/v.vtu"));
+}
+
+TEST(InputScript, DragExpandsIntoPressMovesAndRelease) {
+    const InputScript s = parse(R"([{"frame": 5, "event": "drag", "from": [0, 100], "to": [40, 60], "steps": 4,
+                                    "button": "middle"}])");
+    ASSERT_EQ(s.events.size(), 6u);  // press, 4 moves, release
+    EXPECT_EQ(s.events[0].action, ScriptAction::Press);
+    EXPECT_EQ(s.events[0].frame, 5);
+    EXPECT_EQ(s.events[0].button, GLFW_MOUSE_BUTTON_MIDDLE);
+    for (int i = 1; i <= 4; ++i) {
+        EXPECT_EQ(s.events[i].action, ScriptAction::Move);
+        EXPECT_FALSE(s.events[i].frame);
+        EXPECT_DOUBLE_EQ(s.events[i].x, 10.0 * i);
+        EXPECT_DOUBLE_EQ(s.events[i].y, 100 - 10.0 * i);
+    }
+    EXPECT_EQ(s.events[5].action, ScriptAction::Release);
+    EXPECT_EQ(s.events[5].button, GLFW_MOUSE_BUTTON_MIDDLE);
+    EXPECT_EQ(s.events[5].x, 40);
+
+    const InputScript through = parse(R"([{"event": "drag", "points": [[1, 2], [3, 4], [5, 6]]}])");
+    ASSERT_EQ(through.events.size(), 4u);
+    EXPECT_EQ(through.events[2].x, 5);
+    EXPECT_EQ(through.events[3].action, ScriptAction::Release);
+    EXPECT_EQ(through.events[3].button, GLFW_MOUSE_BUTTON_LEFT);
+}
+
+TEST(InputScript, BadScriptsGetOneLineErrorsNamingTheFileAndEntry) {
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {R"({"event": "press"})", "s.json: an input script is a JSON list"},
+        {R"([{"event": "press", "x": 1, "y": 2}, 3])", "s.json: entry 1"},
+        {R"([{"x": 1}])", "s.json: entry 0: missing field 'event'"},
+        {R"([{"event": "hover", "x": 1, "y": 2}])", "s.json: entry 0: unknown event \"hover\""},
+        {R"([{"event": "press", "x": 1}])", "s.json: entry 0 (press): missing field 'y'"},
+        {R"([{"event": "press", "x": "a", "y": 1}])", "s.json: entry 0 (press): field 'x'"},
+        {R"([{"event": "press", "x": 1, "y": 1, "button": "fourth"}])", "field 'button'"},
+        {R"([{"event": "press", "x": 1, "y": 1, "mods": ["hyper"]}])", "field 'mods'"},
+        {R"([{"event": "press", "x": 1, "y": 1, "colour": 3}])", "unknown field 'colour'"},
+        {R"([{"event": "move", "x": 1, "y": 1, "frame": -1}])", "field 'frame'"},
+        {R"([{"event": "key", "key": "F13"}])", "s.json: entry 0 (key): field 'key'"},
+        {R"([{"event": "tool", "tool": "chisel"}])", "expected one of orbit, cut, exact_cut"},
+        {R"([{"event": "drag", "from": [0, 0]}])", "missing field 'to'"},
+        {R"([{"event": "drag", "from": [0, 0], "to": [1, 1], "points": [[0, 0], [1, 1]]}])", "either"},
+        {R"([{"event": "drag", "points": [[0, 0]]}])", "at least two"},
+        {R"([{"event": "drag", "from": [0, 0], "to": [1, 1], "steps": 0}])", "field 'steps'"},
+        {R"([{"event": "save_volume", "file": ""}])", "s.json: entry 0 (save_volume): field 'file'"},
+        {R"([{"event": "scroll", "x": 1, "y": 1}])", "missing field 'dy'"},
+    };
+    for (const auto& [text, expected] : cases) {
+        const std::string message = parse_error(text);
+        EXPECT_NE(message.find(expected), std::string::npos) << text << " -> " << message;
+        EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+}
+
+TEST(InputScript, UnreadableOrMalformedFilesAreFileErrors) {
+    EXPECT_THROW(read_input_script("/nonexistent/script.json"), FileError);
+    const auto path = std::filesystem::temp_directory_path() / ("waxwork_bad_script_" + std::to_string(::getpid()) + ".json");
+    std::ofstream(path) << "[{\"event\": ";
+    try {
+        read_input_script(path);
+        ADD_FAILURE() << "malformed JSON was accepted";
+    } catch (const FileError& e) {
+        EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+    }
+    std::filesystem::remove(path);
+}
+
+// Records what the player does, frame by frame.
+class FakeTarget final : public ScriptTarget {
+public:
+    bool is_ready = false, is_idle = true;
+    int frame = 0;
+    std::vector<std::string> log;
+    bool ready() const override { return is_ready; }
+    bool idle() const override { return is_idle; }
+    void cursor(double x, double y) override { add("cursor " + std::to_string(int(x)) + "," + std::to_string(int(y))); }
+    void button(int button, bool press, int) override { add((press ? "press " : "release ") + std::to_string(button)); }
+    void scroll(double steps) override { add("scroll " + std::to_string(int(steps))); }
+    void key(int key, int) override { add("key " + std::to_string(key)); }
+    void select_tool(Tool tool) override { add("tool " + std::to_string(static_cast<int>(tool))); }
+    void save_session(const std::filesystem::path& f) override { add("session " + f.filename().string()); }
+    void save_volume(const std::filesystem::path& f) override { add("volume " + f.filename().string()); }
+
+private:
+    void add(const std::string& s) { log.push_back(std::to_string(frame) + ": " + s); }
+};
+
+TEST(InputScriptPlayer, FiresInOrderOnePerFrameFromTheFirstReadyFrame) {
+    InputScriptPlayer player(parse(R"([{"event": "tool", "tool": "cut"},
+        {"frame": 3, "event": "drag", "from": [0, 0], "to": [10, 0], "steps": 1},
+        {"event": "idle"}, {"event": "save_volume", "file": "v.vtu"}])"));
+    FakeTarget target;
+    // Not ready: nothing fires and frames do not count.
+    for (target.frame = 0; target.frame < 3; ++target.frame) player.advance(target);
+    EXPECT_TRUE(target.log.empty());
+    target.is_ready = true;
+    for (; target.frame < 13; ++target.frame) {
+        target.is_idle = target.frame >= 10;  // the cut is being applied until window frame 10
+        player.advance(target);
+        EXPECT_EQ(player.done(), target.frame >= 11) << target.frame;
+    }
+    // Ready at window frame 3 = script frame 0; the press waits for script frame 3 (window frame 6);
+    // one event per frame after it; the save waits for idle (frame 10) and fires one frame later.
+    const std::vector<std::string> expected = {"3: tool 1",      "6: cursor 0,0",  "6: press 0",     "7: cursor 10,0",
+                                               "8: cursor 10,0", "8: release 0",   "11: volume v.vtu"};
+    EXPECT_EQ(target.log, expected);
+}
+
+TEST(InputScript, ExampleScriptsParse) {
+    int count = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(WAXWORK_ASSET_DIR) / "input")) {
+        if (entry.path().extension() != ".json") continue;
+        ++count;
+        const InputScript script = read_input_script(entry.path());
+        EXPECT_FALSE(script.events.empty()) << entry.path();
+    }
+    EXPECT_GE(count, 1);
+}
+
+TEST(InputScript, KeyNames) {
+    EXPECT_EQ(key_from_name("c"), GLFW_KEY_C);
+    EXPECT_EQ(key_from_name("Z"), GLFW_KEY_Z);
+    EXPECT_EQ(key_from_name("7"), GLFW_KEY_7);
+    EXPECT_EQ(key_from_name("Esc"), GLFW_KEY_ESCAPE);
+    EXPECT_EQ(key_from_name("ESCAPE"), GLFW_KEY_ESCAPE);
+    EXPECT_FALSE(key_from_name("F1"));
+    EXPECT_FALSE(key_from_name(""));
+}
+
+}  // namespace
+}  // namespace waxwork
