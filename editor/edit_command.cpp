@@ -29,6 +29,8 @@ struct EditCommandOptions {
     std::vector<std::string> lights;
     double scale = 1.0;
     std::vector<double> view;
+    std::string backend = "cpu";
+    std::string method = "jacobi";
 };
 
 void run_edit_command(const EditCommandOptions& o) {
@@ -48,6 +50,8 @@ void run_edit_command(const EditCommandOptions& o) {
     options.max_tets = o.max_tets;
     options.material = chosen_material(o.material);
     options.scale = o.scale;
+    options.solver_backend = parse_live_backend(o.backend);
+    options.solver_method = parse_live_method(o.method);
     for (const std::string& spec : o.lights) options.lights.push_back(parse_light_spec(spec));
     if (!o.view.empty()) {
         const Eigen::Vector3d v(o.view[0], o.view[1], o.view[2]);
@@ -62,7 +66,8 @@ void run_edit_command(const EditCommandOptions& o) {
             {"frame_ms", stats.mean_frame_ms}, {"view_ms", stats.mean_view_ms},
             {"solver_ticks", stats.ticks}, {"tick_ms", stats.tick_ms}, {"tets", stats.tets},
             {"vertices", stats.vertices},  {"gl_version", stats.gl_version},
-            {"gl_renderer", stats.gl_renderer},
+            {"gl_renderer", stats.gl_renderer}, {"solver_backend", stats.solver_backend},
+            {"gpu_fallback_reason", stats.gpu_fallback_reason},
         };
         std::cout << summary.dump() << "\n";
     }
@@ -94,6 +99,12 @@ void add_edit_command(CLI::App& app) {
     cmd->add_option("--view", options->view, "Direction from the object towards the camera, X,Y,Z")
         ->delimiter(',')
         ->expected(3);
+    cmd->add_option("--backend", options->backend,
+                    "Live solver: cpu, or gpu (CG on OpenGL compute shaders in a context shared with the window; "
+                    "falls back to the CPU, saying why, when the driver cannot run it)")
+        ->check(CLI::IsMember({"cpu", "gpu"}));
+    cmd->add_option("--method", options->method, "Live solver method on the CPU: jacobi or mgcg (multigrid CG)")
+        ->check(CLI::IsMember({"jacobi", "mgcg"}));
     cmd->footer(
         "Mouse: right drag (or Alt+left) orbits, middle drag (or Shift+right) pans, the wheel zooms.\n"
         "With --hide-ui the first frame shows exactly what `waxwork render` writes for the same volume,\n"

@@ -34,6 +34,7 @@
 #pragma once
 
 #include "editor/document.h"
+#include "editor/live_solver.h"
 #include "editor/render_pipeline.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
@@ -54,6 +55,11 @@ struct LiveSceneOptions {
     double mm_per_unit = 1.0;
     // converge() and converged() stop at this estimated relative error of phi (conjugate_gradient.h).
     double relative_tolerance = 1e-3;
+    // The per-frame solver (live_solver.h): method, backend, and the GPU backend's context (null: an
+    // OSMesa context of its own). A failing GPU falls back to the CPU (LiveScene::gpu_fallback_reason).
+    LiveMethod method = LiveMethod::JacobiCg;
+    LiveBackend backend = LiveBackend::Cpu;
+    std::shared_ptr<SolverGlContext> gl_context;
 };
 
 // One frame of the solve.
@@ -118,6 +124,11 @@ public:
     const DiffusionMatrix& matrix() const { return matrix_; }
     const TetConnectivity& connectivity() const { return *connectivity_; }
     std::vector<std::array<double, 3>> phi() const;
+    // The backend solving now (Cpu after a GPU fallback), why the GPU was given up ("" if it was not),
+    // and a line for the solver panel ("GPU CG (llvmpipe ...)").
+    LiveBackend backend() const;
+    std::string gpu_fallback_reason() const;
+    std::string solver_description() const;
 
 private:
     void rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update);
@@ -139,7 +150,7 @@ private:
     std::vector<Rgb> q_;                        // per volume vertex
     std::array<std::vector<double>, 3> b_;      // right-hand side per channel
     std::array<std::vector<double>, 3> phi_;    // current fluence per channel
-    std::array<double, 3> eigenvalue_hint_{};
+    std::unique_ptr<LiveSolver> solver_;
     std::array<double, 3> error_{1, 1, 1};
     std::array<bool, 3> converged_{};
     bool solved_since_change_ = false;
