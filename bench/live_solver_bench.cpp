@@ -25,7 +25,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr size_t kFrameTets = 100'000;
-constexpr int kFrames = 60;
+constexpr int kFrames = 30;
 constexpr int kFrameIterations = 8;  // as live_scene_bench: CG iterations per channel and frame
 
 double ms_since(Clock::time_point start) {

@@ -380,6 +380,10 @@ void EditorApp::start_tick() {
             progress.set_stage("radiance");
             const SolvedScene solved = core->live->solved_scene();
             r->input = make_render_input(mesh, solved, core->live->lighting(), settings);
+            // GPU backend in the hidden window's context (shared with this window's): the view draws E
+            // from the solver's device buffer. Not with an OSMesa context of the solver's own (when no
+            // shared context could be made): its buffers are not this window's.
+            if (core->live->options().gl_context) r->input->device_radiance = core->live->device_radiance();
             if (need_bvh || r->geometry_changed) {
                 r->bvh = std::make_shared<const TriangleBvh>(r->input->positions, r->input->triangles);
                 // Each surface vertex's piece, for picking pieces to move.
@@ -803,6 +807,7 @@ EditorRunStats run_editor(const EditorOptions& options) {
         stats.tick_ms = scene.ticks ? scene.tick_ms_sum / scene.ticks : 0;
         stats.solver_backend = live_backend_name(scene.solver_backend);
         stats.gpu_fallback_reason = scene.gpu_fallback_reason;
+        stats.view_reads_device_radiance = scene.render_input && scene.render_input->device_radiance;
     }
     glfwDestroyWindow(window);
     return stats;

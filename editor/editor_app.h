@@ -66,6 +66,7 @@ struct EditorRunStats {
     std::string gl_version, gl_renderer;
     std::string solver_backend;       // "cpu" or "gpu": what solved the last frame
     std::string gpu_fallback_reason;  // why the GPU backend was given up, if it was
+    bool view_reads_device_radiance = false;  // the 3D view drew E from the GPU solver's buffer
 };
 EditorRunStats run_editor(const EditorOptions& options);
 

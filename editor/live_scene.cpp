@@ -296,6 +296,11 @@ std::string LiveScene::solver_description() const {
     return solver_->description();
 }
 
+std::shared_ptr<const GpuBuffer> LiveScene::device_radiance() {
+    const std::lock_guard lock(mutex_);
+    return solver_->radiance_on_device(*mesh_, *connectivity_, q_, surface_.vertices);
+}
+
 std::vector<std::array<float, 3>> LiveScene::radiance_factors() const {
     const std::vector<std::array<double, 3>> phi = this->phi();
     const std::lock_guard lock(mutex_);

@@ -19,7 +19,8 @@
 // Solver choice: Jacobi-preconditioned CG in double, warm-started, per channel. The multires solver
 // (multires/multires_solver.h) is not used per frame: on spot it does not beat Jacobi CG to 1%
 // (README, multires_bench: 2.3 vs 2.1 ms at 50K, 27.1 vs 26.8 ms at 500K) and its hierarchy build
-// (224 ms at 500K) would take half of a cut's 500 ms budget, for no gain.
+// (224 ms at 500K) would take half of a cut's 500 ms budget, for no gain. That is the default;
+// LiveSceneOptions::method and backend select multigrid CG or the GPU instead (live_solver.h).
 //
 // Threading: every public member locks one internal mutex, so the window may call step() on a worker
 // thread while the UI thread applies edits; apply_change() and set_lighting() then wait for the
@@ -129,6 +130,10 @@ public:
     LiveBackend backend() const;
     std::string gpu_fallback_reason() const;
     std::string solver_description() const;
+    // With the GPU backend running: E per surface vertex (solved_scene().surface order) on the device,
+    // from the resident phi (LiveSolver::radiance_on_device), for a renderer sharing the solver's
+    // context to draw instead of the CPU's radiance_factor; else null. Reads the mesh.
+    std::shared_ptr<const GpuBuffer> device_radiance();
 
 private:
     void rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update);

@@ -5,6 +5,7 @@
 #include "multires/multigrid_preconditioner.h"
 #include "solver/gpu_compute.h"
 #include "solver/gpu_conjugate_gradient.h"
+#include "solver/gpu_radiance.h"
 #include "tetops/error.h"
 
 #include <algorithm>
@@ -70,6 +71,12 @@ struct LiveSolver::Multigrid {
 struct LiveSolver::Gpu {
     std::unique_ptr<GpuDiffusionSolver> solver;
     std::vector<std::array<double, 3>> staging;  // interleaved phi for uploads and read-backs
+    // Device radiance: weights from the boundary eta (reset when materials change), q (re-sent when
+    // the right-hand sides change), E per volume vertex, and the surface's volume-vertex index.
+    std::unique_ptr<GpuRadiance> radiance;
+    bool radiance_stale_weights = true, radiance_light_stale = true;
+    GpuBuffer volume_e, surface_index;
+    std::vector<int32_t> surface_vertices;  // what surface_index holds
 };
 
 LiveSolver::LiveSolver(const LiveSolverOptions& options)
@@ -133,6 +140,7 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
 // Material changes keep the eigenvalue hints, as the CPU path always did: the stopping rule confirms
 // convergence with the true residual anyway (conjugate_gradient.h).
 void LiveSolver::values_changed() {
+    if (gpu_) gpu_->radiance_stale_weights = true;  // the boundary eta may have changed
     multigrid_values_stale_ = true;
     gpu_values_stale_ = true;
     pending_rows_.clear();
@@ -140,6 +148,7 @@ void LiveSolver::values_changed() {
 
 void LiveSolver::rows_changed(std::span<const int32_t> rows) {
     if (rows.empty()) return;
+    if (gpu_) gpu_->radiance_stale_weights = true;
     if (gpu_values_stale_ && multigrid_values_stale_) return;  // everything is re-sent anyway
     std::vector<int32_t> merged;
     merged.reserve(pending_rows_.size() + rows.size());
@@ -150,7 +159,10 @@ void LiveSolver::rows_changed(std::span<const int32_t> rows) {
     pending_rows_.swap(merged);
 }
 
-void LiveSolver::right_hand_sides_changed() { gpu_rhs_stale_ = true; }
+void LiveSolver::right_hand_sides_changed() {
+    gpu_rhs_stale_ = true;
+    if (gpu_) gpu_->radiance_light_stale = true;
+}
 void LiveSolver::solution_changed() { gpu_solution_stale_ = true; }
 
 std::string LiveSolver::description() const {
@@ -289,6 +301,48 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu(const DiffusionMatrix& 
         for (int c = 0; c < 3; ++c) phi[c][v] = staging[v][c];
     for (int c = 0; c < 3; ++c) out[c] = {results[c].iterations, results[c].estimated_relative_error, results[c].converged};
     return out;
+}
+
+std::shared_ptr<const GpuBuffer> LiveSolver::radiance_on_device(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                                                const std::vector<std::array<double, 3>>& q,
+                                                                const std::vector<int32_t>& surface_vertices) {
+    if (backend_ != LiveBackend::Gpu || !gpu_ || !context_ || surface_vertices.empty()) return nullptr;
+    const size_t n = gpu_->solver->size();
+    if (mesh.vertex_count() != n || q.size() != n)
+        throw InvalidArgumentError("live solver: radiance_on_device needs the mesh and light of the solved matrix");
+    try {
+        const CurrentContext current(*context_);
+        const GlApi& gl = context_->gl();
+        GpuKernels& kernels = gpu_->solver->kernels();
+        if (!gpu_->radiance || gpu_->radiance_stale_weights) {
+            gpu_->radiance.reset();  // frees its buffers with the context current
+            gpu_->radiance = std::make_unique<GpuRadiance>(kernels, mesh, connectivity, mesh.materials);
+            gpu_->radiance_stale_weights = false;
+            gpu_->radiance_light_stale = true;
+        }
+        if (gpu_->radiance_light_stale) gpu_->radiance->set_light(q);
+        gpu_->radiance_light_stale = false;
+        if (gpu_->volume_e.bytes() != 3 * n * sizeof(float)) gpu_->volume_e = kernels.vector(n);
+        gpu_->radiance->compute(gpu_->solver->solution_buffer(), gpu_->volume_e);
+        if (gpu_->surface_vertices != surface_vertices) {
+            for (const int32_t v : surface_vertices)
+                if (v < 0 || static_cast<size_t>(v) >= n)
+                    throw InvalidArgumentError("live solver: surface vertex " + std::to_string(v) + " out of range");
+            gpu_->surface_index = GpuBuffer::from<int32_t>(gl, surface_vertices);
+            gpu_->surface_vertices = surface_vertices;
+        }
+        const size_t m = surface_vertices.size();
+        auto e = std::make_shared<GpuBuffer>(gl, 3 * m * sizeof(float));
+        kernels.gather(m, gpu_->surface_index, gpu_->volume_e, *e);
+        check_gpu_error(gl, "computing the radiance on the device");
+        // The main window's context reads it next: the writes must be complete (a shared object's
+        // changes are visible to another context only after the writing context finished them).
+        gl.Finish();
+        return e;
+    } catch (const GpuError& e) {
+        fall_back(e.what());
+        return nullptr;
+    }
 }
 
 }  // namespace waxwork

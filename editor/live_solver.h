@@ -23,6 +23,8 @@
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/gl_context.h"
+#include "solver/gpu_compute.h"
+#include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
 #include <array>
@@ -95,6 +97,17 @@ public:
     std::array<LiveSolverChannel, 3> iterate(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
                                              std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                              double relative_tolerance, const std::array<bool, 3>& skip);
+
+    // The exitant radiance factor E (Eq. 3 without F_t, gpu_radiance.h) of every surface vertex, computed
+    // on the device from the resident phi and gathered into surface order (`surface_vertices`: the
+    // volume vertex of each surface vertex), 3 floats per vertex: what a renderer in the context's
+    // share group binds as its radiance attribute instead of uploading a CPU copy. A new buffer per
+    // call (the renderer may still draw the previous one), complete when returned (glFinish: another
+    // context reads it next). Null unless the GPU backend is running; a GPU failure here falls back
+    // like iterate(). q: the incident light per volume vertex, as for the right-hand sides.
+    std::shared_ptr<const GpuBuffer> radiance_on_device(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                                        const std::vector<std::array<double, 3>>& q,
+                                                        const std::vector<int32_t>& surface_vertices);
 
     LiveMethod method() const { return method_; }
     // The backend that solves now (Cpu after a fallback).

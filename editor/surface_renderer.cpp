@@ -197,6 +197,8 @@ void validate_input(const SurfaceRenderInput& input) {
     if (input.radiance_factor.size() != n) {
         fail(std::to_string(input.radiance_factor.size()) + " radiance factors for " + std::to_string(n) + " vertices");
     }
+    if (input.device_radiance && input.device_radiance->bytes() < n * 3 * sizeof(float))
+        fail("the device radiance buffer holds fewer than " + std::to_string(n) + " vertices");
     if (!input.eta.empty() && input.eta.size() != n) fail(std::to_string(input.eta.size()) + " eta values for " + std::to_string(n) + " vertices");
     for (size_t t = 0; t < input.triangles.size(); ++t) {
         for (int32_t v : input.triangles[t]) {
@@ -388,7 +390,14 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float) && sizeof(std::array<float, 3>) == 3 * sizeof(float));
         attribute(0, r.buffers[0], input.positions.data(), n * sizeof(Eigen::Vector3f), 3);
         attribute(1, r.buffers[1], input.normals.data(), n * sizeof(Eigen::Vector3f), 3);
-        attribute(2, r.buffers[2], input.radiance_factor.data(), n * sizeof(std::array<float, 3>), 3);
+        if (input.device_radiance) {
+            // E straight from the solver's buffer (same layout as the uploaded attribute).
+            gl.BindBuffer(GL_ARRAY_BUFFER, input.device_radiance->id());
+            gl.EnableVertexAttribArray(2);
+            gl.VertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+        } else {
+            attribute(2, r.buffers[2], input.radiance_factor.data(), n * sizeof(std::array<float, 3>), 3);
+        }
         attribute(3, r.buffers[3], eta.data(), n * sizeof(float), 1);
         gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, r.buffers[4]);
         gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(input.triangles.size() * sizeof(input.triangles[0])),

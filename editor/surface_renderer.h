@@ -5,6 +5,7 @@
 #pragma once
 
 #include "solver/gl_context.h"
+#include "solver/gpu_compute.h"
 #include "io/image_io.h"
 #include "solver/lighting.h"
 
@@ -13,6 +14,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace waxwork {
@@ -71,6 +73,11 @@ struct SurfaceRenderInput {
     float exposure = 1.0f;
     ToneMap tone_map = ToneMap::Aces;
     std::array<uint8_t, 3> background = {38, 40, 46}; // sRGB
+    // Optional: E per vertex already on the device (3 floats per vertex, in the order of `positions`),
+    // in a buffer of the drawing context's share group, complete (the editor's GPU solver writes it in
+    // its own context and finishes, live_solver.h). Drawn instead of radiance_factor, which still sets
+    // the automatic exposure.
+    std::shared_ptr<const GpuBuffer> device_radiance;
 };
 
 inline constexpr int kMaxRenderLights = 8;

@@ -52,6 +52,9 @@ TEST_F(EditorGpuWindow, GpuBackendShowsWhatTheCpuBackendShows) {
     const nlohmann::json s = summary_of(gpu);
     EXPECT_EQ(s.value("solver_backend", ""), "gpu") << s.value("gpu_fallback_reason", "");
     EXPECT_EQ(s.value("gpu_fallback_reason", "?"), "");
+    // The view drew E from the solver's buffer in the shared context, not from a CPU copy.
+    EXPECT_TRUE(s.value("view_reads_device_radiance", false));
+    EXPECT_FALSE(summary_of(cpu).value("view_reads_device_radiance", true));
     const Image a = read_png(dir / "cpu.png"), b = read_png(dir / "gpu.png");
     ASSERT_EQ(a.width, b.width);
     ASSERT_EQ(a.height, b.height);
@@ -71,6 +74,7 @@ TEST_F(EditorGpuWindow, AFailingGpuFallsBackAndReportsWhy) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const nlohmann::json s = summary_of(r);
     EXPECT_EQ(s.value("solver_backend", ""), "cpu");
+    EXPECT_FALSE(s.value("view_reads_device_radiance", true));
     EXPECT_NE(s.value("gpu_fallback_reason", "").find("WAXWORK_GPU_FORCE_FAIL"), std::string::npos)
         << s.value("gpu_fallback_reason", "");
 }
