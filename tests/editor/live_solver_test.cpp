@@ -122,6 +122,24 @@ TEST(LiveSolver, EditedScenesConvergeToWhatAFreshSceneGives) {
     }
 }
 
+// Large enough for a hierarchy of several levels: painting then updates the coarse Galerkin rows in
+// place (MultigridPreconditioner::update_values) instead of the one-level rebuild of the small cube.
+TEST(LiveSolver, MultigridOnSeveralLevelsFollowsPaintToTheFreshSolution) {
+    Document doc(testing::make_cube_mesh(14), material_preset("marble"));
+    LiveScene scene(doc.mesh(), key_lighting(), options_for(kConfigs[1]));
+    scene.converge();
+    for (int i = 0; i < 3; ++i) {
+        const SceneUpdate update =
+            scene.apply_change(doc.mesh(), doc.apply(paint_at({0.2 + 0.3 * i, 0.5, 0.4}, i % 2 ? "skin1" : "ketchup")));
+        ASSERT_FALSE(update.updated_rows.empty());
+        scene.step(2);
+    }
+    const FrameReport report = scene.converge();
+    EXPECT_LT(report.total_iterations(), 60);  // a preconditioner that follows the paint stays strong
+    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
+    EXPECT_NE(scene.solver_description().find("multigrid"), std::string::npos);
+}
+
 TEST(LiveSolver, AFailingGpuFallsBackToTheCpuWithAReason) {
     Document doc(testing::make_cube_mesh(6), material_preset("marble"));
     setenv("WAXWORK_GPU_FORCE_FAIL", "1", 1);
