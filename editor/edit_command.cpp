@@ -34,6 +34,8 @@ struct EditCommandOptions {
     std::string slice_normal;
     double slice_offset = 0;
     bool quality_interior = false;
+    std::string backend = "cpu";
+    std::string method = "jacobi";
 };
 
 void run_edit_command(const EditCommandOptions& o) {
@@ -58,6 +60,8 @@ void run_edit_command(const EditCommandOptions& o) {
     options.max_tets = o.max_tets;
     options.material = chosen_material(o.material);
     options.scale = o.scale;
+    options.solver_backend = parse_live_backend(o.backend);
+    options.solver_method = parse_live_method(o.method);
     for (const std::string& spec : o.lights) options.lights.push_back(parse_light_spec(spec));
     // Read before the window opens: a bad script is a one-line error, with or without a display.
     if (!o.input.empty()) options.input = read_input_script(o.input);
@@ -74,7 +78,9 @@ void run_edit_command(const EditCommandOptions& o) {
             {"frame_ms", stats.mean_frame_ms}, {"view_ms", stats.mean_view_ms},
             {"solver_ticks", stats.ticks}, {"tick_ms", stats.tick_ms}, {"tets", stats.tets},
             {"vertices", stats.vertices},  {"gl_version", stats.gl_version},
-            {"gl_renderer", stats.gl_renderer},
+            {"gl_renderer", stats.gl_renderer}, {"solver_backend", stats.solver_backend},
+            {"gpu_fallback_reason", stats.gpu_fallback_reason},
+            {"view_reads_device_radiance", stats.view_reads_device_radiance},
         };
         std::cout << summary.dump() << "\n";
     }
@@ -117,6 +123,12 @@ void add_edit_command(CLI::App& app) {
         ->capture_default_str();
     cmd->add_flag("--quality-interior", options->quality_interior,
                   "--show quality: also cut at the slice plane and colour the cross-section's tets");
+    cmd->add_option("--backend", options->backend,
+                    "Live solver: cpu, or gpu (CG on OpenGL compute shaders in a context shared with the window; "
+                    "falls back to the CPU, saying why, when the driver cannot run it)")
+        ->check(CLI::IsMember({"cpu", "gpu"}));
+    cmd->add_option("--method", options->method, "Live solver method on the CPU: jacobi or mgcg (multigrid CG)")
+        ->check(CLI::IsMember({"jacobi", "mgcg"}));
     cmd->footer(
         "Mouse: left drag uses the current tool; right drag (or Alt+left) orbits, middle drag (or Shift+right)\n"
         "pans, the wheel zooms, Home resets the view, Esc cancels a stroke or drag.\n"

@@ -76,6 +76,7 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
     lighting_.lights = options.lights.empty() ? std::vector<Light>{default_key_light()} : options.lights;
     lighting_.ambient = {0.02, 0.02, 0.02};  // `waxwork render`'s default --ambient
     live_options_.mm_per_unit = options.scale;
+    choose_solver(options.solver_method, options.solver_backend);
     const std::vector<std::string> presets = material_preset_names();
     selected_preset_ = static_cast<int>(std::find(presets.begin(), presets.end(), "marble") - presets.begin());
 
@@ -133,11 +134,10 @@ namespace {
 
 // Installs a freshly loaded volume: a document (stored materials kept, else `material` on every
 // tet) and its live scene. Runs on the load worker.
-std::shared_ptr<SceneCore> make_core(TetMesh mesh, Session setup) {
+std::shared_ptr<SceneCore> make_core(TetMesh mesh, Session setup, LiveSceneOptions live) {
     if (mesh.tet_count() == 0) throw InvalidArgumentError(setup.name + ": the volume has no tets");
     auto core = std::make_shared<SceneCore>();
     core->document = std::make_shared<Document>(std::move(mesh), setup.material);
-    LiveSceneOptions live;
     live.mm_per_unit = setup.scale;
     live.relative_tolerance = setup.tolerance;
     core->live = std::make_shared<LiveScene>(core->document->mesh(), setup.lighting, live);
@@ -168,18 +168,18 @@ void EditorApp::open_file(const fs::path& path) {
     setup.frame_iterations = frame_iterations_;
     const std::string material_name = options_.material ? "custom" : "marble (or stored)";
     status_ = "Loading " + path.string();
-    load_task_.start(path.filename().string(), [this, path, setup, material_name](TaskProgress& progress) {
+    load_task_.start(path.filename().string(), [this, path, setup, material_name, solver = live_options_](TaskProgress& progress) {
         progress.set_stage(setup.input.volume.empty() ? "meshing the surface" : "reading the volume");
         TetMesh mesh = load_session_input(setup);
         progress.set_stage("building the document and the live scene");
-        auto core = make_core(std::move(mesh), setup);
+        auto core = make_core(std::move(mesh), setup, solver);
         return BackgroundTask::Apply([this, path, core, material_name] { install_core(core, path, material_name, {}); });
     });
 }
 
 void EditorApp::open_session(const fs::path& path) {
     status_ = "Loading session " + path.string();
-    load_task_.start(path.filename().string(), [this, path](TaskProgress& progress) {
+    load_task_.start(path.filename().string(), [this, path, solver = live_options_](TaskProgress& progress) {
         progress.set_stage("reading the session");
         Session session = read_session(path);
         progress.set_stage(session.input.volume.empty() ? "meshing the surface" : "reading the volume");
@@ -194,7 +194,7 @@ void EditorApp::open_session(const fs::path& path) {
         Session setup = session;
         setup.steps.clear();
         progress.set_stage("building the document and the live scene");
-        auto core = make_core(std::move(mesh), setup);
+        auto core = make_core(std::move(mesh), setup, solver);
         return BackgroundTask::Apply([this, path, core, edits] { install_core(core, path, "session", edits); });
     });
 }
@@ -366,6 +366,8 @@ void EditorApp::start_tick() {
         double min_dihedral = 0;
         double ms = 0;
         std::shared_ptr<const ViewGeometry> view;
+        LiveBackend backend = LiveBackend::Cpu;
+        std::string solver_description, gpu_fallback_reason;
     };
     tick_task_.start(label, [this, target, core, jobs, lighting, budget, first, need_bvh, settings, view, view_changed,
                              view_worker](TaskProgress& progress) {
@@ -398,6 +400,10 @@ void EditorApp::start_tick() {
                                                  view_worker->geometry_version, view_worker->solution_version);
                 apply_view(*r->view, *r->input);
             }
+            // GPU backend in the hidden window's context (shared with this window's): the view draws E
+            // from the solver's device buffer. Not with an OSMesa context of the solver's own (when no
+            // shared context could be made): its buffers are not this window's.
+            if (core->live->options().gl_context) r->input->device_radiance = core->live->device_radiance();
             if (need_bvh || r->geometry_changed) {
                 r->bvh = std::make_shared<const TriangleBvh>(r->input->positions, r->input->triangles);
                 // Each surface vertex's piece, for picking pieces to move.
@@ -416,6 +422,9 @@ void EditorApp::start_tick() {
         r->tets = mesh.tet_count();
         r->vertices = mesh.vertex_count();
         r->min_dihedral = core->document->min_dihedral_deg();
+        r->backend = core->live->backend();
+        r->solver_description = core->live->solver_description();
+        r->gpu_fallback_reason = core->live->gpu_fallback_reason();
         r->ms = ms_since(start);
         return BackgroundTask::Apply([this, target, r] {
             if (scene_.get() != target) return;  // another file was opened meanwhile
@@ -443,6 +452,9 @@ void EditorApp::start_tick() {
             s.tets = r->tets;
             s.vertices = r->vertices;
             s.min_dihedral_deg = r->min_dihedral;
+            s.solver_backend = r->backend;
+            s.solver_description = r->solver_description;
+            s.gpu_fallback_reason = r->gpu_fallback_reason;
             s.tick_ms = r->ms;
             if (!s.converged || r->frame.total_iterations() > 0) {
                 s.tick_ms_sum += r->ms;
@@ -684,6 +696,9 @@ EditorRunStats run_editor(const EditorOptions& options) {
         stats.vertices = scene.vertices;
         stats.ticks = scene.ticks;
         stats.tick_ms = scene.ticks ? scene.tick_ms_sum / scene.ticks : 0;
+        stats.solver_backend = live_backend_name(scene.solver_backend);
+        stats.gpu_fallback_reason = scene.gpu_fallback_reason;
+        stats.view_reads_device_radiance = scene.render_input && scene.render_input->device_radiance;
     }
     glfwDestroyWindow(window);
     return stats;

@@ -54,6 +54,8 @@ struct EditorOptions {
     CameraSettings camera;               // the first view (as `waxwork render --view`)
     ViewOptions view;                    // what the 3D view shows (as `waxwork render --show`)
     std::optional<InputScript> input;    // replayed into the window once the object shows (--input)
+    LiveMethod solver_method = LiveMethod::JacobiCg;  // the live solver (live_solver.h); the solver
+    LiveBackend solver_backend = LiveBackend::Cpu;    // panel switches both
 };
 
 // Opens the window and runs until it is closed (or, with a screenshot, until it is saved). Throws
@@ -67,6 +69,9 @@ struct EditorRunStats {
     int ticks = 0;
     size_t tets = 0, vertices = 0;
     std::string gl_version, gl_renderer;
+    std::string solver_backend;       // "cpu" or "gpu": what solved the last frame
+    std::string gpu_fallback_reason;  // why the GPU backend was given up, if it was
+    bool view_reads_device_radiance = false;  // the 3D view drew E from the GPU solver's buffer
 };
 EditorRunStats run_editor(const EditorOptions& options);
 
@@ -115,6 +120,9 @@ struct EditorScene {
     double tick_ms_sum = 0;
     int ticks = 0;
     double min_dihedral_deg = 0;
+    LiveBackend solver_backend = LiveBackend::Cpu;  // after the latest tick (Cpu after a fallback)
+    std::string solver_description;
+    std::string gpu_fallback_reason;
 };
 
 // Everything the window shows and edits. UI-thread only.
@@ -166,6 +174,9 @@ private:
     void draw_material_panel();
     void draw_light_panel();
     void draw_solver_panel();
+    // editor_solver_choice.cpp: the method and backend combos, and the GPU context they need.
+    void draw_solver_choice();
+    void choose_solver(LiveMethod method, LiveBackend backend);
     void draw_view_panel();
     void draw_view_mode_panel();  // view_mode_panel.cpp: the optional views and their legend
     void draw_view_mode_menu();   // view_mode_panel.cpp: View > Show
@@ -217,6 +228,10 @@ private:
     int msaa_samples_ = 4;
     float ui_scale_ = 1.0f;
 
+    // The GPU solver's context (window_gl_context.h), shared with this window's; opened when the GPU
+    // backend is first chosen. Declared before scene_: the live scenes using it are destroyed first.
+    std::shared_ptr<SolverGlContext> solver_context_;
+    std::string solver_context_error_;
     // The scene: the volume, its materials and lights, the latest solved image input.
     std::unique_ptr<Scene> scene_;
     Lighting lighting_;

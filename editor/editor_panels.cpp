@@ -223,9 +223,8 @@ void EditorApp::draw_material_panel() {
 }
 
 void EditorApp::draw_solver_panel() {
-    ImGui::TextDisabled("TransCut matrix, Jacobi CG (double), warm-started");
-    int backend = 0;
-    ImGui::Combo("backend", &backend, "CPU, per frame\0");
+    ImGui::TextDisabled("TransCut matrix, warm-started CG per frame");
+    draw_solver_choice();
     ImGui::SliderInt("iterations / frame", &frame_iterations_, 1, 200);
     float tolerance_exponent = static_cast<float>(std::log10(live_options_.relative_tolerance));
     // Solver settings rebuild the live scene: only when the user lets go of the slider.

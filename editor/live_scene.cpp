@@ -39,6 +39,7 @@ LiveScene::LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSc
         throw InvalidArgumentError("live scene: the relative tolerance must be in (0, 1)");
     validate(lighting_);
     check_materials(mesh);
+    solver_ = std::make_unique<LiveSolver>(LiveSolverOptions{options.method, options.backend, options.gl_context});
     SceneUpdate update;
     rebuild_all(nullptr, update);
 }
@@ -68,6 +69,7 @@ void LiveScene::refresh_right_hand_sides() {
         b_[c].resize(n);
         diffusion_right_hand_side(matrix_, q_, c, b_[c]);
     }
+    solver_->right_hand_sides_changed();
     mark_unconverged();
 }
 
@@ -80,9 +82,9 @@ void LiveScene::rebuild_all(std::shared_ptr<const TetConnectivity> connectivity,
     matrix_ = assemble_diffusion_matrix(*mesh_, *connectivity_, mesh_->materials, assembly_options(options_));
     update.reassembled_matrix = true;
     rebuild_surface(update);
-    // The smallest-eigenvalue hints belong to the old matrix: a stale hint could be too large and
+    // Also drops the smallest-eigenvalue hints of the old matrix: a stale hint could be too large and
     // make the error estimate optimistic.
-    eigenvalue_hint_ = {0, 0, 0};
+    solver_->matrix_rebuilt(*mesh_, matrix_);
     for (auto& phi : phi_) phi.resize(matrix_.size(), 0.0);
 }
 
@@ -121,17 +123,19 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
         // Same tets, moved vertices: new geometry on the same connectivity.
         matrix_ = assemble_diffusion_matrix(mesh, *connectivity_, mesh.materials, assembly_options(options_));
         update.reassembled_matrix = true;
-        eigenvalue_hint_ = {0, 0, 0};
+        solver_->matrix_rebuilt(mesh, matrix_);
         rebuild_surface(update);
     } else {
         bool eta_changed = false;
         if (change.all_materials) {
             assemble_diffusion_values(matrix_, *connectivity_, mesh.materials);
+            solver_->values_changed();
             update.recomputed_values = true;
             eta_changed = true;
         } else if (!change.changed_material_tets.empty()) {
             update.updated_rows = update_diffusion_matrix(matrix_, mesh, *connectivity_, mesh.materials,
                                                           change.changed_material_tets);
+            solver_->rows_changed(update.updated_rows);
             // q depends on eta through the Fresnel transmittance: only a changed tet with a boundary
             // face can change a boundary vertex's eta.
             for (const int32_t t : change.changed_material_tets) {
@@ -176,6 +180,7 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
                         for (int c = 0; c < 3; ++c) sum[c] += matrix_.source[k] * q_[matrix_.columns[k]][c];
                 for (int c = 0; c < 3; ++c) b_[c][i] = sum[c];
             }
+            solver_->right_hand_sides_changed();
         }
     }
     mark_unconverged();
@@ -198,22 +203,18 @@ FrameReport LiveScene::iterate(int iteration_budget) {
     const auto start = std::chrono::steady_clock::now();
     FrameReport report;
     const size_t n = matrix_.size();
+    std::array<bool, 3> skip{};
+    for (int c = 0; c < 3; ++c) skip[c] = converged_[c] || n == 0;
+    const auto channels = solver_->iterate(matrix_, b_, phi_, iteration_budget, options_.relative_tolerance, skip);
     for (int c = 0; c < 3; ++c) {
-        if (converged_[c] || n == 0) {
+        if (skip[c]) {
             converged_[c] = true;
             report.estimated_relative_error[c] = n == 0 ? 0 : error_[c];
             continue;
         }
-        ConjugateGradientOptions cg;
-        cg.relative_tolerance = options_.relative_tolerance;
-        cg.max_iterations = iteration_budget;
-        cg.smallest_eigenvalue_hint = eigenvalue_hint_[c];
-        const CsrMatrixView<double> view{n, matrix_.offsets.data(), matrix_.columns.data(), matrix_.values[c].data()};
-        const ConjugateGradientResult r = solve_jacobi_cg<double>(view, b_[c], phi_[c], cg);
-        report.iterations[c] = r.iterations;
-        if (r.smallest_eigenvalue_estimate > 0) eigenvalue_hint_[c] = r.smallest_eigenvalue_estimate;
-        error_[c] = r.estimated_relative_error;
-        converged_[c] = r.converged;
+        report.iterations[c] = channels[c].iterations;
+        error_[c] = channels[c].estimated_relative_error;
+        converged_[c] = channels[c].converged;
         report.estimated_relative_error[c] = error_[c];
     }
     report.converged = converged_[0] && converged_[1] && converged_[2];
@@ -278,6 +279,26 @@ std::vector<std::array<double, 3>> LiveScene::phi() const {
     for (size_t v = 0; v < phi.size(); ++v)
         for (int c = 0; c < 3; ++c) phi[v][c] = phi_[c][v];
     return phi;
+}
+
+LiveBackend LiveScene::backend() const {
+    const std::lock_guard lock(mutex_);
+    return solver_->backend();
+}
+
+std::string LiveScene::gpu_fallback_reason() const {
+    const std::lock_guard lock(mutex_);
+    return solver_->gpu_fallback_reason();
+}
+
+std::string LiveScene::solver_description() const {
+    const std::lock_guard lock(mutex_);
+    return solver_->description();
+}
+
+std::shared_ptr<const GpuBuffer> LiveScene::device_radiance() {
+    const std::lock_guard lock(mutex_);
+    return solver_->radiance_on_device(*mesh_, *connectivity_, q_, surface_.vertices);
 }
 
 std::vector<std::array<float, 3>> LiveScene::radiance_factors() const {

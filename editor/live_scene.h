@@ -19,7 +19,8 @@
 // Solver choice: Jacobi-preconditioned CG in double, warm-started, per channel. The multires solver
 // (multires/multires_solver.h) is not used per frame: on spot it does not beat Jacobi CG to 1%
 // (README, multires_bench: 2.3 vs 2.1 ms at 50K, 27.1 vs 26.8 ms at 500K) and its hierarchy build
-// (224 ms at 500K) would take half of a cut's 500 ms budget, for no gain.
+// (224 ms at 500K) would take half of a cut's 500 ms budget, for no gain. That is the default;
+// LiveSceneOptions::method and backend select multigrid CG or the GPU instead (live_solver.h).
 //
 // Threading: every public member locks one internal mutex, so the window may call step() on a worker
 // thread while the UI thread applies edits; apply_change() and set_lighting() then wait for the
@@ -34,6 +35,7 @@
 #pragma once
 
 #include "editor/document.h"
+#include "editor/live_solver.h"
 #include "editor/render_pipeline.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
@@ -54,6 +56,11 @@ struct LiveSceneOptions {
     double mm_per_unit = 1.0;
     // converge() and converged() stop at this estimated relative error of phi (conjugate_gradient.h).
     double relative_tolerance = 1e-3;
+    // The per-frame solver (live_solver.h): method, backend, and the GPU backend's context (null: an
+    // OSMesa context of its own). A failing GPU falls back to the CPU (LiveScene::gpu_fallback_reason).
+    LiveMethod method = LiveMethod::JacobiCg;
+    LiveBackend backend = LiveBackend::Cpu;
+    std::shared_ptr<SolverGlContext> gl_context;
 };
 
 // One frame of the solve.
@@ -118,6 +125,15 @@ public:
     const DiffusionMatrix& matrix() const { return matrix_; }
     const TetConnectivity& connectivity() const { return *connectivity_; }
     std::vector<std::array<double, 3>> phi() const;
+    // The backend solving now (Cpu after a GPU fallback), why the GPU was given up ("" if it was not),
+    // and a line for the solver panel ("GPU CG (llvmpipe ...)").
+    LiveBackend backend() const;
+    std::string gpu_fallback_reason() const;
+    std::string solver_description() const;
+    // With the GPU backend running: E per surface vertex (solved_scene().surface order) on the device,
+    // from the resident phi (LiveSolver::radiance_on_device), for a renderer sharing the solver's
+    // context to draw instead of the CPU's radiance_factor; else null. Reads the mesh.
+    std::shared_ptr<const GpuBuffer> device_radiance();
 
 private:
     void rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update);
@@ -140,7 +156,7 @@ private:
     std::vector<Rgb> q_;                        // per volume vertex
     std::array<std::vector<double>, 3> b_;      // right-hand side per channel
     std::array<std::vector<double>, 3> phi_;    // current fluence per channel
-    std::array<double, 3> eigenvalue_hint_{};
+    std::unique_ptr<LiveSolver> solver_;
     std::array<double, 3> error_{1, 1, 1};
     std::array<bool, 3> converged_{};
     bool solved_since_change_ = false;

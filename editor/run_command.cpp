@@ -15,11 +15,18 @@ namespace {
 struct RunCommandOptions {
     std::string session;
     std::string output;
+    std::string backend = "cpu";
+    std::string method = "jacobi";
 };
 
 void run_run_command(const RunCommandOptions& o) {
     const Session session = read_session(o.session);
-    const SessionResult result = run_session(session, o.output);
+    SessionRunOptions run;
+    run.backend = parse_live_backend(o.backend);
+    run.method = parse_live_method(o.method);
+    const SessionResult result = run_session(session, o.output, run);
+    if (!result.gpu_fallback_reason.empty())
+        std::cerr << "warning: solved on the CPU instead: " << result.gpu_fallback_reason << "\n";
     std::cout << std::fixed << std::setprecision(1) << "loaded the input in " << result.load_ms << " ms ("
               << (result.steps.empty() ? result.mesh.tet_count() : result.steps.front().tets) << " tets)\n";
     for (size_t i = 0; i < result.steps.size(); ++i) {
@@ -40,6 +47,13 @@ void add_run_command(CLI::App& app) {
     cmd->add_option("session", options->session, "Session file (.json)")->required()->check(CLI::ExistingFile);
     cmd->add_option("-o,--output", options->output, "Directory for the frames, saved volumes and metrics.json")
         ->required();
+    cmd->add_option("--backend", options->backend,
+                    "Live solver backend: cpu, or gpu (CG on OpenGL 4.3 compute shaders in the renderer's OSMesa "
+                    "context; falls back to the CPU with a warning when the driver cannot run it)")
+        ->check(CLI::IsMember({"cpu", "gpu"}));
+    cmd->add_option("--method", options->method,
+                    "Live solver method on the CPU: jacobi (Jacobi CG) or mgcg (multigrid-preconditioned CG)")
+        ->check(CLI::IsMember({"jacobi", "mgcg"}));
     cmd->footer("Steps: edit operations ({\"op\": \"plane_cut\", ...}), {\"render\": \"a.png\"}, {\"save\": \"a.vtu\"},\n"
                 "{\"light\": {...}}, {\"camera\": {...}}, {\"undo\": 1}, {\"redo\": 1}. See assets/sessions/.");
     cmd->callback([options] { run_run_command(*options); });

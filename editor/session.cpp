@@ -325,7 +325,7 @@ TetMesh load_session_input(const Session& session) {
     return tetrahedralize(loaded.surface, meshing).mesh;
 }
 
-SessionResult run_session(const Session& session, const fs::path& output_directory) {
+SessionResult run_session(const Session& session, const fs::path& output_directory, const SessionRunOptions& run_options) {
     std::error_code ec;
     fs::create_directories(output_directory, ec);
     if (ec) throw FileError(output_directory.string(), "cannot create the directory: " + ec.message());
@@ -337,14 +337,26 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
     LiveSceneOptions scene_options;
     scene_options.mm_per_unit = session.scale;
     scene_options.relative_tolerance = session.tolerance;
+    scene_options.method = run_options.method;
+    scene_options.backend = run_options.backend;
+    // One GL context for the whole session, created at the first render (or now, for the GPU solver,
+    // which then shares it with the renderer). A context that fails here makes the solver fall back
+    // with the reason (live_solver.h).
+    std::unique_ptr<HeadlessGlContext> context;
+    if (run_options.backend == LiveBackend::Gpu) {
+        try {
+            context = std::make_unique<HeadlessGlContext>();
+            scene_options.gl_context = borrow_headless_solver_context(*context);
+        } catch (const Error&) {
+            context.reset();
+        }
+    }
+    std::unique_ptr<SurfaceRenderer> renderer;
     LiveScene scene(document.mesh(), session.lighting, scene_options);
     ImageSettings image;
     image.width = session.width;
     image.height = session.height;
     image.camera = session.camera;
-    // One GL context for the whole session, created at the first render.
-    std::unique_ptr<HeadlessGlContext> context;
-    std::unique_ptr<SurfaceRenderer> renderer;
 
     Json metrics = Json::array();
     for (size_t i = 0; i < session.steps.size(); ++i) {
@@ -367,10 +379,9 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
                     frame = scene.converge();
                     m.solver_iterations = frame.total_iterations();
                 }
-                if (!renderer) {
-                    context = std::make_unique<HeadlessGlContext>();
-                    renderer = std::make_unique<SurfaceRenderer>(context->gl());
-                }
+                if (!context) context = std::make_unique<HeadlessGlContext>();
+                context->make_current();  // the solver may have used its own context meanwhile
+                if (!renderer) renderer = std::make_unique<SurfaceRenderer>(context->gl());
                 const SolvedScene solved = scene.solved_scene();
                 const Image picture =
                     render_scene(*renderer, make_render_input(document.mesh(), solved, scene.lighting(), image));
@@ -426,9 +437,14 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
                        {"load_milliseconds", result.load_ms},
                        {"undo_bytes", document.undo_bytes()},
                        {"undo_entries_evicted", document.evicted_undo_count()},
+                       {"solver_backend", live_backend_name(scene.backend())},
+                       {"solver_method", live_method_name(run_options.method)},
+                       {"gpu_fallback_reason", scene.gpu_fallback_reason()},
                        {"steps", metrics}};
     write_file_atomically(output_directory / "metrics.json", [&](std::ostream& out) { out << summary.dump(2) << "\n"; });
     result.mesh = document.mesh();
+    result.solver_backend = scene.backend();
+    result.gpu_fallback_reason = scene.gpu_fallback_reason();
     return result;
 }
 

@@ -30,6 +30,7 @@
 
 #include "editor/document.h"
 #include "editor/edit_operation.h"
+#include "editor/live_solver.h"
 #include "editor/surface_renderer.h"
 #include "solver/lighting.h"
 #include "tetops/tet_mesh.h"
@@ -122,10 +123,20 @@ struct SessionResult {
     std::vector<StepMetrics> steps;
     double load_ms = 0;  // meshing or reading the input
     std::vector<std::filesystem::path> written;  // images and volumes, in order
+    LiveBackend solver_backend = LiveBackend::Cpu;  // that solved the last step (Cpu after a fallback)
+    std::string gpu_fallback_reason;                // why the GPU was given up ("" if it was not)
+};
+
+// How `waxwork run` solves (live_solver.h). The GPU backend shares the renderer's OSMesa context.
+struct SessionRunOptions {
+    LiveMethod method = LiveMethod::JacobiCg;
+    LiveBackend backend = LiveBackend::Cpu;
 };
 
 // Replays the session, writing renders and saves under `output_directory` (created) and
 // OUTDIR/metrics.json. Errors name the session and the step index.
-SessionResult run_session(const Session& session, const std::filesystem::path& output_directory);
+// metrics.json also names the solver backend (solver_backend, and gpu_fallback_reason after one).
+SessionResult run_session(const Session& session, const std::filesystem::path& output_directory,
+                          const SessionRunOptions& run_options = {});
 
 }  // namespace waxwork

@@ -258,6 +258,8 @@ void validate_input(const SurfaceRenderInput& input) {
     if (input.radiance_factor.size() != n) {
         fail(std::to_string(input.radiance_factor.size()) + " radiance factors for " + std::to_string(n) + " vertices");
     }
+    if (input.device_radiance && input.device_radiance->bytes() < n * 3 * sizeof(float))
+        fail("the device radiance buffer holds fewer than " + std::to_string(n) + " vertices");
     if (!input.eta.empty() && input.eta.size() != n) fail(std::to_string(input.eta.size()) + " eta values for " + std::to_string(n) + " vertices");
     for (size_t t = 0; t < input.triangles.size(); ++t) {
         for (int32_t v : input.triangles[t]) {
@@ -536,9 +538,17 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float) && sizeof(std::array<float, 3>) == 3 * sizeof(float));
         attribute(0, r.buffers[0], input.positions.data(), n * sizeof(Eigen::Vector3f), 3);
         attribute(1, r.buffers[1], input.normals.data(), n * sizeof(Eigen::Vector3f), 3);
-        // The colour modes pass their per-vertex colours where the radiance factors go.
-        const auto& factors = input.shading == SurfaceShading::VertexColour ? input.colours : input.radiance_factor;
-        attribute(2, r.buffers[2], factors.data(), n * sizeof(std::array<float, 3>), 3);
+        if (input.device_radiance && input.shading == SurfaceShading::Radiance) {
+            // E straight from the solver's buffer (same layout as the uploaded attribute).
+            gl.BindBuffer(GL_ARRAY_BUFFER, input.device_radiance->id());
+            gl.EnableVertexAttribArray(2);
+            gl.VertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+        } else {
+            // The colour modes pass their per-vertex colours where the radiance factors go.
+            const auto& factors =
+                input.shading == SurfaceShading::VertexColour ? input.colours : input.radiance_factor;
+            attribute(2, r.buffers[2], factors.data(), n * sizeof(std::array<float, 3>), 3);
+        }
         attribute(3, r.buffers[3], eta.data(), n * sizeof(float), 1);
         // Visibility as two vec4 attributes of eight lights each (1 where not given).
         const size_t light_count_in = input.lighting.lights.size();

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "solver/gl_context.h"
+#include "solver/gpu_compute.h"
 #include "io/image_io.h"
 #include "solver/lighting.h"
 
@@ -14,6 +15,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <memory>
 #include <vector>
 
 namespace waxwork {
@@ -108,6 +110,11 @@ struct SurfaceRenderInput {
     // (n, d): surface fragments at points p with n.p + d < 0 are not drawn (the slice view's cut-away
     // half). The overlay is never clipped.
     std::optional<Eigen::Vector4f> clip_plane;
+    // Optional: E per vertex already on the device (3 floats per vertex, in the order of `positions`),
+    // in a buffer of the drawing context's share group, complete (the editor's GPU solver writes it in
+    // its own context and finishes, live_solver.h). Drawn instead of radiance_factor, which still sets
+    // the automatic exposure.
+    std::shared_ptr<const GpuBuffer> device_radiance;
 };
 
 inline constexpr int kMaxRenderLights = 8;

@@ -32,6 +32,24 @@ GpuMultiresSolver::GpuMultiresSolver(const GlApi& gl, const DiffusionMatrix& mat
     check_gpu_error(gl, "uploading the multires hierarchy");
 }
 
+void GpuMultiresSolver::update_rows(const DiffusionMatrix& matrix, const MultiresHierarchy& hierarchy,
+                                    const std::vector<std::vector<int32_t>>& level_rows) {
+    if (hierarchy.level_count() != levels_.size() + 1 || level_rows.size() > hierarchy.level_count())
+        throw InvalidArgumentError("GPU multires update_rows: the hierarchy does not match the uploaded one");
+    if (!level_rows.empty()) fine_.update_rows(matrix, level_rows[0]);
+    GpuKernels& K = fine_.kernels();
+    for (size_t l = 1; l < level_rows.size(); ++l) {
+        if (level_rows[l].empty()) continue;
+        const HierarchyLevel& level = hierarchy.levels[l];
+        Level& gpu = levels_[l - 1];
+        if (level.size() != gpu.rows)
+            throw InvalidArgumentError("GPU multires update_rows: level " + std::to_string(l) + " changed size");
+        K.upload_rows(gpu.matrix, level_view(level), level_rows[l]);
+        GpuBuffer diag = K.vector(level.size());
+        K.extract_diagonal(gpu.matrix, diag, gpu.inv_diag);
+    }
+}
+
 GpuMultiresReport GpuMultiresSolver::solve(const MultiresSolveOptions& options, GpuCgOptions fine_options) {
     GpuMultiresReport report;
     GpuKernels& K = fine_.kernels();

@@ -45,6 +45,13 @@ public:
     bool solve_frame(int iteration_budget, double relative_tolerance) {
         return fine_.solve_frame(iteration_budget, relative_tolerance);
     }
+    // After painting: `matrix` and `hierarchy` (this solver's, updated by MultiresSolver::update_values)
+    // changed only in `level_rows` (its return value: rows per level). Uploads only those rows of
+    // every level and refreshes the Jacobi diagonals: the device then holds exactly what a new solver
+    // built on them would (bit for bit), for O(changed entries) of transfer instead of the hierarchy.
+    // Throws InvalidArgumentError when the levels do not match the uploaded ones.
+    void update_rows(const DiffusionMatrix& matrix, const MultiresHierarchy& hierarchy,
+                     const std::vector<std::vector<int32_t>>& level_rows);
     std::vector<std::array<double, 3>> solution() const { return fine_.solution(); }
     const GpuBuffer& solution_buffer() const { return fine_.solution_buffer(); }
 

@@ -34,7 +34,8 @@ void MultiresSolver::update_values(const DiffusionMatrix& matrix) {
         build_coarse_matrix(hierarchy_.levels[l - 1], hierarchy_.levels[l].parent_vertex, hierarchy_.levels[l]);
 }
 
-void MultiresSolver::update_values(const DiffusionMatrix& matrix, std::span<const int32_t> changed_rows) {
+std::vector<std::vector<int32_t>> MultiresSolver::update_values(const DiffusionMatrix& matrix,
+                                                               std::span<const int32_t> changed_rows) {
     HierarchyLevel& level0 = hierarchy_.levels[0];
     if (matrix.offsets.size() != level0.offsets.size() || matrix.columns.size() != level0.columns.size())
         throw InvalidArgumentError("multires update_values: the matrix pattern changed (rebuild the solver)");
@@ -51,6 +52,8 @@ void MultiresSolver::update_values(const DiffusionMatrix& matrix, std::span<cons
                       matrix.values[ch].begin() + static_cast<std::ptrdiff_t>(end),
                       level0.values[ch].begin() + static_cast<std::ptrdiff_t>(begin));
     }
+    std::vector<std::vector<int32_t>> level_rows(hierarchy_.level_count());
+    level_rows[0] = changed;
     std::vector<int32_t> rows;
     for (size_t l = 1; l < hierarchy_.level_count() && !changed.empty(); ++l) {
         HierarchyLevel& coarse = hierarchy_.levels[l];
@@ -62,8 +65,10 @@ void MultiresSolver::update_values(const DiffusionMatrix& matrix, std::span<cons
                 rows.push_back(static_cast<int32_t>(it - coarse.parent_vertex.begin()));
         }
         update_coarse_rows(hierarchy_.levels[l - 1], coarse.parent_vertex, coarse, rows);
+        level_rows[l] = rows;
         changed.swap(rows);
     }
+    return level_rows;
 }
 
 void MultiresSolver::reset_warm_start() {

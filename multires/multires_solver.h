@@ -91,7 +91,9 @@ public:
     // coarse rows that depend on them, level by level (Eq. 17 row c reads fine row parent_vertex[c]
     // only), in time proportional to the change. Equals update_values(matrix) bit for bit.
     // Throws InvalidArgumentError on a changed pattern or a row out of range.
-    void update_values(const DiffusionMatrix& matrix, std::span<const int32_t> changed_rows);
+    // Returns the rows that changed on each level (level 0: changed_rows sorted and unique), what a
+    // device copy of the hierarchy re-uploads (GpuMultiresSolver::update_rows).
+    std::vector<std::vector<int32_t>> update_values(const DiffusionMatrix& matrix, std::span<const int32_t> changed_rows);
 
     // Forget the previous frames' solutions (after an edit that changes the solution a lot).
     void reset_warm_start();

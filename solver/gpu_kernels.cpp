@@ -410,6 +410,28 @@ void GpuKernels::scatter(size_t count, const GpuBuffer& slots, const GpuBuffer& 
     launch(scatter_, count, count, {{0, &slots}, {1, &source}, {2, &values}});
 }
 
+void GpuKernels::upload_rows(GpuMatrix& target, const RgbCsrView& matrix, std::span<const int32_t> rows) {
+    const size_t n = matrix.offsets.empty() ? 0 : matrix.offsets.size() - 1;
+    if (n != target.layout.rows || matrix.columns.size() != target.layout.stored_index.size())
+        throw InvalidArgumentError("GPU upload_rows: the matrix does not have the device matrix's pattern");
+    // Stored positions and new values of the rows' entries, scattered by one dispatch: works for every
+    // format (ELL/SELL spread a row's entries across the buffer).
+    std::vector<int32_t> slots;
+    std::vector<float> values;
+    for (const int32_t row : rows) {
+        if (row < 0 || static_cast<size_t>(row) >= n)
+            throw InvalidArgumentError("GPU upload_rows: row " + std::to_string(row) + " out of range");
+        for (int32_t k = matrix.offsets[row]; k < matrix.offsets[row + 1]; ++k) {
+            slots.push_back(target.layout.stored_index[k]);
+            for (int c = 0; c < 3; ++c) values.push_back(static_cast<float>(matrix.values[c][k]));
+        }
+    }
+    if (slots.empty()) return;
+    const GpuBuffer slot_buffer = GpuBuffer::from<int32_t>(gl(), slots);
+    const GpuBuffer value_buffer = GpuBuffer::from<float>(gl(), values);
+    scatter(slots.size(), slot_buffer, value_buffer, target.values);
+}
+
 void GpuKernels::hadamard(size_t rows, const GpuBuffer& w, const GpuBuffer& x, GpuBuffer& y) {
     launch(hadamard_, rows, 3 * rows, {{0, &w}, {1, &x}, {2, &y}});
 }

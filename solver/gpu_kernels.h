@@ -75,6 +75,11 @@ public:
                   const GpuBuffer& q, GpuBuffer& e, bool clamp_negative);
     // values[3 * slot[k] + c] = source[3 * k + c] for k < count: row updates after painting.
     void scatter(size_t count, const GpuBuffer& slots, const GpuBuffer& source, GpuBuffer& values);
+    // The rows `rows` of `matrix` (its CSR entries, same pattern as `target` was built from) into
+    // target's stored values, converted to float as at upload: equal to uploading the whole matrix
+    // again, for O(the rows' entries). Throws InvalidArgumentError on a row out of range or a size
+    // mismatch. The caller refreshes the Jacobi diagonal (extract_diagonal) afterwards.
+    void upload_rows(GpuMatrix& target, const RgbCsrView& matrix, std::span<const int32_t> rows);
 
 private:
     struct Binding {

@@ -1,0 +1,128 @@
+// The live editor's frames per solver method and backend (editor/live_solver.h, issue 5): the per-frame
+// solve while the light rotates and while a brush paints, on spot at ~100K tets, as
+// bench/live_scene_bench.cpp measures the default (CPU Jacobi CG), for
+//   0: CPU Jacobi CG (double), 1: CPU multigrid-preconditioned CG, 2: GPU CG (float, OpenGL compute).
+//   ./build/bench/live_solver_bench
+// The GPU backend runs in an OSMesa context: on a machine without a GPU (and in CI) that is Mesa's
+// llvmpipe, which runs the compute shaders on the CPU cores, so its times say nothing about a real
+// GPU (WAXWORK_GL_DEVICE=egl reaches one where there is one). A GPU frame includes reading phi back
+// (the host copy the CPU radiance and saves use); counters as in live_scene_bench.
+#include "bench_meshes.h"
+#include "editor/document.h"
+#include "editor/live_scene.h"
+#include "solver/material.h"
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+namespace waxwork {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr size_t kFrameTets = 100'000;
+constexpr int kFrames = 30;
+constexpr int kFrameIterations = 8;  // as live_scene_bench: CG iterations per channel and frame
+
+double ms_since(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+struct Variant {
+    LiveMethod method;
+    LiveBackend backend;
+    const char* label;
+};
+constexpr Variant kVariants[] = {
+    {LiveMethod::JacobiCg, LiveBackend::Cpu, "cpu_jacobi"},
+    {LiveMethod::MultigridCg, LiveBackend::Cpu, "cpu_mgcg"},
+    {LiveMethod::JacobiCg, LiveBackend::Gpu, "gpu_cg_llvmpipe"},
+};
+
+LiveSceneOptions scene_options(const TetMesh& mesh, const Variant& variant) {
+    const auto box = bounding_box(mesh);
+    LiveSceneOptions o;
+    o.mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();  // spot 100 mm long
+    o.relative_tolerance = 1e-3;
+    o.method = variant.method;
+    o.backend = variant.backend;
+    return o;
+}
+
+Lighting light_at(double degrees) {
+    const double a = degrees * std::numbers::pi / 180;
+    Lighting l;
+    Light light;
+    light.vector = Eigen::Vector3d(std::cos(a), -0.8, std::sin(a)).normalized();
+    l.lights = {light};
+    l.ambient = {0.02, 0.02, 0.02};
+    return l;
+}
+
+void report(benchmark::State& state, std::vector<double> ms, const LiveScene& scene, int iterations) {
+    std::sort(ms.begin(), ms.end());
+    state.counters["median_ms"] = ms[ms.size() / 2];
+    state.counters["p90_ms"] = ms[static_cast<size_t>(0.9 * (ms.size() - 1))];
+    state.counters["median_fps"] = 1000.0 / ms[ms.size() / 2];
+    state.counters["cg_its_per_frame"] = static_cast<double>(iterations) / ms.size();
+    state.counters["final_error"] = scene.estimated_error().value_or(-1);
+    if (scene.backend() != kVariants[state.range(0)].backend)
+        state.SkipWithError(("fell back to the CPU: " + scene.gpu_fallback_reason()).c_str());
+    state.SetLabel(scene.solver_description());
+}
+
+void BM_RelightFrames(benchmark::State& state) {
+    const Variant& variant = kVariants[state.range(0)];
+    Document doc(bench::spot_volume(kFrameTets), material_preset("marble"));
+    LiveScene scene(doc.mesh(), light_at(0), scene_options(doc.mesh(), variant));
+    scene.converge();
+    std::vector<double> ms;
+    int iterations = 0;
+    for (auto _ : state) {
+        for (int f = 1; f <= kFrames; ++f) {
+            const auto start = Clock::now();
+            scene.set_lighting(light_at(3.0 * f));
+            iterations += scene.step(kFrameIterations).total_iterations();
+            benchmark::DoNotOptimize(scene.radiance_factors().data());
+            ms.push_back(ms_since(start));
+        }
+    }
+    report(state, ms, scene, iterations);
+}
+BENCHMARK(BM_RelightFrames)->DenseRange(0, 2)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_PaintFrames(benchmark::State& state) {
+    const Variant& variant = kVariants[state.range(0)];
+    Document doc(bench::spot_volume(kFrameTets), material_preset("marble"));
+    LiveScene scene(doc.mesh(), light_at(0), scene_options(doc.mesh(), variant));
+    scene.converge();
+    const auto box = bounding_box(doc.mesh());
+    const Eigen::Vector3d centre = 0.5 * (box[0] + box[1]);
+    const double diagonal = (box[1] - box[0]).norm();
+    std::vector<double> ms;
+    int iterations = 0;
+    for (auto _ : state) {
+        for (int f = 0; f < kFrames; ++f) {
+            PaintOp op;
+            op.points = {centre + Eigen::Vector3d(0, 0.25 * diagonal * 0.3, (f / double(kFrames) - 0.5) * 0.5 * diagonal)};
+            op.material = material_preset("ketchup");
+            op.sigma = 0.01 * diagonal;
+            const auto start = Clock::now();
+            scene.apply_change(doc.mesh(), doc.apply(op));
+            iterations += scene.step(kFrameIterations).total_iterations();
+            benchmark::DoNotOptimize(scene.radiance_factors().data());
+            ms.push_back(ms_since(start));
+        }
+    }
+    report(state, ms, scene, iterations);
+}
+BENCHMARK(BM_PaintFrames)->DenseRange(0, 2)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace waxwork
+
+BENCHMARK_MAIN();

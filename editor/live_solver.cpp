@@ -1,0 +1,348 @@
+#include "editor/live_solver.h"
+
+#include "multires/hierarchy.h"
+#include "multires/multigrid_cg.h"
+#include "multires/multigrid_preconditioner.h"
+#include "solver/gpu_compute.h"
+#include "solver/gpu_conjugate_gradient.h"
+#include "solver/gpu_radiance.h"
+#include "tetops/error.h"
+
+#include <algorithm>
+#include <iterator>
+
+namespace waxwork {
+
+const char* live_method_name(LiveMethod method) { return method == LiveMethod::MultigridCg ? "mgcg" : "jacobi"; }
+const char* live_backend_name(LiveBackend backend) { return backend == LiveBackend::Gpu ? "gpu" : "cpu"; }
+
+LiveMethod parse_live_method(const std::string& name) {
+    if (name == "jacobi") return LiveMethod::JacobiCg;
+    if (name == "mgcg") return LiveMethod::MultigridCg;
+    throw InvalidArgumentError("live solver: unknown method '" + name + "' (jacobi or mgcg)");
+}
+
+LiveBackend parse_live_backend(const std::string& name) {
+    if (name == "cpu") return LiveBackend::Cpu;
+    if (name == "gpu") return LiveBackend::Gpu;
+    throw InvalidArgumentError("live solver: unknown backend '" + name + "' (cpu or gpu)");
+}
+
+namespace {
+
+class HeadlessSolverContext : public SolverGlContext {
+public:
+    explicit HeadlessSolverContext(HeadlessGlContext* borrowed) : context_(borrowed) {}
+    HeadlessSolverContext() : owned_(std::make_unique<HeadlessGlContext>()), context_(owned_.get()) {}
+    void make_current() override { context_->make_current(); }
+    const GlApi& gl() const override { return context_->gl(); }
+
+private:
+    std::unique_ptr<HeadlessGlContext> owned_;
+    HeadlessGlContext* context_;
+};
+
+// Makes a context current for one scope and releases it afterwards (also when a GPU call throws).
+class CurrentContext {
+public:
+    explicit CurrentContext(SolverGlContext& context) : context_(context) { context_.make_current(); }
+    ~CurrentContext() { context_.release(); }
+    CurrentContext(const CurrentContext&) = delete;
+    CurrentContext& operator=(const CurrentContext&) = delete;
+
+private:
+    SolverGlContext& context_;
+};
+
+}  // namespace
+
+std::shared_ptr<SolverGlContext> open_headless_solver_context() { return std::make_shared<HeadlessSolverContext>(); }
+
+std::shared_ptr<SolverGlContext> borrow_headless_solver_context(HeadlessGlContext& context) {
+    return std::make_shared<HeadlessSolverContext>(&context);
+}
+
+struct LiveSolver::Multigrid {
+    MultiresHierarchy hierarchy;
+    // Borrows `hierarchy`: declared after it, destroyed before it; the struct itself never moves.
+    std::unique_ptr<MultigridPreconditioner> preconditioner;
+};
+
+struct LiveSolver::Gpu {
+    std::unique_ptr<GpuDiffusionSolver> solver;
+    std::vector<std::array<double, 3>> staging;  // interleaved phi for uploads and read-backs
+    // Device radiance: weights from the boundary eta (reset when materials change), q (re-sent when
+    // the right-hand sides change), E per volume vertex, and the surface's volume-vertex index.
+    std::unique_ptr<GpuRadiance> radiance;
+    bool radiance_stale_weights = true, radiance_light_stale = true;
+    GpuBuffer volume_e, surface_index;
+    std::vector<int32_t> surface_vertices;  // what surface_index holds
+};
+
+LiveSolver::LiveSolver(const LiveSolverOptions& options)
+    : method_(options.method), backend_(options.backend), requested_backend_(options.backend),
+      context_(options.gl_context) {}
+
+LiveSolver::~LiveSolver() {
+    try {
+        release_gpu();
+    } catch (...) {
+        // Freeing device buffers cannot fail in a way the caller could act on.
+    }
+}
+
+void LiveSolver::release_gpu() {
+    if (!gpu_) return;
+    if (context_) {
+        const CurrentContext current(*context_);
+        gpu_.reset();  // GpuBuffer frees with the context current
+    } else {
+        gpu_.reset();
+    }
+}
+
+void LiveSolver::fall_back(const std::string& reason) {
+    gpu_fallback_reason_ = reason;
+    backend_ = LiveBackend::Cpu;
+    try {
+        release_gpu();
+    } catch (...) {
+        gpu_.release();  // a context that cannot be made current any more: leak rather than crash
+    }
+}
+
+void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix) {
+    eigenvalue_hint_ = {0, 0, 0};  // belong to the old matrix (a stale hint can be too optimistic)
+    multigrid_.reset();
+    multigrid_values_stale_ = false;
+    // The GPU backend runs Jacobi CG whatever the method (there is no device V-cycle); after a fallback
+    // the CPU then uses Jacobi CG until the next rebuild builds the hierarchy.
+    if (method_ == LiveMethod::MultigridCg && backend_ == LiveBackend::Cpu && matrix.size() > 0) {
+        // Built now, while the mesh is at hand (the scene borrows it only during its calls).
+        if (mesh.vertex_count() != matrix.size())
+            throw InvalidArgumentError("live solver: the matrix does not belong to the mesh");
+        multigrid_ = std::make_unique<Multigrid>();
+        multigrid_->hierarchy = build_multires_hierarchy(matrix, mesh.positions);
+        multigrid_->preconditioner = std::make_unique<MultigridPreconditioner>(multigrid_->hierarchy);
+    }
+    pending_rows_.clear();
+    gpu_values_stale_ = false;
+    if (gpu_) {
+        try {
+            release_gpu();  // a new pattern: rebuilt at the next frame
+        } catch (const std::exception& e) {
+            fall_back(std::string("GPU solver: ") + e.what());
+        }
+    }
+    gpu_rhs_stale_ = gpu_solution_stale_ = true;
+}
+
+// Material changes keep the eigenvalue hints, as the CPU path always did: the stopping rule confirms
+// convergence with the true residual anyway (conjugate_gradient.h).
+void LiveSolver::values_changed() {
+    if (gpu_) gpu_->radiance_stale_weights = true;  // the boundary eta may have changed
+    multigrid_values_stale_ = true;
+    gpu_values_stale_ = true;
+    pending_rows_.clear();
+}
+
+void LiveSolver::rows_changed(std::span<const int32_t> rows) {
+    if (rows.empty()) return;
+    if (gpu_) gpu_->radiance_stale_weights = true;
+    if (gpu_values_stale_ && multigrid_values_stale_) return;  // everything is re-sent anyway
+    std::vector<int32_t> merged;
+    merged.reserve(pending_rows_.size() + rows.size());
+    std::vector<int32_t> sorted(rows.begin(), rows.end());
+    std::sort(sorted.begin(), sorted.end());
+    std::set_union(pending_rows_.begin(), pending_rows_.end(), sorted.begin(), sorted.end(), std::back_inserter(merged));
+    merged.erase(std::unique(merged.begin(), merged.end()), merged.end());
+    pending_rows_.swap(merged);
+}
+
+void LiveSolver::right_hand_sides_changed() {
+    gpu_rhs_stale_ = true;
+    if (gpu_) gpu_->radiance_light_stale = true;
+}
+void LiveSolver::solution_changed() { gpu_solution_stale_ = true; }
+
+std::string LiveSolver::description() const {
+    std::string text = backend_ == LiveBackend::Gpu ? "GPU Jacobi CG (float)"
+                       : multigrid_                 ? "CPU multigrid CG (double)"
+                                                    : "CPU Jacobi CG (double)";
+    if (backend_ == LiveBackend::Gpu && !renderer_.empty()) text += " (" + renderer_ + ")";
+    return text;
+}
+
+std::array<LiveSolverChannel, 3> LiveSolver::iterate(const DiffusionMatrix& matrix,
+                                                     const std::array<std::vector<double>, 3>& b,
+                                                     std::array<std::vector<double>, 3>& phi, int iteration_budget,
+                                                     double relative_tolerance, const std::array<bool, 3>& skip) {
+    if (backend_ == LiveBackend::Gpu) {
+        try {
+            return iterate_gpu(matrix, b, phi, iteration_budget, relative_tolerance, skip);
+        } catch (const GpuError& e) {
+            fall_back(e.what());
+        } catch (const AlgorithmError&) {
+            throw;  // a breakdown is the system's, not the driver's: the CPU would report it too
+        } catch (const Error& e) {
+            fall_back(std::string("GPU solver: ") + e.what());  // e.g. no OpenGL 4.3 context
+        }
+        // The host phi is the last frame's read-back (iterate_gpu writes it only on success).
+    }
+    return iterate_cpu(matrix, b, phi, iteration_budget, relative_tolerance, skip);
+}
+
+std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& matrix,
+                                                         const std::array<std::vector<double>, 3>& b,
+                                                         std::array<std::vector<double>, 3>& phi, int iteration_budget,
+                                                         double relative_tolerance, const std::array<bool, 3>& skip) {
+    const size_t n = matrix.size();
+    const bool multigrid = multigrid_ && n > 0;
+    if (multigrid) {
+        if (multigrid_values_stale_) {
+            multigrid_->hierarchy.levels[0].values = matrix.values;
+            multigrid_->preconditioner.reset();
+            multigrid_->preconditioner = std::make_unique<MultigridPreconditioner>(multigrid_->hierarchy);
+        } else if (!pending_rows_.empty()) {
+            // Paint: only these level-0 rows changed; the preconditioner recomputes the coarse
+            // Galerkin rows that depend on them (equal to a rebuild).
+            HierarchyLevel& level0 = multigrid_->hierarchy.levels[0];
+            for (const int32_t row : pending_rows_)
+                for (int c = 0; c < 3; ++c)
+                    std::copy(matrix.values[c].begin() + matrix.offsets[row],
+                              matrix.values[c].begin() + matrix.offsets[row + 1],
+                              level0.values[c].begin() + level0.offsets[row]);
+            // A one-level hierarchy is its own coarsest level, which update_values does not
+            // refactorise (it refactorises only a coarse level it reached): rebuild that small case.
+            if (multigrid_->hierarchy.level_count() > 1) {
+                multigrid_->preconditioner->update_values(pending_rows_);
+            } else {
+                multigrid_->preconditioner.reset();
+                multigrid_->preconditioner = std::make_unique<MultigridPreconditioner>(multigrid_->hierarchy);
+            }
+        }
+    }
+    multigrid_values_stale_ = false;
+    // The rows stay pending for the GPU only if it is still meant to run (not after a fallback).
+    if (backend_ == LiveBackend::Cpu) pending_rows_.clear();
+
+    std::array<LiveSolverChannel, 3> out;
+    for (int c = 0; c < 3; ++c) {
+        if (skip[c] || n == 0) {
+            out[c].converged = true;
+            out[c].estimated_relative_error = 0;
+            continue;
+        }
+        ConjugateGradientOptions cg;
+        cg.relative_tolerance = relative_tolerance;
+        cg.max_iterations = iteration_budget;
+        cg.smallest_eigenvalue_hint = eigenvalue_hint_[c];
+        ConjugateGradientResult r;
+        if (multigrid) {
+            r = solve_multigrid_cg(*multigrid_->preconditioner, c, b[c], phi[c], cg);
+        } else {
+            const CsrMatrixView<double> view{n, matrix.offsets.data(), matrix.columns.data(), matrix.values[c].data()};
+            r = solve_jacobi_cg<double>(view, b[c], phi[c], cg);
+        }
+        if (r.smallest_eigenvalue_estimate > 0) eigenvalue_hint_[c] = r.smallest_eigenvalue_estimate;
+        out[c] = {r.iterations, r.estimated_relative_error, r.converged};
+    }
+    // The device no longer holds this phi.
+    gpu_solution_stale_ = true;
+    return out;
+}
+
+std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu(const DiffusionMatrix& matrix,
+                                                         const std::array<std::vector<double>, 3>& b,
+                                                         std::array<std::vector<double>, 3>& phi, int iteration_budget,
+                                                         double relative_tolerance, const std::array<bool, 3>& skip) {
+    const size_t n = matrix.size();
+    std::array<LiveSolverChannel, 3> out;
+    if (n == 0 || (skip[0] && skip[1] && skip[2])) {
+        for (int c = 0; c < 3; ++c) out[c] = {0, skip[c] ? 0.0 : 1.0, skip[c] || n == 0};
+        return out;
+    }
+    if (!context_) context_ = open_headless_solver_context();
+    const CurrentContext current(*context_);
+    const GlApi& gl = context_->gl();
+    if (!gpu_) {
+        require_compute_support(gl);
+        auto gpu = std::make_unique<Gpu>();
+        gpu->solver = std::make_unique<GpuDiffusionSolver>(gl, matrix);
+        gpu_ = std::move(gpu);
+        const GLubyte* renderer = gl.GetString(GL_RENDERER);
+        renderer_ = renderer ? reinterpret_cast<const char*>(renderer) : "";
+        gpu_rhs_stale_ = gpu_solution_stale_ = true;
+    } else if (gpu_values_stale_) {
+        gpu_->solver->update_values(matrix);
+    } else if (!pending_rows_.empty()) {
+        gpu_->solver->update_rows(matrix, pending_rows_);  // paint: O(changed entries) upload
+    }
+    gpu_values_stale_ = false;
+    pending_rows_.clear();
+    if (gpu_rhs_stale_) gpu_->solver->set_right_hand_side(b);
+    gpu_rhs_stale_ = false;
+    auto& staging = gpu_->staging;
+    if (gpu_solution_stale_) {
+        staging.resize(n);
+        for (size_t v = 0; v < n; ++v)
+            for (int c = 0; c < 3; ++c) staging[v][c] = phi[c][v];
+        gpu_->solver->set_solution(staging);
+    }
+    gpu_solution_stale_ = false;
+
+    GpuCgOptions options;
+    options.relative_tolerance = relative_tolerance;
+    options.max_iterations = iteration_budget;
+    options.use_eigenvalue_hints = true;
+    const std::array<ConjugateGradientResult, 3> results = gpu_->solver->solve(options);
+    staging = gpu_->solver->solution();
+    for (size_t v = 0; v < n; ++v)
+        for (int c = 0; c < 3; ++c) phi[c][v] = staging[v][c];
+    for (int c = 0; c < 3; ++c) out[c] = {results[c].iterations, results[c].estimated_relative_error, results[c].converged};
+    return out;
+}
+
+std::shared_ptr<const GpuBuffer> LiveSolver::radiance_on_device(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                                                const std::vector<std::array<double, 3>>& q,
+                                                                const std::vector<int32_t>& surface_vertices) {
+    if (backend_ != LiveBackend::Gpu || !gpu_ || !context_ || surface_vertices.empty()) return nullptr;
+    const size_t n = gpu_->solver->size();
+    if (mesh.vertex_count() != n || q.size() != n)
+        throw InvalidArgumentError("live solver: radiance_on_device needs the mesh and light of the solved matrix");
+    try {
+        const CurrentContext current(*context_);
+        const GlApi& gl = context_->gl();
+        GpuKernels& kernels = gpu_->solver->kernels();
+        if (!gpu_->radiance || gpu_->radiance_stale_weights) {
+            gpu_->radiance.reset();  // frees its buffers with the context current
+            gpu_->radiance = std::make_unique<GpuRadiance>(kernels, mesh, connectivity, mesh.materials);
+            gpu_->radiance_stale_weights = false;
+            gpu_->radiance_light_stale = true;
+        }
+        if (gpu_->radiance_light_stale) gpu_->radiance->set_light(q);
+        gpu_->radiance_light_stale = false;
+        if (gpu_->volume_e.bytes() != 3 * n * sizeof(float)) gpu_->volume_e = kernels.vector(n);
+        gpu_->radiance->compute(gpu_->solver->solution_buffer(), gpu_->volume_e);
+        if (gpu_->surface_vertices != surface_vertices) {
+            for (const int32_t v : surface_vertices)
+                if (v < 0 || static_cast<size_t>(v) >= n)
+                    throw InvalidArgumentError("live solver: surface vertex " + std::to_string(v) + " out of range");
+            gpu_->surface_index = GpuBuffer::from<int32_t>(gl, surface_vertices);
+            gpu_->surface_vertices = surface_vertices;
+        }
+        const size_t m = surface_vertices.size();
+        auto e = std::make_shared<GpuBuffer>(gl, 3 * m * sizeof(float));
+        kernels.gather(m, gpu_->surface_index, gpu_->volume_e, *e);
+        check_gpu_error(gl, "computing the radiance on the device");
+        // The main window's context reads it next: the writes must be complete (a shared object's
+        // changes are visible to another context only after the writing context finished them).
+        gl.Finish();
+        return e;
+    } catch (const GpuError& e) {
+        fall_back(e.what());
+        return nullptr;
+    }
+}
+
+}  // namespace waxwork

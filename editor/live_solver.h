@@ -1,0 +1,147 @@
+// The per-frame diffusion solver behind LiveScene (issues 5 and 7): one interface for the methods and
+// backends a live editor can use, each warm-started from the previous frame's phi and told what an
+// edit changed, so it redoes only that.
+//
+//   CPU Jacobi CG        conjugate_gradient.h in double, per channel (the default: on spot it is as
+//                        fast to 1% as the multires solver, live_scene.h).
+//   CPU multigrid CG     multires/multigrid_cg.h: CG preconditioned by the V-cycle on the hierarchy of
+//                        Li et al. 2013 (Sec. 4.1, Eq. 16). The hierarchy is built once per topology;
+//                        after painting only the level-0 rows that changed are copied and the coarse
+//                        Galerkin rows depending on them recomputed (MultigridPreconditioner::update_values).
+//   GPU CG               solver/gpu_conjugate_gradient.h (float, OpenGL 4.3 compute shaders): matrix,
+//                        right-hand sides and phi stay on the device between frames; painting uploads
+//                        only the rewritten rows (GpuDiffusionSolver::update_rows). phi is read back
+//                        after each frame so the host copy (phi(), saves, the CPU radiance) stays valid.
+//
+// The GPU backend runs on a SolverGlContext: the editor's hidden window sharing the main window's
+// objects, or an OSMesa context (tests, `waxwork run`). The context is made current around every GPU
+// call, because the editor runs each frame on a new worker thread. When the context or a shader fails
+// (no OpenGL 4.3, a driver bug, WAXWORK_GPU_FORCE_FAIL), the solver switches to the CPU method for
+// good and says why (gpu_fallback_reason()): a driver problem never stops the editor.
+#pragma once
+
+#include "solver/conjugate_gradient.h"
+#include "solver/diffusion_matrix.h"
+#include "solver/gl_context.h"
+#include "solver/gpu_compute.h"
+#include "tetops/connectivity.h"
+#include "tetops/tet_mesh.h"
+
+#include <array>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace waxwork {
+
+enum class LiveMethod { JacobiCg, MultigridCg };
+enum class LiveBackend { Cpu, Gpu };
+
+// "jacobi" / "mgcg" and "cpu" / "gpu" (command line and session files); parse_* throw
+// InvalidArgumentError naming the accepted values.
+const char* live_method_name(LiveMethod method);
+const char* live_backend_name(LiveBackend backend);
+LiveMethod parse_live_method(const std::string& name);
+LiveBackend parse_live_backend(const std::string& name);
+
+// An OpenGL >= 4.3 context the GPU solver may use from any thread, one thread at a time.
+class SolverGlContext {
+public:
+    virtual ~SolverGlContext() = default;
+    // Makes the context current on the calling thread.
+    virtual void make_current() = 0;
+    // The calling thread is done with it for now (a GLFW context must not stay current on a thread
+    // that ends while another thread may take it next). Default: nothing.
+    virtual void release() {}
+    virtual const GlApi& gl() const = 0;
+};
+
+// An OSMesa/EGL context (gl_context.h) as a SolverGlContext: owned (opened here) or borrowed (the
+// caller's, e.g. the one `waxwork run` renders with, which must then outlive this object).
+std::shared_ptr<SolverGlContext> open_headless_solver_context();  // throws waxwork::Error
+std::shared_ptr<SolverGlContext> borrow_headless_solver_context(HeadlessGlContext& context);
+
+struct LiveSolverOptions {
+    LiveMethod method = LiveMethod::JacobiCg;
+    LiveBackend backend = LiveBackend::Cpu;
+    // The GPU backend's context; null: an OSMesa context is opened at the first GPU frame.
+    std::shared_ptr<SolverGlContext> gl_context;
+};
+
+struct LiveSolverChannel {
+    int iterations = 0;
+    double estimated_relative_error = 1;
+    bool converged = false;
+};
+
+// Not thread-safe: LiveScene calls it under its mutex.
+class LiveSolver {
+public:
+    explicit LiveSolver(const LiveSolverOptions& options = {});
+    ~LiveSolver();  // frees the device buffers with the context current
+    LiveSolver(const LiveSolver&) = delete;
+    LiveSolver& operator=(const LiveSolver&) = delete;
+
+    // What changed since the last iterate(); each only marks work for the next one.
+    // A new matrix (pattern or geometry): every derived structure is rebuilt (multigrid CG: the
+    // hierarchy now, its Eq. 16 weights from the mesh's rest positions; the device: at the next frame).
+    void matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix);
+    void values_changed();                          // all values, same pattern
+    void rows_changed(std::span<const int32_t> rows);  // update_diffusion_matrix's rows
+    void right_hand_sides_changed();
+    void solution_changed();                        // phi replaced on the host (a cut's vertex map)
+
+    // At most `iteration_budget` iterations per channel from `phi` (the warm start and the result).
+    // Channels flagged in `skip` are not iterated. Throws AlgorithmError on a CG breakdown.
+    std::array<LiveSolverChannel, 3> iterate(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
+                                             std::array<std::vector<double>, 3>& phi, int iteration_budget,
+                                             double relative_tolerance, const std::array<bool, 3>& skip);
+
+    // The exitant radiance factor E (Eq. 3 without F_t, gpu_radiance.h) of every surface vertex, computed
+    // on the device from the resident phi and gathered into surface order (`surface_vertices`: the
+    // volume vertex of each surface vertex), 3 floats per vertex: what a renderer in the context's
+    // share group binds as its radiance attribute instead of uploading a CPU copy. A new buffer per
+    // call (the renderer may still draw the previous one), complete when returned (glFinish: another
+    // context reads it next). Null unless the GPU backend is running; a GPU failure here falls back
+    // like iterate(). q: the incident light per volume vertex, as for the right-hand sides.
+    std::shared_ptr<const GpuBuffer> radiance_on_device(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                                        const std::vector<std::array<double, 3>>& q,
+                                                        const std::vector<int32_t>& surface_vertices);
+
+    LiveMethod method() const { return method_; }
+    // The backend that solves now (Cpu after a fallback).
+    LiveBackend backend() const { return backend_; }
+    LiveBackend requested_backend() const { return requested_backend_; }
+    // Why the GPU backend was given up ("" when it was not requested or runs).
+    const std::string& gpu_fallback_reason() const { return gpu_fallback_reason_; }
+    // "GPU CG (llvmpipe (LLVM 15.0.6, 256 bits))", "CPU multigrid CG", ...: for the panel and logs.
+    std::string description() const;
+
+private:
+    struct Gpu;
+    struct Multigrid;
+    std::array<LiveSolverChannel, 3> iterate_cpu(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
+                                                 std::array<std::vector<double>, 3>& phi, int iteration_budget,
+                                                 double relative_tolerance, const std::array<bool, 3>& skip);
+    std::array<LiveSolverChannel, 3> iterate_gpu(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
+                                                 std::array<std::vector<double>, 3>& phi, int iteration_budget,
+                                                 double relative_tolerance, const std::array<bool, 3>& skip);
+    void fall_back(const std::string& reason);
+    void release_gpu();
+
+    LiveMethod method_;
+    LiveBackend backend_, requested_backend_;
+    std::shared_ptr<SolverGlContext> context_;
+    std::string gpu_fallback_reason_;
+    std::string renderer_;
+    std::array<double, 3> eigenvalue_hint_{};
+    std::unique_ptr<Multigrid> multigrid_;
+    bool multigrid_values_stale_ = false;
+    std::unique_ptr<Gpu> gpu_;
+    // Pending device work (applied at the next GPU iterate, with the context current).
+    bool gpu_values_stale_ = false, gpu_rhs_stale_ = true, gpu_solution_stale_ = true;
+    std::vector<int32_t> pending_rows_;  // ascending, unique; for the GPU and the multigrid levels
+};
+
+}  // namespace waxwork

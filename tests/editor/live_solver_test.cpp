@@ -1,0 +1,223 @@
+// The live scene's methods and backends (editor/live_solver.h): each converges to the same phi, follows
+// edits (paint rows, all values, a cut) to what a fresh scene gives, and a GPU that fails falls back to
+// the CPU with a reason.
+#include "editor/live_scene.h"
+#include "editor/surface_renderer.h"
+#include "solver/material.h"
+#include "tetops/error.h"
+#include "tetops/test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+namespace waxwork {
+namespace {
+
+Lighting key_lighting() {
+    Lighting l;
+    Light light;
+    light.vector = Eigen::Vector3d(1, -0.8, -0.5).normalized();
+    l.lights = {light};
+    l.ambient = {0.02, 0.02, 0.02};
+    return l;
+}
+
+struct Config {
+    LiveMethod method;
+    LiveBackend backend;
+    // The GPU solves in float: its estimated error cannot go far below 1e-6 (gpu_conjugate_gradient.h).
+    double tolerance;
+    const char* name;
+};
+
+const Config kConfigs[] = {
+    {LiveMethod::JacobiCg, LiveBackend::Cpu, 1e-9, "cpu jacobi"},
+    {LiveMethod::MultigridCg, LiveBackend::Cpu, 1e-9, "cpu mgcg"},
+    {LiveMethod::JacobiCg, LiveBackend::Gpu, 1e-6, "gpu cg"},
+};
+
+LiveSceneOptions options_for(const Config& config) {
+    LiveSceneOptions o;
+    o.mm_per_unit = 10;  // a 1 cm marble cube: phi varies strongly across it
+    o.relative_tolerance = config.tolerance;
+    o.method = config.method;
+    o.backend = config.backend;
+    return o;
+}
+
+// max |a - b| / max |b| over vertices and channels.
+double relative_difference(const std::vector<std::array<double, 3>>& a, const std::vector<std::array<double, 3>>& b) {
+    EXPECT_EQ(a.size(), b.size());
+    double largest = 0, difference = 0;
+    for (size_t v = 0; v < std::min(a.size(), b.size()); ++v)
+        for (int c = 0; c < 3; ++c) {
+            largest = std::max(largest, std::abs(b[v][c]));
+            difference = std::max(difference, std::abs(a[v][c] - b[v][c]));
+        }
+    EXPECT_GT(largest, 0);
+    return difference / largest;
+}
+
+std::vector<std::array<double, 3>> reference_phi(const TetMesh& mesh) {
+    LiveScene scene(mesh, key_lighting(), options_for(kConfigs[0]));
+    scene.converge();
+    return scene.phi();
+}
+
+PaintOp paint_at(const Eigen::Vector3d& p, const char* material) {
+    PaintOp op;
+    op.points = {p};
+    op.material = material_preset(material);
+    op.sigma = 0.08;
+    return op;
+}
+
+TEST(LiveSolver, EveryMethodAndBackendConvergesToTheSamePhi) {
+    const TetMesh mesh = testing::make_cube_mesh(7);
+    Document doc(mesh, material_preset("marble"));
+    const auto reference = reference_phi(doc.mesh());
+    for (const Config& config : kConfigs) {
+        LiveScene scene(doc.mesh(), key_lighting(), options_for(config));
+        // Frames of a few iterations, as the editor runs them, then to the tolerance.
+        for (int i = 0; i < 3; ++i) scene.step(4);
+        scene.converge();
+        EXPECT_EQ(scene.backend(), config.backend) << config.name << ": " << scene.gpu_fallback_reason();
+        EXPECT_EQ(scene.gpu_fallback_reason(), "") << config.name;
+        EXPECT_LT(relative_difference(scene.phi(), reference), 1e-4) << config.name;
+    }
+}
+
+TEST(LiveSolver, EditedScenesConvergeToWhatAFreshSceneGives) {
+    for (const Config& config : kConfigs) {
+        Document doc(testing::make_cube_mesh(7), material_preset("marble"));
+        LiveScene scene(doc.mesh(), key_lighting(), options_for(config));
+        scene.converge();
+        // Paint (rows only: the device and the multigrid levels take only the changed rows), twice
+        // before the next frame so the pending rows merge.
+        scene.apply_change(doc.mesh(), doc.apply(paint_at({0.5, 0.5, 0.5}, "ketchup")));
+        const SceneUpdate update = scene.apply_change(doc.mesh(), doc.apply(paint_at({0.3, 0.6, 0.4}, "skin1")));
+        ASSERT_FALSE(update.updated_rows.empty());
+        ASSERT_FALSE(update.reassembled_matrix);
+        scene.step(3);
+        scene.converge();
+        {
+            LiveScene fresh(doc.mesh(), key_lighting(), options_for(config));
+            fresh.converge();
+            EXPECT_LT(relative_difference(scene.phi(), fresh.phi()), 1e-4) << config.name << " paint";
+            EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4) << config.name << " paint";
+        }
+        // All values on the kept pattern.
+        scene.apply_change(doc.mesh(), doc.apply(SetMaterialOp{material_preset("skin2"), std::nullopt}));
+        scene.converge();
+        EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4) << config.name << " set material";
+        // A cut: new pattern, warm start through the vertex map.
+        PlaneCutOp cut;
+        cut.plane = {Eigen::Vector3d(1, 0.3, 0.2), 0.6};
+        scene.apply_change(doc.mesh(), doc.apply(cut));
+        scene.step(2);
+        scene.converge();
+        EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4) << config.name << " cut";
+        EXPECT_EQ(scene.backend(), config.backend) << config.name << ": " << scene.gpu_fallback_reason();
+    }
+}
+
+// Large enough for a hierarchy of several levels: painting then updates the coarse Galerkin rows in
+// place (MultigridPreconditioner::update_values) instead of the one-level rebuild of the small cube.
+TEST(LiveSolver, MultigridOnSeveralLevelsFollowsPaintToTheFreshSolution) {
+    Document doc(testing::make_cube_mesh(14), material_preset("marble"));
+    LiveScene scene(doc.mesh(), key_lighting(), options_for(kConfigs[1]));
+    scene.converge();
+    for (int i = 0; i < 3; ++i) {
+        const SceneUpdate update =
+            scene.apply_change(doc.mesh(), doc.apply(paint_at({0.2 + 0.3 * i, 0.5, 0.4}, i % 2 ? "skin1" : "ketchup")));
+        ASSERT_FALSE(update.updated_rows.empty());
+        scene.step(2);
+    }
+    const FrameReport report = scene.converge();
+    EXPECT_LT(report.total_iterations(), 60);  // a preconditioner that follows the paint stays strong
+    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
+    EXPECT_NE(scene.solver_description().find("multigrid"), std::string::npos);
+}
+
+TEST(LiveSolver, AFailingGpuFallsBackToTheCpuWithAReason) {
+    Document doc(testing::make_cube_mesh(6), material_preset("marble"));
+    setenv("WAXWORK_GPU_FORCE_FAIL", "1", 1);
+    LiveSceneOptions o = options_for(kConfigs[2]);
+    LiveScene scene(doc.mesh(), key_lighting(), o);
+    FrameReport frame = scene.step(5);
+    unsetenv("WAXWORK_GPU_FORCE_FAIL");
+    EXPECT_GT(frame.total_iterations(), 0);  // the frame was solved on the CPU instead
+    EXPECT_EQ(scene.backend(), LiveBackend::Cpu);
+    const std::string reason = scene.gpu_fallback_reason();
+    EXPECT_NE(reason.find("WAXWORK_GPU_FORCE_FAIL"), std::string::npos) << reason;
+    EXPECT_NE(scene.solver_description().find("CPU"), std::string::npos);
+    scene.converge();
+    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
+    // Painting after the fallback keeps working on the CPU.
+    scene.apply_change(doc.mesh(), doc.apply(paint_at({0.5, 0.5, 0.5}, "ketchup")));
+    scene.converge();
+    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
+}
+
+// The renderer reading E from the GPU solver's buffer draws what it draws from the CPU's E.
+TEST(LiveSolver, DeviceRadianceDrawsWhatTheCpuRadianceDraws) {
+    HeadlessGlContext context;
+    Document doc(testing::make_cube_mesh(7), material_preset("marble"));
+    doc.apply(paint_at({0.5, 0.5, 0.9}, "skin1"));
+    LiveSceneOptions o = options_for(kConfigs[2]);
+    o.gl_context = borrow_headless_solver_context(context);
+    LiveScene scene(doc.mesh(), key_lighting(), o);
+    scene.converge();
+    ASSERT_EQ(scene.backend(), LiveBackend::Gpu) << scene.gpu_fallback_reason();
+    ImageSettings settings;
+    settings.width = 96;
+    settings.height = 72;
+    SurfaceRenderInput input = make_render_input(doc.mesh(), scene.solved_scene(), key_lighting(), settings);
+    const std::shared_ptr<const GpuBuffer> device = scene.device_radiance();
+    ASSERT_TRUE(device);
+    context.make_current();
+    const std::vector<float> e = device->download<float>();
+    ASSERT_EQ(e.size(), 3 * input.positions.size());
+    float largest = 0;
+    for (size_t i = 0; i < input.positions.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            largest = std::max(largest, input.radiance_factor[i][c]);
+            EXPECT_NEAR(e[3 * i + c], input.radiance_factor[i][c], 1e-5f * std::abs(input.radiance_factor[i][c]) + 1e-7f);
+        }
+    EXPECT_GT(largest, 0);
+
+    SurfaceRenderer renderer(context.gl());
+    const Image from_cpu = renderer.render(input);
+    input.device_radiance = device;
+    const Image from_device = renderer.render(input);
+    int difference = 0;
+    for (size_t i = 0; i < from_cpu.rgba.size(); ++i)
+        difference = std::max(difference, std::abs(int(from_cpu.rgba[i]) - int(from_device.rgba[i])));
+    EXPECT_LE(difference, 1);
+    // The buffer is really what is drawn: a black one gives another image.
+    const std::vector<float> zeros(e.size(), 0.0f);
+    input.device_radiance = std::make_shared<GpuBuffer>(context.gl(), zeros.size() * sizeof(float), zeros.data());
+    const Image black = renderer.render(input);
+    difference = 0;
+    for (size_t i = 0; i < from_cpu.rgba.size(); ++i)
+        difference = std::max(difference, std::abs(int(from_cpu.rgba[i]) - int(black.rgba[i])));
+    EXPECT_GT(difference, 40);
+
+    // The CPU backends have no device buffer.
+    LiveScene cpu(doc.mesh(), key_lighting(), options_for(kConfigs[0]));
+    cpu.converge();
+    EXPECT_FALSE(cpu.device_radiance());
+}
+
+TEST(LiveSolver, NamesParseAndBadNamesAreRejected) {
+    EXPECT_EQ(parse_live_method(live_method_name(LiveMethod::MultigridCg)), LiveMethod::MultigridCg);
+    EXPECT_EQ(parse_live_method(live_method_name(LiveMethod::JacobiCg)), LiveMethod::JacobiCg);
+    EXPECT_EQ(parse_live_backend(live_backend_name(LiveBackend::Gpu)), LiveBackend::Gpu);
+    EXPECT_EQ(parse_live_backend(live_backend_name(LiveBackend::Cpu)), LiveBackend::Cpu);
+    EXPECT_THROW(parse_live_method("gauss"), InvalidArgumentError);
+    EXPECT_THROW(parse_live_backend("tpu"), InvalidArgumentError);
+}
+
+}  // namespace
+}  // namespace waxwork
