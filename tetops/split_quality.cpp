@@ -61,11 +61,12 @@ std::array<Eigen::Vector3d, 4> moved_corners(const TetMesh& mesh, const Tet& tet
 }
 
 // Adds the part of `n` orthogonal to `basis` when it is not (numerically) in its span already. Face
-// normals of one plane agree to rounding; 1e-9 tells a plane from one bent by more than a nanoradian.
+// normals of one plane agree to rounding (more loosely for thin faces); 1e-8 tells a plane from one
+// bent by more than 10 nanoradians.
 void add_constraint(std::vector<Eigen::Vector3d>& basis, const Eigen::Vector3d& n) {
     Eigen::Vector3d r = n;
     for (const Eigen::Vector3d& b : basis) r -= b.dot(r) * b;
-    if (r.norm() > 1e-9) basis.push_back(r.normalized());
+    if (r.norm() > 1e-8) basis.push_back(r.normalized());
 }
 
 struct VertexState {
@@ -159,20 +160,29 @@ size_t smooth_split_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world,
         }
         s.reproject = normal.norm() > 0;
         bool on_surface_face = false;
+        // Planes to keep, best-shaped face first: the rounding error of a face normal grows as the
+        // face gets thinner (about eps x longest edge^2 / twice the area), and the first face of a plane
+        // sets the plane the vertex moves in.
+        std::vector<std::pair<double, Eigen::Vector3d>> normals;
         for (const KeptFace& face : kept) {
             const auto& f = face.vertices;
             const bool surface_face =
                 on_surface && !face.on_boundary && values[f[0]] == 0 && values[f[1]] == 0 && values[f[2]] == 0;
             on_surface_face |= surface_face;
             if (surface_face && s.reproject) continue;
-            const Eigen::Vector3d n =
-                (mesh.positions[f[1]] - mesh.positions[f[0]]).cross(mesh.positions[f[2]] - mesh.positions[f[0]]);
+            const Eigen::Vector3d& a = mesh.positions[f[0]];
+            const Eigen::Vector3d& b = mesh.positions[f[1]];
+            const Eigen::Vector3d& c = mesh.positions[f[2]];
+            const Eigen::Vector3d n = (b - a).cross(c - a);
+            const double longest = std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
             if (!(n.norm() > 0)) {
                 s.fixed = true;  // a flat face has no plane to keep
                 return;
             }
-            add_constraint(s.basis, n.normalized());
+            normals.emplace_back(n.norm() / longest, n.normalized());
         }
+        std::stable_sort(normals.begin(), normals.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+        for (const auto& [shape, n] : normals) add_constraint(s.basis, n);
         if (s.reproject) {
             // Back onto the surface along the part of its normal the other planes leave free, so the
             // correction does not move the vertex off the boundary or a wall.
@@ -273,9 +283,10 @@ size_t smooth_split_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world,
             gradient[axis] = min_dihedral_angle_deg(plus[0], plus[1], plus[2], plus[3]) -
                              min_dihedral_angle_deg(minus[0], minus[1], minus[2], minus[3]);
         }
-        gradient = constrain(gradient);
-        if (gradient.norm() > 0) {
-            const Eigen::Vector3d direction = gradient.normalized();
+        // A gradient (nearly) normal to the kept planes leaves only rounding noise in them: no direction.
+        const Eigen::Vector3d free_gradient = constrain(gradient);
+        if (free_gradient.norm() > 1e-6 * gradient.norm()) {
+            const Eigen::Vector3d direction = constrain(free_gradient.normalized());
             for (double f : {0.3, 0.15, 0.08, 0.04, 0.02, 0.01, 0.005}) candidates.push_back(x + f * length * direction);
         }
 
