@@ -196,6 +196,7 @@ size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::ve
             for (int k = 0; k < 4; ++k) p[k] = tet[k] == v ? target : mesh.positions[tet[k]];
             if (!(signed_volume(p[0], p[1], p[2], p[3]) > 0)) return false;
             const double after = min_dihedral_angle_deg(p[0], p[1], p[2], p[3]);
+            if (after >= options.min_dihedral_guard_deg) continue;
             const double before = min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]],
                                                          mesh.positions[tet[2]], mesh.positions[tet[3]]);
             const double floor =
@@ -403,18 +404,23 @@ SplitReport split_along_field(TetMesh& mesh, std::vector<Eigen::Vector3d>& world
         // Regions after the split: the given labels, told apart by side, so the new surface and the
         // earlier walls are both kept faces.
         std::vector<int64_t> labels(mesh.tet_count());
-        for (size_t t = 0; t < mesh.tet_count(); ++t) {
-            const size_t source = t < tets_before ? t : static_cast<size_t>(report.appended_parents[t - tets_before]);
-            labels[t] = (options.tet_labels ? (*options.tet_labels)[source] : 0) * 2 + report.positive[t];
-            if (!options.smooth_positive_side && report.positive[t]) touched[t] = 0;
-        }
+        std::vector<uint8_t> start = touched;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.tet_count(), 4096), [&](const auto& range) {
+            for (size_t t = range.begin(); t != range.end(); ++t) {
+                const size_t source =
+                    t < tets_before ? t : static_cast<size_t>(report.appended_parents[t - tets_before]);
+                labels[t] = (options.tet_labels ? (*options.tet_labels)[source] : 0) * 2 + report.positive[t];
+                if (!options.smooth_positive_side && report.positive[t]) start[t] = 0;
+            }
+        });
         SplitSmoothingOptions smoothing;
         smoothing.guard_deg = options.min_dihedral_guard_deg;
         smoothing.target_deg = options.smooth_below_deg;
         report.vertices_smoothed =
-            smooth_split_vertices(mesh, world, values, field, labels, reference, touched, smoothing);
+            smooth_split_vertices(mesh, world, values, field, labels, reference, start, touched, smoothing);
     }
-    report.tets_under_guard = count_tets_under_guard(mesh, reference, options.min_dihedral_guard_deg);
+    // Only tets this split touched can have changed since the reference was taken.
+    report.tets_under_guard = count_tets_under_guard(mesh, reference, options.min_dihedral_guard_deg, &touched);
     return report;
 }
 

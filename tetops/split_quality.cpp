@@ -82,14 +82,15 @@ struct VertexState {
 
 }  // namespace
 
-size_t count_tets_under_guard(const TetMesh& mesh, const std::vector<double>& reference_deg, double guard_deg) {
-    if (reference_deg.size() != mesh.tet_count())
-        throw InvalidArgumentError("guard count: one reference angle per tet expected");
+size_t count_tets_under_guard(const TetMesh& mesh, const std::vector<double>& reference_deg, double guard_deg,
+                              const std::vector<uint8_t>* only) {
+    if (reference_deg.size() != mesh.tet_count() || (only && only->size() != mesh.tet_count()))
+        throw InvalidArgumentError("guard count: one reference angle (and flag) per tet expected");
     return tbb::parallel_reduce(
         tbb::blocked_range<size_t>(0, mesh.tet_count(), 4096), size_t{0},
         [&](const tbb::blocked_range<size_t>& range, size_t count) {
             for (size_t t = range.begin(); t != range.end(); ++t)
-                if (!std::isnan(reference_deg[t]) &&
+                if (!std::isnan(reference_deg[t]) && (!only || (*only)[t]) &&
                     tet_angle(mesh, mesh.tets[t]) < guard_floor_deg(guard_deg, reference_deg[t]))
                     ++count;
             return count;
@@ -100,10 +101,11 @@ size_t count_tets_under_guard(const TetMesh& mesh, const std::vector<double>& re
 size_t smooth_split_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, const std::vector<double>& values,
                              const SplitField& field, const std::vector<int64_t>& labels,
                              std::vector<double>& reference_deg, const std::vector<uint8_t>& start,
-                             const SplitSmoothingOptions& options) {
+                             std::vector<uint8_t>& touched, const SplitSmoothingOptions& options) {
     const size_t tet_count = mesh.tet_count();
     const size_t vertex_count = mesh.vertex_count();
     if (labels.size() != tet_count || reference_deg.size() != tet_count || start.size() != tet_count ||
+        touched.size() != tet_count ||
         world.size() != vertex_count || values.size() != vertex_count)
         throw InvalidArgumentError("split smoothing: per-tet or per-vertex arrays do not match the mesh");
     if (options.max_sweeps <= 0) return 0;
@@ -305,19 +307,29 @@ size_t smooth_split_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world,
         return true;
     };
 
+    // A vertex whose star did not change since its last visit would find the same answer: skip it.
+    std::vector<uint8_t> dirty(states.size(), 1), next_dirty(states.size(), 0);
     for (int sweep = 0; sweep < options.max_sweeps; ++sweep) {
         size_t accepted = 0;
+        std::fill(next_dirty.begin(), next_dirty.end(), 0);
         for (const std::vector<int32_t>& members : classes) {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, members.size(), 16), [&](const auto& range) {
                 for (size_t i = range.begin(); i != range.end(); ++i)
-                    moved_now[members[i]] = update(states[members[i]]);
+                    moved_now[members[i]] = dirty[members[i]] && update(states[members[i]]);
             });
             for (int32_t i : members) {
-                accepted += moved_now[i];
-                moved[i] |= moved_now[i];
+                if (!moved_now[i]) continue;
+                ++accepted;
+                moved[i] = 1;
+                for (int32_t t : states[i].star) {
+                    touched[t] = 1;
+                    for (int32_t u : mesh.tets[t])
+                        if (slot[u] >= 0) next_dirty[slot[u]] = 1;
+                }
             }
         }
         if (accepted == 0) break;
+        dirty.swap(next_dirty);
     }
     return static_cast<size_t>(std::count(moved.begin(), moved.end(), uint8_t{1}));
 }

@@ -37,8 +37,10 @@ inline double guard_floor_deg(double guard_deg, double reference_deg) {
 }
 
 // Tets whose minimum dihedral angle is under min(guard, reference[t]); tets with a NaN reference
-// (untouched) are skipped. Counted from the mesh as it is (parallel).
-size_t count_tets_under_guard(const TetMesh& mesh, const std::vector<double>& reference_deg, double guard_deg);
+// (untouched) are skipped, and with `only` (per tet) those not flagged. Counted from the mesh as it
+// is (parallel).
+size_t count_tets_under_guard(const TetMesh& mesh, const std::vector<double>& reference_deg, double guard_deg,
+                              const std::vector<uint8_t>* only = nullptr);
 
 struct SplitSmoothingOptions {
     double guard_deg = 0.5;
@@ -55,12 +57,13 @@ struct SplitSmoothingOptions {
 // `field` (re-projected when the field can project, else held in the plane of its faces on the
 // surface); faces on the boundary or between different `labels` keep their planes, so a vertex moves
 // only in the space their normals leave free (none: it stays). `reference_deg` (per tet, NaN =
-// untouched) is filled in for every tet a move touches first. `world` is kept in step with positions
-// (rest frames of the pieces). Deterministic: vertices are coloured so that no two of one colour
-// share a tet and each colour moves in parallel. Returns the number of vertices moved.
+// untouched) is filled in, and `touched` (per tet) set, for every tet of the star of a moved vertex.
+// `world` is kept in step with positions (rest frames of the pieces). Deterministic: vertices are
+// coloured so that no two of one colour share a tet and each colour moves in parallel; a vertex is
+// revisited only when it or a neighbour moved in the previous sweep. Returns the vertices moved.
 size_t smooth_split_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, const std::vector<double>& values,
                              const SplitField& field, const std::vector<int64_t>& labels,
                              std::vector<double>& reference_deg, const std::vector<uint8_t>& start,
-                             const SplitSmoothingOptions& options = {});
+                             std::vector<uint8_t>& touched, const SplitSmoothingOptions& options = {});
 
 }  // namespace waxwork
