@@ -239,14 +239,19 @@ size_t smooth_split_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world,
             for (const Eigen::Vector3d& b : s.basis) d -= b.dot(d) * b;
             return d;
         };
-        // The star's worst angle with v at y, or nothing when a tet would invert or fall under
-        // min(guard, reference) while getting worse.
-        auto evaluate = [&](const Eigen::Vector3d& y) -> std::optional<double> {
+        // The star's worst angle with v at y, or nothing when a tet would invert, fall under
+        // min(guard, reference) while getting worse, or not beat `bar` (then y cannot win). The worst
+        // tet is tried first: it is the likeliest to end the test early.
+        std::vector<size_t> order(s.star.size());
+        std::iota(order.begin(), order.end(), size_t{0});
+        std::swap(order[0], order[worst_index]);
+        auto evaluate = [&](const Eigen::Vector3d& y, double bar) -> std::optional<double> {
             double w = std::numeric_limits<double>::infinity();
-            for (size_t k = 0; k < s.star.size(); ++k) {
+            for (size_t k : order) {
                 const auto p = moved_corners(mesh, mesh.tets[s.star[k]], v, y);
                 if (!(signed_volume(p[0], p[1], p[2], p[3]) > 0)) return std::nullopt;
                 const double a = min_dihedral_angle_deg(p[0], p[1], p[2], p[3]);
+                if (!(a > bar)) return std::nullopt;
                 if (a < guard_floor_deg(guard, reference_deg[s.star[k]]) && a < current[k]) return std::nullopt;
                 w = std::min(w, a);
             }
@@ -298,7 +303,7 @@ size_t smooth_split_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world,
             if (c == x) continue;
             Eigen::Vector3d c_world;
             const Eigen::Vector3d y = place(c, c_world);
-            const std::optional<double> w = evaluate(y);
+            const std::optional<double> w = evaluate(y, best);
             if (w && *w > best) best = *w, best_rest = y, best_world = c_world;
         }
         if (!(best > worst)) return false;
