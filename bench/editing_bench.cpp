@@ -96,6 +96,7 @@ void BM_ExactCutConnectivity(benchmark::State& state) {
     state.counters["tets_split"] = static_cast<double>(result.tets_split);
     state.counters["snapped"] = static_cast<double>(result.vertices_snapped);
     state.counters["min_dihedral_deg"] = result.min_dihedral_deg;
+    state.counters["tets_under_guard"] = static_cast<double>(result.tets_under_guard);
 }
 BENCHMARK(BM_ExactCutConnectivity)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -138,6 +139,7 @@ void BM_Fracture8(benchmark::State& state) {
     state.counters["tets_split"] = static_cast<double>(result.tets_split);
     state.counters["vertices_duplicated"] = static_cast<double>(result.vertices_duplicated);
     state.counters["min_dihedral_deg"] = result.min_dihedral_deg;
+    state.counters["tets_under_guard"] = static_cast<double>(result.tets_under_guard);
 }
 BENCHMARK(BM_Fracture8)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
 

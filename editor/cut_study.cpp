@@ -76,6 +76,7 @@ std::vector<CutModeResult> compare_cut_modes(const TetMesh& source, const PlaneC
         const auto start = std::chrono::steady_clock::now();
         const ExactCutResult cut = cut_exact(mesh, plane);
         r.milliseconds = ms_since(start);
+        r.tets_under_guard = cut.tets_under_guard;
         std::vector<uint8_t> on_original_boundary(mesh.vertex_count(), 0);
         for (size_t v = 0; v < mesh.vertex_count(); ++v) {
             const auto [a, b] = cut.vertex_origins[v];
@@ -92,16 +93,19 @@ std::vector<CutModeResult> compare_cut_modes(const TetMesh& source, const PlaneC
 
 nlohmann::ordered_json to_json(const std::vector<CutModeResult>& results) {
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
-    for (const CutModeResult& r : results)
-        out.push_back({{"mode", r.mode},
-                       {"tets_after", r.tets_after},
-                       {"milliseconds", r.milliseconds},
-                       {"cross_section_vertices", r.distances_per_edge.size()},
-                       {"max_distance_per_edge", r.max_distance_per_edge()},
-                       {"rms_distance_per_edge", r.rms_distance_per_edge()},
-                       {"worst_dihedral_deg", r.worst_dihedral_deg()},
-                       {"tets_below_0.5_deg", r.tets_below(0.5)},
-                       {"tets_below_5_deg", r.tets_below(5.0)}});
+    for (const CutModeResult& r : results) {
+        nlohmann::ordered_json row = {{"mode", r.mode},
+                                      {"tets_after", r.tets_after},
+                                      {"milliseconds", r.milliseconds},
+                                      {"cross_section_vertices", r.distances_per_edge.size()},
+                                      {"max_distance_per_edge", r.max_distance_per_edge()},
+                                      {"rms_distance_per_edge", r.rms_distance_per_edge()},
+                                      {"worst_dihedral_deg", r.worst_dihedral_deg()},
+                                      {"tets_below_0.5_deg", r.tets_below(0.5)},
+                                      {"tets_below_5_deg", r.tets_below(5.0)}};
+        if (r.mode == "exact") row["tets_under_guard"] = r.tets_under_guard;
+        out.push_back(std::move(row));
+    }
     return out;
 }
 

@@ -22,6 +22,7 @@ struct CutModeResult {
     double milliseconds = 0;                 // cut (+ relaxation), without the connectivity rebuild
     std::vector<double> distances_per_edge;  // cross-section vertex distances / mean edge length, ascending
     std::vector<double> min_dihedral_deg;    // per tet after the cut, ascending
+    size_t tets_under_guard = 0;             // exact mode: ExactCutResult::tets_under_guard
     double max_distance_per_edge() const { return distances_per_edge.empty() ? 0 : distances_per_edge.back(); }
     double rms_distance_per_edge() const;
     double worst_dihedral_deg() const { return min_dihedral_deg.empty() ? 0 : min_dihedral_deg.front(); }

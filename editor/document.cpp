@@ -83,8 +83,10 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
             connectivity = std::make_shared<TetConnectivity>(build_connectivity(*after));
             min_dihedral_deg_ = result.min_dihedral_deg;
             report.vertex_origins = std::move(result.vertex_origins);
+            report.tets_under_guard = result.tets_under_guard;
             details << result.tets_split << " tets split, " << result.tets_removed << " tets removed, "
-                    << result.vertices_snapped << " vertices snapped onto the surface";
+                    << result.vertices_snapped << " vertices snapped onto the surface, " << result.tets_under_guard
+                    << " tets under the angle guard";
         } else {
             CutResult removed = remove_cut_away_tets(*after, *surface);
             connectivity = std::make_shared<TetConnectivity>(build_connectivity(*after));
@@ -272,8 +274,10 @@ void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, Ch
         mesh_ = std::move(*after);
         min_dihedral_deg_ = result.min_dihedral_deg;
         report.topology = true;
+        report.tets_under_guard = result.tets_under_guard;
         details << result.pieces_before << " -> " << result.pieces_after << " pieces, " << result.tets_split
-                << " tets split, " << result.vertices_duplicated << " crack vertices duplicated";
+                << " tets split, " << result.vertices_duplicated << " crack vertices duplicated, "
+                << result.tets_under_guard << " tets under the angle guard";
     } else if (const auto* o = std::get_if<MovePieceOp>(&op)) {
         if (o->piece < 0 || static_cast<size_t>(o->piece) >= mesh_.piece_transforms.size())
             throw InvalidArgumentError("move_piece: piece " + std::to_string(o->piece) + " does not exist (" +

@@ -47,6 +47,8 @@ struct ChangeReport {
     size_t tets_before = 0, tets_after = 0;
     size_t vertices_before = 0, vertices_after = 0;
     double min_dihedral_deg = 0;  // of the whole mesh afterwards (0 when empty)
+    // Exact cut and exact fracture: tets left under min(0.5 degrees, their parent's angle) (split_quality.h).
+    size_t tets_under_guard = 0;
 
     bool topology = false;         // tets/vertices added, removed or renumbered
     bool positions = false;        // rest positions moved (topology unchanged)

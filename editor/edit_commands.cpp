@@ -98,7 +98,9 @@ void run_exact_cut(const CutCommandOptions& o, const PlaneCut& plane) {
         {"vertices_snapped", cut.vertices_snapped},
         {"vertices_added", cut.vertices_added},
         {"components", connectivity.component_count},
+        {"vertices_smoothed", cut.vertices_smoothed},
         {"min_dihedral_deg", cut.min_dihedral_deg},
+        {"tets_under_guard", cut.tets_under_guard},
         {"milliseconds", elapsed},
     };
     std::cout << summary.dump() << "\n";
@@ -184,6 +186,7 @@ void run_fracture_command(const FractureCommandOptions& o) {
         {"tets_split", result.tets_split},
         {"vertices_duplicated", result.vertices_duplicated},
         {"min_dihedral_deg", result.min_dihedral_deg},
+        {"tets_under_guard", result.tets_under_guard},
         {"milliseconds", elapsed},
     };
     std::cout << summary.dump() << "\n";

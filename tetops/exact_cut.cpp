@@ -3,6 +3,7 @@
 #include "tetops/connectivity.h"
 #include "tetops/error.h"
 #include "tetops/quality.h"
+#include "tetops/split_quality.h"
 
 #include <tbb/parallel_for.h>
 
@@ -102,45 +103,6 @@ void split_tet(const Tet& g, const std::array<int, 4>& s, const std::array<int32
     }
 }
 
-// A face at a vertex that snapping must keep in its plane: on the boundary of the volume (met once in
-// the vertex's star) or between two regions (met twice, by tets of different labels).
-struct KeptFace {
-    std::array<int32_t, 3> vertices;
-    bool on_boundary;
-};
-
-// The kept faces of v's star that contain v. Every tet sharing a face through v also contains v, so
-// counting faces within the star is enough.
-std::vector<KeptFace> kept_faces_at(const TetMesh& mesh, const std::vector<int32_t>& star, int32_t v,
-                                    const std::vector<int64_t>* labels) {
-    std::vector<std::array<int32_t, 3>> sorted_faces, faces;
-    std::vector<int64_t> face_label;
-    for (int32_t t : star) {
-        const Tet& tet = mesh.tets[t];
-        for (int k = 0; k < 4; ++k) {
-            if (tet[k] == v) continue;  // the face opposite v does not contain it
-            const auto& f = kTetFaces[k];
-            std::array<int32_t, 3> key = {tet[f[0]], tet[f[1]], tet[f[2]]};
-            faces.push_back(key);
-            std::sort(key.begin(), key.end());
-            sorted_faces.push_back(key);
-            face_label.push_back(labels ? (*labels)[t] : 0);
-        }
-    }
-    std::vector<size_t> order(faces.size());
-    std::iota(order.begin(), order.end(), size_t{0});
-    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return sorted_faces[a] < sorted_faces[b]; });
-    std::vector<KeptFace> kept;
-    for (size_t i = 0; i < order.size();) {
-        size_t j = i + 1;
-        while (j < order.size() && sorted_faces[order[j]] == sorted_faces[order[i]]) ++j;
-        if (j - i == 1) kept.push_back({faces[order[i]], true});
-        if (j - i == 2 && face_label[order[i]] != face_label[order[i + 1]]) kept.push_back({faces[order[i]], false});
-        i = j;
-    }
-    return kept;
-}
-
 // Whether v may slide towards w: the step must stay in the plane of every kept face at v (so every
 // wall, flat part and straight crease of the boundary keeps its shape) and run along an edge of a
 // boundary face (of a wall face when v is on walls only), never into the volume. Where the boundary faces at v
@@ -184,7 +146,8 @@ bool may_slide(const TetMesh& mesh, const std::vector<KeptFace>& faces, int32_t 
 // are split instead.
 size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::vector<double>& values,
                      const std::vector<int32_t>& crossed, const std::vector<int>& sign, const SplitField& field,
-                     const SplitOptions& options, const std::vector<int32_t>& piece_of) {
+                     const SplitOptions& options, const std::vector<int32_t>& piece_of,
+                     std::vector<double>& reference, std::vector<uint8_t>& touched) {
     struct Candidate {
         int32_t vertex;
         int32_t other;  // the far end of the edge the crossing is on
@@ -224,6 +187,8 @@ size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::ve
         for (int32_t v : mesh.tets[t])
             if (slot[v] >= 0) star[slot[v]].push_back(static_cast<int32_t>(t));
 
+    // A tet's reference is taken the first time it is touched (split_quality.h): the guard holds when
+    // every tet of the star stays at or above min(guard, reference) or does not get worse.
     auto guard_holds = [&](int32_t v, const Eigen::Vector3d& target) {
         for (int32_t t : star[slot[v]]) {
             const Tet& tet = mesh.tets[t];
@@ -231,10 +196,12 @@ size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::ve
             for (int k = 0; k < 4; ++k) p[k] = tet[k] == v ? target : mesh.positions[tet[k]];
             if (!(signed_volume(p[0], p[1], p[2], p[3]) > 0)) return false;
             const double after = min_dihedral_angle_deg(p[0], p[1], p[2], p[3]);
-            if (after < options.min_dihedral_guard_deg &&
-                after < min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]], mesh.positions[tet[2]],
-                                               mesh.positions[tet[3]]))
-                return false;
+            if (after >= options.min_dihedral_guard_deg) continue;
+            const double before = min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]],
+                                                         mesh.positions[tet[2]], mesh.positions[tet[3]]);
+            const double floor =
+                guard_floor_deg(options.min_dihedral_guard_deg, std::isnan(reference[t]) ? before : reference[t]);
+            if (after < floor && after < before) return false;
         }
         return true;
     };
@@ -258,6 +225,14 @@ size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::ve
         if (!target_world || values[v] == 0) continue;
         const Eigen::Vector3d target = to_rest(mesh, piece_of[v], *target_world);
         if (!guard_holds(v, target)) continue;
+        for (int32_t t : star[slot[v]]) {
+            if (std::isnan(reference[t])) {
+                const Tet& tet = mesh.tets[t];
+                reference[t] = min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]],
+                                                      mesh.positions[tet[2]], mesh.positions[tet[3]]);
+            }
+            touched[t] = 1;
+        }
         mesh.positions[v] = target;
         world[v] = *target_world;
         values[v] = 0;
@@ -310,15 +285,26 @@ SplitReport split_along_field(TetMesh& mesh, std::vector<Eigen::Vector3d>& world
         throw InvalidArgumentError("split: the boundary bend must be in [0, 90) degrees");
     if (options.tet_labels && options.tet_labels->size() != mesh.tet_count())
         throw InvalidArgumentError("split: one label per tet expected");
+    if (options.reference_deg && options.reference_deg->size() != mesh.tet_count())
+        throw InvalidArgumentError("split: one reference angle per tet expected");
+    if (!(options.smooth_below_deg >= 0) || !(options.smooth_below_deg < 70))
+        throw InvalidArgumentError("split: the smoothing target must be in [0, 70) degrees");
     for (double v : values)
         if (!std::isfinite(v)) throw InvalidArgumentError("split: non-finite field value");
 
     SplitReport report;
+    std::vector<double>& reference = report.reference_deg;
+    if (options.reference_deg)
+        reference = *options.reference_deg;
+    else
+        reference.assign(mesh.tet_count(), std::numeric_limits<double>::quiet_NaN());
+    std::vector<uint8_t> touched(mesh.tet_count(), 0);  // new or moved by this split
     const std::vector<int32_t> piece_of = vertex_pieces(mesh);
     std::vector<int> sign = signs_of(values, options.zero_tolerance, values);
     std::vector<int32_t> crossed = find_crossed_tets(mesh, sign);
     if (options.snap_fraction > 0 && !crossed.empty()) {
-        report.vertices_snapped = snap_vertices(mesh, world, values, crossed, sign, field, options, piece_of);
+        report.vertices_snapped = snap_vertices(mesh, world, values, crossed, sign, field, options, piece_of,
+                                                reference, touched);
         if (report.vertices_snapped > 0) {
             sign = signs_of(values, options.zero_tolerance, values);
             crossed = find_crossed_tets(mesh, sign);
@@ -364,6 +350,14 @@ SplitReport split_along_field(TetMesh& mesh, std::vector<Eigen::Vector3d>& world
     const bool has_materials = mesh.materials.size() == tets_before;
     const bool has_original_ids = mesh.original_ids.size() == tets_before;
     const bool has_piece_ids = mesh.piece_ids.size() == tets_before;
+    for (int32_t t : crossed) {
+        if (std::isnan(reference[t])) {
+            const Tet& tet = mesh.tets[t];
+            reference[t] = min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]],
+                                                  mesh.positions[tet[2]], mesh.positions[tet[3]]);
+        }
+        touched[t] = 1;
+    }
     std::vector<Child> children;
     for (int32_t t : crossed) {
         const Tet parent = mesh.tets[t];
@@ -396,12 +390,37 @@ SplitReport split_along_field(TetMesh& mesh, std::vector<Eigen::Vector3d>& world
             mesh.tets.push_back(tet);
             report.positive.push_back(children[c].positive);
             report.appended_parents.push_back(t);
+            const double parent_reference = reference[t];
+            reference.push_back(parent_reference);
+            touched.push_back(1);
             if (has_materials) mesh.materials.push_back(mesh.materials[t]);
             if (has_original_ids) mesh.original_ids.push_back(mesh.original_ids[t]);
             if (has_piece_ids) mesh.piece_ids.push_back(mesh.piece_ids[t]);
         }
     }
     report.tets_split = crossed.size();
+
+    if (options.smooth_below_deg > 0 && !crossed.empty()) {
+        // Regions after the split: the given labels, told apart by side, so the new surface and the
+        // earlier walls are both kept faces.
+        std::vector<int64_t> labels(mesh.tet_count());
+        std::vector<uint8_t> start = touched;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, mesh.tet_count(), 4096), [&](const auto& range) {
+            for (size_t t = range.begin(); t != range.end(); ++t) {
+                const size_t source =
+                    t < tets_before ? t : static_cast<size_t>(report.appended_parents[t - tets_before]);
+                labels[t] = (options.tet_labels ? (*options.tet_labels)[source] : 0) * 2 + report.positive[t];
+                if (!options.smooth_positive_side && report.positive[t]) start[t] = 0;
+            }
+        });
+        SplitSmoothingOptions smoothing;
+        smoothing.guard_deg = options.min_dihedral_guard_deg;
+        smoothing.target_deg = options.smooth_below_deg;
+        report.vertices_smoothed =
+            smooth_split_vertices(mesh, world, values, field, labels, reference, start, touched, smoothing);
+    }
+    // Only tets this split touched can have changed since the reference was taken.
+    report.tets_under_guard = count_tets_under_guard(mesh, reference, options.min_dihedral_guard_deg, &touched);
     return report;
 }
 
@@ -438,11 +457,13 @@ ExactCutResult cut_exact(TetMesh& mesh, const CuttingSurface& surface, const Exa
         for (const auto& p : world) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
         split.zero_tolerance = 1e-13 * std::max((hi - lo).norm(), lo.cwiseAbs().maxCoeff() + hi.cwiseAbs().maxCoeff());
     }
+    split.smooth_positive_side = false;  // cut away right after
     const CuttingSurfaceField field(surface);
     SplitReport report = split_along_field(mesh, world, values, field, split);
     result.tets_split = report.tets_split;
     result.vertices_snapped = report.vertices_snapped;
     result.vertices_added = report.appended_vertex_edges.size();
+    result.vertices_smoothed = report.vertices_smoothed;
 
     const CutResult removal = remove_tets(mesh, report.positive);
     result.tets_removed = removal.tets_removed;
@@ -461,6 +482,10 @@ ExactCutResult cut_exact(TetMesh& mesh, const CuttingSurface& surface, const Exa
                                                        : report.appended_vertex_edges[v - vertices_before];
     }
     result.min_dihedral_deg = mesh_min_dihedral_deg(mesh);
+    // Recounted on the cut mesh: each tet against the reference of the tet before the cut it came from.
+    std::vector<double> reference(mesh.tet_count());
+    for (size_t n = 0; n < mesh.tet_count(); ++n) reference[n] = report.reference_deg[removal.new_to_old_tet[n]];
+    result.tets_under_guard = count_tets_under_guard(mesh, reference, split.min_dihedral_guard_deg);
     return result;
 }
 

@@ -6,8 +6,11 @@
 // whose endpoints have strictly opposite signs gets one new vertex at the surface crossing, shared by
 // all tets around that edge; vertices whose crossing lies very close to them are first moved onto the
 // surface (snapping, guarded like relaxation.h) because splitting there would make slivers; each
-// crossed tet is then split into tets on either side. fracture.cpp uses the same machinery with the
-// Voronoi cell walls as the field.
+// crossed tet is then split into tets on either side, and a guarded optimisation moves the vertices
+// around poor new tets, within the surface, the walls and the flat parts of the boundary
+// (split_quality.h). Guarantee: every tet the split creates or moves has a minimum dihedral angle of
+// at least min(min_dihedral_guard_deg, that of the tet it comes from); the exceptions are counted
+// (tets_under_guard). fracture.cpp uses the same machinery with the Voronoi cell walls as the field.
 #pragma once
 
 #include "tetops/cut.h"
@@ -52,6 +55,15 @@ struct SplitOptions {
     // kept in their planes like flat boundary faces (bend 0): a vertex on them snaps only by sliding
     // along an edge that stays in all of them, so earlier walls stay where they are. Null: one region.
     const std::vector<int64_t>* tet_labels = nullptr;
+    // Per tet: the angle (degrees) the quality guarantee compares it with, min(guard, reference), from
+    // an earlier split of the same operation (fracture: the tet's ancestor before the fracture); NaN
+    // or null: the tet as it is now (split_quality.h).
+    const std::vector<double>* reference_deg = nullptr;
+    // After the split, vertices around new or moved tets under this angle (degrees) are optimised,
+    // guarded (split_quality.h); 0 turns the pass off.
+    double smooth_below_deg = 5;
+    // False: tets on the positive side (about to be cut away) are not worth optimising.
+    bool smooth_positive_side = true;
 };
 
 struct SplitReport {
@@ -63,6 +75,13 @@ struct SplitReport {
     std::vector<std::array<int32_t, 2>> appended_vertex_edges;
     size_t tets_split = 0;
     size_t vertices_snapped = 0;
+    size_t vertices_smoothed = 0;
+    // Per tet after the split: its reference angle (SplitOptions::reference_deg, carried to the
+    // children; NaN for tets the split did not touch).
+    std::vector<double> reference_deg;
+    // Tets under min(min_dihedral_guard_deg, reference) after the split, counted from the mesh: the
+    // exceptions to the guarantee (a case split that no guarded move could repair).
+    size_t tets_under_guard = 0;
 };
 
 // Splits `mesh` along the zero set of the field sampled in `values` (one per vertex; updated: snapped
@@ -104,7 +123,11 @@ struct ExactCutResult {
     size_t vertices_added = 0;
     size_t tets_removed = 0;     // counted after splitting (cut-away children included)
     size_t vertices_removed = 0;
+    size_t vertices_smoothed = 0;  // moved by the guarded optimisation after the split
     double min_dihedral_deg = 0;  // of the whole mesh afterwards (0 if empty)
+    // Tets left whose minimum dihedral angle is under min(guard, that of the tet before the cut they
+    // come from): every other tet the cut created or moved meets that bound (split_quality.h).
+    size_t tets_under_guard = 0;
     // Per tet after the cut: the tet before the cut it is (part of).
     std::vector<int32_t> new_to_old_tet;
     // Per vertex after the cut: {v, v} for a vertex v of the mesh before, or the edge {a, b} of the
@@ -114,7 +137,9 @@ struct ExactCutResult {
 
 // Splits every tet crossed by `surface` along it and removes the cut-away side (side() > 0). The
 // cross-section is made of faces whose vertices lie on the surface (exactly up to rounding for a
-// plane, to bisection precision for other surfaces). No relaxation is needed afterwards.
+// plane, to bisection precision for other surfaces). No relaxation is needed afterwards. On spot at
+// 486,745 tets, the plane x = 0 leaves a worst dihedral angle of 1.29 degrees (0.24 with the split
+// alone) and no tet under the guard.
 ExactCutResult cut_exact(TetMesh& mesh, const CuttingSurface& surface, const ExactCutOptions& options = {});
 
 }  // namespace waxwork

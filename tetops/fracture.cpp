@@ -5,6 +5,7 @@
 #include "tetops/error.h"
 #include "tetops/exact_cut.h"
 #include "tetops/quality.h"
+#include "tetops/split_quality.h"
 
 #include <nanoflann.hpp>
 #include <tbb/parallel_for.h>
@@ -118,6 +119,8 @@ void check_options(const FractureOptions& options) {
         throw InvalidArgumentError("fracture: the snap fraction must be in [0, 0.5)");
     if (!(options.boundary_bend_deg >= 0 && options.boundary_bend_deg < 90))
         throw InvalidArgumentError("fracture: the boundary bend must be in [0, 90) degrees");
+    if (!(options.smooth_below_deg >= 0 && options.smooth_below_deg < 70))
+        throw InvalidArgumentError("fracture: the smoothing target must be in [0, 70) degrees");
 }
 
 // Turns per-tet cell labels into pieces: each face-connected part of one cell within one existing
@@ -125,7 +128,7 @@ void check_options(const FractureOptions& options) {
 // with, and every vertex on a crack is duplicated so pieces share none. Pieces are numbered by their
 // lowest tet and take their parent's transform.
 void make_pieces(TetMesh& mesh, const std::vector<int64_t>& label, const FractureOptions& options,
-                 FractureResult& result) {
+                 const std::vector<double>& reference, FractureResult& result) {
     const size_t n = mesh.tet_count();
     const std::vector<std::array<int32_t, 4>> neighbors = build_face_neighbors(mesh);
     DisjointSets parts(n);
@@ -200,6 +203,8 @@ void make_pieces(TetMesh& mesh, const std::vector<int64_t>& label, const Fractur
     mesh.piece_transforms = std::move(transforms);
     result.pieces_after = static_cast<int>(mesh.piece_transforms.size());
     result.min_dihedral_deg = mesh_min_dihedral_deg(mesh);
+    // Tets keep their order and shapes above: the recount against the ancestors' angles.
+    result.tets_under_guard = count_tets_under_guard(mesh, reference, SplitOptions{}.min_dihedral_guard_deg);
 }
 
 // Common start: the checks the fracture relies on (a full validate() sorts every face, costlier than
@@ -224,6 +229,7 @@ SplitOptions wall_split_options(const std::vector<Eigen::Vector3d>& world, const
     SplitOptions split;
     split.snap_fraction = options.snap_fraction;
     split.boundary_bend_deg = options.boundary_bend_deg;
+    split.smooth_below_deg = options.smooth_below_deg;
     split.zero_tolerance = 1e-12 * extent_of(world);
     return split;
 }
@@ -281,6 +287,8 @@ FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> 
     };
 
     std::vector<int64_t> label(mesh.tet_count(), 0);
+    // Per tet: the minimum dihedral angle of its ancestor before the fracture (NaN: untouched).
+    std::vector<double> reference(mesh.tet_count(), std::numeric_limits<double>::quiet_NaN());
     if (options.exact && seeds.size() > 1) {
         // The Voronoi diagram built one seed at a time: adding seed k takes from every tet of cell j
         // the part closer to k than to j. Every tet lies in one cell of the previous diagram, where the
@@ -307,7 +315,9 @@ FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> 
                 values[v] = needs_value[v] ? field.value(world[v]) : (closer[v] ? 1.0 : -1.0);
             });
             split.tet_labels = &label;
-            const SplitReport report = split_along_field(mesh, world, values, field, split);
+            split.reference_deg = &reference;
+            SplitReport report = split_along_field(mesh, world, values, field, split);
+            reference = std::move(report.reference_deg);
             result.tets_split += report.tets_split;
             for (int32_t parent : report.appended_parents) label.push_back(label[parent]);
             for (size_t t = 0; t < mesh.tet_count(); ++t)
@@ -328,7 +338,7 @@ FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> 
         tbb::parallel_for(size_t{0}, mesh.tet_count(),
                           [&](size_t t) { label[t] = nearest(tet_centroid(world, mesh.tets[t])); });
     }
-    make_pieces(mesh, label, options, result);
+    make_pieces(mesh, label, options, reference, result);
     return result;
 }
 
@@ -341,17 +351,20 @@ FractureResult fracture_planes(TetMesh& mesh, std::span<const Eigen::Vector4d> p
     std::vector<Eigen::Vector3d> world = prepare(mesh, result);
     if (mesh.tets.empty()) return result;
 
+    std::vector<double> reference(mesh.tet_count(), std::numeric_limits<double>::quiet_NaN());
     if (options.exact) {
         // Regions so far (sides of the earlier planes) label the tets, so snapping onto a later
         // plane keeps the earlier ones flat (split.tet_labels).
         SplitOptions split = wall_split_options(world, options);
         std::vector<int64_t> region(mesh.tet_count(), 0);
         split.tet_labels = &region;
+        split.reference_deg = &reference;
         for (const PlaneCut& cut : cuts) {
             const PlaneField field(cut);
             std::vector<double> values(world.size());
             tbb::parallel_for(size_t{0}, world.size(), [&](size_t v) { values[v] = cut.side(world[v]); });
-            const SplitReport report = split_along_field(mesh, world, values, field, split);
+            SplitReport report = split_along_field(mesh, world, values, field, split);
+            reference = std::move(report.reference_deg);
             result.tets_split += report.tets_split;
             for (int32_t parent : report.appended_parents) region.push_back(region[parent]);
             std::map<std::pair<int64_t, uint8_t>, int64_t> renumber;
@@ -370,7 +383,7 @@ FractureResult fracture_planes(TetMesh& mesh, std::span<const Eigen::Vector4d> p
         for (size_t i = 0; i < cuts.size(); ++i) sides[i] = cuts[i].side(c) > 0;
         label[t] = regions.try_emplace(sides, static_cast<int64_t>(regions.size())).first->second;
     }
-    make_pieces(mesh, label, options, result);
+    make_pieces(mesh, label, options, reference, result);
     return result;
 }
 

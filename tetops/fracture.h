@@ -30,6 +30,10 @@ struct FractureOptions {
     // Exact mode: boundary vertices slide onto a wall where the surface bends by at most this angle
     // (SplitOptions::boundary_bend_deg; 0 keeps the outer surface exactly).
     double boundary_bend_deg = 20;
+    // Exact mode: after each wall is split in, vertices around new or moved tets under this angle
+    // (degrees) are optimised within the walls and the boundary, guarded (SplitOptions::
+    // smooth_below_deg, split_quality.h); 0 leaves the split as the case table made it.
+    double smooth_below_deg = 5;
 };
 
 struct FractureResult {
@@ -38,6 +42,9 @@ struct FractureResult {
     size_t vertices_duplicated = 0;  // vertices added on crack faces
     size_t tets_split = 0;           // tets split along cell walls (exact mode)
     double min_dihedral_deg = 0;     // of the whole mesh afterwards
+    // Exact mode: tets whose minimum dihedral angle is under min(0.5 degrees, that of the tet before
+    // the fracture they come from), counted from the result; all others meet that bound.
+    size_t tets_under_guard = 0;
 };
 
 // `count` seed points scattered inside the volume (world space), deterministic for `seed`: a tet drawn

@@ -31,6 +31,11 @@ TEST(CutStudy, ExactCrossSectionLiesOnThePlaneRelaxedOneNearIt) {
         EXPECT_LT(r.tets_after, cube.tet_count() + cube.tet_count()) << r.mode;
     }
     EXPECT_EQ(to_json(results)[1]["mode"], "exact");
+    // The cube's tets are far above 0.5 degrees: the exact cut's worst angle is under 0.5 exactly when
+    // it reports tets under the guard.
+    EXPECT_EQ(to_json(results)[1]["tets_under_guard"], exact.tets_under_guard);
+    EXPECT_EQ(exact.tets_under_guard == 0, exact.worst_dihedral_deg() >= 0.5);
+    EXPECT_FALSE(to_json(results)[0].contains("tets_under_guard"));
 }
 
 }  // namespace

@@ -3,12 +3,15 @@
 #include "editor/cli_run.h"
 #include "io/volume_file.h"
 #include "tetops/connectivity.h"
+#include "tetops/quality.h"
 #include "tetops/tet_mesh.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
+#include <map>
 #include <set>
 
 namespace waxwork {
@@ -29,6 +32,19 @@ fs::path meshed_cube(const fs::path& dir) {
     return volume;
 }
 
+// Tets of `mesh` under min(0.5 degrees, the angle of the tet of `before` with the same original id):
+// the exceptions to the guarantee of exact cuts and fractures, recounted from the written files.
+size_t tets_under_guard(const TetMesh& mesh, const TetMesh& before) {
+    std::map<int64_t, size_t> index;
+    for (size_t t = 0; t < before.tet_count(); ++t) index[before.original_ids[t]] = t;
+    EXPECT_EQ(index.size(), before.tet_count()) << "original ids are not unique";
+    const std::vector<double> after_deg = min_dihedral_angles_deg(mesh), before_deg = min_dihedral_angles_deg(before);
+    size_t count = 0;
+    for (size_t t = 0; t < mesh.tet_count(); ++t)
+        if (after_deg[t] < std::min(0.5, before_deg[index.at(mesh.original_ids[t])])) ++count;
+    return count;
+}
+
 TEST(FractureCommand, BreaksIntoPiecesAndSummarises) {
     const auto dir = scratch_dir("fracture_cli");
     const auto in = meshed_cube(dir);
@@ -40,10 +56,11 @@ TEST(FractureCommand, BreaksIntoPiecesAndSummarises) {
         ASSERT_EQ(line_count(r.out), 1u) << r.out;
         const auto summary = nlohmann::json::parse(r.out);
         for (const char* key : {"tets_before", "vertices_before", "tets_after", "vertices_after", "pieces",
-                                "min_dihedral_deg", "milliseconds"})
+                                "min_dihedral_deg", "tets_under_guard", "milliseconds"})
             EXPECT_TRUE(summary.contains(key)) << key;
         EXPECT_EQ(summary["tets_before"], before.tet_count());
         const TetMesh mesh = read_volume(out.string());
+        EXPECT_EQ(size_t(summary["tets_under_guard"]), tets_under_guard(mesh, before)) << mode;
         EXPECT_NO_THROW(validate(mesh));
         EXPECT_EQ(summary["tets_after"], mesh.tet_count());
         EXPECT_EQ(summary["vertices_after"], mesh.vertex_count());
@@ -96,6 +113,8 @@ TEST(CutCommand, ExactCutLeavesTheCrossSectionOnThePlane) {
     EXPECT_EQ(summary["mode"], "exact");
     EXPECT_GT(int(summary["tets_split"]), 0);
     const TetMesh mesh = read_volume(out.string());
+    ASSERT_TRUE(summary.contains("tets_under_guard"));
+    EXPECT_EQ(size_t(summary["tets_under_guard"]), tets_under_guard(mesh, before));
     EXPECT_NO_THROW(validate(mesh));
     EXPECT_EQ(summary["tets_after"], mesh.tet_count());
     const double mid_written = std::stod(std::to_string(mid));

@@ -22,6 +22,7 @@ using testing::expect_pieces_separate_and_connected;
 using testing::expect_valid_conforming;
 using testing::make_cube_mesh;
 using testing::on_unit_cube_boundary;
+using testing::tets_under_parent_guard;
 using testing::volume_by_original_id;
 
 // The two nearest seeds of x: (nearest, second nearest).
@@ -56,9 +57,11 @@ TEST(FractureVoronoi, ExactCellsArePiecesWithFlatCracks) {
     TetMesh mesh = before;
     // Four well separated seeds: every cell holds plenty of tets, so exactly four pieces.
     const std::vector<Eigen::Vector3d> seeds = {{0.2, 0.3, 0.25}, {0.8, 0.2, 0.3}, {0.3, 0.75, 0.7}, {0.7, 0.8, 0.65}};
-    // Without snapping no vertex moves, so children add up exactly to their parents (below).
+    // Without snapping nor the guarded optimisation no vertex moves, so children add up exactly to
+    // their parents (below).
     FractureOptions options;
     options.snap_fraction = 0;
+    options.smooth_below_deg = 0;
     const FractureResult r = fracture_voronoi(mesh, seeds, options);
     EXPECT_EQ(r.pieces_before, 1);
     EXPECT_EQ(r.pieces_after, 4);
@@ -112,6 +115,80 @@ TEST(FractureVoronoi, ExactCellsArePiecesWithFlatCracks) {
     }
     EXPECT_GT(crack_faces, 0u);
     EXPECT_LT(worst, 1e-12);
+}
+
+// Parent of each tet after a fracture: the tet of `before` with its original id.
+std::vector<size_t> parents_by_original_id(const TetMesh& mesh, const TetMesh& before) {
+    std::map<int64_t, size_t> index;
+    for (size_t t = 0; t < before.tet_count(); ++t) index[before.original_ids[t]] = t;
+    std::vector<size_t> parent(mesh.tet_count());
+    for (size_t t = 0; t < mesh.tet_count(); ++t) parent[t] = index.at(mesh.original_ids[t]);
+    return parent;
+}
+
+// The guarantee with snapping and the guarded optimisation on: every tet has a minimum dihedral angle
+// of at least min(0.5 degrees, its parent's) except exactly tets_under_guard; cracks stay flat (on
+// bisectors) and the volume whole. Without the optimisation more tets fall under the guard.
+TEST(FractureVoronoi, ExactTetsKeepTheGuardOrAreCountedAndCracksStayFlat) {
+    const TetMesh before = make_cube_mesh(6);
+    size_t with_total = 0, without_total = 0;
+    for (uint32_t seed : {1u, 2u, 3u}) {
+        const std::vector<Eigen::Vector3d> seeds = scatter_fracture_seeds(before, 8, seed);
+        TetMesh mesh = before, plain = before;
+        const FractureResult r = fracture_voronoi(mesh, seeds);
+        const std::vector<size_t> parent = parents_by_original_id(mesh, before);
+        EXPECT_EQ(r.tets_under_guard, tets_under_parent_guard(mesh, before, [&](size_t t) { return parent[t]; }));
+        const TetConnectivity c = expect_valid_conforming(mesh, false);
+        EXPECT_NEAR(total_volume(mesh), 1.0, 1e-12);
+        // Crack faces (not on the cube) lie on the bisector of some two seeds.
+        double worst = 0;
+        for (const BoundaryFace& f : c.boundary_faces) {
+            bool outer = true;
+            for (int32_t v : f.vertices) outer = outer && on_unit_cube_boundary(mesh.positions[v]);
+            if (outer) continue;
+            double best = std::numeric_limits<double>::infinity();
+            for (size_t i = 0; i < seeds.size(); ++i)
+                for (size_t j = i + 1; j < seeds.size(); ++j) {
+                    double face_worst = 0;
+                    for (int32_t v : f.vertices) {
+                        const Eigen::Vector3d& p = mesh.positions[v];
+                        face_worst = std::max(face_worst, std::abs((p - seeds[i]).norm() - (p - seeds[j]).norm()));
+                    }
+                    best = std::min(best, face_worst);
+                }
+            worst = std::max(worst, best);
+        }
+        EXPECT_LT(worst, 1e-12) << seed;
+
+        FractureOptions options;
+        options.smooth_below_deg = 0;
+        const FractureResult p = fracture_voronoi(plain, seeds, options);
+        const std::vector<size_t> plain_parent = parents_by_original_id(plain, before);
+        EXPECT_EQ(p.tets_under_guard,
+                  tets_under_parent_guard(plain, before, [&](size_t t) { return plain_parent[t]; }));
+        with_total += r.tets_under_guard;
+        without_total += p.tets_under_guard;
+    }
+    EXPECT_GT(without_total, 0u);
+    EXPECT_LT(with_total, without_total);
+}
+
+// A deliberately coarse case: a cube of 6 tets broken into 8 cells cannot keep every piece's tets
+// above the guard; the count says so instead of a silent violation.
+TEST(FractureVoronoi, CoarseCubeReportsTetsUnderTheGuard) {
+    const TetMesh before = make_cube_mesh(1);
+    ASSERT_EQ(before.tet_count(), 6u);
+    const std::vector<Eigen::Vector3d> seeds = {{0.1, 0.2, 0.15}, {0.85, 0.2, 0.3}, {0.2, 0.9, 0.25}, {0.8, 0.75, 0.2},
+                                                {0.3, 0.2, 0.8},  {0.9, 0.3, 0.7}, {0.15, 0.7, 0.9}, {0.6, 0.6, 0.6}};
+    TetMesh mesh = before;
+    FractureOptions options;
+    options.min_piece_tets = 0;
+    const FractureResult r = fracture_voronoi(mesh, seeds, options);
+    const std::vector<size_t> parent = parents_by_original_id(mesh, before);
+    EXPECT_GT(r.tets_under_guard, 0u);
+    EXPECT_EQ(r.tets_under_guard, tets_under_parent_guard(mesh, before, [&](size_t t) { return parent[t]; }));
+    expect_valid_conforming(mesh, false);
+    EXPECT_NEAR(total_volume(mesh), 1.0, 1e-12);
 }
 
 TEST(FractureVoronoi, ScatteredSeedsDeterministicAndVolumePreserving) {

@@ -4,6 +4,7 @@
 
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
+#include "tetops/quality.h"
 #include "tetops/tet_mesh.h"
 
 #include <gtest/gtest.h>
@@ -13,6 +14,18 @@
 #include <set>
 
 namespace waxwork::testing {
+
+// Tets of `mesh` whose minimum dihedral angle is under min(guard, that of their parent in `before`),
+// parent_of(t) giving the parent's index: the guarantee of exact cuts and fractures, recounted here
+// independently of tetops/split_quality.h (an untouched tet equals its parent and never counts).
+template <class ParentOf>
+size_t tets_under_parent_guard(const TetMesh& mesh, const TetMesh& before, ParentOf parent_of, double guard = 0.5) {
+    const std::vector<double> after_deg = min_dihedral_angles_deg(mesh), before_deg = min_dihedral_angles_deg(before);
+    size_t count = 0;
+    for (size_t t = 0; t < mesh.tet_count(); ++t)
+        if (after_deg[t] < std::min(guard, before_deg[parent_of(t)])) ++count;
+    return count;
+}
 
 // On a face of the unit cube [0, 1]^3 (to rounding).
 inline bool on_unit_cube_boundary(const Eigen::Vector3d& p) {
