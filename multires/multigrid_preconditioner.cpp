@@ -58,6 +58,14 @@ struct MultigridLevelData {
     std::vector<Scalar> b, x, r, d;
 };
 
+// The same for apply_rgb: the three channels interleaved (entry 3 k + c is channel c of entry k).
+template <typename Scalar>
+struct MultigridRgbLevelData {
+    std::vector<Scalar> values;    // 3 per stored entry
+    std::vector<Scalar> inv_diag;  // 3 per row
+    std::vector<Scalar> b, x, r, d, y;  // 3 per row; y: the next smoothing iterate (swapped with x)
+};
+
 struct MultigridPreconditioner::Level {
     size_t n = 0;
     std::vector<int32_t> offsets{0}, columns, diagonal;
@@ -71,6 +79,8 @@ struct MultigridPreconditioner::Level {
     std::array<std::vector<double>, 3> ap_values;
     MultigridLevelData<float> f;
     MultigridLevelData<double> d;
+    MultigridRgbLevelData<float> rgb_f;
+    MultigridRgbLevelData<double> rgb_d;
     std::array<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>, 3> coarsest;  // coarsest level only
     Eigen::VectorXd coarse_rhs, coarse_solution;
 
@@ -80,6 +90,13 @@ struct MultigridPreconditioner::Level {
             return f;
         else
             return d;
+    }
+    template <typename Scalar>
+    MultigridRgbLevelData<Scalar>& rgb() {
+        if constexpr (std::is_same_v<Scalar, float>)
+            return rgb_f;
+        else
+            return rgb_d;
     }
 };
 
@@ -134,10 +151,17 @@ MultigridPreconditioner::MultigridPreconditioner(const MultiresHierarchy& hierar
                 data.pt_weights.assign(level.pt.weights.begin(), level.pt.weights.end());
             }
         };
-        if (options_.single_precision)
+        auto size_rgb = [&](auto& data) {
+            using S = typename std::decay_t<decltype(data.b)>::value_type;
+            for (auto* v : {&data.b, &data.x, &data.r, &data.d, &data.y}) v->assign(3 * level.n, S(0));
+        };
+        if (options_.single_precision) {
             copy_transfer(level.f);
-        else
+            size_rgb(level.rgb_f);
+        } else {
             copy_transfer(level.d);
+            size_rgb(level.rgb_d);
+        }
     }
     factorize_coarsest();
     setup_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -336,6 +360,13 @@ void MultigridPreconditioner::prepare_smoother(size_t l, std::span<const int32_t
             data_d.inv_diag[ch].resize(level.n);
         }
     }
+    if (single) {
+        level.rgb_f.values.resize(3 * level.columns.size());
+        level.rgb_f.inv_diag.resize(3 * level.n);
+    } else {
+        level.rgb_d.values.resize(3 * level.columns.size());
+        level.rgb_d.inv_diag.resize(3 * level.n);
+    }
     std::atomic<bool> bad{false};
     for_rows(rows.size(), [&](size_t index) {
         const auto i = static_cast<size_t>(rows[index]);
@@ -349,16 +380,23 @@ void MultigridPreconditioner::prepare_smoother(size_t l, std::span<const int32_t
             double sum = 0;
             for (int32_t k = level.offsets[i]; k < level.offsets[i + 1]; ++k) {
                 sum += std::abs(values[static_cast<size_t>(k)]);
-                if (single)
+                const auto rgb_slot = 3 * static_cast<size_t>(k) + ch;
+                if (single) {
                     data_f.values[ch][static_cast<size_t>(k)] = static_cast<float>(values[static_cast<size_t>(k)]);
-                else
+                    level.rgb_f.values[rgb_slot] = data_f.values[ch][static_cast<size_t>(k)];
+                } else {
                     data_d.values[ch][static_cast<size_t>(k)] = values[static_cast<size_t>(k)];
+                    level.rgb_d.values[rgb_slot] = values[static_cast<size_t>(k)];
+                }
             }
             level.row_bound[ch][i] = sum / diag;
-            if (single)
+            if (single) {
                 data_f.inv_diag[ch][i] = static_cast<float>(1.0 / diag);
-            else
+                level.rgb_f.inv_diag[3 * i + ch] = data_f.inv_diag[ch][i];
+            } else {
                 data_d.inv_diag[ch][i] = 1.0 / diag;
+                level.rgb_d.inv_diag[3 * i + ch] = 1.0 / diag;
+            }
         }
     });
     if (bad)
@@ -524,6 +562,172 @@ void MultigridPreconditioner::apply(int channel, std::span<const double> r, std:
         run(levels_[0]->f, float{});
     else
         run(levels_[0]->d, double{});
+}
+
+}  // namespace waxwork
+
+namespace waxwork {
+
+namespace {
+
+// out[3 i + c] = b[3 i + c] - (A_c x_c)_i for the three channels of row i, summed in the order of
+// the per-channel kernels (vcycle): the same rounding.
+template <typename Scalar>
+inline void rgb_residual_row(size_t i, const int32_t* offsets, const int32_t* columns, const Scalar* values,
+                             const Scalar* b, const Scalar* x, Scalar out[3]) {
+    Scalar s0 = b[3 * i], s1 = b[3 * i + 1], s2 = b[3 * i + 2];
+    for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
+        const Scalar* v = values + 3 * static_cast<size_t>(k);
+        const Scalar* xc = x + 3 * static_cast<size_t>(columns[k]);
+        s0 -= v[0] * xc[0];
+        s1 -= v[1] * xc[1];
+        s2 -= v[2] * xc[2];
+    }
+    out[0] = s0;
+    out[1] = s1;
+    out[2] = s2;
+}
+
+}  // namespace
+
+template <typename Scalar>
+void MultigridPreconditioner::vcycle_rgb(size_t l) {
+    Level& level = *levels_[l];
+    MultigridRgbLevelData<Scalar>& w = level.rgb<Scalar>();
+    const size_t n = level.n;
+    if (l + 1 == levels_.size()) {
+        for (size_t ch = 0; ch < 3; ++ch) {
+            for (size_t i = 0; i < n; ++i)
+                level.coarse_rhs[static_cast<Eigen::Index>(i)] = static_cast<double>(w.b[3 * i + ch]);
+            level.coarse_solution = level.coarsest[ch].solve(level.coarse_rhs);
+            for (size_t i = 0; i < n; ++i)
+                w.x[3 * i + ch] = static_cast<Scalar>(level.coarse_solution[static_cast<Eigen::Index>(i)]);
+        }
+        return;
+    }
+    const Scalar* values = w.values.data();
+    const Scalar* inv_diag = w.inv_diag.data();
+    const int32_t* offsets = level.offsets.data();
+    const int32_t* columns = level.columns.data();
+    // Chebyshev constants per channel (vcycle has the derivation).
+    std::array<double, 3> theta{}, delta{}, sigma{};
+    std::array<Scalar, 3> inv_theta{};
+    for (size_t ch = 0; ch < 3; ++ch) {
+        const double upper = level.upper[ch], lower = upper / options_.chebyshev_ratio;
+        theta[ch] = 0.5 * (upper + lower);
+        delta[ch] = 0.5 * (upper - lower);
+        sigma[ch] = theta[ch] / delta[ch];
+        inv_theta[ch] = static_cast<Scalar>(1.0 / theta[ch]);
+    }
+    // Steps 2.. of the polynomial: d = c_d d + c_r D^-1 (b - A x), x' = x + d, written to y (rows read
+    // their neighbours' x, so the new iterate goes to the other buffer; one pass instead of two).
+    auto chebyshev_steps = [&] {
+        std::array<double, 3> rho{};
+        for (size_t ch = 0; ch < 3; ++ch) rho[ch] = 1.0 / sigma[ch];
+        for (int step = 1; step < options_.smoothing_steps; ++step) {
+            std::array<Scalar, 3> c_d{}, c_r{};
+            for (size_t ch = 0; ch < 3; ++ch) {
+                const double rho_next = 1.0 / (2.0 * sigma[ch] - rho[ch]);
+                c_d[ch] = static_cast<Scalar>(rho_next * rho[ch]);
+                c_r[ch] = static_cast<Scalar>(2.0 * rho_next / delta[ch]);
+                rho[ch] = rho_next;
+            }
+            const Scalar* x = w.x.data();
+            Scalar* y = w.y.data();
+            for_rows(n, [&](size_t i) {
+                Scalar sum[3];
+                rgb_residual_row(i, offsets, columns, values, w.b.data(), x, sum);
+                for (size_t ch = 0; ch < 3; ++ch) {
+                    const size_t e = 3 * i + ch;
+                    w.d[e] = c_d[ch] * w.d[e] + c_r[ch] * (sum[ch] * inv_diag[e]);
+                    y[e] = x[e] + w.d[e];
+                }
+            });
+            std::swap(w.x, w.y);
+        }
+    };
+    // Pre-smoothing from a zero start.
+    for_rows(n, [&](size_t i) {
+        for (size_t ch = 0; ch < 3; ++ch) {
+            const size_t e = 3 * i + ch;
+            const Scalar r = w.b[e] * inv_diag[e];
+            w.d[e] = r * inv_theta[ch];
+            w.x[e] = w.d[e];
+        }
+    });
+    chebyshev_steps();
+    // r = b - A x, restricted with P^T.
+    for_rows(n, [&](size_t i) { rgb_residual_row(i, offsets, columns, values, w.b.data(), w.x.data(), &w.r[3 * i]); });
+    Level& coarse = *levels_[l + 1];
+    MultigridRgbLevelData<Scalar>& next = coarse.rgb<Scalar>();
+    const MultigridLevelData<Scalar>& transfer = level.data<Scalar>();
+    const InterpolationOperator& pt = level.pt;
+    for_rows(coarse.n, [&](size_t c) {
+        Scalar s0 = 0, s1 = 0, s2 = 0;
+        for (int32_t a = pt.offsets[c]; a < pt.offsets[c + 1]; ++a) {
+            const Scalar weight = transfer.pt_weights[static_cast<size_t>(a)];
+            const Scalar* r = &w.r[3 * static_cast<size_t>(pt.columns[static_cast<size_t>(a)])];
+            s0 += weight * r[0];
+            s1 += weight * r[1];
+            s2 += weight * r[2];
+        }
+        next.b[3 * c] = s0;
+        next.b[3 * c + 1] = s1;
+        next.b[3 * c + 2] = s2;
+    });
+    vcycle_rgb<Scalar>(l + 1);
+    const InterpolationOperator& p = *level.p;
+    for_rows(n, [&](size_t i) {
+        Scalar s0 = 0, s1 = 0, s2 = 0;
+        for (int32_t q = p.offsets[i]; q < p.offsets[i + 1]; ++q) {
+            const Scalar weight = transfer.p_weights[static_cast<size_t>(q)];
+            const Scalar* xc = &next.x[3 * static_cast<size_t>(p.columns[static_cast<size_t>(q)])];
+            s0 += weight * xc[0];
+            s1 += weight * xc[1];
+            s2 += weight * xc[2];
+        }
+        w.x[3 * i] += s0;
+        w.x[3 * i + 1] += s1;
+        w.x[3 * i + 2] += s2;
+    });
+    // Post-smoothing: the same polynomial from the corrected iterate (first step fused: y = x + d).
+    {
+        const Scalar* x = w.x.data();
+        Scalar* y = w.y.data();
+        for_rows(n, [&](size_t i) {
+            Scalar sum[3];
+            rgb_residual_row(i, offsets, columns, values, w.b.data(), x, sum);
+            for (size_t ch = 0; ch < 3; ++ch) {
+                const size_t e = 3 * i + ch;
+                const Scalar r = sum[ch] * inv_diag[e];
+                w.d[e] = r * inv_theta[ch];
+                y[e] = x[e] + w.d[e];
+            }
+        });
+        std::swap(w.x, w.y);
+    }
+    chebyshev_steps();
+}
+
+void MultigridPreconditioner::apply_rgb(std::span<const double> r, std::span<double> z) {
+    const size_t n = levels_[0]->n;
+    if (r.size() != 3 * n || z.size() != 3 * n)
+        throw InvalidArgumentError("multigrid apply_rgb: vectors of size " + std::to_string(r.size()) + " and " +
+                                   std::to_string(z.size()) + " for 3 x " + std::to_string(n) + " entries");
+    auto run = [&](auto& data, auto tag) {
+        using Scalar = decltype(tag);
+        for_rows(n, [&](size_t i) {
+            for (size_t e = 3 * i; e < 3 * i + 3; ++e) data.b[e] = static_cast<Scalar>(r[e]);
+        });
+        vcycle_rgb<Scalar>(0);
+        for_rows(n, [&](size_t i) {
+            for (size_t e = 3 * i; e < 3 * i + 3; ++e) z[e] = static_cast<double>(data.x[e]);
+        });
+    };
+    if (options_.single_precision)
+        run(levels_[0]->rgb_f, float{});
+    else
+        run(levels_[0]->rgb_d, double{});
 }
 
 }  // namespace waxwork
