@@ -238,7 +238,8 @@ void BM_MultigridSetup(benchmark::State& state) {
 // Reported: the time, level-0 iterations and the true error of the result against a tight MG-CG
 // solution (1e-9) for the new light. Second argument: 0 = warm MG-CG, 1 = MultiresSolver::solve_frame
 // (warm Jacobi CG), 2 = warm Jacobi CG in double; 3, 4 = MultigridFrameSolver (the three channels in
-// one pass) with a budget of 1 and 2 V-cycles, 5 = the same stopping on its estimate (budget 10).
+// one pass) with a budget of 1 and 2 V-cycles, 5 = the same stopping on its estimate (budget 10),
+// 6, 7 = budgets 1 and 2 with a Chebyshev smoother of degree 1 (half the smoothing sweeps).
 // For 3-5 the frame solver's state is that of the previous frame (converged on the old light, its
 // eigenvalue estimates kept); the timed part is what a frame pays: set_right_hand_side and step.
 struct LightTurn {
@@ -341,7 +342,7 @@ std::array<std::span<const double>, 3> spans3(const std::array<std::vector<doubl
     return {v[0], v[1], v[2]};
 }
 
-void light_turn_frame_solver(benchmark::State& state, int budget) {
+void light_turn_frame_solver(benchmark::State& state, int budget, int smoothing_steps = 2) {
     const Scene& s = scene(static_cast<size_t>(state.range(0)));
     const LightTurn* turn = nullptr;
     {
@@ -349,7 +350,9 @@ void light_turn_frame_solver(benchmark::State& state, int budget) {
         MultigridPreconditioner mg(h);
         turn = &light_turn(static_cast<size_t>(state.range(0)), mg);
     }
-    MultigridFrameSolver solver(s.matrix, s.mesh->positions);
+    FrameSolverOptions options;
+    options.multigrid.smoothing_steps = smoothing_steps;
+    MultigridFrameSolver solver(s.matrix, s.mesh->positions, options);
     // The previous frames: converged on the old light (this also sets the eigenvalue estimates).
     solver.set_right_hand_side(spans3(turn->before));
     for (int frame = 0; frame < 100 && !solver.step(4).converged; ++frame) {
@@ -377,6 +380,8 @@ void BM_LightTurn10Degrees(benchmark::State& state) {
     if (mode == 3) return light_turn_frame_solver(state, 1);
     if (mode == 4) return light_turn_frame_solver(state, 2);
     if (mode == 5) return light_turn_frame_solver(state, 10);
+    if (mode == 6) return light_turn_frame_solver(state, 1, 1);
+    if (mode == 7) return light_turn_frame_solver(state, 2, 1);
     light_turn_per_channel(state);
 }
 
@@ -480,7 +485,7 @@ BENCHMARK(BM_MultigridCgTo1Percent)
     ->MeasureProcessCPUTime();
 BENCHMARK(BM_MultigridCgFrameTo1Percent)->WAXWORK_SIZES;
 BENCHMARK(BM_LightTurn10Degrees)
-    ->ArgsProduct({{50000, 500000}, {0, 1, 2, 3, 4, 5}})
+    ->ArgsProduct({{50000, 500000}, {0, 1, 2, 3, 4, 5, 6, 7}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();

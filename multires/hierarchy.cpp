@@ -194,9 +194,11 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
         coarse.original_vertex.resize(coarse_to_fine.size());
         for (size_t c = 0; c < coarse_to_fine.size(); ++c)
             coarse.original_vertex[c] = fine.original_vertex[static_cast<size_t>(coarse_to_fine[c])];
-        coarse.graph = build_coarse_graph(fine.graph, selection.retained, coarse_index);
         fine.interpolation =
             build_interpolation(fine.graph, selection.retained, coarse_index, fine.original_vertex, positions);
+        // P's columns are exactly each fine vertex's coarse links (independent_set.h).
+        coarse.graph = build_coarse_graph(fine.graph, coarse_index, fine.interpolation.offsets,
+                                          fine.interpolation.columns);
         fine.independent_set_rounds = selection.independent_set_rounds;
         fine.enhancement_passes = selection.enhancement_passes;
         fine.enhancement_vertices = selection.enhancement_vertices;

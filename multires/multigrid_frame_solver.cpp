@@ -210,12 +210,13 @@ FrameStep MultigridFrameSolver::step(int budget) {
         std::array<double, 3> beta{};
         for (size_t c = 0; c < 3; ++c) beta[c] = restart_ || rz_[c] == 0 ? 0.0 : sums[c] / rz_[c];
         const bool restart = restart_;
-        for_rows(n_, [&](size_t i) {
-            for (size_t c = 0; c < 3; ++c) {
-                const size_t e = 3 * i + c;
-                p_[e] = restart ? z_[e] : z_[e] + beta[c] * p_[e];
-            }
-        });
+        if (restart) {
+            std::swap(p_, z_);  // z is recomputed before it is read again
+        } else {
+            for_rows(n_, [&](size_t i) {
+                for (size_t c = 0; c < 3; ++c) p_[3 * i + c] = z_[3 * i + c] + beta[c] * p_[3 * i + c];
+            });
+        }
         // q = M p and p . q.
         const Sums<3> pq = reduce_rows<3>(n_, [&](size_t i, Sums<3>& acc) {
             double* q = &q_[3 * i];
