@@ -68,14 +68,17 @@ InterpolationOperator build_interpolation(const CompressedRows& graph, std::span
     const size_t n = graph.row_count();
     InterpolationOperator p;
     p.offsets.assign(n + 1, 0);
-    for (size_t v = 0; v < n; ++v) {
-        int32_t count = 1;
-        if (!retained[v]) {
-            count = 0;
-            for (int32_t u : graph.row(v)) count += retained[u] ? 1 : 0;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            int32_t count = 1;
+            if (!retained[v]) {
+                count = 0;
+                for (int32_t u : graph.row(v)) count += retained[static_cast<size_t>(u)] ? 1 : 0;
+            }
+            p.offsets[v + 1] = count;
         }
-        p.offsets[v + 1] = p.offsets[v] + count;
-    }
+    });
+    for (size_t v = 0; v < n; ++v) p.offsets[v + 1] += p.offsets[v];
     p.columns.resize(static_cast<size_t>(p.offsets[n]));
     p.weights.resize(p.columns.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 2048), [&](const tbb::blocked_range<size_t>& r) {
