@@ -164,35 +164,19 @@ std::vector<int32_t> still_lost(const CompressedRows& graph, std::span<const uin
     tbb::enumerable_thread_specific<std::vector<int32_t>> tags([n] { return std::vector<int32_t>(n, -1); });
     tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         std::vector<int32_t>& tag = tags.local();
-        std::vector<int32_t> ri;  // R(i), the retained neighbours of the candidate
         for (size_t a = r.begin(); a != r.end(); ++a) {
             const int32_t i = candidates[a];
             if (retained[static_cast<size_t>(i)]) continue;
-            ri.clear();
             for (int32_t k : graph.row(static_cast<size_t>(i)))
-                if (retained[static_cast<size_t>(k)]) {
-                    tag[static_cast<size_t>(k)] = i;
-                    ri.push_back(k);
-                }
+                if (retained[static_cast<size_t>(k)]) tag[static_cast<size_t>(k)] = i;
             for (int32_t j : graph.row(static_cast<size_t>(i))) {
                 if (retained[static_cast<size_t>(j)]) continue;
                 bool shared = false;
-                const auto row_j = graph.row(static_cast<size_t>(j));
-                // Either look each k of R(i) up in the sorted row of j, or scan that row against the
-                // tags, whichever reads fewer entries (R(i) is a few vertices; rows grow on coarse levels).
-                if (ri.size() * static_cast<size_t>(std::bit_width(row_j.size())) < row_j.size()) {
-                    for (int32_t k : ri)
-                        if (std::binary_search(row_j.begin(), row_j.end(), k)) {
-                            shared = true;
-                            break;
-                        }
-                } else {
-                    for (int32_t k : row_j)
-                        if (tag[static_cast<size_t>(k)] == i) {
-                            shared = true;
-                            break;
-                        }
-                }
+                for (int32_t k : graph.row(static_cast<size_t>(j)))
+                    if (tag[static_cast<size_t>(k)] == i) {
+                        shared = true;
+                        break;
+                    }
                 if (!shared) {
                     lost[a] = 1;
                     break;

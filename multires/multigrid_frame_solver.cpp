@@ -87,7 +87,7 @@ std::span<const double> MultigridFrameSolver::phi(int channel) const {
 
 void MultigridFrameSolver::reset() {
     for (auto& v : phi_) std::fill(v.begin(), v.end(), 0.0);
-    restart_ = refresh_ = true;
+    restart_ = refresh_ = phi_zero_ = true;
     for (size_t c = 0; c < 3; ++c) {
         t_diag_[c].clear();
         t_off_[c].clear();
@@ -106,6 +106,7 @@ void MultigridFrameSolver::set_phi(const std::array<std::span<const double>, 3>&
     }
     for (size_t c = 0; c < 3; ++c) std::copy(phi[c].begin(), phi[c].end(), phi_[c].begin());
     restart_ = refresh_ = true;
+    phi_zero_ = false;
     if (has_b_) refresh_residual();
 }
 
@@ -132,6 +133,12 @@ void MultigridFrameSolver::set_right_hand_side(const std::array<std::span<const 
 }
 
 void MultigridFrameSolver::refresh_residual() {
+    if (phi_zero_) {
+        r_ = b_;
+        refresh_ = false;
+        updates_since_refresh_ = 0;
+        return;
+    }
     const int32_t* offsets = hierarchy_->levels[0].offsets.data();
     const int32_t* columns = hierarchy_->levels[0].columns.data();
     for_rows(n_, [&](size_t i) {
@@ -239,6 +246,7 @@ FrameStep MultigridFrameSolver::step(int budget) {
             rz_[c] = rz;
         }
         for (size_t c = 0; c < 3; ++c) beta_prev_[c] = beta[c];
+        phi_zero_ = false;
         for_rows(n_, [&](size_t i) {
             for (size_t c = 0; c < 3; ++c) {
                 const size_t e = 3 * i + c;

@@ -102,6 +102,7 @@ private:
     std::array<std::vector<double>, 3> phi_;
     std::vector<double> b_, r_, z_, p_, q_;  // interleaved: entry 3 i + c is channel c at vertex i
     bool has_b_ = false, restart_ = true, refresh_ = true;
+    bool phi_zero_ = true;  // phi is exactly zero (a cold start): r = b needs no product
     int updates_since_refresh_ = 0;
     std::array<double, 3> rz_{}, alpha_prev_{}, beta_prev_{};
     std::array<std::vector<double>, 3> t_diag_, t_off_;  // Lanczos matrix since the last restart
