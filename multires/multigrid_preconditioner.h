@@ -88,10 +88,11 @@ public:
     void apply(int channel, std::span<const double> r, std::span<double> z);
 
     // The three channels at once, vectors interleaved (r[3 i + c] is channel c at vertex i): one sweep
-    // over each level's pattern serves all three channels (their values are stored interleaved too),
-    // so a V-cycle reads the column indices once instead of three times and the vector entries of a
-    // row's neighbours share cache lines. The arithmetic per channel is the same, in the same order, as
-    // apply()'s: the result equals three apply() calls exactly. Not thread-safe.
+    // over each level's pattern serves all three channels, so a V-cycle reads the column indices once
+    // instead of three times. Inside, a vertex's (and a stored entry's) channels are one four-lane
+    // vector (r, g, b, 0), so each row operation is one SIMD operation for the three channels. The
+    // arithmetic per channel is the same, in the same order, as apply()'s: the result equals three
+    // apply() calls exactly (tested). Not thread-safe.
     void apply_rgb(std::span<const double> r, std::span<double> z);
 
     // After the level-0 values changed in the rows `changed_rows` (ascending; pattern and hierarchy
