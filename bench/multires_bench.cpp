@@ -9,12 +9,14 @@
 // presets), lit from +z as in solver_bench.cpp. Wall and process CPU time are both reported: the
 // machine may be shared.
 //
-// Also: MG-CG (multigrid_cg.h) to 1% and its setup, a 10-degree light turn per frame
-// (BM_LightTurn10Degrees) and the updates after painting (BM_PaintUpdate); see each benchmark.
+// Also: MG-CG (multigrid_cg.h) to 1% and its setup, the three-channel frame solver to 1% from cold
+// (BM_MultigridCgFrameTo1Percent), a 10-degree light turn per frame (BM_LightTurn10Degrees) and the
+// updates after painting (BM_PaintUpdate); see each benchmark.
 //
 // Run: build-bench/bench/multires_bench (configure with -DWAXWORK_BUILD_BENCH=ON).
 #include "bench_meshes.h"
 #include "multires/multigrid_cg.h"
+#include "multires/multigrid_frame_solver.h"
 #include "multires/multires_solver.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
@@ -235,7 +237,11 @@ void BM_MultigridSetup(benchmark::State& state) {
 // and stops on its own estimate (relative_tolerance 1e-2, the frame's accuracy), all three channels.
 // Reported: the time, level-0 iterations and the true error of the result against a tight MG-CG
 // solution (1e-9) for the new light. Second argument: 0 = warm MG-CG, 1 = MultiresSolver::solve_frame
-// (warm Jacobi CG), 2 = warm Jacobi CG in double.
+// (warm Jacobi CG), 2 = warm Jacobi CG in double; 3, 4 = MultigridFrameSolver (the three channels in
+// one pass) with a budget of 1 and 2 V-cycles, 5 = the same stopping on its estimate (budget 10),
+// 6, 7 = budgets 1 and 2 with a Chebyshev smoother of degree 1 (half the smoothing sweeps).
+// For 3-5 the frame solver's state is that of the previous frame (converged on the old light, its
+// eigenvalue estimates kept); the timed part is what a frame pays: set_right_hand_side and step.
 struct LightTurn {
     std::array<std::vector<double>, 3> before, after;  // right-hand sides
     std::array<std::vector<double>, 3> start, exact;   // converged solutions for before / after
@@ -285,7 +291,7 @@ double relative_error3(const std::array<std::vector<double>, 3>& x, const std::a
     return std::sqrt(e / r);
 }
 
-void BM_LightTurn10Degrees(benchmark::State& state) {
+void light_turn_per_channel(benchmark::State& state) {
     const Scene& s = scene(static_cast<size_t>(state.range(0)));
     const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh->positions);
     MultigridPreconditioner mg(h);
@@ -330,6 +336,102 @@ void BM_LightTurn10Degrees(benchmark::State& state) {
     state.counters["iters"] = iterations;
     state.counters["true_err"] = relative_error3(x, turn.exact);
     state.counters["start_err"] = relative_error3(turn.start, turn.exact);
+}
+
+std::array<std::span<const double>, 3> spans3(const std::array<std::vector<double>, 3>& v) {
+    return {v[0], v[1], v[2]};
+}
+
+void light_turn_frame_solver(benchmark::State& state, int budget, int smoothing_steps = 2) {
+    const Scene& s = scene(static_cast<size_t>(state.range(0)));
+    const LightTurn* turn = nullptr;
+    {
+        const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh->positions);
+        MultigridPreconditioner mg(h);
+        turn = &light_turn(static_cast<size_t>(state.range(0)), mg);
+    }
+    FrameSolverOptions options;
+    options.multigrid.smoothing_steps = smoothing_steps;
+    MultigridFrameSolver solver(s.matrix, s.mesh->positions, options);
+    // The previous frames: converged on the old light (this also sets the eigenvalue estimates).
+    solver.set_right_hand_side(spans3(turn->before));
+    for (int frame = 0; frame < 100 && !solver.step(4).converged; ++frame) {
+    }
+    FrameStep step;
+    for (auto _ : state) {
+        state.PauseTiming();
+        solver.set_right_hand_side(spans3(turn->before));
+        solver.set_phi(spans3(turn->start));
+        state.ResumeTiming();
+        solver.set_right_hand_side(spans3(turn->after));
+        step = solver.step(budget);
+    }
+    std::array<std::vector<double>, 3> x;
+    for (int c = 0; c < 3; ++c) x[static_cast<size_t>(c)].assign(solver.phi(c).begin(), solver.phi(c).end());
+    state.counters["iters"] = step.vcycles;
+    state.counters["true_err"] = relative_error3(x, turn->exact);
+    state.counters["start_err"] = relative_error3(turn->start, turn->exact);
+    state.counters["est_err"] = std::max({step.estimated_relative_error[0], step.estimated_relative_error[1],
+                                          step.estimated_relative_error[2]});
+}
+
+void BM_LightTurn10Degrees(benchmark::State& state) {
+    const int mode = static_cast<int>(state.range(1));
+    if (mode == 3) return light_turn_frame_solver(state, 1);
+    if (mode == 4) return light_turn_frame_solver(state, 2);
+    if (mode == 5) return light_turn_frame_solver(state, 10);
+    if (mode == 6) return light_turn_frame_solver(state, 1, 1);
+    if (mode == 7) return light_turn_frame_solver(state, 2, 1);
+    light_turn_per_channel(state);
+}
+
+// The three channels from phi = 0 to 1% with MultigridFrameSolver (what a frame after a cut pays on
+// top of the setup): the smallest V-cycle budget whose result is within 1% of a tight MG-CG solution
+// in every channel, found once and then timed (hierarchy and preconditioner built beforehand).
+// Second and third arguments: the Chebyshev degree and ratio (MultigridOptions; defaults 2 and 8).
+void BM_MultigridCgFrameTo1Percent(benchmark::State& state) {
+    const Scene& s = scene(static_cast<size_t>(state.range(0)));
+    const bench::LitSpot& lit = bench::lit_spot(static_cast<size_t>(state.range(0)));
+    std::array<std::vector<double>, 3> b, exact;
+    FrameSolverOptions options;
+    options.relative_tolerance = 1e-14;  // never stop on the estimate: run exactly the budget
+    options.multigrid.smoothing_steps = static_cast<int>(state.range(1));
+    options.multigrid.chebyshev_ratio = static_cast<double>(state.range(2));
+    MultigridFrameSolver solver(s.matrix, s.mesh->positions, options);
+    {
+        MultigridPreconditioner mg(solver.hierarchy());
+        ConjugateGradientOptions tight;
+        tight.relative_tolerance = 1e-9;
+        for (size_t c = 0; c < 3; ++c) {
+            b[c].resize(s.matrix.size());
+            diffusion_right_hand_side(s.matrix, lit.q, static_cast<int>(c), b[c]);
+            exact[c].assign(s.matrix.size(), 0.0);
+            solve_multigrid_cg(mg, static_cast<int>(c), b[c], exact[c], tight);
+        }
+    }
+    solver.set_right_hand_side(spans3(b));
+    auto worst_error = [&] {
+        double worst = 0;
+        for (int c = 0; c < 3; ++c) {
+            const Eigen::Map<const Eigen::VectorXd> ref(exact[static_cast<size_t>(c)].data(),
+                                                        static_cast<Eigen::Index>(s.matrix.size()));
+            worst = std::max(worst, relative_error(solver.phi(c), ref));
+        }
+        return worst;
+    };
+    const int budget = smallest_budget(
+        [&](int k) {
+            solver.reset();
+            if (k > 0) solver.step(k);
+            return worst_error();
+        },
+        1000);
+    for (auto _ : state) {
+        solver.reset();
+        solver.step(budget);
+    }
+    state.counters["vcycles"] = budget;
+    state.counters["true_err"] = worst_error();
 }
 
 // After painting: the tets within 5% of the model's size of a surface point get a new material
@@ -384,8 +486,15 @@ BENCHMARK(BM_MultigridCgTo1Percent)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
+BENCHMARK(BM_MultigridCgFrameTo1Percent)
+    ->ArgsProduct({{50000, 500000}, {2, 3}, {8}})
+    ->Args({500000, 2, 4})
+    ->Args({500000, 3, 16})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 BENCHMARK(BM_LightTurn10Degrees)
-    ->ArgsProduct({{50000, 500000}, {0, 1, 2}})
+    ->ArgsProduct({{50000, 500000}, {0, 1, 2, 3, 4, 5, 6, 7}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();

@@ -15,24 +15,47 @@ namespace waxwork {
 
 namespace {
 
+// Copies a large array in parallel chunks (the fine level's copy of the matrix is tens of MB at
+// 500K tets; one thread's memcpy leaves the other core idle).
+template <typename T>
+std::vector<T> parallel_copy(const std::vector<T>& source) {
+    std::vector<T> copy(source.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, source.size(), size_t{1} << 16),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          std::copy(source.begin() + static_cast<std::ptrdiff_t>(r.begin()),
+                                    source.begin() + static_cast<std::ptrdiff_t>(r.end()),
+                                    copy.begin() + static_cast<std::ptrdiff_t>(r.begin()));
+                      });
+    return copy;
+}
+
 HierarchyLevel fine_level(const DiffusionMatrix& matrix) {
     HierarchyLevel level;
     const size_t n = matrix.size();
     level.offsets = matrix.offsets;
-    level.columns = matrix.columns;
+    level.columns = parallel_copy(matrix.columns);
     level.diagonal = matrix.diagonal;
-    level.values = matrix.values;
+    for (size_t c = 0; c < 3; ++c) level.values[c] = parallel_copy(matrix.values[c]);
     level.original_vertex.resize(n);
     for (size_t v = 0; v < n; ++v) level.original_vertex[v] = static_cast<int32_t>(v);
-    // G^0: the matrix pattern without the diagonal (the mesh's vertex_vertices).
-    level.graph.offsets.assign(n + 1, 0);
-    level.graph.indices.reserve(matrix.nonzeros() - n);
+    // G^0: the matrix pattern without the diagonal (the mesh's vertex_vertices). Every row holds its
+    // diagonal once, so row i of G^0 starts at offsets[i] - i and the rows fill in parallel.
     for (size_t i = 0; i < n; ++i) {
-        for (int32_t k = matrix.offsets[i]; k < matrix.offsets[i + 1]; ++k)
-            if (static_cast<size_t>(matrix.columns[static_cast<size_t>(k)]) != i)
-                level.graph.indices.push_back(matrix.columns[static_cast<size_t>(k)]);
-        level.graph.offsets[i + 1] = static_cast<int32_t>(level.graph.indices.size());
+        const int32_t d = matrix.diagonal[i];
+        if (d < matrix.offsets[i] || d >= matrix.offsets[i + 1] || matrix.columns[static_cast<size_t>(d)] != static_cast<int32_t>(i))
+            throw InvalidArgumentError("multires hierarchy: row " + std::to_string(i) + " of the matrix has no diagonal entry");
     }
+    level.graph.offsets.resize(n + 1);
+    for (size_t i = 0; i <= n; ++i) level.graph.offsets[i] = matrix.offsets[i] - static_cast<int32_t>(i);
+    level.graph.indices.resize(matrix.nonzeros() - n);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            auto out = static_cast<size_t>(level.graph.offsets[i]);
+            for (int32_t k = matrix.offsets[i]; k < matrix.offsets[i + 1]; ++k)
+                if (static_cast<size_t>(matrix.columns[static_cast<size_t>(k)]) != i)
+                    level.graph.indices[out++] = matrix.columns[static_cast<size_t>(k)];
+        }
+    });
     return level;
 }
 
@@ -45,14 +68,17 @@ InterpolationOperator build_interpolation(const CompressedRows& graph, std::span
     const size_t n = graph.row_count();
     InterpolationOperator p;
     p.offsets.assign(n + 1, 0);
-    for (size_t v = 0; v < n; ++v) {
-        int32_t count = 1;
-        if (!retained[v]) {
-            count = 0;
-            for (int32_t u : graph.row(v)) count += retained[u] ? 1 : 0;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            int32_t count = 1;
+            if (!retained[v]) {
+                count = 0;
+                for (int32_t u : graph.row(v)) count += retained[static_cast<size_t>(u)] ? 1 : 0;
+            }
+            p.offsets[v + 1] = count;
         }
-        p.offsets[v + 1] = p.offsets[v] + count;
-    }
+    });
+    for (size_t v = 0; v < n; ++v) p.offsets[v + 1] += p.offsets[v];
     p.columns.resize(static_cast<size_t>(p.offsets[n]));
     p.weights.resize(p.columns.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 2048), [&](const tbb::blocked_range<size_t>& r) {
@@ -194,9 +220,11 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
         coarse.original_vertex.resize(coarse_to_fine.size());
         for (size_t c = 0; c < coarse_to_fine.size(); ++c)
             coarse.original_vertex[c] = fine.original_vertex[static_cast<size_t>(coarse_to_fine[c])];
-        coarse.graph = build_coarse_graph(fine.graph, selection.retained, coarse_index);
         fine.interpolation =
             build_interpolation(fine.graph, selection.retained, coarse_index, fine.original_vertex, positions);
+        // P's columns are exactly each fine vertex's coarse links (independent_set.h).
+        coarse.graph = build_coarse_graph(fine.graph, coarse_index, fine.interpolation.offsets,
+                                          fine.interpolation.columns);
         fine.independent_set_rounds = selection.independent_set_rounds;
         fine.enhancement_passes = selection.enhancement_passes;
         fine.enhancement_vertices = selection.enhancement_vertices;

@@ -228,30 +228,56 @@ std::vector<int32_t> coarse_vertex_index(std::span<const uint8_t> retained) {
 
 CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const uint8_t> retained,
                                   std::span<const int32_t> coarse_index) {
-    std::vector<int32_t> coarse_to_fine;
-    for (size_t v = 0; v < retained.size(); ++v)
-        if (retained[v]) coarse_to_fine.push_back(static_cast<int32_t>(v));
-    const size_t m = coarse_to_fine.size();
-    // Row c: retained neighbours of i, and retained neighbours of its dropped neighbours (2-ring),
-    // deduplicated with a per-thread tag array instead of a container per row: the 2-ring repeats each
-    // coarse neighbour several times, and allocating and sorting those duplicates was most of the
-    // hierarchy build (bench/multires_bench.cpp, BM_MultiresBuild).
-    tbb::enumerable_thread_specific<std::vector<int32_t>> tags([m] { return std::vector<int32_t>(m, -1); });
-    auto walk = [&](size_t c, std::vector<int32_t>& tag, int32_t key, auto&& emit) {
-        const int32_t i = coarse_to_fine[c];
-        auto visit = [&](int32_t fine_vertex) {
-            const int32_t k = coarse_index[static_cast<size_t>(fine_vertex)];
-            if (tag[static_cast<size_t>(k)] != key) {
-                tag[static_cast<size_t>(k)] = key;
-                emit(k);
+    // Links: the coarse index of a retained vertex, the retained neighbours' of a dropped one.
+    const size_t n = graph.row_count();
+    CompressedRows links;
+    links.offsets.assign(n + 1, 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t v = range.begin(); v != range.end(); ++v) {
+            int32_t count = 1;
+            if (!retained[v]) {
+                count = 0;
+                for (int32_t u : graph.row(v)) count += retained[static_cast<size_t>(u)];
             }
-        };
-        for (int32_t j : graph.row(static_cast<size_t>(i))) {
-            if (retained[static_cast<size_t>(j)]) {
-                visit(j);  // fine edge between retained vertices: kept
-            } else {
-                for (int32_t k : graph.row(static_cast<size_t>(j)))  // 2-ring through the dropped vertex j
-                    if (retained[static_cast<size_t>(k)] && k != i) visit(k);
+            links.offsets[v + 1] = count;
+        }
+    });
+    for (size_t v = 0; v < n; ++v) links.offsets[v + 1] += links.offsets[v];
+    links.indices.resize(static_cast<size_t>(links.offsets[n]));
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t v = range.begin(); v != range.end(); ++v) {
+            auto out = static_cast<size_t>(links.offsets[v]);
+            if (retained[v]) {
+                links.indices[out] = coarse_index[v];
+                continue;
+            }
+            for (int32_t u : graph.row(v))
+                if (retained[static_cast<size_t>(u)]) links.indices[out++] = coarse_index[static_cast<size_t>(u)];
+        }
+    });
+    return build_coarse_graph(graph, coarse_index, links.offsets, links.indices);
+}
+
+CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const int32_t> coarse_index,
+                                  std::span<const int32_t> link_offsets, std::span<const int32_t> links) {
+    std::vector<int32_t> coarse_to_fine;
+    for (size_t v = 0; v < coarse_index.size(); ++v)
+        if (coarse_index[v] >= 0) coarse_to_fine.push_back(static_cast<int32_t>(v));
+    const size_t m = coarse_to_fine.size();
+    // Row c (fine vertex i): the links of every neighbour j of i, except c itself. A retained j links
+    // to itself (a fine edge between retained vertices is kept); a dropped j links to its retained
+    // neighbours (the 2-ring through a dropped vertex). Deduplicated with a per-thread tag array
+    // instead of a container per row: the 2-ring repeats each coarse neighbour several times.
+    tbb::enumerable_thread_specific<std::vector<int32_t>> tags([m] { return std::vector<int32_t>(m, -1); });
+    auto walk = [&](size_t c, std::vector<int32_t>& tag, auto&& emit) {
+        const auto key = static_cast<int32_t>(c);
+        for (int32_t j : graph.row(static_cast<size_t>(coarse_to_fine[c]))) {
+            for (int32_t q = link_offsets[static_cast<size_t>(j)]; q < link_offsets[static_cast<size_t>(j) + 1]; ++q) {
+                const int32_t k = links[static_cast<size_t>(q)];
+                if (k != key && tag[static_cast<size_t>(k)] != key) {
+                    tag[static_cast<size_t>(k)] = key;
+                    emit(k);
+                }
             }
         }
     };
@@ -267,7 +293,7 @@ CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const u
         std::vector<int32_t>& buffer = buffers[chunk];
         for (size_t c = chunk * kChunk; c < std::min(m, (chunk + 1) * kChunk); ++c) {
             const size_t first = buffer.size();
-            walk(c, tag, static_cast<int32_t>(c), [&](int32_t k) { buffer.push_back(k); });
+            walk(c, tag, [&](int32_t k) { buffer.push_back(k); });
             std::sort(buffer.begin() + static_cast<std::ptrdiff_t>(first), buffer.end());
             coarse.offsets[c + 1] = static_cast<int32_t>(buffer.size() - first);
         }

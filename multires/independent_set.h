@@ -64,4 +64,12 @@ std::vector<int32_t> coarse_vertex_index(std::span<const uint8_t> retained);
 CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const uint8_t> retained,
                                   std::span<const int32_t> coarse_index);
 
+// The same from precomputed links: per fine vertex v, links[link_offsets[v] .. link_offsets[v+1]) are
+// the coarse vertices v is represented by (itself when retained, its retained neighbours when dropped):
+// the columns of Eq. 16's interpolation operator, which the hierarchy builds anyway. Walking a dropped
+// neighbour's links (a few entries) instead of its whole graph row (its degree, which grows on coarse
+// levels) is what makes this the cheap way.
+CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const int32_t> coarse_index,
+                                  std::span<const int32_t> link_offsets, std::span<const int32_t> links);
+
 }  // namespace waxwork

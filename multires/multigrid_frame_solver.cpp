@@ -1,0 +1,292 @@
+#include "multires/multigrid_frame_solver.h"
+
+#include "solver/conjugate_gradient.h"
+#include "tetops/error.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/partitioner.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace waxwork {
+namespace {
+
+constexpr size_t kGrain = 2048;
+
+template <typename Body>
+void for_rows(size_t n, const Body& body) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) body(i);
+    });
+}
+
+template <size_t N>
+using Sums = std::array<double, N>;
+
+// Fixed chunks and a fixed combination order: bit-identical sums on any thread count.
+template <size_t N, typename Body>
+Sums<N> reduce_rows(size_t n, const Body& body) {
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<size_t>(0, n, kGrain), Sums<N>{},
+        [&](const tbb::blocked_range<size_t>& r, Sums<N> acc) {
+            for (size_t i = r.begin(); i != r.end(); ++i) body(i, acc);
+            return acc;
+        },
+        [](Sums<N> a, const Sums<N>& b) {
+            for (size_t k = 0; k < N; ++k) a[k] += b[k];
+            return a;
+        },
+        tbb::simple_partitioner());
+}
+
+// out[c] = (M_c x)_i for the three channels of row i; x interleaved.
+inline void product_row(size_t i, const int32_t* offsets, const int32_t* columns, const double* values,
+                        const double* x, double out[3]) {
+    double s0 = 0, s1 = 0, s2 = 0;
+    for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
+        const double* v = values + 3 * static_cast<size_t>(k);
+        const double* xc = x + 3 * static_cast<size_t>(columns[k]);
+        s0 += v[0] * xc[0];
+        s1 += v[1] * xc[1];
+        s2 += v[2] * xc[2];
+    }
+    out[0] = s0;
+    out[1] = s1;
+    out[2] = s2;
+}
+
+}  // namespace
+
+MultigridFrameSolver::MultigridFrameSolver(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
+                                           const FrameSolverOptions& options)
+    : options_(options), n_(matrix.size()) {
+    if (!(options.relative_tolerance > 0) || options.residual_refresh_interval < 1)
+        throw InvalidArgumentError("frame solver: tolerance must be positive and the refresh interval >= 1");
+    hierarchy_ = std::make_unique<MultiresHierarchy>(build_multires_hierarchy(matrix, positions, options.hierarchy));
+    preconditioner_ = std::make_unique<MultigridPreconditioner>(*hierarchy_, options.multigrid);
+    values_.resize(3 * matrix.nonzeros());
+    for_rows(matrix.nonzeros(), [&](size_t k) {
+        for (size_t c = 0; c < 3; ++c) values_[3 * k + c] = matrix.values[c][k];
+    });
+    for (auto& v : phi_) v.assign(n_, 0.0);
+    for (auto* v : {&b_, &r_, &z_, &p_, &q_}) v->assign(3 * n_, 0.0);
+}
+
+MultigridFrameSolver::~MultigridFrameSolver() = default;
+
+std::span<const double> MultigridFrameSolver::phi(int channel) const {
+    if (channel < 0 || channel > 2)
+        throw InvalidArgumentError("frame solver: channel " + std::to_string(channel) + " is not 0, 1 or 2");
+    return phi_[static_cast<size_t>(channel)];
+}
+
+void MultigridFrameSolver::reset() {
+    for (auto& v : phi_) std::fill(v.begin(), v.end(), 0.0);
+    restart_ = refresh_ = phi_zero_ = true;
+    for (size_t c = 0; c < 3; ++c) {
+        t_diag_[c].clear();
+        t_off_[c].clear();
+        lambda_floor_[c] = 0;
+    }
+}
+
+void MultigridFrameSolver::set_phi(const std::array<std::span<const double>, 3>& phi) {
+    for (size_t c = 0; c < 3; ++c) {
+        if (phi[c].size() != n_)
+            throw InvalidArgumentError("frame solver: phi of channel " + std::to_string(c) + " has " +
+                                       std::to_string(phi[c].size()) + " entries for " + std::to_string(n_) +
+                                       " vertices");
+        if (!std::all_of(phi[c].begin(), phi[c].end(), [](double v) { return std::isfinite(v); }))
+            throw AlgorithmError("frame solver: phi of channel " + std::to_string(c) + " is not finite");
+    }
+    for (size_t c = 0; c < 3; ++c) std::copy(phi[c].begin(), phi[c].end(), phi_[c].begin());
+    restart_ = refresh_ = true;
+    phi_zero_ = false;
+    if (has_b_) refresh_residual();
+}
+
+void MultigridFrameSolver::set_right_hand_side(const std::array<std::span<const double>, 3>& b) {
+    for (size_t c = 0; c < 3; ++c) {
+        if (b[c].size() != n_)
+            throw InvalidArgumentError("frame solver: right-hand side of channel " + std::to_string(c) + " has " +
+                                       std::to_string(b[c].size()) + " entries for " + std::to_string(n_) +
+                                       " vertices");
+        if (!std::all_of(b[c].begin(), b[c].end(), [](double v) { return std::isfinite(v); }))
+            throw AlgorithmError("frame solver: right-hand side of channel " + std::to_string(c) + " is not finite");
+    }
+    // r = b - M phi changes by exactly the change of b.
+    const bool follow = has_b_ && !refresh_;
+    for_rows(n_, [&](size_t i) {
+        for (size_t c = 0; c < 3; ++c) {
+            const double value = b[c][i];
+            if (follow) r_[3 * i + c] += value - b_[3 * i + c];
+            b_[3 * i + c] = value;
+        }
+    });
+    has_b_ = true;
+    restart_ = true;
+}
+
+void MultigridFrameSolver::refresh_residual() {
+    if (phi_zero_) {
+        r_ = b_;
+        refresh_ = false;
+        updates_since_refresh_ = 0;
+        return;
+    }
+    const int32_t* offsets = hierarchy_->levels[0].offsets.data();
+    const int32_t* columns = hierarchy_->levels[0].columns.data();
+    for_rows(n_, [&](size_t i) {
+        double s[3] = {0, 0, 0};
+        for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
+            const double* v = &values_[3 * static_cast<size_t>(k)];
+            const auto j = static_cast<size_t>(columns[k]);
+            for (size_t c = 0; c < 3; ++c) s[c] += v[c] * phi_[c][j];
+        }
+        for (size_t c = 0; c < 3; ++c) r_[3 * i + c] = b_[3 * i + c] - s[c];
+    });
+    refresh_ = false;
+    updates_since_refresh_ = 0;
+}
+
+double MultigridFrameSolver::smallest_eigenvalue(size_t c) const {
+    double lambda = lambda_floor_[c] > 0 ? lambda_floor_[c] : std::numeric_limits<double>::infinity();
+    if (!t_diag_[c].empty()) lambda = std::min(lambda, smallest_tridiagonal_eigenvalue(t_diag_[c], t_off_[c]));
+    return lambda;
+}
+
+FrameStep MultigridFrameSolver::step(int budget) {
+    if (!has_b_) throw InvalidArgumentError("frame solver: step() before set_right_hand_side()");
+    if (budget < 1) throw InvalidArgumentError("frame solver: budget " + std::to_string(budget) + " < 1");
+    FrameStep result;
+    if (refresh_) {
+        refresh_residual();
+        restart_ = true;
+    }
+    if (restart_) {
+        // The Lanczos matrix belongs to the old Krylov space; keep what it said about lambda_min.
+        for (size_t c = 0; c < 3; ++c) {
+            if (!t_diag_[c].empty()) {
+                const double ritz = smallest_tridiagonal_eigenvalue(t_diag_[c], t_off_[c]);
+                lambda_floor_[c] = lambda_floor_[c] > 0 ? std::min(lambda_floor_[c], ritz) : ritz;
+            }
+            t_diag_[c].clear();
+            t_off_[c].clear();
+        }
+    }
+    const int32_t* offsets = hierarchy_->levels[0].offsets.data();
+    const int32_t* columns = hierarchy_->levels[0].columns.data();
+    for (int cycle = 0; cycle < budget; ++cycle) {
+        preconditioner_->apply_rgb(r_, z_);
+        ++result.vcycles;
+        // r . z and phi . M phi = phi . (b - r) per channel.
+        const Sums<6> sums = reduce_rows<6>(n_, [&](size_t i, Sums<6>& acc) {
+            for (size_t c = 0; c < 3; ++c) {
+                const size_t e = 3 * i + c;
+                acc[c] += r_[e] * z_[e];
+                acc[3 + c] += phi_[c][i] * (b_[e] - r_[e]);
+            }
+        });
+        bool all_converged = true;
+        for (size_t c = 0; c < 3; ++c) {
+            const double rz = sums[c], xmx = sums[3 + c];
+            if (!std::isfinite(rz) || !std::isfinite(xmx))
+                throw AlgorithmError("frame solver: the iterate became non-finite");
+            if (rz < 0)
+                throw AlgorithmError("frame solver: r.Br = " + std::to_string(rz) +
+                                     " (preconditioner not positive definite)");
+            const double lambda = smallest_eigenvalue(c);
+            double estimate = std::numeric_limits<double>::infinity();
+            if (rz == 0)
+                estimate = 0;
+            else if (xmx > 0 && std::isfinite(lambda))
+                estimate = std::sqrt(rz / lambda / xmx);
+            result.estimated_relative_error[c] = estimate;
+            all_converged = all_converged && estimate <= options_.relative_tolerance;
+        }
+        if (all_converged) {
+            result.converged = true;
+            break;
+        }
+        // p = z on a restart, else z + beta p (beta = new r.z / old r.z).
+        std::array<double, 3> beta{};
+        for (size_t c = 0; c < 3; ++c) beta[c] = restart_ || rz_[c] == 0 ? 0.0 : sums[c] / rz_[c];
+        const bool restart = restart_;
+        if (restart) {
+            std::swap(p_, z_);  // z is recomputed before it is read again
+        } else {
+            for_rows(n_, [&](size_t i) {
+                for (size_t c = 0; c < 3; ++c) p_[3 * i + c] = z_[3 * i + c] + beta[c] * p_[3 * i + c];
+            });
+        }
+        // q = M p and p . q.
+        const Sums<3> pq = reduce_rows<3>(n_, [&](size_t i, Sums<3>& acc) {
+            double* q = &q_[3 * i];
+            product_row(i, offsets, columns, values_.data(), p_.data(), q);
+            for (size_t c = 0; c < 3; ++c) acc[c] += p_[3 * i + c] * q[c];
+        });
+        std::array<double, 3> alpha{};
+        for (size_t c = 0; c < 3; ++c) {
+            const double rz = sums[c];
+            if (rz == 0) continue;  // this channel is solved exactly: leave it
+            if (!(pq[c] > 0) || !std::isfinite(pq[c]))
+                throw AlgorithmError("frame solver: p.Mp = " + std::to_string(pq[c]) +
+                                     " (matrix not positive definite)");
+            alpha[c] = rz / pq[c];
+            // Lanczos coefficients of B M (Saad, Iterative Methods, Sec. 6.7.3).
+            const bool first = restart || t_diag_[c].empty();
+            t_diag_[c].push_back(1.0 / alpha[c] + (first ? 0.0 : beta_prev_[c] / alpha_prev_[c]));
+            if (!first) t_off_[c].push_back(std::sqrt(beta_prev_[c]) / alpha_prev_[c]);
+            alpha_prev_[c] = alpha[c];
+            rz_[c] = rz;
+        }
+        for (size_t c = 0; c < 3; ++c) beta_prev_[c] = beta[c];
+        phi_zero_ = false;
+        for_rows(n_, [&](size_t i) {
+            for (size_t c = 0; c < 3; ++c) {
+                const size_t e = 3 * i + c;
+                phi_[c][i] += alpha[c] * p_[e];
+                r_[e] -= alpha[c] * q_[e];
+            }
+        });
+        restart_ = false;
+        if (++updates_since_refresh_ >= options_.residual_refresh_interval) {
+            // The recursive residual drifts from b - M phi by rounding: recompute it and restart.
+            refresh_residual();
+            restart_ = true;
+            for (size_t c = 0; c < 3; ++c) {
+                const double ritz = smallest_tridiagonal_eigenvalue(t_diag_[c], t_off_[c]);
+                lambda_floor_[c] = lambda_floor_[c] > 0 ? std::min(lambda_floor_[c], ritz) : ritz;
+                t_diag_[c].clear();
+                t_off_[c].clear();
+            }
+        }
+    }
+    return result;
+}
+
+void MultigridFrameSolver::update_values(const DiffusionMatrix& matrix, std::span<const int32_t> changed_rows) {
+    HierarchyLevel& level0 = hierarchy_->levels[0];
+    if (matrix.size() != n_ || matrix.columns != level0.columns)
+        throw InvalidArgumentError("frame solver update_values: the matrix pattern changed (rebuild the solver)");
+    for (int32_t row : changed_rows) {
+        if (row < 0 || static_cast<size_t>(row) >= n_)
+            throw InvalidArgumentError("frame solver update_values: row " + std::to_string(row) + " out of range");
+        for (int32_t k = matrix.offsets[static_cast<size_t>(row)]; k < matrix.offsets[static_cast<size_t>(row) + 1]; ++k)
+            for (size_t c = 0; c < 3; ++c) {
+                level0.values[c][static_cast<size_t>(k)] = matrix.values[c][static_cast<size_t>(k)];
+                values_[3 * static_cast<size_t>(k) + c] = matrix.values[c][static_cast<size_t>(k)];
+            }
+    }
+    preconditioner_->update_values(changed_rows);
+    refresh_ = true;
+    restart_ = true;
+    for (size_t c = 0; c < 3; ++c) lambda_floor_[c] = 0;  // another operator: earlier estimates do not hold
+}
+
+}  // namespace waxwork

@@ -1,0 +1,199 @@
+#include "multires/multigrid_cg.h"
+#include "multires/multigrid_frame_solver.h"
+#include "multires/multigrid_preconditioner.h"
+#include "multires_test_systems.h"
+#include "solver/lighting.h"
+#include "tetops/error.h"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <random>
+
+namespace waxwork {
+namespace {
+
+HierarchyOptions small_levels(int64_t min_coarse) {
+    HierarchyOptions h;
+    h.min_coarse_vertices = min_coarse;
+    return h;
+}
+
+FrameSolverOptions frame_options(int64_t min_coarse, double tolerance) {
+    FrameSolverOptions options;
+    options.hierarchy = small_levels(min_coarse);
+    options.relative_tolerance = tolerance;
+    return options;
+}
+
+std::vector<double> reference_solution(const DiffusionMatrix& m, std::span<const double> b, int channel) {
+    std::vector<double> x(b.size(), 0.0);
+    ConjugateGradientOptions options;
+    options.relative_tolerance = 1e-12;
+    const CsrMatrixView<double> view{m.size(), m.offsets.data(), m.columns.data(),
+                                     m.values[static_cast<size_t>(channel)].data()};
+    EXPECT_TRUE(solve_jacobi_cg<double>(view, b, x, options).converged);
+    return x;
+}
+
+double relative_error(std::span<const double> x, const std::vector<double>& reference) {
+    double e = 0, r = 0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        e += (x[i] - reference[i]) * (x[i] - reference[i]);
+        r += reference[i] * reference[i];
+    }
+    return std::sqrt(e / r);
+}
+
+std::array<std::span<const double>, 3> spans(const std::array<std::vector<double>, 3>& v) {
+    return {v[0], v[1], v[2]};
+}
+
+// The right-hand sides of the test cube lit by the key light turned by `degrees` about the vertical.
+std::array<std::vector<double>, 3> light_rhs(const testing::TestSystem& s, double degrees) {
+    const std::vector<TetMaterial> materials(s.mesh.tet_count(), testing::test_material());
+    Lighting lighting;
+    Light light;
+    light.vector = Eigen::AngleAxisd(degrees * M_PI / 180, Eigen::Vector3d::UnitY()) *
+                   Eigen::Vector3d(1, -1, -1).normalized();
+    lighting.lights.push_back(light);
+    const std::vector<Rgb> q = incident_light(s.mesh, s.connectivity, materials, lighting);
+    std::array<std::vector<double>, 3> b;
+    for (int c = 0; c < 3; ++c) {
+        b[static_cast<size_t>(c)].resize(s.matrix.size());
+        diffusion_right_hand_side(s.matrix, q, c, b[static_cast<size_t>(c)]);
+    }
+    return b;
+}
+
+TEST(MultigridPreconditioner, ApplyRgbEqualsThreeApplyCalls) {
+    const auto s = testing::make_test_system(9);
+    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(50));
+    ASSERT_GE(h.level_count(), 3u);
+    const size_t n = h.levels[0].size();
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<double> r(3 * n), z(3 * n);
+    for (double& v : r) v = u(rng);
+    for (bool single : {true, false}) {
+        MultigridOptions options;
+        options.single_precision = single;
+        MultigridPreconditioner mg(h, options);
+        mg.apply_rgb(r, z);
+        for (int c = 0; c < 3; ++c) {
+            std::vector<double> rc(n), zc(n);
+            for (size_t i = 0; i < n; ++i) rc[i] = r[3 * i + static_cast<size_t>(c)];
+            mg.apply(c, rc, zc);
+            size_t differing = 0;
+            for (size_t i = 0; i < n; ++i) differing += zc[i] != z[3 * i + static_cast<size_t>(c)] ? 1 : 0;
+            EXPECT_EQ(differing, 0u) << "channel " << c << " single " << single;
+        }
+    }
+    MultigridPreconditioner mg(h);
+    std::vector<double> wrong(3 * n - 1);
+    EXPECT_THROW(mg.apply_rgb(wrong, z), InvalidArgumentError);
+}
+
+TEST(MultigridFrameSolver, ConvergesToTheDoublePrecisionSolution) {
+    const auto s = testing::make_test_system(12);  // 2197 vertices
+    MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(100, 1e-9));
+    ASSERT_GE(solver.hierarchy().level_count(), 3u);
+    solver.set_right_hand_side(spans(s.b));
+    FrameStep step;
+    int frames = 0;
+    for (; frames < 20 && !step.converged; ++frames) step = solver.step(5);
+    EXPECT_TRUE(step.converged);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_LE(step.estimated_relative_error[static_cast<size_t>(c)], 1e-9);
+        const auto reference = reference_solution(s.matrix, s.b[static_cast<size_t>(c)], c);
+        EXPECT_LT(relative_error(solver.phi(c), reference), 1e-7) << "channel " << c;
+    }
+}
+
+// The budget the live editor gives a frame after the light moved (bench/multires_bench.cpp,
+// BM_LightTurn10Degrees mode 3, times it on spot).
+constexpr int kLightTurnBudget = 1;
+
+TEST(MultigridFrameSolver, WarmStartAfterALightTurnIsWithinOnePercentInOneVcycle) {
+    const auto s = testing::make_test_system(12);
+    MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(100, 1e-2));
+    const auto before = light_rhs(s, 0), after = light_rhs(s, 10);
+    solver.set_right_hand_side(spans(before));
+    // The previous frames: converged on the old light.
+    FrameStep step;
+    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(4);
+    ASSERT_TRUE(step.converged);
+    std::array<std::vector<double>, 3> reference;
+    for (int c = 0; c < 3; ++c) {
+        const auto cu = static_cast<size_t>(c);
+        reference[cu] = reference_solution(s.matrix, after[cu], c);
+        ASSERT_GT(relative_error(solver.phi(c), reference[cu]), 2e-2) << "the turn must change the solution";
+    }
+    solver.set_right_hand_side(spans(after));
+    step = solver.step(kLightTurnBudget);
+    EXPECT_EQ(step.vcycles, kLightTurnBudget);
+    for (int c = 0; c < 3; ++c)
+        EXPECT_LT(relative_error(solver.phi(c), reference[static_cast<size_t>(c)]), 1e-2) << "channel " << c;
+    // More frames on the same light continue the solve down to the tolerance.
+    for (int frames = 0; frames < 10 && !step.converged; ++frames) step = solver.step(kLightTurnBudget);
+    EXPECT_TRUE(step.converged);
+}
+
+TEST(MultigridFrameSolver, IsDeterministicAcrossThreadCounts) {
+    const auto s = testing::make_test_system(10);
+    auto run = [&] {
+        MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(50, 1e-6));
+        solver.set_right_hand_side(spans(s.b));
+        solver.step(3);
+        std::array<std::vector<double>, 3> phi;
+        for (int c = 0; c < 3; ++c) phi[static_cast<size_t>(c)].assign(solver.phi(c).begin(), solver.phi(c).end());
+        return phi;
+    };
+    const auto many = run();
+    const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+    EXPECT_EQ(many, run());
+}
+
+TEST(MultigridFrameSolver, FollowsPaintedValues) {
+    auto s = testing::make_test_system(8);
+    MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(30, 1e-8));
+    solver.set_right_hand_side(spans(s.b));
+    FrameStep step;
+    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(5);
+    ASSERT_TRUE(step.converged);
+    const std::vector<int32_t> rows = testing::paint_test_system(s, 40, 7);
+    solver.update_values(s.matrix, rows);
+    step = FrameStep{};
+    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(5);
+    EXPECT_TRUE(step.converged);
+    for (int c = 0; c < 3; ++c) {
+        const auto reference = reference_solution(s.matrix, s.b[static_cast<size_t>(c)], c);
+        EXPECT_LT(relative_error(solver.phi(c), reference), 1e-6) << "channel " << c;
+    }
+}
+
+TEST(MultigridFrameSolver, RejectsBadInput) {
+    const auto s = testing::make_test_system(5);
+    MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(20, 1e-2));
+    EXPECT_THROW(solver.step(1), InvalidArgumentError);  // no right-hand side yet
+    std::vector<double> short_b(s.b[0].size() - 1);
+    EXPECT_THROW(solver.set_right_hand_side({short_b, s.b[1], s.b[2]}), InvalidArgumentError);
+    std::vector<double> nan_b = s.b[0];
+    nan_b[3] = std::nan("");
+    EXPECT_THROW(solver.set_right_hand_side({nan_b, s.b[1], s.b[2]}), AlgorithmError);
+    solver.set_right_hand_side(spans(s.b));
+    EXPECT_THROW(solver.step(0), InvalidArgumentError);
+    EXPECT_THROW((void)solver.phi(3), InvalidArgumentError);
+    // A zero right-hand side is solved by phi = 0 at once.
+    const std::vector<double> zero(s.b[0].size(), 0.0);
+    solver.set_right_hand_side({zero, zero, zero});
+    solver.reset();
+    const FrameStep step = solver.step(1);
+    EXPECT_TRUE(step.converged);
+    for (int c = 0; c < 3; ++c)
+        for (double v : solver.phi(c)) EXPECT_EQ(v, 0.0);
+}
+
+}  // namespace
+}  // namespace waxwork
