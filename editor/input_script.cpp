@@ -1,7 +1,6 @@
 #include "editor/input_script.h"
 
 #include "editor/json_fields.h"
-#include "io/file_contents.h"
 #include "tetops/error.h"
 
 #include <GLFW/glfw3.h>
@@ -185,14 +184,7 @@ InputScript parse_input_script(const Json& json, const fs::path& base_directory,
 }
 
 InputScript read_input_script(const fs::path& path) {
-    const std::string text = read_file_contents(path);
-    Json json;
-    try {
-        json = Json::parse(text);
-    } catch (const nlohmann::json::parse_error& e) {
-        throw FileError(path.string(), std::string("not valid JSON: ") + e.what());
-    }
-    return parse_input_script(json, fs::absolute(path).parent_path(), path.string());
+    return parse_input_script(read_json_file(path), fs::absolute(path).parent_path(), path.string());
 }
 
 void InputScriptPlayer::advance(ScriptTarget& target) {

@@ -1,5 +1,6 @@
 #include "editor/json_fields.h"
 
+#include "io/file_contents.h"
 #include "tetops/error.h"
 
 namespace waxwork {
@@ -10,6 +11,15 @@ std::string prefixed(const std::string& context, const std::string& message) {
 
 void fail_json(const std::string& context, const std::string& message) {
     throw InvalidArgumentError(prefixed(context, message));
+}
+
+nlohmann::ordered_json read_json_file(const std::filesystem::path& path) {
+    const std::string text = read_file_contents(path);
+    try {
+        return nlohmann::ordered_json::parse(text);
+    } catch (const nlohmann::json::parse_error& e) {
+        throw FileError(path.string(), std::string("not valid JSON: ") + e.what());
+    }
 }
 
 }  // namespace waxwork

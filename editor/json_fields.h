@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <filesystem>
 #include <set>
 #include <string>
 #include <vector>
@@ -21,6 +22,10 @@ namespace waxwork {
 std::string prefixed(const std::string& context, const std::string& message);
 // Throws InvalidArgumentError(prefixed(context, message)).
 [[noreturn]] void fail_json(const std::string& context, const std::string& message);
+
+// The JSON document in `path` (key order kept); FileError naming the file when it cannot be read or
+// is not valid JSON.
+nlohmann::ordered_json read_json_file(const std::filesystem::path& path);
 
 // Reads the fields of one JSON object, naming the object and field in every error, and rejects
 // fields nobody asked for (finish()).

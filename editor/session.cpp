@@ -5,7 +5,6 @@
 #include "editor/live_scene.h"
 #include "editor/render_pipeline.h"
 #include "io/atomic_file.h"
-#include "io/file_contents.h"
 #include "io/image_io.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
@@ -256,14 +255,7 @@ Session parse_session(const Json& json, const fs::path& base_directory, const st
 }
 
 Session read_session(const fs::path& path) {
-    const std::string text = read_file_contents(path);
-    Json json;
-    try {
-        json = Json::parse(text);
-    } catch (const nlohmann::json::parse_error& e) {
-        throw FileError(path.string(), std::string("not valid JSON: ") + e.what());
-    }
-    return parse_session(json, path.parent_path(), path.string());
+    return parse_session(read_json_file(path), path.parent_path(), path.string());
 }
 
 Json session_to_json(const Session& session) {

@@ -55,4 +55,13 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
     return dir;
 }
 
+// Whether xvfb-run is installed (the window tests skip without it).
+inline bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+
+// Runs waxwork under its own virtual display (-a: a free server number, so tests may run in
+// parallel); `environment` (e.g. "VAR=1 ") is put before the launcher.
+inline CommandResult run_under_xvfb(const std::string& arguments, const std::string& environment = "") {
+    return run_waxwork(arguments, environment + "xvfb-run -a -s '-screen 0 1280x1024x24' ");
+}
+
 }  // namespace waxwork::testing

@@ -14,17 +14,14 @@
 namespace waxwork {
 namespace {
 
+using testing::have_xvfb;
+using testing::run_under_xvfb;
 using testing::run_waxwork;
 using testing::scratch_dir;
 namespace fs = std::filesystem;
 
 const std::string kAssets = WAXWORK_ASSET_DIR;
 
-bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
-
-testing::CommandResult run_under_xvfb(const std::string& arguments, const std::string& environment = "") {
-    return run_waxwork(arguments, environment + "xvfb-run -a -s '-screen 0 1280x1024x24' ");
-}
 
 // The summary line `edit --screenshot` prints.
 nlohmann::json summary_of(const testing::CommandResult& r) {

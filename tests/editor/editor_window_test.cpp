@@ -22,18 +22,14 @@
 namespace waxwork {
 namespace {
 
+using testing::have_xvfb;
+using testing::run_under_xvfb;
 using testing::run_waxwork;
 using testing::scratch_dir;
 namespace fs = std::filesystem;
 
 const std::string kAssets = WAXWORK_ASSET_DIR;
 
-bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
-
-// Runs waxwork under its own virtual display (-a: a free server number, so tests may run in parallel).
-testing::CommandResult run_under_xvfb(const std::string& arguments) {
-    return run_waxwork(arguments, "xvfb-run -a -s '-screen 0 1280x1024x24' ");
-}
 
 // Mean of r + g + b over a rectangle.
 double mean_brightness(const Image& image, int x0, int y0, int x1, int y1) {
