@@ -6,7 +6,9 @@
 // The GPU backend runs in an OSMesa context: on a machine without a GPU (and in CI) that is Mesa's
 // llvmpipe, which runs the compute shaders on the CPU cores, so its times say nothing about a real
 // GPU (WAXWORK_GL_DEVICE=egl reaches one where there is one). A GPU frame includes reading phi back
-// (the host copy the CPU radiance and saves use); counters as in live_scene_bench.
+// (the host copy the CPU radiance and saves use); counters as in live_scene_bench, plus true_error:
+// max |phi - phi*| / max |phi*| after the last frame, phi* the same scene converged to 1e-8 with CPU
+// Jacobi CG (final_error is the solver's own estimate, which for multigrid CG lags one update).
 #include "bench_meshes.h"
 #include "editor/document.h"
 #include "editor/live_scene.h"
@@ -63,13 +65,36 @@ Lighting light_at(double degrees) {
     return l;
 }
 
-void report(benchmark::State& state, std::vector<double> ms, const LiveScene& scene, int iterations) {
+// max |a - b| / max |b| over vertices and channels.
+double relative_difference(const std::vector<std::array<double, 3>>& a, const std::vector<std::array<double, 3>>& b) {
+    double largest = 0, difference = 0;
+    for (size_t v = 0; v < std::min(a.size(), b.size()); ++v)
+        for (int c = 0; c < 3; ++c) {
+            largest = std::max(largest, std::abs(b[v][c]));
+            difference = std::max(difference, std::abs(a[v][c] - b[v][c]));
+        }
+    return largest > 0 ? difference / largest : -1;
+}
+
+double true_error(const TetMesh& mesh, const LiveScene& scene) {
+    LiveSceneOptions o = scene.options();
+    o.method = LiveMethod::JacobiCg;
+    o.backend = LiveBackend::Cpu;
+    o.relative_tolerance = 1e-8;
+    LiveScene reference(mesh, scene.lighting(), o);
+    reference.converge(100000);
+    return relative_difference(scene.phi(), reference.phi());
+}
+
+void report(benchmark::State& state, std::vector<double> ms, const LiveScene& scene, int iterations,
+            const TetMesh& mesh) {
     std::sort(ms.begin(), ms.end());
     state.counters["median_ms"] = ms[ms.size() / 2];
     state.counters["p90_ms"] = ms[static_cast<size_t>(0.9 * (ms.size() - 1))];
     state.counters["median_fps"] = 1000.0 / ms[ms.size() / 2];
     state.counters["cg_its_per_frame"] = static_cast<double>(iterations) / ms.size();
     state.counters["final_error"] = scene.estimated_error().value_or(-1);
+    state.counters["true_error"] = true_error(mesh, scene);
     if (scene.backend() != kVariants[state.range(0)].backend)
         state.SkipWithError(("fell back to the CPU: " + scene.gpu_fallback_reason()).c_str());
     state.SetLabel(scene.solver_description());
@@ -91,7 +116,7 @@ void BM_RelightFrames(benchmark::State& state) {
             ms.push_back(ms_since(start));
         }
     }
-    report(state, ms, scene, iterations);
+    report(state, ms, scene, iterations, doc.mesh());
 }
 BENCHMARK(BM_RelightFrames)->DenseRange(0, 2)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -118,7 +143,7 @@ void BM_PaintFrames(benchmark::State& state) {
             ms.push_back(ms_since(start));
         }
     }
-    report(state, ms, scene, iterations);
+    report(state, ms, scene, iterations, doc.mesh());
 }
 BENCHMARK(BM_PaintFrames)->DenseRange(0, 2)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
