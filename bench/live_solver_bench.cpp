@@ -8,7 +8,8 @@
 // GPU (WAXWORK_GL_DEVICE=egl reaches one where there is one). A GPU frame includes reading phi back
 // (the host copy the CPU radiance and saves use); counters as in live_scene_bench, plus true_error:
 // max |phi - phi*| / max |phi*| after the last frame, phi* the same scene converged to 1e-8 with CPU
-// Jacobi CG (final_error is the solver's own estimate, which for multigrid CG lags one update).
+// Jacobi CG, and true_error_l2: the largest per-channel sqrt(sum (phi - phi*)^2 / sum phi*^2) (final_error is
+// the solver's own estimate, which for multigrid CG lags one update: it describes phi before it).
 #include "bench_meshes.h"
 #include "editor/document.h"
 #include "editor/live_scene.h"
@@ -76,14 +77,30 @@ double relative_difference(const std::vector<std::array<double, 3>>& a, const st
     return largest > 0 ? difference / largest : -1;
 }
 
-double true_error(const TetMesh& mesh, const LiveScene& scene) {
+// max over channels of sqrt(sum (a - b)^2 / sum b^2): the measure of bench/multires_bench.cpp.
+double relative_l2_error(const std::vector<std::array<double, 3>>& a, const std::vector<std::array<double, 3>>& b) {
+    double largest = 0;
+    for (int c = 0; c < 3; ++c) {
+        double e = 0, norm = 0;
+        for (size_t v = 0; v < std::min(a.size(), b.size()); ++v) {
+            e += (a[v][c] - b[v][c]) * (a[v][c] - b[v][c]);
+            norm += b[v][c] * b[v][c];
+        }
+        largest = std::max(largest, norm > 0 ? std::sqrt(e / norm) : -1.0);
+    }
+    return largest;
+}
+
+// The scene's phi against the same scene converged far below the frames' tolerance.
+void true_errors(benchmark::State& state, const TetMesh& mesh, const LiveScene& scene) {
     LiveSceneOptions o = scene.options();
     o.method = LiveMethod::JacobiCg;
     o.backend = LiveBackend::Cpu;
     o.relative_tolerance = 1e-8;
     LiveScene reference(mesh, scene.lighting(), o);
     reference.converge(100000);
-    return relative_difference(scene.phi(), reference.phi());
+    state.counters["true_error"] = relative_difference(scene.phi(), reference.phi());
+    state.counters["true_error_l2"] = relative_l2_error(scene.phi(), reference.phi());
 }
 
 void report(benchmark::State& state, std::vector<double> ms, const LiveScene& scene, int iterations,
@@ -94,7 +111,7 @@ void report(benchmark::State& state, std::vector<double> ms, const LiveScene& sc
     state.counters["median_fps"] = 1000.0 / ms[ms.size() / 2];
     state.counters["cg_its_per_frame"] = static_cast<double>(iterations) / ms.size();
     state.counters["final_error"] = scene.estimated_error().value_or(-1);
-    state.counters["true_error"] = true_error(mesh, scene);
+    true_errors(state, mesh, scene);
     if (scene.backend() != kVariants[state.range(0)].backend)
         state.SkipWithError(("fell back to the CPU: " + scene.gpu_fallback_reason()).c_str());
     state.SetLabel(scene.solver_description());
