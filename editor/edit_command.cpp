@@ -129,7 +129,7 @@ void add_edit_command(CLI::App& app) {
         ->check(CLI::IsMember({"cpu", "gpu"}));
     cmd->add_option("--method", options->method,
                     "Live solver method on the CPU: jacobi (Jacobi CG per channel) or mgcg (multigrid CG, three "
-                    "channels per V-cycle; one V-cycle per 8 iterations of the frame budget)")
+                    "channels per V-cycle; one V-cycle per 4 iterations of the frame budget)")
         ->check(CLI::IsMember({"jacobi", "mgcg"}));
     cmd->footer(
         "Mouse: left drag uses the current tool; right drag (or Alt+left) orbits, middle drag (or Shift+right)\n"

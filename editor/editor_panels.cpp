@@ -228,7 +228,7 @@ void EditorApp::draw_solver_panel() {
     ImGui::SliderInt("iterations / frame", &frame_iterations_, 1, 200);
     if (ImGui::IsItemHovered())
         ImGui::SetTooltip("Jacobi CG: CG iterations per channel and frame.\n"
-                          "Multigrid CG: one V-cycle (all three channels) per 8, at least one.");
+                          "Multigrid CG: one V-cycle (all three channels) per 4, at least one.");
     float tolerance_exponent = static_cast<float>(std::log10(live_options_.relative_tolerance));
     // Solver settings rebuild the live scene: only when the user lets go of the slider.
     if (ImGui::SliderFloat("tolerance", &tolerance_exponent, -6.0f, -1.0f, "1e%.1f"))

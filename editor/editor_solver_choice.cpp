@@ -27,7 +27,7 @@ void EditorApp::draw_solver_choice() {
     if (ImGui::IsItemHovered())
         ImGui::SetTooltip("CPU: Jacobi-preconditioned CG per channel (double), or multigrid CG, three channels\n"
                           "per V-cycle: CG preconditioned by a V-cycle on the multires hierarchy, warm across\n"
-                          "frames, one V-cycle per 8 iterations of the budget. The GPU backend always runs\n"
+                          "frames, one V-cycle per 4 iterations of the budget. The GPU backend always runs\n"
                           "Jacobi CG (float).");
     changed |= ImGui::Combo("backend", &backend, "CPU\0GPU (OpenGL compute)\0");
     if (changed) {

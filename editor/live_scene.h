@@ -66,7 +66,7 @@ struct LiveSceneOptions {
 // One frame of the solve.
 struct FrameReport {
     // CG iterations per rgb channel this frame; multigrid CG: V-cycles, each serving all three channels
-    // (the same count in each; live_solver.h maps an iteration budget k to max(1, k / 8) of them).
+    // (the same count in each; live_solver.h maps an iteration budget k to max(1, k / 4) of them).
     std::array<int, 3> iterations{};
     std::array<double, 3> estimated_relative_error{}; // after this frame
     bool converged = false;                          // every channel within the tolerance
@@ -105,8 +105,8 @@ public:
     FrameReport step(int iteration_budget);
     // A time budget instead: CG in chunks of `chunk_iterations` per channel until `milliseconds` have
     // passed or the tolerance is reached (each chunk restarts CG from the current phi, which costs a
-    // little convergence against one longer run; at least one chunk runs). Multigrid CG runs one
-    // V-cycle per chunk of up to 15 iterations and resumes its CG across chunks instead.
+    // little convergence against one longer run; at least one chunk runs). Multigrid CG runs max(1, chunk / 4)
+    // V-cycles per chunk and resumes its CG across chunks instead.
     FrameReport step_for(double milliseconds, int chunk_iterations = 4);
     // Iterates until the tolerance (or `max_iterations` per channel: AlgorithmError if not reached).
     FrameReport converge(int max_iterations = 10000);

@@ -11,8 +11,9 @@
 //                        moves the residual by the change of b (set_right_hand_side), painting updates
 //                        the changed level-0 rows and the coarse Galerkin rows depending on them
 //                        (update_values), a new matrix (cut, relaxation) rebuilds it. Its budget is
-//                        counted in V-cycles: an iteration budget of k maps to max(1, k / 8) V-cycles
-//                        (kIterationsPerVcycle; 0 runs none), and FrameReport counts V-cycles as each
+//                        counted in V-cycles: an iteration budget of k maps to max(1, k / 4) V-cycles
+//                        (kIterationsPerVcycle: one costs about 4 Jacobi CG iterations of the three
+//                        channels; 0 runs none), and FrameReport counts V-cycles as each
 //                        channel's iterations. Its error estimate lags one CG update when the budget runs
 //                        out (an upper estimate, multigrid_frame_solver.h).
 //   GPU CG               solver/gpu_conjugate_gradient.h (float, OpenGL 4.3 compute shaders): matrix,

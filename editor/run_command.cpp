@@ -53,7 +53,7 @@ void add_run_command(CLI::App& app) {
         ->check(CLI::IsMember({"cpu", "gpu"}));
     cmd->add_option("--method", options->method,
                     "Live solver method on the CPU: jacobi (Jacobi CG per channel) or mgcg (multigrid CG, three "
-                    "channels per V-cycle; one V-cycle per 8 frame iterations)")
+                    "channels per V-cycle; one V-cycle per 4 frame iterations)")
         ->check(CLI::IsMember({"jacobi", "mgcg"}));
     cmd->footer("Steps: edit operations ({\"op\": \"plane_cut\", ...}), {\"render\": \"a.png\"}, {\"save\": \"a.vtu\"},\n"
                 "{\"light\": {...}}, {\"camera\": {...}}, {\"undo\": 1}, {\"redo\": 1}. See assets/sessions/.");

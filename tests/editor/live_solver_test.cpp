@@ -160,27 +160,31 @@ std::array<double, 3> relative_l2_error(const std::vector<std::array<double, 3>>
 
 // The editor's frame after a 10-degree light turn: multigrid CG warm-started from the previous light's
 // solution (MultigridFrameSolver::set_right_hand_side) is within 1% of the new converged solution
-// after one frame of budget 8 (one V-cycle), measured against a converged reference (its own estimate
-// lags one update and still describes the phi before it), and within 1% everywhere after two.
+// after one frame of budget 8 (two V-cycles) everywhere, and after one V-cycle (budget 4) in the l2
+// sense, measured against a converged reference (its own estimate lags one update and still
+// describes the phi before it).
 TEST(LiveSolver, MultigridIsWithinOnePercentOfATurnedLightAfterOneFrame) {
     Document doc(testing::make_cube_mesh(14), material_preset("marble"));
-    LiveSceneOptions o = options_for(kConfigs[1]);
-    o.relative_tolerance = 1e-3;  // the editor's frames
-    LiveScene scene(doc.mesh(), key_lighting(), o);
-    scene.converge();
     Lighting turned = key_lighting();
     turned.lights[0].vector = Eigen::AngleAxisd(10 * M_PI / 180, Eigen::Vector3d::UnitZ()) * turned.lights[0].vector;
     LiveScene reference(doc.mesh(), turned, options_for(kConfigs[0]));
     reference.converge();
-    for (const double before : relative_l2_error(scene.phi(), reference.phi()))
-        ASSERT_GT(before, 5e-2) << "the turn must change phi";
-    scene.set_lighting(turned);
-    const FrameReport frame = scene.step(8);
-    for (int c = 0; c < 3; ++c) EXPECT_EQ(frame.iterations[c], 1);
-    const std::array<double, 3> after = relative_l2_error(scene.phi(), reference.phi());
-    for (int c = 0; c < 3; ++c) EXPECT_LT(after[c], 1e-2) << "channel " << c;
-    scene.step(8);
-    EXPECT_LT(relative_difference(scene.phi(), reference.phi()), 1e-2);
+    for (const auto& [budget, vcycles] : {std::pair{8, 2}, std::pair{4, 1}}) {
+        LiveSceneOptions o = options_for(kConfigs[1]);
+        o.relative_tolerance = 1e-3;  // the editor's frames
+        LiveScene scene(doc.mesh(), key_lighting(), o);
+        scene.converge();
+        for (const double before : relative_l2_error(scene.phi(), reference.phi()))
+            ASSERT_GT(before, 5e-2) << "the turn must change phi";
+        scene.set_lighting(turned);
+        const FrameReport frame = scene.step(budget);
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(frame.iterations[c], vcycles);
+        const std::array<double, 3> after = relative_l2_error(scene.phi(), reference.phi());
+        for (int c = 0; c < 3; ++c) EXPECT_LT(after[c], 1e-2) << "budget " << budget << ", channel " << c;
+        if (vcycles == 2) {
+            EXPECT_LT(relative_difference(scene.phi(), reference.phi()), 1e-2);
+        }
+    }
 }
 
 // Painting then running frames (no converge()) reaches what a fresh scene of the painted document gives.
@@ -195,7 +199,7 @@ TEST(LiveSolver, MultigridFramesAfterPaintingEqualAFreshScene) {
         int frames = 0;
         for (; frames < 200 && !frame.converged; ++frames) {
             frame = scene.step(8);
-            for (int c = 0; c < 3; ++c) EXPECT_LE(frame.iterations[c], 1);
+            for (int c = 0; c < 3; ++c) EXPECT_LE(frame.iterations[c], 2);
         }
         EXPECT_TRUE(frame.converged) << n;
         LiveScene fresh(doc.mesh(), key_lighting(), options_for(kConfigs[1]));
