@@ -1,7 +1,8 @@
 // The live editor's frames per solver method and backend (editor/live_solver.h, issue 5): the per-frame
 // solve while the light rotates and while a brush paints, on spot at ~100K tets, as
 // bench/live_scene_bench.cpp measures the default (CPU Jacobi CG), for
-//   0: CPU Jacobi CG (double), 1: CPU multigrid-preconditioned CG, 2: GPU CG (float, OpenGL compute).
+//   0: CPU Jacobi CG (double), 1: CPU multigrid CG, three channels per V-cycle (the budget of 8 is 2
+//   V-cycles; cg_its_per_frame counts each V-cycle once per channel), 2: GPU CG (float, OpenGL compute).
 //   ./build/bench/live_solver_bench
 // The GPU backend runs in an OSMesa context: on a machine without a GPU (and in CI) that is Mesa's
 // llvmpipe, which runs the compute shaders on the CPU cores, so its times say nothing about a real
