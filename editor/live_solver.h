@@ -10,7 +10,9 @@
 //                        residual, search directions) persists across frames: a light change only
 //                        moves the residual by the change of b (set_right_hand_side), painting updates
 //                        the changed level-0 rows and the coarse Galerkin rows depending on them
-//                        (update_values), a new matrix (cut, relaxation) rebuilds it. Its budget is
+//                        (update_values; a whole-object material every row), a new matrix (cut,
+//                        relaxation) rebuilds it. solver.phi(c) is copied into the host phi after
+//                        each frame (phi(), the radiance, saves, a cut's warm start). Its budget is
 //                        counted in V-cycles: an iteration budget of k maps to max(1, k / 4) V-cycles
 //                        (kIterationsPerVcycle: one costs about 4 Jacobi CG iterations of the three
 //                        channels; 0 runs none), and FrameReport counts V-cycles as each
