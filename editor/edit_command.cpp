@@ -127,7 +127,9 @@ void add_edit_command(CLI::App& app) {
                     "Live solver: cpu, or gpu (CG on OpenGL compute shaders in a context shared with the window; "
                     "falls back to the CPU, saying why, when the driver cannot run it)")
         ->check(CLI::IsMember({"cpu", "gpu"}));
-    cmd->add_option("--method", options->method, "Live solver method on the CPU: jacobi or mgcg (multigrid CG)")
+    cmd->add_option("--method", options->method,
+                    "Live solver method on the CPU: jacobi (Jacobi CG per channel) or mgcg (multigrid CG, three "
+                    "channels per V-cycle; one V-cycle per 4 iterations of the frame budget)")
         ->check(CLI::IsMember({"jacobi", "mgcg"}));
     cmd->footer(
         "Mouse: left drag uses the current tool; right drag (or Alt+left) orbits, middle drag (or Shift+right)\n"

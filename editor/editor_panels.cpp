@@ -226,6 +226,9 @@ void EditorApp::draw_solver_panel() {
     ImGui::TextDisabled("TransCut matrix, warm-started CG per frame");
     draw_solver_choice();
     ImGui::SliderInt("iterations / frame", &frame_iterations_, 1, 200);
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("Jacobi CG: CG iterations per channel and frame.\n"
+                          "Multigrid CG: one V-cycle (all three channels) per 4, at least one.");
     float tolerance_exponent = static_cast<float>(std::log10(live_options_.relative_tolerance));
     // Solver settings rebuild the live scene: only when the user lets go of the slider.
     if (ImGui::SliderFloat("tolerance", &tolerance_exponent, -6.0f, -1.0f, "1e%.1f"))
@@ -247,7 +250,10 @@ void EditorApp::draw_solver_panel() {
     if (s.core) {
         const FrameReport& f = s.last_frame;
         ImGui::Text("%s", s.converged ? "converged" : "refining...");
-        ImGui::Text("iterations   %d %d %d (last frame)", f.iterations[0], f.iterations[1], f.iterations[2]);
+        if (s.solver_description.find("V-cycle") != std::string::npos)  // multigrid CG: rgb in one pass
+            ImGui::Text("V-cycles     %d (last frame, three channels each)", f.iterations[0]);
+        else
+            ImGui::Text("iterations   %d %d %d (last frame)", f.iterations[0], f.iterations[1], f.iterations[2]);
         if (s.estimated_error)
             ImGui::Text("est. error   %.1e (tolerance %.0e)", *s.estimated_error, live_options_.relative_tolerance);
         ImGui::Text("solver tick  %.1f ms", s.tick_ms);

@@ -23,10 +23,12 @@ void EditorApp::choose_solver(LiveMethod method, LiveBackend backend) {
 void EditorApp::draw_solver_choice() {
     int method = live_options_.method == LiveMethod::MultigridCg ? 1 : 0;
     int backend = live_options_.backend == LiveBackend::Gpu ? 1 : 0;
-    bool changed = ImGui::Combo("method", &method, "Jacobi CG\0Multigrid CG\0");
+    bool changed = ImGui::Combo("method", &method, "Jacobi CG\0Multigrid CG (rgb per V-cycle)\0");
     if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("CPU: Jacobi-preconditioned CG (double), or CG preconditioned by a V-cycle on the\n"
-                          "multires hierarchy. The GPU backend always runs Jacobi CG (float).");
+        ImGui::SetTooltip("CPU: Jacobi-preconditioned CG per channel (double), or multigrid CG, three channels\n"
+                          "per V-cycle: CG preconditioned by a V-cycle on the multires hierarchy, warm across\n"
+                          "frames, one V-cycle per 4 iterations of the budget. The GPU backend always runs\n"
+                          "Jacobi CG (float).");
     changed |= ImGui::Combo("backend", &backend, "CPU\0GPU (OpenGL compute)\0");
     if (changed) {
         choose_solver(method == 1 ? LiveMethod::MultigridCg : LiveMethod::JacobiCg,

@@ -65,7 +65,9 @@ struct LiveSceneOptions {
 
 // One frame of the solve.
 struct FrameReport {
-    std::array<int, 3> iterations{};                 // CG iterations per rgb channel this frame
+    // CG iterations per rgb channel this frame; multigrid CG: V-cycles, each serving all three channels
+    // (the same count in each; live_solver.h maps an iteration budget k to max(1, k / 4) of them).
+    std::array<int, 3> iterations{};
     std::array<double, 3> estimated_relative_error{}; // after this frame
     bool converged = false;                          // every channel within the tolerance
     double milliseconds = 0;
@@ -103,7 +105,8 @@ public:
     FrameReport step(int iteration_budget);
     // A time budget instead: CG in chunks of `chunk_iterations` per channel until `milliseconds` have
     // passed or the tolerance is reached (each chunk restarts CG from the current phi, which costs a
-    // little convergence against one longer run; at least one chunk runs).
+    // little convergence against one longer run; at least one chunk runs). Multigrid CG runs max(1, chunk / 4)
+    // V-cycles per chunk and resumes its CG across chunks instead.
     FrameReport step_for(double milliseconds, int chunk_iterations = 4);
     // Iterates until the tolerance (or `max_iterations` per channel: AlgorithmError if not reached).
     FrameReport converge(int max_iterations = 10000);

@@ -4,10 +4,20 @@
 //
 //   CPU Jacobi CG        conjugate_gradient.h in double, per channel (the default: on spot it is as
 //                        fast to 1% as the multires solver, live_scene.h).
-//   CPU multigrid CG     multires/multigrid_cg.h: CG preconditioned by the V-cycle on the hierarchy of
-//                        Li et al. 2013 (Sec. 4.1, Eq. 16). The hierarchy is built once per topology;
-//                        after painting only the level-0 rows that changed are copied and the coarse
-//                        Galerkin rows depending on them recomputed (MultigridPreconditioner::update_values).
+//   CPU multigrid CG     multires/multigrid_frame_solver.h: CG preconditioned by the V-cycle on the
+//                        hierarchy of Li et al. 2013 (Sec. 4.1, Eq. 16), the three rgb channels in one
+//                        pass (one sweep over the pattern per level serves all three). Its state (phi,
+//                        residual, search directions) persists across frames: a light change only
+//                        moves the residual by the change of b (set_right_hand_side), painting updates
+//                        the changed level-0 rows and the coarse Galerkin rows depending on them
+//                        (update_values; a whole-object material every row), a new matrix (cut,
+//                        relaxation) rebuilds it. solver.phi(c) is copied into the host phi after
+//                        each frame (phi(), the radiance, saves, a cut's warm start). Its budget is
+//                        counted in V-cycles: an iteration budget of k maps to max(1, k / 4) V-cycles
+//                        (kIterationsPerVcycle: one costs about 4 Jacobi CG iterations of the three
+//                        channels; 0 runs none), and FrameReport counts V-cycles as each
+//                        channel's iterations. Its error estimate lags one CG update when the budget runs
+//                        out (an upper estimate, multigrid_frame_solver.h).
 //   GPU CG               solver/gpu_conjugate_gradient.h (float, OpenGL 4.3 compute shaders): matrix,
 //                        right-hand sides and phi stay on the device between frames; painting uploads
 //                        only the rewritten rows (GpuDiffusionSolver::update_rows). phi is read back
@@ -34,6 +44,8 @@
 #include <vector>
 
 namespace waxwork {
+
+class MultigridFrameSolver;
 
 enum class LiveMethod { JacobiCg, MultigridCg };
 enum class LiveBackend { Cpu, Gpu };
@@ -115,15 +127,20 @@ public:
     LiveBackend requested_backend() const { return requested_backend_; }
     // Why the GPU backend was given up ("" when it was not requested or runs).
     const std::string& gpu_fallback_reason() const { return gpu_fallback_reason_; }
-    // "GPU CG (llvmpipe (LLVM 15.0.6, 256 bits))", "CPU multigrid CG", ...: for the panel and logs.
+    // "GPU Jacobi CG (float) (llvmpipe ...)", "CPU multigrid CG, three channels per V-cycle", ...: for the
+    // panel and logs.
     std::string description() const;
 
 private:
     struct Gpu;
-    struct Multigrid;
     std::array<LiveSolverChannel, 3> iterate_cpu(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
                                                  std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                  double relative_tolerance, const std::array<bool, 3>& skip);
+    std::array<LiveSolverChannel, 3> iterate_multigrid(const DiffusionMatrix& matrix,
+                                                       const std::array<std::vector<double>, 3>& b,
+                                                       std::array<std::vector<double>, 3>& phi, int iteration_budget,
+                                                       double relative_tolerance, const std::array<bool, 3>& skip);
+    void multigrid_changed();
     std::array<LiveSolverChannel, 3> iterate_gpu(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
                                                  std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                  double relative_tolerance, const std::array<bool, 3>& skip);
@@ -136,8 +153,11 @@ private:
     std::string gpu_fallback_reason_;
     std::string renderer_;
     std::array<double, 3> eigenvalue_hint_{};
-    std::unique_ptr<Multigrid> multigrid_;
-    bool multigrid_values_stale_ = false;
+    std::unique_ptr<MultigridFrameSolver> multigrid_;
+    // Pending multigrid work (applied at the next iterate): all values, b, the host phi (a warm start).
+    bool multigrid_values_stale_ = false, multigrid_rhs_stale_ = true, multigrid_solution_stale_ = true;
+    // The last frame's estimates, reported by a frame of no V-cycles (1 after a change).
+    std::array<double, 3> multigrid_error_{1, 1, 1};
     std::unique_ptr<Gpu> gpu_;
     // Pending device work (applied at the next GPU iterate, with the context current).
     bool gpu_values_stale_ = false, gpu_rhs_stale_ = true, gpu_solution_stale_ = true;

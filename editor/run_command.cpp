@@ -52,7 +52,8 @@ void add_run_command(CLI::App& app) {
                     "context; falls back to the CPU with a warning when the driver cannot run it)")
         ->check(CLI::IsMember({"cpu", "gpu"}));
     cmd->add_option("--method", options->method,
-                    "Live solver method on the CPU: jacobi (Jacobi CG) or mgcg (multigrid-preconditioned CG)")
+                    "Live solver method on the CPU: jacobi (Jacobi CG per channel) or mgcg (multigrid CG, three "
+                    "channels per V-cycle; one V-cycle per 4 frame iterations)")
         ->check(CLI::IsMember({"jacobi", "mgcg"}));
     cmd->footer("Steps: edit operations ({\"op\": \"plane_cut\", ...}), {\"render\": \"a.png\"}, {\"save\": \"a.vtu\"},\n"
                 "{\"light\": {...}}, {\"camera\": {...}}, {\"undo\": 1}, {\"redo\": 1}. See assets/sessions/.");

@@ -85,6 +85,12 @@ std::span<const double> MultigridFrameSolver::phi(int channel) const {
     return phi_[static_cast<size_t>(channel)];
 }
 
+void MultigridFrameSolver::set_relative_tolerance(double tolerance) {
+    if (!(tolerance > 0) || !std::isfinite(tolerance))
+        throw InvalidArgumentError("frame solver: tolerance " + std::to_string(tolerance) + " must be positive");
+    options_.relative_tolerance = tolerance;
+}
+
 void MultigridFrameSolver::reset() {
     for (auto& v : phi_) std::fill(v.begin(), v.end(), 0.0);
     restart_ = refresh_ = phi_zero_ = true;

@@ -72,6 +72,10 @@ public:
     // matrix or preconditioner turns out not to be positive definite.
     FrameStep step(int budget);
 
+    // The tolerance step() stops at (FrameSolverOptions::relative_tolerance), e.g. a tighter one to
+    // converge a scene the frames left at a looser one. Throws InvalidArgumentError unless positive.
+    void set_relative_tolerance(double tolerance);
+
     // The current solution of one channel (valid until the next step or reset).
     std::span<const double> phi(int channel) const;
     // phi = 0 (forgets the warm start and the eigenvalue estimates).

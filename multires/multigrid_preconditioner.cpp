@@ -457,6 +457,9 @@ void MultigridPreconditioner::update_values(std::span<const int32_t> changed_row
     }
     std::vector<int32_t> rows(changed_rows.begin(), changed_rows.end());
     prepare_smoother(0, rows);
+    // A one-level hierarchy: level 0 is the coarsest level, solved exactly, so its factorisation must
+    // follow the new values (the loop below refactorises only a coarsest level it reaches).
+    if (levels_.size() == 1 && !rows.empty()) factorize_coarsest();
     std::vector<uint8_t> touched;
     for (size_t l = 1; l < levels_.size() && !rows.empty(); ++l) {
         // Coarse row I depends on the fine rows v with P_vI != 0 (and, by symmetry of A, on nothing

@@ -98,7 +98,8 @@ public:
     // After the level-0 values changed in the rows `changed_rows` (ascending; pattern and hierarchy
     // unchanged; the hierarchy's level 0 already holds the new values): recomputes exactly the coarse
     // rows that depend on them, level by level, and refactorises the coarsest level if it was
-    // reached. The result equals a new preconditioner built on the updated hierarchy.
+    // reached (level 0 itself in a one-level hierarchy). The result equals a new preconditioner built
+    // on the updated hierarchy.
     void update_values(std::span<const int32_t> changed_rows);
 
 private:

@@ -202,5 +202,35 @@ TEST(LiveScene, TimeBudgetedStepsReachTheTolerance) {
     EXPECT_THROW(scene.step_for(-1), InvalidArgumentError);
 }
 
+// Multigrid CG counts its budget in V-cycles (one per 4 iterations of the editor's budget, at least
+// one; live_solver.h), each serving all three channels, and its phi and radiance follow edits to the
+// from-scratch solve.
+TEST(LiveScene, MultigridFramesRunVcyclesAndFollowTheFreshSolve) {
+    Document doc(testing::make_cube_mesh(12), material_preset("marble"));
+    LiveSceneOptions o = options();
+    o.method = LiveMethod::MultigridCg;
+    LiveScene scene(doc.mesh(), key_lighting(), o);
+    EXPECT_EQ(scene.step(0).total_iterations(), 0);
+    for (const auto& [budget, vcycles] : {std::pair{3, 1}, std::pair{4, 1}, std::pair{9, 2}}) {
+        const FrameReport frame = scene.step(budget);
+        ASSERT_FALSE(frame.converged) << budget;
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(frame.iterations[c], vcycles) << "budget " << budget;
+        EXPECT_GT(frame.max_error(), kTolerance);
+    }
+    // A time budget runs whole V-cycles, at least one.
+    const FrameReport timed = scene.step_for(0);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(timed.iterations[c], 1);
+    expect_matches_fresh_solve(scene, doc.mesh(), key_lighting(), "multigrid");
+    EXPECT_TRUE(scene.converged());
+    EXPECT_EQ(scene.step(8).total_iterations(), 0);  // idle once converged
+    scene.apply_change(doc.mesh(), doc.apply(paint_at({0.5, 0.5, 0.5})));
+    EXPECT_FALSE(scene.converged());
+    expect_matches_fresh_solve(scene, doc.mesh(), key_lighting(), "multigrid after paint");
+    Lighting turned = key_lighting();
+    turned.lights[0].vector = Eigen::Vector3d(0.8, -0.8, -0.7).normalized();
+    scene.set_lighting(turned);
+    expect_matches_fresh_solve(scene, doc.mesh(), turned, "multigrid after a light change");
+}
+
 }  // namespace
 }  // namespace waxwork

@@ -249,6 +249,30 @@ TEST(MultigridPreconditioner, PartialUpdateAfterPaintingEqualsARebuild) {
     EXPECT_EQ(xa, xb);
 }
 
+// A system too small to coarsen is one level, solved exactly by its factorisation: painting must
+// refactorise it, so the V-cycle stays the exact inverse of the painted matrix.
+TEST(MultigridPreconditioner, PartialUpdateOfAOneLevelHierarchyRefactorisesIt) {
+    auto s = testing::make_test_system(3);
+    MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(100000));
+    ASSERT_EQ(h.level_count(), 1u);
+    MultigridPreconditioner updated(h);
+    const std::vector<int32_t> rows = testing::paint_test_system(s, 10, 5);
+    ASSERT_FALSE(rows.empty());
+    ASSERT_LT(rows.size(), s.matrix.size());
+    h.levels[0].values = s.matrix.values;
+    updated.update_values(rows);
+    MultigridPreconditioner rebuilt(h);
+    for (int channel = 0; channel < 3; ++channel) {
+        std::vector<double> xa(s.b[0].size(), 0.0), xb(s.b[0].size(), 0.0);
+        updated.apply(channel, s.b[static_cast<size_t>(channel)], xa);
+        rebuilt.apply(channel, s.b[static_cast<size_t>(channel)], xb);
+        EXPECT_EQ(xa, xb) << "channel " << channel;
+        // The exact solve of the painted system.
+        EXPECT_LT(relative_error(xa, reference_solution(s.matrix, s.b[static_cast<size_t>(channel)], channel)), 1e-6)
+            << "channel " << channel;
+    }
+}
+
 }  // namespace
 }  // namespace waxwork
 

@@ -111,6 +111,29 @@ TEST(MultigridFrameSolver, ConvergesToTheDoublePrecisionSolution) {
     }
 }
 
+// The live editor converges a scene its frames left at a looser tolerance: a tighter tolerance set later
+// makes step() continue from where it stopped, to the tighter error.
+TEST(MultigridFrameSolver, ATighterToleranceContinuesTheSolve) {
+    const auto s = testing::make_test_system(10);
+    MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(100, 1e-2));
+    solver.set_right_hand_side(spans(s.b));
+    FrameStep step;
+    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(2);
+    ASSERT_TRUE(step.converged);
+    const auto reference = reference_solution(s.matrix, s.b[0], 0);
+    const double loose = relative_error(solver.phi(0), reference);
+    EXPECT_TRUE(solver.step(1).converged);  // still within the loose tolerance
+    solver.set_relative_tolerance(1e-8);
+    step = solver.step(1);
+    EXPECT_FALSE(step.converged);
+    EXPECT_EQ(step.vcycles, 1);
+    for (int frames = 0; frames < 50 && !step.converged; ++frames) step = solver.step(2);
+    EXPECT_TRUE(step.converged);
+    EXPECT_LT(relative_error(solver.phi(0), reference), std::min(1e-6, 0.01 * loose));
+    EXPECT_THROW(solver.set_relative_tolerance(0), InvalidArgumentError);
+    EXPECT_THROW(solver.set_relative_tolerance(std::nan("")), InvalidArgumentError);
+}
+
 // The budget the live editor gives a frame after the light moved (bench/multires_bench.cpp,
 // BM_LightTurn10Degrees mode 3, times it on spot).
 constexpr int kLightTurnBudget = 1;
