@@ -8,6 +8,7 @@
 // and p90 process CPU milliseconds (all threads; on an idle two-core machine a frame's wall time lies
 // between half of it and all of it). The edit benchmarks' CPU column is the whole process too.
 #include "bench_meshes.h"
+#include "live_scene_setup.h"
 #include "editor/document.h"
 #include "editor/live_scene.h"
 #include "solver/material.h"
@@ -43,25 +44,7 @@ double process_cpu_ms() {
     return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
 }
 
-// Spot 100 mm long (as in the README's performance table).
-LiveSceneOptions scene_options(const TetMesh& mesh) {
-    const auto box = bounding_box(mesh);
-    LiveSceneOptions o;
-    o.mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();
-    o.relative_tolerance = 1e-3;
-    return o;
-}
-
-Lighting light_at(double degrees) {
-    const double a = degrees * std::numbers::pi / 180;
-    Lighting l;
-    Light light;
-    light.vector = Eigen::Vector3d(std::cos(a), -0.8, std::sin(a)).normalized();
-    l.lights = {light};
-    l.ambient = {0.02, 0.02, 0.02};
-    return l;
-}
-
+using bench::turning_light;
 void report_frames(benchmark::State& state, std::vector<double> ms, std::vector<double> cpu) {
     std::sort(cpu.begin(), cpu.end());
     state.counters["median_cpu_ms"] = cpu[cpu.size() / 2];
@@ -82,7 +65,7 @@ void frame(LiveScene& scene, int& iterations) {
 
 void BM_RelightFrames(benchmark::State& state) {
     Document doc(bench::spot_volume(kFrameTets), material_preset("marble"));
-    LiveScene scene(doc.mesh(), light_at(0), scene_options(doc.mesh()));
+    LiveScene scene(doc.mesh(), turning_light(0), bench::live_scene_options(doc.mesh()));
     scene.converge();
     std::vector<double> ms, cpu;
     int iterations = 0;
@@ -90,7 +73,7 @@ void BM_RelightFrames(benchmark::State& state) {
         for (int f = 1; f <= kFrames; ++f) {
             const auto start = Clock::now();
             const double cpu_start = process_cpu_ms();
-            scene.set_lighting(light_at(3.0 * f));  // a few degrees per frame
+            scene.set_lighting(turning_light(3.0 * f));  // a few degrees per frame
             frame(scene, iterations);
             ms.push_back(ms_since(start));
             cpu.push_back(process_cpu_ms() - cpu_start);
@@ -106,7 +89,7 @@ BENCHMARK(BM_RelightFrames)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRe
 // A stroke point per frame: paint (one undoable operation), matrix row update, solver step.
 void BM_PaintFrames(benchmark::State& state) {
     Document doc(bench::spot_volume(kFrameTets), material_preset("marble"));
-    LiveScene scene(doc.mesh(), light_at(0), scene_options(doc.mesh()));
+    LiveScene scene(doc.mesh(), turning_light(0), bench::live_scene_options(doc.mesh()));
     scene.converge();
     const auto box = bounding_box(doc.mesh());
     const Eigen::Vector3d centre = 0.5 * (box[0] + box[1]);
@@ -156,7 +139,7 @@ void BM_CutWithRebuild(benchmark::State& state) {
     for (auto _ : state) {
         state.PauseTiming();
         Document doc(source, material_preset("marble"));
-        LiveScene scene(doc.mesh(), light_at(0), scene_options(doc.mesh()));
+        LiveScene scene(doc.mesh(), turning_light(0), bench::live_scene_options(doc.mesh()));
         state.ResumeTiming();
         const ChangeReport report = doc.apply(cut);
         const SceneUpdate update = scene.apply_change(doc.mesh(), report);
@@ -177,7 +160,7 @@ BENCHMARK(BM_CutWithRebuild)->Iterations(3)->Unit(benchmark::kMillisecond)->Meas
 // is built by a first stroke outside the timing (it lives until the geometry changes).
 void BM_PaintStrokeWithRowUpdates(benchmark::State& state) {
     Document doc(bench::spot_volume(kEditTets), material_preset("marble"));
-    LiveScene scene(doc.mesh(), light_at(0), scene_options(doc.mesh()));
+    LiveScene scene(doc.mesh(), turning_light(0), bench::live_scene_options(doc.mesh()));
     const auto box = bounding_box(doc.mesh());
     const Eigen::Vector3d centre = 0.5 * (box[0] + box[1]);
     const double diagonal = (box[1] - box[0]).norm();

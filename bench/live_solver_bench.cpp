@@ -12,6 +12,7 @@
 // Jacobi CG, and true_error_l2: the largest per-channel sqrt(sum (phi - phi*)^2 / sum phi*^2) (final_error is
 // the solver's own estimate, which for multigrid CG lags one update: it describes phi before it).
 #include "bench_meshes.h"
+#include "live_scene_setup.h"
 #include "editor/document.h"
 #include "editor/live_scene.h"
 #include "solver/material.h"
@@ -48,24 +49,13 @@ constexpr Variant kVariants[] = {
 };
 
 LiveSceneOptions scene_options(const TetMesh& mesh, const Variant& variant) {
-    const auto box = bounding_box(mesh);
-    LiveSceneOptions o;
-    o.mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();  // spot 100 mm long
-    o.relative_tolerance = 1e-3;
+    LiveSceneOptions o = bench::live_scene_options(mesh);
     o.method = variant.method;
     o.backend = variant.backend;
     return o;
 }
 
-Lighting light_at(double degrees) {
-    const double a = degrees * std::numbers::pi / 180;
-    Lighting l;
-    Light light;
-    light.vector = Eigen::Vector3d(std::cos(a), -0.8, std::sin(a)).normalized();
-    l.lights = {light};
-    l.ambient = {0.02, 0.02, 0.02};
-    return l;
-}
+using bench::turning_light;
 
 // max |a - b| / max |b| over vertices and channels.
 double relative_difference(const std::vector<std::array<double, 3>>& a, const std::vector<std::array<double, 3>>& b) {
@@ -121,14 +111,14 @@ void report(benchmark::State& state, std::vector<double> ms, const LiveScene& sc
 void BM_RelightFrames(benchmark::State& state) {
     const Variant& variant = kVariants[state.range(0)];
     Document doc(bench::spot_volume(kFrameTets), material_preset("marble"));
-    LiveScene scene(doc.mesh(), light_at(0), scene_options(doc.mesh(), variant));
+    LiveScene scene(doc.mesh(), turning_light(0), scene_options(doc.mesh(), variant));
     scene.converge();
     std::vector<double> ms;
     int iterations = 0;
     for (auto _ : state) {
         for (int f = 1; f <= kFrames; ++f) {
             const auto start = Clock::now();
-            scene.set_lighting(light_at(3.0 * f));
+            scene.set_lighting(turning_light(3.0 * f));
             iterations += scene.step(kFrameIterations).total_iterations();
             benchmark::DoNotOptimize(scene.radiance_factors().data());
             ms.push_back(ms_since(start));
@@ -141,7 +131,7 @@ BENCHMARK(BM_RelightFrames)->DenseRange(0, 2)->Iterations(1)->Unit(benchmark::kM
 void BM_PaintFrames(benchmark::State& state) {
     const Variant& variant = kVariants[state.range(0)];
     Document doc(bench::spot_volume(kFrameTets), material_preset("marble"));
-    LiveScene scene(doc.mesh(), light_at(0), scene_options(doc.mesh(), variant));
+    LiveScene scene(doc.mesh(), turning_light(0), scene_options(doc.mesh(), variant));
     scene.converge();
     const auto box = bounding_box(doc.mesh());
     const Eigen::Vector3d centre = 0.5 * (box[0] + box[1]);
