@@ -3,6 +3,7 @@
 // --hide-ui) as a PNG and exits: for the docs and the tests, under xvfb-run on a server.
 #include "editor/commands.h"
 #include "editor/editor_app.h"
+#include "editor/live_solver_choice.h"
 #include "editor/material_options.h"
 #include "tetops/error.h"
 
@@ -34,8 +35,7 @@ struct EditCommandOptions {
     std::string slice_normal;
     double slice_offset = 0;
     bool quality_interior = false;
-    std::string backend = "cpu";
-    std::string method = "jacobi";
+    LiveSolverChoice solver;
 };
 
 void run_edit_command(const EditCommandOptions& o) {
@@ -60,8 +60,8 @@ void run_edit_command(const EditCommandOptions& o) {
     options.max_tets = o.max_tets;
     options.material = chosen_material(o.material);
     options.scale = o.scale;
-    options.solver_backend = parse_live_backend(o.backend);
-    options.solver_method = parse_live_method(o.method);
+    options.solver_backend = parse_live_backend(o.solver.backend);
+    options.solver_method = parse_live_method(o.solver.method);
     for (const std::string& spec : o.lights) options.lights.push_back(parse_light_spec(spec));
     // Read before the window opens: a bad script is a one-line error, with or without a display.
     if (!o.input.empty()) options.input = read_input_script(o.input);
@@ -123,14 +123,7 @@ void add_edit_command(CLI::App& app) {
         ->capture_default_str();
     cmd->add_flag("--quality-interior", options->quality_interior,
                   "--show quality: also cut at the slice plane and colour the cross-section's tets");
-    cmd->add_option("--backend", options->backend,
-                    "Live solver: cpu, or gpu (CG on OpenGL compute shaders in a context shared with the window; "
-                    "falls back to the CPU, saying why, when the driver cannot run it)")
-        ->check(CLI::IsMember({"cpu", "gpu"}));
-    cmd->add_option("--method", options->method,
-                    "Live solver method on the CPU: jacobi (Jacobi CG per channel) or mgcg (multigrid CG, three "
-                    "channels per V-cycle; one V-cycle per 4 iterations of the frame budget)")
-        ->check(CLI::IsMember({"jacobi", "mgcg"}));
+    add_live_solver_options(*cmd, options->solver, "in a context shared with the window");
     cmd->footer(
         "Mouse: left drag uses the current tool; right drag (or Alt+left) orbits, middle drag (or Shift+right)\n"
         "pans, the wheel zooms, Home resets the view, Esc cancels a stroke or drag.\n"

@@ -1,6 +1,7 @@
 // `waxwork run SESSION.json -o OUTDIR`: replays a scripted editing session headless (session.h) and
 // prints one line per step; OUTDIR/metrics.json holds the same numbers.
 #include "editor/commands.h"
+#include "editor/live_solver_choice.h"
 #include "editor/session.h"
 
 #include <CLI/CLI.hpp>
@@ -15,15 +16,14 @@ namespace {
 struct RunCommandOptions {
     std::string session;
     std::string output;
-    std::string backend = "cpu";
-    std::string method = "jacobi";
+    LiveSolverChoice solver;
 };
 
 void run_run_command(const RunCommandOptions& o) {
     const Session session = read_session(o.session);
     SessionRunOptions run;
-    run.backend = parse_live_backend(o.backend);
-    run.method = parse_live_method(o.method);
+    run.backend = parse_live_backend(o.solver.backend);
+    run.method = parse_live_method(o.solver.method);
     const SessionResult result = run_session(session, o.output, run);
     if (!result.gpu_fallback_reason.empty())
         std::cerr << "warning: solved on the CPU instead: " << result.gpu_fallback_reason << "\n";
@@ -47,14 +47,7 @@ void add_run_command(CLI::App& app) {
     cmd->add_option("session", options->session, "Session file (.json)")->required()->check(CLI::ExistingFile);
     cmd->add_option("-o,--output", options->output, "Directory for the frames, saved volumes and metrics.json")
         ->required();
-    cmd->add_option("--backend", options->backend,
-                    "Live solver backend: cpu, or gpu (CG on OpenGL 4.3 compute shaders in the renderer's OSMesa "
-                    "context; falls back to the CPU with a warning when the driver cannot run it)")
-        ->check(CLI::IsMember({"cpu", "gpu"}));
-    cmd->add_option("--method", options->method,
-                    "Live solver method on the CPU: jacobi (Jacobi CG per channel) or mgcg (multigrid CG, three "
-                    "channels per V-cycle; one V-cycle per 4 frame iterations)")
-        ->check(CLI::IsMember({"jacobi", "mgcg"}));
+    add_live_solver_options(*cmd, options->solver, "in the renderer's OSMesa context");
     cmd->footer("Steps: edit operations ({\"op\": \"plane_cut\", ...}), {\"render\": \"a.png\"}, {\"save\": \"a.vtu\"},\n"
                 "{\"light\": {...}}, {\"camera\": {...}}, {\"undo\": 1}, {\"redo\": 1}. See assets/sessions/.");
     cmd->callback([options] { run_run_command(*options); });

@@ -2,6 +2,7 @@
 #include "solver/material.h"
 #include "tetops/error.h"
 #include "tetops/test_meshes.h"
+#include "live_test_scene.h"
 
 #include <gtest/gtest.h>
 
@@ -10,16 +11,10 @@
 namespace waxwork {
 namespace {
 
-constexpr double kTolerance = 1e-9;
+using testing::key_lighting;
+using testing::paint_at;
 
-Lighting key_lighting() {
-    Lighting l;
-    Light light;
-    light.vector = Eigen::Vector3d(1, -0.8, -0.5).normalized();
-    l.lights = {light};
-    l.ambient = {0.02, 0.02, 0.02};
-    return l;
-}
+constexpr double kTolerance = 1e-9;
 
 LiveSceneOptions options() {
     LiveSceneOptions o;
@@ -56,14 +51,6 @@ void expect_matches_fresh_solve(LiveScene& scene, const TetMesh& mesh, const Lig
             EXPECT_NEAR(snapshot.radiance_factor[v][c], fresh.radiance_factor[v][c],
                         1e-4 * std::abs(fresh.radiance_factor[v][c]) + 1e-6)
                 << what;
-}
-
-PaintOp paint_at(const Eigen::Vector3d& p, const char* material = "ketchup") {
-    PaintOp op;
-    op.points = {p};
-    op.material = material_preset(material);
-    op.sigma = 0.08;
-    return op;
 }
 
 TEST(LiveScene, FollowsEveryKindOfChangeToTheFreshSolution) {

@@ -6,6 +6,7 @@
 #include "solver/material.h"
 #include "tetops/error.h"
 #include "tetops/test_meshes.h"
+#include "live_test_scene.h"
 
 #include <gtest/gtest.h>
 
@@ -15,14 +16,8 @@
 namespace waxwork {
 namespace {
 
-Lighting key_lighting() {
-    Lighting l;
-    Light light;
-    light.vector = Eigen::Vector3d(1, -0.8, -0.5).normalized();
-    l.lights = {light};
-    l.ambient = {0.02, 0.02, 0.02};
-    return l;
-}
+using testing::key_lighting;
+using testing::paint_at;
 
 struct Config {
     LiveMethod method;
@@ -64,14 +59,6 @@ std::vector<std::array<double, 3>> reference_phi(const TetMesh& mesh) {
     LiveScene scene(mesh, key_lighting(), options_for(kConfigs[0]));
     scene.converge();
     return scene.phi();
-}
-
-PaintOp paint_at(const Eigen::Vector3d& p, const char* material) {
-    PaintOp op;
-    op.points = {p};
-    op.material = material_preset(material);
-    op.sigma = 0.08;
-    return op;
 }
 
 TEST(LiveSolver, EveryMethodAndBackendConvergesToTheSamePhi) {
