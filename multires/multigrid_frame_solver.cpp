@@ -1,5 +1,7 @@
 #include "multires/multigrid_frame_solver.h"
 
+#include "multires/parallel_rows.h"
+
 #include "solver/conjugate_gradient.h"
 #include "tetops/error.h"
 
@@ -17,13 +19,6 @@ namespace waxwork {
 namespace {
 
 constexpr size_t kGrain = 2048;
-
-template <typename Body>
-void for_rows(size_t n, const Body& body) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) body(i);
-    });
-}
 
 template <size_t N>
 using Sums = std::array<double, N>;
@@ -70,7 +65,7 @@ MultigridFrameSolver::MultigridFrameSolver(const DiffusionMatrix& matrix, std::s
     hierarchy_ = std::make_unique<MultiresHierarchy>(build_multires_hierarchy(matrix, positions, options.hierarchy));
     preconditioner_ = std::make_unique<MultigridPreconditioner>(*hierarchy_, options.multigrid);
     values_.resize(3 * matrix.nonzeros());
-    for_rows(matrix.nonzeros(), [&](size_t k) {
+    for_rows(matrix.nonzeros(), kGrain, [&](size_t k) {
         for (size_t c = 0; c < 3; ++c) values_[3 * k + c] = matrix.values[c][k];
     });
     for (auto& v : phi_) v.assign(n_, 0.0);
@@ -127,7 +122,7 @@ void MultigridFrameSolver::set_right_hand_side(const std::array<std::span<const 
     }
     // r = b - M phi changes by exactly the change of b.
     const bool follow = has_b_ && !refresh_;
-    for_rows(n_, [&](size_t i) {
+    for_rows(n_, kGrain, [&](size_t i) {
         for (size_t c = 0; c < 3; ++c) {
             const double value = b[c][i];
             if (follow) r_[3 * i + c] += value - b_[3 * i + c];
@@ -147,7 +142,7 @@ void MultigridFrameSolver::refresh_residual() {
     }
     const int32_t* offsets = hierarchy_->levels[0].offsets.data();
     const int32_t* columns = hierarchy_->levels[0].columns.data();
-    for_rows(n_, [&](size_t i) {
+    for_rows(n_, kGrain, [&](size_t i) {
         double s[3] = {0, 0, 0};
         for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
             const double* v = &values_[3 * static_cast<size_t>(k)];
@@ -226,7 +221,7 @@ FrameStep MultigridFrameSolver::step(int budget) {
         if (restart) {
             std::swap(p_, z_);  // z is recomputed before it is read again
         } else {
-            for_rows(n_, [&](size_t i) {
+            for_rows(n_, kGrain, [&](size_t i) {
                 for (size_t c = 0; c < 3; ++c) p_[3 * i + c] = z_[3 * i + c] + beta[c] * p_[3 * i + c];
             });
         }
@@ -253,7 +248,7 @@ FrameStep MultigridFrameSolver::step(int budget) {
         }
         for (size_t c = 0; c < 3; ++c) beta_prev_[c] = beta[c];
         phi_zero_ = false;
-        for_rows(n_, [&](size_t i) {
+        for_rows(n_, kGrain, [&](size_t i) {
             for (size_t c = 0; c < 3; ++c) {
                 const size_t e = 3 * i + c;
                 phi_[c][i] += alpha[c] * p_[e];

@@ -1,5 +1,7 @@
 #include "multires/multigrid_preconditioner.h"
 
+#include "multires/parallel_rows.h"
+
 #include "tetops/error.h"
 
 #include <Eigen/SparseCholesky>
@@ -20,13 +22,6 @@ namespace waxwork {
 namespace {
 
 constexpr size_t kGrain = 1024;
-
-template <typename Body>
-void for_rows(size_t n, const Body& body) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) body(i);
-    });
-}
 
 // P^T as compressed rows: row I lists the fine vertices v with P_vI != 0 in ascending v.
 InterpolationOperator transpose(const InterpolationOperator& p, size_t coarse_rows) {
@@ -217,7 +212,7 @@ void MultigridPreconditioner::build_product_pattern(size_t l) {
             }
         };
         fine.ap_offsets.assign(n + 1, 0);
-        for_rows(n, [&](size_t v) {
+        for_rows(n, kGrain, [&](size_t v) {
             int32_t count = 0;
             walk(v, scratch.local(), [&](int32_t) { ++count; });
             fine.ap_offsets[v + 1] = count;
@@ -225,7 +220,7 @@ void MultigridPreconditioner::build_product_pattern(size_t l) {
         std::partial_sum(fine.ap_offsets.begin(), fine.ap_offsets.end(), fine.ap_offsets.begin());
         fine.ap_columns.resize(static_cast<size_t>(fine.ap_offsets[n]));
         for (auto& acc : scratch) std::fill(acc.tag.begin(), acc.tag.end(), -1);  // pass two walks the same rows
-        for_rows(n, [&](size_t v) {
+        for_rows(n, kGrain, [&](size_t v) {
             auto out = static_cast<size_t>(fine.ap_offsets[v]);
             walk(v, scratch.local(), [&](int32_t k) { fine.ap_columns[out++] = k; });
         });
@@ -239,7 +234,7 @@ void MultigridPreconditioner::build_product_pattern(size_t l) {
     tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
     std::array<std::vector<double>, 3> diagonal;
     for (auto& d : diagonal) d.assign(m, 0.0);
-    for_rows(m, [&](size_t row) {
+    for_rows(m, kGrain, [&](size_t row) {
         Accumulator& acc = scratch.local();
         accumulate_galerkin_row(l, row, acc);
         for (size_t ch = 0; ch < 3; ++ch) diagonal[ch][row] = acc.sum[ch][row];
@@ -253,7 +248,7 @@ void MultigridPreconditioner::build_product_pattern(size_t l) {
         return false;
     };
     coarse.offsets.assign(m + 1, 0);
-    for_rows(m, [&](size_t row) {
+    for_rows(m, kGrain, [&](size_t row) {
         Accumulator& acc = scratch.local();
         accumulate_galerkin_row(l, row, acc);
         int32_t count = 0;
@@ -264,7 +259,7 @@ void MultigridPreconditioner::build_product_pattern(size_t l) {
     std::partial_sum(coarse.offsets.begin(), coarse.offsets.end(), coarse.offsets.begin());
     coarse.columns.resize(static_cast<size_t>(coarse.offsets[m]));
     coarse.diagonal.assign(m, -1);
-    for_rows(m, [&](size_t row) {
+    for_rows(m, kGrain, [&](size_t row) {
         Accumulator& acc = scratch.local();
         accumulate_galerkin_row(l, row, acc);
         auto out = static_cast<size_t>(coarse.offsets[row]);
@@ -312,7 +307,7 @@ void MultigridPreconditioner::compute_product_rows(size_t l, std::span<const int
     const InterpolationOperator& p = *fine.p;
     const size_t m = levels_[l]->n;
     tbb::enumerable_thread_specific<std::vector<int32_t>> slots([m] { return std::vector<int32_t>(m, -1); });
-    for_rows(rows.size(), [&](size_t index) {
+    for_rows(rows.size(), kGrain, [&](size_t index) {
         const auto v = static_cast<size_t>(rows[index]);
         auto& slot = slots.local();
         const auto begin = static_cast<size_t>(fine.ap_offsets[v]), end = static_cast<size_t>(fine.ap_offsets[v + 1]);
@@ -334,7 +329,7 @@ void MultigridPreconditioner::compute_galerkin_rows(size_t l, std::span<const in
     Level& coarse = *levels_[l];
     const size_t m = coarse.n;
     tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
-    for_rows(rows.size(), [&](size_t index) {
+    for_rows(rows.size(), kGrain, [&](size_t index) {
         const auto row = static_cast<size_t>(rows[index]);
         Accumulator& acc = scratch.local();
         accumulate_galerkin_row(l, row, acc);
@@ -384,7 +379,7 @@ void MultigridPreconditioner::prepare_smoother(size_t l, std::span<const int32_t
         level.rgb_d.inv_diag.resize(level.n);
     }
     std::atomic<bool> bad{false};
-    for_rows(rows.size(), [&](size_t index) {
+    for_rows(rows.size(), kGrain, [&](size_t index) {
         const auto i = static_cast<size_t>(rows[index]);
         for (size_t ch = 0; ch < 3; ++ch) {
             const std::vector<double>& values = level.values[ch];
@@ -485,7 +480,7 @@ namespace {
 template <typename Scalar>
 void scaled_residual(size_t n, const int32_t* offsets, const int32_t* columns, const Scalar* values,
                      const Scalar* inv_diag, const Scalar* b, const Scalar* x, Scalar* y) {
-    for_rows(n, [&](size_t i) {
+    for_rows(n, kGrain, [&](size_t i) {
         Scalar sum = b[i];
         for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) sum -= values[k] * x[columns[k]];
         y[i] = sum * inv_diag[i];
@@ -516,12 +511,12 @@ void MultigridPreconditioner::vcycle(size_t l, int channel) {
     const double theta = 0.5 * (upper + lower), delta = 0.5 * (upper - lower), sigma = theta / delta;
     auto smooth = [&](bool zero_start) {
         if (zero_start) {
-            for_rows(n, [&](size_t i) { w.r[i] = w.b[i] * inv_diag[i]; });
+            for_rows(n, kGrain, [&](size_t i) { w.r[i] = w.b[i] * inv_diag[i]; });
         } else {
             scaled_residual(n, offsets, columns, values, inv_diag, w.b.data(), w.x.data(), w.r.data());
         }
         const auto inv_theta = static_cast<Scalar>(1.0 / theta);
-        for_rows(n, [&](size_t i) {
+        for_rows(n, kGrain, [&](size_t i) {
             w.d[i] = w.r[i] * inv_theta;
             w.x[i] = zero_start ? w.d[i] : w.x[i] + w.d[i];
         });
@@ -531,24 +526,24 @@ void MultigridPreconditioner::vcycle(size_t l, int channel) {
             const auto c_d = static_cast<Scalar>(rho_next * rho), c_r = static_cast<Scalar>(2.0 * rho_next / delta);
             rho = rho_next;
             // d = c_d d + c_r D^-1 (b - A x), then x += d (a second pass: rows read neighbours' x).
-            for_rows(n, [&](size_t i) {
+            for_rows(n, kGrain, [&](size_t i) {
                 Scalar sum = w.b[i];
                 for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) sum -= values[k] * w.x[static_cast<size_t>(columns[k])];
                 w.d[i] = c_d * w.d[i] + c_r * (sum * inv_diag[i]);
             });
-            for_rows(n, [&](size_t i) { w.x[i] += w.d[i]; });
+            for_rows(n, kGrain, [&](size_t i) { w.x[i] += w.d[i]; });
         }
     };
     smooth(true);
     // r = b - A x, restricted with P^T to the next level's right-hand side.
-    for_rows(n, [&](size_t i) {
+    for_rows(n, kGrain, [&](size_t i) {
         Scalar sum = w.b[i];
         for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) sum -= values[k] * w.x[static_cast<size_t>(columns[k])];
         w.r[i] = sum;
     });
     MultigridLevelData<Scalar>& next = levels_[l + 1]->data<Scalar>();
     const InterpolationOperator& pt = level.pt;
-    for_rows(levels_[l + 1]->n, [&](size_t c) {
+    for_rows(levels_[l + 1]->n, kGrain, [&](size_t c) {
         Scalar sum = 0;
         for (int32_t a = pt.offsets[c]; a < pt.offsets[c + 1]; ++a)
             sum += w.pt_weights[static_cast<size_t>(a)] * w.r[static_cast<size_t>(pt.columns[static_cast<size_t>(a)])];
@@ -556,7 +551,7 @@ void MultigridPreconditioner::vcycle(size_t l, int channel) {
     });
     vcycle<Scalar>(l + 1, channel);
     const InterpolationOperator& p = *level.p;
-    for_rows(n, [&](size_t i) {
+    for_rows(n, kGrain, [&](size_t i) {
         Scalar sum = 0;
         for (int32_t q = p.offsets[i]; q < p.offsets[i + 1]; ++q)
             sum += w.p_weights[static_cast<size_t>(q)] * next.x[static_cast<size_t>(p.columns[static_cast<size_t>(q)])];
@@ -574,9 +569,9 @@ void MultigridPreconditioner::apply(int channel, std::span<const double> r, std:
                                    std::to_string(z.size()) + " for " + std::to_string(n) + " vertices");
     auto run = [&](auto& data, auto tag) {
         using Scalar = decltype(tag);
-        for_rows(n, [&](size_t i) { data.b[i] = static_cast<Scalar>(r[i]); });
+        for_rows(n, kGrain, [&](size_t i) { data.b[i] = static_cast<Scalar>(r[i]); });
         vcycle<Scalar>(0, channel);
-        for_rows(n, [&](size_t i) { z[i] = static_cast<double>(data.x[i]); });
+        for_rows(n, kGrain, [&](size_t i) { z[i] = static_cast<double>(data.x[i]); });
     };
     if (options_.single_precision)
         run(levels_[0]->f, float{});
@@ -638,7 +633,7 @@ void MultigridPreconditioner::vcycle_rgb(size_t l) {
             }
             const V* x = w.x.data();
             V* y = w.y.data();
-            for_rows(n, [&](size_t i) {
+            for_rows(n, kGrain, [&](size_t i) {
                 V sum;
                 residual(i, x, sum);
                 w.d[i] = c_d * w.d[i] + c_r * (sum * inv_diag[i]);
@@ -648,19 +643,19 @@ void MultigridPreconditioner::vcycle_rgb(size_t l) {
         }
     };
     // Pre-smoothing from a zero start.
-    for_rows(n, [&](size_t i) {
+    for_rows(n, kGrain, [&](size_t i) {
         const V r = w.b[i] * inv_diag[i];
         w.d[i] = r * inv_theta;
         w.x[i] = w.d[i];
     });
     chebyshev_steps();
     // r = b - A x, restricted with P^T.
-    for_rows(n, [&](size_t i) { residual(i, w.x.data(), w.r[i]); });
+    for_rows(n, kGrain, [&](size_t i) { residual(i, w.x.data(), w.r[i]); });
     Level& coarse = *levels_[l + 1];
     MultigridRgbLevelData<Scalar>& next = coarse.rgb<Scalar>();
     const MultigridLevelData<Scalar>& transfer = level.data<Scalar>();
     const InterpolationOperator& pt = level.pt;
-    for_rows(coarse.n, [&](size_t c) {
+    for_rows(coarse.n, kGrain, [&](size_t c) {
         V sum{};
         for (int32_t a = pt.offsets[c]; a < pt.offsets[c + 1]; ++a)
             sum += transfer.pt_weights[static_cast<size_t>(a)] * w.r[static_cast<size_t>(pt.columns[static_cast<size_t>(a)])];
@@ -668,7 +663,7 @@ void MultigridPreconditioner::vcycle_rgb(size_t l) {
     });
     vcycle_rgb<Scalar>(l + 1);
     const InterpolationOperator& p = *level.p;
-    for_rows(n, [&](size_t i) {
+    for_rows(n, kGrain, [&](size_t i) {
         V sum{};
         for (int32_t q = p.offsets[i]; q < p.offsets[i + 1]; ++q)
             sum += transfer.p_weights[static_cast<size_t>(q)] * next.x[static_cast<size_t>(p.columns[static_cast<size_t>(q)])];
@@ -678,7 +673,7 @@ void MultigridPreconditioner::vcycle_rgb(size_t l) {
     {
         const V* x = w.x.data();
         V* y = w.y.data();
-        for_rows(n, [&](size_t i) {
+        for_rows(n, kGrain, [&](size_t i) {
             V sum;
             residual(i, x, sum);
             const V r = sum * inv_diag[i];
@@ -697,12 +692,12 @@ void MultigridPreconditioner::apply_rgb(std::span<const double> r, std::span<dou
                                    std::to_string(z.size()) + " for 3 x " + std::to_string(n) + " entries");
     auto run = [&](auto& data, auto tag) {
         using Scalar = decltype(tag);
-        for_rows(n, [&](size_t i) {
+        for_rows(n, kGrain, [&](size_t i) {
             data.b[i] = typename RgbLanes<Scalar>::type{static_cast<Scalar>(r[3 * i]), static_cast<Scalar>(r[3 * i + 1]),
                                                         static_cast<Scalar>(r[3 * i + 2]), Scalar(0)};
         });
         vcycle_rgb<Scalar>(0);
-        for_rows(n, [&](size_t i) {
+        for_rows(n, kGrain, [&](size_t i) {
             for (size_t ch = 0; ch < 3; ++ch) z[3 * i + ch] = static_cast<double>(data.x[i][ch]);
         });
     };
