@@ -94,13 +94,18 @@ TEST(Lighting, VolumeVertexFormZeroesInteriorVertices) {
     }
 }
 
-TEST(Lighting, PieceBetweenLightAndCubeCastsAShadow) {
-    // Cube A in [0,1]^3; a wider slab, as a second piece moved above it by its rigid transform.
+// Cube A in [0,1]^3; a wider slab, as a second piece moved above it by its rigid transform.
+TetMesh cube_under_floating_slab() {
     TetMesh mesh = testing::make_box_mesh(4, {0, 0, 0}, {1, 1, 1});
     const TetMesh slab = testing::make_box_mesh(2, {-0.5, -0.5, 0}, {1.5, 1.5, 0.3});
     RigidTransform lift;
     lift.translation = {0, 0, 2};
     append_piece(mesh, slab, lift);
+    return mesh;
+}
+
+TEST(Lighting, PieceBetweenLightAndCubeCastsAShadow) {
+    const TetMesh mesh = cube_under_floating_slab();
     const TetConnectivity connectivity = build_connectivity(mesh);
     Lighting lighting;
     lighting.lights.push_back({LightType::Directional, {0, 0, -1}, {1, 1, 1}});
@@ -130,11 +135,7 @@ TEST(Lighting, PieceBetweenLightAndCubeCastsAShadow) {
 TEST(Lighting, VisibilityOutputIsWhatTheShadowRaysFound) {
     // The same scene with two lights: one from above (the slab shadows the cube's top), one from the
     // side (+x travelling -x: nothing in its way for the cube's +x face).
-    TetMesh mesh = testing::make_box_mesh(4, {0, 0, 0}, {1, 1, 1});
-    const TetMesh slab = testing::make_box_mesh(2, {-0.5, -0.5, 0}, {1.5, 1.5, 0.3});
-    RigidTransform lift;
-    lift.translation = {0, 0, 2};
-    append_piece(mesh, slab, lift);
+    const TetMesh mesh = cube_under_floating_slab();
     const TetConnectivity connectivity = build_connectivity(mesh);
     Lighting lighting;
     lighting.lights.push_back({LightType::Directional, {0, 0, -1}, {1, 1, 1}});
