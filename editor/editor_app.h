@@ -162,6 +162,8 @@ public:
     void on_mouse_button(int button, int action, int mods);
     void on_scroll(double steps);
     void select_tool(Tool tool);
+    // The material panel's preset `name` becomes the brush's material (as clicking it in the panel).
+    void select_brush_material(const std::string& name);
     void save_session(const std::filesystem::path& path);
 
 private:

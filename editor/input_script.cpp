@@ -1,6 +1,7 @@
 #include "editor/input_script.h"
 
 #include "editor/json_fields.h"
+#include "solver/material.h"
 #include "tetops/error.h"
 
 #include <GLFW/glfw3.h>
@@ -156,6 +157,17 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
         }
         e.tool = it->tool;
         events.push_back(e);
+    } else if (kind == "material") {
+        e.action = ScriptAction::SelectMaterial;
+        const Json& m = in.at("material");
+        const std::vector<std::string> names = material_preset_names();
+        if (!m.is_string() || std::find(names.begin(), names.end(), m.get<std::string>()) == names.end()) {
+            std::string list;
+            for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+            fail_json(in.field("material"), "expected a measured preset: " + list);
+        }
+        e.material = m.get<std::string>();
+        events.push_back(e);
     } else if (kind == "idle") {
         e.action = ScriptAction::WaitIdle;
         events.push_back(e);
@@ -208,6 +220,7 @@ void InputScriptPlayer::advance(ScriptTarget& target) {
             break;
         case ScriptAction::Key: target.key(e.key, e.mods); break;
         case ScriptAction::SelectTool: target.select_tool(e.tool); break;
+        case ScriptAction::SelectMaterial: target.select_material(e.material); break;
         case ScriptAction::WaitIdle: break;
         case ScriptAction::SaveSession: target.save_session(e.file); break;
         case ScriptAction::SaveVolume: target.save_volume(e.file); break;

@@ -4,6 +4,7 @@
 //
 //   [
 //     {"event": "tool", "tool": "cut"},                       select a tool (ids: tool_infos())
+//     {"event": "material", "material": "ketchup"},           the brush's material (a measured preset)
 //     {"frame": 3, "event": "press", "x": 200, "y": 300, "button": "left", "mods": ["shift"]},
 //     {"event": "move", "x": 260, "y": 310},
 //     {"event": "release", "x": 420, "y": 320, "button": "left"},
@@ -35,7 +36,7 @@
 
 namespace waxwork {
 
-enum class ScriptAction { Move, Press, Release, Scroll, Key, SelectTool, WaitIdle, SaveSession, SaveVolume };
+enum class ScriptAction { Move, Press, Release, Scroll, Key, SelectTool, SelectMaterial, WaitIdle, SaveSession, SaveVolume };
 
 struct ScriptEvent {
     ScriptAction action = ScriptAction::Move;
@@ -46,6 +47,7 @@ struct ScriptEvent {
     double scroll = 0;         // wheel steps
     int key = 0;               // GLFW_KEY_*
     Tool tool = Tool::Orbit;
+    std::string material;        // SelectMaterial: a preset name (material_preset_names())
     std::filesystem::path file;  // SaveSession, SaveVolume (absolute after parsing)
     std::string context;         // "SCRIPT: entry N (kind)" for messages
 };
@@ -77,6 +79,7 @@ public:
     virtual void scroll(double steps) = 0;
     virtual void key(int key, int mods) = 0;  // press and release
     virtual void select_tool(Tool tool) = 0;
+    virtual void select_material(const std::string& preset) = 0;  // as a click in the material panel
     virtual void save_session(const std::filesystem::path& file) = 0;
     virtual void save_volume(const std::filesystem::path& file) = 0;
 };

@@ -120,6 +120,14 @@ void EditorApp::select_tool(Tool tool) {
     else tools_.set_tool(tool, viewport_context());
 }
 
+void EditorApp::select_brush_material(const std::string& name) {
+    const std::vector<std::string> names = material_preset_names();
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) throw InvalidArgumentError("no material preset named '" + name + "'");
+    selected_preset_ = static_cast<int>(it - names.begin());
+    custom_material_ = material_preset(name);
+}
+
 std::optional<PieceHit> EditorApp::piece_under(const Eigen::Vector2d& pixel) const {
     if (!camera_ || !scene_->surface_bvh || !scene_->render_input) return std::nullopt;
     const auto hit = first_hit(*scene_->surface_bvh, camera_->unproject(pixel, view_w_, view_h_),
@@ -219,6 +227,7 @@ public:
         f(window_, key, scancode, GLFW_RELEASE, mods);
     }
     void select_tool(Tool tool) override { app_.select_tool(tool); }
+    void select_material(const std::string& preset) override { app_.select_brush_material(preset); }
     void save_session(const std::filesystem::path& file) override { app_.save_session(file); }
     void save_volume(const std::filesystem::path& file) override { app_.save_volume(file); }
 

@@ -217,10 +217,11 @@ TEST_F(EditorWindow, CutStrokeCutsTheSideDrawnAndTheSessionReplaysIt) {
 
 TEST_F(EditorWindow, PaintStrokeChangesTheMaterialWhereDrawn) {
     const fs::path dir = scratch_dir("editor_paint_stroke");
-    // The object is skin; the brush paints marble (the material panel's default) along the upper
+    // The object is skin; the brush paints ketchup (chosen as in the material panel) along the upper
     // part of the front face.
     const auto r = run_script(dir, R"([
         {"event": "tool", "tool": "paint"},
+        {"event": "material", "material": "ketchup"},
         {"frame": 2, "event": "drag", "from": [150, 90], "to": [250, 90], "steps": 10},
         {"event": "idle"},
         {"event": "save_volume", "file": "painted.vtu"},
@@ -239,6 +240,9 @@ TEST_F(EditorWindow, PaintStrokeChangesTheMaterialWhereDrawn) {
     for (size_t t = 0; t < painted.tet_count(); ++t) {
         if (painted.materials[t] == skin) continue;
         ++changed;
+        // Blended towards ketchup, which absorbs green far more than skin (marble, the panel's default,
+        // absorbs less): the brush took the scripted material.
+        EXPECT_GT(painted.materials[t].mua[1], skin.mua[1]) << "tet " << t;
         Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
         for (const int32_t v : painted.tets[t]) centroid += 0.25 * painted.positions[v];
         const double s = std::clamp((centroid - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);

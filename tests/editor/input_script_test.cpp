@@ -95,6 +95,8 @@ TEST(InputScript, BadScriptsGetOneLineErrorsNamingTheFileAndEntry) {
         {R"([{"event": "move", "x": 1, "y": 1, "frame": -1}])", "field 'frame'"},
         {R"([{"event": "key", "key": "F13"}])", "s.json: entry 0 (key): field 'key'"},
         {R"([{"event": "tool", "tool": "chisel"}])", "expected one of orbit, cut, exact_cut"},
+        {R"([{"event": "material", "material": "cheese"}])", "s.json: entry 0 (material): field 'material': expected a measured preset: apple"},
+        {R"([{"event": "material", "material": 3}])", "field 'material'"},
         {R"([{"event": "drag", "from": [0, 0]}])", "missing field 'to'"},
         {R"([{"event": "drag", "from": [0, 0], "to": [1, 1], "points": [[0, 0], [1, 1]]}])", "either"},
         {R"([{"event": "drag", "points": [[0, 0]]}])", "at least two"},
@@ -135,6 +137,7 @@ public:
     void scroll(double steps) override { add("scroll " + std::to_string(int(steps))); }
     void key(int key, int) override { add("key " + std::to_string(key)); }
     void select_tool(Tool tool) override { add("tool " + std::to_string(static_cast<int>(tool))); }
+    void select_material(const std::string& preset) override { add("material " + preset); }
     void save_session(const std::filesystem::path& f) override { add("session " + f.filename().string()); }
     void save_volume(const std::filesystem::path& f) override { add("volume " + f.filename().string()); }
 
@@ -143,7 +146,7 @@ private:
 };
 
 TEST(InputScriptPlayer, FiresInOrderOnePerFrameFromTheFirstReadyFrame) {
-    InputScriptPlayer player(parse(R"([{"event": "tool", "tool": "cut"},
+    InputScriptPlayer player(parse(R"([{"event": "tool", "tool": "cut"}, {"event": "material", "material": "ketchup"},
         {"frame": 3, "event": "drag", "from": [0, 0], "to": [10, 0], "steps": 1},
         {"event": "idle"}, {"event": "save_volume", "file": "v.vtu"}])"));
     FakeTarget target;
@@ -158,7 +161,7 @@ TEST(InputScriptPlayer, FiresInOrderOnePerFrameFromTheFirstReadyFrame) {
     }
     // Ready at window frame 3 = script frame 0; the press waits for script frame 3 (window frame 6);
     // one event per frame after it; the save waits for idle (frame 10) and fires one frame later.
-    const std::vector<std::string> expected = {"3: tool 1",      "6: cursor 0,0",  "6: press 0",     "7: cursor 10,0",
+    const std::vector<std::string> expected = {"3: tool 1",      "4: material ketchup", "6: cursor 0,0",  "6: press 0",     "7: cursor 10,0",
                                                "8: cursor 10,0", "8: release 0",   "11: volume v.vtu"};
     EXPECT_EQ(target.log, expected);
 }
