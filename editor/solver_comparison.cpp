@@ -230,10 +230,11 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
         result.multigrid_rgb_setup_ms = elapsed_ms(setup_start);
         const std::array<std::span<const double>, 3> rhs{b_copy[0], b_copy[1], b_copy[2]};
         result.solvers.push_back(measurer.curve("multigrid_cg_rgb", [&](int cap, Fields& x) {
-            if (cap == 0) return;  // step() needs a budget >= 1; x is already phi = 0
+            // Cap 0 is the cold start alone (phi = 0; step() needs a budget >= 1), timed like the other
+            // solvers' cap 0, which also set up their vectors without updating phi.
             frame.reset();
             frame.set_right_hand_side(rhs);
-            frame.step(cap);
+            if (cap > 0) frame.step(cap);
             for (size_t c = 0; c < 3; ++c) {
                 const std::span<const double> phi = frame.phi(static_cast<int>(c));
                 std::copy(phi.begin(), phi.end(), x[c].begin());
