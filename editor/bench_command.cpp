@@ -102,6 +102,7 @@ void run_solvers_command(const SolversCommandOptions& o) {
         {"levels", comparison.levels},
         {"hierarchy_ms", comparison.hierarchy_ms},
         {"multigrid_setup_ms", comparison.multigrid_setup_ms},
+        {"multigrid_rgb_setup_ms", comparison.multigrid_rgb_setup_ms},
         {"time_to_1pct_ms", summary_times},
     };
     if (context) summary["gpu_renderer"] = context->renderer();

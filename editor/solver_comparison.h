@@ -18,7 +18,8 @@
 //
 // What is timed. Per-mesh setup that a frame does not repeat is excluded and reported separately: the
 // multires hierarchy (hierarchy_ms), the multigrid Galerkin operators and coarsest factorisation
-// (multigrid_setup_ms), the float copies of the matrices and the Eigen sparse matrices. Eigen's
+// (multigrid_setup_ms), the frame solver's own hierarchy, Galerkin operators and interleaved matrix
+// (multigrid_rgb_setup_ms), the float copies of the matrices and the Eigen sparse matrices. Eigen's
 // incomplete Cholesky factorisation is part of every eigen_ic_cg run (its API factorises per solve),
 // and the direct solver's time is factorisation plus solve.
 #pragma once
@@ -51,14 +52,17 @@ struct SolverCurve {
     std::string name;
     std::vector<std::pair<double, double>> curve;  // (ms, relative error), time strictly increasing
     std::optional<double> time_to_target_ms;       // nullopt when the target was not reached
+    std::optional<int> cap_to_target;              // the smallest cap reaching it (nullopt: not reached,
+                                                   // or no cap, as for direct)
 };
 
 struct SolverComparison {
     size_t tets = 0, vertices = 0, levels = 0;
     double hierarchy_ms = 0;
     double multigrid_setup_ms = 0;
-    std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, eigen_ic_cg,
-                                       // [gpu_cg, gpu_multires,] direct
+    double multigrid_rgb_setup_ms = 0;  // MultigridFrameSolver's constructor (its own hierarchy included)
+    std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, multigrid_cg_rgb,
+                                       // eigen_ic_cg, [gpu_cg, gpu_multires,] direct
     std::string gpu_fallback_reason;   // options.gl given but the GPU could not run (curves left out)
 };
 
@@ -70,8 +74,9 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
                                  const SolverComparisonOptions& options);
 
 // Writes DIR/STEM.json, {"mesh", "tets", "vertices", "levels", "hierarchy_ms", "multigrid_setup_ms",
-// "solvers": {NAME: {"time_to_1pct_ms", "curve": [[ms, rel_error], ...]}}}, and DIR/STEM.svg (error
-// against time, one line per solver), atomically. `mesh_name` is recorded as given.
+// "multigrid_rgb_setup_ms", "solvers": {NAME: {"time_to_1pct_ms", "cap_to_1pct", "curve": [[ms, rel_error],
+// ...]}}}, and DIR/STEM.svg (error against time, one line per solver), atomically. `mesh_name` is
+// recorded as given.
 void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const std::string& mesh_name,
                              const SolverComparison& comparison);
 

@@ -18,11 +18,17 @@ namespace {
 using testing::run_waxwork;
 using testing::scratch_dir;
 
-// A solver's entry: a strictly monotone curve ending below 1%, and its time to 1%.
+// A solver's entry: a strictly monotone curve ending below 1%, and its time (and cap, null for direct)
+// to 1%.
 void expect_valid_curve(const nlohmann::json& solvers, const std::string& name) {
     ASSERT_TRUE(solvers.contains(name)) << name;
     const auto& s = solvers[name];
-    EXPECT_EQ(s.size(), 2u) << name;
+    EXPECT_EQ(s.size(), 3u) << name;
+    ASSERT_TRUE(s.contains("cap_to_1pct")) << name;
+    if (name == "direct")
+        EXPECT_TRUE(s["cap_to_1pct"].is_null());
+    else
+        EXPECT_GE(s["cap_to_1pct"].get<int>(), 1) << name;  // cap 0 is phi = 0: error 1
     const auto& curve = s["curve"];
     ASSERT_FALSE(curve.empty()) << name;
     double last_ms = 0, best_error = 2;
@@ -52,13 +58,15 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
     const auto json = nlohmann::json::parse(testing::read_text(out / "solvers.json"));
     std::vector<std::string> keys;
     for (const auto& [key, value] : json.items()) keys.push_back(key);
-    EXPECT_EQ(keys, (std::vector<std::string>{"hierarchy_ms", "levels", "mesh", "multigrid_setup_ms", "solvers", "tets", "vertices"}));
+    EXPECT_EQ(keys, (std::vector<std::string>{"hierarchy_ms", "levels", "mesh", "multigrid_rgb_setup_ms",
+                                              "multigrid_setup_ms", "solvers", "tets", "vertices"}));
     EXPECT_EQ(json["tets"].get<size_t>(), 9u * 9u * 9u * 6u);
     EXPECT_EQ(json["vertices"].get<size_t>(), 1000u);
     EXPECT_GE(json["levels"].get<int>(), 1);
     EXPECT_GE(json["hierarchy_ms"].get<double>(), 0.0);
     const auto& solvers = json["solvers"];
-    for (const std::string name : {"jacobi_cg", "jacobi_cg_double", "multires", "multigrid_cg", "eigen_ic_cg", "direct"})
+    for (const std::string name :
+         {"jacobi_cg", "jacobi_cg_double", "multires", "multigrid_cg", "multigrid_cg_rgb", "eigen_ic_cg", "direct"})
         expect_valid_curve(solvers, name);
     EXPECT_FALSE(solvers.contains("gpu_cg"));
     const std::string svg = testing::read_text(out / "solvers.svg");
@@ -69,6 +77,39 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
 
 // --backend gpu adds the GPU curves (llvmpipe here); a driver that rejects a shader leaves them out
 // with a one-line warning.
+// The three-channel frame solver (multires/multigrid_frame_solver.h): its setup is reported, its error
+// falls with the V-cycle cap from phi = 0 to below 1%, and as cap k V-cycles give the iterate of
+// multigrid_cg's cap k CG iterations, both need the same cap for 1% (one apart at most: the float
+// V-cycle's rounding differs between the interleaved and the per-channel sweeps).
+TEST(BenchSolversCommand, FrameSolverCurveFallsWithTheVcycleCap) {
+    const auto dir = scratch_dir("bench_solvers_rgb");
+    const auto volume = dir / "cube.vtu";
+    write_volume(testing::make_cube_mesh(9, Eigen::Vector3d::Zero(), 1.0), volume);
+    const auto out = dir / "out";
+    const auto result = run_waxwork("bench solvers --mesh " + volume.string() + " -o " + out.string() +
+                                    " --backend cpu --floor 1e-3 --max-seconds 20");
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    EXPECT_GT(nlohmann::json::parse(result.out)["multigrid_rgb_setup_ms"].get<double>(), 0.0);
+    const auto json = nlohmann::json::parse(testing::read_text(out / "solvers.json"));
+    EXPECT_GT(json["multigrid_rgb_setup_ms"].get<double>(), 0.0);
+    const auto& solvers = json["solvers"];
+    expect_valid_curve(solvers, "multigrid_cg_rgb");
+    const auto& curve = solvers["multigrid_cg_rgb"]["curve"];
+    ASSERT_GE(curve.size(), 2u);
+    // Cap 0 is phi = 0 (error exactly 1) and the fastest run, so always kept. Each later point (a larger
+    // cap) is no worse than the ones before it by more than CG's L2 wobble (CG minimises the energy norm).
+    EXPECT_DOUBLE_EQ(curve[0][1].get<double>(), 1.0);
+    double best = curve[0][1].get<double>();
+    for (size_t i = 1; i < curve.size(); ++i) {
+        EXPECT_LE(curve[i][1].get<double>(), 1.5 * best) << "point " << i;
+        best = std::min(best, curve[i][1].get<double>());
+    }
+    const int rgb_cap = solvers["multigrid_cg_rgb"]["cap_to_1pct"].get<int>();
+    const int per_channel_cap = solvers["multigrid_cg"]["cap_to_1pct"].get<int>();
+    EXPECT_LE(std::abs(rgb_cap - per_channel_cap), 1) << rgb_cap << " vs " << per_channel_cap;
+    EXPECT_NE(testing::read_text(out / "solvers.svg").find("multigrid_cg_rgb"), std::string::npos);
+}
+
 TEST(BenchSolversCommand, GpuBackendAddsGpuCurvesOrWarns) {
     const auto dir = scratch_dir("bench_solvers_gpu");
     const auto volume = dir / "cube.vtu";
