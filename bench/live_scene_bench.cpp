@@ -92,18 +92,12 @@ void BM_PaintFrames(benchmark::State& state) {
     LiveScene scene(doc.mesh(), turning_light(0), bench::live_scene_options(doc.mesh()));
     scene.converge();
     const auto box = bounding_box(doc.mesh());
-    const Eigen::Vector3d centre = 0.5 * (box[0] + box[1]);
-    const double diagonal = (box[1] - box[0]).norm();
     std::vector<double> ms, cpu;
     int iterations = 0;
     size_t rows = 0;
     for (auto _ : state) {
         for (int f = 0; f < kFrames; ++f) {
-            PaintOp op;
-            // Along the body, near the top of the back.
-            op.points = {centre + Eigen::Vector3d(0, 0.25 * diagonal * 0.3, (f / double(kFrames) - 0.5) * 0.5 * diagonal)};
-            op.material = material_preset("ketchup");
-            op.sigma = 0.01 * diagonal;
+            const PaintOp op = bench::body_stroke_dab(box, f, kFrames);
             const auto start = Clock::now();
             const double cpu_start = process_cpu_ms();
             rows += scene.apply_change(doc.mesh(), doc.apply(op)).updated_rows.size();

@@ -3,12 +3,15 @@
 // turns around the vertical axis.
 #pragma once
 
+#include "editor/edit_operation.h"
 #include "editor/live_scene.h"
+#include "solver/material.h"
 #include "solver/lighting.h"
 #include "tetops/tet_mesh.h"
 
 #include <Eigen/Geometry>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -31,6 +34,18 @@ inline Lighting turning_light(double degrees) {
     l.lights = {light};
     l.ambient = {0.02, 0.02, 0.02};
     return l;
+}
+
+// Frame f of `frames` of a paint stroke along spot's body near the top of its back: one ketchup dab
+// per frame, sigma 1% of the diagonal of the bounding box `box`.
+inline PaintOp body_stroke_dab(const std::array<Eigen::Vector3d, 2>& box, int f, int frames) {
+    const Eigen::Vector3d centre = 0.5 * (box[0] + box[1]);
+    const double diagonal = (box[1] - box[0]).norm();
+    PaintOp op;
+    op.points = {centre + Eigen::Vector3d(0, 0.25 * diagonal * 0.3, (f / double(frames) - 0.5) * 0.5 * diagonal)};
+    op.material = material_preset("ketchup");
+    op.sigma = 0.01 * diagonal;
+    return op;
 }
 
 }  // namespace waxwork::bench

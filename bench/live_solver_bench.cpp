@@ -134,16 +134,11 @@ void BM_PaintFrames(benchmark::State& state) {
     LiveScene scene(doc.mesh(), turning_light(0), scene_options(doc.mesh(), variant));
     scene.converge();
     const auto box = bounding_box(doc.mesh());
-    const Eigen::Vector3d centre = 0.5 * (box[0] + box[1]);
-    const double diagonal = (box[1] - box[0]).norm();
     std::vector<double> ms;
     int iterations = 0;
     for (auto _ : state) {
         for (int f = 0; f < kFrames; ++f) {
-            PaintOp op;
-            op.points = {centre + Eigen::Vector3d(0, 0.25 * diagonal * 0.3, (f / double(kFrames) - 0.5) * 0.5 * diagonal)};
-            op.material = material_preset("ketchup");
-            op.sigma = 0.01 * diagonal;
+            const PaintOp op = bench::body_stroke_dab(box, f, kFrames);
             const auto start = Clock::now();
             scene.apply_change(doc.mesh(), doc.apply(op));
             iterations += scene.step(kFrameIterations).total_iterations();

@@ -47,13 +47,28 @@ void expect_valid_curve(const nlohmann::json& solvers, const std::string& name) 
     EXPECT_LT(curve.back()[1].get<double>(), 1e-2) << name;
 }
 
+// `bench solvers` on a cube of 4,374 tets (CPU curves), run once per test process and shared by the
+// tests that read its output.
+struct CubeSolversRun {
+    testing::CommandResult result;
+    std::filesystem::path out;
+};
+const CubeSolversRun& cube_solvers_run() {
+    static const CubeSolversRun run = [] {
+        const auto dir = scratch_dir("bench_solvers");
+        const auto volume = dir / "cube.vtu";
+        write_volume(testing::make_cube_mesh(9, Eigen::Vector3d::Zero(), 1.0), volume);
+        CubeSolversRun r;
+        r.out = dir / "out";
+        r.result = run_waxwork("bench solvers --mesh " + volume.string() + " -o " + r.out.string() +
+                               " --backend cpu --floor 1e-3 --max-seconds 20");
+        return r;
+    }();
+    return run;
+}
+
 TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
-    const auto dir = scratch_dir("bench_solvers");
-    const auto volume = dir / "cube.vtu";
-    write_volume(testing::make_cube_mesh(9, Eigen::Vector3d::Zero(), 1.0), volume);
-    const auto out = dir / "out";
-    const auto result = run_waxwork("bench solvers --mesh " + volume.string() + " -o " + out.string() +
-                                    " --backend cpu --floor 1e-3 --max-seconds 20");
+    const auto& [result, out] = cube_solvers_run();
     ASSERT_EQ(result.exit_code, 0) << result.err;
     const auto json = nlohmann::json::parse(testing::read_text(out / "solvers.json"));
     std::vector<std::string> keys;
@@ -82,12 +97,7 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
 // multigrid_cg's cap k CG iterations, both need the same cap for 1% (one apart at most: the float
 // V-cycle's rounding differs between the interleaved and the per-channel sweeps).
 TEST(BenchSolversCommand, FrameSolverCurveFallsWithTheVcycleCap) {
-    const auto dir = scratch_dir("bench_solvers_rgb");
-    const auto volume = dir / "cube.vtu";
-    write_volume(testing::make_cube_mesh(9, Eigen::Vector3d::Zero(), 1.0), volume);
-    const auto out = dir / "out";
-    const auto result = run_waxwork("bench solvers --mesh " + volume.string() + " -o " + out.string() +
-                                    " --backend cpu --floor 1e-3 --max-seconds 20");
+    const auto& [result, out] = cube_solvers_run();
     ASSERT_EQ(result.exit_code, 0) << result.err;
     EXPECT_GT(nlohmann::json::parse(result.out)["multigrid_rgb_setup_ms"].get<double>(), 0.0);
     const auto json = nlohmann::json::parse(testing::read_text(out / "solvers.json"));

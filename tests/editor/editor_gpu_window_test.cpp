@@ -22,7 +22,6 @@ namespace fs = std::filesystem;
 
 const std::string kAssets = WAXWORK_ASSET_DIR;
 
-
 // The summary line `edit --screenshot` prints.
 nlohmann::json summary_of(const testing::CommandResult& r) {
     const size_t start = r.out.find('{');
