@@ -21,17 +21,22 @@ void EditorApp::choose_solver(LiveMethod method, LiveBackend backend) {
 }
 
 void EditorApp::draw_solver_choice() {
-    int method = live_options_.method == LiveMethod::MultigridCg ? 1 : 0;
+    int method = live_options_.method == LiveMethod::MultigridCg ? 1 : live_options_.method == LiveMethod::Multires ? 2 : 0;
     int backend = live_options_.backend == LiveBackend::Gpu ? 1 : 0;
-    bool changed = ImGui::Combo("method", &method, "Jacobi CG\0Multigrid CG (rgb per V-cycle)\0");
+    bool changed = ImGui::Combo("method", &method, "Jacobi CG\0Multigrid CG (rgb per V-cycle)\0Multires (paper Sec. 4)\0");
     if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("CPU: Jacobi-preconditioned CG per channel (double), or multigrid CG, three channels\n"
-                          "per V-cycle: CG preconditioned by a V-cycle on the multires hierarchy, warm across\n"
-                          "frames, one V-cycle per 4 iterations of the budget. The GPU backend always runs\n"
-                          "Jacobi CG (float).");
+        ImGui::SetTooltip("Jacobi-preconditioned CG per channel (double on the CPU, float on the GPU).\n"
+                          "Multigrid CG, three channels per V-cycle: CG preconditioned by a V-cycle on the\n"
+                          "multires hierarchy, warm across frames, one V-cycle per 4 iterations of the budget\n"
+                          "(CPU only: on the GPU backend it runs Jacobi CG).\n"
+                          "Multires: the paper's scheme, BiCGSTAB coarse to fine after a rebuild, then a warm\n"
+                          "level-0 CG per frame; painting updates only the changed rows of every level. Runs on\n"
+                          "the CPU or on the device.");
     changed |= ImGui::Combo("backend", &backend, "CPU\0GPU (OpenGL compute)\0");
     if (changed) {
-        choose_solver(method == 1 ? LiveMethod::MultigridCg : LiveMethod::JacobiCg,
+        choose_solver(method == 1   ? LiveMethod::MultigridCg
+                      : method == 2 ? LiveMethod::Multires
+                                    : LiveMethod::JacobiCg,
                       backend == 1 ? LiveBackend::Gpu : LiveBackend::Cpu);
         rebuild_live_scene();
     }

@@ -1,6 +1,8 @@
 #include "editor/live_solver.h"
 
+#include "multires/gpu_multires_solver.h"
 #include "multires/multigrid_frame_solver.h"
+#include "multires/multires_solver.h"
 #include "solver/gpu_compute.h"
 #include "solver/gpu_conjugate_gradient.h"
 #include "solver/gpu_radiance.h"
@@ -12,13 +14,21 @@
 
 namespace waxwork {
 
-const char* live_method_name(LiveMethod method) { return method == LiveMethod::MultigridCg ? "mgcg" : "jacobi"; }
+const char* live_method_name(LiveMethod method) {
+    switch (method) {
+        case LiveMethod::MultigridCg: return "mgcg";
+        case LiveMethod::Multires: return "multires";
+        case LiveMethod::JacobiCg: break;
+    }
+    return "jacobi";
+}
 const char* live_backend_name(LiveBackend backend) { return backend == LiveBackend::Gpu ? "gpu" : "cpu"; }
 
 LiveMethod parse_live_method(const std::string& name) {
     if (name == "jacobi") return LiveMethod::JacobiCg;
     if (name == "mgcg") return LiveMethod::MultigridCg;
-    throw InvalidArgumentError("live solver: unknown method '" + name + "' (jacobi or mgcg)");
+    if (name == "multires") return LiveMethod::Multires;
+    throw InvalidArgumentError("live solver: unknown method '" + name + "' (jacobi, mgcg or multires)");
 }
 
 LiveBackend parse_live_backend(const std::string& name) {
@@ -74,7 +84,9 @@ std::shared_ptr<SolverGlContext> borrow_headless_solver_context(HeadlessGlContex
 }
 
 struct LiveSolver::Gpu {
+    // One of the two: Jacobi CG (also for the multigrid method) or the multires hierarchy.
     std::unique_ptr<GpuDiffusionSolver> solver;
+    std::unique_ptr<GpuMultiresSolver> multires;
     std::vector<std::array<double, 3>> staging;  // interleaved phi for uploads and read-backs
     // Device radiance: weights from the boundary eta (reset when materials change), q (re-sent when
     // the right-hand sides change), E per volume vertex, and the surface's volume-vertex index.
@@ -82,6 +94,10 @@ struct LiveSolver::Gpu {
     bool radiance_stale_weights = true, radiance_light_stale = true;
     GpuBuffer volume_e, surface_index;
     std::vector<int32_t> surface_vertices;  // what surface_index holds
+
+    size_t size() const { return solver ? solver->size() : multires->size(); }
+    GpuKernels& kernels() { return solver ? solver->kernels() : multires->kernels(); }
+    const GpuBuffer& solution_buffer() const { return solver ? solver->solution_buffer() : multires->solution_buffer(); }
 };
 
 LiveSolver::LiveSolver(const LiveSolverOptions& options)
@@ -108,6 +124,7 @@ void LiveSolver::release_gpu() {
 
 void LiveSolver::fall_back(const std::string& reason) {
     gpu_fallback_reason_ = reason;
+    multires_cold_ = true;  // the CPU hierarchy has no warm start of its own yet
     backend_ = LiveBackend::Cpu;
     try {
         release_gpu();
@@ -130,6 +147,16 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
             throw InvalidArgumentError("live solver: the matrix does not belong to the mesh");
         multigrid_ = std::make_unique<MultigridFrameSolver>(matrix, mesh.positions);
     }
+    multires_.reset();
+    multires_values_stale_ = false;
+    multires_cold_ = true;
+    gpu_level_rows_.clear();
+    // Built for either backend: the device copy is made from it, and a fallback keeps solving with it.
+    if (method_ == LiveMethod::Multires && matrix.size() > 0) {
+        if (mesh.vertex_count() != matrix.size())
+            throw InvalidArgumentError("live solver: the matrix does not belong to the mesh");
+        multires_ = std::make_unique<MultiresSolver>(matrix, mesh.positions);
+    }
     pending_rows_.clear();
     gpu_values_stale_ = false;
     if (gpu_) {
@@ -147,12 +174,17 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
 void LiveSolver::values_changed() {
     if (gpu_) gpu_->radiance_stale_weights = true;  // the boundary eta may have changed
     multigrid_values_stale_ = true;
+    multires_values_stale_ = true;
     multigrid_changed();
     gpu_values_stale_ = true;
     pending_rows_.clear();
+    gpu_level_rows_.clear();
 }
 
-void LiveSolver::multigrid_changed() { multigrid_error_ = {1, 1, 1}; }
+void LiveSolver::multigrid_changed() {
+    multigrid_error_ = {1, 1, 1};
+    multires_error_ = {1, 1, 1};
+}
 
 void LiveSolver::rows_changed(std::span<const int32_t> rows) {
     if (rows.empty()) return;
@@ -177,13 +209,19 @@ void LiveSolver::right_hand_sides_changed() {
 void LiveSolver::solution_changed() {
     gpu_solution_stale_ = true;
     multigrid_solution_stale_ = true;
+    multires_cold_ = true;  // the solvers keep their own warm starts: solve the new state coarse to fine
     multigrid_changed();
 }
 
 std::string LiveSolver::description() const {
-    std::string text = backend_ == LiveBackend::Gpu ? "GPU Jacobi CG (float)"
-                       : multigrid_                 ? "CPU multigrid CG, three channels per V-cycle"
-                                                    : "CPU Jacobi CG (double)";
+    std::string text;
+    if (method_ == LiveMethod::Multires)
+        text = backend_ == LiveBackend::Gpu ? "GPU multires, BiCGSTAB coarse to fine, warm CG per frame (float)"
+                                            : "CPU multires, BiCGSTAB coarse to fine, warm CG per frame (double)";
+    else
+        text = backend_ == LiveBackend::Gpu ? "GPU Jacobi CG (float)"
+               : multigrid_                 ? "CPU multigrid CG, three channels per V-cycle"
+                                            : "CPU Jacobi CG (double)";
     if (backend_ == LiveBackend::Gpu && !renderer_.empty()) text += " (" + renderer_ + ")";
     return text;
 }
@@ -192,6 +230,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate(const DiffusionMatrix& matr
                                                      const std::array<std::vector<double>, 3>& b,
                                                      std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                      double relative_tolerance, const std::array<bool, 3>& skip) {
+    if (multires_) update_multires_values(matrix);  // the host hierarchy first, whichever backend solves
     if (backend_ == LiveBackend::Gpu) {
         try {
             return iterate_gpu(matrix, b, phi, iteration_budget, relative_tolerance, skip);
@@ -213,6 +252,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& 
                                                          double relative_tolerance, const std::array<bool, 3>& skip) {
     const size_t n = matrix.size();
     if (multigrid_ && n > 0) return iterate_multigrid(matrix, b, phi, iteration_budget, relative_tolerance, skip);
+    if (multires_ && n > 0) return iterate_multires(b, phi, iteration_budget, relative_tolerance, skip);
     // The rows stay pending for the GPU only if it is still meant to run (not after a fallback).
     if (backend_ == LiveBackend::Cpu) pending_rows_.clear();
 
@@ -307,6 +347,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu(const DiffusionMatrix& 
     }
     if (!context_) context_ = open_headless_solver_context();
     const CurrentContext current(*context_);
+    if (multires_) return iterate_gpu_multires(matrix, b, phi, iteration_budget, relative_tolerance);
     const GlApi& gl = context_->gl();
     if (!gpu_) {
         require_compute_support(gl);
@@ -346,17 +387,131 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu(const DiffusionMatrix& 
     return out;
 }
 
+void LiveSolver::update_multires_values(const DiffusionMatrix& matrix) {
+    if (multires_values_stale_) {
+        multires_->update_values(matrix);  // all values on the kept pattern and selection
+        gpu_level_rows_.clear();           // gpu_values_stale_: the device takes every row
+    } else if (!pending_rows_.empty()) {
+        // Paint: the changed level-0 rows and the Eq. 17 coarse rows that read them.
+        const std::vector<std::vector<int32_t>> level_rows = multires_->update_values(matrix, pending_rows_);
+        if (backend_ == LiveBackend::Gpu && !gpu_values_stale_) {
+            gpu_level_rows_.resize(std::max(gpu_level_rows_.size(), level_rows.size()));
+            for (size_t l = 0; l < level_rows.size(); ++l) {
+                std::vector<int32_t> merged;
+                std::set_union(gpu_level_rows_[l].begin(), gpu_level_rows_[l].end(), level_rows[l].begin(),
+                               level_rows[l].end(), std::back_inserter(merged));
+                gpu_level_rows_[l].swap(merged);
+            }
+        }
+    }
+    multires_values_stale_ = false;
+    pending_rows_.clear();
+}
+
+std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<std::vector<double>, 3>& b,
+                                                              std::array<std::vector<double>, 3>& phi,
+                                                              int iteration_budget, double relative_tolerance,
+                                                              const std::array<bool, 3>& skip) {
+    std::array<LiveSolverChannel, 3> out;
+    if (iteration_budget > 0 && multires_cold_) {
+        multires_->reset_warm_start();  // solve_frame then runs the coarse-to-fine pass
+        multires_cold_ = false;
+    }
+    MultiresSolveOptions options;
+    options.relative_tolerance = relative_tolerance;
+    for (int c = 0; c < 3; ++c) {
+        if (skip[c]) {
+            out[c] = {0, 0.0, true};
+            continue;
+        }
+        if (iteration_budget <= 0) {
+            out[c] = {0, multires_error_[c], multires_error_[c] <= relative_tolerance};
+            continue;
+        }
+        MultiresSolveReport report;
+        const std::span<const double> solved = multires_->solve_frame(b[c], c, iteration_budget, &report, options);
+        std::copy(solved.begin(), solved.end(), phi[c].begin());  // the host copy: radiance, saves, cuts
+        multires_error_[c] = report.fine.estimated_relative_error;
+        out[c] = {report.fine.iterations, report.fine.estimated_relative_error, report.fine.converged};
+    }
+    gpu_solution_stale_ = true;
+    return out;
+}
+
+std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multires(const DiffusionMatrix& matrix,
+                                                                  const std::array<std::vector<double>, 3>& b,
+                                                                  std::array<std::vector<double>, 3>& phi,
+                                                                  int iteration_budget, double relative_tolerance) {
+    // Called by iterate_gpu with the context current.
+    const GlApi& gl = context_->gl();
+    const MultiresHierarchy& hierarchy = multires_->hierarchy();
+    if (!gpu_) {
+        require_compute_support(gl);
+        auto gpu = std::make_unique<Gpu>();
+        gpu->multires = std::make_unique<GpuMultiresSolver>(gl, matrix, hierarchy);
+        gpu_ = std::move(gpu);
+        const GLubyte* renderer = gl.GetString(GL_RENDERER);
+        renderer_ = renderer ? reinterpret_cast<const char*>(renderer) : "";
+        gpu_rhs_stale_ = true;
+        multires_cold_ = true;
+    } else if (gpu_values_stale_) {
+        // All values: every row of every level (the uploaded patterns stay).
+        std::vector<std::vector<int32_t>> all(hierarchy.level_count());
+        for (size_t l = 0; l < all.size(); ++l) {
+            all[l].resize(hierarchy.levels[l].size());
+            std::iota(all[l].begin(), all[l].end(), 0);
+        }
+        gpu_->multires->update_rows(matrix, hierarchy, all);
+    } else if (!gpu_level_rows_.empty()) {
+        gpu_->multires->update_rows(matrix, hierarchy, gpu_level_rows_);  // paint: O(changed entries)
+    }
+    gpu_values_stale_ = false;
+    gpu_level_rows_.clear();
+    if (gpu_rhs_stale_) gpu_->multires->set_right_hand_side(b);
+    gpu_rhs_stale_ = false;
+
+    std::array<LiveSolverChannel, 3> out;
+    if (iteration_budget <= 0) {
+        for (int c = 0; c < 3; ++c) out[c] = {0, multires_error_[c], multires_error_[c] <= relative_tolerance};
+        return out;
+    }
+    GpuCgOptions fine;
+    fine.relative_tolerance = relative_tolerance;
+    fine.max_iterations = iteration_budget;
+    fine.use_eigenvalue_hints = true;
+    std::array<ConjugateGradientResult, 3> results;
+    if (multires_cold_) {
+        MultiresSolveOptions options;
+        options.relative_tolerance = relative_tolerance;
+        options.max_iterations = iteration_budget;
+        results = gpu_->multires->solve(options, fine).fine;
+        multires_cold_ = false;
+    } else {
+        results = gpu_->multires->solve_fine(fine);  // warm from the resident phi
+    }
+    auto& staging = gpu_->staging;
+    staging = gpu_->multires->solution();
+    const size_t n = staging.size();
+    for (size_t v = 0; v < n; ++v)
+        for (int c = 0; c < 3; ++c) phi[c][v] = staging[v][c];
+    for (int c = 0; c < 3; ++c) {
+        multires_error_[c] = results[c].estimated_relative_error;
+        out[c] = {results[c].iterations, results[c].estimated_relative_error, results[c].converged};
+    }
+    return out;
+}
+
 std::shared_ptr<const GpuBuffer> LiveSolver::radiance_on_device(const TetMesh& mesh, const TetConnectivity& connectivity,
                                                                 const std::vector<std::array<double, 3>>& q,
                                                                 const std::vector<int32_t>& surface_vertices) {
     if (backend_ != LiveBackend::Gpu || !gpu_ || !context_ || surface_vertices.empty()) return nullptr;
-    const size_t n = gpu_->solver->size();
+    const size_t n = gpu_->size();
     if (mesh.vertex_count() != n || q.size() != n)
         throw InvalidArgumentError("live solver: radiance_on_device needs the mesh and light of the solved matrix");
     try {
         const CurrentContext current(*context_);
         const GlApi& gl = context_->gl();
-        GpuKernels& kernels = gpu_->solver->kernels();
+        GpuKernels& kernels = gpu_->kernels();
         if (!gpu_->radiance || gpu_->radiance_stale_weights) {
             gpu_->radiance.reset();  // frees its buffers with the context current
             gpu_->radiance = std::make_unique<GpuRadiance>(kernels, mesh, connectivity, mesh.materials);
@@ -366,7 +521,7 @@ std::shared_ptr<const GpuBuffer> LiveSolver::radiance_on_device(const TetMesh& m
         if (gpu_->radiance_light_stale) gpu_->radiance->set_light(q);
         gpu_->radiance_light_stale = false;
         if (gpu_->volume_e.bytes() != 3 * n * sizeof(float)) gpu_->volume_e = kernels.vector(n);
-        gpu_->radiance->compute(gpu_->solver->solution_buffer(), gpu_->volume_e);
+        gpu_->radiance->compute(gpu_->solution_buffer(), gpu_->volume_e);
         if (gpu_->surface_vertices != surface_vertices) {
             for (const int32_t v : surface_vertices)
                 if (v < 0 || static_cast<size_t>(v) >= n)

@@ -18,6 +18,16 @@
 //                        channels; 0 runs none), and FrameReport counts V-cycles as each
 //                        channel's iterations. Its error estimate lags one CG update when the budget runs
 //                        out (an upper estimate, multigrid_frame_solver.h).
+//   multires             multires/multires_solver.h (CPU) or multires/gpu_multires_solver.h (GPU): the
+//                        paper's own per-frame scheme (Sec. 4). The first frame after a (re)build (or a
+//                        replaced phi) solves coarse to fine (BiCGSTAB on the coarse levels of the Eq. 17
+//                        hierarchy, Eq. 16 interpolation, CG on level 0 within the frame's budget); later
+//                        frames run only the level-0 Jacobi CG, warm from the previous frame's phi (a light
+//                        change: new right-hand sides, same warm start). Painting updates the changed
+//                        level-0 rows and the coarse rows depending on them (MultiresSolver::update_values
+//                        with rows), and the GPU re-uploads only those rows of every level (update_rows).
+//                        The hierarchy lives on the host for both backends (the device copy is built from
+//                        it, and a fallback to the CPU keeps solving with it).
 //   GPU CG               solver/gpu_conjugate_gradient.h (float, OpenGL 4.3 compute shaders): matrix,
 //                        right-hand sides and phi stay on the device between frames; painting uploads
 //                        only the rewritten rows (GpuDiffusionSolver::update_rows). phi is read back
@@ -46,11 +56,12 @@
 namespace waxwork {
 
 class MultigridFrameSolver;
+class MultiresSolver;
 
-enum class LiveMethod { JacobiCg, MultigridCg };
+enum class LiveMethod { JacobiCg, MultigridCg, Multires };
 enum class LiveBackend { Cpu, Gpu };
 
-// "jacobi" / "mgcg" and "cpu" / "gpu" (command line and session files); parse_* throw
+// "jacobi" / "mgcg" / "multires" and "cpu" / "gpu" (command line and session files); parse_* throw
 // InvalidArgumentError naming the accepted values.
 const char* live_method_name(LiveMethod method);
 const char* live_backend_name(LiveBackend backend);
@@ -141,6 +152,16 @@ private:
                                                        std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                        double relative_tolerance, const std::array<bool, 3>& skip);
     void multigrid_changed();
+    // Multires (both backends): applies pending value changes to the host hierarchy and queues the
+    // changed rows of every level for the device.
+    void update_multires_values(const DiffusionMatrix& matrix);
+    std::array<LiveSolverChannel, 3> iterate_multires(const std::array<std::vector<double>, 3>& b,
+                                                      std::array<std::vector<double>, 3>& phi, int iteration_budget,
+                                                      double relative_tolerance, const std::array<bool, 3>& skip);
+    std::array<LiveSolverChannel, 3> iterate_gpu_multires(const DiffusionMatrix& matrix,
+                                                          const std::array<std::vector<double>, 3>& b,
+                                                          std::array<std::vector<double>, 3>& phi, int iteration_budget,
+                                                          double relative_tolerance);
     std::array<LiveSolverChannel, 3> iterate_gpu(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
                                                  std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                  double relative_tolerance, const std::array<bool, 3>& skip);
@@ -158,6 +179,14 @@ private:
     bool multigrid_values_stale_ = false, multigrid_rhs_stale_ = true, multigrid_solution_stale_ = true;
     // The last frame's estimates, reported by a frame of no V-cycles (1 after a change).
     std::array<double, 3> multigrid_error_{1, 1, 1};
+    std::unique_ptr<MultiresSolver> multires_;
+    // Pending multires work: all values (else pending_rows_); the next frame solves coarse to fine
+    // (after a rebuild or a replaced phi; the CPU's warm starts are the solver's own last solutions).
+    bool multires_values_stale_ = false, multires_cold_ = true;
+    std::array<double, 3> multires_error_{1, 1, 1};  // reported by a frame of no iterations
+    // Rows per level the device copy of the hierarchy has not received yet (ascending, unique), or
+    // all of them (gpu_values_stale_).
+    std::vector<std::vector<int32_t>> gpu_level_rows_;
     std::unique_ptr<Gpu> gpu_;
     // Pending device work (applied at the next GPU iterate, with the context current).
     bool gpu_values_stale_ = false, gpu_rhs_stale_ = true, gpu_solution_stale_ = true;

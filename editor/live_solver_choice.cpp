@@ -13,9 +13,11 @@ void add_live_solver_options(CLI::App& command, LiveSolverChoice& options, const
         ->capture_default_str();
     command
         .add_option("--method", options.method,
-                    "Live solver method on the CPU: jacobi (Jacobi CG per channel) or mgcg (multigrid CG, three "
-                    "channels per V-cycle; one V-cycle per 4 iterations of the frame budget)")
-        ->check(CLI::IsMember({"jacobi", "mgcg"}))
+                    "Live solver method: jacobi (Jacobi CG per channel), mgcg (multigrid CG, three channels per "
+                    "V-cycle; one V-cycle per 4 iterations of the frame budget; CPU only, the GPU runs jacobi) or "
+                    "multires (the paper's Sec. 4 scheme: BiCGSTAB coarse to fine after a rebuild, then warm "
+                    "level-0 CG per frame; CPU or GPU)")
+        ->check(CLI::IsMember({"jacobi", "mgcg", "multires"}))
         ->capture_default_str();
 }
 

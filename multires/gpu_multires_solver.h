@@ -54,6 +54,10 @@ public:
                      const std::vector<std::vector<int32_t>>& level_rows);
     std::vector<std::array<double, 3>> solution() const { return fine_.solution(); }
     const GpuBuffer& solution_buffer() const { return fine_.solution_buffer(); }
+    // solve_frame with the per-channel results (a live editor reports iterations and error estimates).
+    std::array<ConjugateGradientResult, 3> solve_fine(const GpuCgOptions& options) { return fine_.solve(options); }
+    // The kernels the solution buffer belongs to (device radiance from the resident phi).
+    GpuKernels& kernels() { return fine_.kernels(); }
 
 private:
     struct Level {

@@ -31,6 +31,8 @@ const Config kConfigs[] = {
     {LiveMethod::JacobiCg, LiveBackend::Cpu, 1e-9, "cpu jacobi"},
     {LiveMethod::MultigridCg, LiveBackend::Cpu, 1e-9, "cpu mgcg"},
     {LiveMethod::JacobiCg, LiveBackend::Gpu, 1e-6, "gpu cg"},
+    {LiveMethod::Multires, LiveBackend::Cpu, 1e-9, "cpu multires"},
+    {LiveMethod::Multires, LiveBackend::Gpu, 1e-6, "gpu multires"},
 };
 
 LiveSceneOptions options_for(const Config& config) {
@@ -197,23 +199,29 @@ TEST(LiveSolver, MultigridFramesAfterPaintingEqualAFreshScene) {
 }
 
 TEST(LiveSolver, AFailingGpuFallsBackToTheCpuWithAReason) {
-    Document doc(testing::make_cube_mesh(6), material_preset("marble"));
-    setenv("WAXWORK_GPU_FORCE_FAIL", "1", 1);
-    LiveSceneOptions o = options_for(kConfigs[2]);
-    LiveScene scene(doc.mesh(), key_lighting(), o);
-    FrameReport frame = scene.step(5);
-    unsetenv("WAXWORK_GPU_FORCE_FAIL");
-    EXPECT_GT(frame.total_iterations(), 0);  // the frame was solved on the CPU instead
-    EXPECT_EQ(scene.backend(), LiveBackend::Cpu);
-    const std::string reason = scene.gpu_fallback_reason();
-    EXPECT_NE(reason.find("WAXWORK_GPU_FORCE_FAIL"), std::string::npos) << reason;
-    EXPECT_NE(scene.solver_description().find("CPU"), std::string::npos);
-    scene.converge();
-    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
-    // Painting after the fallback keeps working on the CPU.
-    scene.apply_change(doc.mesh(), doc.apply(paint_at({0.5, 0.5, 0.5}, "ketchup")));
-    scene.converge();
-    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
+    for (const Config& config : {kConfigs[2], kConfigs[4]}) {
+        Document doc(testing::make_cube_mesh(6), material_preset("marble"));
+        setenv("WAXWORK_GPU_FORCE_FAIL", "1", 1);
+        LiveSceneOptions o = options_for(config);
+        LiveScene scene(doc.mesh(), key_lighting(), o);
+        FrameReport frame = scene.step(5);
+        unsetenv("WAXWORK_GPU_FORCE_FAIL");
+        EXPECT_GT(frame.total_iterations(), 0) << config.name;  // the frame was solved on the CPU instead
+        EXPECT_EQ(scene.backend(), LiveBackend::Cpu) << config.name;
+        const std::string reason = scene.gpu_fallback_reason();
+        EXPECT_NE(reason.find("WAXWORK_GPU_FORCE_FAIL"), std::string::npos) << config.name << ": " << reason;
+        EXPECT_NE(scene.solver_description().find("CPU"), std::string::npos) << config.name;
+        // The method stays: multires falls back to the CPU multires solver, not to Jacobi CG.
+        if (config.method == LiveMethod::Multires) {
+            EXPECT_NE(scene.solver_description().find("multires"), std::string::npos) << scene.solver_description();
+        }
+        scene.converge();
+        EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4) << config.name;
+        // Painting after the fallback keeps working on the CPU.
+        scene.apply_change(doc.mesh(), doc.apply(paint_at({0.5, 0.5, 0.5}, "ketchup")));
+        scene.converge();
+        EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4) << config.name;
+    }
 }
 
 // The renderer reading E from the GPU solver's buffer draws what it draws from the CPU's E.
@@ -269,6 +277,8 @@ TEST(LiveSolver, DeviceRadianceDrawsWhatTheCpuRadianceDraws) {
 TEST(LiveSolver, NamesParseAndBadNamesAreRejected) {
     EXPECT_EQ(parse_live_method(live_method_name(LiveMethod::MultigridCg)), LiveMethod::MultigridCg);
     EXPECT_EQ(parse_live_method(live_method_name(LiveMethod::JacobiCg)), LiveMethod::JacobiCg);
+    EXPECT_EQ(parse_live_method("multires"), LiveMethod::Multires);
+    EXPECT_STREQ(live_method_name(LiveMethod::Multires), "multires");
     EXPECT_EQ(parse_live_backend(live_backend_name(LiveBackend::Gpu)), LiveBackend::Gpu);
     EXPECT_EQ(parse_live_backend(live_backend_name(LiveBackend::Cpu)), LiveBackend::Cpu);
     EXPECT_THROW(parse_live_method("gauss"), InvalidArgumentError);

@@ -1,5 +1,6 @@
 // `waxwork run --backend gpu`: the same volume and, within the float solver's tolerance, the same
 // images as the CPU backend; metrics.json names the backend.
+#include "editor/cli_run.h"
 #include "editor/session.h"
 #include "io/image_io.h"
 #include "io/volume_file.h"
@@ -17,6 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
+using testing::run_waxwork;
 
 fs::path scratch(const std::string& name) {
     const fs::path dir = fs::temp_directory_path() / ("waxwork_session_backend_test_" + name);
@@ -85,6 +87,30 @@ TEST(SessionBackend, AFailingGpuRunFallsBackAndSaysWhy) {
     EXPECT_EQ(metrics.at("solver_backend"), "cpu");
     EXPECT_EQ(metrics.at("gpu_fallback_reason").get<std::string>(), result.gpu_fallback_reason);
     EXPECT_TRUE(fs::exists(dir / "out" / "cut.png"));
+}
+
+// `waxwork run --method multires` (editor/live_solver_choice.cpp) runs the session with the paper's
+// multires solver, on the CPU and on the GPU, and gives the images of the default method; an unknown
+// method is refused.
+TEST(SessionBackend, RunAcceptsTheMultiresMethod) {
+    const fs::path dir = scratch("multires");
+    write_session_file(dir);
+    const auto jacobi = run_waxwork("run " + (dir / "s.json").string() + " -o " + (dir / "jacobi").string());
+    ASSERT_EQ(jacobi.exit_code, 0) << jacobi.err;
+    for (const std::string backend : {"cpu", "gpu"}) {
+        const fs::path out = dir / backend;
+        const auto run = run_waxwork("run " + (dir / "s.json").string() + " --method multires --backend " + backend +
+                                     " -o " + out.string());
+        ASSERT_EQ(run.exit_code, 0) << run.err;
+        const Json metrics = read_metrics(out / "metrics.json");
+        EXPECT_EQ(metrics.at("solver_method"), "multires");
+        EXPECT_EQ(metrics.at("solver_backend"), backend) << metrics.dump();
+        for (const char* name : {"start.png", "painted.png", "cut.png"})
+            EXPECT_LE(max_channel_difference(read_png(dir / "jacobi" / name), read_png(out / name)), 2) << backend << name;
+    }
+    const auto bad = run_waxwork("run " + (dir / "s.json").string() + " --method gauss -o " + (dir / "bad").string());
+    EXPECT_NE(bad.exit_code, 0);
+    EXPECT_NE(bad.err.find("method"), std::string::npos) << bad.err;
 }
 
 }  // namespace
