@@ -405,6 +405,10 @@ void LiveSolver::update_multires_values(const DiffusionMatrix& matrix) {
         }
     }
     multires_values_stale_ = false;
+    // rows_changed skips rows while every consumer re-sends all values: the multigrid flag has no
+    // consumer with this method, and the CPU has no device to re-send to.
+    multigrid_values_stale_ = false;
+    if (backend_ == LiveBackend::Cpu) gpu_values_stale_ = false;
     pending_rows_.clear();
 }
 

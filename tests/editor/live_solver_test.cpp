@@ -198,6 +198,26 @@ TEST(LiveSolver, MultigridFramesAfterPaintingEqualAFreshScene) {
     }
 }
 
+// The multires solvers keep their hierarchy across frames: paint after a whole-object material must
+// still reach every level (the value change must not swallow later row changes).
+TEST(LiveSolver, MultiresFollowsPaintAfterAMaterialChange) {
+    for (const Config& config : {kConfigs[3], kConfigs[4]}) {
+        Document doc(testing::make_cube_mesh(7), material_preset("marble"));
+        LiveScene scene(doc.mesh(), key_lighting(), options_for(config));
+        scene.converge();
+        scene.apply_change(doc.mesh(), doc.apply(SetMaterialOp{material_preset("skin2"), std::nullopt}));
+        scene.step(3);
+        for (const Eigen::Vector3d& at : {Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(0.2, 0.7, 0.6)}) {
+            const SceneUpdate update = scene.apply_change(doc.mesh(), doc.apply(paint_at(at, "ketchup")));
+            ASSERT_FALSE(update.updated_rows.empty());
+            scene.step(3);
+        }
+        scene.converge();
+        EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4) << config.name;
+        EXPECT_EQ(scene.backend(), config.backend) << config.name << ": " << scene.gpu_fallback_reason();
+    }
+}
+
 TEST(LiveSolver, AFailingGpuFallsBackToTheCpuWithAReason) {
     for (const Config& config : {kConfigs[2], kConfigs[4]}) {
         Document doc(testing::make_cube_mesh(6), material_preset("marble"));
