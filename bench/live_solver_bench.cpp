@@ -2,7 +2,9 @@
 // solve while the light rotates and while a brush paints, on spot at ~100K tets, as
 // bench/live_scene_bench.cpp measures the default (CPU Jacobi CG), for
 //   0: CPU Jacobi CG (double), 1: CPU multigrid CG, three channels per V-cycle (the budget of 8 is 2
-//   V-cycles; cg_its_per_frame counts each V-cycle once per channel), 2: GPU CG (float, OpenGL compute).
+//   V-cycles; cg_its_per_frame counts each V-cycle once per channel), 2: GPU CG (float, OpenGL compute),
+//   3: CPU multires (Li et al. Sec. 4: coarse to fine after a rebuild, then the level-0 Jacobi CG warm
+//   per frame, double), 4: the same on the GPU (GpuMultiresSolver, float).
 //   ./build/bench/live_solver_bench
 // The GPU backend runs in an OSMesa context: on a machine without a GPU (and in CI) that is Mesa's
 // llvmpipe, which runs the compute shaders on the CPU cores, so its times say nothing about a real
@@ -46,6 +48,8 @@ constexpr Variant kVariants[] = {
     {LiveMethod::JacobiCg, LiveBackend::Cpu, "cpu_jacobi"},
     {LiveMethod::MultigridCg, LiveBackend::Cpu, "cpu_mgcg"},
     {LiveMethod::JacobiCg, LiveBackend::Gpu, "gpu_cg_llvmpipe"},
+    {LiveMethod::Multires, LiveBackend::Cpu, "cpu_multires"},
+    {LiveMethod::Multires, LiveBackend::Gpu, "gpu_multires_llvmpipe"},
 };
 
 LiveSceneOptions scene_options(const TetMesh& mesh, const Variant& variant) {
@@ -126,7 +130,7 @@ void BM_RelightFrames(benchmark::State& state) {
     }
     report(state, ms, scene, iterations, doc.mesh());
 }
-BENCHMARK(BM_RelightFrames)->DenseRange(0, 2)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RelightFrames)->DenseRange(0, 4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_PaintFrames(benchmark::State& state) {
     const Variant& variant = kVariants[state.range(0)];
@@ -148,7 +152,7 @@ void BM_PaintFrames(benchmark::State& state) {
     }
     report(state, ms, scene, iterations, doc.mesh());
 }
-BENCHMARK(BM_PaintFrames)->DenseRange(0, 2)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PaintFrames)->DenseRange(0, 4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace waxwork
