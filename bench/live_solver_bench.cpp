@@ -154,6 +154,39 @@ void BM_PaintFrames(benchmark::State& state) {
 }
 BENCHMARK(BM_PaintFrames)->DenseRange(0, 4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// The first frame after a plane cut through the middle (a new matrix): scene_ms is the scene's rebuild
+// (for multigrid CG and multires including the hierarchy), frame_ms one frame of the usual budget from
+// the cut's warm start (Jacobi CG, multigrid CG: the old phi through the vertex map; multires: its
+// coarse-to-fine pass, Sec. 4), true_error as above after that frame.
+void BM_FirstFrameAfterCut(benchmark::State& state) {
+    const Variant& variant = kVariants[state.range(0)];
+    Document doc(bench::spot_volume(kFrameTets), material_preset("marble"));
+    LiveScene scene(doc.mesh(), turning_light(0), scene_options(doc.mesh(), variant));
+    scene.converge();
+    const auto box = bounding_box(doc.mesh());
+    PlaneCutOp cut;
+    cut.plane.normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
+    cut.plane.offset = cut.plane.normal.dot(0.5 * (box[0] + box[1]));
+    double scene_ms = 0, frame_ms = 0;
+    int iterations = 0;
+    for (auto _ : state) {
+        const SceneUpdate update = scene.apply_change(doc.mesh(), doc.apply(cut));
+        scene_ms = update.milliseconds;
+        const auto start = Clock::now();
+        iterations = scene.step(kFrameIterations).total_iterations();
+        benchmark::DoNotOptimize(scene.radiance_factors().data());
+        frame_ms = ms_since(start);
+    }
+    state.counters["scene_ms"] = scene_ms;
+    state.counters["frame_ms"] = frame_ms;
+    state.counters["cg_its"] = iterations;
+    true_errors(state, doc.mesh(), scene);
+    if (scene.backend() != variant.backend)
+        state.SkipWithError(("fell back to the CPU: " + scene.gpu_fallback_reason()).c_str());
+    state.SetLabel(scene.solver_description());
+}
+BENCHMARK(BM_FirstFrameAfterCut)->DenseRange(0, 4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 }  // namespace
 }  // namespace waxwork
 
