@@ -14,6 +14,9 @@
 namespace waxwork {
 namespace {
 
+using testing::reference_solution;
+using testing::relative_error;
+
 std::vector<double> random_vector(size_t n, unsigned seed) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(-1, 1);
@@ -48,25 +51,6 @@ HierarchyOptions small_levels(int64_t min_coarse) {
     HierarchyOptions h;
     h.min_coarse_vertices = min_coarse;
     return h;
-}
-
-std::vector<double> reference_solution(const DiffusionMatrix& m, const std::vector<double>& b, int channel) {
-    std::vector<double> x(b.size(), 0.0);
-    ConjugateGradientOptions options;
-    options.relative_tolerance = 1e-12;
-    const CsrMatrixView<double> view{m.size(), m.offsets.data(), m.columns.data(),
-                                     m.values[static_cast<size_t>(channel)].data()};
-    EXPECT_TRUE(solve_jacobi_cg<double>(view, b, x, options).converged);
-    return x;
-}
-
-double relative_error(const std::vector<double>& x, const std::vector<double>& reference) {
-    double e = 0, r = 0;
-    for (size_t i = 0; i < x.size(); ++i) {
-        e += (x[i] - reference[i]) * (x[i] - reference[i]);
-        r += reference[i] * reference[i];
-    }
-    return std::sqrt(e / r);
 }
 
 TEST(MultigridPreconditioner, CoarseOperatorsAreGalerkinProducts) {

@@ -14,6 +14,9 @@
 namespace waxwork {
 namespace {
 
+using testing::reference_solution;
+using testing::relative_error;
+
 HierarchyOptions small_levels(int64_t min_coarse) {
     HierarchyOptions h;
     h.min_coarse_vertices = min_coarse;
@@ -25,25 +28,6 @@ FrameSolverOptions frame_options(int64_t min_coarse, double tolerance) {
     options.hierarchy = small_levels(min_coarse);
     options.relative_tolerance = tolerance;
     return options;
-}
-
-std::vector<double> reference_solution(const DiffusionMatrix& m, std::span<const double> b, int channel) {
-    std::vector<double> x(b.size(), 0.0);
-    ConjugateGradientOptions options;
-    options.relative_tolerance = 1e-12;
-    const CsrMatrixView<double> view{m.size(), m.offsets.data(), m.columns.data(),
-                                     m.values[static_cast<size_t>(channel)].data()};
-    EXPECT_TRUE(solve_jacobi_cg<double>(view, b, x, options).converged);
-    return x;
-}
-
-double relative_error(std::span<const double> x, const std::vector<double>& reference) {
-    double e = 0, r = 0;
-    for (size_t i = 0; i < x.size(); ++i) {
-        e += (x[i] - reference[i]) * (x[i] - reference[i]);
-        r += reference[i] * reference[i];
-    }
-    return std::sqrt(e / r);
 }
 
 std::array<std::span<const double>, 3> spans(const std::array<std::vector<double>, 3>& v) {

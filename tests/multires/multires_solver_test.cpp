@@ -12,28 +12,17 @@
 namespace waxwork {
 namespace {
 
-double relative_error(std::span<const double> x, std::span<const double> reference) {
-    double e = 0, r = 0;
-    for (size_t i = 0; i < x.size(); ++i) {
-        e += (x[i] - reference[i]) * (x[i] - reference[i]);
-        r += reference[i] * reference[i];
-    }
-    return std::sqrt(e / r);
+using testing::relative_error;
+
+// This suite's references stop at 1e-11.
+std::vector<double> reference_solution(const DiffusionMatrix& m, std::span<const double> b, int channel) {
+    return testing::reference_solution(m, b, channel, 1e-11);
 }
 
 bool all_finite(std::span<const double> x) {
     for (double v : x)
         if (!std::isfinite(v)) return false;
     return true;
-}
-
-std::vector<double> reference_solution(const DiffusionMatrix& m, const std::vector<double>& b, int channel) {
-    std::vector<double> x(b.size(), 0.0);
-    ConjugateGradientOptions options;
-    options.relative_tolerance = 1e-11;
-    const CsrMatrixView<double> view{m.size(), m.offsets.data(), m.columns.data(), m.values[static_cast<size_t>(channel)].data()};
-    EXPECT_TRUE(solve_jacobi_cg<double>(view, b, x, options).converged);
-    return x;
 }
 
 // A small non-symmetric CSR system with its diagonal slots.

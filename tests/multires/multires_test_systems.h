@@ -1,11 +1,16 @@
 // Small assembled diffusion systems for the multires tests.
 #pragma once
 
+#include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "tetops/connectivity.h"
 #include "tetops/test_meshes.h"
 
+#include <gtest/gtest.h>
+
 #include <array>
+#include <cmath>
+#include <span>
 #include <vector>
 
 namespace waxwork::testing {
@@ -50,6 +55,28 @@ inline std::vector<int32_t> paint_test_system(TestSystem& s, int count, int stri
         materials[static_cast<size_t>(t * stride)] = TetMaterial{{0.3, 0.02, 0.1}, {2, 1, 0.5}, 1.4};
     }
     return update_diffusion_matrix(s.matrix, s.mesh, s.connectivity, materials, painted);
+}
+
+// sqrt(sum (x - reference)^2 / sum reference^2).
+inline double relative_error(std::span<const double> x, std::span<const double> reference) {
+    double e = 0, r = 0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        e += (x[i] - reference[i]) * (x[i] - reference[i]);
+        r += reference[i] * reference[i];
+    }
+    return std::sqrt(e / r);
+}
+
+// The level-0 solution of `channel` for right-hand side `b`: Jacobi CG in double to `tolerance`.
+inline std::vector<double> reference_solution(const DiffusionMatrix& m, std::span<const double> b, int channel,
+                                              double tolerance = 1e-12) {
+    std::vector<double> x(b.size(), 0.0);
+    ConjugateGradientOptions options;
+    options.relative_tolerance = tolerance;
+    const CsrMatrixView<double> view{m.size(), m.offsets.data(), m.columns.data(),
+                                     m.values[static_cast<size_t>(channel)].data()};
+    EXPECT_TRUE(solve_jacobi_cg<double>(view, b, x, options).converged);
+    return x;
 }
 
 }  // namespace waxwork::testing
