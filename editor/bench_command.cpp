@@ -119,8 +119,8 @@ void add_bench_command(CLI::App& app) {
     bench->require_subcommand(0, 1);
     bench->add_option("-o,--output", *suite_output, "Output directory of the whole suite");
     bench->add_flag("--quick", suite->quick, "Smaller meshes and fewer samples (under 2 minutes)");
-    bench->add_option("--only", suite->only, "Run only these parts (solvers_50k, solvers_500k, accuracy, cut_modes, table1, "
-                                             "stability, resolution)")
+    bench->add_option("--only", suite->only, "Run only these parts (solvers_50k, solvers_500k, coarse_start, accuracy, cut_modes, "
+                                             "table1, stability, resolution)")
         ->delimiter(',');
     bench->footer("Without a subcommand runs every part (editor/bench_suite.h) and writes JSON, SVG charts and\n"
                   "markdown tables into the output directory.");

@@ -11,6 +11,8 @@
 #include "io/atomic_file.h"
 #include "io/file_contents.h"
 #include "io/surface_reader.h"
+#include "multires/coarse_start_bound.h"
+#include "solver/reference_solvers.h"
 #include "solver/material.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
@@ -47,18 +49,34 @@ TetMesh spot_volume(const BenchSuiteOptions& o, size_t target_tets) {
     return tetrahedralize(load_closed_surface(o.asset_dir / "meshes/spot.obj").surface, meshing).mesh;
 }
 
-void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index) {
-    const TetMesh mesh = spot_volume(o, target_tets);
-    const TetConnectivity connectivity = build_connectivity(mesh);
-    const std::vector<TetMaterial> materials(mesh.tet_count(), material_preset("marble"));
+// The solver parts' scene: spot in marble, 30 mm per unit, under the key light.
+constexpr double solver_scene_mm_per_unit = 30;
+
+struct SolverScene {
+    TetMesh mesh;
+    TetConnectivity connectivity;
+    std::vector<TetMaterial> materials;
     Lighting lighting;
-    lighting.lights.push_back(default_key_light());
+    double mm_per_unit = solver_scene_mm_per_unit;
+};
+
+SolverScene solver_scene(const BenchSuiteOptions& o, size_t target_tets) {
+    SolverScene scene;
+    scene.mesh = spot_volume(o, target_tets);
+    scene.connectivity = build_connectivity(scene.mesh);
+    scene.materials.assign(scene.mesh.tet_count(), material_preset("marble"));
+    scene.lighting.lights.push_back(default_key_light());
+    return scene;
+}
+
+void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index) {
+    const SolverScene scene = solver_scene(o, target_tets);
     SolverComparisonOptions options;
-    options.mm_per_unit = 30;
+    options.mm_per_unit = scene.mm_per_unit;
     options.max_seconds = o.quick ? 8.0 : 60.0;
     // Every path, the GPU one included (llvmpipe here: a CPU, so its times are not GPU times).
     const std::unique_ptr<HeadlessGlContext> context = open_gpu_for_comparison(options);
-    const SolverComparison comparison = compare_solvers(mesh, connectivity, materials, lighting, options);
+    const SolverComparison comparison = compare_solvers(scene.mesh, scene.connectivity, scene.materials, scene.lighting, options);
     if (!comparison.gpu_fallback_reason.empty())
         std::cerr << "warning: no GPU curves: " << comparison.gpu_fallback_reason << "\n";
     const std::string stem = "solvers_spot_" + std::to_string((target_tets + 500) / 1000) + "k";
@@ -66,6 +84,50 @@ void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index
     Json& listed = index["solvers"];
     if (!listed.is_array()) listed = Json::array();
     if (std::find(listed.begin(), listed.end(), Json(stem + ".json")) == listed.end()) listed.push_back(stem + ".json");
+}
+
+// The best start the paper's coarse level can give the level-0 CG, on the solver parts' systems
+// (multires/coarse_start_bound.h): why its coarse-to-fine scheme saves so few iterations here.
+void run_coarse_start_part(const BenchSuiteOptions& o, Json& index) {
+    Json sizes = Json::array();
+    const std::vector<size_t> targets = o.quick ? std::vector<size_t>{50'000} : std::vector<size_t>{50'000, 500'000};
+    for (const size_t target : targets) {
+        const SolverScene scene = solver_scene(o, target);
+        AssemblyOptions assembly;
+        assembly.mm_per_unit = scene.mm_per_unit;
+        const DiffusionMatrix matrix = assemble_diffusion_matrix(scene.mesh, scene.connectivity, scene.materials, assembly);
+        const std::vector<Rgb> q = incident_light(scene.mesh, scene.connectivity, scene.materials, scene.lighting);
+        ChannelVectors b, reference;
+        for (int c = 0; c < 3; ++c) {
+            const auto sc = static_cast<size_t>(c);
+            b[sc].resize(matrix.size());
+            diffusion_right_hand_side(matrix, q, c, b[sc]);
+            const Eigen::VectorXd x = refined_direct_solution(
+                to_eigen_sparse(matrix, c), Eigen::Map<const Eigen::VectorXd>(b[sc].data(), static_cast<Eigen::Index>(b[sc].size())));
+            reference[sc].assign(x.data(), x.data() + x.size());
+        }
+        const MultiresHierarchy hierarchy = build_multires_hierarchy(matrix, scene.mesh.positions);
+        const CoarseStartBound bound = measure_coarse_start_bound(hierarchy, b, reference);
+        const auto ratio = [&](int iterations) {
+            return bound.iterations_from_zero > 0 && iterations >= 0
+                       ? Json(static_cast<double>(iterations) / bound.iterations_from_zero)
+                       : Json(nullptr);
+        };
+        sizes.push_back({{"tets", scene.mesh.tet_count()},
+                         {"vertices", bound.fine_vertices},
+                         {"level1_vertices", bound.coarse_vertices},
+                         {"interpolation_error", bound.interpolation_error},
+                         {"eq17_start_error", bound.eq17_start_error},
+                         {"galerkin_start_error", bound.galerkin_start_error},
+                         {"iterations_to_1pct", {{"zero_start", bound.iterations_from_zero},
+                                                 {"eq17_exact_level1", bound.iterations_from_eq17},
+                                                 {"galerkin_exact_level1", bound.iterations_from_galerkin}}},
+                         {"iteration_ratio_eq17", ratio(bound.iterations_from_eq17)},
+                         {"iteration_ratio_galerkin", ratio(bound.iterations_from_galerkin)}});
+    }
+    write_json(o.output_dir / "coarse_start.json",
+               {{"mesh", "assets/meshes/spot.obj"}, {"material", "marble"}, {"mm_per_unit", solver_scene_mm_per_unit}, {"sizes", sizes}});
+    index["coarse_start"] = "coarse_start.json";
 }
 
 // Cross-section distance and dihedral distributions of both cut modes (issue 6, part 2).
@@ -239,6 +301,7 @@ void run_bench_suite(const BenchSuiteOptions& o) {
         {"solvers_50k", [&](Json& i) { run_solver_part(o, 50'000, i); }},
     };
     if (!o.quick) parts.emplace_back("solvers_500k", [&](Json& i) { run_solver_part(o, 500'000, i); });
+    parts.emplace_back("coarse_start", [&](Json& i) { run_coarse_start_part(o, i); });
     parts.emplace_back("accuracy", [&](Json& i) { run_accuracy_part(o, i); });
     parts.emplace_back("cut_modes", [&](Json& i) { run_cut_modes_part(o, i); });
     parts.emplace_back("table1", [&](Json& i) { run_table1_part(o, i); });

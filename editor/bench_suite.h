@@ -1,6 +1,7 @@
 // `waxwork bench [--quick] -o DIR`: the reproducible speed-against-accuracy suite (issue 8). Writes
 // into DIR, each part as JSON plus a chart (SVG) or a markdown table:
 //   solvers_*.json/.svg   error of phi against time for every solver path (paper Fig. 7), per mesh size
+//   coarse_start.json     the best level-0 start a coarse level can give the paper's multires scheme
 //   accuracy.json, accuracy_ball.svg, accuracy_spot.svg
 //                         error against tet size: the analytic ball, spot against a fine reference
 //   cut_modes.json, cut_modes.svg, cut_quality.svg
@@ -24,7 +25,7 @@ struct BenchSuiteOptions {
     bool quick = false;
     std::filesystem::path asset_dir;                    // holds meshes/spot.obj, torus.obj, skull.obj
     std::function<void(const std::string&)> progress;   // one line per part started; may be empty
-    // Run only these parts (names as in bench.json: solvers_50k, solvers_500k, accuracy, cut_modes, table1,
+    // Run only these parts (names as in bench.json: solvers_50k, solvers_500k, coarse_start, accuracy, cut_modes, table1,
     // stability, resolution); empty: all. An unknown name is an InvalidArgumentError.
     std::vector<std::string> only;
 };

@@ -66,4 +66,11 @@ Eigen::VectorXd DirectSolver::solve(const Eigen::VectorXd& b) const {
     return x;
 }
 
+Eigen::VectorXd refined_direct_solution(const Eigen::SparseMatrix<double>& matrix, const Eigen::VectorXd& b) {
+    const DirectSolver direct(matrix);
+    Eigen::VectorXd x = direct.solve(b);
+    x += direct.solve(b - matrix * x);
+    return x;
+}
+
 }  // namespace waxwork

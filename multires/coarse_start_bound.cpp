@@ -1,0 +1,175 @@
+#include "multires/coarse_start_bound.h"
+
+#include "solver/conjugate_gradient.h"
+#include "tetops/error.h"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+
+#include <cmath>
+#include <string>
+
+namespace waxwork {
+
+namespace {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+void require_level1(const MultiresHierarchy& hierarchy, const std::vector<double>& b) {
+    if (hierarchy.level_count() < 2)
+        throw InvalidArgumentError("coarse start bound: the hierarchy has no level 1 (" +
+                                   std::to_string(hierarchy.levels.empty() ? 0 : hierarchy.levels[0].size()) +
+                                   " vertices on level 0)");
+    if (b.size() != hierarchy.levels[0].size())
+        throw InvalidArgumentError("coarse start bound: right-hand side has " + std::to_string(b.size()) +
+                                   " entries, level 0 has " + std::to_string(hierarchy.levels[0].size()));
+}
+
+SparseMatrix level_matrix(const HierarchyLevel& level, int channel) {
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(level.columns.size());
+    const std::vector<double>& values = level.values[static_cast<size_t>(channel)];
+    for (size_t row = 0; row < level.size(); ++row)
+        for (int32_t k = level.offsets[row]; k < level.offsets[row + 1]; ++k)
+            entries.emplace_back(static_cast<int>(row), level.columns[static_cast<size_t>(k)], values[static_cast<size_t>(k)]);
+    SparseMatrix m(static_cast<Eigen::Index>(level.size()), static_cast<Eigen::Index>(level.size()));
+    m.setFromTriplets(entries.begin(), entries.end());
+    return m;
+}
+
+// P^0 (Eq. 16) as an Eigen matrix, level-0 rows by level-1 columns.
+SparseMatrix interpolation_matrix(const MultiresHierarchy& hierarchy) {
+    const InterpolationOperator& p = hierarchy.levels[0].interpolation;
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(p.columns.size());
+    for (size_t row = 0; row < p.rows(); ++row)
+        for (int32_t k = p.offsets[row]; k < p.offsets[row + 1]; ++k)
+            entries.emplace_back(static_cast<int>(row), p.columns[static_cast<size_t>(k)], p.weights[static_cast<size_t>(k)]);
+    SparseMatrix m(static_cast<Eigen::Index>(p.rows()), static_cast<Eigen::Index>(hierarchy.levels[1].size()));
+    m.setFromTriplets(entries.begin(), entries.end());
+    return m;
+}
+
+std::vector<double> to_std(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
+
+Eigen::Map<const Eigen::VectorXd> as_eigen(const std::vector<double>& v) {
+    return {v.data(), static_cast<Eigen::Index>(v.size())};
+}
+
+void check_channel(int channel) {
+    if (channel < 0 || channel > 2)
+        throw InvalidArgumentError("coarse start bound: channel " + std::to_string(channel) + " is not 0, 1 or 2");
+}
+
+double combined_error(const ChannelVectors& x, const ChannelVectors& reference) {
+    double error = 0, norm = 0;
+    for (size_t c = 0; c < 3; ++c) {
+        error += (as_eigen(x[c]) - as_eigen(reference[c])).squaredNorm();
+        norm += as_eigen(reference[c]).squaredNorm();
+    }
+    return std::sqrt(error / norm);
+}
+
+ChannelVectors interpolated(const MultiresHierarchy& hierarchy, const ChannelVectors& coarse) {
+    ChannelVectors fine;
+    for (size_t c = 0; c < 3; ++c) {
+        fine[c].resize(hierarchy.levels[0].size());
+        interpolate(hierarchy.levels[0].interpolation, coarse[c], fine[c]);
+    }
+    return fine;
+}
+
+}  // namespace
+
+std::vector<double> solve_level1_eq17(const MultiresHierarchy& hierarchy, int channel, const std::vector<double>& b) {
+    require_level1(hierarchy, b);
+    check_channel(channel);
+    const HierarchyLevel& coarse = hierarchy.levels[1];
+    Eigen::VectorXd injected(static_cast<Eigen::Index>(coarse.size()));
+    for (size_t i = 0; i < coarse.size(); ++i)
+        injected[static_cast<Eigen::Index>(i)] = b[static_cast<size_t>(coarse.parent_vertex[i])];  // Eq. 17
+    Eigen::SparseLU<SparseMatrix> lu;
+    lu.compute(level_matrix(coarse, channel));  // not symmetric: LU, not Cholesky
+    if (lu.info() != Eigen::Success)
+        throw AlgorithmError("coarse start bound: level 1's Eq. 17 matrix is singular (" + lu.lastErrorMessage() + ")");
+    return to_std(lu.solve(injected));
+}
+
+std::vector<double> solve_level1_galerkin(const MultiresHierarchy& hierarchy, int channel, const std::vector<double>& b) {
+    require_level1(hierarchy, b);
+    check_channel(channel);
+    const SparseMatrix p = interpolation_matrix(hierarchy);
+    const SparseMatrix pt = p.transpose();
+    const SparseMatrix galerkin = pt * level_matrix(hierarchy.levels[0], channel) * p;
+    Eigen::SimplicialLDLT<SparseMatrix> ldlt(galerkin);
+    if (ldlt.info() != Eigen::Success)
+        throw AlgorithmError("coarse start bound: the Galerkin level-1 matrix is not positive definite");
+    return to_std(ldlt.solve(Eigen::VectorXd(pt * as_eigen(b))));
+}
+
+int jacobi_cg_iterations_to(const MultiresHierarchy& hierarchy, const ChannelVectors& b, const ChannelVectors& start,
+                            const ChannelVectors& reference, double target_error, int max_iterations) {
+    const HierarchyLevel& fine = hierarchy.levels[0];
+    ChannelVectors x;
+    const auto error_after = [&](int iterations) {
+        for (size_t c = 0; c < 3; ++c) {
+            x[c] = start[c];
+            if (iterations == 0) continue;
+            ConjugateGradientOptions options;
+            options.relative_tolerance = 1e-15;  // never stop on the estimate: run the count
+            options.max_iterations = iterations;
+            solve_jacobi_cg<double>(fine.view(static_cast<int>(c)), b[c], x[c], options);
+        }
+        return combined_error(x, reference);
+    };
+    if (error_after(0) <= target_error) return 0;
+    int hi = 1;
+    while (error_after(hi) > target_error) {
+        if (hi >= max_iterations) return -1;
+        hi = std::min(2 * hi, max_iterations);
+    }
+    int lo = hi / 2;  // error_after(lo) > target (lo = 0 was tested above)
+    while (hi - lo > 1) {
+        const int mid = (lo + hi) / 2;
+        (error_after(mid) <= target_error ? hi : lo) = mid;
+    }
+    return hi;
+}
+
+CoarseStartBound measure_coarse_start_bound(const MultiresHierarchy& hierarchy, const ChannelVectors& b,
+                                            const ChannelVectors& reference, double target_error, int max_iterations) {
+    if (!(target_error > 0 && target_error < 1))
+        throw InvalidArgumentError("coarse start bound: target error " + std::to_string(target_error) +
+                                   " is not in (0, 1)");
+    for (size_t c = 0; c < 3; ++c) {
+        require_level1(hierarchy, b[c]);
+        if (reference[c].size() != b[c].size())
+            throw InvalidArgumentError("coarse start bound: reference and right-hand side sizes differ");
+    }
+    const HierarchyLevel& coarse = hierarchy.levels[1];
+    CoarseStartBound bound;
+    bound.fine_vertices = hierarchy.levels[0].size();
+    bound.coarse_vertices = coarse.size();
+
+    ChannelVectors restricted, eq17, galerkin, zero;
+    for (size_t c = 0; c < 3; ++c) {
+        restricted[c].resize(coarse.size());
+        for (size_t i = 0; i < coarse.size(); ++i) restricted[c][i] = reference[c][static_cast<size_t>(coarse.parent_vertex[i])];
+        eq17[c] = solve_level1_eq17(hierarchy, static_cast<int>(c), b[c]);
+        galerkin[c] = solve_level1_galerkin(hierarchy, static_cast<int>(c), b[c]);
+        zero[c].assign(b[c].size(), 0.0);
+    }
+    bound.interpolation_error = combined_error(interpolated(hierarchy, restricted), reference);
+    const ChannelVectors eq17_start = interpolated(hierarchy, eq17);
+    const ChannelVectors galerkin_start = interpolated(hierarchy, galerkin);
+    bound.eq17_start_error = combined_error(eq17_start, reference);
+    bound.galerkin_start_error = combined_error(galerkin_start, reference);
+    bound.iterations_from_zero = jacobi_cg_iterations_to(hierarchy, b, zero, reference, target_error, max_iterations);
+    bound.iterations_from_eq17 = jacobi_cg_iterations_to(hierarchy, b, eq17_start, reference, target_error, max_iterations);
+    bound.iterations_from_galerkin =
+        jacobi_cg_iterations_to(hierarchy, b, galerkin_start, reference, target_error, max_iterations);
+    return bound;
+}
+
+}  // namespace waxwork
