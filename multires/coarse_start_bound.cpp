@@ -62,15 +62,6 @@ void check_channel(int channel) {
         throw InvalidArgumentError("coarse start bound: channel " + std::to_string(channel) + " is not 0, 1 or 2");
 }
 
-double combined_error(const ChannelVectors& x, const ChannelVectors& reference) {
-    double error = 0, norm = 0;
-    for (size_t c = 0; c < 3; ++c) {
-        error += (as_eigen(x[c]) - as_eigen(reference[c])).squaredNorm();
-        norm += as_eigen(reference[c]).squaredNorm();
-    }
-    return std::sqrt(error / norm);
-}
-
 ChannelVectors interpolated(const MultiresHierarchy& hierarchy, const ChannelVectors& coarse) {
     ChannelVectors fine;
     for (size_t c = 0; c < 3; ++c) {
@@ -81,6 +72,15 @@ ChannelVectors interpolated(const MultiresHierarchy& hierarchy, const ChannelVec
 }
 
 }  // namespace
+
+double combined_relative_error(const ChannelVectors& x, const ChannelVectors& reference) {
+    double error = 0, norm = 0;
+    for (size_t c = 0; c < 3; ++c) {
+        error += (as_eigen(x[c]) - as_eigen(reference[c])).squaredNorm();
+        norm += as_eigen(reference[c]).squaredNorm();
+    }
+    return std::sqrt(error / norm);
+}
 
 std::vector<double> solve_level1_eq17(const MultiresHierarchy& hierarchy, int channel, const std::vector<double>& b) {
     require_level1(hierarchy, b);
@@ -121,7 +121,7 @@ int jacobi_cg_iterations_to(const MultiresHierarchy& hierarchy, const ChannelVec
             options.max_iterations = iterations;
             solve_jacobi_cg<double>(fine.view(static_cast<int>(c)), b[c], x[c], options);
         }
-        return combined_error(x, reference);
+        return combined_relative_error(x, reference);
     };
     if (error_after(0) <= target_error) return 0;
     int hi = 1;
@@ -160,11 +160,11 @@ CoarseStartBound measure_coarse_start_bound(const MultiresHierarchy& hierarchy, 
         galerkin[c] = solve_level1_galerkin(hierarchy, static_cast<int>(c), b[c]);
         zero[c].assign(b[c].size(), 0.0);
     }
-    bound.interpolation_error = combined_error(interpolated(hierarchy, restricted), reference);
+    bound.interpolation_error = combined_relative_error(interpolated(hierarchy, restricted), reference);
     const ChannelVectors eq17_start = interpolated(hierarchy, eq17);
     const ChannelVectors galerkin_start = interpolated(hierarchy, galerkin);
-    bound.eq17_start_error = combined_error(eq17_start, reference);
-    bound.galerkin_start_error = combined_error(galerkin_start, reference);
+    bound.eq17_start_error = combined_relative_error(eq17_start, reference);
+    bound.galerkin_start_error = combined_relative_error(galerkin_start, reference);
     bound.iterations_from_zero = jacobi_cg_iterations_to(hierarchy, b, zero, reference, target_error, max_iterations);
     bound.iterations_from_eq17 = jacobi_cg_iterations_to(hierarchy, b, eq17_start, reference, target_error, max_iterations);
     bound.iterations_from_galerkin =

@@ -4,10 +4,13 @@
 // iterations from a zero start.
 //
 // Why a bound. The scheme gains the level-0 iterations its start saves, minus what the coarse pass
-// costs. No coarse pass on the hierarchy can give a better level-1 solution than the exact one of
-// Eq. 17, so if even that free, exact start saves less than half the iterations, no tuning of the
-// coarse levels (iterations per level, tolerances, another Krylov method) makes the scheme twice as
-// fast as Jacobi CG on that system. The same bound for the Galerkin system P^T M P y = P^T b (whose
+// costs. Its coarse pass approximates the exact solution of level 1's Eq. 17 system, and comes closer
+// to it the more work it spends on the coarse levels; the iterations left after that exact solution
+// are what the scheme needs in the limit of exact coarse solves that cost nothing. If even that start
+// saves less than half the iterations, tuning the coarse levels (iterations per level, tolerances,
+// another Krylov method) cannot make the scheme twice as fast as Jacobi CG on that system (a cheap,
+// inexact coarse pass could land closer by chance, but the measured one does not: its level-0 start
+// is further off than the exact one). The same bound for the Galerkin system P^T M P y = P^T b (whose
 // P y is the element of range(P) closest to the solution in the M-norm) separates what Eq. 17's
 // collocation loses from what Eq. 16's interpolation itself loses: the interpolation error of the
 // exact solution's own coarse values is reported too.
@@ -52,6 +55,9 @@ std::vector<double> solve_level1_galerkin(const MultiresHierarchy& hierarchy, in
 // error is taken as non-increasing in k); -1 when max_iterations does not reach it.
 int jacobi_cg_iterations_to(const MultiresHierarchy& hierarchy, const ChannelVectors& b, const ChannelVectors& start,
                             const ChannelVectors& reference, double target_error, int max_iterations);
+
+// sqrt(sum_c |x_c - reference_c|^2 / sum_c |reference_c|^2), the error every number here uses.
+double combined_relative_error(const ChannelVectors& x, const ChannelVectors& reference);
 
 // All of CoarseStartBound. reference: the exact level-0 solutions of b. Throws InvalidArgumentError on
 // sizes that do not match the hierarchy, no level 1, or a target_error not in (0, 1).

@@ -202,6 +202,10 @@ TEST(BenchSuiteCommand, CoarseStartPartBoundsThePapersSchemeOnTheSolverSystem) {
     const int zero = size["iterations_to_1pct"]["zero_start"];
     const int eq17 = size["iterations_to_1pct"]["eq17_exact_level1"];
     const int galerkin = size["iterations_to_1pct"]["galerkin_exact_level1"];
+    const int scheme = size["iterations_to_1pct"]["scheme_coarse_pass"];
+    EXPECT_GT(scheme, 0);
+    EXPECT_LE(scheme, zero);
+    EXPECT_GT(size["scheme_start_error"].get<double>(), 0);
     EXPECT_GT(zero, 0);
     EXPECT_GT(eq17, 0);
     EXPECT_GT(galerkin, 0);
