@@ -140,10 +140,7 @@ MultigridPreconditioner::MultigridPreconditioner(const MultiresHierarchy& hierar
         next->n = hierarchy.levels[l + 1].size();
         levels_[l]->pt = transpose(*levels_[l]->p, next->n);
         levels_.push_back(std::move(next));
-        build_product_pattern(l + 1);
-        std::vector<int32_t> all(levels_[l + 1]->n);
-        std::iota(all.begin(), all.end(), 0);
-        compute_galerkin_rows(l + 1, all);
+        build_galerkin_operator(l + 1);
     }
     for (size_t l = 0; l < levels_.size(); ++l) {
         Level& level = *levels_[l];
@@ -189,7 +186,7 @@ struct MultigridPreconditioner::Accumulator {
     }
 };
 
-void MultigridPreconditioner::build_product_pattern(size_t l) {
+void MultigridPreconditioner::build_galerkin_operator(size_t l) {
     Level& fine = *levels_[l - 1];
     Level& coarse = *levels_[l];
     const InterpolationOperator& p = *fine.p;
@@ -230,16 +227,28 @@ void MultigridPreconditioner::build_product_pattern(size_t l) {
     std::iota(all.begin(), all.end(), 0);
     compute_product_rows(l, all);
 
-    // P^T (A P), full: accumulated row by row; then the kept pattern (see drop_tolerance).
-    tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
+    // P^T (A P), full: accumulated row by row; then the kept pattern (see drop_tolerance) and its
+    // values. The drop test needs every row's diagonal first; a diagonal entry is one column of the
+    // row, found in the few A P rows of P^T's row instead of accumulating the whole row.
+    const InterpolationOperator& pt = fine.pt;
     std::array<std::vector<double>, 3> diagonal;
     for (auto& d : diagonal) d.assign(m, 0.0);
     for_rows(m, kGrain, [&](size_t row) {
-        Accumulator& acc = scratch.local();
-        accumulate_galerkin_row(l, row, acc);
-        for (size_t ch = 0; ch < 3; ++ch) diagonal[ch][row] = acc.sum[ch][row];
-        clear(acc);
+        // The same additions in the same order as accumulate_galerkin_row's for column `row` (each A P
+        // row holds a column once), so the diagonal is bit-identical to the accumulated one.
+        std::array<double, 3> sum{};
+        for (int32_t a = pt.offsets[row]; a < pt.offsets[row + 1]; ++a) {
+            const auto v = static_cast<size_t>(pt.columns[static_cast<size_t>(a)]);
+            const double w = pt.weights[static_cast<size_t>(a)];
+            for (int32_t e = fine.ap_offsets[v]; e < fine.ap_offsets[v + 1]; ++e) {
+                if (fine.ap_columns[static_cast<size_t>(e)] != static_cast<int32_t>(row)) continue;
+                for (size_t ch = 0; ch < 3; ++ch) sum[ch] += w * fine.ap_values[ch][static_cast<size_t>(e)];
+                break;
+            }
+        }
+        for (size_t ch = 0; ch < 3; ++ch) diagonal[ch][row] = sum[ch];
     });
+    tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
     const double theta = options_.drop_tolerance;
     auto kept = [&](size_t row, size_t k, const Accumulator& acc) {
         if (k == row) return true;
@@ -259,19 +268,36 @@ void MultigridPreconditioner::build_product_pattern(size_t l) {
     std::partial_sum(coarse.offsets.begin(), coarse.offsets.end(), coarse.offsets.begin());
     coarse.columns.resize(static_cast<size_t>(coarse.offsets[m]));
     coarse.diagonal.assign(m, -1);
+    for (auto& v : coarse.values) v.assign(coarse.columns.size(), 0.0);
+    // Pattern and values in one pass: what compute_galerkin_rows does for a row, with the kept
+    // columns chosen here (dropped entries lumped in first-touch order, as there: bit-identical).
     for_rows(m, kGrain, [&](size_t row) {
         Accumulator& acc = scratch.local();
         accumulate_galerkin_row(l, row, acc);
-        auto out = static_cast<size_t>(coarse.offsets[row]);
-        for (int32_t k : acc.touched)
-            if (kept(row, static_cast<size_t>(k), acc)) coarse.columns[out++] = k;
+        const auto begin = static_cast<size_t>(coarse.offsets[row]), end = static_cast<size_t>(coarse.offsets[row + 1]);
+        size_t out = begin;
+        std::array<double, 3> lumped{};
+        for (int32_t k : acc.touched) {
+            if (kept(row, static_cast<size_t>(k), acc)) {
+                coarse.columns[out++] = k;
+                continue;
+            }
+            for (size_t ch = 0; ch < 3; ++ch) {
+                const double value = acc.sum[ch][static_cast<size_t>(k)];
+                lumped[ch] += options_.lumping == DropLumping::Absolute ? std::abs(value) : value;
+            }
+        }
+        int32_t* columns = coarse.columns.data();
+        std::sort(columns + begin, columns + end);
+        const auto diagonal_slot = static_cast<size_t>(
+            std::lower_bound(columns + begin, columns + end, static_cast<int32_t>(row)) - columns);
+        coarse.diagonal[row] = static_cast<int32_t>(diagonal_slot);
+        for (size_t ch = 0; ch < 3; ++ch) {
+            for (size_t s = begin; s < end; ++s) coarse.values[ch][s] = acc.sum[ch][static_cast<size_t>(columns[s])];
+            coarse.values[ch][diagonal_slot] += lumped[ch];
+        }
         clear(acc);
-        auto* begin = coarse.columns.data() + coarse.offsets[row];
-        auto* end = coarse.columns.data() + coarse.offsets[row + 1];
-        std::sort(begin, end);
-        coarse.diagonal[row] = static_cast<int32_t>(std::lower_bound(begin, end, static_cast<int32_t>(row)) - coarse.columns.data());
     });
-    for (auto& v : coarse.values) v.assign(coarse.columns.size(), 0.0);
 }
 
 void MultigridPreconditioner::clear(Accumulator& acc) {

@@ -105,7 +105,8 @@ public:
 private:
     struct Level;
     struct Accumulator;
-    void build_product_pattern(size_t l);
+    // A P's pattern and values, then P^T A P's kept pattern and values (compute_galerkin_rows' result).
+    void build_galerkin_operator(size_t l);
     void compute_product_rows(size_t l, std::span<const int32_t> rows);
     void accumulate_galerkin_row(size_t l, size_t row, Accumulator& acc) const;
     static void clear(Accumulator& acc);
