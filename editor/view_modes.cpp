@@ -338,16 +338,14 @@ ViewGeometry interior_quality_view(const TetMesh& mesh, const BoundarySurface& s
     return view;
 }
 
-std::vector<int32_t> hierarchy_vertex_levels(const TetMesh& mesh, const TetConnectivity& connectivity,
-                                             const std::vector<TetMaterial>& materials) {
-    const DiffusionMatrix matrix = assemble_diffusion_matrix(mesh, connectivity, materials);
+std::vector<int32_t> hierarchy_vertex_levels(const TetMesh& mesh, const TetConnectivity& connectivity) {
     HierarchyOptions options;
     // The solver stops coarsening at 1000 vertices; the view goes further so small volumes show levels.
     options.min_coarse_vertices = 32;
-    const MultiresHierarchy hierarchy = build_multires_hierarchy(matrix, mesh.positions, options);
     std::vector<int32_t> level(mesh.vertex_count(), 0);
-    for (size_t l = 1; l < hierarchy.level_count(); ++l)
-        for (const int32_t v : hierarchy.levels[l].original_vertex) level[static_cast<size_t>(v)] = static_cast<int32_t>(l);
+    const std::vector<std::vector<int32_t>> levels = hierarchy_level_vertices(connectivity.vertex_vertices, options);
+    for (size_t l = 0; l < levels.size(); ++l)
+        for (const int32_t v : levels[l]) level[static_cast<size_t>(v)] = static_cast<int32_t>(l + 1);
     return level;
 }
 
@@ -390,7 +388,7 @@ ViewGeometry build_view_geometry(const TetMesh& mesh, const TetConnectivity& con
                                             : quality_view(mesh, scene.surface);
         case ViewMode::Wireframe: return wireframe_view(mesh, connectivity);
         case ViewMode::Slice: return slice_view(mesh, scene.diffusion.phi, options);
-        case ViewMode::Levels: return levels_view(scene.surface, hierarchy_vertex_levels(mesh, connectivity, materials));
+        case ViewMode::Levels: return levels_view(scene.surface, hierarchy_vertex_levels(mesh, connectivity));
     }
     return ViewGeometry{};
 }
@@ -419,7 +417,7 @@ std::shared_ptr<const ViewGeometry> ViewGeometryCache::get(const TetMesh& mesh, 
     if (!stale) return view_;
     if (options.mode == ViewMode::Levels) {
         if (levels_version_ != geometry_version) {
-            levels_ = hierarchy_vertex_levels(mesh, connectivity, materials);
+            levels_ = hierarchy_vertex_levels(mesh, connectivity);
             levels_version_ = geometry_version;
         }
         validate(options);

@@ -100,10 +100,10 @@ ViewGeometry wireframe_view(const TetMesh& mesh, const TetConnectivity& connecti
 // phi: per volume vertex (SolvedScene::diffusion.phi).
 ViewGeometry slice_view(const TetMesh& mesh, const std::vector<std::array<double, 3>>& phi, const ViewOptions& options);
 // Levels of each volume vertex: the index of the coarsest hierarchy level it belongs to (0: only the
-// fine level). Builds the hierarchy on the volume's diffusion matrix with a small coarsest size so
-// that even a small volume shows several levels.
-std::vector<int32_t> hierarchy_vertex_levels(const TetMesh& mesh, const TetConnectivity& connectivity,
-                                             const std::vector<TetMaterial>& materials);
+// fine level). The solver's vertex selection on the mesh graph (hierarchy_level_vertices: the levels
+// depend on the connectivity only, not on materials or operators), with a small coarsest size so that
+// even a small volume shows several levels.
+std::vector<int32_t> hierarchy_vertex_levels(const TetMesh& mesh, const TetConnectivity& connectivity);
 ViewGeometry levels_view(const BoundarySurface& surface, const std::vector<int32_t>& vertex_levels);
 
 // The view `options.mode` asks for; Radiance gives an empty geometry. materials: one per tet (as

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <numeric>
+#include <optional>
 #include <string>
 
 namespace waxwork {
@@ -193,6 +195,34 @@ void restrict_right_hand_side(const HierarchyLevel& level, std::span<const doubl
     for (size_t v = 0; v < level.size(); ++v) b[v] = level0_b[static_cast<size_t>(level.original_vertex[v])];
 }
 
+namespace {
+
+// One coarsening step of a level with `level_count` levels built so far (the stopping rule of hierarchy.h).
+struct CoarseningStep {
+    VertexSelection selection;
+    std::vector<int32_t> coarse_index;    // fine -> coarse, -1 when dropped
+    std::vector<int32_t> coarse_to_fine;  // coarse -> fine
+};
+
+std::optional<CoarseningStep> coarsen(const CompressedRows& graph, size_t level_count, const HierarchyOptions& options) {
+    const size_t n = graph.row_count();
+    if (static_cast<int>(level_count) >= options.max_levels || static_cast<int64_t>(n) < options.min_coarse_vertices)
+        return std::nullopt;
+    // Each level gets its own key so that successive selections are uncorrelated.
+    const uint32_t seed = options.seed * 0x9e3779b1u + static_cast<uint32_t>(level_count);
+    CoarseningStep step;
+    step.selection = select_coarse_vertices(graph, seed, options.enhance);
+    step.coarse_index = coarse_vertex_index(step.selection.retained);
+    for (size_t v = 0; v < n; ++v)
+        if (step.selection.retained[v]) step.coarse_to_fine.push_back(static_cast<int32_t>(v));
+    if (static_cast<double>(step.coarse_to_fine.size()) > options.max_keep_ratio * static_cast<double>(n) ||
+        step.coarse_to_fine.empty())
+        return std::nullopt;
+    return step;
+}
+
+}  // namespace
+
 MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                                            const HierarchyOptions& options) {
     if (positions.size() != matrix.size())
@@ -201,39 +231,42 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
     const auto start = std::chrono::steady_clock::now();
     MultiresHierarchy hierarchy;
     hierarchy.levels.push_back(fine_level(matrix));
-    while (static_cast<int>(hierarchy.levels.size()) < options.max_levels) {
+    while (std::optional<CoarseningStep> step = coarsen(hierarchy.levels.back().graph, hierarchy.levels.size(), options)) {
         HierarchyLevel& fine = hierarchy.levels.back();
-        const size_t n = fine.size();
-        if (static_cast<int64_t>(n) < options.min_coarse_vertices) break;
-        // Each level gets its own key so that successive selections are uncorrelated.
-        const uint32_t seed = options.seed * 0x9e3779b1u + static_cast<uint32_t>(hierarchy.levels.size());
-        VertexSelection selection = select_coarse_vertices(fine.graph, seed, options.enhance);
-        const std::vector<int32_t> coarse_index = coarse_vertex_index(selection.retained);
-        std::vector<int32_t> coarse_to_fine;
-        for (size_t v = 0; v < n; ++v)
-            if (selection.retained[v]) coarse_to_fine.push_back(static_cast<int32_t>(v));
-        if (static_cast<double>(coarse_to_fine.size()) > options.max_keep_ratio * static_cast<double>(n) ||
-            coarse_to_fine.empty())
-            break;
         HierarchyLevel coarse;
-        coarse.parent_vertex = coarse_to_fine;
-        coarse.original_vertex.resize(coarse_to_fine.size());
-        for (size_t c = 0; c < coarse_to_fine.size(); ++c)
-            coarse.original_vertex[c] = fine.original_vertex[static_cast<size_t>(coarse_to_fine[c])];
-        fine.interpolation =
-            build_interpolation(fine.graph, selection.retained, coarse_index, fine.original_vertex, positions);
+        coarse.parent_vertex = step->coarse_to_fine;
+        coarse.original_vertex.resize(step->coarse_to_fine.size());
+        for (size_t c = 0; c < step->coarse_to_fine.size(); ++c)
+            coarse.original_vertex[c] = fine.original_vertex[static_cast<size_t>(step->coarse_to_fine[c])];
+        fine.interpolation = build_interpolation(fine.graph, step->selection.retained, step->coarse_index,
+                                                 fine.original_vertex, positions);
         // P's columns are exactly each fine vertex's coarse links (independent_set.h).
-        coarse.graph = build_coarse_graph(fine.graph, coarse_index, fine.interpolation.offsets,
+        coarse.graph = build_coarse_graph(fine.graph, step->coarse_index, fine.interpolation.offsets,
                                           fine.interpolation.columns);
-        fine.independent_set_rounds = selection.independent_set_rounds;
-        fine.enhancement_passes = selection.enhancement_passes;
-        fine.enhancement_vertices = selection.enhancement_vertices;
-        build_coarse_matrix(fine, coarse_to_fine, coarse);
+        fine.independent_set_rounds = step->selection.independent_set_rounds;
+        fine.enhancement_passes = step->selection.enhancement_passes;
+        fine.enhancement_vertices = step->selection.enhancement_vertices;
+        build_coarse_matrix(fine, step->coarse_to_fine, coarse);
         hierarchy.levels.push_back(std::move(coarse));
     }
     hierarchy.build_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return hierarchy;
+}
+
+std::vector<std::vector<int32_t>> hierarchy_level_vertices(const CompressedRows& graph, const HierarchyOptions& options) {
+    std::vector<std::vector<int32_t>> levels;
+    CompressedRows level_graph = graph;
+    std::vector<int32_t> original(graph.row_count());
+    std::iota(original.begin(), original.end(), 0);
+    while (std::optional<CoarseningStep> step = coarsen(level_graph, levels.size() + 1, options)) {
+        std::vector<int32_t> kept(step->coarse_to_fine.size());
+        for (size_t c = 0; c < kept.size(); ++c) kept[c] = original[static_cast<size_t>(step->coarse_to_fine[c])];
+        level_graph = build_coarse_graph(level_graph, step->selection.retained, step->coarse_index);
+        original = kept;
+        levels.push_back(std::move(kept));
+    }
+    return levels;
 }
 
 }  // namespace waxwork

@@ -85,6 +85,13 @@ struct MultiresHierarchy {
 MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                                            const HierarchyOptions& options = {});
 
+// The vertices each coarse level keeps, without building any operator: entry l-1 lists the level-0
+// vertices of level l (HierarchyLevel::original_vertex), for views and statistics. graph: G^0, the
+// matrix pattern without the diagonal (the mesh's vertex_vertices). The same levels as
+// build_multires_hierarchy on a matrix with this pattern and the same options, at the cost of the
+// selections and coarse graphs only.
+std::vector<std::vector<int32_t>> hierarchy_level_vertices(const CompressedRows& graph, const HierarchyOptions& options = {});
+
 // Eq. 16 weights for one coarsening step: row v of the operator from the retained flags.
 InterpolationOperator build_interpolation(const CompressedRows& graph, std::span<const uint8_t> retained,
                                           std::span<const int32_t> coarse_index,

@@ -417,7 +417,7 @@ TEST(ViewModes, LevelsShowSeveralHierarchyLevels) {
     const TetMesh mesh = make_box_mesh({10, 10, 10}, {-1, -1, -1}, {1, 1, 1});
     const TetConnectivity connectivity = build_connectivity(mesh);
     const std::vector<TetMaterial> materials(mesh.tet_count(), material_preset("marble"));
-    const std::vector<int32_t> levels = hierarchy_vertex_levels(mesh, connectivity, materials);
+    const std::vector<int32_t> levels = hierarchy_vertex_levels(mesh, connectivity);
     ASSERT_EQ(levels.size(), mesh.vertex_count());
     const int32_t deepest = *std::max_element(levels.begin(), levels.end());
     EXPECT_GE(deepest, 2);

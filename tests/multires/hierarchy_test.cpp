@@ -117,6 +117,27 @@ TEST(Hierarchy, DeterministicAcrossRunsAndThreadCounts) {
     }
 }
 
+// The selection-only build (for views) keeps the same vertices on every level as the full build, for
+// several stopping rules (size floor, level cap, keep ratio).
+TEST(Hierarchy, LevelVerticesWithoutOperatorsEqualTheFullBuild) {
+    const auto s = testing::make_test_system(9);
+    std::vector<HierarchyOptions> variants(4);
+    variants[0].min_coarse_vertices = 30;
+    variants[1].min_coarse_vertices = 300;
+    variants[2].min_coarse_vertices = 30;
+    variants[2].max_levels = 3;
+    variants[3].min_coarse_vertices = 30;
+    variants[3].max_keep_ratio = 0.3;  // stops where a level keeps more than 30%
+    variants[3].seed = 7;
+    for (const HierarchyOptions& options : variants) {
+        const MultiresHierarchy full = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
+        const std::vector<std::vector<int32_t>> levels = hierarchy_level_vertices(s.connectivity.vertex_vertices, options);
+        ASSERT_EQ(levels.size() + 1, full.level_count());
+        for (size_t l = 0; l < levels.size(); ++l) EXPECT_EQ(levels[l], full.levels[l + 1].original_vertex) << "level " << l + 1;
+    }
+    EXPECT_GE(build_multires_hierarchy(s.matrix, s.mesh.positions, variants[0]).level_count(), 3u);
+}
+
 TEST(Hierarchy, RejectsMismatchedPositions) {
     const auto s = testing::make_test_system(2);
     std::vector<Eigen::Vector3d> too_few(3);
