@@ -4,12 +4,14 @@
 // round trip per iteration, which costs more than the iterations on small meshes).
 //
 // Model: the milliseconds a frame costs per iteration, as an exponential moving average over the
-// frames measured so far (alpha = smoothing weight of the newest frame). The frame time includes
-// what does not scale with iterations (uploading changed right-hand sides, reading phi back), so the
-// average per iteration depends on how many iterations a frame runs; the prediction is self-correcting
-// all the same: a frame that ran over makes the next one shorter. Frames that did one-off work (a
-// first upload of the matrix, a coarse-to-fine pass) should not be recorded: they would make the next
-// frames far too short.
+// frames measured so far (the smoothing weight of the newest frame). The frame time also holds what
+// does not scale with iterations (uploading changed right-hand sides, reading phi back: O ms), so a
+// frame of k iterations of c ms measures (O + k c) / k per iteration. The prediction k' = B k / (O + k c)
+// for a budget B still settles where O + k c = B, i.e. on the k that fills the budget exactly (or on one
+// iteration when O alone exceeds B: the budget cannot be met, bench/live_solver_bench.cpp shows this
+// for llvmpipe at 100K tets). A two-parameter fit would find the same point; this needs one number.
+// Frames that did one-off work (a first upload of the matrix, a coarse-to-fine pass) should not be
+// recorded: they would make the next frames far too short.
 //
 // Before any frame was measured the prediction is the budget's iteration limit, or
 // kDefaultFirstFrameIterations without one (the editor's default "iterations / frame").

@@ -6,6 +6,7 @@
 #include "editor/live_scene.h"
 #include "editor/live_solver.h"
 #include "editor/session.h"
+#include "io/image_io.h"
 #include "io/volume_file.h"
 #include "live_test_scene.h"
 #include "solver/material.h"
@@ -15,6 +16,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -255,6 +257,25 @@ TEST(CliFrameBudget, BadFrameMsIsAOneLineError) {
     const auto good = run_waxwork(run + " --frame-ms 5");
     EXPECT_EQ(good.exit_code, 0) << good.err;
     EXPECT_TRUE(fs::exists(dir / "out" / "a.png"));
+}
+
+// The editor with `--frame-ms` solves in timed ticks and, once converged, shows what the iteration
+// budget shows (both converge to the same tolerance: the pictures agree to rounding).
+TEST(CliFrameBudget, EditorWithATimeBudgetConvergesToTheSamePicture) {
+    if (!waxwork::testing::have_xvfb()) GTEST_SKIP() << "xvfb-run is not installed";
+    const fs::path dir = scratch("editor");
+    write_volume(testing::make_cube_mesh(6), dir / "cube.vtu");
+    const std::string common = "edit " + (dir / "cube.vtu").string() + " --hide-ui --width 320 --height 240 --frames 1";
+    const auto iterations = waxwork::testing::run_under_xvfb(common + " --screenshot " + (dir / "iterations.png").string());
+    ASSERT_EQ(iterations.exit_code, 0) << iterations.err;
+    const auto timed =
+        waxwork::testing::run_under_xvfb(common + " --frame-ms 2 --screenshot " + (dir / "timed.png").string());
+    ASSERT_EQ(timed.exit_code, 0) << timed.err;
+    const Image a = read_png(dir / "iterations.png"), b = read_png(dir / "timed.png");
+    ASSERT_EQ(a.rgba.size(), b.rgba.size());
+    int largest = 0;
+    for (size_t i = 0; i < a.rgba.size(); ++i) largest = std::max(largest, std::abs(a.rgba[i] - b.rgba[i]));
+    EXPECT_LE(largest, 2);
 }
 
 }  // namespace
