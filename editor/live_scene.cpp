@@ -39,7 +39,8 @@ LiveScene::LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSc
         throw InvalidArgumentError("live scene: the relative tolerance must be in (0, 1)");
     validate(lighting_);
     check_materials(mesh);
-    solver_ = std::make_unique<LiveSolver>(LiveSolverOptions{options.method, options.backend, options.gl_context, options.clock});
+    solver_ = std::make_unique<LiveSolver>(
+        LiveSolverOptions{options.method, options.backend, options.gl_context, options.clock});
     SceneUpdate update;
     rebuild_all(nullptr, update);
 }
@@ -205,9 +206,9 @@ FrameReport LiveScene::iterate(int iteration_budget, const FrameBudget* time_bud
     const size_t n = matrix_.size();
     std::array<bool, 3> skip{};
     for (int c = 0; c < 3; ++c) skip[c] = converged_[c] || n == 0;
-    const auto channels = time_budget
-                              ? solver_->iterate(matrix_, b_, phi_, *time_budget, options_.relative_tolerance, skip)
-                              : solver_->iterate(matrix_, b_, phi_, iteration_budget, options_.relative_tolerance, skip);
+    const double tolerance = options_.relative_tolerance;
+    const auto channels = time_budget ? solver_->iterate(matrix_, b_, phi_, *time_budget, tolerance, skip)
+                                      : solver_->iterate(matrix_, b_, phi_, iteration_budget, tolerance, skip);
     for (int c = 0; c < 3; ++c) {
         if (skip[c]) {
             converged_[c] = true;

@@ -31,7 +31,8 @@
 // radiance_factors(), which read it). step(), step_for(), converge() and phi() never read the mesh.
 // A window's loop, for example:
 //   UI thread:     { lock edit_mutex; report = document.apply(op); scene.apply_change(document.mesh(), report); }
-//   solver thread: scene.step_for(12 /* ms */); { lock edit_mutex; E = scene.radiance_factors(); } upload E
+//   solver thread: scene.step(FrameBudget::milliseconds(12)); { lock edit_mutex; E = scene.radiance_factors(); }
+//                  upload E
 #pragma once
 
 #include "editor/document.h"

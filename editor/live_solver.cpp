@@ -480,9 +480,9 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<s
         MultiresSolveReport report;
         // As for Jacobi CG: each channel's level-0 CG gets its share of the frame's time left.
         const std::span<const double> solved =
-            deadline_.bounded()
-                ? multires_->solve_frame(b[c], c, budget_until(deadline_, parts, iteration_budget), &report, options, clock_)
-                : multires_->solve_frame(b[c], c, iteration_budget, &report, options);
+            deadline_.bounded() ? multires_->solve_frame(b[c], c, budget_until(deadline_, parts, iteration_budget),
+                                                         &report, options, clock_)
+                                : multires_->solve_frame(b[c], c, iteration_budget, &report, options);
         std::copy(solved.begin(), solved.end(), phi[c].begin());  // the host copy: radiance, saves, cuts
         multires_error_[c] = report.fine.estimated_relative_error;
         out[c] = {report.fine.iterations, report.fine.estimated_relative_error, report.fine.converged};

@@ -108,7 +108,8 @@ TEST(LiveFrameBudget, TimedFramesConvergeOnEveryCpuMethod) {
         // channel's first costs a clock read.
         for (int c = 0; c < 3; ++c) {
             EXPECT_GE(first.iterations[static_cast<size_t>(c)], 1) << config.name;
-            EXPECT_LE(first.iterations[static_cast<size_t>(c)], static_cast<int>(budget_ms / step_ms) + 1) << config.name;
+            EXPECT_LE(first.iterations[static_cast<size_t>(c)], static_cast<int>(budget_ms / step_ms) + 1)
+                << config.name;
         }
         const double first_difference = relative_difference(scene.phi(), reference);
         EXPECT_GT(first_difference, 0.01) << config.name << ": one frame was enough, the test says nothing";
@@ -237,7 +238,8 @@ TEST(CliFrameBudget, BadFrameMsIsAOneLineError) {
     using waxwork::testing::run_waxwork;
     const fs::path dir = scratch("cli");
     write_volume(testing::make_cube_mesh(3), dir / "cube.vtu");
-    std::ofstream(dir / "s.json") << R"({"input": {"volume": "cube.vtu"}, "steps": [{"render": "a.png", "frames": 1}]})";
+    std::ofstream(dir / "s.json")
+        << R"({"input": {"volume": "cube.vtu"}, "steps": [{"render": "a.png", "frames": 1}]})";
     const std::string run = "run " + (dir / "s.json").string() + " -o " + (dir / "out").string();
     const std::string edit = "edit " + (dir / "cube.vtu").string() + " --screenshot " + (dir / "x.png").string();
     for (const std::string& command : {run, edit}) {
@@ -266,7 +268,8 @@ TEST(CliFrameBudget, EditorWithATimeBudgetConvergesToTheSamePicture) {
     const fs::path dir = scratch("editor");
     write_volume(testing::make_cube_mesh(6), dir / "cube.vtu");
     const std::string common = "edit " + (dir / "cube.vtu").string() + " --hide-ui --width 320 --height 240 --frames 1";
-    const auto iterations = waxwork::testing::run_under_xvfb(common + " --screenshot " + (dir / "iterations.png").string());
+    const auto iterations =
+        waxwork::testing::run_under_xvfb(common + " --screenshot " + (dir / "iterations.png").string());
     ASSERT_EQ(iterations.exit_code, 0) << iterations.err;
     const auto timed =
         waxwork::testing::run_under_xvfb(common + " --frame-ms 2 --screenshot " + (dir / "timed.png").string());

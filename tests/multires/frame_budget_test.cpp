@@ -161,7 +161,8 @@ TEST(MultigridFrameBudget, StepStopsAtTheDeadlineLikeAVcycleBudget) {
         EXPECT_EQ(a.estimated_relative_error, b.estimated_relative_error);
         for (int c = 0; c < 3; ++c) {
             const auto pa = timed.phi(c), pb = counted.phi(c);
-            EXPECT_TRUE(std::equal(pa.begin(), pa.end(), pb.begin(), pb.end())) << "channel " << c << ", " << ms << " ms";
+            EXPECT_TRUE(std::equal(pa.begin(), pa.end(), pb.begin(), pb.end()))
+                << "channel " << c << ", " << ms << " ms";
         }
     }
     // A V-cycle limit below the time limit wins; an expired deadline still runs one V-cycle.
@@ -174,7 +175,8 @@ TEST(MultigridFrameBudget, SuccessiveTimedFramesConverge) {
     MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(1e-6));
     solver.set_right_hand_side(spans(s.b));
     std::array<std::vector<double>, 3> exact;
-    for (int c = 0; c < 3; ++c) exact[static_cast<size_t>(c)] = testing::reference_solution(s.matrix, s.b[static_cast<size_t>(c)], c);
+    for (size_t c = 0; c < 3; ++c)
+        exact[c] = testing::reference_solution(s.matrix, s.b[c], static_cast<int>(c));
     // CG lowers each channel's energy-norm error at every update, so their maximum falls frame by frame.
     auto worst = [&](bool energy) {
         double e = 0;

@@ -102,7 +102,8 @@ struct CubeSystem {
     std::vector<double> b;
     CubeSystem() {
         const TetConnectivity conn = build_connectivity(mesh);
-        matrix = assemble_diffusion_matrix(mesh, conn, std::vector<TetMaterial>(mesh.tet_count(), material_preset("marble")));
+        const std::vector<TetMaterial> marble(mesh.tet_count(), material_preset("marble"));
+        matrix = assemble_diffusion_matrix(mesh, conn, marble);
         const double top = bounding_box(mesh)[1].z();
         std::vector<std::array<double, 3>> q(mesh.vertex_count(), {0, 0, 0});
         for (size_t v = 0; v < mesh.vertex_count(); ++v)
