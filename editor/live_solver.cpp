@@ -240,10 +240,22 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate(const DiffusionMatrix& matr
                                                      const std::array<std::vector<double>, 3>& b,
                                                      std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                      double relative_tolerance, const std::array<bool, 3>& skip) {
+    // A frame that uploads the whole matrix or runs the coarse-to-fine pass costs far more than its
+    // iterations: measuring it would make the next time-budgeted frames much too short.
+    const bool one_off_work = !gpu_ || gpu_values_stale_ || (multires_ && multires_cold_);
     if (multires_) update_multires_values(matrix);  // the host hierarchy first, whichever backend solves
     if (backend_ == LiveBackend::Gpu) {
         try {
-            return iterate_gpu(matrix, b, phi, iteration_budget, relative_tolerance, skip);
+            // Every GPU frame is measured, iteration-budgeted ones too: a switch to a time budget then
+            // starts from what the device costs instead of a default.
+            const double start = clock_();
+            const auto out = iterate_gpu(matrix, b, phi, iteration_budget, relative_tolerance, skip);
+            if (!one_off_work) {
+                // The channels run in lockstep on the device: the frame cost the most any one ran.
+                const int ran = std::max({out[0].iterations, out[1].iterations, out[2].iterations});
+                gpu_iteration_time_.record(ran, clock_() - start);
+            }
+            return out;
         } catch (const GpuError& e) {
             fall_back(e.what());
         } catch (const AlgorithmError&) {
@@ -261,27 +273,18 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate(const DiffusionMatrix& matr
                                                      std::array<std::vector<double>, 3>& phi, const FrameBudget& budget,
                                                      double relative_tolerance, const std::array<bool, 3>& skip) {
     validate(budget);
-    const double start = clock_();
     deadline_ = FrameDeadline::of(budget, clock_);
     // The deadline belongs to this frame only: int-budget frames after it (or after a throw) have none.
     struct ClearDeadline {
         FrameDeadline& deadline;
         ~ClearDeadline() { deadline = FrameDeadline{}; }
     } clear{deadline_};
-    const bool on_gpu = backend_ == LiveBackend::Gpu;
-    // A frame that uploads the whole matrix or runs the coarse-to-fine pass costs far more than its
-    // iterations: measuring it would make the next frames much too short.
-    const bool one_off_work = !gpu_ || gpu_values_stale_ || (multires_ && multires_cold_);
-    const int iterations = on_gpu ? gpu_iteration_time_.iterations_for(budget)
+    // The GPU cannot stop at a deadline: it runs the iterations predicted to fit (measured in the int
+    // overload). The CPU runs up to the limit, stopped by deadline_.
+    const int iterations = backend_ == LiveBackend::Gpu ? gpu_iteration_time_.iterations_for(budget)
                            : budget.limits_iterations() ? budget.max_iterations
                                                         : std::numeric_limits<int>::max();
-    const auto out = iterate(matrix, b, phi, iterations, relative_tolerance, skip);
-    if (on_gpu && backend_ == LiveBackend::Gpu && !one_off_work) {
-        // The channels run in lockstep on the device: the frame cost the most iterations any one ran.
-        const int ran = std::max({out[0].iterations, out[1].iterations, out[2].iterations});
-        gpu_iteration_time_.record(ran, clock_() - start);
-    }
-    return out;
+    return iterate(matrix, b, phi, iterations, relative_tolerance, skip);
 }
 
 std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& matrix,

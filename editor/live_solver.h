@@ -132,9 +132,9 @@ public:
     //                               multires frame after a rebuild runs its coarse-to-fine pass whole.
     //   CPU multigrid CG            the deadline is checked between V-cycles (at least one runs).
     //   GPU (both methods)          the device queue cannot stop part-way: the budget becomes an
-    //                               iteration count predicted from earlier frames (gpu_iteration_time();
-    //                               frames that uploaded the matrix or ran the coarse pass are not
-    //                               measured).
+    //                               iteration count predicted from earlier GPU frames of either overload
+    //                               (gpu_iteration_time(); frames that uploaded the matrix or ran the
+    //                               coarse pass are not measured).
     // An iteration-only budget gives the int overload's result bit for bit.
     std::array<LiveSolverChannel, 3> iterate(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
                                              std::array<std::vector<double>, 3>& phi, const FrameBudget& budget,

@@ -123,7 +123,8 @@ TEST(LiveFrameBudget, TimedFramesConvergeOnEveryCpuMethod) {
 
 TEST(LiveFrameBudget, GpuTurnsTheTimeBudgetIntoPredictedIterations) {
     const auto s = testing::make_test_system(10);
-    const double step_ms = 1;  // each GPU frame reads the clock at its start, for its deadline, at its end
+    // A timed GPU frame reads the clock for its deadline, then before and after the device work.
+    const double step_ms = 1;
     for (const Config& config : kGpuConfigs) {
         LiveSolverOptions options;
         options.method = config.method;
@@ -144,15 +145,20 @@ TEST(LiveFrameBudget, GpuTurnsTheTimeBudgetIntoPredictedIterations) {
         EXPECT_EQ(frame(), IterationTimePredictor::kDefaultFirstFrameIterations) << config.name;
         if (solver.backend() != LiveBackend::Gpu) GTEST_SKIP() << "no GPU here: " << solver.gpu_fallback_reason();
         EXPECT_FALSE(solver.gpu_iteration_time().milliseconds_per_iteration()) << config.name;
-        // Second frame: still the default, now measured (3 reads: 2 ms for 10 iterations).
+        // Second frame: still the default, now measured (1 ms between the reads around 10 iterations).
         EXPECT_EQ(frame(), IterationTimePredictor::kDefaultFirstFrameIterations) << config.name;
         ASSERT_TRUE(solver.gpu_iteration_time().milliseconds_per_iteration()) << config.name;
-        const double per_iteration = 2 * step_ms / IterationTimePredictor::kDefaultFirstFrameIterations;
+        const double per_iteration = step_ms / IterationTimePredictor::kDefaultFirstFrameIterations;
         EXPECT_DOUBLE_EQ(*solver.gpu_iteration_time().milliseconds_per_iteration(), per_iteration);
         // Third frame: as many as fit in the budget at that cost.
         const int predicted = solver.gpu_iteration_time().iterations_for(budget);
         EXPECT_EQ(predicted, static_cast<int>(std::floor(3 / per_iteration + 1e-9)));
         EXPECT_EQ(frame(), predicted) << config.name;
+        // Iteration-budgeted frames are measured as well: 4 iterations in 1 ms move the average.
+        const double before = *solver.gpu_iteration_time().milliseconds_per_iteration();
+        const auto counted = solver.iterate(s.matrix, s.b, phi, 4, tolerance, {});
+        EXPECT_EQ(counted[0].iterations, 4) << config.name;
+        EXPECT_GT(*solver.gpu_iteration_time().milliseconds_per_iteration(), before) << config.name;
     }
 }
 
