@@ -437,12 +437,15 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
                                {"estimated_error", error ? Json(*error) : Json(nullptr)}});
         result.steps.push_back(m);
     }
+    const FrameBudget budget = session_frame_budget(session, run_options);
     const Json summary{{"session", session.name},
                        {"load_milliseconds", result.load_ms},
                        {"undo_bytes", document.undo_bytes()},
                        {"undo_entries_evicted", document.evicted_undo_count()},
                        {"solver_backend", live_backend_name(scene.backend())},
                        {"solver_method", live_method_name(run_options.method)},
+                       // The time budget of the frames of render steps with "frames"; null: frame_iterations.
+                       {"frame_ms", budget.limits_time() ? Json(budget.max_milliseconds) : Json(nullptr)},
                        {"gpu_fallback_reason", scene.gpu_fallback_reason()},
                        {"steps", metrics}};
     write_file_atomically(output_directory / "metrics.json", [&](std::ostream& out) { out << summary.dump(2) << "\n"; });

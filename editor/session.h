@@ -143,6 +143,7 @@ FrameBudget session_frame_budget(const Session& session, const SessionRunOptions
 // Replays the session, writing renders and saves under `output_directory` (created) and
 // OUTDIR/metrics.json. Errors name the session and the step index.
 // metrics.json also names the solver backend (solver_backend, and gpu_fallback_reason after one).
+// and the frames' time budget (frame_ms; null for an iteration budget).
 SessionResult run_session(const Session& session, const std::filesystem::path& output_directory,
                           const SessionRunOptions& run_options = {});
 

@@ -237,6 +237,9 @@ TEST(SessionFrameBudget, RunReplaysWithATimeBudget) {
     EXPECT_GE(result.steps[0].solver_iterations, 2 * 3);  // at least one iteration per channel and frame
     EXPECT_TRUE(fs::exists(dir / "out" / "a.png"));
     EXPECT_TRUE(fs::exists(dir / "out" / "b.png"));
+    std::ifstream metrics_file(dir / "out" / "metrics.json");
+    const nlohmann::json metrics = nlohmann::json::parse(metrics_file);
+    EXPECT_EQ(metrics.at("frame_ms"), 5.0);
 }
 
 TEST(CliFrameBudget, BadFrameMsIsAOneLineError) {
@@ -261,10 +264,14 @@ TEST(CliFrameBudget, BadFrameMsIsAOneLineError) {
         EXPECT_NE(help.out.find("--frame-ms"), std::string::npos) << name;
         EXPECT_NE(help.out.find("milliseconds"), std::string::npos) << name;
     }
-    EXPECT_FALSE(fs::exists(dir / "out"));
+    EXPECT_FALSE(fs::exists(dir / "out"));  // refused before running
+    const auto plain = run_waxwork(run);
+    ASSERT_EQ(plain.exit_code, 0) << plain.err;
+    EXPECT_TRUE(nlohmann::json::parse(std::ifstream(dir / "out" / "metrics.json")).at("frame_ms").is_null());
     const auto good = run_waxwork(run + " --frame-ms 5");
-    EXPECT_EQ(good.exit_code, 0) << good.err;
+    ASSERT_EQ(good.exit_code, 0) << good.err;
     EXPECT_TRUE(fs::exists(dir / "out" / "a.png"));
+    EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir / "out" / "metrics.json")).at("frame_ms"), 5.0);
 }
 
 // The editor with `--frame-ms` solves in timed ticks and, once converged, shows what the iteration
