@@ -6,6 +6,8 @@
 //   3: CPU multires (Li et al. Sec. 4: coarse to fine after a rebuild, then the level-0 Jacobi CG warm
 //   per frame, double), 4: the same on the GPU (GpuMultiresSolver, float).
 //   ./build/bench/live_solver_bench
+// BM_RelightFramesWithinBudget: the same relighting with a budget of 10 ms per frame instead of 8
+// iterations (below).
 // The GPU backend runs in an OSMesa context: on a machine without a GPU (and in CI) that is Mesa's
 // llvmpipe, which runs the compute shaders on the CPU cores, so its times say nothing about a real
 // GPU (WAXWORK_GL_DEVICE=egl reaches one where there is one). A GPU frame includes reading phi back
@@ -17,6 +19,7 @@
 #include "live_scene_setup.h"
 #include "editor/document.h"
 #include "editor/live_scene.h"
+#include "solver/frame_budget.h"
 #include "solver/material.h"
 
 #include <benchmark/benchmark.h>
@@ -186,6 +189,58 @@ void BM_FirstFrameAfterCut(benchmark::State& state) {
     state.SetLabel(scene.solver_description());
 }
 BENCHMARK(BM_FirstFrameAfterCut)->DenseRange(0, 4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Frames with a time budget instead of iterations (solver/frame_budget.h, `--frame-ms`): the light
+// turns 3 degrees per frame as in BM_RelightFrames and each frame's solver step gets kFrameBudgetMs.
+// step_* is the solver step alone (what the budget limits), over_* how far it went past the budget
+// (an iteration or V-cycle that started finishes; with three channels one after the other, each gets
+// its share), frame_* the whole frame (light + step + radiance), its_per_frame the iterations per
+// frame summed over channels (multigrid CG: V-cycles, counted once per channel). The GPU rows turn
+// the budget into a predicted iteration count (iteration_time_predictor.h); on llvmpipe.
+//   ./build/bench/live_solver_bench --benchmark_filter=BM_RelightFramesWithinBudget
+constexpr double kFrameBudgetMs = 10;
+
+double percentile(std::vector<double> v, double p) {
+    std::sort(v.begin(), v.end());
+    return v[static_cast<size_t>(p * static_cast<double>(v.size() - 1))];
+}
+
+void BM_RelightFramesWithinBudget(benchmark::State& state) {
+    const Variant& variant = kVariants[state.range(0)];
+    Document doc(bench::spot_volume(kFrameTets), material_preset("marble"));
+    LiveScene scene(doc.mesh(), turning_light(0), scene_options(doc.mesh(), variant));
+    scene.converge();
+    const FrameBudget budget = FrameBudget::milliseconds(kFrameBudgetMs);
+    std::vector<double> frame_ms, step_ms, over_ms;
+    int iterations = 0;
+    for (auto _ : state) {
+        for (int f = 1; f <= kFrames; ++f) {
+            const auto start = Clock::now();
+            scene.set_lighting(turning_light(3.0 * f));
+            const auto step_start = Clock::now();
+            iterations += scene.step(budget).total_iterations();
+            step_ms.push_back(ms_since(step_start));
+            benchmark::DoNotOptimize(scene.radiance_factors().data());
+            frame_ms.push_back(ms_since(start));
+            over_ms.push_back(step_ms.back() - kFrameBudgetMs);
+        }
+    }
+    state.counters["budget_ms"] = kFrameBudgetMs;
+    state.counters["step_median_ms"] = percentile(step_ms, 0.5);
+    state.counters["step_p90_ms"] = percentile(step_ms, 0.9);
+    state.counters["step_max_ms"] = percentile(step_ms, 1.0);
+    state.counters["over_median_ms"] = percentile(over_ms, 0.5);
+    state.counters["over_p90_ms"] = percentile(over_ms, 0.9);
+    state.counters["frame_median_ms"] = percentile(frame_ms, 0.5);
+    state.counters["frame_p90_ms"] = percentile(frame_ms, 0.9);
+    state.counters["its_per_frame"] = static_cast<double>(iterations) / kFrames;
+    state.counters["final_error"] = scene.estimated_error().value_or(-1);
+    true_errors(state, doc.mesh(), scene);
+    if (scene.backend() != variant.backend)
+        state.SkipWithError(("fell back to the CPU: " + scene.gpu_fallback_reason()).c_str());
+    state.SetLabel(scene.solver_description());
+}
+BENCHMARK(BM_RelightFramesWithinBudget)->DenseRange(0, 4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace waxwork

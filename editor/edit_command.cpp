@@ -62,6 +62,7 @@ void run_edit_command(const EditCommandOptions& o) {
     options.scale = o.scale;
     options.solver_backend = parse_live_backend(o.solver.backend);
     options.solver_method = parse_live_method(o.solver.method);
+    options.frame_ms = o.solver.frame_ms;
     for (const std::string& spec : o.lights) options.lights.push_back(parse_light_spec(spec));
     // Read before the window opens: a bad script is a one-line error, with or without a display.
     if (!o.input.empty()) options.input = read_input_script(o.input);

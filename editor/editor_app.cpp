@@ -77,6 +77,10 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
     lighting_.ambient = {0.02, 0.02, 0.02};  // `waxwork render`'s default --ambient
     live_options_.mm_per_unit = options.scale;
     choose_solver(options.solver_method, options.solver_backend);
+    if (options.frame_ms) {
+        frame_budget_in_ms_ = true;
+        frame_ms_ = static_cast<float>(*options.frame_ms);
+    }
     const std::vector<std::string> presets = material_preset_names();
     selected_preset_ = static_cast<int>(std::find(presets.begin(), presets.end(), "marble") - presets.begin());
 
@@ -166,6 +170,7 @@ void EditorApp::open_file(const fs::path& path) {
     setup.lighting = lighting_;
     setup.camera = options_.camera;
     setup.frame_iterations = frame_iterations_;
+    if (frame_budget_in_ms_) setup.frame_ms = frame_ms_;
     const std::string material_name = options_.material ? "custom" : "marble (or stored)";
     status_ = "Loading " + path.string();
     load_task_.start(path.filename().string(), [this, path, setup, material_name, solver = live_options_](TaskProgress& progress) {
@@ -195,7 +200,10 @@ void EditorApp::open_session(const fs::path& path) {
         setup.steps.clear();
         progress.set_stage("building the document and the live scene");
         auto core = make_core(std::move(mesh), setup, solver);
-        return BackgroundTask::Apply([this, path, core, edits] { install_core(core, path, "session", edits); });
+        return BackgroundTask::Apply([this, path, core, edits] {
+            install_core(core, path, "session", edits);
+            adopt_frame_budget(core->setup);
+        });
     });
 }
 
@@ -254,8 +262,12 @@ void EditorApp::save_session(const fs::path& path) {
     current.camera = camera_ ? camera_->settings(static_cast<double>(view_w_) / view_h_) : options_.camera;
     current.width = view_w_;
     current.height = view_h_;
+    current.frame_iterations = frame_iterations_;  // the budget as the panel has it now
+    if (frame_budget_in_ms_) current.frame_ms = frame_ms_;
     queue_job("save session", [path, current](SceneCore& core) {
         Session setup = core.setup;
+        setup.frame_iterations = current.frame_iterations;
+        setup.frame_ms = current.frame_ms;
         setup.lighting = current.lighting;
         setup.camera = current.camera;
         setup.width = current.width;
@@ -332,7 +344,7 @@ void EditorApp::start_tick() {
     std::optional<Lighting> lighting;
     if (lighting_dirty_) lighting = lighting_;
     lighting_dirty_ = false;
-    const int budget = frame_iterations_;
+    const FrameBudget budget = frame_budget();
     const bool first = !scene_->render_input;
     const bool need_bvh = !scene_->surface_bvh;
     ImageSettings settings;

@@ -56,6 +56,8 @@ struct EditorOptions {
     std::optional<InputScript> input;    // replayed into the window once the object shows (--input)
     LiveMethod solver_method = LiveMethod::JacobiCg;  // the live solver (live_solver.h); the solver
     LiveBackend solver_backend = LiveBackend::Cpu;    // panel switches both
+    std::optional<double> frame_ms;      // a time budget per solver step instead of iterations (--frame-ms);
+                                         // also wins over an opened session's
 };
 
 // Opens the window and runs until it is closed (or, with a screenshot, until it is saved). Throws
@@ -179,6 +181,10 @@ private:
     // editor_solver_choice.cpp: the method and backend combos, and the GPU context they need.
     void draw_solver_choice();
     void choose_solver(LiveMethod method, LiveBackend backend);
+    // frame_budget_choice.cpp: "iterations / frame" or "ms / frame" and the budget each tick solves with.
+    void draw_frame_budget_choice();
+    FrameBudget frame_budget() const;
+    void adopt_frame_budget(const Session& session);  // an opened session's, unless --frame-ms was given
     void draw_view_panel();
     void draw_view_mode_panel();  // view_mode_panel.cpp: the optional views and their legend
     void draw_view_mode_menu();   // view_mode_panel.cpp: View > Show
@@ -239,6 +245,8 @@ private:
     Lighting lighting_;
     LiveSceneOptions live_options_;
     int frame_iterations_ = 10;                // CG iterations per channel and tick
+    bool frame_budget_in_ms_ = false;          // the solver step's budget is frame_ms_, not frame_iterations_
+    float frame_ms_ = 10;                      // milliseconds of solver step per tick
     float exposure_stops_ = 0;                 // added to the automatic exposure
     std::optional<OrbitCamera> camera_;
     std::filesystem::path current_file_;

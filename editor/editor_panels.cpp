@@ -225,10 +225,7 @@ void EditorApp::draw_material_panel() {
 void EditorApp::draw_solver_panel() {
     ImGui::TextDisabled("TransCut matrix, warm-started CG per frame");
     draw_solver_choice();
-    ImGui::SliderInt("iterations / frame", &frame_iterations_, 1, 200);
-    if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("Jacobi CG: CG iterations per channel and frame.\n"
-                          "Multigrid CG: one V-cycle (all three channels) per 4, at least one.");
+    draw_frame_budget_choice();  // frame_budget_choice.cpp: iterations or ms per frame
     float tolerance_exponent = static_cast<float>(std::log10(live_options_.relative_tolerance));
     // Solver settings rebuild the live scene: only when the user lets go of the slider.
     if (ImGui::SliderFloat("tolerance", &tolerance_exponent, -6.0f, -1.0f, "1e%.1f"))

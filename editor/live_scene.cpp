@@ -39,7 +39,8 @@ LiveScene::LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSc
         throw InvalidArgumentError("live scene: the relative tolerance must be in (0, 1)");
     validate(lighting_);
     check_materials(mesh);
-    solver_ = std::make_unique<LiveSolver>(LiveSolverOptions{options.method, options.backend, options.gl_context});
+    solver_ = std::make_unique<LiveSolver>(
+        LiveSolverOptions{options.method, options.backend, options.gl_context, options.clock});
     SceneUpdate update;
     rebuild_all(nullptr, update);
 }
@@ -199,13 +200,15 @@ SceneUpdate LiveScene::set_lighting(const Lighting& lighting) {
     return update;
 }
 
-FrameReport LiveScene::iterate(int iteration_budget) {
+FrameReport LiveScene::iterate(int iteration_budget, const FrameBudget* time_budget) {
     const auto start = std::chrono::steady_clock::now();
     FrameReport report;
     const size_t n = matrix_.size();
     std::array<bool, 3> skip{};
     for (int c = 0; c < 3; ++c) skip[c] = converged_[c] || n == 0;
-    const auto channels = solver_->iterate(matrix_, b_, phi_, iteration_budget, options_.relative_tolerance, skip);
+    const double tolerance = options_.relative_tolerance;
+    const auto channels = time_budget ? solver_->iterate(matrix_, b_, phi_, *time_budget, tolerance, skip)
+                                      : solver_->iterate(matrix_, b_, phi_, iteration_budget, tolerance, skip);
     for (int c = 0; c < 3; ++c) {
         if (skip[c]) {
             converged_[c] = true;
@@ -227,6 +230,12 @@ FrameReport LiveScene::step(int iteration_budget) {
     if (iteration_budget < 0) throw InvalidArgumentError("live scene: the iteration budget must be >= 0");
     const std::lock_guard lock(mutex_);
     return iterate(iteration_budget);
+}
+
+FrameReport LiveScene::step(const FrameBudget& budget) {
+    validate(budget);
+    const std::lock_guard lock(mutex_);
+    return iterate(budget.max_iterations, &budget);
 }
 
 FrameReport LiveScene::step_for(double milliseconds, int chunk_iterations) {

@@ -31,7 +31,8 @@
 // radiance_factors(), which read it). step(), step_for(), converge() and phi() never read the mesh.
 // A window's loop, for example:
 //   UI thread:     { lock edit_mutex; report = document.apply(op); scene.apply_change(document.mesh(), report); }
-//   solver thread: scene.step_for(12 /* ms */); { lock edit_mutex; E = scene.radiance_factors(); } upload E
+//   solver thread: scene.step(FrameBudget::milliseconds(12)); { lock edit_mutex; E = scene.radiance_factors(); }
+//                  upload E
 #pragma once
 
 #include "editor/document.h"
@@ -61,6 +62,8 @@ struct LiveSceneOptions {
     LiveMethod method = LiveMethod::JacobiCg;
     LiveBackend backend = LiveBackend::Cpu;
     std::shared_ptr<SolverGlContext> gl_context;
+    // The clock of step(FrameBudget)'s time limits (LiveSolverOptions::clock); empty: steady_clock.
+    MillisecondClock clock;
 };
 
 // One frame of the solve.
@@ -103,6 +106,10 @@ public:
     // At most `iteration_budget` CG iterations per channel, from the current phi. Channels already
     // within the tolerance are not iterated (an idle scene costs nothing).
     FrameReport step(int iteration_budget);
+    // Within a frame budget instead (solver/frame_budget.h; validated, InvalidArgumentError): an
+    // iteration and/or millisecond limit, which the solver enforces itself (LiveSolver::iterate): one
+    // warm CG (or V-cycle) run per channel stopped at the deadline, unlike step_for's restarted chunks.
+    FrameReport step(const FrameBudget& budget);
     // A time budget instead: CG in chunks of `chunk_iterations` per channel until `milliseconds` have
     // passed or the tolerance is reached (each chunk restarts CG from the current phi, which costs a
     // little convergence against one longer run; at least one chunk runs). Multigrid CG runs max(1, chunk / 4)
@@ -144,7 +151,8 @@ private:
     void relight(SceneUpdate& update);
     void refresh_right_hand_sides();
     void mark_unconverged();
-    FrameReport iterate(int iteration_budget);
+    // `time_budget` (optional) replaces the iteration budget.
+    FrameReport iterate(int iteration_budget, const FrameBudget* time_budget = nullptr);
 
     mutable std::mutex mutex_;
     const TetMesh* mesh_;

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <iterator>
+#include <limits>
 #include <numeric>
 
 namespace waxwork {
@@ -49,6 +50,14 @@ constexpr int kIterationsPerVcycle = 4;
 
 int vcycle_budget(int iteration_budget) {
     return iteration_budget <= 0 ? 0 : std::max(1, iteration_budget / kIterationsPerVcycle);
+}
+
+// A budget of `max_iterations` (> 0) and the `parts`-th share of what is left of `deadline` (bounded),
+// for the solver objects that take a FrameBudget. A deadline already passed still gives a positive
+// (vanishing) time limit: 0 would mean "no time limit", and the solver then runs its one iteration.
+FrameBudget budget_until(const FrameDeadline& deadline, int parts, int max_iterations) {
+    const double share = deadline.remaining() / std::max(parts, 1);
+    return FrameBudget::milliseconds(std::max(share, std::numeric_limits<double>::denorm_min()), max_iterations);
 }
 
 class HeadlessSolverContext : public SolverGlContext {
@@ -102,7 +111,8 @@ struct LiveSolver::Gpu {
 
 LiveSolver::LiveSolver(const LiveSolverOptions& options)
     : method_(options.method), backend_(options.backend), requested_backend_(options.backend),
-      context_(options.gl_context) {}
+      context_(options.gl_context),
+      clock_(options.clock ? options.clock : MillisecondClock(steady_clock_milliseconds)) {}
 
 LiveSolver::~LiveSolver() {
     try {
@@ -230,10 +240,22 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate(const DiffusionMatrix& matr
                                                      const std::array<std::vector<double>, 3>& b,
                                                      std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                      double relative_tolerance, const std::array<bool, 3>& skip) {
+    // A frame that uploads the whole matrix or runs the coarse-to-fine pass costs far more than its
+    // iterations: measuring it would make the next time-budgeted frames much too short.
+    const bool one_off_work = !gpu_ || gpu_values_stale_ || (multires_ && multires_cold_);
     if (multires_) update_multires_values(matrix);  // the host hierarchy first, whichever backend solves
     if (backend_ == LiveBackend::Gpu) {
         try {
-            return iterate_gpu(matrix, b, phi, iteration_budget, relative_tolerance, skip);
+            // Every GPU frame is measured, iteration-budgeted ones too: a switch to a time budget then
+            // starts from what the device costs instead of a default.
+            const double start = clock_();
+            const auto out = iterate_gpu(matrix, b, phi, iteration_budget, relative_tolerance, skip);
+            if (!one_off_work) {
+                // The channels run in lockstep on the device: the frame cost the most any one ran.
+                const int ran = std::max({out[0].iterations, out[1].iterations, out[2].iterations});
+                gpu_iteration_time_.record(ran, clock_() - start);
+            }
+            return out;
         } catch (const GpuError& e) {
             fall_back(e.what());
         } catch (const AlgorithmError&) {
@@ -244,6 +266,25 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate(const DiffusionMatrix& matr
         // The host phi is the last frame's read-back (iterate_gpu writes it only on success).
     }
     return iterate_cpu(matrix, b, phi, iteration_budget, relative_tolerance, skip);
+}
+
+std::array<LiveSolverChannel, 3> LiveSolver::iterate(const DiffusionMatrix& matrix,
+                                                     const std::array<std::vector<double>, 3>& b,
+                                                     std::array<std::vector<double>, 3>& phi, const FrameBudget& budget,
+                                                     double relative_tolerance, const std::array<bool, 3>& skip) {
+    validate(budget);
+    deadline_ = FrameDeadline::of(budget, clock_);
+    // The deadline belongs to this frame only: int-budget frames after it (or after a throw) have none.
+    struct ClearDeadline {
+        FrameDeadline& deadline;
+        ~ClearDeadline() { deadline = FrameDeadline{}; }
+    } clear{deadline_};
+    // The GPU cannot stop at a deadline: it runs the iterations predicted to fit (measured in the int
+    // overload). The CPU runs up to the limit, stopped by deadline_.
+    const int iterations = backend_ == LiveBackend::Gpu ? gpu_iteration_time_.iterations_for(budget)
+                           : budget.limits_iterations() ? budget.max_iterations
+                                                        : std::numeric_limits<int>::max();
+    return iterate(matrix, b, phi, iterations, relative_tolerance, skip);
 }
 
 std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& matrix,
@@ -257,6 +298,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& 
     if (backend_ == LiveBackend::Cpu) pending_rows_.clear();
 
     std::array<LiveSolverChannel, 3> out;
+    int channels_left = static_cast<int>(std::count(skip.begin(), skip.end(), false));
     for (int c = 0; c < 3; ++c) {
         if (skip[c] || n == 0) {
             out[c].converged = true;
@@ -267,6 +309,8 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& 
         cg.relative_tolerance = relative_tolerance;
         cg.max_iterations = iteration_budget;
         cg.smallest_eigenvalue_hint = eigenvalue_hint_[c];
+        // The channels run one after the other: each gets its share of the frame's time left.
+        cg.deadline = deadline_.share(channels_left--);
         const CsrMatrixView<double> view{n, matrix.offsets.data(), matrix.columns.data(), matrix.values[c].data()};
         const ConjugateGradientResult r = solve_jacobi_cg<double>(view, b[c], phi[c], cg);
         if (r.smallest_eigenvalue_estimate > 0) eigenvalue_hint_[c] = r.smallest_eigenvalue_estimate;
@@ -313,7 +357,9 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multigrid(const DiffusionMa
     int vcycles = 0;
     // The channels are solved together: a channel within the tolerance rides along with the others.
     if (!(skip[0] && skip[1] && skip[2]) && vcycle_budget(iteration_budget) > 0) {
-        const FrameStep step = solver.step(vcycle_budget(iteration_budget));
+        const FrameStep step = deadline_.bounded()
+                                   ? solver.step(budget_until(deadline_, 1, vcycle_budget(iteration_budget)), clock_)
+                                   : solver.step(vcycle_budget(iteration_budget));
         vcycles = step.vcycles;
         multigrid_error_ = step.estimated_relative_error;
         for (int c = 0; c < 3; ++c) {
@@ -423,17 +469,23 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<s
     }
     MultiresSolveOptions options;
     options.relative_tolerance = relative_tolerance;
+    int channels_left = static_cast<int>(std::count(skip.begin(), skip.end(), false));
     for (int c = 0; c < 3; ++c) {
         if (skip[c]) {
             out[c] = {0, 0.0, true};
             continue;
         }
+        const int parts = channels_left--;
         if (iteration_budget <= 0) {
             out[c] = {0, multires_error_[c], multires_error_[c] <= relative_tolerance};
             continue;
         }
         MultiresSolveReport report;
-        const std::span<const double> solved = multires_->solve_frame(b[c], c, iteration_budget, &report, options);
+        // As for Jacobi CG: each channel's level-0 CG gets its share of the frame's time left.
+        const std::span<const double> solved =
+            deadline_.bounded() ? multires_->solve_frame(b[c], c, budget_until(deadline_, parts, iteration_budget),
+                                                         &report, options, clock_)
+                                : multires_->solve_frame(b[c], c, iteration_budget, &report, options);
         std::copy(solved.begin(), solved.end(), phi[c].begin());  // the host copy: radiance, saves, cuts
         multires_error_[c] = report.fine.estimated_relative_error;
         out[c] = {report.fine.iterations, report.fine.estimated_relative_error, report.fine.converged};

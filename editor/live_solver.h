@@ -42,8 +42,10 @@
 
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
+#include "solver/frame_budget.h"
 #include "solver/gl_context.h"
 #include "solver/gpu_compute.h"
+#include "solver/iteration_time_predictor.h"
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
@@ -90,6 +92,8 @@ struct LiveSolverOptions {
     LiveBackend backend = LiveBackend::Cpu;
     // The GPU backend's context; null: an OSMesa context is opened at the first GPU frame.
     std::shared_ptr<SolverGlContext> gl_context;
+    // The clock of time budgets (frame_budget.h); empty: steady_clock. Tests inject a fake one.
+    MillisecondClock clock;
 };
 
 struct LiveSolverChannel {
@@ -120,6 +124,23 @@ public:
     std::array<LiveSolverChannel, 3> iterate(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
                                              std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                              double relative_tolerance, const std::array<bool, 3>& skip);
+    // The same within a frame budget (frame_budget.h; validated). budget.max_iterations means what
+    // iteration_budget does (0: no limit). The time limit starts now, on LiveSolverOptions::clock:
+    //   CPU Jacobi CG and multires  the level-0 CG of each channel stops at its share of the time left
+    //                               (remaining / channels left, so a channel that finishes early leaves
+    //                               its time to the next); at least one iteration per channel. The
+    //                               multires frame after a rebuild runs its coarse-to-fine pass whole.
+    //   CPU multigrid CG            the deadline is checked between V-cycles (at least one runs).
+    //   GPU (both methods)          the device queue cannot stop part-way: the budget becomes an
+    //                               iteration count predicted from earlier GPU frames of either overload
+    //                               (gpu_iteration_time(); frames that uploaded the matrix or ran the
+    //                               coarse pass are not measured).
+    // An iteration-only budget gives the int overload's result bit for bit.
+    std::array<LiveSolverChannel, 3> iterate(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
+                                             std::array<std::vector<double>, 3>& phi, const FrameBudget& budget,
+                                             double relative_tolerance, const std::array<bool, 3>& skip);
+    // The GPU backend's measured cost per iteration (what turns a time budget into iterations there).
+    const IterationTimePredictor& gpu_iteration_time() const { return gpu_iteration_time_; }
 
     // The exitant radiance factor E (Eq. 3 without F_t, gpu_radiance.h) of every surface vertex, computed
     // on the device from the resident phi and gathered into surface order (`surface_vertices`: the
@@ -191,6 +212,11 @@ private:
     // Pending device work (applied at the next GPU iterate, with the context current).
     bool gpu_values_stale_ = false, gpu_rhs_stale_ = true, gpu_solution_stale_ = true;
     std::vector<int32_t> pending_rows_;  // ascending, unique; for the GPU and the multigrid levels
+    // Time budgets: the clock, the deadline of the frame being solved (unbounded outside a budgeted
+    // iterate(): the CPU paths read it), and the GPU's cost per iteration.
+    MillisecondClock clock_;
+    FrameDeadline deadline_;
+    IterationTimePredictor gpu_iteration_time_;
 };
 
 }  // namespace waxwork

@@ -2,6 +2,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
+#include <sstream>
+
 namespace waxwork {
 
 void add_live_solver_options(CLI::App& command, LiveSolverChoice& options, const std::string& gpu_context) {
@@ -19,6 +22,32 @@ void add_live_solver_options(CLI::App& command, LiveSolverChoice& options, const
                     "level-0 CG per frame; CPU or GPU)")
         ->check(CLI::IsMember({"jacobi", "mgcg", "multires"}))
         ->capture_default_str();
+    // Checked on the text, before conversion: CLI11 would read "nan" as a number.
+    const CLI::Validator frame_ms_check(
+        [](std::string& text) {
+            std::istringstream in(text);
+            double ms = 0;
+            if (!(in >> ms) || !(in >> std::ws).eof()) return "'" + text + "' is not a number of milliseconds";
+            const std::string problem = frame_ms_problem(ms);
+            return problem.empty() ? problem : "'" + text + "' " + problem;
+        },
+        "MS", "frame ms");
+    command
+        .add_option("--frame-ms", options.frame_ms,
+                    "Live solver budget per frame in milliseconds instead of iterations: the CPU methods stop "
+                    "iterating at the deadline (an iteration that started finishes; at least one runs per channel), "
+                    "the GPU predicts the iterations that fit from the previous frames' times. Default: the "
+                    "iteration budget (the editor's slider, a session's frame_iterations)")
+        ->check(frame_ms_check);
+}
+
+std::string frame_ms_problem(double milliseconds) {
+    if (!std::isfinite(milliseconds) || milliseconds <= 0 || milliseconds > kMaxFrameMilliseconds) {
+        std::ostringstream msg;
+        msg << "must be a time in milliseconds in (0, " << kMaxFrameMilliseconds << "]";
+        return msg.str();
+    }
+    return "";
 }
 
 }  // namespace waxwork

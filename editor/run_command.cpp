@@ -24,6 +24,7 @@ void run_run_command(const RunCommandOptions& o) {
     SessionRunOptions run;
     run.backend = parse_live_backend(o.solver.backend);
     run.method = parse_live_method(o.solver.method);
+    run.frame_ms = o.solver.frame_ms;
     const SessionResult result = run_session(session, o.output, run);
     if (!result.gpu_fallback_reason.empty())
         std::cerr << "warning: solved on the CPU instead: " << result.gpu_fallback_reason << "\n";

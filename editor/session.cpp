@@ -3,6 +3,7 @@
 #include "solver/gl_context.h"
 #include "editor/json_fields.h"
 #include "editor/live_scene.h"
+#include "editor/live_solver_choice.h"
 #include "editor/render_pipeline.h"
 #include "io/atomic_file.h"
 #include "io/image_io.h"
@@ -246,6 +247,11 @@ Session parse_session(const Json& json, const fs::path& base_directory, const st
     session.tolerance = in.number("tolerance", session.tolerance);
     if (!(session.tolerance > 0 && session.tolerance < 1)) fail_json(in.field("tolerance"), "must be in (0, 1)");
     if (in.has("frame_iterations")) session.frame_iterations = count_from(in, "frame_iterations");
+    if (in.has("frame_ms")) {
+        session.frame_ms = in.number("frame_ms");
+        const std::string problem = frame_ms_problem(*session.frame_ms);
+        if (!problem.empty()) fail_json(in.field("frame_ms"), problem);
+    }
     const Json& steps = in.at("steps");
     if (!steps.is_array()) fail_json(in.field("steps"), "expected an array of steps");
     for (size_t i = 0; i < steps.size(); ++i)
@@ -277,6 +283,7 @@ Json session_to_json(const Session& session) {
     j["image"] = Json{{"width", session.width}, {"height", session.height}};
     j["tolerance"] = session.tolerance;
     j["frame_iterations"] = session.frame_iterations;
+    if (session.frame_ms) j["frame_ms"] = *session.frame_ms;
     Json steps = Json::array();
     for (const SessionStep& step : session.steps) steps.push_back(step_to_json(step, session));
     j["steps"] = steps;
@@ -315,6 +322,11 @@ TetMesh load_session_input(const Session& session) {
         meshing.sizing = default_mesh_sizing(loaded.surface, session.material, session.scale);
     }
     return tetrahedralize(loaded.surface, meshing).mesh;
+}
+
+FrameBudget session_frame_budget(const Session& session, const SessionRunOptions& run_options) {
+    const std::optional<double> ms = run_options.frame_ms ? run_options.frame_ms : session.frame_ms;
+    return ms ? FrameBudget::milliseconds(*ms) : FrameBudget::iterations(session.frame_iterations);
 }
 
 SessionResult run_session(const Session& session, const fs::path& output_directory, const SessionRunOptions& run_options) {
@@ -364,7 +376,7 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
                 FrameReport frame;
                 if (r->frames) {
                     for (int f = 0; f < *r->frames; ++f) {
-                        frame = scene.step(session.frame_iterations);
+                        frame = scene.step(session_frame_budget(session, run_options));
                         m.solver_iterations += frame.total_iterations();
                     }
                 } else {
@@ -425,12 +437,15 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
                                {"estimated_error", error ? Json(*error) : Json(nullptr)}});
         result.steps.push_back(m);
     }
+    const FrameBudget budget = session_frame_budget(session, run_options);
     const Json summary{{"session", session.name},
                        {"load_milliseconds", result.load_ms},
                        {"undo_bytes", document.undo_bytes()},
                        {"undo_entries_evicted", document.evicted_undo_count()},
                        {"solver_backend", live_backend_name(scene.backend())},
                        {"solver_method", live_method_name(run_options.method)},
+                       // The time budget of the frames of render steps with "frames"; null: frame_iterations.
+                       {"frame_ms", budget.limits_time() ? Json(budget.max_milliseconds) : Json(nullptr)},
                        {"gpu_fallback_reason", scene.gpu_fallback_reason()},
                        {"steps", metrics}};
     write_file_atomically(output_directory / "metrics.json", [&](std::ostream& out) { out << summary.dump(2) << "\n"; });

@@ -14,6 +14,8 @@
 //     "image": {"width": 640, "height": 480},
 //     "tolerance": 0.001,                  relative error a converged frame reaches
 //     "frame_iterations": 10,              CG iterations per channel of one live frame
+//     "frame_ms": 10,                      optional: a live frame's time budget in ms instead (solver/
+//                                          frame_budget.h); renders after "frames" then vary with the machine
 //     "steps": [
 //       {"op": "plane_cut", ...},          any edit operation (edit_operation.h)
 //       {"render": "cut.png"},             a converged frame; {"render": "f.png", "frames": 3}: the frame
@@ -87,6 +89,7 @@ struct Session {
     int height = 480;
     double tolerance = 1e-3;
     int frame_iterations = 10;
+    std::optional<double> frame_ms;  // nullopt: frames are budgeted by frame_iterations
     std::vector<SessionStep> steps;
 };
 
@@ -131,11 +134,16 @@ struct SessionResult {
 struct SessionRunOptions {
     LiveMethod method = LiveMethod::JacobiCg;
     LiveBackend backend = LiveBackend::Cpu;
+    std::optional<double> frame_ms;  // `run --frame-ms`: replaces the session's frame budget
 };
+
+// The budget of one live frame of `session` run with `run_options` (frame_ms, else frame_iterations).
+FrameBudget session_frame_budget(const Session& session, const SessionRunOptions& run_options = {});
 
 // Replays the session, writing renders and saves under `output_directory` (created) and
 // OUTDIR/metrics.json. Errors name the session and the step index.
 // metrics.json also names the solver backend (solver_backend, and gpu_fallback_reason after one).
+// and the frames' time budget (frame_ms; null for an iteration budget).
 SessionResult run_session(const Session& session, const std::filesystem::path& output_directory,
                           const SessionRunOptions& run_options = {});
 

@@ -164,6 +164,17 @@ double MultigridFrameSolver::smallest_eigenvalue(size_t c) const {
 FrameStep MultigridFrameSolver::step(int budget) {
     if (!has_b_) throw InvalidArgumentError("frame solver: step() before set_right_hand_side()");
     if (budget < 1) throw InvalidArgumentError("frame solver: budget " + std::to_string(budget) + " < 1");
+    return step_within(budget, FrameDeadline{});
+}
+
+FrameStep MultigridFrameSolver::step(const FrameBudget& budget, const MillisecondClock& clock) {
+    validate(budget);
+    const FrameDeadline deadline = FrameDeadline::of(budget, clock);
+    return step_within(budget.limits_iterations() ? budget.max_iterations : std::numeric_limits<int>::max(), deadline);
+}
+
+FrameStep MultigridFrameSolver::step_within(int budget, const FrameDeadline& deadline) {
+    if (!has_b_) throw InvalidArgumentError("frame solver: step() before set_right_hand_side()");
     FrameStep result;
     if (refresh_) {
         refresh_residual();
@@ -182,7 +193,8 @@ FrameStep MultigridFrameSolver::step(int budget) {
     }
     const int32_t* offsets = hierarchy_->levels[0].offsets.data();
     const int32_t* columns = hierarchy_->levels[0].columns.data();
-    for (int cycle = 0; cycle < budget; ++cycle) {
+    // The deadline is read between V-cycles only (one clock read each): the first always runs.
+    for (int cycle = 0; cycle < budget && !(cycle > 0 && deadline.expired()); ++cycle) {
         preconditioner_->apply_rgb(r_, z_);
         ++result.vcycles;
         // r . z and phi . M phi = phi . (b - r) per channel.

@@ -29,6 +29,7 @@
 #include "multires/hierarchy.h"
 #include "multires/multigrid_preconditioner.h"
 #include "solver/diffusion_matrix.h"
+#include "solver/frame_budget.h"
 
 #include <Eigen/Core>
 
@@ -71,6 +72,13 @@ public:
     // InvalidArgumentError when no right-hand side was set or budget < 1, AlgorithmError when the
     // matrix or preconditioner turns out not to be positive definite.
     FrameStep step(int budget);
+    // The same within a frame budget (solver/frame_budget.h): budget.max_iterations counts V-cycles
+    // (0: no limit), budget.max_milliseconds runs on `clock` (empty: steady_clock) from the call and
+    // is checked between V-cycles (each with its CG update finishes; at least one runs). Stopping
+    // between V-cycles leaves the same state as a V-cycle budget would: a budget that ran k V-cycles
+    // equals step(k) bit for bit, and the next frame resumes from it. Throws InvalidArgumentError for
+    // an invalid budget (validate(FrameBudget)) and as step(int).
+    FrameStep step(const FrameBudget& budget, const MillisecondClock& clock = {});
 
     // The tolerance step() stops at (FrameSolverOptions::relative_tolerance), e.g. a tighter one to
     // converge a scene the frames left at a looser one. Throws InvalidArgumentError unless positive.
@@ -95,6 +103,7 @@ public:
     const MultigridPreconditioner& preconditioner() const { return *preconditioner_; }
 
 private:
+    FrameStep step_within(int max_vcycles, const FrameDeadline& deadline);
     void refresh_residual();
     double smallest_eigenvalue(size_t channel) const;
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace waxwork {
 
@@ -77,13 +78,15 @@ void MultiresSolver::reset_warm_start() {
 }
 
 void MultiresSolver::solve_fine(std::span<const double> b, int channel, std::span<double> x,
-                                const MultiresSolveOptions& options, MultiresSolveReport& report) {
+                                const MultiresSolveOptions& options, MultiresSolveReport& report,
+                                const FrameDeadline& deadline) {
     const auto start = std::chrono::steady_clock::now();
     const HierarchyLevel& level0 = hierarchy_.levels[0];
     ConjugateGradientOptions cg;
     cg.relative_tolerance = options.relative_tolerance;
     cg.max_iterations = options.max_iterations;
     cg.smallest_eigenvalue_hint = eigenvalue_hint_[static_cast<size_t>(channel)];
+    cg.deadline = deadline;  // the cold retry below shares it (and still runs at least one iteration)
     try {
         report.fine = solve_jacobi_cg<double>(level0.view(channel), b, x, cg);
     } catch (const AlgorithmError& error) {
@@ -102,6 +105,11 @@ void MultiresSolver::solve_fine(std::span<const double> b, int channel, std::spa
 
 MultiresSolveReport MultiresSolver::solve(std::span<const double> b, int channel, std::span<double> x,
                                           const MultiresSolveOptions& options) {
+    return solve_within(b, channel, x, options, FrameDeadline{});
+}
+
+MultiresSolveReport MultiresSolver::solve_within(std::span<const double> b, int channel, std::span<double> x,
+                                                 const MultiresSolveOptions& options, const FrameDeadline& deadline) {
     check_channel(channel);
     const size_t n0 = hierarchy_.levels[0].size();
     if (b.size() != n0 || x.size() != n0)
@@ -147,7 +155,7 @@ MultiresSolveReport MultiresSolver::solve(std::span<const double> b, int channel
         std::fill(x.begin(), x.end(), 0.0);
     }
     report.coarse_ms = elapsed_ms(start);
-    solve_fine(b, channel, x, options, report);
+    solve_fine(b, channel, x, options, report, deadline);
     std::vector<double>& last = last_solution_[static_cast<size_t>(channel)];
     if (last.data() != x.data()) last.assign(x.begin(), x.end());  // solve_frame passes `last` itself
     return report;
@@ -155,19 +163,36 @@ MultiresSolveReport MultiresSolver::solve(std::span<const double> b, int channel
 
 std::span<const double> MultiresSolver::solve_frame(std::span<const double> b, int channel, int iteration_budget,
                                                     MultiresSolveReport* report, const MultiresSolveOptions& options) {
+    return solve_frame_within(b, channel, std::max(iteration_budget, 0), report, options, FrameDeadline{});
+}
+
+std::span<const double> MultiresSolver::solve_frame(std::span<const double> b, int channel, const FrameBudget& budget,
+                                                    MultiresSolveReport* report, const MultiresSolveOptions& options,
+                                                    const MillisecondClock& clock) {
+    validate(budget);
+    // The deadline starts here, so a coarse-to-fine pass counts against the frame.
+    const FrameDeadline deadline = FrameDeadline::of(budget, clock);
+    const int max_iterations = budget.limits_iterations() ? budget.max_iterations : std::numeric_limits<int>::max();
+    return solve_frame_within(b, channel, max_iterations, report, options, deadline);
+}
+
+std::span<const double> MultiresSolver::solve_frame_within(std::span<const double> b, int channel, int max_iterations,
+                                                           MultiresSolveReport* report,
+                                                           const MultiresSolveOptions& options,
+                                                           const FrameDeadline& deadline) {
     check_channel(channel);
     MultiresSolveOptions budgeted = options;
-    budgeted.max_iterations = std::max(iteration_budget, 0);
+    budgeted.max_iterations = max_iterations;
     std::vector<double>& last = last_solution_[static_cast<size_t>(channel)];
     MultiresSolveReport local;
     if (last.size() != hierarchy_.levels[0].size()) {
         last.assign(hierarchy_.levels[0].size(), 0.0);
-        local = solve(b, channel, last, budgeted);
+        local = solve_within(b, channel, last, budgeted, deadline);
     } else {
         if (b.size() != last.size())
             throw InvalidArgumentError("multires solve_frame: right-hand side of size " + std::to_string(b.size()) +
                                        " for " + std::to_string(last.size()) + " vertices");
-        solve_fine(b, channel, last, budgeted, local);
+        solve_fine(b, channel, last, budgeted, local, deadline);
     }
     if (report) *report = std::move(local);
     return last;

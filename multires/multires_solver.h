@@ -17,6 +17,7 @@
 #include "multires/hierarchy.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
+#include "solver/frame_budget.h"
 
 #include <array>
 #include <span>
@@ -81,6 +82,17 @@ public:
     std::span<const double> solve_frame(std::span<const double> b, int channel, int iteration_budget,
                                         MultiresSolveReport* report = nullptr,
                                         const MultiresSolveOptions& options = {});
+    // The same within a frame budget (solver/frame_budget.h): at most budget.max_iterations level-0 CG
+    // iterations (0: no limit) and/or until budget.max_milliseconds have passed on `clock` (empty:
+    // steady_clock) since the call, checked before each CG iteration (at least one runs). A frame that
+    // must first run the coarse-to-fine pass runs that pass whole, however long it takes: it is the
+    // start vector the later frames warm-start from, and BiCGSTAB stopped part-way on a coarse level
+    // would hand the finer levels a worse start, not a cheaper frame; the level-0 CG then gets what is
+    // left (at least one iteration). An iteration-only budget gives the int overload's result bit for
+    // bit. Throws InvalidArgumentError for an invalid budget (validate(FrameBudget)).
+    std::span<const double> solve_frame(std::span<const double> b, int channel, const FrameBudget& budget,
+                                        MultiresSolveReport* report = nullptr,
+                                        const MultiresSolveOptions& options = {}, const MillisecondClock& clock = {});
 
     // After a material change (painting) on the same mesh: takes the new level-0 values and recomputes
     // the coarse matrices (Eq. 17) on the kept graphs and interpolation, without a new selection.
@@ -99,8 +111,13 @@ public:
     void reset_warm_start();
 
 private:
+    MultiresSolveReport solve_within(std::span<const double> b, int channel, std::span<double> x,
+                                     const MultiresSolveOptions& options, const FrameDeadline& deadline);
+    std::span<const double> solve_frame_within(std::span<const double> b, int channel, int max_iterations,
+                                               MultiresSolveReport* report, const MultiresSolveOptions& options,
+                                               const FrameDeadline& deadline);
     void solve_fine(std::span<const double> b, int channel, std::span<double> x, const MultiresSolveOptions& options,
-                    MultiresSolveReport& report);
+                    MultiresSolveReport& report, const FrameDeadline& deadline);
 
     MultiresHierarchy hierarchy_;
     std::array<std::vector<double>, 3> last_solution_;

@@ -189,7 +189,8 @@ ConjugateGradientResult solve_jacobi_cg(const CsrMatrixView<Scalar>& m, std::spa
     }
 
     int k = 0;
-    for (; k < options.max_iterations && st.active; ++k) {
+    // The deadline is read last (short-circuit): only when another iteration would otherwise run.
+    for (; k < options.max_iterations && st.active && !(k > 0 && options.deadline.expired()); ++k) {
         // q = M p and p . q in one pass.
         const double pq = reduce_rows(n, [&](size_t begin, size_t end) {
             double acc = 0;

@@ -22,6 +22,8 @@
 // non-finite iterate throw AlgorithmError: the solver never returns NaN.
 #pragma once
 
+#include "solver/frame_budget.h"
+
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -46,6 +48,11 @@ struct ConjugateGradientOptions {
     // Called after every iteration with the iterate and its error estimate (slower: the estimate is
     // then refreshed every iteration). For tests and convergence plots.
     std::function<void(int iteration, double estimated_relative_error)> on_iteration;
+    // A frame's time limit (frame_budget.h): checked before each iteration after the first (one clock
+    // read), so an iteration that started finishes and at least one runs. The stop is just an earlier
+    // max_iterations: a run the deadline stopped after k iterations equals the run with
+    // max_iterations = k bit for bit. Default: none.
+    FrameDeadline deadline;
 };
 
 struct ConjugateGradientResult {
