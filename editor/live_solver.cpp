@@ -134,8 +134,10 @@ void LiveSolver::release_gpu() {
 
 void LiveSolver::fall_back(const std::string& reason) {
     gpu_fallback_reason_ = reason;
-    multires_cold_ = true;  // the CPU hierarchy has no warm start of its own yet
+    multires_pending_.solution = true;  // the CPU hierarchy has no warm start of its own yet
     backend_ = LiveBackend::Cpu;
+    gpu_pending_ = PendingChanges{};  // no device to catch up any more
+    gpu_level_rows_.clear();
     try {
         release_gpu();
     } catch (...) {
@@ -143,12 +145,20 @@ void LiveSolver::fall_back(const std::string& reason) {
     }
 }
 
+void LiveSolver::PendingChanges::rows_changed(std::span<const int32_t> ascending_unique) {
+    if (all_values) return;  // every row is re-sent anyway
+    std::vector<int32_t> merged;
+    merged.reserve(rows.size() + ascending_unique.size());
+    std::set_union(rows.begin(), rows.end(), ascending_unique.begin(), ascending_unique.end(), std::back_inserter(merged));
+    rows.swap(merged);
+}
+
 void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix) {
     eigenvalue_hint_ = {0, 0, 0};  // belong to the old matrix (a stale hint can be too optimistic)
     multigrid_.reset();
-    multigrid_changed();
-    multigrid_values_stale_ = false;
-    multigrid_rhs_stale_ = multigrid_solution_stale_ = true;
+    forget_estimates();
+    // Every copy is rebuilt from this matrix: nothing of the old one is pending, b and phi are.
+    multigrid_pending_ = multires_pending_ = gpu_pending_ = PendingChanges{};
     // The GPU backend runs Jacobi CG whatever the method (there is no device V-cycle); after a fallback
     // the CPU then uses Jacobi CG until the next rebuild builds the hierarchy.
     if (method_ == LiveMethod::MultigridCg && backend_ == LiveBackend::Cpu && matrix.size() > 0) {
@@ -158,8 +168,6 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
         multigrid_ = std::make_unique<MultigridFrameSolver>(matrix, mesh.positions);
     }
     multires_.reset();
-    multires_values_stale_ = false;
-    multires_cold_ = true;
     gpu_level_rows_.clear();
     // Built for either backend: the device copy is made from it, and a fallback keeps solving with it.
     if (method_ == LiveMethod::Multires && matrix.size() > 0) {
@@ -167,8 +175,6 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
             throw InvalidArgumentError("live solver: the matrix does not belong to the mesh");
         multires_ = std::make_unique<MultiresSolver>(matrix, mesh.positions);
     }
-    pending_rows_.clear();
-    gpu_values_stale_ = false;
     if (gpu_) {
         try {
             release_gpu();  // a new pattern: rebuilt at the next frame
@@ -176,22 +182,18 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
             fall_back(std::string("GPU solver: ") + e.what());
         }
     }
-    gpu_rhs_stale_ = gpu_solution_stale_ = true;
 }
 
 // Material changes keep the eigenvalue hints, as the CPU path always did: the stopping rule confirms
 // convergence with the true residual anyway (conjugate_gradient.h).
 void LiveSolver::values_changed() {
     if (gpu_) gpu_->radiance_stale_weights = true;  // the boundary eta may have changed
-    multigrid_values_stale_ = true;
-    multires_values_stale_ = true;
-    multigrid_changed();
-    gpu_values_stale_ = true;
-    pending_rows_.clear();
+    forget_estimates();
+    for (PendingChanges* pending : {&multigrid_pending_, &multires_pending_, &gpu_pending_}) pending->values_changed();
     gpu_level_rows_.clear();
 }
 
-void LiveSolver::multigrid_changed() {
+void LiveSolver::forget_estimates() {
     multigrid_error_ = {1, 1, 1};
     multires_error_ = {1, 1, 1};
 }
@@ -199,28 +201,27 @@ void LiveSolver::multigrid_changed() {
 void LiveSolver::rows_changed(std::span<const int32_t> rows) {
     if (rows.empty()) return;
     if (gpu_) gpu_->radiance_stale_weights = true;
-    multigrid_changed();
-    if (gpu_values_stale_ && multigrid_values_stale_) return;  // everything is re-sent anyway
-    std::vector<int32_t> merged;
-    merged.reserve(pending_rows_.size() + rows.size());
+    forget_estimates();
     std::vector<int32_t> sorted(rows.begin(), rows.end());
     std::sort(sorted.begin(), sorted.end());
-    std::set_union(pending_rows_.begin(), pending_rows_.end(), sorted.begin(), sorted.end(), std::back_inserter(merged));
-    merged.erase(std::unique(merged.begin(), merged.end()), merged.end());
-    pending_rows_.swap(merged);
+    sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+    // Only copies that exist (or, for the device, will at the next GPU frame) collect rows.
+    if (multigrid_) multigrid_pending_.rows_changed(sorted);
+    if (multires_) multires_pending_.rows_changed(sorted);
+    if (backend_ == LiveBackend::Gpu) gpu_pending_.rows_changed(sorted);
 }
 
 void LiveSolver::right_hand_sides_changed() {
-    gpu_rhs_stale_ = true;
-    multigrid_rhs_stale_ = true;
-    multigrid_changed();
+    gpu_pending_.right_hand_sides = true;
+    multigrid_pending_.right_hand_sides = true;
+    forget_estimates();
     if (gpu_) gpu_->radiance_light_stale = true;
 }
 void LiveSolver::solution_changed() {
-    gpu_solution_stale_ = true;
-    multigrid_solution_stale_ = true;
-    multires_cold_ = true;  // the solvers keep their own warm starts: solve the new state coarse to fine
-    multigrid_changed();
+    gpu_pending_.solution = true;
+    multigrid_pending_.solution = true;
+    multires_pending_.solution = true;  // the solvers keep their own warm starts: solve the new state coarse to fine
+    forget_estimates();
 }
 
 std::string LiveSolver::description() const {
@@ -242,7 +243,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate(const DiffusionMatrix& matr
                                                      double relative_tolerance, const std::array<bool, 3>& skip) {
     // A frame that uploads the whole matrix or runs the coarse-to-fine pass costs far more than its
     // iterations: measuring it would make the next time-budgeted frames much too short.
-    const bool one_off_work = !gpu_ || gpu_values_stale_ || (multires_ && multires_cold_);
+    const bool one_off_work = !gpu_ || gpu_pending_.all_values || (multires_ && multires_pending_.solution);
     if (multires_) update_multires_values(matrix);  // the host hierarchy first, whichever backend solves
     if (backend_ == LiveBackend::Gpu) {
         try {
@@ -294,8 +295,6 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& 
     const size_t n = matrix.size();
     if (multigrid_ && n > 0) return iterate_multigrid(matrix, b, phi, iteration_budget, relative_tolerance, skip);
     if (multires_ && n > 0) return iterate_multires(b, phi, iteration_budget, relative_tolerance, skip);
-    // The rows stay pending for the GPU only if it is still meant to run (not after a fallback).
-    if (backend_ == LiveBackend::Cpu) pending_rows_.clear();
 
     std::array<LiveSolverChannel, 3> out;
     int channels_left = static_cast<int>(std::count(skip.begin(), skip.end(), false));
@@ -316,8 +315,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& 
         if (r.smallest_eigenvalue_estimate > 0) eigenvalue_hint_[c] = r.smallest_eigenvalue_estimate;
         out[c] = {r.iterations, r.estimated_relative_error, r.converged};
     }
-    // The device no longer holds this phi.
-    gpu_solution_stale_ = true;
+    gpu_pending_.solution = true;  // the device no longer holds this phi
     return out;
 }
 
@@ -327,20 +325,20 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multigrid(const DiffusionMa
                                                                int iteration_budget, double relative_tolerance,
                                                                const std::array<bool, 3>& skip) {
     MultigridFrameSolver& solver = *multigrid_;
-    if (multigrid_values_stale_) {
+    PendingChanges& pending = multigrid_pending_;
+    if (pending.all_values) {
         // All values on the kept pattern: every row changed (the hierarchy's graphs and Eq. 16 weights
         // depend on the pattern and rest positions only, so they stay).
         std::vector<int32_t> all(matrix.size());
         std::iota(all.begin(), all.end(), 0);
         solver.update_values(matrix, all);
-    } else if (!pending_rows_.empty()) {
-        solver.update_values(matrix, pending_rows_);  // paint: the changed rows and their coarse rows
+    } else if (!pending.rows.empty()) {
+        solver.update_values(matrix, pending.rows);  // paint: the changed rows and their coarse rows
     }
-    multigrid_values_stale_ = false;
-    pending_rows_.clear();  // the solver exists only on the CPU backend
-    if (multigrid_rhs_stale_) solver.set_right_hand_side({b[0], b[1], b[2]});
-    multigrid_rhs_stale_ = false;
-    if (multigrid_solution_stale_) {
+    pending.values_applied();
+    if (pending.right_hand_sides) solver.set_right_hand_side({b[0], b[1], b[2]});
+    pending.right_hand_sides = false;
+    if (pending.solution) {
         // A zero phi is where the solver starts anyway (no product to form its residual).
         const bool zero = std::all_of(phi.begin(), phi.end(), [](const std::vector<double>& v) {
             return std::all_of(v.begin(), v.end(), [](double x) { return x == 0.0; });
@@ -350,7 +348,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multigrid(const DiffusionMa
         else
             solver.set_phi({phi[0], phi[1], phi[2]});
     }
-    multigrid_solution_stale_ = false;
+    pending.solution = false;
     solver.set_relative_tolerance(relative_tolerance);
 
     std::array<LiveSolverChannel, 3> out;
@@ -376,8 +374,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multigrid(const DiffusionMa
         // update (the update only lowers the energy-norm error).
         out[c] = {vcycles, multigrid_error_[c], multigrid_error_[c] <= relative_tolerance};
     }
-    // The device no longer holds this phi.
-    gpu_solution_stale_ = true;
+    gpu_pending_.solution = true;  // the device no longer holds this phi
     return out;
 }
 
@@ -402,24 +399,23 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu(const DiffusionMatrix& 
         gpu_ = std::move(gpu);
         const GLubyte* renderer = gl.GetString(GL_RENDERER);
         renderer_ = renderer ? reinterpret_cast<const char*>(renderer) : "";
-        gpu_rhs_stale_ = gpu_solution_stale_ = true;
-    } else if (gpu_values_stale_) {
+        gpu_pending_ = PendingChanges{};  // a new device copy: the current values; b and phi to send
+    } else if (gpu_pending_.all_values) {
         gpu_->solver->update_values(matrix);
-    } else if (!pending_rows_.empty()) {
-        gpu_->solver->update_rows(matrix, pending_rows_);  // paint: O(changed entries) upload
+    } else if (!gpu_pending_.rows.empty()) {
+        gpu_->solver->update_rows(matrix, gpu_pending_.rows);  // paint: O(changed entries) upload
     }
-    gpu_values_stale_ = false;
-    pending_rows_.clear();
-    if (gpu_rhs_stale_) gpu_->solver->set_right_hand_side(b);
-    gpu_rhs_stale_ = false;
+    gpu_pending_.values_applied();
+    if (gpu_pending_.right_hand_sides) gpu_->solver->set_right_hand_side(b);
+    gpu_pending_.right_hand_sides = false;
     auto& staging = gpu_->staging;
-    if (gpu_solution_stale_) {
+    if (gpu_pending_.solution) {
         staging.resize(n);
         for (size_t v = 0; v < n; ++v)
             for (int c = 0; c < 3; ++c) staging[v][c] = phi[c][v];
         gpu_->solver->set_solution(staging);
     }
-    gpu_solution_stale_ = false;
+    gpu_pending_.solution = false;
 
     GpuCgOptions options;
     options.relative_tolerance = relative_tolerance;
@@ -434,13 +430,13 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu(const DiffusionMatrix& 
 }
 
 void LiveSolver::update_multires_values(const DiffusionMatrix& matrix) {
-    if (multires_values_stale_) {
+    if (multires_pending_.all_values) {
         multires_->update_values(matrix);  // all values on the kept pattern and selection
-        gpu_level_rows_.clear();           // gpu_values_stale_: the device takes every row
-    } else if (!pending_rows_.empty()) {
+        gpu_level_rows_.clear();           // gpu_pending_.all_values: the device takes every row
+    } else if (!multires_pending_.rows.empty()) {
         // Paint: the changed level-0 rows and the Eq. 17 coarse rows that read them.
-        const std::vector<std::vector<int32_t>> level_rows = multires_->update_values(matrix, pending_rows_);
-        if (backend_ == LiveBackend::Gpu && !gpu_values_stale_) {
+        const std::vector<std::vector<int32_t>> level_rows = multires_->update_values(matrix, multires_pending_.rows);
+        if (backend_ == LiveBackend::Gpu && !gpu_pending_.all_values) {
             gpu_level_rows_.resize(std::max(gpu_level_rows_.size(), level_rows.size()));
             for (size_t l = 0; l < level_rows.size(); ++l) {
                 std::vector<int32_t> merged;
@@ -450,12 +446,8 @@ void LiveSolver::update_multires_values(const DiffusionMatrix& matrix) {
             }
         }
     }
-    multires_values_stale_ = false;
-    // rows_changed skips rows while every consumer re-sends all values: the multigrid flag has no
-    // consumer with this method, and the CPU has no device to re-send to.
-    multigrid_values_stale_ = false;
-    if (backend_ == LiveBackend::Cpu) gpu_values_stale_ = false;
-    pending_rows_.clear();
+    multires_pending_.values_applied();
+    gpu_pending_.rows.clear();  // the device copy of the hierarchy takes them per level (gpu_level_rows_)
 }
 
 std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<std::vector<double>, 3>& b,
@@ -463,9 +455,9 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<s
                                                               int iteration_budget, double relative_tolerance,
                                                               const std::array<bool, 3>& skip) {
     std::array<LiveSolverChannel, 3> out;
-    if (iteration_budget > 0 && multires_cold_) {
+    if (iteration_budget > 0 && multires_pending_.solution) {
         multires_->reset_warm_start();  // solve_frame then runs the coarse-to-fine pass
-        multires_cold_ = false;
+        multires_pending_.solution = false;
     }
     MultiresSolveOptions options;
     options.relative_tolerance = relative_tolerance;
@@ -490,7 +482,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<s
         multires_error_[c] = report.fine.estimated_relative_error;
         out[c] = {report.fine.iterations, report.fine.estimated_relative_error, report.fine.converged};
     }
-    gpu_solution_stale_ = true;
+    gpu_pending_.solution = true;  // the device no longer holds this phi
     return out;
 }
 
@@ -508,9 +500,10 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multires(const Diffusio
         gpu_ = std::move(gpu);
         const GLubyte* renderer = gl.GetString(GL_RENDERER);
         renderer_ = renderer ? reinterpret_cast<const char*>(renderer) : "";
-        gpu_rhs_stale_ = true;
-        multires_cold_ = true;
-    } else if (gpu_values_stale_) {
+        gpu_pending_ = PendingChanges{};  // a new device copy: the current values; b to send
+        gpu_level_rows_.clear();
+        multires_pending_.solution = true;  // its phi starts at zero: coarse to fine
+    } else if (gpu_pending_.all_values) {
         // All values: every row of every level (the uploaded patterns stay).
         std::vector<std::vector<int32_t>> all(hierarchy.level_count());
         for (size_t l = 0; l < all.size(); ++l) {
@@ -521,10 +514,10 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multires(const Diffusio
     } else if (!gpu_level_rows_.empty()) {
         gpu_->multires->update_rows(matrix, hierarchy, gpu_level_rows_);  // paint: O(changed entries)
     }
-    gpu_values_stale_ = false;
+    gpu_pending_.values_applied();
     gpu_level_rows_.clear();
-    if (gpu_rhs_stale_) gpu_->multires->set_right_hand_side(b);
-    gpu_rhs_stale_ = false;
+    if (gpu_pending_.right_hand_sides) gpu_->multires->set_right_hand_side(b);
+    gpu_pending_.right_hand_sides = false;
 
     std::array<LiveSolverChannel, 3> out;
     if (iteration_budget <= 0) {
@@ -536,12 +529,12 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multires(const Diffusio
     fine.max_iterations = iteration_budget;
     fine.use_eigenvalue_hints = true;
     std::array<ConjugateGradientResult, 3> results;
-    if (multires_cold_) {
+    if (multires_pending_.solution) {
         MultiresSolveOptions options;
         options.relative_tolerance = relative_tolerance;
         options.max_iterations = iteration_budget;
         results = gpu_->multires->solve(options, fine).fine;
-        multires_cold_ = false;
+        multires_pending_.solution = false;
     } else {
         results = gpu_->multires->solve_fine(fine);  // warm from the resident phi
     }

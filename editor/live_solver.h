@@ -172,7 +172,8 @@ private:
                                                        const std::array<std::vector<double>, 3>& b,
                                                        std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                        double relative_tolerance, const std::array<bool, 3>& skip);
-    void multigrid_changed();
+    // The multigrid and multires estimates a frame of no iterations reports go back to 1 (unknown).
+    void forget_estimates();
     // Multires (both backends): applies pending value changes to the host hierarchy and queues the
     // changed rows of every level for the device.
     void update_multires_values(const DiffusionMatrix& matrix);
@@ -195,23 +196,42 @@ private:
     std::string gpu_fallback_reason_;
     std::string renderer_;
     std::array<double, 3> eigenvalue_hint_{};
+    // What changed since one copy of the system last caught up; each copy (the multigrid frame
+    // solver, the multires hierarchy, the device) applies its own record at its next frame, so a
+    // change reaches every copy exactly once whichever of them runs when.
+    struct PendingChanges {
+        bool all_values = false;    // every matrix value changed (same pattern); rows is then empty
+        std::vector<int32_t> rows;  // else the rows that changed, ascending and unique
+        bool right_hand_sides = true;
+        bool solution = true;  // the host phi was replaced (or never sent): start from it
+
+        void values_changed() {
+            all_values = true;
+            rows.clear();
+        }
+        void rows_changed(std::span<const int32_t> ascending_unique);  // nothing to add after all_values
+        void values_applied() {
+            all_values = false;
+            rows.clear();
+        }
+    };
+
     std::unique_ptr<MultigridFrameSolver> multigrid_;
-    // Pending multigrid work (applied at the next iterate): all values, b, the host phi (a warm start).
-    bool multigrid_values_stale_ = false, multigrid_rhs_stale_ = true, multigrid_solution_stale_ = true;
+    PendingChanges multigrid_pending_;  // values, b, and phi as a warm start
     // The last frame's estimates, reported by a frame of no V-cycles (1 after a change).
     std::array<double, 3> multigrid_error_{1, 1, 1};
     std::unique_ptr<MultiresSolver> multires_;
-    // Pending multires work: all values (else pending_rows_); the next frame solves coarse to fine
-    // (after a rebuild or a replaced phi; the CPU's warm starts are the solver's own last solutions).
-    bool multires_values_stale_ = false, multires_cold_ = true;
+    // Values, and `solution`: the next frame solves coarse to fine (after a rebuild or a replaced phi;
+    // the CPU's warm starts are the solver's own last solutions), on the host or the device.
+    PendingChanges multires_pending_;
     std::array<double, 3> multires_error_{1, 1, 1};  // reported by a frame of no iterations
-    // Rows per level the device copy of the hierarchy has not received yet (ascending, unique), or
-    // all of them (gpu_values_stale_).
+    // Rows per level the device copy of the hierarchy has not received yet (ascending, unique); all of
+    // them when gpu_pending_.all_values.
     std::vector<std::vector<int32_t>> gpu_level_rows_;
     std::unique_ptr<Gpu> gpu_;
-    // Pending device work (applied at the next GPU iterate, with the context current).
-    bool gpu_values_stale_ = false, gpu_rhs_stale_ = true, gpu_solution_stale_ = true;
-    std::vector<int32_t> pending_rows_;  // ascending, unique; for the GPU and the multigrid levels
+    // Device work, applied at the next GPU iterate with the context current. Rows are collected only
+    // while the GPU backend runs (a device made later is sent everything).
+    PendingChanges gpu_pending_;
     // Time budgets: the clock, the deadline of the frame being solved (unbounded outside a budgeted
     // iterate(): the CPU paths read it), and the GPU's cost per iteration.
     MillisecondClock clock_;
