@@ -81,6 +81,7 @@ void run_edit_command(const EditCommandOptions& o) {
             {"vertices", stats.vertices},  {"gl_version", stats.gl_version},
             {"gl_renderer", stats.gl_renderer}, {"solver_backend", stats.solver_backend},
             {"gpu_fallback_reason", stats.gpu_fallback_reason},
+            {"method_fallback_reason", stats.method_fallback_reason},
             {"view_reads_device_radiance", stats.view_reads_device_radiance},
         };
         std::cout << summary.dump() << "\n";

@@ -379,7 +379,7 @@ void EditorApp::start_tick() {
         double ms = 0;
         std::shared_ptr<const ViewGeometry> view;
         LiveBackend backend = LiveBackend::Cpu;
-        std::string solver_description, gpu_fallback_reason;
+        std::string solver_description, gpu_fallback_reason, method_fallback_reason;
     };
     tick_task_.start(label, [this, target, core, jobs, lighting, budget, first, need_bvh, settings, view, view_changed,
                              view_worker](TaskProgress& progress) {
@@ -437,6 +437,7 @@ void EditorApp::start_tick() {
         r->backend = core->live->backend();
         r->solver_description = core->live->solver_description();
         r->gpu_fallback_reason = core->live->gpu_fallback_reason();
+        r->method_fallback_reason = core->live->method_fallback_reason();
         r->ms = ms_since(start);
         return BackgroundTask::Apply([this, target, r] {
             if (scene_.get() != target) return;  // another file was opened meanwhile
@@ -467,6 +468,7 @@ void EditorApp::start_tick() {
             s.solver_backend = r->backend;
             s.solver_description = r->solver_description;
             s.gpu_fallback_reason = r->gpu_fallback_reason;
+            s.method_fallback_reason = r->method_fallback_reason;
             s.tick_ms = r->ms;
             if (!s.converged || r->frame.total_iterations() > 0) {
                 s.tick_ms_sum += r->ms;
@@ -710,6 +712,7 @@ EditorRunStats run_editor(const EditorOptions& options) {
         stats.tick_ms = scene.ticks ? scene.tick_ms_sum / scene.ticks : 0;
         stats.solver_backend = live_backend_name(scene.solver_backend);
         stats.gpu_fallback_reason = scene.gpu_fallback_reason;
+        stats.method_fallback_reason = scene.method_fallback_reason;
         stats.view_reads_device_radiance = scene.render_input && scene.render_input->device_radiance;
     }
     glfwDestroyWindow(window);

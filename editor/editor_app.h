@@ -73,6 +73,7 @@ struct EditorRunStats {
     std::string gl_version, gl_renderer;
     std::string solver_backend;       // "cpu" or "gpu": what solved the last frame
     std::string gpu_fallback_reason;  // why the GPU backend was given up, if it was
+    std::string method_fallback_reason;  // why the chosen method ran as Jacobi CG, if it did
     bool view_reads_device_radiance = false;  // the 3D view drew E from the GPU solver's buffer
 };
 EditorRunStats run_editor(const EditorOptions& options);
@@ -125,6 +126,7 @@ struct EditorScene {
     LiveBackend solver_backend = LiveBackend::Cpu;  // after the latest tick (Cpu after a fallback)
     std::string solver_description;
     std::string gpu_fallback_reason;
+    std::string method_fallback_reason;
 };
 
 // Everything the window shows and edits. UI-thread only.

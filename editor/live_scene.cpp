@@ -40,7 +40,7 @@ LiveScene::LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSc
     validate(lighting_);
     check_materials(mesh);
     solver_ = std::make_unique<LiveSolver>(
-        LiveSolverOptions{options.method, options.backend, options.gl_context, options.clock});
+        LiveSolverOptions{options.method, options.backend, options.gl_context, options.clock, options.multigrid});
     SceneUpdate update;
     rebuild_all(nullptr, update);
 }
@@ -298,6 +298,11 @@ LiveBackend LiveScene::backend() const {
 std::string LiveScene::gpu_fallback_reason() const {
     const std::lock_guard lock(mutex_);
     return solver_->gpu_fallback_reason();
+}
+
+std::string LiveScene::method_fallback_reason() const {
+    const std::lock_guard lock(mutex_);
+    return solver_->method_fallback_reason();
 }
 
 std::string LiveScene::solver_description() const {

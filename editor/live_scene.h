@@ -64,6 +64,7 @@ struct LiveSceneOptions {
     std::shared_ptr<SolverGlContext> gl_context;
     // The clock of step(FrameBudget)'s time limits (LiveSolverOptions::clock); empty: steady_clock.
     MillisecondClock clock;
+    MultigridOptions multigrid;  // LiveSolverOptions::multigrid
 };
 
 // One frame of the solve.
@@ -139,6 +140,8 @@ public:
     // and a line for the solver panel ("GPU CG (llvmpipe ...)").
     LiveBackend backend() const;
     std::string gpu_fallback_reason() const;
+    // Why the chosen method runs as Jacobi CG ("" if it does not; LiveSolver::method_fallback_reason).
+    std::string method_fallback_reason() const;
     std::string solver_description() const;
     // With the GPU backend running: E per surface vertex (solved_scene().surface order) on the device,
     // from the resident phi (LiveSolver::radiance_on_device), for a renderer sharing the solver's

@@ -111,7 +111,7 @@ struct LiveSolver::Gpu {
 
 LiveSolver::LiveSolver(const LiveSolverOptions& options)
     : method_(options.method), backend_(options.backend), requested_backend_(options.backend),
-      context_(options.gl_context),
+      context_(options.gl_context), multigrid_options_(options.multigrid),
       clock_(options.clock ? options.clock : MillisecondClock(steady_clock_milliseconds)) {}
 
 LiveSolver::~LiveSolver() {
@@ -165,7 +165,14 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
         // Built now, while the mesh is at hand (the scene borrows it only during its calls).
         if (mesh.vertex_count() != matrix.size())
             throw InvalidArgumentError("live solver: the matrix does not belong to the mesh");
-        multigrid_ = std::make_unique<MultigridFrameSolver>(matrix, mesh.positions);
+        try {
+            FrameSolverOptions frame_options;
+            frame_options.multigrid = multigrid_options_;
+            multigrid_ = std::make_unique<MultigridFrameSolver>(matrix, mesh.positions, frame_options);
+            method_fallback_reason_.clear();
+        } catch (const AlgorithmError& e) {
+            method_fallback_reason_ = std::string("multigrid CG: ") + e.what();
+        }
     }
     multires_.reset();
     gpu_level_rows_.clear();
@@ -293,7 +300,15 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& 
                                                          std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                          double relative_tolerance, const std::array<bool, 3>& skip) {
     const size_t n = matrix.size();
-    if (multigrid_ && n > 0) return iterate_multigrid(matrix, b, phi, iteration_budget, relative_tolerance, skip);
+    if (multigrid_ && n > 0) {
+        try {
+            return iterate_multigrid(matrix, b, phi, iteration_budget, relative_tolerance, skip);
+        } catch (const AlgorithmError& e) {
+            // phi is still the last frame's (the host copy is written only after a successful step).
+            multigrid_.reset();
+            method_fallback_reason_ = std::string("multigrid CG: ") + e.what();
+        }
+    }
     if (multires_ && n > 0) return iterate_multires(b, phi, iteration_budget, relative_tolerance, skip);
 
     std::array<LiveSolverChannel, 3> out;

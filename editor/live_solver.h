@@ -38,8 +38,14 @@
 // call, because the editor runs each frame on a new worker thread. When the context or a shader fails
 // (no OpenGL 4.3, a driver bug, WAXWORK_GPU_FORCE_FAIL), the solver switches to the CPU method for
 // good and says why (gpu_fallback_reason()): a driver problem never stops the editor.
+//
+// Likewise when the multigrid V-cycle cannot be built or applied (AlgorithmError: a coarse Galerkin
+// operator that is not positive definite, as on volumes of extreme slivers; the stability study's
+// "slivers, multigrid" table), the frame and the following ones run Jacobi CG from the last phi and
+// method_fallback_reason() says why; the next matrix rebuild (a cut) tries the multigrid again.
 #pragma once
 
+#include "multires/multigrid_preconditioner.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/frame_budget.h"
@@ -94,6 +100,8 @@ struct LiveSolverOptions {
     std::shared_ptr<SolverGlContext> gl_context;
     // The clock of time budgets (frame_budget.h); empty: steady_clock. Tests inject a fake one.
     MillisecondClock clock;
+    // The multigrid method's V-cycle (smoother, dropping, lumping and its fallback).
+    MultigridOptions multigrid;
 };
 
 struct LiveSolverChannel {
@@ -159,6 +167,8 @@ public:
     LiveBackend requested_backend() const { return requested_backend_; }
     // Why the GPU backend was given up ("" when it was not requested or runs).
     const std::string& gpu_fallback_reason() const { return gpu_fallback_reason_; }
+    // Why the multigrid method solves with Jacobi CG instead ("" when it runs, or was not chosen).
+    const std::string& method_fallback_reason() const { return method_fallback_reason_; }
     // "GPU Jacobi CG (float) (llvmpipe ...)", "CPU multigrid CG, three channels per V-cycle", ...: for the
     // panel and logs.
     std::string description() const;
@@ -194,6 +204,8 @@ private:
     LiveBackend backend_, requested_backend_;
     std::shared_ptr<SolverGlContext> context_;
     std::string gpu_fallback_reason_;
+    std::string method_fallback_reason_;
+    MultigridOptions multigrid_options_;
     std::string renderer_;
     std::array<double, 3> eigenvalue_hint_{};
     // What changed since one copy of the system last caught up; each copy (the multigrid frame

@@ -447,11 +447,13 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
                        // The time budget of the frames of render steps with "frames"; null: frame_iterations.
                        {"frame_ms", budget.limits_time() ? Json(budget.max_milliseconds) : Json(nullptr)},
                        {"gpu_fallback_reason", scene.gpu_fallback_reason()},
+                       {"method_fallback_reason", scene.method_fallback_reason()},
                        {"steps", metrics}};
     write_file_atomically(output_directory / "metrics.json", [&](std::ostream& out) { out << summary.dump(2) << "\n"; });
     result.mesh = document.mesh();
     result.solver_backend = scene.backend();
     result.gpu_fallback_reason = scene.gpu_fallback_reason();
+    result.method_fallback_reason = scene.method_fallback_reason();
     return result;
 }
 

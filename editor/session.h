@@ -128,6 +128,7 @@ struct SessionResult {
     std::vector<std::filesystem::path> written;  // images and volumes, in order
     LiveBackend solver_backend = LiveBackend::Cpu;  // that solved the last step (Cpu after a fallback)
     std::string gpu_fallback_reason;                // why the GPU was given up ("" if it was not)
+    std::string method_fallback_reason;             // why the method ran as Jacobi CG ("" if it did not)
 };
 
 // How `waxwork run` solves (live_solver.h). The GPU backend shares the renderer's OSMesa context.
@@ -142,7 +143,8 @@ FrameBudget session_frame_budget(const Session& session, const SessionRunOptions
 
 // Replays the session, writing renders and saves under `output_directory` (created) and
 // OUTDIR/metrics.json. Errors name the session and the step index.
-// metrics.json also names the solver backend (solver_backend, and gpu_fallback_reason after one).
+// metrics.json also names the solver backend (solver_backend, and gpu_fallback_reason after one), why
+// the method fell back to Jacobi CG (method_fallback_reason, "" if it did not),
 // and the frames' time budget (frame_ms; null for an iteration budget).
 SessionResult run_session(const Session& session, const std::filesystem::path& output_directory,
                           const SessionRunOptions& run_options = {});

@@ -126,6 +126,21 @@ MultigridPreconditioner::MultigridPreconditioner(const MultiresHierarchy& hierar
     if (options.smoothing_steps < 1 || !(options.chebyshev_ratio > 1))
         throw InvalidArgumentError("multigrid: smoothing_steps must be >= 1 and chebyshev_ratio > 1");
     const auto start = std::chrono::steady_clock::now();
+    try {
+        build_levels();
+    } catch (const AlgorithmError& e) {
+        const bool lumped_rows = options_.lumping == DropLumping::RowSum && options_.drop_tolerance > 0;
+        if (!lumped_rows || !options_.fall_back_to_absolute) throw;
+        lumping_fallback_reason_ = std::string(e.what()) + " with row-sum lumping; built with absolute lumping";
+        options_.lumping = DropLumping::Absolute;
+        levels_.clear();
+        build_levels();
+    }
+    setup_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void MultigridPreconditioner::build_levels() {
+    const MultiresHierarchy& hierarchy = hierarchy_;
     const HierarchyLevel& fine = hierarchy.levels.at(0);
     auto level0 = std::make_unique<Level>();
     level0->n = fine.size();
@@ -172,7 +187,6 @@ MultigridPreconditioner::MultigridPreconditioner(const MultiresHierarchy& hierar
         }
     }
     factorize_coarsest();
-    setup_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 // Per-thread sparse accumulator over the columns of one product row.

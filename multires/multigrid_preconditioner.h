@@ -34,6 +34,7 @@
 #include <array>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace waxwork {
@@ -46,10 +47,13 @@ enum class DropLumping {
     // weaker (on spot, 500K tets, drop 0.02: 7 MG-CG iterations to 1% instead of 2).
     Absolute,
     // Their signed values are added to the diagonal, preserving row sums (A 1, the smooth mode the
-    // coarse levels exist for). Positive dropped entries keep definiteness, negative ones can lose it
-    // in principle; the coarsest factorisation checks it, and MG-CG reports a preconditioner that is
-    // not positive (r.Br < 0) as AlgorithmError. On spot it keeps 2-3 iterations with 40% of the
-    // operator entries of the exact products (bench/multires_bench.cpp).
+    // coarse levels exist for). Positive dropped entries keep definiteness, negative ones can lose it,
+    // and on volumes of extreme slivers they do (a box of 16^3 cells flattened to 0.009 degree
+    // dihedrals: the coarsest level is not positive definite). The setup checks every diagonal and the
+    // coarsest factorisation; when either fails it is redone with Absolute lumping (see
+    // MultigridOptions::fall_back_to_absolute), and MG-CG reports a preconditioner that is not
+    // positive (r.Br < 0) as AlgorithmError. On spot it keeps 2-3 iterations with 40% of the operator
+    // entries of the exact products (bench/multires_bench.cpp).
     RowSum,
 };
 
@@ -64,6 +68,10 @@ struct MultigridOptions {
     // setup expensive; 0.02 keeps 1.45 times level 0's.
     double drop_tolerance = 0.02;
     DropLumping lumping = DropLumping::RowSum;
+    // When a RowSum setup fails (a coarse diagonal or the coarsest factorisation not positive), build
+    // again with Absolute lumping, which is positive definite by construction (stability study,
+    // "slivers, multigrid"). false: throw the AlgorithmError instead.
+    bool fall_back_to_absolute = true;
 };
 
 class MultigridPreconditioner {
@@ -83,6 +91,9 @@ public:
     // Level l's operator for one channel, in double (for tests).
     CsrMatrixView<double> view(size_t level, int channel) const;
     double setup_ms() const { return setup_ms_; }
+    // The lumping the operators were built with: Absolute after a RowSum setup failed, with the reason.
+    DropLumping lumping() const { return options_.lumping; }
+    const std::string& lumping_fallback_reason() const { return lumping_fallback_reason_; }
 
     // z = B r for one channel: one V-cycle from a zero start. Not thread-safe (shared work vectors).
     void apply(int channel, std::span<const double> r, std::span<double> z);
@@ -105,6 +116,7 @@ public:
 private:
     struct Level;
     struct Accumulator;
+    void build_levels();
     // A P's pattern and values, then P^T A P's kept pattern and values (compute_galerkin_rows' result).
     void build_galerkin_operator(size_t l);
     void compute_product_rows(size_t l, std::span<const int32_t> rows);
@@ -122,6 +134,7 @@ private:
     MultigridOptions options_;
     std::vector<std::unique_ptr<Level>> levels_;
     double setup_ms_ = 0;
+    std::string lumping_fallback_reason_;
 };
 
 }  // namespace waxwork
