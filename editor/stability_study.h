@@ -53,6 +53,10 @@ StudyTable study_kappa_contrast(const StudySize& size);
 // Coarse levels made singular, indefinite or non-finite on purpose: the multires fallbacks.
 StudyTable study_coarse_breakdown(const StudySize& size);
 
+// The multigrid V-cycle (multires/multigrid_preconditioner.h) on slivers: where its row-sum lumped
+// setup fails and what the absolute-lumping fallback gives.
+StudyTable study_multigrid_slivers(const StudySize& size);
+
 // All of the above, in that order.
 std::vector<StudyTable> run_stability_studies(const StudySize& size);
 

@@ -183,7 +183,7 @@ TEST(BenchSuiteCommand, OnlyRunsTheNamedParts) {
     EXPECT_EQ(index["parts"].size(), 1u);
     EXPECT_EQ(index["parts"]["stability"]["status"], "ok");
     const auto stability = nlohmann::json::parse(testing::read_text(dir / "stability.json"));
-    EXPECT_EQ(stability.size(), 6u);
+    EXPECT_EQ(stability.size(), 7u);
     EXPECT_NE(testing::read_text(dir / "stability.md").find("### slivers"), std::string::npos);
     const auto unknown = run_waxwork("bench --quick --only nonsense -o " + dir.string());
     EXPECT_NE(unknown.exit_code, 0);
