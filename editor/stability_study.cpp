@@ -122,6 +122,13 @@ void add_precision_form_rows(StudyTable& table, const std::vector<Json>& prefix,
 
 double mesh_min_dihedral(const TetMesh& mesh) { return measure_quality(mesh).min_dihedral_deg; }
 
+// A box of n^3 unit cells with six interior vertices pushed into caps of relative height `flatness`.
+TetMesh sliver_box(int n, double flatness) {
+    TetMesh mesh = make_box_mesh({n, n, n}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(n));
+    flatten_into_slivers(mesh, build_connectivity(mesh), 6, flatness);
+    return mesh;
+}
+
 }  // namespace
 
 nlohmann::ordered_json StudyTable::to_json() const {
@@ -179,9 +186,8 @@ StudyTable study_slivers(const StudySize& size) {
     const std::vector<double> flatness = size.quick ? std::vector<double>{0.1, 1e-3, 1e-4}
                                                     : std::vector<double>{0.1, 0.03, 0.01, 3e-3, 1e-3, 3e-4, 1e-4};
     for (double f : flatness) {
-        TetMesh mesh = make_box_mesh({n, n, n}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(n));
+        const TetMesh mesh = sliver_box(n, f);
         const TetConnectivity connectivity = build_connectivity(mesh);
-        flatten_into_slivers(mesh, connectivity, 6, f);
         add_precision_form_rows(table, {f, mesh_min_dihedral(mesh)}, mesh, connectivity, 1e-4);
     }
     return table;
@@ -454,9 +460,8 @@ StudyTable study_multigrid_slivers(const StudySize& size) {
     const TetMaterial marble = material_preset("marble");  // the material the failure was found with
     for (const int n : cells)
         for (const double f : flatness) {
-            TetMesh mesh = make_box_mesh({n, n, n}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(n));
+            const TetMesh mesh = sliver_box(n, f);
             const TetConnectivity connectivity = build_connectivity(mesh);
-            flatten_into_slivers(mesh, connectivity, 6, f);
             const std::vector<TetMaterial> materials(mesh.tet_count(), marble);
             const DiffusionMatrix matrix = assemble_diffusion_matrix(mesh, connectivity, materials);
             const auto q = boundary_light(mesh, connectivity, everywhere);

@@ -2,6 +2,7 @@
 #include "solver/diffusion_matrix.h"
 #include "solver/material.h"
 #include "solver/reference_solvers.h"
+#include "lit_block_system.h"
 #include "solver_test_meshes.h"
 #include "tetops/error.h"
 #include "tetops/sliver_maker.h"
@@ -17,49 +18,7 @@
 namespace waxwork {
 namespace {
 
-// A lit block of marble (mm units): light from +z on the top face only.
-struct System {
-    TetMesh mesh;
-    TetConnectivity conn;
-    std::vector<TetMaterial> materials;
-    DiffusionMatrix matrix;
-    std::vector<double> b;
-    System(TetMesh m, const char* material = "marble", double mm = 1.0) : mesh(std::move(m)) {
-        conn = build_connectivity(mesh);
-        materials.assign(mesh.tet_count(), material_preset(material));
-        AssemblyOptions options;
-        options.mm_per_unit = mm;
-        matrix = assemble_diffusion_matrix(mesh, conn, materials, options);
-        const double top = bounding_box(mesh)[1].z();
-        std::vector<std::array<double, 3>> q(mesh.vertex_count(), {0, 0, 0});
-        for (size_t v = 0; v < mesh.vertex_count(); ++v)
-            if (mesh.positions[v].z() > top - 1e-9) q[v] = {1, 1, 1};
-        b.resize(mesh.vertex_count());
-        diffusion_right_hand_side(matrix, q, 0, b);
-    }
-    template <typename Scalar>
-    std::vector<Scalar> values() const {
-        return std::vector<Scalar>(matrix.values[0].begin(), matrix.values[0].end());
-    }
-    template <typename Scalar>
-    CsrMatrixView<Scalar> view(const std::vector<Scalar>& v) const {
-        return {matrix.size(), matrix.offsets.data(), matrix.columns.data(), v.data()};
-    }
-    Eigen::VectorXd exact() const {
-        return DirectSolver(to_eigen_sparse(matrix, 0)).solve(Eigen::Map<const Eigen::VectorXd>(b.data(), b.size()));
-    }
-    // Relative error in the D-norm (the norm the estimate is stated in).
-    template <typename Scalar>
-    double d_error(const std::vector<Scalar>& x, const Eigen::VectorXd& ref) const {
-        double e = 0, n = 0;
-        for (size_t i = 0; i < x.size(); ++i) {
-            const double d = matrix.values[0][matrix.diagonal[i]];
-            e += d * std::pow(x[i] - ref[i], 2);
-            n += d * ref[i] * ref[i];
-        }
-        return std::sqrt(e / n);
-    }
-};
+using System = test::LitBlockSystem;
 
 TEST(ConjugateGradient, SmallestTridiagonalEigenvalue) {
     std::mt19937 rng(3);

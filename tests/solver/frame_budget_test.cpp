@@ -6,6 +6,7 @@
 #include "solver/frame_budget.h"
 #include "solver/iteration_time_predictor.h"
 #include "solver/material.h"
+#include "lit_block_system.h"
 #include "solver_test_meshes.h"
 #include "tetops/error.h"
 
@@ -95,25 +96,9 @@ TEST(FrameDeadline, SharesSplitWhatIsLeft) {
     EXPECT_TRUE(frame.share(2).expired());
 }
 
-// A lit cube of marble, as in conjugate_gradient_test.cpp.
-struct CubeSystem {
-    TetMesh mesh = test::make_cube_mesh(8, 2.0);  // 16 mm of marble
-    DiffusionMatrix matrix;
-    std::vector<double> b;
-    CubeSystem() {
-        const TetConnectivity conn = build_connectivity(mesh);
-        const std::vector<TetMaterial> marble(mesh.tet_count(), material_preset("marble"));
-        matrix = assemble_diffusion_matrix(mesh, conn, marble);
-        const double top = bounding_box(mesh)[1].z();
-        std::vector<std::array<double, 3>> q(mesh.vertex_count(), {0, 0, 0});
-        for (size_t v = 0; v < mesh.vertex_count(); ++v)
-            if (mesh.positions[v].z() > top - 1e-9) q[v] = {1, 1, 1};
-        b.resize(mesh.vertex_count());
-        diffusion_right_hand_side(matrix, q, 0, b);
-    }
-    CsrMatrixView<double> view() const {
-        return {matrix.size(), matrix.offsets.data(), matrix.columns.data(), matrix.values[0].data()};
-    }
+// A lit cube of marble, 16 mm.
+struct CubeSystem : test::LitBlockSystem {
+    CubeSystem() : LitBlockSystem(test::make_cube_mesh(8, 2.0)) {}
 };
 
 TEST(FrameBudget, JacobiCgStopsAtTheDeadlineLikeAnIterationBudget) {
