@@ -241,6 +241,8 @@ std::string LiveSolver::description() const {
                : multigrid_                 ? "CPU multigrid CG, three channels per V-cycle"
                                             : "CPU Jacobi CG (double)";
     if (backend_ == LiveBackend::Gpu && !renderer_.empty()) text += " (" + renderer_ + ")";
+    if (multigrid_ && !multigrid_->preconditioner().lumping_fallback_reason().empty())
+        text += ", absolute lumping (the row-sum setup failed)";
     return text;
 }
 

@@ -264,6 +264,7 @@ TEST(LiveSolver, MultigridThatCannotBeBuiltFallsBackToJacobiWithAReason) {
         if (absolute_fallback) {
             EXPECT_EQ(scene.method_fallback_reason(), "");
             EXPECT_NE(description.find("multigrid"), std::string::npos) << description;
+            EXPECT_NE(description.find("absolute lumping"), std::string::npos) << description;
         } else {
             EXPECT_NE(scene.method_fallback_reason().find("not positive definite"), std::string::npos)
                 << scene.method_fallback_reason();
