@@ -343,20 +343,10 @@ TEST(MultigridCg, LightTurnOfTenDegreesConvergesWithinAFewWarmIterations) {
     const auto s = testing::make_test_system(12);
     const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(100));
     MultigridPreconditioner mg(h);
-    const std::vector<TetMaterial> materials(s.mesh.tet_count(), testing::test_material());
-    auto rhs = [&](double degrees, int channel) {
-        Lighting lighting;
-        Light light;
-        light.vector = Eigen::AngleAxisd(degrees * M_PI / 180, Eigen::Vector3d::UnitY()) *
-                       Eigen::Vector3d(1, -1, -1).normalized();
-        lighting.lights.push_back(light);
-        const std::vector<Rgb> q = incident_light(s.mesh, s.connectivity, materials, lighting);
-        std::vector<double> b(s.matrix.size());
-        diffusion_right_hand_side(s.matrix, q, channel, b);
-        return b;
-    };
+    const auto lit_before = testing::light_rhs(s, 0), lit_after = testing::light_rhs(s, 10);
     for (int channel = 0; channel < 3; ++channel) {
-        const auto before = rhs(0, channel), after = rhs(10, channel);
+        const auto& before = lit_before[static_cast<size_t>(channel)];
+        const auto& after = lit_after[static_cast<size_t>(channel)];
         std::vector<double> x(before.size(), 0.0);
         ConjugateGradientOptions tight;
         tight.relative_tolerance = 1e-8;

@@ -34,22 +34,6 @@ std::array<std::span<const double>, 3> spans(const std::array<std::vector<double
     return {v[0], v[1], v[2]};
 }
 
-// The right-hand sides of the test cube lit by the key light turned by `degrees` about the vertical.
-std::array<std::vector<double>, 3> light_rhs(const testing::TestSystem& s, double degrees) {
-    const std::vector<TetMaterial> materials(s.mesh.tet_count(), testing::test_material());
-    Lighting lighting;
-    Light light;
-    light.vector = Eigen::AngleAxisd(degrees * M_PI / 180, Eigen::Vector3d::UnitY()) *
-                   Eigen::Vector3d(1, -1, -1).normalized();
-    lighting.lights.push_back(light);
-    const std::vector<Rgb> q = incident_light(s.mesh, s.connectivity, materials, lighting);
-    std::array<std::vector<double>, 3> b;
-    for (int c = 0; c < 3; ++c) {
-        b[static_cast<size_t>(c)].resize(s.matrix.size());
-        diffusion_right_hand_side(s.matrix, q, c, b[static_cast<size_t>(c)]);
-    }
-    return b;
-}
 
 TEST(MultigridPreconditioner, ApplyRgbEqualsThreeApplyCalls) {
     const auto s = testing::make_test_system(9);
@@ -125,7 +109,7 @@ constexpr int kLightTurnBudget = 1;
 TEST(MultigridFrameSolver, WarmStartAfterALightTurnIsWithinOnePercentInOneVcycle) {
     const auto s = testing::make_test_system(12);
     MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(100, 1e-2));
-    const auto before = light_rhs(s, 0), after = light_rhs(s, 10);
+    const auto before = testing::light_rhs(s, 0), after = testing::light_rhs(s, 10);
     solver.set_right_hand_side(spans(before));
     // The previous frames: converged on the old light.
     FrameStep step;

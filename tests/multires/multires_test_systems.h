@@ -3,9 +3,11 @@
 
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
+#include "solver/lighting.h"
 #include "tetops/connectivity.h"
 #include "tetops/test_meshes.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <array>
@@ -43,6 +45,23 @@ inline TestSystem make_test_system(int n, double size = 4.0) {
         diffusion_right_hand_side(s.matrix, q, c, s.b[static_cast<size_t>(c)]);
     }
     return s;
+}
+
+// The right-hand sides of the test cube lit by the key light turned by `degrees` about the vertical.
+inline std::array<std::vector<double>, 3> light_rhs(const TestSystem& s, double degrees) {
+    const std::vector<TetMaterial> materials(s.mesh.tet_count(), test_material());
+    Lighting lighting;
+    Light light;
+    light.vector = Eigen::AngleAxisd(degrees * M_PI / 180, Eigen::Vector3d::UnitY()) *
+                   Eigen::Vector3d(1, -1, -1).normalized();
+    lighting.lights.push_back(light);
+    const std::vector<Rgb> q = incident_light(s.mesh, s.connectivity, materials, lighting);
+    std::array<std::vector<double>, 3> b;
+    for (int c = 0; c < 3; ++c) {
+        b[static_cast<size_t>(c)].resize(s.matrix.size());
+        diffusion_right_hand_side(s.matrix, q, c, b[static_cast<size_t>(c)]);
+    }
+    return b;
 }
 
 // Paints `count` tets (every `stride`-th) of a make_test_system volume with another material and
