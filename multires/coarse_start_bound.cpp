@@ -1,6 +1,7 @@
 #include "multires/coarse_start_bound.h"
 
 #include "solver/conjugate_gradient.h"
+#include "solver/reference_solvers.h"
 #include "tetops/error.h"
 
 #include <Eigen/SparseCholesky>
@@ -26,29 +27,11 @@ void require_level1(const MultiresHierarchy& hierarchy, const std::vector<double
                                    " entries, level 0 has " + std::to_string(hierarchy.levels[0].size()));
 }
 
-SparseMatrix level_matrix(const HierarchyLevel& level, int channel) {
-    std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(level.columns.size());
-    const std::vector<double>& values = level.values[static_cast<size_t>(channel)];
-    for (size_t row = 0; row < level.size(); ++row)
-        for (int32_t k = level.offsets[row]; k < level.offsets[row + 1]; ++k)
-            entries.emplace_back(static_cast<int>(row), level.columns[static_cast<size_t>(k)], values[static_cast<size_t>(k)]);
-    SparseMatrix m(static_cast<Eigen::Index>(level.size()), static_cast<Eigen::Index>(level.size()));
-    m.setFromTriplets(entries.begin(), entries.end());
-    return m;
-}
-
 // P^0 (Eq. 16) as an Eigen matrix, level-0 rows by level-1 columns.
 SparseMatrix interpolation_matrix(const MultiresHierarchy& hierarchy) {
     const InterpolationOperator& p = hierarchy.levels[0].interpolation;
-    std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(p.columns.size());
-    for (size_t row = 0; row < p.rows(); ++row)
-        for (int32_t k = p.offsets[row]; k < p.offsets[row + 1]; ++k)
-            entries.emplace_back(static_cast<int>(row), p.columns[static_cast<size_t>(k)], p.weights[static_cast<size_t>(k)]);
-    SparseMatrix m(static_cast<Eigen::Index>(p.rows()), static_cast<Eigen::Index>(hierarchy.levels[1].size()));
-    m.setFromTriplets(entries.begin(), entries.end());
-    return m;
+    return to_eigen_sparse(CsrMatrixView<double>{p.rows(), p.offsets.data(), p.columns.data(), p.weights.data()},
+                           hierarchy.levels[1].size());
 }
 
 std::vector<double> to_std(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
@@ -90,7 +73,7 @@ std::vector<double> solve_level1_eq17(const MultiresHierarchy& hierarchy, int ch
     for (size_t i = 0; i < coarse.size(); ++i)
         injected[static_cast<Eigen::Index>(i)] = b[static_cast<size_t>(coarse.parent_vertex[i])];  // Eq. 17
     Eigen::SparseLU<SparseMatrix> lu;
-    lu.compute(level_matrix(coarse, channel));  // not symmetric: LU, not Cholesky
+    lu.compute(to_eigen_sparse(coarse.view(channel)));  // not symmetric: LU, not Cholesky
     if (lu.info() != Eigen::Success)
         throw AlgorithmError("coarse start bound: level 1's Eq. 17 matrix is singular (" + lu.lastErrorMessage() + ")");
     return to_std(lu.solve(injected));
@@ -101,7 +84,7 @@ std::vector<double> solve_level1_galerkin(const MultiresHierarchy& hierarchy, in
     check_channel(channel);
     const SparseMatrix p = interpolation_matrix(hierarchy);
     const SparseMatrix pt = p.transpose();
-    const SparseMatrix galerkin = pt * level_matrix(hierarchy.levels[0], channel) * p;
+    const SparseMatrix galerkin = pt * to_eigen_sparse(hierarchy.levels[0].view(channel)) * p;
     Eigen::SimplicialLDLT<SparseMatrix> ldlt(galerkin);
     if (ldlt.info() != Eigen::Success)
         throw AlgorithmError("coarse start bound: the Galerkin level-1 matrix is not positive definite");

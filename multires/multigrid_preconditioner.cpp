@@ -1,6 +1,7 @@
 #include "multires/multigrid_preconditioner.h"
 
 #include "multires/parallel_rows.h"
+#include "solver/reference_solvers.h"
 
 #include "tetops/error.h"
 
@@ -462,15 +463,8 @@ void MultigridPreconditioner::factorize_coarsest() {
     Level& level = *levels_.back();
     const auto n = static_cast<Eigen::Index>(level.n);
     for (size_t ch = 0; ch < 3; ++ch) {
-        std::vector<Eigen::Triplet<double>> triplets;
-        triplets.reserve(level.columns.size());
-        for (Eigen::Index i = 0; i < n; ++i)
-            for (int32_t k = level.offsets[static_cast<size_t>(i)]; k < level.offsets[static_cast<size_t>(i) + 1]; ++k)
-                triplets.emplace_back(static_cast<int>(i), level.columns[static_cast<size_t>(k)],
-                                      level.values[ch][static_cast<size_t>(k)]);
-        Eigen::SparseMatrix<double> a(n, n);
-        a.setFromTriplets(triplets.begin(), triplets.end());
-        level.coarsest[ch].compute(a);
+        level.coarsest[ch].compute(
+            to_eigen_sparse(CsrMatrixView<double>{level.n, level.offsets.data(), level.columns.data(), level.values[ch].data()}));
         if (level.coarsest[ch].info() != Eigen::Success || (level.coarsest[ch].vectorD().array() <= 0).any())
             throw AlgorithmError("multigrid: the coarsest level (" + std::to_string(level.n) +
                                  " vertices) is not positive definite");

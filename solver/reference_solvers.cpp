@@ -14,14 +14,18 @@ namespace waxwork {
 
 Eigen::SparseMatrix<double> to_eigen_sparse(const DiffusionMatrix& m, int channel) {
     if (channel < 0 || channel > 2) throw InvalidArgumentError("to_eigen_sparse: channel must be 0, 1 or 2");
-    const auto n = static_cast<Eigen::Index>(m.size());
-    // The pattern is symmetric, so the row-compressed arrays read as column-compressed give M^T = M.
-    Eigen::SparseMatrix<double> a(n, n);
+    return to_eigen_sparse(CsrMatrixView<double>{m.size(), m.offsets.data(), m.columns.data(),
+                                                 m.values[static_cast<size_t>(channel)].data()});
+}
+
+Eigen::SparseMatrix<double> to_eigen_sparse(const CsrMatrixView<double>& m, size_t columns) {
+    const auto rows = static_cast<Eigen::Index>(m.rows);
+    Eigen::SparseMatrix<double> a(rows, columns == 0 ? rows : static_cast<Eigen::Index>(columns));
     std::vector<Eigen::Triplet<double>> triplets;
-    triplets.reserve(m.nonzeros());
-    for (Eigen::Index i = 0; i < n; ++i)
+    triplets.reserve(m.rows == 0 ? 0 : static_cast<size_t>(m.offsets[m.rows]));
+    for (Eigen::Index i = 0; i < rows; ++i)
         for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k)
-            triplets.emplace_back(static_cast<int>(i), m.columns[k], m.values[channel][k]);
+            triplets.emplace_back(static_cast<int>(i), m.columns[k], m.values[k]);
     a.setFromTriplets(triplets.begin(), triplets.end());
     return a;
 }

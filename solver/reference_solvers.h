@@ -3,6 +3,7 @@
 // otherwise). Used as references in tests and as baselines in bench/solver_bench.cpp.
 #pragma once
 
+#include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 
 #include <Eigen/Core>
@@ -16,6 +17,9 @@ namespace waxwork {
 // The matrix of one channel as an Eigen column-major sparse matrix (the matrix is symmetric, so this
 // is also its transpose).
 Eigen::SparseMatrix<double> to_eigen_sparse(const DiffusionMatrix& matrix, int channel);
+// Any compressed-row matrix (a hierarchy level, an interpolation operator) of `columns` columns
+// (0: square) as an Eigen column-major sparse matrix.
+Eigen::SparseMatrix<double> to_eigen_sparse(const CsrMatrixView<double>& matrix, size_t columns = 0);
 
 struct EigenCgResult {
     int iterations = 0;
