@@ -256,13 +256,15 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
 
 std::vector<std::vector<int32_t>> hierarchy_level_vertices(const CompressedRows& graph, const HierarchyOptions& options) {
     std::vector<std::vector<int32_t>> levels;
-    CompressedRows level_graph = graph;
+    const CompressedRows* level_graph = &graph;  // G^0 is read in place, coarser graphs are owned
+    CompressedRows coarse_graph;
     std::vector<int32_t> original(graph.row_count());
     std::iota(original.begin(), original.end(), 0);
-    while (std::optional<CoarseningStep> step = coarsen(level_graph, levels.size() + 1, options)) {
+    while (std::optional<CoarseningStep> step = coarsen(*level_graph, levels.size() + 1, options)) {
         std::vector<int32_t> kept(step->coarse_to_fine.size());
         for (size_t c = 0; c < kept.size(); ++c) kept[c] = original[static_cast<size_t>(step->coarse_to_fine[c])];
-        level_graph = build_coarse_graph(level_graph, step->selection.retained, step->coarse_index);
+        coarse_graph = build_coarse_graph(*level_graph, step->selection.retained, step->coarse_index);
+        level_graph = &coarse_graph;
         original = kept;
         levels.push_back(std::move(kept));
     }
