@@ -2,6 +2,8 @@
 
 #include "tetops/error.h"
 
+#include <CGAL/IO/OFF.h>
+#include <CGAL/Simple_cartesian.h>
 #include <OpenMesh/Core/IO/IOManager.hh>
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/IO/importer/ImporterT.hh>
@@ -9,7 +11,11 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <mutex>
@@ -145,6 +151,70 @@ std::string format_name(const std::string& ext) {
     return name;
 }
 
+// OpenMesh's ascii readers skip a vertex whose coordinates do not parse ("nan", "1e400", "x") and
+// carry on, so every later index is off by one and the error that surfaces ("face 7 refers to a
+// vertex that does not exist", or a bogus open surface) hides the real problem. The vertex records
+// are therefore checked here first: the first three numbers of each must be finite doubles.
+std::string_view first_token(std::string_view line, size_t& end) {
+    size_t begin = 0;
+    while (begin < line.size() && std::isspace(static_cast<unsigned char>(line[begin]))) ++begin;
+    end = begin;
+    while (end < line.size() && !std::isspace(static_cast<unsigned char>(line[end]))) ++end;
+    return line.substr(begin, end - begin);
+}
+
+// One coordinate; throws FileError naming the line and the token.
+void check_coordinate(const std::filesystem::path& path, size_t line_number, std::string_view token) {
+    const std::string where = "line " + std::to_string(line_number) + ": vertex coordinate '" + std::string(token) + "' ";
+    double value = 0;
+    // from_chars does not take a leading '+', which some exporters write.
+    const std::string_view digits = !token.empty() && token.front() == '+' ? token.substr(1) : token;
+    const auto [ptr, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (error == std::errc::result_out_of_range) throw FileError(path.string(), where + "is out of range");
+    if (error != std::errc() || ptr != digits.data() + digits.size())
+        throw FileError(path.string(), where + "is not a number");
+    if (!std::isfinite(value)) throw FileError(path.string(), where + "is not finite");
+}
+
+// The three coordinates at the start of `rest`.
+void check_coordinates(const std::filesystem::path& path, size_t line_number, std::string_view rest) {
+    for (int axis = 0; axis < 3; ++axis) {
+        size_t end = 0;
+        const std::string_view token = first_token(rest, end);
+        if (token.empty() || token.front() == '#')
+            throw FileError(path.string(), "line " + std::to_string(line_number) +
+                                               ": vertex coordinates: expected 3 numbers, found " + std::to_string(axis));
+        check_coordinate(path, line_number, token);
+        rest = rest.substr(end);
+    }
+}
+
+// Every line whose first word is `keyword` ("v" in OBJ, "vertex" in ascii STL) holds a vertex.
+void check_vertex_lines(const std::filesystem::path& path, std::string_view text, std::string_view keyword) {
+    size_t line_number = 0;
+    for (size_t start = 0; start < text.size();) {
+        const size_t newline = std::min(text.find('\n', start), text.size());
+        const std::string_view line = text.substr(start, newline - start);
+        ++line_number;
+        size_t end = 0;
+        if (first_token(line, end) == keyword) check_coordinates(path, line_number, line.substr(end));
+        start = newline + 1;
+    }
+}
+
+// A binary STL's 50-byte records hold a normal and three vertices as little-endian floats.
+void check_binary_stl_coordinates(const std::filesystem::path& path, std::string_view bytes, uint32_t count) {
+    for (uint32_t t = 0; t < count; ++t) {
+        for (int k = 0; k < 9; ++k) {
+            float value = 0;
+            std::memcpy(&value, bytes.data() + 84 + 50 * static_cast<size_t>(t) + 12 + 4 * k, sizeof value);
+            if (!std::isfinite(value))
+                throw FileError(path.string(), "triangle " + std::to_string(t) + ": vertex " + std::to_string(k / 3) +
+                                                   " has a non-finite coordinate");
+        }
+    }
+}
+
 // OpenMesh trusts the element counts in OFF and PLY headers: a corrupt count makes it reserve memory
 // for it, and in ascii files a truncated body makes it loop on a failed stream and invent elements
 // from stale values (faces like 0 0 0), which would pass for a smaller mesh. So the header is checked
@@ -178,6 +248,7 @@ void check_off_body(const std::filesystem::path& path, std::uintmax_t size) {
     // Whitespace-separated tokens with '#' comments removed; only counted past the header.
     std::vector<std::string_view> header;
     size_t body_tokens = 0;
+    size_t counts_end = 0;  // just past "ne", the last of the header's counts
     bool in_comment = false;
     for (size_t i = 0; i < text.size();) {
         const char c = text[i];
@@ -192,9 +263,10 @@ void check_off_body(const std::filesystem::path& path, std::uintmax_t size) {
         }
         size_t j = i;
         while (j < text.size() && !std::isspace(static_cast<unsigned char>(text[j])) && text[j] != '#') ++j;
-        if (header.size() < 5)
+        if (header.size() < 5) {
             header.emplace_back(text.data() + i, j - i);
-        else
+            if (header.size() == 4) counts_end = j;
+        } else
             ++body_tokens;
         i = j;
     }
@@ -212,6 +284,49 @@ void check_off_body(const std::filesystem::path& path, std::uintmax_t size) {
         throw FileError(path.string(), "truncated: the header declares " + std::to_string(vertices) +
                                            " vertices and " + std::to_string(faces) +
                                            " faces but the file ends before them");
+    // One record per line after the counts: vertices (a [C][N]OFF vertex carries colour or normal
+    // values after its three coordinates), then faces "k i_1 ... i_k" (maybe followed by a colour).
+    size_t line_number = 1 + static_cast<size_t>(std::count(text.begin(), text.begin() + counts_end, '\n'));
+    size_t start = std::min(text.find('\n', counts_end), text.size());
+    for (unsigned long long record = 0; record < vertices + faces && start < text.size();) {
+        ++start;
+        ++line_number;
+        const size_t newline = std::min(text.find('\n', start), text.size());
+        std::string_view line = std::string_view(text).substr(start, newline - start);
+        start = newline;
+        line = line.substr(0, std::min(line.find('#'), line.size()));
+        size_t end = 0;
+        if (first_token(line, end).empty()) continue;
+        if (record++ < vertices) {
+            check_coordinates(path, line_number, line);
+            continue;
+        }
+        const unsigned long long face = record - 1 - vertices;
+        const std::string where = "line " + std::to_string(line_number) + ": face " + std::to_string(face);
+        unsigned long long corners = 0;
+        for (long long k = -1; k < static_cast<long long>(corners); ++k) {
+            const std::string_view token = first_token(line, end);
+            line = line.substr(end);
+            unsigned long long value = 0;
+            const auto [ptr, error] = std::from_chars(token.data(), token.data() + token.size(), value);
+            if (token.empty() && k >= 0)
+                throw FileError(path.string(), where + ": " + std::to_string(k) + " vertex indices where its count says " +
+                                                   std::to_string(corners));
+            if (error != std::errc() || ptr != token.data() + token.size())
+                throw FileError(path.string(), where + ": '" + std::string(token) + "' is not " +
+                                                   (k < 0 ? "a vertex count" : "a vertex index"));
+            if (k < 0) {
+                corners = value;
+                // Each index takes at least two characters: a larger count cannot be on this line.
+                if (corners > line.size())
+                    throw FileError(path.string(), where + ": a count of " + std::to_string(corners) +
+                                                       " vertex indices on a line that cannot hold them");
+            } else if (value >= vertices) {
+                throw FileError(path.string(), where + " refers to vertex " + std::to_string(value) +
+                                                   " but the file has " + std::to_string(vertices) + " vertices");
+            }
+        }
+    }
 }
 
 void check_ply_body(const std::filesystem::path& path, std::uintmax_t size) {
@@ -219,26 +334,65 @@ void check_ply_body(const std::filesystem::path& path, std::uintmax_t size) {
     std::string line;
     bool ascii = false;
     unsigned long long elements = 0;
+    // Where the vertices' x, y and z are in an ascii body: the lines of the elements before "vertex"
+    // come first, then one line per vertex with its properties in header order.
+    unsigned long long lines_before_vertices = 0, vertex_count = 0;
+    bool in_vertex = false, seen_vertex = false, vertex_has_list = false;
+    std::array<int, 3> xyz = {-1, -1, -1};
+    int vertex_properties = 0;
+    size_t header_lines = 0;
     for (int lines = 0;; ++lines) {
         // OpenMesh loops forever on a header without end_header, so that is caught here.
         if (!std::getline(in, line) || lines > 10000)
             throw FileError(path.string(), "truncated or malformed PLY header (no end_header)");
+        ++header_lines;
         if (!line.empty() && line.back() == '\r') line.pop_back();
         std::istringstream words(line);
-        std::string keyword, first, second;
-        words >> keyword >> first >> second;
+        std::string keyword, first, second, third;
+        words >> keyword >> first >> second >> third;
         if (keyword == "end_header") break;
         if (keyword == "format") ascii = first == "ascii";
         if (keyword == "element") {
             const auto count = parse_count(path, second);
             check_count_fits(path, first + " elements", count, size);
             elements += count;
+            in_vertex = first == "vertex" && !seen_vertex;
+            if (in_vertex) {
+                seen_vertex = true;
+                vertex_count = count;
+            } else if (!seen_vertex) {
+                lines_before_vertices += count;
+            }
+        }
+        if (keyword == "property" && in_vertex) {
+            vertex_has_list = vertex_has_list || first == "list";
+            const std::string& property = first == "list" ? third : second;
+            for (int axis = 0; axis < 3; ++axis)
+                if (property == std::string(1, char('x' + axis))) xyz[axis] = vertex_properties;
+            ++vertex_properties;
         }
     }
     if (!ascii) return;
+    const bool check_vertices = seen_vertex && !vertex_has_list && xyz[0] >= 0 && xyz[1] >= 0 && xyz[2] >= 0;
     unsigned long long body_lines = 0;
-    while (std::getline(in, line))
-        if (line.find_first_not_of(" \t\r") != std::string::npos) ++body_lines;
+    size_t line_number = header_lines;
+    while (std::getline(in, line)) {
+        ++line_number;
+        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+        if (check_vertices && body_lines >= lines_before_vertices && body_lines < lines_before_vertices + vertex_count) {
+            std::string_view rest = line;
+            std::array<std::string_view, 3> tokens;
+            for (int k = 0; k < vertex_properties; ++k) {
+                size_t end = 0;
+                const std::string_view token = first_token(rest, end);
+                rest = rest.substr(end);
+                for (int axis = 0; axis < 3; ++axis)
+                    if (xyz[axis] == k) tokens[axis] = token;
+            }
+            for (const std::string_view token : tokens) check_coordinate(path, line_number, token);
+        }
+        ++body_lines;
+    }
     if (body_lines < elements)
         throw FileError(path.string(), "truncated: the header declares " + std::to_string(elements) +
                                            " elements but the file holds only " + std::to_string(body_lines) +
@@ -260,10 +414,14 @@ void check_stl_size(const std::filesystem::path& path, std::uintmax_t size) {
     const bool says_solid = first != std::string::npos && start.compare(first, 5, "solid") == 0;
     // Binary STL stores the count little-endian; so do the machines Waxwork runs on.
     const std::uintmax_t binary_size = 84 + 50 * static_cast<std::uintmax_t>(count);
-    if (has_count && binary_size == size) return;
+    if (has_count && binary_size == size) {
+        check_binary_stl_coordinates(path, read_all(path), count);
+        return;
+    }
     if (says_solid || size < 5) {
         if (!says_solid)
             throw FileError(path.string(), "neither an ascii STL (no 'solid') nor a binary STL (too short)");
+        check_vertex_lines(path, read_all(path), "vertex");
         return;
     }
     if (!has_count)
@@ -272,6 +430,59 @@ void check_stl_size(const std::filesystem::path& path, std::uintmax_t size) {
     throw FileError(path.string(), "not an ascii STL (no 'solid') and, as a binary STL, truncated or corrupt: "
                                    "it declares " + std::to_string(count) + " triangles (" +
                                    std::to_string(binary_size) + " bytes) but has " + std::to_string(size) + " bytes");
+}
+
+// A file's vertices and polygons as it states them; `complaint` is the reader's first warning, if any.
+struct PolygonSoup {
+    std::vector<Eigen::Vector3d> points;
+    std::vector<std::vector<int32_t>> faces;  // -1: an index naming no vertex
+    std::string complaint;
+};
+
+// OBJ, PLY and STL through OpenMesh, recording the soup as the file states it (SoupImporter).
+PolygonSoup read_with_openmesh(const std::filesystem::path& path, const std::string& ext) {
+    const std::string name = path.string();
+    ReaderMesh mesh;
+    SoupImporter importer(mesh);
+    bool ok = false;
+    std::string complaint;
+    {
+        std::lock_guard lock(reader_mutex());
+        OpenMeshOutputCapture capture;
+        OpenMesh::IO::Options options;  // geometry only: no normals, colours or texture coordinates
+        try {
+            ok = OpenMesh::IO::IOManager().read(name, importer, options);
+        } catch (const std::exception& e) {
+            complaint = e.what();
+            ok = false;
+        }
+        if (complaint.empty()) complaint = capture.first_error();
+    }
+    if (!ok)
+        throw FileError(name, "not a readable " + format_name(ext) + " file" +
+                                  (complaint.empty() ? "" : " (" + complaint + ")"));
+    return {importer.points(), importer.faces(), complaint};
+}
+
+// OFF through CGAL's reader: OpenMesh's takes neither the counts on the "OFF" line nor comments and
+// blank lines between records (all legal OFF, written by Geomview and CGAL) and misreads them as
+// missing vertices or no faces. check_off_body has already named any bad record of the plain layout.
+PolygonSoup read_off(const std::filesystem::path& path) {
+    using Point = CGAL::Simple_cartesian<double>::Point_3;
+    std::vector<Point> cgal_points;
+    std::vector<std::vector<std::size_t>> polygons;
+    std::ifstream in(path, std::ios::binary);
+    if (!CGAL::IO::read_OFF(in, cgal_points, polygons))
+        throw FileError(path.string(), "not a readable OFF file");
+    PolygonSoup soup;
+    soup.points.reserve(cgal_points.size());
+    for (const Point& p : cgal_points) soup.points.emplace_back(p.x(), p.y(), p.z());
+    soup.faces.reserve(polygons.size());
+    for (const auto& polygon : polygons) {
+        std::vector<int32_t>& face = soup.faces.emplace_back();
+        for (std::size_t i : polygon) face.push_back(i < soup.points.size() ? static_cast<int32_t>(i) : -1);
+    }
+    return soup;
 }
 
 }  // namespace
@@ -292,30 +503,17 @@ TriangleSurface read_surface_file(const std::filesystem::path& path) {
     if (ext == ".off") check_off_body(path, size);
     if (ext == ".ply") check_ply_body(path, size);
     if (ext == ".stl") check_stl_size(path, size);
+    if (ext == ".obj") check_vertex_lines(path, read_all(path), "v");
 
-    ReaderMesh mesh;
-    SoupImporter importer(mesh);
-    bool ok = false;
-    std::string complaint;
-    {
-        std::lock_guard lock(reader_mutex());
-        OpenMeshOutputCapture capture;
-        OpenMesh::IO::Options options;  // geometry only: no normals, colours or texture coordinates
-        try {
-            ok = OpenMesh::IO::IOManager().read(name, importer, options);
-        } catch (const std::exception& e) {
-            complaint = e.what();
-            ok = false;
-        }
-        if (complaint.empty()) complaint = capture.first_error();
-    }
-    if (!ok)
-        throw FileError(name, "not a readable " + format_name(ext) + " file" +
-                                  (complaint.empty() ? "" : " (" + complaint + ")"));
-
+    const PolygonSoup soup = ext == ".off" ? read_off(path) : read_with_openmesh(path, ext);
+    const std::string& complaint = soup.complaint;
+    const auto& faces = soup.faces;
     TriangleSurface surface;
-    surface.points = importer.points();
-    const auto& faces = importer.faces();
+    surface.points = soup.points;
+    // The formats not checked above (PLY, binary or ascii) can still carry NaN or infinity.
+    for (size_t v = 0; v < surface.points.size(); ++v)
+        if (!surface.points[v].allFinite())
+            throw FileError(name, "vertex " + std::to_string(v) + " has a non-finite coordinate");
     for (size_t f = 0; f < faces.size(); ++f) {
         const auto& face = faces[f];
         if (face.size() < 3)

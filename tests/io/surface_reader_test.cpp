@@ -8,6 +8,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -304,6 +306,88 @@ TEST_F(SurfaceReaderFiles, AbsurdHeaderCountsGiveFileErrors) {
 
 TEST_F(SurfaceReaderFiles, FaceWithMissingVertexGivesFileError) {
     expect_file_error(write_text("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "");
+}
+
+// The cube's vertices and faces as OFF records, with `vertex_line(k)` for vertex k.
+std::string cube_off_body(const std::function<std::string(int)>& vertex_line) {
+    const int faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                              {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    std::string text;
+    for (int k = 0; k < 8; ++k) text += vertex_line(k);
+    for (const auto& f : faces)
+        text += "3 " + std::to_string(f[0]) + " " + std::to_string(f[1]) + " " + std::to_string(f[2]) + "\n";
+    return text;
+}
+
+std::string corner(int k) {
+    return std::to_string(k & 1) + " " + std::to_string((k >> 1) & 1) + " " + std::to_string((k >> 2) & 1);
+}
+
+TEST_F(SurfaceReaderFiles, LegalOffLayoutsReadAsTheCube) {
+    // OpenMesh's OFF reader misread each of these (no faces, or faces naming missing vertices).
+    const std::string plain = cube_off_body([](int k) { return corner(k) + "\n"; });
+    const std::string layouts[] = {
+        "OFF 8 12 0\n" + plain,                                                      // counts on the OFF line
+        "# made by hand\nOFF\n# counts\n8 12 0\n\n" + plain,                          // comment and blank lines
+        "OFF\n8 12 0\n" + cube_off_body([](int k) { return corner(k) + " # corner\n\n"; }),  // trailing comments
+        "COFF\n8 12 0\n" + cube_off_body([](int k) { return corner(k) + " 255 0 0 255\n"; }),  // colours
+    };
+    for (size_t k = 0; k < std::size(layouts); ++k) {
+        SCOPED_TRACE(layouts[k].substr(0, 30));
+        const LoadedSurface loaded = load_closed_surface(write_text("cube" + std::to_string(k) + ".off", layouts[k]));
+        EXPECT_EQ(loaded.surface.points.size(), 8u);
+        EXPECT_EQ(loaded.surface.triangles.size(), 12u);
+        EXPECT_NEAR(find_surface_defects(loaded.surface).signed_volume, 1.0, 1e-12);
+    }
+}
+
+TEST_F(SurfaceReaderFiles, BadCoordinatesAreNamedWithTheirLine) {
+    // Vertex 5 (the sixth) gets a bad y; OpenMesh's readers silently skipped such a vertex, so the
+    // error used to be about a face instead.
+    for (const char* bad : {"nan", "inf", "-inf", "1e400", "x", "1.5.2"}) {
+        SCOPED_TRACE(bad);
+        const std::string fragment = std::string("vertex coordinate '") + bad + "' is ";
+        auto with_bad = [&](const std::string& prefix, const std::string& suffix) {
+            return [=](int k) { return prefix + (k == 5 ? "1 " + std::string(bad) + " 1" : corner(k)) + suffix; };
+        };
+        // OBJ: vertex 5 is on line 6.
+        std::string obj;
+        for (int k = 0; k < 8; ++k) obj += with_bad("v ", "\n")(k);
+        expect_file_error(write_text("bad.obj", obj + "f 1 3 2\n"), "line 6: " + fragment);
+        // OFF: two header lines, then the vertices.
+        expect_file_error(write_text("bad.off", "OFF\n8 12 0\n" + cube_off_body(with_bad("", "\n"))), "line 8: " + fragment);
+        // Ascii PLY: nine header lines.
+        const std::string ply_header =
+            "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+            "element face 12\nproperty list uchar int vertex_indices\nend_header\n";
+        expect_file_error(write_text("bad.ply", ply_header + cube_off_body(with_bad("", "\n"))), "line 15: " + fragment);
+        // Ascii STL: a facet's first vertex on line 4.
+        expect_file_error(write_text("bad.stl", "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 " + std::string(bad) +
+                                                    " 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n"),
+                          "line 4: " + fragment);
+    }
+}
+
+TEST_F(SurfaceReaderFiles, NonFiniteBinaryCoordinatesAreNamed) {
+    auto cube = make_openmesh_cube();
+    cube.set_point(OpenMesh::VertexHandle(3), {0.0f, std::numeric_limits<float>::quiet_NaN(), 1.0f});
+    ASSERT_TRUE(OpenMesh::IO::write_mesh(cube, file("nan.stl").string(), OpenMesh::IO::Options::Binary));
+    expect_file_error(file("nan.stl"), "has a non-finite coordinate");
+    ASSERT_TRUE(OpenMesh::IO::write_mesh(cube, file("nan.ply").string(), OpenMesh::IO::Options::Binary));
+    expect_file_error(file("nan.ply"), "vertex 3 has a non-finite coordinate");
+}
+
+TEST_F(SurfaceReaderFiles, BadOffFacesAreNamedWithTheirLine) {
+    const std::string body = cube_off_body([](int k) { return corner(k) + "\n"; });
+    std::string bad_index = body;
+    bad_index.replace(bad_index.rfind("3 3 7 5"), 7, "3 3 8 5");
+    expect_file_error(write_text("index.off", "OFF\n8 12 0\n" + bad_index), "line 22: face 11 refers to vertex 8");
+    std::string short_face = body;
+    short_face.replace(short_face.rfind("3 3 7 5"), 7, "4 3 7 5");
+    expect_file_error(write_text("short.off", "OFF\n8 12 0\n" + short_face), "line 22: face 11: 3 vertex indices");
+    std::string word = body;
+    word.replace(word.rfind("3 3 7 5"), 7, "3 3 seven 5");
+    expect_file_error(write_text("word.off", "OFF\n8 12 0\n" + word), "line 22: face 11: 'seven' is not a vertex index");
 }
 
 TEST_F(SurfaceReaderFiles, TruncatedFilesGiveFileErrors) {
