@@ -80,6 +80,7 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
             // Crossed tets are split along the surface (tetops/exact_cut.h): nothing is left on the
             // cut-away side, so there is nothing to relax.
             ExactCutResult result = cut_exact(*after, *surface);
+            require_tets_left_by_cut(*after, mesh_.tet_count());
             connectivity = std::make_shared<TetConnectivity>(build_connectivity(*after));
             min_dihedral_deg_ = result.min_dihedral_deg;
             report.vertex_origins = std::move(result.vertex_origins);
@@ -89,6 +90,7 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
                     << " tets under the angle guard";
         } else {
             CutResult removed = remove_cut_away_tets(*after, *surface);
+            require_tets_left_by_cut(*after, mesh_.tet_count());
             connectivity = std::make_shared<TetConnectivity>(build_connectivity(*after));
             const RelaxationReport relaxed =
                 relax_cut_vertices(*after, *connectivity, *surface, relaxation_options(relax));

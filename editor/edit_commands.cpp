@@ -83,6 +83,7 @@ void run_exact_cut(const CutCommandOptions& o, const PlaneCut& plane) {
     const size_t vertices_before = mesh.vertex_count();
     const auto start = Clock::now();
     const ExactCutResult cut = cut_exact(mesh, plane);
+    require_tets_left_by_cut(mesh, tets_before);
     const TetConnectivity connectivity = build_connectivity(mesh);
     const double elapsed = milliseconds_since(start);
     write_volume(mesh, o.output);
@@ -118,6 +119,7 @@ void run_cut_command(const CutCommandOptions& o) {
 
     const auto start = Clock::now();
     const CutResult cut = remove_cut_away_tets(mesh, plane);
+    require_tets_left_by_cut(mesh, tets_before);
     const TetConnectivity connectivity = build_connectivity(mesh);
     RelaxationOptions relax;
     relax.max_iterations = o.relax_iterations;

@@ -138,6 +138,13 @@ std::vector<Eigen::Vector3d> world_positions(const TetMesh& mesh) {
     return world;
 }
 
+void require_tets_left_by_cut(const TetMesh& after, size_t tets_before) {
+    if (after.tet_count() == 0 && tets_before > 0)
+        throw InvalidArgumentError("the cut removes all " + std::to_string(tets_before) +
+                                   " tets: nothing would be left (a plane cuts away the side its normal points "
+                                   "to, a stroke the side on its left; flip it to keep that side)");
+}
+
 CutResult remove_cut_away_tets(TetMesh& mesh, const CuttingSurface& surface) {
     const std::vector<Eigen::Vector3d> world = world_positions(mesh);
     std::vector<uint8_t> cut_away(mesh.vertex_count());

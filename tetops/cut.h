@@ -96,6 +96,12 @@ std::vector<Eigen::Vector3d> world_positions(const TetMesh& mesh);
 // become empty). Cutting everything away leaves a valid empty mesh.
 CutResult remove_cut_away_tets(TetMesh& mesh, const CuttingSurface& surface);
 
+// For the callers that must not leave an empty volume (the editor, sessions, `waxwork cut`): throws
+// InvalidArgumentError when a cut of a mesh of `tets_before` tets left `after` without any, so the
+// caller keeps its mesh unchanged. An empty volume can be neither lit nor rendered, and cutting on
+// the wrong side is an easy slip of a plane's sign or a stroke's direction.
+void require_tets_left_by_cut(const TetMesh& after, size_t tets_before);
+
 // Removes the tets flagged in `remove` (one flag per tet) and the vertices left without a tet, with
 // the same compaction and bookkeeping as remove_cut_away_tets (which is this with a side test).
 // Throws InvalidArgumentError when the flag count differs from the tet count.

@@ -56,6 +56,21 @@ TEST(Document, LoadingWithoutMaterialsAssignsTheDefault) {
     EXPECT_GT(doc.min_dihedral_deg(), 0);
 }
 
+TEST(Document, ACutThatWouldRemoveEverythingIsRefusedAndChangesNothing) {
+    for (const bool exact : {false, true}) {
+        SCOPED_TRACE(exact ? "exact" : "remove and relax");
+        Document doc(test_cube(), material_preset("marble"));
+        const TetMesh before = doc.mesh();
+        PlaneCutOp everything = plane_cut(-10);  // the whole cube is on the side n.x > -10
+        everything.exact = exact;
+        EXPECT_THROW(doc.apply(everything), InvalidArgumentError);
+        EXPECT_EQ(doc.mesh(), before);
+        EXPECT_FALSE(doc.can_undo());
+        EXPECT_NO_THROW(doc.apply(plane_cut(0.55)));  // and the document still works
+        EXPECT_LT(doc.mesh().tet_count(), before.tet_count());
+    }
+}
+
 TEST(Document, UndoRestoresTheMeshBitForBitForEveryKind) {
     for (const EditOperation& op : material_and_geometry_ops()) {
         Document doc(test_cube(), material_preset("marble"));

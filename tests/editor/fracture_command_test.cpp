@@ -1,4 +1,4 @@
-// `waxwork cut --exact` and `waxwork fracture` end to end: a meshed cube in, a valid volume and a
+// `waxwork cut` and `waxwork fracture` end to end: a meshed cube in, a valid volume and a
 // one-line JSON summary out; bad input gives a one-line error and writes nothing.
 #include "editor/cli_run.h"
 #include "io/volume_file.h"
@@ -127,6 +127,19 @@ TEST(CutCommand, ExactCutLeavesTheCrossSectionOnThePlane) {
     const auto bad = run_waxwork("cut " + in.string() + " -o " + (dir / "x.vtu").string() + " --plane=0,0,0,1 --exact");
     EXPECT_NE(bad.exit_code, 0);
     EXPECT_EQ(line_count(bad.err), 1u);
+}
+
+TEST(CutCommand, ACutThatLeavesNothingIsAnErrorAndWritesNothing) {
+    const auto dir = scratch_dir("cut_everything_cli");
+    const auto in = meshed_cube(dir);
+    const auto out = dir / "never.vtu";
+    for (const std::string mode : {"", " --exact"}) {
+        const auto r = run_waxwork("cut " + in.string() + " -o " + out.string() + " --plane=1,0,0,-100" + mode);
+        EXPECT_NE(r.exit_code, 0) << mode;
+        EXPECT_EQ(line_count(r.err), 1u) << r.err;
+        EXPECT_NE(r.err.find("nothing would be left"), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(out)) << mode;
+    }
 }
 
 }  // namespace

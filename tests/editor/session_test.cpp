@@ -127,9 +127,13 @@ TEST(Session, RecordedHistoryReplaysToTheSameVolumeBitForBit) {
     doc.apply(SetMaterialOp{material_preset("skin1"), 0});
     doc.undo();  // not part of the record
     StrokeCutOp stroke;
+    // Seen from the eye, the stroke's surface crosses the cube near x = 0.3.
     stroke.stroke = {Eigen::Vector3d(0.5, 0.5, 5), Eigen::Vector3d(0, 0, -1),
-                     {Eigen::Vector3d(0.1, -1, 4), Eigen::Vector3d(0.3, 2, 4)}, true};
+                     {Eigen::Vector3d(0.45, -1, 4), Eigen::Vector3d(0.47, 2, 4)}, true};
+    const size_t tets_before_stroke = doc.mesh().tet_count();
     doc.apply(stroke);
+    EXPECT_GT(doc.mesh().tet_count(), 0u);
+    EXPECT_LT(doc.mesh().tet_count(), tets_before_stroke);
     paint.points = {Eigen::Vector3d(0.5, 0.5, 0.5)};
     doc.apply(paint);
 

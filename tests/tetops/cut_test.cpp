@@ -153,6 +153,22 @@ TEST(CutPlane, RepeatedCutsUntilNothingIsLeft) {
     EXPECT_NO_THROW(validate(mesh));
 }
 
+TEST(CutPlane, RequireTetsLeftRefusesOnlyACutThatEmptiedTheMesh) {
+    TetMesh mesh = make_cube_mesh(3);
+    const size_t before = mesh.tet_count();
+    remove_cut_away_tets(mesh, PlaneCut(Eigen::Vector3d::UnitX(), 0.5));  // half is left
+    EXPECT_NO_THROW(require_tets_left_by_cut(mesh, before));
+    remove_cut_away_tets(mesh, PlaneCut(Eigen::Vector3d::UnitX(), -1.0));  // nothing is left
+    ASSERT_EQ(mesh.tet_count(), 0u);
+    try {
+        require_tets_left_by_cut(mesh, before);
+        ADD_FAILURE() << "an emptied mesh passed";
+    } catch (const InvalidArgumentError& e) {
+        EXPECT_NE(std::string(e.what()).find("removes all " + std::to_string(before) + " tets"), std::string::npos) << e.what();
+    }
+    EXPECT_NO_THROW(require_tets_left_by_cut(mesh, 0));  // it was empty before: nothing was lost
+}
+
 TEST(CutPlane, CutThroughAUShapeLeavesTwoComponents) {
     // A U standing on the xy plane: a base row of cells and two pillars at x = 0 and x = 4.
     TetMesh mesh = make_cell_mesh(5, 4, 1, [](int i, int j, int) { return j == 0 || i == 0 || i == 4; });
