@@ -8,6 +8,7 @@
 #include "editor/solver_comparison.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
+#include "solver/material.h"
 #include "tetops/error.h"
 #include "tetops/tetrahedralize.h"
 
@@ -61,8 +62,7 @@ double mm_per_unit(const TetMesh& mesh, const std::optional<double>& scale) {
 }
 
 void run_solvers_command(const SolversCommandOptions& o) {
-    if (o.scale && (!std::isfinite(*o.scale) || *o.scale < 1e-6 || *o.scale > 1e6))
-        throw InvalidArgumentError("--scale must be a length in mm per model unit between 1e-6 and 1e6");
+    if (o.scale) validate_mm_per_unit(*o.scale, "--scale");
     if (!(o.floor_error > 0 && o.floor_error < 1))
         throw InvalidArgumentError("--floor must be between 0 and 1");
     if (!(o.max_seconds > 0) || !std::isfinite(o.max_seconds))

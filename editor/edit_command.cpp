@@ -5,6 +5,7 @@
 #include "editor/editor_app.h"
 #include "editor/live_solver_choice.h"
 #include "editor/material_options.h"
+#include "solver/material.h"
 #include "tetops/error.h"
 
 #include <CLI/CLI.hpp>
@@ -42,8 +43,7 @@ void run_edit_command(const EditCommandOptions& o) {
     if (o.width < 64 || o.height < 64 || o.width > kMaxImageSide || o.height > kMaxImageSide)
         throw InvalidArgumentError("--width/--height must be between 64 and " + std::to_string(kMaxImageSide));
     if (o.frames < 1 || o.frames > 100000) throw InvalidArgumentError("--frames must be between 1 and 100000");
-    if (!std::isfinite(o.scale) || o.scale < 1e-6 || o.scale > 1e6)
-        throw InvalidArgumentError("--scale must be a length in mm per model unit between 1e-6 and 1e6");
+    validate_mm_per_unit(o.scale, "--scale");
     EditorOptions options;
     options.view.mode = parse_view_mode(o.show);
     if (!o.slice_normal.empty()) options.view.slice_normal = parse_slice_normal(o.slice_normal);

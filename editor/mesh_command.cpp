@@ -33,6 +33,7 @@ struct MeshCommandOptions {
 };
 
 void run_mesh_command(const MeshCommandOptions& o) {
+    validate_mm_per_unit(o.scale, "--scale");  // before the (possibly long) surface checks
     SurfaceRepairOptions repair;
     repair.fill_holes = o.fill_holes;
     repair.autorefine = o.autorefine;

@@ -4,6 +4,7 @@
 #include "editor/render_pipeline.h"
 #include "editor/view_modes.h"
 #include "io/volume_file.h"
+#include "solver/material.h"
 #include "tetops/connectivity.h"
 #include "tetops/error.h"
 
@@ -57,8 +58,6 @@ ViewOptions view_options(const RenderCommandOptions& o) {
 
 // Physically meaningless values are refused before any work: a scale beyond these bounds is a unit
 // error (a nanometre or a kilometre per model unit), not a scene.
-constexpr double kMinScale = 1e-6;
-constexpr double kMaxScale = 1e6;
 
 void check_options(const RenderCommandOptions& o) {
     auto fail = [](const std::string& what) { throw InvalidArgumentError(what); };
@@ -66,8 +65,7 @@ void check_options(const RenderCommandOptions& o) {
         fail("--width/--height must be between 1 and " + std::to_string(kMaxImageSide) + " (got " +
              std::to_string(o.width) + "x" + std::to_string(o.height) + ")");
     }
-    if (!std::isfinite(o.scale) || o.scale < kMinScale || o.scale > kMaxScale)
-        fail("--scale must be a length in mm per model unit between 1e-6 and 1e6");
+    validate_mm_per_unit(o.scale, "--scale");
     if (!std::isfinite(o.tolerance) || o.tolerance <= 0 || o.tolerance >= 1)
         fail("--tol must be a relative tolerance in (0, 1)");
     if (!std::isfinite(o.ambient) || o.ambient < 0) fail("--ambient must be finite and non-negative");

@@ -1,6 +1,5 @@
 #include "editor/session.h"
 
-#include "solver/gl_context.h"
 #include "editor/json_fields.h"
 #include "editor/live_scene.h"
 #include "editor/live_solver_choice.h"
@@ -9,6 +8,8 @@
 #include "io/image_io.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
+#include "solver/gl_context.h"
+#include "solver/material.h"
 #include "solver/mesh_resolution.h"
 #include "tetops/error.h"
 
@@ -227,7 +228,8 @@ Session parse_session(const Json& json, const fs::path& base_directory, const st
     }
     session.material = in.has("material") ? in.material("material") : material_from_json(Json("marble"), name);
     session.scale = in.number("scale", session.scale);
-    if (!(session.scale > 0)) fail_json(in.field("scale"), "must be positive (millimetres per model unit)");
+    if (!(session.scale >= kMinMmPerUnit && session.scale <= kMaxMmPerUnit))
+        fail_json(in.field("scale"), "must be a length in mm per model unit between 1e-6 and 1e6");
     read_lighting_fields(in, session.lighting);
     try {
         validate(session.lighting);

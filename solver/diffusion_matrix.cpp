@@ -211,9 +211,7 @@ template std::array<long double, 6> tet_edge_stiffness<long double>(
 
 DiffusionMatrix assemble_diffusion_pattern(const TetMesh& mesh, const TetConnectivity& conn,
                                            const AssemblyOptions& options) {
-    if (!std::isfinite(options.mm_per_unit) || options.mm_per_unit <= 0)
-        throw InvalidArgumentError("diffusion matrix: mm_per_unit = " + std::to_string(options.mm_per_unit) +
-                                   " must be positive and finite");
+    validate_mm_per_unit(options.mm_per_unit, "diffusion matrix: mm_per_unit");
     if (conn.vertex_tets.row_count() != mesh.vertex_count() || conn.vertex_vertices.row_count() != mesh.vertex_count())
         throw InvalidArgumentError("diffusion matrix: connectivity does not match the mesh (rebuild it after edits)");
 

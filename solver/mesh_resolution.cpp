@@ -17,9 +17,7 @@ double smallest_diffusion_length_mm(const TetMaterial& material) {
 
 MeshSizing default_mesh_sizing(const TriangleSurface& surface, const TetMaterial& material, double mm_per_unit,
                                const MeshResolutionRule& rule) {
-    if (!(mm_per_unit > 0) || !std::isfinite(mm_per_unit))
-        throw InvalidArgumentError("scale must be a positive number of mm per model unit (got " +
-                                   std::to_string(mm_per_unit) + ")");
+    validate_mm_per_unit(mm_per_unit);
     validate_material(material);
     if (surface.points.empty()) throw InvalidArgumentError("cannot size an empty surface");
     if (!(rule.size_factor > 0) || !std::isfinite(rule.size_factor))

@@ -122,7 +122,7 @@ TEST(Cli, AbsurdParametersAreRejected) {
     const auto dir = scratch_dir("cli_absurd");
     const std::string in = kAssets + "/meshes/cube.obj -o " + (dir / "x.vtu").string();
     for (const std::string args : {" --edge -1", " --edge nan", " --max-tets 0", " --min-dihedral 80",
-                                   " --scale 0", " --mua 0.1,0.1 --musp 1,1,1 --eta 1.3",
+                                   " --scale 0", " --scale 1e300", " --mua 0.1,0.1 --musp 1,1,1 --eta 1.3",
                                    " --mua -1,0,0 --musp 1,1,1 --eta 1.3", " --material unobtainium"}) {
         const auto r = run_waxwork("mesh " + in + args);
         EXPECT_NE(r.exit_code, 0) << args;

@@ -89,6 +89,8 @@ TEST(Session, ErrorsNameTheFileAndTheStep) {
     EXPECT_NE(e.find("step 1: field 'light'"), std::string::npos) << e;
     e = session_error(R"({"input": {"volume": "v.vtu", "max_tets": 5}, "steps": []})");
     EXPECT_NE(e.find("bad.json: field 'input'"), std::string::npos) << e;
+    e = session_error(R"({"input": {"volume": "v.vtu"}, "scale": 1e308, "steps": []})");  // overflowed tet volumes
+    EXPECT_NE(e.find("bad.json: field 'scale': must be a length in mm per model unit"), std::string::npos) << e;
     e = session_error(R"({"input": {"volume": "v.vtu"}, "steps": [})");
     EXPECT_NE(e.find("bad.json: not valid JSON"), std::string::npos) << e;
 }

@@ -75,6 +75,19 @@ TEST(Material, UnknownPresetNamesTheKnownOnes) {
     }
 }
 
+TEST(Material, ScaleMustBeAFiniteLengthInRange) {
+    for (double good : {kMinMmPerUnit, 1.0, 30.0, kMaxMmPerUnit}) EXPECT_NO_THROW(validate_mm_per_unit(good)) << good;
+    for (double bad : {0.0, -3.0, 1e-7, 2e6, 1e308, std::numeric_limits<double>::infinity(),
+                       std::numeric_limits<double>::quiet_NaN()}) {
+        try {
+            validate_mm_per_unit(bad, "--scale");
+            ADD_FAILURE() << "accepted " << bad;
+        } catch (const InvalidArgumentError& e) {
+            EXPECT_EQ(std::string(e.what()).rfind("--scale must be a length in mm per model unit", 0), 0u) << e.what();
+        }
+    }
+}
+
 TEST(Material, ValidationRejectsBadCoefficients) {
     const TetMaterial good = material_preset("marble");
     auto expect_bad = [&](TetMaterial m, const std::string& fragment) {
