@@ -2,6 +2,7 @@
 
 #include "tetops/error.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -49,7 +50,9 @@ void GpuMultigridFrameSolver::set_relative_tolerance(double tolerance) {
 }
 
 void GpuMultigridFrameSolver::reset() {
-    kernels_->axpby(n_, {0, 0, 0}, phi_, {0, 0, 0}, phi_);  // 0 x + 0 y: phi is finite, so exactly 0
+    // Written, not scaled by 0: a phi left non-finite by a breakdown must become 0 as well.
+    std::fill(staging_.begin(), staging_.end(), 0.0f);
+    phi_.write(0, staging_.size() * sizeof(float), staging_.data());
     refresh_ = phi_zero_ = true;
     cg_.restart();
     cg_.forget_eigenvalues(true);

@@ -9,8 +9,10 @@
 // transpose. The kernels (GpuKernels::multigrid_smooth, multigrid_residual, interpolate) perform the
 // CPU float V-cycle's operations in its order without fused multiply-adds (`precise`), and the
 // coarsest solve is the CPU's own, so the device result is apply_rgb's bit for bit on llvmpipe
-// (tests/multires/gpu_multigrid_preconditioner_test.cpp); a driver that fused anyway would differ by
-// float rounding only.
+// (tests/multires/gpu_multigrid_preconditioner_test.cpp). llvmpipe (Mesa 22.3, LLVM 15) happens to give
+// the same bits without `precise` too (tried); it is there for drivers that contract a * b + c into
+// fused multiply-adds, which GLSL allows by default. A driver that fused anyway would differ by float
+// rounding only.
 //
 // The coarsest level is solved on the host with the CPU preconditioner's exact sparse LDL^T
 // factorisation (one read-back of the coarsest right-hand side and one upload of its solution per
