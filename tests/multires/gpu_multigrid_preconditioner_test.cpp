@@ -83,7 +83,7 @@ TEST(GpuMultigridPreconditioner, VcycleEqualsTheCpuFloatApplyRgb) {
         EXPECT_LE(difference, kFloatRoundingBound) << steps << " smoothing steps";
         size_t differing = 0;
         for (size_t i = 0; i < z.size(); ++i) differing += static_cast<double>(zg[i]) != z[i] ? 1 : 0;
-        // llvmpipe (CI) honours `precise`: the very same bits.
+        // llvmpipe (CI) runs the very same float operations: the very same bits.
         if (llvmpipe) {
             EXPECT_EQ(differing, 0u) << steps << " smoothing steps";
         }
