@@ -94,7 +94,6 @@ public:
     // The lumping the operators were built with: Absolute after a RowSum setup failed, with the reason.
     DropLumping lumping() const { return options_.lumping; }
     const std::string& lumping_fallback_reason() const { return lumping_fallback_reason_; }
-    const MultigridOptions& options() const { return options_; }
 
     // What a device V-cycle (gpu_multigrid_preconditioner.h) needs to run the same algorithm with the
     // same coefficients. Level l's position of (i, i) in its stored entries:
