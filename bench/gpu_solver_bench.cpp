@@ -12,6 +12,7 @@
 // Run: build/bench/gpu_solver_bench [--benchmark_filter=...]
 #include "bench_meshes.h"
 #include "multires/gpu_independent_set.h"
+#include "multires/gpu_multigrid_frame_solver.h"
 #include "multires/gpu_multires_solver.h"
 #include "multires/hierarchy.h"
 #include "solver/conjugate_gradient.h"
@@ -148,6 +149,86 @@ void BM_GpuMultires(benchmark::State& state) {
     state.counters["coarsest_iters_g"] = report.coarse_levels.empty() ? 0 : report.coarse_levels.front()[1].iterations;
 }
 
+// The GPU multigrid CG (multires/gpu_multigrid_frame_solver.h) from phi = 0 to an estimated 1% error,
+// hierarchy and levels resident (their setup excluded): compare with BM_GpuCg<SellCSigma>, GPU Jacobi CG
+// on the same system to the same estimate. V-cycles per frame are unlimited; counters: V-cycles run.
+void BM_GpuMultigridCg(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    FrameSolverOptions options;
+    options.relative_tolerance = 1e-2;
+    GpuMultigridFrameSolver solver(context().gl(), s.matrix, s.mesh.positions, options);
+    std::array<std::vector<double>, 3> b;
+    for (int c = 0; c < 3; ++c) {
+        b[c].resize(s.matrix.size());
+        diffusion_right_hand_side(s.matrix, s.q, c, b[c]);
+    }
+    solver.set_right_hand_side({b[0], b[1], b[2]});
+    FrameStep step;
+    for (auto _ : state) {
+        solver.reset();
+        step = solver.step(1000);
+    }
+    state.counters["vcycles"] = step.vcycles;
+    state.counters["converged"] = step.converged;
+    state.counters["levels"] = static_cast<double>(solver.preconditioner().level_count());
+}
+
+// A frame after a 5% light change, warm from the previous solution (as BM_GpuCgWarm): the residual
+// follows the change of b on the device, then V-cycles to an estimated 1%.
+void BM_GpuMultigridCgWarm(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    FrameSolverOptions options;
+    options.relative_tolerance = 1e-2;
+    GpuMultigridFrameSolver solver(context().gl(), s.matrix, s.mesh.positions, options);
+    std::array<std::vector<double>, 3> b, b2;
+    for (int c = 0; c < 3; ++c) {
+        b[c].resize(s.matrix.size());
+        diffusion_right_hand_side(s.matrix, s.q, c, b[c]);
+        b2[c] = b[c];
+        for (double& v : b2[c]) v *= 1.05;
+    }
+    solver.set_right_hand_side({b[0], b[1], b[2]});
+    solver.step(1000);
+    const auto previous = solver.phi();
+    FrameStep step;
+    for (auto _ : state) {
+        solver.set_phi({previous[0], previous[1], previous[2]});  // back to the previous frame's phi
+        solver.set_right_hand_side({b2[0], b2[1], b2[2]});
+        step = solver.step(1000);
+        solver.set_right_hand_side({b[0], b[1], b[2]});
+    }
+    state.counters["vcycles"] = step.vcycles;
+}
+
+// One device V-cycle z = B r (gpu_multigrid_preconditioner.h), and arg 2 = 1: only its coarsest solve's
+// round trip (read-back of the coarsest right-hand side, the host LDL^T solve, upload of x), to weigh the
+// choice of a host solve against the whole V-cycle.
+void BM_GpuMultigridVcycle(benchmark::State& state) {
+    const Scene& s = scene(state.range(0));
+    const MultiresHierarchy hierarchy = build_multires_hierarchy(s.matrix, s.mesh.positions);
+    MultigridPreconditioner cpu(hierarchy);
+    GpuKernels kernels(context().gl(), {GpuMatrixFormat::SellCSigma});
+    GpuMultigridPreconditioner gpu(kernels, cpu);
+    const size_t n = s.matrix.size(), coarse = cpu.rows(cpu.level_count() - 1);
+    const std::vector<float> ones(3 * n, 1.0f);
+    const GpuBuffer r = kernels.vector(n, ones.data());
+    GpuBuffer z = kernels.vector(n), cb = kernels.vector(coarse, ones.data()), cx = kernels.vector(coarse);
+    std::vector<float> hb(3 * coarse), hx(3 * coarse);
+    const bool round_trip_only = state.range(1) == 1;
+    for (auto _ : state) {
+        if (round_trip_only) {
+            cb.read(0, hb.size() * sizeof(float), hb.data());
+            cpu.solve_coarsest_rgb(hb, hx);
+            cx.write(0, hx.size() * sizeof(float), hx.data());
+        } else {
+            gpu.apply(r, z);
+        }
+        context().gl().Finish();
+    }
+    state.counters["levels"] = static_cast<double>(cpu.level_count());
+    state.counters["coarsest_rows"] = static_cast<double>(coarse);
+}
+
 // What a scene load costs: kernels compiled, pattern and values uploaded, diagonal extracted.
 void BM_GpuSetup(benchmark::State& state) {
     const Scene& s = scene(state.range(0));
@@ -235,6 +316,9 @@ BENCHMARK(BM_GpuCg<GpuMatrixFormat::Csr>)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuCg<GpuMatrixFormat::SellCSigma>)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuCgWarm)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuMultires)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuMultigridCg)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuMultigridCgWarm)->WAXWORK_SIZES;
+BENCHMARK(BM_GpuMultigridVcycle)->ArgsProduct({{50000, 500000}, {0, 1}})->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 BENCHMARK(BM_GpuSetup)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuPaintRowUpdate)->WAXWORK_SIZES;
 BENCHMARK(BM_GpuAssembleValues)->WAXWORK_SIZES;

@@ -4,7 +4,8 @@
 //   0: CPU Jacobi CG (double), 1: CPU multigrid CG, three channels per V-cycle (the budget of 8 is 2
 //   V-cycles; cg_its_per_frame counts each V-cycle once per channel), 2: GPU CG (float, OpenGL compute),
 //   3: CPU multires (Li et al. Sec. 4: coarse to fine after a rebuild, then the level-0 Jacobi CG warm
-//   per frame, double), 4: the same on the GPU (GpuMultiresSolver, float).
+//   per frame, double), 4: the same on the GPU (GpuMultiresSolver, float), 5: multigrid CG on the GPU
+//   (GpuMultigridFrameSolver, float; V-cycles counted as in 1; a time budget checked between V-cycles).
 //   ./build/bench/live_solver_bench
 // BM_RelightFramesWithinBudget: the same relighting with a budget of 10 ms per frame instead of 8
 // iterations (below).
@@ -53,6 +54,7 @@ constexpr Variant kVariants[] = {
     {LiveMethod::JacobiCg, LiveBackend::Gpu, "gpu_cg_llvmpipe"},
     {LiveMethod::Multires, LiveBackend::Cpu, "cpu_multires"},
     {LiveMethod::Multires, LiveBackend::Gpu, "gpu_multires_llvmpipe"},
+    {LiveMethod::MultigridCg, LiveBackend::Gpu, "gpu_mgcg_llvmpipe"},
 };
 
 LiveSceneOptions scene_options(const TetMesh& mesh, const Variant& variant) {
@@ -133,7 +135,7 @@ void BM_RelightFrames(benchmark::State& state) {
     }
     report(state, ms, scene, iterations, doc.mesh());
 }
-BENCHMARK(BM_RelightFrames)->DenseRange(0, 4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RelightFrames)->DenseRange(0, 5)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_PaintFrames(benchmark::State& state) {
     const Variant& variant = kVariants[state.range(0)];
@@ -155,7 +157,7 @@ void BM_PaintFrames(benchmark::State& state) {
     }
     report(state, ms, scene, iterations, doc.mesh());
 }
-BENCHMARK(BM_PaintFrames)->DenseRange(0, 4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PaintFrames)->DenseRange(0, 5)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The first frame after a plane cut through the middle (a new matrix): scene_ms is the scene's rebuild
 // (for multigrid CG and multires including the hierarchy), frame_ms one frame of the usual budget from
@@ -188,15 +190,16 @@ void BM_FirstFrameAfterCut(benchmark::State& state) {
         state.SkipWithError(("fell back to the CPU: " + scene.gpu_fallback_reason()).c_str());
     state.SetLabel(scene.solver_description());
 }
-BENCHMARK(BM_FirstFrameAfterCut)->DenseRange(0, 4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FirstFrameAfterCut)->DenseRange(0, 5)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Frames with a time budget instead of iterations (solver/frame_budget.h, `--frame-ms`): the light
 // turns 3 degrees per frame as in BM_RelightFrames and each frame's solver step gets kFrameBudgetMs.
 // step_* is the solver step alone (what the budget limits), over_* how far it went past the budget
 // (an iteration or V-cycle that started finishes; with three channels one after the other, each gets
 // its share), frame_* the whole frame (light + step + radiance), its_per_frame the iterations per
-// frame summed over channels (multigrid CG: V-cycles, counted once per channel). The GPU rows turn
-// the budget into a predicted iteration count (iteration_time_predictor.h); on llvmpipe.
+// frame summed over channels (multigrid CG: V-cycles, counted once per channel). The GPU Jacobi and
+// multires rows turn the budget into a predicted iteration count (iteration_time_predictor.h); the GPU
+// multigrid checks the deadline between V-cycles; on llvmpipe.
 //   ./build/bench/live_solver_bench --benchmark_filter=BM_RelightFramesWithinBudget
 constexpr double kFrameBudgetMs = 10;
 
@@ -240,7 +243,7 @@ void BM_RelightFramesWithinBudget(benchmark::State& state) {
         state.SkipWithError(("fell back to the CPU: " + scene.gpu_fallback_reason()).c_str());
     state.SetLabel(scene.solver_description());
 }
-BENCHMARK(BM_RelightFramesWithinBudget)->DenseRange(0, 4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RelightFramesWithinBudget)->DenseRange(0, 5)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace waxwork

@@ -28,7 +28,7 @@ void EditorApp::draw_solver_choice() {
         ImGui::SetTooltip("Jacobi-preconditioned CG per channel (double on the CPU, float on the GPU).\n"
                           "Multigrid CG, three channels per V-cycle: CG preconditioned by a V-cycle on the\n"
                           "multires hierarchy, warm across frames, one V-cycle per 4 iterations of the budget\n"
-                          "(CPU only: on the GPU backend it runs Jacobi CG).\n"
+                          "(CPU, or the device: the same V-cycle in float there).\n"
                           "Multires: the paper's scheme, BiCGSTAB coarse to fine after a rebuild, then a warm\n"
                           "level-0 CG per frame; painting updates only the changed rows of every level. Runs on\n"
                           "the CPU or on the device.");

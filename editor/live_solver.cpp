@@ -1,5 +1,6 @@
 #include "editor/live_solver.h"
 
+#include "multires/gpu_multigrid_frame_solver.h"
 #include "multires/gpu_multires_solver.h"
 #include "multires/multigrid_frame_solver.h"
 #include "multires/multires_solver.h"
@@ -93,8 +94,9 @@ std::shared_ptr<SolverGlContext> borrow_headless_solver_context(HeadlessGlContex
 }
 
 struct LiveSolver::Gpu {
-    // One of the two: Jacobi CG (also for the multigrid method) or the multires hierarchy.
+    // One of the three: Jacobi CG, the multigrid CG or the multires hierarchy.
     std::unique_ptr<GpuDiffusionSolver> solver;
+    std::unique_ptr<GpuMultigridFrameSolver> multigrid;
     std::unique_ptr<GpuMultiresSolver> multires;
     std::vector<std::array<double, 3>> staging;  // interleaved phi for uploads and read-backs
     // Device radiance: weights from the boundary eta (reset when materials change), q (re-sent when
@@ -104,9 +106,11 @@ struct LiveSolver::Gpu {
     GpuBuffer volume_e, surface_index;
     std::vector<int32_t> surface_vertices;  // what surface_index holds
 
-    size_t size() const { return solver ? solver->size() : multires->size(); }
-    GpuKernels& kernels() { return solver ? solver->kernels() : multires->kernels(); }
-    const GpuBuffer& solution_buffer() const { return solver ? solver->solution_buffer() : multires->solution_buffer(); }
+    size_t size() const { return solver ? solver->size() : multigrid ? multigrid->size() : multires->size(); }
+    GpuKernels& kernels() { return solver ? solver->kernels() : multigrid ? multigrid->kernels() : multires->kernels(); }
+    const GpuBuffer& solution_buffer() const {
+        return solver ? solver->solution_buffer() : multigrid ? multigrid->solution_buffer() : multires->solution_buffer();
+    }
 };
 
 LiveSolver::LiveSolver(const LiveSolverOptions& options)
@@ -159,19 +163,17 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
     forget_estimates();
     // Every copy is rebuilt from this matrix: nothing of the old one is pending, b and phi are.
     multigrid_pending_ = multires_pending_ = gpu_pending_ = PendingChanges{};
-    // The GPU backend runs Jacobi CG whatever the method (there is no device V-cycle); after a fallback
-    // the CPU then uses Jacobi CG until the next rebuild builds the hierarchy.
-    if (method_ == LiveMethod::MultigridCg && backend_ == LiveBackend::Cpu && matrix.size() > 0) {
-        // Built now, while the mesh is at hand (the scene borrows it only during its calls).
+    multigrid_positions_.clear();
+    if (method_ == LiveMethod::MultigridCg && matrix.size() > 0) {
         if (mesh.vertex_count() != matrix.size())
             throw InvalidArgumentError("live solver: the matrix does not belong to the mesh");
-        try {
-            FrameSolverOptions frame_options;
-            frame_options.multigrid = multigrid_options_;
-            multigrid_ = std::make_unique<MultigridFrameSolver>(matrix, mesh.positions, frame_options);
+        // Built now, while the mesh is at hand (the scene borrows it only during its calls); the device
+        // solver at the next GPU frame, with the context current, from a copy of the rest positions.
+        if (backend_ == LiveBackend::Cpu) {
+            build_cpu_multigrid(mesh.positions, matrix);
+        } else {
+            multigrid_positions_ = mesh.positions;
             method_fallback_reason_.clear();
-        } catch (const AlgorithmError& e) {
-            method_fallback_reason_ = std::string("multigrid CG: ") + e.what();
         }
     }
     multires_.reset();
@@ -188,6 +190,18 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
         } catch (const std::exception& e) {
             fall_back(std::string("GPU solver: ") + e.what());
         }
+    }
+}
+
+void LiveSolver::build_cpu_multigrid(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix) {
+    try {
+        FrameSolverOptions frame_options;
+        frame_options.multigrid = multigrid_options_;
+        multigrid_ = std::make_unique<MultigridFrameSolver>(matrix, positions, frame_options);
+        multigrid_pending_ = PendingChanges{};  // a new solver: b and phi to send
+        method_fallback_reason_.clear();
+    } catch (const AlgorithmError& e) {
+        method_fallback_reason_ = std::string("multigrid CG: ") + e.what();
     }
 }
 
@@ -237,11 +251,16 @@ std::string LiveSolver::description() const {
         text = backend_ == LiveBackend::Gpu ? "GPU multires, BiCGSTAB coarse to fine, warm CG per frame (float)"
                                             : "CPU multires, BiCGSTAB coarse to fine, warm CG per frame (double)";
     else
-        text = backend_ == LiveBackend::Gpu ? "GPU Jacobi CG (float)"
+        text = gpu_multigrid()              ? "GPU multigrid CG, three channels per V-cycle (float)"
+               : backend_ == LiveBackend::Gpu ? "GPU Jacobi CG (float)"
                : multigrid_                 ? "CPU multigrid CG, three channels per V-cycle"
                                             : "CPU Jacobi CG (double)";
     if (backend_ == LiveBackend::Gpu && !renderer_.empty()) text += " (" + renderer_ + ")";
-    if (multigrid_ && !multigrid_->preconditioner().lumping_fallback_reason().empty())
+    const MultigridPreconditioner* preconditioner =
+        multigrid_ ? &multigrid_->preconditioner()
+        : gpu_ && gpu_->multigrid ? &gpu_->multigrid->preconditioner()
+                                  : nullptr;
+    if (preconditioner && !preconditioner->lumping_fallback_reason().empty())
         text += ", absolute lumping (the row-sum setup failed)";
     return text;
 }
@@ -259,8 +278,9 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate(const DiffusionMatrix& matr
             // Every GPU frame is measured, iteration-budgeted ones too: a switch to a time budget then
             // starts from what the device costs instead of a default.
             const double start = clock_();
+            const bool multigrid = gpu_multigrid();  // its budgets need no prediction: not measured
             const auto out = iterate_gpu(matrix, b, phi, iteration_budget, relative_tolerance, skip);
-            if (!one_off_work) {
+            if (!one_off_work && !multigrid) {
                 // The channels run in lockstep on the device: the frame cost the most any one ran.
                 const int ran = std::max({out[0].iterations, out[1].iterations, out[2].iterations});
                 gpu_iteration_time_.record(ran, clock_() - start);
@@ -291,7 +311,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate(const DiffusionMatrix& matr
     } clear{deadline_};
     // The GPU cannot stop at a deadline: it runs the iterations predicted to fit (measured in the int
     // overload). The CPU runs up to the limit, stopped by deadline_.
-    const int iterations = backend_ == LiveBackend::Gpu ? gpu_iteration_time_.iterations_for(budget)
+    const int iterations = backend_ == LiveBackend::Gpu && !gpu_multigrid() ? gpu_iteration_time_.iterations_for(budget)
                            : budget.limits_iterations() ? budget.max_iterations
                                                         : std::numeric_limits<int>::max();
     return iterate(matrix, b, phi, iterations, relative_tolerance, skip);
@@ -302,6 +322,12 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& 
                                                          std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                          double relative_tolerance, const std::array<bool, 3>& skip) {
     const size_t n = matrix.size();
+    if (!multigrid_positions_.empty() && n > 0) {
+        // After a GPU fallback the multigrid method goes on with the CPU multigrid CG (built here: the
+        // device held the hierarchy), warm from the last read-back phi.
+        build_cpu_multigrid(multigrid_positions_, matrix);
+        multigrid_positions_.clear();
+    }
     if (multigrid_ && n > 0) {
         try {
             return iterate_multigrid(matrix, b, phi, iteration_budget, relative_tolerance, skip);
@@ -408,6 +434,21 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu(const DiffusionMatrix& 
     if (!context_) context_ = open_headless_solver_context();
     const CurrentContext current(*context_);
     if (multires_) return iterate_gpu_multires(matrix, b, phi, iteration_budget, relative_tolerance);
+    if (!multigrid_positions_.empty()) {
+        try {
+            return iterate_gpu_multigrid(matrix, b, phi, iteration_budget, relative_tolerance, skip);
+        } catch (const AlgorithmError& e) {
+            // The V-cycle cannot be built or applied: GPU Jacobi CG from the last frame's phi (the host
+            // copy is written only after a successful step), until the next rebuild tries again.
+            method_fallback_reason_ = std::string("multigrid CG: ") + e.what();
+            multigrid_positions_.clear();
+            gpu_.reset();  // the context is current
+            gpu_pending_ = PendingChanges{};
+            // Its budget was counted in V-cycles, or unlimited under a deadline it no longer reads.
+            if (deadline_.bounded())
+                iteration_budget = gpu_iteration_time_.iterations_for(budget_until(deadline_, 1, iteration_budget));
+        }
+    }
     const GlApi& gl = context_->gl();
     if (!gpu_) {
         require_compute_support(gl);
@@ -443,6 +484,67 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu(const DiffusionMatrix& 
     for (size_t v = 0; v < n; ++v)
         for (int c = 0; c < 3; ++c) phi[c][v] = staging[v][c];
     for (int c = 0; c < 3; ++c) out[c] = {results[c].iterations, results[c].estimated_relative_error, results[c].converged};
+    return out;
+}
+
+std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multigrid(const DiffusionMatrix& matrix,
+                                                                   const std::array<std::vector<double>, 3>& b,
+                                                                   std::array<std::vector<double>, 3>& phi,
+                                                                   int iteration_budget, double relative_tolerance,
+                                                                   const std::array<bool, 3>& skip) {
+    // Called by iterate_gpu with the context current. The same bookkeeping as iterate_multigrid, with
+    // the device copy's record (gpu_pending_).
+    const GlApi& gl = context_->gl();
+    if (!gpu_) {
+        require_compute_support(gl);
+        FrameSolverOptions frame_options;
+        frame_options.multigrid = multigrid_options_;
+        auto gpu = std::make_unique<Gpu>();
+        gpu->multigrid = std::make_unique<GpuMultigridFrameSolver>(gl, matrix, multigrid_positions_, frame_options);
+        gpu_ = std::move(gpu);
+        const GLubyte* renderer = gl.GetString(GL_RENDERER);
+        renderer_ = renderer ? reinterpret_cast<const char*>(renderer) : "";
+        gpu_pending_ = PendingChanges{};  // a new device copy: the current values; b and phi to send
+    }
+    GpuMultigridFrameSolver& solver = *gpu_->multigrid;
+    if (gpu_pending_.all_values) {
+        std::vector<int32_t> all(matrix.size());
+        std::iota(all.begin(), all.end(), 0);
+        solver.update_values(matrix, all);
+    } else if (!gpu_pending_.rows.empty()) {
+        solver.update_values(matrix, gpu_pending_.rows);  // paint: the changed rows of every level
+    }
+    gpu_pending_.values_applied();
+    if (gpu_pending_.right_hand_sides) solver.set_right_hand_side({b[0], b[1], b[2]});
+    gpu_pending_.right_hand_sides = false;
+    if (gpu_pending_.solution) {
+        const bool zero = std::all_of(phi.begin(), phi.end(), [](const std::vector<double>& v) {
+            return std::all_of(v.begin(), v.end(), [](double x) { return x == 0.0; });
+        });
+        if (zero)
+            solver.reset();
+        else
+            solver.set_phi({phi[0], phi[1], phi[2]});
+    }
+    gpu_pending_.solution = false;
+    solver.set_relative_tolerance(relative_tolerance);
+
+    int vcycles = 0;
+    if (vcycle_budget(iteration_budget) > 0) {
+        const FrameStep step = deadline_.bounded()
+                                   ? solver.step(budget_until(deadline_, 1, vcycle_budget(iteration_budget)), clock_)
+                                   : solver.step(vcycle_budget(iteration_budget));
+        vcycles = step.vcycles;
+        multigrid_error_ = step.estimated_relative_error;
+        phi = solver.phi();  // the host copy: saves, cuts, the CPU radiance
+    }
+    std::array<LiveSolverChannel, 3> out;
+    for (int c = 0; c < 3; ++c) {
+        if (skip[c])
+            out[c] = {0, 0.0, true};
+        else
+            out[c] = {vcycles, multigrid_error_[c], multigrid_error_[c] <= relative_tolerance};
+    }
     return out;
 }
 

@@ -32,6 +32,14 @@
 //                        right-hand sides and phi stay on the device between frames; painting uploads
 //                        only the rewritten rows (GpuDiffusionSolver::update_rows). phi is read back
 //                        after each frame so the host copy (phi(), saves, the CPU radiance) stays valid.
+//   GPU multigrid CG     multires/gpu_multigrid_frame_solver.h: the CPU multigrid CG's algorithm with phi,
+//                        r, p, q and the V-cycle's levels on the device (float); the hierarchy and the
+//                        Galerkin operators are built on the host at the first GPU frame after a
+//                        (re)build (from the rest positions kept by matrix_rebuilt), painting uploads the
+//                        recomputed rows of every level. Budgets as for the CPU multigrid (V-cycles;
+//                        a time limit is checked between V-cycles, each CG step reads back its sums
+//                        anyway, so no prediction is needed). After a GPU failure the CPU multigrid CG
+//                        takes over; when the V-cycle cannot be built (AlgorithmError) GPU Jacobi CG does.
 //
 // The GPU backend runs on a SolverGlContext: the editor's hidden window sharing the main window's
 // objects, or an OSMesa context (tests, `waxwork run`). The context is made current around every GPU
@@ -139,7 +147,8 @@ public:
     //                               its time to the next); at least one iteration per channel. The
     //                               multires frame after a rebuild runs its coarse-to-fine pass whole.
     //   CPU multigrid CG            the deadline is checked between V-cycles (at least one runs).
-    //   GPU (both methods)          the device queue cannot stop part-way: the budget becomes an
+    //   GPU multigrid CG            as the CPU multigrid CG: the deadline is checked between V-cycles.
+    //   GPU (other methods)         the device queue cannot stop part-way: the budget becomes an
     //                               iteration count predicted from earlier GPU frames of either overload
     //                               (gpu_iteration_time(); frames that uploaded the matrix or ran the
     //                               coarse pass are not measured).
@@ -194,6 +203,14 @@ private:
                                                           const std::array<std::vector<double>, 3>& b,
                                                           std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                           double relative_tolerance);
+    std::array<LiveSolverChannel, 3> iterate_gpu_multigrid(const DiffusionMatrix& matrix,
+                                                           const std::array<std::vector<double>, 3>& b,
+                                                           std::array<std::vector<double>, 3>& phi, int iteration_budget,
+                                                           double relative_tolerance, const std::array<bool, 3>& skip);
+    // The multigrid runs on the device (or will at the next GPU frame).
+    bool gpu_multigrid() const { return backend_ == LiveBackend::Gpu && !multigrid_positions_.empty(); }
+    // The CPU multigrid frame solver for `matrix` (sets method_fallback_reason_ when it cannot be built).
+    void build_cpu_multigrid(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix);
     std::array<LiveSolverChannel, 3> iterate_gpu(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
                                                  std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                  double relative_tolerance, const std::array<bool, 3>& skip);
@@ -230,6 +247,11 @@ private:
 
     std::unique_ptr<MultigridFrameSolver> multigrid_;
     PendingChanges multigrid_pending_;  // values, b, and phi as a warm start
+    // The multigrid method on the GPU backend: the mesh's rest positions (the hierarchy's Eq. 16
+    // weights), kept from matrix_rebuilt for the device solver built at the next GPU frame and for a
+    // CPU multigrid after a fallback. Empty when the method is not (or no longer) run on the device;
+    // the device solver takes its changes through gpu_pending_.
+    std::vector<Eigen::Vector3d> multigrid_positions_;
     // The last frame's estimates, reported by a frame of no V-cycles (1 after a change).
     std::array<double, 3> multigrid_error_{1, 1, 1};
     std::unique_ptr<MultiresSolver> multires_;

@@ -17,7 +17,7 @@ void add_live_solver_options(CLI::App& command, LiveSolverChoice& options, const
     command
         .add_option("--method", options.method,
                     "Live solver method: jacobi (Jacobi CG per channel), mgcg (multigrid CG, three channels per "
-                    "V-cycle; one V-cycle per 4 iterations of the frame budget; CPU only, the GPU runs jacobi) or "
+                    "V-cycle; one V-cycle per 4 iterations of the frame budget; CPU or GPU) or "
                     "multires (the paper's Sec. 4 scheme: BiCGSTAB coarse to fine after a rebuild, then warm "
                     "level-0 CG per frame; CPU or GPU)")
         ->check(CLI::IsMember({"jacobi", "mgcg", "multires"}))
@@ -36,7 +36,8 @@ void add_live_solver_options(CLI::App& command, LiveSolverChoice& options, const
         .add_option("--frame-ms", options.frame_ms,
                     "Live solver budget per frame in milliseconds instead of iterations: the CPU methods stop "
                     "iterating at the deadline (an iteration that started finishes; at least one runs per channel), "
-                    "the GPU predicts the iterations that fit from the previous frames' times. Default: the "
+                    "so does the GPU multigrid CG (between V-cycles), the other GPU methods predict the iterations "
+                    "that fit from the previous frames' times. Default: the "
                     "iteration budget (the editor's slider, a session's frame_iterations)")
         ->check(frame_ms_check);
 }

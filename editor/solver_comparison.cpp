@@ -2,6 +2,7 @@
 
 #include "editor/svg_chart.h"
 #include "io/atomic_file.h"
+#include "multires/gpu_multigrid_frame_solver.h"
 #include "multires/gpu_multires_solver.h"
 #include "multires/multigrid_cg.h"
 #include "multires/multigrid_frame_solver.h"
@@ -249,8 +250,9 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
         }
     }));
 
-    // The GPU path: CG and the multires scheme in float on compute shaders, matrices resident (the
-    // upload is per-mesh setup, excluded); cap = level-0 CG iterations.
+    // The GPU path: CG, the multires scheme and the multigrid CG in float on compute shaders, matrices
+    // resident (the upload is per-mesh setup, excluded); cap = level-0 CG iterations (V-cycles for the
+    // multigrid CG).
     if (options.gl) {
         try {
             auto read_back = [](const std::vector<std::array<double, 3>>& phi, Fields& x) {
@@ -276,6 +278,18 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
                 solve.max_iterations = cap;
                 gpu_multires.solve(solve);
                 read_back(gpu_multires.solution(), x);
+            }));
+            // The multigrid CG on the device (gpu_multigrid_frame_solver.h), as multigrid_cg_rgb: cap =
+            // V-cycles from phi = 0; its own hierarchy and levels are setup (excluded).
+            FrameSolverOptions frame_options;
+            frame_options.relative_tolerance = 1e-15;  // never stop on the estimate: run the cap
+            GpuMultigridFrameSolver gpu_multigrid(*options.gl, matrix, mesh.positions, frame_options);
+            const std::array<std::span<const double>, 3> rhs{b[0], b[1], b[2]};
+            result.solvers.push_back(measurer.curve("gpu_multigrid_cg", [&](int cap, Fields& x) {
+                gpu_multigrid.reset();
+                gpu_multigrid.set_right_hand_side(rhs);
+                if (cap > 0) gpu_multigrid.step(cap);
+                x = gpu_multigrid.phi();
             }));
         } catch (const GpuError& e) {
             result.gpu_fallback_reason = e.what();

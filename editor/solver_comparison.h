@@ -43,8 +43,9 @@ struct SolverComparisonOptions {
     double target_error = 1e-2;   // time_to_1pct_ms
     double floor_error = 1e-4;    // a curve stops once below this
     double max_seconds = 60.0;    // per solver, measuring included
-    // When set (a current OpenGL >= 4.3 context): also the GPU curves gpu_cg (solver/gpu_conjugate_gradient.h)
-    // and gpu_multires (multires/gpu_multires_solver.h); their times include reading phi back.
+    // When set (a current OpenGL >= 4.3 context): also the GPU curves gpu_cg (solver/gpu_conjugate_gradient.h),
+    // gpu_multires (multires/gpu_multires_solver.h) and gpu_multigrid_cg (multires/gpu_multigrid_frame_solver.h);
+    // their times include reading phi back.
     const GlApi* gl = nullptr;
 };
 
@@ -62,7 +63,7 @@ struct SolverComparison {
     double multigrid_setup_ms = 0;
     double multigrid_rgb_setup_ms = 0;  // MultigridFrameSolver's constructor (its own hierarchy included)
     std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, multigrid_cg_rgb,
-                                       // eigen_ic_cg, [gpu_cg, gpu_multires,] direct
+                                       // eigen_ic_cg, [gpu_cg, gpu_multires, gpu_multigrid_cg,] direct
     std::string gpu_fallback_reason;   // options.gl given but the GPU could not run (curves left out)
 };
 

@@ -88,38 +88,22 @@ void MultigridFrameSolver::set_relative_tolerance(double tolerance) {
 
 void MultigridFrameSolver::reset() {
     for (auto& v : phi_) std::fill(v.begin(), v.end(), 0.0);
-    restart_ = refresh_ = phi_zero_ = true;
-    for (size_t c = 0; c < 3; ++c) {
-        t_diag_[c].clear();
-        t_off_[c].clear();
-        lambda_floor_[c] = 0;
-    }
+    refresh_ = phi_zero_ = true;
+    cg_.restart();
+    cg_.forget_eigenvalues(true);
 }
 
 void MultigridFrameSolver::set_phi(const std::array<std::span<const double>, 3>& phi) {
-    for (size_t c = 0; c < 3; ++c) {
-        if (phi[c].size() != n_)
-            throw InvalidArgumentError("frame solver: phi of channel " + std::to_string(c) + " has " +
-                                       std::to_string(phi[c].size()) + " entries for " + std::to_string(n_) +
-                                       " vertices");
-        if (!std::all_of(phi[c].begin(), phi[c].end(), [](double v) { return std::isfinite(v); }))
-            throw AlgorithmError("frame solver: phi of channel " + std::to_string(c) + " is not finite");
-    }
+    check_frame_channels(phi, n_, "phi");
     for (size_t c = 0; c < 3; ++c) std::copy(phi[c].begin(), phi[c].end(), phi_[c].begin());
-    restart_ = refresh_ = true;
+    refresh_ = true;
+    cg_.restart();
     phi_zero_ = false;
     if (has_b_) refresh_residual();
 }
 
 void MultigridFrameSolver::set_right_hand_side(const std::array<std::span<const double>, 3>& b) {
-    for (size_t c = 0; c < 3; ++c) {
-        if (b[c].size() != n_)
-            throw InvalidArgumentError("frame solver: right-hand side of channel " + std::to_string(c) + " has " +
-                                       std::to_string(b[c].size()) + " entries for " + std::to_string(n_) +
-                                       " vertices");
-        if (!std::all_of(b[c].begin(), b[c].end(), [](double v) { return std::isfinite(v); }))
-            throw AlgorithmError("frame solver: right-hand side of channel " + std::to_string(c) + " is not finite");
-    }
+    check_frame_channels(b, n_, "right-hand side");
     // r = b - M phi changes by exactly the change of b.
     const bool follow = has_b_ && !refresh_;
     for_rows(n_, kGrain, [&](size_t i) {
@@ -130,7 +114,7 @@ void MultigridFrameSolver::set_right_hand_side(const std::array<std::span<const 
         }
     });
     has_b_ = true;
-    restart_ = true;
+    cg_.restart();
 }
 
 void MultigridFrameSolver::refresh_residual() {
@@ -155,12 +139,6 @@ void MultigridFrameSolver::refresh_residual() {
     updates_since_refresh_ = 0;
 }
 
-double MultigridFrameSolver::smallest_eigenvalue(size_t c) const {
-    double lambda = lambda_floor_[c] > 0 ? lambda_floor_[c] : std::numeric_limits<double>::infinity();
-    if (!t_diag_[c].empty()) lambda = std::min(lambda, smallest_tridiagonal_eigenvalue(t_diag_[c], t_off_[c]));
-    return lambda;
-}
-
 FrameStep MultigridFrameSolver::step(int budget) {
     if (!has_b_) throw InvalidArgumentError("frame solver: step() before set_right_hand_side()");
     if (budget < 1) throw InvalidArgumentError("frame solver: budget " + std::to_string(budget) + " < 1");
@@ -178,19 +156,9 @@ FrameStep MultigridFrameSolver::step_within(int budget, const FrameDeadline& dea
     FrameStep result;
     if (refresh_) {
         refresh_residual();
-        restart_ = true;
+        cg_.restart();
     }
-    if (restart_) {
-        // The Lanczos matrix belongs to the old Krylov space; keep what it said about lambda_min.
-        for (size_t c = 0; c < 3; ++c) {
-            if (!t_diag_[c].empty()) {
-                const double ritz = smallest_tridiagonal_eigenvalue(t_diag_[c], t_off_[c]);
-                lambda_floor_[c] = lambda_floor_[c] > 0 ? std::min(lambda_floor_[c], ritz) : ritz;
-            }
-            t_diag_[c].clear();
-            t_off_[c].clear();
-        }
-    }
+    if (cg_.restarting()) cg_.begin_restart();
     const int32_t* offsets = hierarchy_->levels[0].offsets.data();
     const int32_t* columns = hierarchy_->levels[0].columns.data();
     // The deadline is read between V-cycles only (one clock read each): the first always runs.
@@ -205,32 +173,13 @@ FrameStep MultigridFrameSolver::step_within(int budget, const FrameDeadline& dea
                 acc[3 + c] += phi_[c][i] * (b_[e] - r_[e]);
             }
         });
-        bool all_converged = true;
-        for (size_t c = 0; c < 3; ++c) {
-            const double rz = sums[c], xmx = sums[3 + c];
-            if (!std::isfinite(rz) || !std::isfinite(xmx))
-                throw AlgorithmError("frame solver: the iterate became non-finite");
-            if (rz < 0)
-                throw AlgorithmError("frame solver: r.Br = " + std::to_string(rz) +
-                                     " (preconditioner not positive definite)");
-            const double lambda = smallest_eigenvalue(c);
-            double estimate = std::numeric_limits<double>::infinity();
-            if (rz == 0)
-                estimate = 0;
-            else if (xmx > 0 && std::isfinite(lambda))
-                estimate = std::sqrt(rz / lambda / xmx);
-            result.estimated_relative_error[c] = estimate;
-            all_converged = all_converged && estimate <= options_.relative_tolerance;
-        }
-        if (all_converged) {
+        if (cg_.estimate(sums, options_.relative_tolerance, result.estimated_relative_error, "frame solver")) {
             result.converged = true;
             break;
         }
         // p = z on a restart, else z + beta p (beta = new r.z / old r.z).
-        std::array<double, 3> beta{};
-        for (size_t c = 0; c < 3; ++c) beta[c] = restart_ || rz_[c] == 0 ? 0.0 : sums[c] / rz_[c];
-        const bool restart = restart_;
-        if (restart) {
+        const std::array<double, 3> beta = cg_.beta(sums);
+        if (cg_.restarting()) {
             std::swap(p_, z_);  // z is recomputed before it is read again
         } else {
             for_rows(n_, kGrain, [&](size_t i) {
@@ -243,22 +192,7 @@ FrameStep MultigridFrameSolver::step_within(int budget, const FrameDeadline& dea
             product_row(i, offsets, columns, values_.data(), p_.data(), q);
             for (size_t c = 0; c < 3; ++c) acc[c] += p_[3 * i + c] * q[c];
         });
-        std::array<double, 3> alpha{};
-        for (size_t c = 0; c < 3; ++c) {
-            const double rz = sums[c];
-            if (rz == 0) continue;  // this channel is solved exactly: leave it
-            if (!(pq[c] > 0) || !std::isfinite(pq[c]))
-                throw AlgorithmError("frame solver: p.Mp = " + std::to_string(pq[c]) +
-                                     " (matrix not positive definite)");
-            alpha[c] = rz / pq[c];
-            // Lanczos coefficients of B M (Saad, Iterative Methods, Sec. 6.7.3).
-            const bool first = restart || t_diag_[c].empty();
-            t_diag_[c].push_back(1.0 / alpha[c] + (first ? 0.0 : beta_prev_[c] / alpha_prev_[c]));
-            if (!first) t_off_[c].push_back(std::sqrt(beta_prev_[c]) / alpha_prev_[c]);
-            alpha_prev_[c] = alpha[c];
-            rz_[c] = rz;
-        }
-        for (size_t c = 0; c < 3; ++c) beta_prev_[c] = beta[c];
+        const std::array<double, 3> alpha = cg_.alpha(sums, pq, beta, "frame solver");
         phi_zero_ = false;
         for_rows(n_, kGrain, [&](size_t i) {
             for (size_t c = 0; c < 3; ++c) {
@@ -267,17 +201,10 @@ FrameStep MultigridFrameSolver::step_within(int budget, const FrameDeadline& dea
                 r_[e] -= alpha[c] * q_[e];
             }
         });
-        restart_ = false;
         if (++updates_since_refresh_ >= options_.residual_refresh_interval) {
             // The recursive residual drifts from b - M phi by rounding: recompute it and restart.
             refresh_residual();
-            restart_ = true;
-            for (size_t c = 0; c < 3; ++c) {
-                const double ritz = smallest_tridiagonal_eigenvalue(t_diag_[c], t_off_[c]);
-                lambda_floor_[c] = lambda_floor_[c] > 0 ? std::min(lambda_floor_[c], ritz) : ritz;
-                t_diag_[c].clear();
-                t_off_[c].clear();
-            }
+            cg_.restart_after_refresh();
         }
     }
     return result;
@@ -298,8 +225,8 @@ void MultigridFrameSolver::update_values(const DiffusionMatrix& matrix, std::spa
     }
     preconditioner_->update_values(changed_rows);
     refresh_ = true;
-    restart_ = true;
-    for (size_t c = 0; c < 3; ++c) lambda_floor_[c] = 0;  // another operator: earlier estimates do not hold
+    cg_.restart();
+    cg_.forget_eigenvalues(false);  // another operator: earlier estimates do not hold
 }
 
 }  // namespace waxwork

@@ -27,6 +27,7 @@
 #pragma once
 
 #include "multires/hierarchy.h"
+#include "multires/multigrid_cg_state.h"
 #include "multires/multigrid_preconditioner.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/frame_budget.h"
@@ -105,7 +106,6 @@ public:
 private:
     FrameStep step_within(int max_vcycles, const FrameDeadline& deadline);
     void refresh_residual();
-    double smallest_eigenvalue(size_t channel) const;
 
     FrameSolverOptions options_;
     size_t n_ = 0;
@@ -114,12 +114,10 @@ private:
     std::vector<double> values_;  // level 0, the three channels interleaved (3 per stored entry)
     std::array<std::vector<double>, 3> phi_;
     std::vector<double> b_, r_, z_, p_, q_;  // interleaved: entry 3 i + c is channel c at vertex i
-    bool has_b_ = false, restart_ = true, refresh_ = true;
+    bool has_b_ = false, refresh_ = true;
     bool phi_zero_ = true;  // phi is exactly zero (a cold start): r = b needs no product
     int updates_since_refresh_ = 0;
-    std::array<double, 3> rz_{}, alpha_prev_{}, beta_prev_{};
-    std::array<std::vector<double>, 3> t_diag_, t_off_;  // Lanczos matrix since the last restart
-    std::array<double, 3> lambda_floor_{};               // smallest Ritz value of earlier restarts
+    MultigridCgState cg_;  // the scalars, the stopping rule and the Lanczos estimate of lambda_min
 };
 
 }  // namespace waxwork

@@ -122,6 +122,58 @@ CsrMatrixView<double> MultigridPreconditioner::view(size_t level, int channel) c
     return {l.n, l.offsets.data(), l.columns.data(), l.values.at(static_cast<size_t>(channel)).data()};
 }
 
+std::span<const int32_t> MultigridPreconditioner::diagonal(size_t level) const { return levels_.at(level)->diagonal; }
+
+const InterpolationOperator& MultigridPreconditioner::interpolation(size_t level) const {
+    const Level& l = *levels_.at(level);
+    if (!l.p) throw InvalidArgumentError("multigrid: level " + std::to_string(level) + " is the coarsest (no P)");
+    return *l.p;
+}
+
+const InterpolationOperator& MultigridPreconditioner::transposed_interpolation(size_t level) const {
+    interpolation(level);  // the same check
+    return levels_[level]->pt;
+}
+
+MultigridPreconditioner::Chebyshev MultigridPreconditioner::chebyshev(size_t level) const {
+    const Level& l = *levels_.at(level);
+    Chebyshev out;
+    std::array<double, 3> delta{}, sigma{}, rho{};
+    for (size_t ch = 0; ch < 3; ++ch) {
+        const double upper = l.upper[ch], lower = upper / options_.chebyshev_ratio;
+        const double theta = 0.5 * (upper + lower);
+        delta[ch] = 0.5 * (upper - lower);
+        sigma[ch] = theta / delta[ch];
+        out.inv_theta[ch] = 1.0 / theta;
+        rho[ch] = 1.0 / sigma[ch];
+    }
+    for (int step = 1; step < options_.smoothing_steps; ++step) {
+        std::array<double, 3> c_d{}, c_r{};
+        for (size_t ch = 0; ch < 3; ++ch) {
+            const double rho_next = 1.0 / (2.0 * sigma[ch] - rho[ch]);
+            c_d[ch] = rho_next * rho[ch];
+            c_r[ch] = 2.0 * rho_next / delta[ch];
+            rho[ch] = rho_next;
+        }
+        out.c_d.push_back(c_d);
+        out.c_r.push_back(c_r);
+    }
+    return out;
+}
+
+void MultigridPreconditioner::solve_coarsest_rgb(std::span<const float> b, std::span<float> x) {
+    Level& level = *levels_.back();
+    const size_t n = level.n;
+    if (b.size() != 3 * n || x.size() != 3 * n)
+        throw InvalidArgumentError("multigrid solve_coarsest_rgb: vectors of size " + std::to_string(b.size()) +
+                                   " and " + std::to_string(x.size()) + " for 3 x " + std::to_string(n) + " entries");
+    for (size_t ch = 0; ch < 3; ++ch) {
+        for (size_t i = 0; i < n; ++i) level.coarse_rhs[static_cast<Eigen::Index>(i)] = static_cast<double>(b[3 * i + ch]);
+        level.coarse_solution = level.coarsest[ch].solve(level.coarse_rhs);
+        for (size_t i = 0; i < n; ++i) x[3 * i + ch] = static_cast<float>(level.coarse_solution[static_cast<Eigen::Index>(i)]);
+    }
+}
+
 MultigridPreconditioner::MultigridPreconditioner(const MultiresHierarchy& hierarchy, const MultigridOptions& options)
     : hierarchy_(hierarchy), options_(options) {
     if (options.smoothing_steps < 1 || !(options.chebyshev_ratio > 1))
@@ -473,7 +525,7 @@ void MultigridPreconditioner::factorize_coarsest() {
     level.coarse_solution.resize(n);
 }
 
-void MultigridPreconditioner::update_values(std::span<const int32_t> changed_rows) {
+std::vector<std::vector<int32_t>> MultigridPreconditioner::update_values(std::span<const int32_t> changed_rows) {
     const HierarchyLevel& fine = hierarchy_.levels[0];
     Level& level0 = *levels_[0];
     for (int32_t row : changed_rows) {
@@ -485,6 +537,7 @@ void MultigridPreconditioner::update_values(std::span<const int32_t> changed_row
                       level0.values[ch].begin() + level0.offsets[static_cast<size_t>(row)]);
     }
     std::vector<int32_t> rows(changed_rows.begin(), changed_rows.end());
+    std::vector<std::vector<int32_t>> level_rows{rows};
     prepare_smoother(0, rows);
     // A one-level hierarchy: level 0 is the coarsest level, solved exactly, so its factorisation must
     // follow the new values (the loop below refactorises only a coarsest level it reaches).
@@ -505,7 +558,10 @@ void MultigridPreconditioner::update_values(std::span<const int32_t> changed_row
         compute_galerkin_rows(l, rows);
         prepare_smoother(l, rows);
         if (l + 1 == levels_.size() && !rows.empty()) factorize_coarsest();
+        level_rows.push_back(rows);
     }
+    level_rows.resize(levels_.size());  // levels the change did not reach: no rows
+    return level_rows;
 }
 
 namespace {
@@ -642,28 +698,19 @@ void MultigridPreconditioner::vcycle_rgb(size_t l) {
         sum = w.b[i];
         for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) sum -= values[k] * x[columns[k]];
     };
-    // Chebyshev constants per channel (vcycle has the derivation); the fourth lane stays zero.
-    std::array<double, 3> delta{}, sigma{};
+    // Chebyshev constants per channel (chebyshev() and vcycle have the derivation); the fourth lane
+    // stays zero.
+    const Chebyshev coefficients = chebyshev(l);
     V inv_theta{};
-    for (size_t ch = 0; ch < 3; ++ch) {
-        const double upper = level.upper[ch], lower = upper / options_.chebyshev_ratio;
-        const double theta = 0.5 * (upper + lower);
-        delta[ch] = 0.5 * (upper - lower);
-        sigma[ch] = theta / delta[ch];
-        inv_theta[ch] = static_cast<Scalar>(1.0 / theta);
-    }
+    for (size_t ch = 0; ch < 3; ++ch) inv_theta[ch] = static_cast<Scalar>(coefficients.inv_theta[ch]);
     // Steps 2.. of the polynomial: d = c_d d + c_r D^-1 (b - A x), x' = x + d, written to y (rows read
     // their neighbours' x, so the new iterate goes to the other buffer; one pass instead of two).
     auto chebyshev_steps = [&] {
-        std::array<double, 3> rho{};
-        for (size_t ch = 0; ch < 3; ++ch) rho[ch] = 1.0 / sigma[ch];
-        for (int step = 1; step < options_.smoothing_steps; ++step) {
+        for (size_t s = 0; s < coefficients.c_d.size(); ++s) {
             V c_d{}, c_r{};
             for (size_t ch = 0; ch < 3; ++ch) {
-                const double rho_next = 1.0 / (2.0 * sigma[ch] - rho[ch]);
-                c_d[ch] = static_cast<Scalar>(rho_next * rho[ch]);
-                c_r[ch] = static_cast<Scalar>(2.0 * rho_next / delta[ch]);
-                rho[ch] = rho_next;
+                c_d[ch] = static_cast<Scalar>(coefficients.c_d[s][ch]);
+                c_r[ch] = static_cast<Scalar>(coefficients.c_r[s][ch]);
             }
             const V* x = w.x.data();
             V* y = w.y.data();

@@ -95,6 +95,25 @@ public:
     DropLumping lumping() const { return options_.lumping; }
     const std::string& lumping_fallback_reason() const { return lumping_fallback_reason_; }
 
+    // What a device V-cycle (gpu_multigrid_preconditioner.h) needs to run the same algorithm with the
+    // same coefficients. Level l's position of (i, i) in its stored entries:
+    std::span<const int32_t> diagonal(size_t level) const;
+    // P^l (level l from level l + 1; Eq. 16 weights) and its transpose. Throws on the coarsest level.
+    const InterpolationOperator& interpolation(size_t level) const;
+    const InterpolationOperator& transposed_interpolation(size_t level) const;
+    // The smoother's polynomial on level l per channel (Saad, Iterative Methods, Alg. 12.1 on D^-1 A):
+    // the first step from a residual r = D^-1 (b - A x) is d = inv_theta r; step s >= 2 (index s - 2)
+    // is d = c_d d + c_r D^-1 (b - A x). Computed in double; the float V-cycle rounds each to float.
+    struct Chebyshev {
+        std::array<double, 3> inv_theta{};
+        std::vector<std::array<double, 3>> c_d, c_r;  // smoothing_steps - 1 entries
+    };
+    Chebyshev chebyshev(size_t level) const;
+    // x = A_L^-1 b on the coarsest level L for three interleaved channels (x[3 i + c]), by the exact
+    // factorisation the V-cycle uses: b is widened to double, x rounded to float, as apply_rgb does.
+    // Throws InvalidArgumentError on a size mismatch. Not thread-safe.
+    void solve_coarsest_rgb(std::span<const float> b, std::span<float> x);
+
     // z = B r for one channel: one V-cycle from a zero start. Not thread-safe (shared work vectors).
     void apply(int channel, std::span<const double> r, std::span<double> z);
 
@@ -110,8 +129,9 @@ public:
     // unchanged; the hierarchy's level 0 already holds the new values): recomputes exactly the coarse
     // rows that depend on them, level by level, and refactorises the coarsest level if it was
     // reached (level 0 itself in a one-level hierarchy). The result equals a new preconditioner built
-    // on the updated hierarchy.
-    void update_values(std::span<const int32_t> changed_rows);
+    // on the updated hierarchy. Returns the rows recomputed on every level (level 0: changed_rows), so a
+    // device copy can upload only those (GpuMultigridPreconditioner::update_values).
+    std::vector<std::vector<int32_t>> update_values(std::span<const int32_t> changed_rows);
 
 private:
     struct Level;

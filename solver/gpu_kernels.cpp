@@ -49,6 +49,15 @@ ACC entry_product(int k) {
     uint e = 3u * uint(k);
     return ACC(values[e], values[e + 1u], values[e + 2u]) * ACC(xin[j], xin[j + 1u], xin[j + 2u]);
 }
+// s - a_ik x_k, rounded twice (product, then difference; `precise`: no fused multiply-add), as the
+// CPU's float V-cycle computes it.
+ACC subtract_entry(ACC s, int k) {
+    uint j = 3u * uint(columns[k]);
+    uint e = 3u * uint(k);
+    precise ACC product = ACC(values[e], values[e + 1u], values[e + 2u]) * ACC(xin[j], xin[j + 1u], xin[j + 2u]);
+    precise ACC difference = s - product;
+    return difference;
+}
 )";
 
 const char* kCsr = R"(
@@ -56,6 +65,10 @@ int slot_row(uint t) { return int(t); }
 ACC slot_product(uint t) {
     ACC s = ACC(0);
     for (int k = starts[t]; k < starts[t + 1u]; ++k) s += entry_product(k);
+    return s;
+}
+ACC slot_residual(uint t, ACC s) {
+    for (int k = starts[t]; k < starts[t + 1u]; ++k) s = subtract_entry(s, k);
     return s;
 }
 )";
@@ -71,6 +84,16 @@ ACC slot_product(uint t) {
     int width = (starts[slice + 1u] - begin) / int(slice_height);
     ACC s = ACC(0);
     for (int k = 0; k < width; ++k) s += entry_product(begin + k * int(slice_height) + lane);
+    return s;
+}
+// s - (each stored entry's product, in the row's order): the CPU's `sum = b; sum -= a_ij x_j`. A
+// padding entry (value 0) subtracts 0 and leaves s as it is.
+ACC slot_residual(uint t, ACC s) {
+    uint slice = t / slice_height;
+    int lane = int(t - slice * slice_height);
+    int begin = starts[slice];
+    int width = (starts[slice + 1u] - begin) / int(slice_height);
+    for (int k = 0; k < width; ++k) s = subtract_entry(s, begin + k * int(slice_height) + lane);
     return s;
 }
 )";
@@ -228,22 +251,83 @@ void main() {
 }
 )";
 
-// fine = P coarse with a channel-independent compressed-row operator (multires, Eq. 16). n = rows.
+// fine = P coarse (or fine += P coarse with `accumulate`) with a channel-independent compressed-row
+// operator (multires Eq. 16; the multigrid V-cycle's prolongation, and with P^T its restriction). The
+// sum is `precise` (no fused multiply-add), so it rounds as the CPU float V-cycle does. n = rows.
 const char* kInterpolate = R"(
 layout(std430, binding = 0) readonly buffer Offsets { int offsets[]; };
 layout(std430, binding = 1) readonly buffer Columns { int columns[]; };
 layout(std430, binding = 2) readonly buffer Weights { float weights[]; };
 layout(std430, binding = 3) readonly buffer Coarse { float coarse[]; };
-layout(std430, binding = 4) writeonly buffer Fine { float fine[]; };
+layout(std430, binding = 4) buffer Fine { float fine[]; };
+uniform uint accumulate;
 void main() {
     for (uint i = gl_GlobalInvocationID.x; i < n; i += STRIDE) {
-        vec3 s = vec3(0.0);
+        precise vec3 s = vec3(0.0);
         for (int k = offsets[i]; k < offsets[i + 1u]; ++k) {
             uint j = 3u * uint(columns[k]);
-            s += weights[k] * vec3(coarse[j], coarse[j + 1u], coarse[j + 2u]);
+            precise vec3 term = weights[k] * vec3(coarse[j], coarse[j + 1u], coarse[j + 2u]);
+            s += term;
         }
+        if (accumulate != 0u) s += vec3(fine[3u * i], fine[3u * i + 1u], fine[3u * i + 2u]);
         fine[3u * i] = s.x; fine[3u * i + 1u] = s.y; fine[3u * i + 2u] = s.z;
     }
+}
+)";
+
+// One pass of the multigrid V-cycle's Chebyshev smoother (multires/multigrid_preconditioner.h) in
+// float, with the CPU apply_rgb's operations in its order and no fused multiply-add (`precise`), so
+// the device V-cycle rounds as the CPU one does:
+//   s = b - A x (b first, then each stored entry subtracted in order; x = 0 with ZERO_START)
+//   mode 0: d = c_r D^-1 s (FIRST) or c_d d + c_r D^-1 s, and y = x + d (y = d from a zero start)
+//   mode 1: y = s (the residual restricted to the next level)
+// Rows read their neighbours' x, so y is another buffer. n = slots.
+const char* kMultigridSmooth = R"(
+layout(std430, binding = 4) buffer D { float d[]; };
+layout(std430, binding = 6) readonly buffer B { float b[]; };
+layout(std430, binding = 7) writeonly buffer Y { float y[]; };
+layout(std430, binding = 8) readonly buffer InvDiag { float inv_diag[]; };
+uniform vec3 c_d;
+uniform vec3 c_r;
+uniform uint flags;  // 1: zero start, 2: first step, 4: residual only
+void main() {
+    bool zero_start = (flags & 1u) != 0u, first = (flags & 2u) != 0u, residual_only = (flags & 4u) != 0u;
+    for (uint t = gl_GlobalInvocationID.x; t < n; t += STRIDE) {
+        int row = slot_row(t);
+        if (row < 0) continue;
+        uint i = 3u * uint(row);
+        vec3 s = vec3(b[i], b[i + 1u], b[i + 2u]);
+        if (!zero_start) s = slot_residual(t, s);
+        if (residual_only) {
+            y[i] = s.x; y[i + 1u] = s.y; y[i + 2u] = s.z;
+            continue;
+        }
+        precise vec3 r = s * vec3(inv_diag[i], inv_diag[i + 1u], inv_diag[i + 2u]);
+        precise vec3 scaled = c_r * r;
+        precise vec3 dv = first ? scaled : c_d * vec3(d[i], d[i + 1u], d[i + 2u]) + scaled;
+        precise vec3 yv = zero_start ? dv : vec3(xin[i], xin[i + 1u], xin[i + 2u]) + dv;
+        d[i] = dv.x; d[i + 1u] = dv.y; d[i + 2u] = dv.z;
+        y[i] = yv.x; y[i + 1u] = yv.y; y[i + 2u] = yv.z;
+    }
+}
+)";
+
+// The two sums of a multigrid-CG step (multires/gpu_multigrid_frame_solver.h) in one reduction:
+// r . z and x . (b - r) (= x . M x, the energy of the iterate) per channel. n = rows.
+const char* kRzEnergy = R"(
+layout(std430, binding = 0) readonly buffer R { float r[]; };
+layout(std430, binding = 1) readonly buffer Z { float z[]; };
+layout(std430, binding = 2) readonly buffer X { float x[]; };
+layout(std430, binding = 3) readonly buffer B { float b[]; };
+void main() {
+    float acc[6] = float[6](0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for (uint i = gl_GlobalInvocationID.x; i < n; i += STRIDE)
+        for (uint c = 0u; c < 3u; ++c) {
+            uint j = 3u * i + c;
+            acc[c] += r[j] * z[j];
+            acc[3u + c] += x[j] * (b[j] - r[j]);
+        }
+    reduce_partials(acc);
 }
 )";
 
@@ -298,6 +382,8 @@ GpuKernels::GpuKernels(const GlApi& gl, std::initializer_list<GpuMatrixFormat> f
         const char* format = f == GpuMatrixFormat::Csr ? kCsr : kSliced;
         multiply_dot_.emplace(f, ComputeProgram(gl, "multiply_dot_" + to_string(f), kernel(3, "vec3", format, kMultiplyDot)));
         residual_.emplace(f, ComputeProgram(gl, "residual_" + to_string(f), kernel(3, "dvec3", format, kResidual)));
+        multigrid_smooth_.emplace(
+            f, ComputeProgram(gl, "multigrid_smooth_" + to_string(f), kernel(0, "vec3", format, kMultigridSmooth)));
     }
     dot_ = ComputeProgram(gl, "dot", kernel(3, nullptr, nullptr, kDot));
     axpby_ = ComputeProgram(gl, "axpby", kernel(0, nullptr, nullptr, kAxpby));
@@ -309,6 +395,7 @@ GpuKernels::GpuKernels(const GlApi& gl, std::initializer_list<GpuMatrixFormat> f
     gather_ = ComputeProgram(gl, "gather", kernel(0, nullptr, nullptr, kGather));
     interpolate_ = ComputeProgram(gl, "interpolate", kernel(0, nullptr, nullptr, kInterpolate));
     radiance_ = ComputeProgram(gl, "radiance", kernel(0, nullptr, nullptr, kRadiance));
+    rz_energy_ = ComputeProgram(gl, "rz_and_energy", kernel(6, nullptr, nullptr, kRzEnergy));
     partials_ = GpuBuffer(gl, kMaxGroups * kGroupSize * kMaxSums * sizeof(float));
     folded_ = GpuBuffer(gl, kGroupSize * kMaxSums * sizeof(float));
     check_gpu_error(gl, "compiling the kernels");
@@ -449,8 +536,32 @@ GpuInterpolation::GpuInterpolation(const GlApi& gl, std::span<const int32_t> off
     weights = GpuBuffer::from<float>(gl, w);
 }
 
-void GpuKernels::interpolate(const GpuInterpolation& p, const GpuBuffer& coarse, GpuBuffer& fine) {
-    launch(interpolate_, p.rows, p.rows, {{0, &p.offsets}, {1, &p.columns}, {2, &p.weights}, {3, &coarse}, {4, &fine}});
+void GpuKernels::interpolate(const GpuInterpolation& p, const GpuBuffer& coarse, GpuBuffer& fine, bool accumulate) {
+    launch(interpolate_, p.rows, p.rows, {{0, &p.offsets}, {1, &p.columns}, {2, &p.weights}, {3, &coarse}, {4, &fine}},
+           [&] { gl_->Uniform1ui(interpolate_.uniform("accumulate"), accumulate ? 1u : 0u); });
+}
+
+void GpuKernels::multigrid_smooth(const GpuMatrix& m, const GpuBuffer& b, const GpuBuffer& x, const GpuBuffer& inv_diag,
+                                  GpuBuffer& d, GpuBuffer& y, const SmoothingPass& pass) {
+    const ComputeProgram& program = multigrid_smooth_.at(m.layout.format);
+    const GLuint flags = (pass.zero_start ? 1u : 0u) | (pass.first_step ? 2u : 0u);
+    launch_matrix(program, m, {{3, &x}, {4, &d}, {6, &b}, {7, &y}, {8, &inv_diag}}, [&] {
+        set_vec3(*gl_, program, "c_d", pass.c_d);
+        set_vec3(*gl_, program, "c_r", pass.c_r);
+        gl_->Uniform1ui(program.uniform("flags"), flags);
+    });
+}
+
+void GpuKernels::multigrid_residual(const GpuMatrix& m, const GpuBuffer& b, const GpuBuffer& x, GpuBuffer& r) {
+    const ComputeProgram& program = multigrid_smooth_.at(m.layout.format);
+    // d and inv_diag are not read in this mode; x and b stand in for them (read-only).
+    launch_matrix(program, m, {{3, &x}, {4, &x}, {6, &b}, {7, &r}, {8, &b}},
+                  [&] { gl_->Uniform1ui(program.uniform("flags"), 4u); });
+}
+
+std::array<double, 6> GpuKernels::rz_and_energy(size_t rows, const GpuBuffer& r, const GpuBuffer& z, const GpuBuffer& x,
+                                                const GpuBuffer& b) {
+    return sum_partials<6>(launch(rz_energy_, rows, rows, {{0, &r}, {1, &z}, {2, &x}, {3, &b}}));
 }
 
 void GpuKernels::radiance(size_t rows, const GpuBuffer& phi_weight, const GpuBuffer& q_weight, const GpuBuffer& phi,

@@ -68,8 +68,24 @@ public:
     void hadamard(size_t rows, const GpuBuffer& w, const GpuBuffer& x, GpuBuffer& y);
     // target[i] = source[index[i]] per channel (restriction by injection).
     void gather(size_t rows, const GpuBuffer& index, const GpuBuffer& source, GpuBuffer& target);
-    // fine = P coarse.
-    void interpolate(const GpuInterpolation& p, const GpuBuffer& coarse, GpuBuffer& fine);
+    // fine = P coarse; with `accumulate`, fine += P coarse (rounded as the CPU's x[i] += sum).
+    void interpolate(const GpuInterpolation& p, const GpuBuffer& coarse, GpuBuffer& fine, bool accumulate = false);
+
+    // The multigrid V-cycle's passes (multires/gpu_multigrid_preconditioner.h), in float with the CPU
+    // float V-cycle's operations in its order and without fused multiply-adds, so they round alike.
+    // One Chebyshev pass: s = b - M x (x = 0 with zero_start), d = c_r D^-1 s (first_step) or
+    // c_d d + c_r D^-1 s, y = x + d. y must not be x (rows read their neighbours' x).
+    struct SmoothingPass {
+        bool zero_start = false, first_step = false;
+        Rgbd c_d{}, c_r{};
+    };
+    void multigrid_smooth(const GpuMatrix& m, const GpuBuffer& b, const GpuBuffer& x, const GpuBuffer& inv_diag,
+                          GpuBuffer& d, GpuBuffer& y, const SmoothingPass& pass);
+    // r = b - M x in float, b first and each stored entry subtracted in the row's order.
+    void multigrid_residual(const GpuMatrix& m, const GpuBuffer& b, const GpuBuffer& x, GpuBuffer& r);
+    // (r . z, x . (b - r)) per channel in that order: a multigrid-CG step's two sums in one reduction.
+    std::array<double, 6> rz_and_energy(size_t rows, const GpuBuffer& r, const GpuBuffer& z, const GpuBuffer& x,
+                                        const GpuBuffer& b);
     // e = max(a phi - c q, 0) (or unclamped) with per-vertex scalars a, c: gpu_radiance.h.
     void radiance(size_t rows, const GpuBuffer& phi_weight, const GpuBuffer& q_weight, const GpuBuffer& phi,
                   const GpuBuffer& q, GpuBuffer& e, bool clamp_negative);
@@ -98,9 +114,9 @@ private:
     std::array<double, K> sum_partials(GLuint groups);
 
     const GlApi* gl_;
-    std::map<GpuMatrixFormat, ComputeProgram> multiply_dot_, residual_;
+    std::map<GpuMatrixFormat, ComputeProgram> multiply_dot_, residual_, multigrid_smooth_;
     ComputeProgram dot_, axpby_, extract_diagonal_, cg_update_, scatter_, fold_, hadamard_, gather_, interpolate_,
-        radiance_;
+        radiance_, rz_energy_;
     GpuBuffer partials_, folded_;
 };
 

@@ -130,7 +130,11 @@ TEST(BenchSolversCommand, GpuBackendAddsGpuCurvesOrWarns) {
     EXPECT_TRUE(result.err.empty()) << result.err;
     EXPECT_FALSE(nlohmann::json::parse(result.out)["gpu_renderer"].get<std::string>().empty());
     const auto json = nlohmann::json::parse(testing::read_text(dir / "gpu" / "solvers.json"));
-    for (const std::string name : {"gpu_cg", "gpu_multires", "jacobi_cg"}) expect_valid_curve(json["solvers"], name);
+    for (const std::string name : {"gpu_cg", "gpu_multires", "gpu_multigrid_cg", "jacobi_cg"})
+        expect_valid_curve(json["solvers"], name);
+    // The device multigrid CG needs far fewer V-cycles to 1% than GPU Jacobi CG needs iterations.
+    EXPECT_LT(json["solvers"]["gpu_multigrid_cg"]["cap_to_1pct"].get<int>(),
+              json["solvers"]["gpu_cg"]["cap_to_1pct"].get<int>());
 
     setenv("WAXWORK_GPU_FORCE_FAIL", "1", 1);
     const auto forced = run_waxwork(args + (dir / "forced").string());

@@ -1,0 +1,184 @@
+// The device multigrid CG (multires/gpu_multigrid_frame_solver.h) against the CPU frame solver and the
+// double-precision solution, on llvmpipe in CI.
+#include "multires/gpu_multigrid_frame_solver.h"
+#include "multires/multigrid_frame_solver.h"
+#include "multires_test_systems.h"
+#include "solver/gpu_conjugate_gradient.h"
+#include "solver/gpu_test_context.h"
+#include "tetops/error.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace waxwork {
+namespace {
+
+using testing::reference_solution;
+using testing::relative_error;
+
+FrameSolverOptions frame_options(int64_t min_coarse, double tolerance) {
+    FrameSolverOptions options;
+    options.hierarchy.min_coarse_vertices = min_coarse;
+    options.relative_tolerance = tolerance;
+    return options;
+}
+
+std::array<std::span<const double>, 3> spans(const std::array<std::vector<double>, 3>& v) {
+    return {v[0], v[1], v[2]};
+}
+
+// The bound the other GPU tests hold float solvers to against the double solution.
+constexpr double kFloatSolutionBound = 1e-4;
+
+TEST(GpuMultigridFrameSolver, ConvergesToTheDoublePrecisionSolutionInFarFewerIterationsThanJacobiCg) {
+    WAXWORK_REQUIRE_GL(context);
+    const auto s = testing::make_test_system(12);  // 2197 vertices
+    GpuMultigridFrameSolver solver(context->gl(), s.matrix, s.mesh.positions, frame_options(100, 1e-6));
+    ASSERT_GE(solver.hierarchy().level_count(), 3u);
+    solver.set_right_hand_side(spans(s.b));
+    FrameStep step;
+    int vcycles = 0;
+    for (int frames = 0; frames < 20 && !step.converged; ++frames) {
+        step = solver.step(5);
+        vcycles += step.vcycles;
+    }
+    EXPECT_TRUE(step.converged);
+    const auto phi = solver.phi();
+    for (int c = 0; c < 3; ++c) {
+        const auto cu = static_cast<size_t>(c);
+        EXPECT_LE(step.estimated_relative_error[cu], 1e-6);
+        EXPECT_LT(relative_error(phi[cu], reference_solution(s.matrix, s.b[cu], c)), kFloatSolutionBound)
+            << "channel " << c;
+    }
+    // GPU Jacobi CG on the same system to the same tolerance.
+    GpuDiffusionSolver jacobi(context->gl(), s.matrix);
+    jacobi.set_right_hand_side(s.b);
+    GpuCgOptions options;
+    options.relative_tolerance = 1e-6;
+    const auto results = jacobi.solve(options);
+    int jacobi_iterations = 0;
+    for (const auto& r : results) jacobi_iterations = std::max(jacobi_iterations, r.iterations);
+    std::printf("[ measured ] %d V-cycles against %d Jacobi CG iterations to 1e-6\n", vcycles, jacobi_iterations);
+    EXPECT_LT(4 * vcycles, jacobi_iterations);
+}
+
+// The CPU frame solver and the device one take the same steps: after the same V-cycle budget their
+// iterates agree to float precision (the CPU runs phi, r and the products in double).
+TEST(GpuMultigridFrameSolver, FollowsTheCpuFrameSolverStepByStep) {
+    WAXWORK_REQUIRE_GL(context);
+    const auto s = testing::make_test_system(10);
+    const FrameSolverOptions options = frame_options(60, 1e-8);
+    GpuMultigridFrameSolver gpu(context->gl(), s.matrix, s.mesh.positions, options);
+    MultigridFrameSolver cpu(s.matrix, s.mesh.positions, options);
+    gpu.set_right_hand_side(spans(s.b));
+    cpu.set_right_hand_side(spans(s.b));
+    for (int frame = 0; frame < 3; ++frame) {
+        const FrameStep g = gpu.step(2), c = cpu.step(2);
+        EXPECT_EQ(g.vcycles, c.vcycles);
+        const auto phi = gpu.phi();
+        for (int ch = 0; ch < 3; ++ch) {
+            const auto cu = static_cast<size_t>(ch);
+            EXPECT_NEAR(g.estimated_relative_error[cu], c.estimated_relative_error[cu],
+                        1e-3 * c.estimated_relative_error[cu] + 1e-6);
+            EXPECT_LT(relative_error(phi[cu], cpu.phi(ch)), kFloatSolutionBound) << "frame " << frame;
+        }
+    }
+}
+
+TEST(GpuMultigridFrameSolver, WarmStartAfterALightTurnIsBackUnderOnePercentInAFewVcycles) {
+    WAXWORK_REQUIRE_GL(context);
+    const auto s = testing::make_test_system(12);
+    GpuMultigridFrameSolver solver(context->gl(), s.matrix, s.mesh.positions, frame_options(100, 1e-2));
+    const auto before = testing::light_rhs(s, 0), after = testing::light_rhs(s, 10);
+    solver.set_right_hand_side(spans(before));
+    FrameStep step;
+    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(4);
+    ASSERT_TRUE(step.converged);
+    std::array<std::vector<double>, 3> reference;
+    auto phi = solver.phi();
+    for (int c = 0; c < 3; ++c) {
+        const auto cu = static_cast<size_t>(c);
+        reference[cu] = reference_solution(s.matrix, after[cu], c);
+        ASSERT_GT(relative_error(phi[cu], reference[cu]), 2e-2) << "the turn must change the solution";
+    }
+    solver.set_right_hand_side(spans(after));
+    step = solver.step(2);
+    EXPECT_LE(step.vcycles, 2);
+    phi = solver.phi();
+    for (int c = 0; c < 3; ++c)
+        EXPECT_LT(relative_error(phi[static_cast<size_t>(c)], reference[static_cast<size_t>(c)]), 1e-2) << "channel " << c;
+    for (int frames = 0; frames < 10 && !step.converged; ++frames) step = solver.step(1);
+    EXPECT_TRUE(step.converged);
+}
+
+TEST(GpuMultigridFrameSolver, FollowsPaintedValues) {
+    WAXWORK_REQUIRE_GL(context);
+    auto s = testing::make_test_system(8);
+    GpuMultigridFrameSolver solver(context->gl(), s.matrix, s.mesh.positions, frame_options(30, 1e-6));
+    solver.set_right_hand_side(spans(s.b));
+    FrameStep step;
+    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(5);
+    ASSERT_TRUE(step.converged);
+    const std::vector<int32_t> rows = testing::paint_test_system(s, 40, 7);
+    solver.update_values(s.matrix, rows);
+    step = FrameStep{};
+    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(5);
+    EXPECT_TRUE(step.converged);
+    const auto phi = solver.phi();
+    for (int c = 0; c < 3; ++c) {
+        const auto reference = reference_solution(s.matrix, s.b[static_cast<size_t>(c)], c);
+        EXPECT_LT(relative_error(phi[static_cast<size_t>(c)], reference), kFloatSolutionBound) << "channel " << c;
+    }
+}
+
+// A time budget stops between V-cycles (a fake clock: no timing in unit tests), and a budget that ran k
+// V-cycles equals step(k).
+TEST(GpuMultigridFrameSolver, TimeBudgetStopsBetweenVcyclesLikeAVcycleBudget) {
+    WAXWORK_REQUIRE_GL(context);
+    const auto s = testing::make_test_system(8);
+    const FrameSolverOptions options = frame_options(30, 1e-12);
+    GpuMultigridFrameSolver timed(context->gl(), s.matrix, s.mesh.positions, options);
+    GpuMultigridFrameSolver counted(context->gl(), s.matrix, s.mesh.positions, options);
+    timed.set_right_hand_side(spans(s.b));
+    counted.set_right_hand_side(spans(s.b));
+    double now = 0;
+    // Each clock read advances 1 ms: the deadline (3.5 ms) reads 0 at the start, then once per V-cycle.
+    const MillisecondClock clock = [&now] { return now++; };
+    const FrameStep step = timed.step(FrameBudget::milliseconds(3.5), clock);
+    EXPECT_GT(step.vcycles, 1);  // the deadline allows several reads
+    EXPECT_LT(step.vcycles, 10);
+    counted.step(step.vcycles);
+    const auto a = timed.phi(), b = counted.phi();
+    EXPECT_EQ(a, b);
+    EXPECT_EQ(timed.step(FrameBudget::iterations(2)).vcycles, 2);
+}
+
+TEST(GpuMultigridFrameSolver, RejectsBadInput) {
+    WAXWORK_REQUIRE_GL(context);
+    const auto s = testing::make_test_system(5);
+    GpuMultigridFrameSolver solver(context->gl(), s.matrix, s.mesh.positions, frame_options(20, 1e-2));
+    EXPECT_THROW(solver.step(1), InvalidArgumentError);  // no right-hand side yet
+    std::vector<double> short_b(s.b[0].size() - 1);
+    EXPECT_THROW(solver.set_right_hand_side({short_b, s.b[1], s.b[2]}), InvalidArgumentError);
+    std::vector<double> nan_b = s.b[0];
+    nan_b[3] = std::nan("");
+    EXPECT_THROW(solver.set_right_hand_side({nan_b, s.b[1], s.b[2]}), AlgorithmError);
+    EXPECT_THROW(solver.set_phi({nan_b, s.b[1], s.b[2]}), AlgorithmError);
+    solver.set_right_hand_side(spans(s.b));
+    EXPECT_THROW(solver.step(0), InvalidArgumentError);
+    EXPECT_THROW(solver.step(FrameBudget{}), InvalidArgumentError);
+    EXPECT_THROW(solver.set_relative_tolerance(-1), InvalidArgumentError);
+    EXPECT_THROW(solver.update_values(s.matrix, std::vector<int32_t>{-1}), InvalidArgumentError);
+    // A zero right-hand side is solved by phi = 0 at once.
+    const std::vector<double> zero(s.b[0].size(), 0.0);
+    solver.set_right_hand_side({zero, zero, zero});
+    solver.reset();
+    const FrameStep step = solver.step(1);
+    EXPECT_TRUE(step.converged);
+    for (const auto& channel : solver.phi())
+        for (double v : channel) EXPECT_EQ(v, 0.0);
+}
+
+}  // namespace
+}  // namespace waxwork
