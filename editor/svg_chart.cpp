@@ -12,8 +12,10 @@
 namespace waxwork {
 namespace {
 
-// Colour-blind-safe palette (Okabe and Ito), cycled.
+// Colour-blind-safe palette (Okabe and Ito), cycled; each further cycle draws dashed (the solver
+// comparison has ten series), so no two series of a chart look alike.
 constexpr const char* kColours[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000", "#F0E442"};
+constexpr const char* kDashes[] = {"", " stroke-dasharray=\"7 4\"", " stroke-dasharray=\"2 3\""};
 
 std::string escape(const std::string& text) {
     std::string out;
@@ -160,12 +162,13 @@ std::string render_svg_chart(const std::vector<ChartSeries>& series, const Chart
     for (size_t i = 0; i < series.size(); ++i) {
         const ChartSeries& s = series[i];
         const char* colour = kColours[i % std::size(kColours)];
+        const char* dash = kDashes[(i / std::size(kColours)) % std::size(kDashes)];
         std::vector<std::pair<double, double>> shown;
         for (const auto& [x, y] : s.points)
             if (visible(x, y)) shown.emplace_back(px(x), py(y));
         svg << "<g clip-path=\"url(#plot)\">";
         if (shown.size() > 1) {
-            svg << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"2\" points=\"";
+            svg << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"2\"" << dash << " points=\"";
             for (const auto& [x, y] : shown) svg << number(x) << "," << number(y) << " ";
             svg << "\"/>";
         }
@@ -176,7 +179,7 @@ std::string render_svg_chart(const std::vector<ChartSeries>& series, const Chart
         const double ly = top + 10 + 20.0 * static_cast<double>(i);
         const double lx = left + plot_w + 15;
         svg << "<line x1=\"" << number(lx) << "\" y1=\"" << number(ly) << "\" x2=\"" << number(lx + 25) << "\" y2=\""
-            << number(ly) << "\" stroke=\"" << colour << "\" stroke-width=\"2\"/>"
+            << number(ly) << "\" stroke=\"" << colour << "\" stroke-width=\"2\"" << dash << "/>"
             << "<text x=\"" << number(lx + 32) << "\" y=\"" << number(ly) << "\" dy=\"4\">" << escape(s.name)
             << "</text>\n";
     }

@@ -37,6 +37,27 @@ TEST(SvgChart, DrawsSeriesLegendAxesAndDecadeTicks) {
     EXPECT_EQ(svg.find("nan"), std::string::npos);
 }
 
+TEST(SvgChart, SeriesBeyondThePaletteAreDashedNotRepeated) {
+    ChartOptions options;
+    options.x = {"x", AxisScale::Linear, 0, 0};
+    options.y = {"y", AxisScale::Linear, 0, 0};
+    std::vector<ChartSeries> series;
+    for (int k = 0; k < 10; ++k) series.push_back({"s" + std::to_string(k), {{0, double(k)}, {1, k + 0.5}}, false});
+    const std::string svg = render_svg_chart(series, options);
+    // Each series' line and its legend entry: the first eight solid, the ninth and tenth dashed.
+    std::vector<std::string> styles;
+    for (size_t at = svg.find("<polyline"); at != std::string::npos; at = svg.find("<polyline", at + 1)) {
+        const std::string element = svg.substr(at, svg.find('>', at) - at);
+        const size_t colour = element.find("stroke=\"");
+        const size_t dash = element.find("stroke-dasharray");
+        styles.push_back(element.substr(colour, 16) + (dash == std::string::npos ? "" : element.substr(dash, 24)));
+    }
+    ASSERT_EQ(styles.size(), 10u);
+    for (size_t a = 0; a < styles.size(); ++a)
+        for (size_t b = a + 1; b < styles.size(); ++b) EXPECT_NE(styles[a], styles[b]) << a << " and " << b;
+    EXPECT_EQ(count(svg, "stroke-dasharray"), 2u * 2u);  // two lines, two legend entries
+}
+
 TEST(SvgChart, SkipsNonPositiveValuesOnLogAxesAndRejectsNonFinite) {
     ChartOptions options;
     options.y.scale = AxisScale::Log;
