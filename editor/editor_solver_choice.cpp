@@ -51,7 +51,7 @@ void EditorApp::draw_solver_choice() {
     }
     if (!s.method_fallback_reason.empty()) {
         ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.6f, 0.3f, 1.0f));
-        ImGui::TextWrapped("Solving with Jacobi CG instead: %s", s.method_fallback_reason.c_str());
+        ImGui::TextWrapped("%s", s.method_fallback_reason.c_str());
         ImGui::PopStyleColor();
     }
 }

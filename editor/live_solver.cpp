@@ -85,6 +85,11 @@ private:
     SolverGlContext& context_;
 };
 
+// method_fallback_reason() when the multigrid V-cycle cannot be built or applied.
+std::string jacobi_instead_of_multigrid(const std::exception& e) {
+    return std::string("solving with Jacobi CG instead of multigrid CG: ") + e.what();
+}
+
 }  // namespace
 
 std::shared_ptr<SolverGlContext> open_headless_solver_context() { return std::make_shared<HeadlessSolverContext>(); }
@@ -201,7 +206,7 @@ void LiveSolver::build_cpu_multigrid(std::span<const Eigen::Vector3d> positions,
         multigrid_pending_ = PendingChanges{};  // a new solver: b and phi to send
         method_fallback_reason_.clear();
     } catch (const AlgorithmError& e) {
-        method_fallback_reason_ = std::string("multigrid CG: ") + e.what();
+        method_fallback_reason_ = jacobi_instead_of_multigrid(e);
     }
 }
 
@@ -334,7 +339,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& 
         } catch (const AlgorithmError& e) {
             // phi is still the last frame's (the host copy is written only after a successful step).
             multigrid_.reset();
-            method_fallback_reason_ = std::string("multigrid CG: ") + e.what();
+            method_fallback_reason_ = jacobi_instead_of_multigrid(e);
         }
     }
     if (multires_ && n > 0) return iterate_multires(b, phi, iteration_budget, relative_tolerance, skip);
@@ -440,7 +445,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu(const DiffusionMatrix& 
         } catch (const AlgorithmError& e) {
             // The V-cycle cannot be built or applied: GPU Jacobi CG from the last frame's phi (the host
             // copy is written only after a successful step), until the next rebuild tries again.
-            method_fallback_reason_ = std::string("multigrid CG: ") + e.what();
+            method_fallback_reason_ = jacobi_instead_of_multigrid(e);
             multigrid_positions_.clear();
             gpu_.reset();  // the context is current
             gpu_pending_ = PendingChanges{};
@@ -569,6 +574,13 @@ void LiveSolver::update_multires_values(const DiffusionMatrix& matrix) {
     gpu_pending_.rows.clear();  // the device copy of the hierarchy takes them per level (gpu_level_rows_)
 }
 
+void LiveSolver::note_coarse_fallbacks(const std::string& reasons) {
+    // A skipped level costs level-0 iterations, not accuracy (the level-0 CG converges from any start),
+    // but a user watching the multires method should know its coarse start did not work as meant.
+    method_fallback_reason_ =
+        reasons.empty() ? "" : "multires: the coarse-to-fine pass skipped " + reasons + " (level-0 CG converges regardless)";
+}
+
 std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<std::vector<double>, 3>& b,
                                                               std::array<std::vector<double>, 3>& phi,
                                                               int iteration_budget, double relative_tolerance,
@@ -581,6 +593,9 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<s
     MultiresSolveOptions options;
     options.relative_tolerance = relative_tolerance;
     int channels_left = static_cast<int>(std::count(skip.begin(), skip.end(), false));
+    static constexpr const char* kChannels[] = {"red", "green", "blue"};
+    std::string coarse_fallbacks;
+    bool coarse_pass = false;
     for (int c = 0; c < 3; ++c) {
         if (skip[c]) {
             out[c] = {0, 0.0, true};
@@ -598,9 +613,15 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<s
                                                          &report, options, clock_)
                                 : multires_->solve_frame(b[c], c, iteration_budget, &report, options);
         std::copy(solved.begin(), solved.end(), phi[c].begin());  // the host copy: radiance, saves, cuts
+        if (!report.coarse_levels.empty()) {
+            coarse_pass = true;
+            if (const std::string reasons = report.fallback_reasons(); !reasons.empty())
+                coarse_fallbacks += (coarse_fallbacks.empty() ? "" : "; ") + (kChannels[c] + (": " + reasons));
+        }
         multires_error_[c] = report.fine.estimated_relative_error;
         out[c] = {report.fine.iterations, report.fine.estimated_relative_error, report.fine.converged};
     }
+    if (coarse_pass) note_coarse_fallbacks(coarse_fallbacks);
     gpu_pending_.solution = true;  // the device no longer holds this phi
     return out;
 }
@@ -652,7 +673,9 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multires(const Diffusio
         MultiresSolveOptions options;
         options.relative_tolerance = relative_tolerance;
         options.max_iterations = iteration_budget;
-        results = gpu_->multires->solve(options, fine).fine;
+        const GpuMultiresReport report = gpu_->multires->solve(options, fine);
+        results = report.fine;
+        note_coarse_fallbacks(report.fallback_reasons());
         multires_pending_.solution = false;
     } else {
         results = gpu_->multires->solve_fine(fine);  // warm from the resident phi

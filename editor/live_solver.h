@@ -176,7 +176,8 @@ public:
     LiveBackend requested_backend() const { return requested_backend_; }
     // Why the GPU backend was given up ("" when it was not requested or runs).
     const std::string& gpu_fallback_reason() const { return gpu_fallback_reason_; }
-    // Why the multigrid method solves with Jacobi CG instead ("" when it runs, or was not chosen).
+    // Why the method does not run as chosen ("" when it does): the multigrid method solving with Jacobi
+    // CG instead, or the multires method's last coarse-to-fine pass skipping levels (and why).
     const std::string& method_fallback_reason() const { return method_fallback_reason_; }
     // "GPU Jacobi CG (float) (llvmpipe ...)", "CPU multigrid CG, three channels per V-cycle", ...: for the
     // panel and logs.
@@ -216,6 +217,9 @@ private:
                                                  double relative_tolerance, const std::array<bool, 3>& skip);
     void fall_back(const std::string& reason);
     void release_gpu();
+    // After a multires coarse-to-fine pass: method_fallback_reason() names its skipped levels ("" when
+    // none was skipped).
+    void note_coarse_fallbacks(const std::string& reasons);
 
     LiveMethod method_;
     LiveBackend backend_, requested_backend_;

@@ -29,7 +29,7 @@ void run_run_command(const RunCommandOptions& o) {
     if (!result.gpu_fallback_reason.empty())
         std::cerr << "warning: solved on the CPU instead: " << result.gpu_fallback_reason << "\n";
     if (!result.method_fallback_reason.empty())
-        std::cerr << "warning: solved with Jacobi CG instead: " << result.method_fallback_reason << "\n";
+        std::cerr << "warning: " << result.method_fallback_reason << "\n";
     std::cout << std::fixed << std::setprecision(1) << "loaded the input in " << result.load_ms << " ms ("
               << (result.steps.empty() ? result.mesh.tet_count() : result.steps.front().tets) << " tets)\n";
     for (size_t i = 0; i < result.steps.size(); ++i) {

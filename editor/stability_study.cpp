@@ -426,8 +426,7 @@ StudyTable study_coarse_breakdown(const StudySize& size) {
         } catch (const AlgorithmError& e) {
             reasons = std::string("error: ") + e.what();
         }
-        for (const LevelSolveReport& level : report.coarse_levels)
-            if (level.skipped) reasons += (reasons.empty() ? "" : "; ") + ("level " + std::to_string(level.level) + ": " + level.reason);
+        if (reasons.empty()) reasons = report.fallback_reasons();
         const bool finite = std::all_of(x.begin(), x.end(), [](double v) { return std::isfinite(v); });
         double error = 0, norm = 0;
         for (size_t v = 0; v < x.size(); ++v) {

@@ -3,6 +3,20 @@
 #include "tetops/error.h"
 
 namespace waxwork {
+
+std::string GpuMultiresReport::fallback_reasons() const {
+    static constexpr const char* kChannels[] = {"red", "green", "blue"};
+    std::string reasons;
+    for (int c = 0; c < 3; ++c) {
+        std::string channel;
+        for (size_t k = 0; k < coarse_levels.size(); ++k)
+            if (coarse_levels[k][c].reverted)
+                channel += (channel.empty() ? "" : "; ") + ("level " + std::to_string(coarse_levels.size() - k) + ": " +
+                                                            to_string(coarse_levels[k][c].status) + ", start vector kept");
+        if (!channel.empty()) reasons += (reasons.empty() ? "" : "; ") + (kChannels[c] + (": " + channel));
+    }
+    return reasons;
+}
 namespace {
 
 RgbCsrView level_view(const HierarchyLevel& level) {

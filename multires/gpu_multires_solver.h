@@ -16,6 +16,7 @@
 
 #include <array>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace waxwork {
@@ -24,6 +25,11 @@ struct GpuMultiresReport {
     // Coarsest level first; per level, the three channels' BiCGSTAB results.
     std::vector<std::array<BicgstabResult, 3>> coarse_levels;
     std::array<ConjugateGradientResult, 3> fine;
+
+    // The levels whose iterate was discarded (BiCGSTAB reverted to the start vector) per channel, as
+    // MultiresSolveReport::fallback_reasons words them: "red: level 3: rho breakdown, start vector
+    // kept; blue: ...". Empty when none was.
+    std::string fallback_reasons() const;
 };
 
 class GpuMultiresSolver {

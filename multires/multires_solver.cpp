@@ -9,6 +9,13 @@
 
 namespace waxwork {
 
+std::string MultiresSolveReport::fallback_reasons() const {
+    std::string reasons;
+    for (const LevelSolveReport& level : coarse_levels)
+        if (level.skipped) reasons += (reasons.empty() ? "" : "; ") + ("level " + std::to_string(level.level) + ": " + level.reason);
+    return reasons;
+}
+
 namespace {
 
 double elapsed_ms(std::chrono::steady_clock::time_point start) {

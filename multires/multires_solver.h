@@ -60,6 +60,9 @@ struct MultiresSolveReport {
         for (const auto& l : coarse_levels) count += l.skipped ? 1 : 0;
         return count;
     }
+    // The skipped levels and why, "level 3: rho breakdown, start vector kept; level 1: ...", coarsest
+    // first; empty when none was skipped.
+    std::string fallback_reasons() const;
 };
 
 class MultiresSolver {

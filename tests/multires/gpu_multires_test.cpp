@@ -110,6 +110,20 @@ TEST(GpuBicgstab, ASingularChannelIsRevertedWhileTheOthersConverge) {
     for (size_t i = 0; i < level.size(); ++i) ASSERT_EQ(xg[3 * i], 0.5f) << "the reverted channel changed at " << i;
 }
 
+TEST(GpuMultiresReport, FallbackReasonsNameTheChannelLevelAndStatus) {
+    GpuMultiresReport report;
+    report.coarse_levels.resize(3);  // coarsest (level 3) first
+    EXPECT_EQ(report.fallback_reasons(), "");
+    report.coarse_levels[0][0] = {BicgstabStatus::RhoBreakdown, 2, 1, 1, true};
+    report.coarse_levels[2][0] = {BicgstabStatus::Divergence, 4, 1, 10, true};
+    report.coarse_levels[1][2] = {BicgstabStatus::NonFinite, 1, 1, 1, true};
+    report.coarse_levels[1][1] = {BicgstabStatus::IterationLimit, 8, 1, 0.1, false};  // kept: not a fallback
+    EXPECT_EQ(report.fallback_reasons(), std::string("red: level 3: ") + to_string(BicgstabStatus::RhoBreakdown) +
+                                             ", start vector kept; level 1: " + to_string(BicgstabStatus::Divergence) +
+                                             ", start vector kept; blue: level 2: " +
+                                             to_string(BicgstabStatus::NonFinite) + ", start vector kept");
+}
+
 TEST(GpuMultires, InterpolationMatchesTheCpu) {
     WAXWORK_REQUIRE_GL(context);
     const HierarchyLevel& fine = hierarchy16().levels[0];

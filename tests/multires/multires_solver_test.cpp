@@ -108,6 +108,7 @@ TEST(MultiresSolver, ConvergesToTheFineSolution) {
         EXPECT_LT(relative_error(x, reference), 1e-4) << "channel " << channel;
         EXPECT_EQ(report.coarse_levels.size(), solver.hierarchy().level_count() - 1);
         EXPECT_EQ(report.coarse_levels.front().status, BicgstabStatus::Converged);
+        EXPECT_EQ(report.fallback_reasons(), "");
     }
 }
 
@@ -128,6 +129,13 @@ TEST(MultiresSolver, SingularCoarsestLevelFallsBackAndStaysFinite) {
     EXPECT_TRUE(report.coarse_levels.front().skipped);
     EXPECT_FALSE(report.coarse_levels.front().reason.empty());
     EXPECT_GE(report.fallbacks(), 1);
+    // What the live editor shows: the coarsest level, named, and why it was skipped.
+    const std::string reasons = report.fallback_reasons();
+    EXPECT_EQ(reasons.rfind("level " + std::to_string(solver.hierarchy().level_count() - 1) + ": " +
+                                report.coarse_levels.front().reason,
+                            0),
+              0u)
+        << reasons;
     EXPECT_TRUE(all_finite(x));
     EXPECT_LT(relative_error(x, reference), 1e-4);
 }
