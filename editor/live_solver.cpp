@@ -367,13 +367,13 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& 
     return out;
 }
 
-std::array<LiveSolverChannel, 3> LiveSolver::iterate_multigrid(const DiffusionMatrix& matrix,
-                                                               const std::array<std::vector<double>, 3>& b,
-                                                               std::array<std::vector<double>, 3>& phi,
-                                                               int iteration_budget, double relative_tolerance,
-                                                               const std::array<bool, 3>& skip) {
-    MultigridFrameSolver& solver = *multigrid_;
-    PendingChanges& pending = multigrid_pending_;
+std::array<LiveSolverChannel, 3> LiveSolver::multigrid_frame(MultigridFrameCg& solver, PendingChanges& pending,
+                                                             const DiffusionMatrix& matrix,
+                                                             const std::array<std::vector<double>, 3>& b,
+                                                             std::array<std::vector<double>, 3>& phi,
+                                                             int iteration_budget, double relative_tolerance,
+                                                             const std::array<bool, 3>& skip,
+                                                             const std::function<void()>& read_phi) {
     if (pending.all_values) {
         // All values on the kept pattern: every row changed (the hierarchy's graphs and Eq. 16 weights
         // depend on the pattern and rest positions only, so they stay).
@@ -408,10 +408,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multigrid(const DiffusionMa
                                    : solver.step(vcycle_budget(iteration_budget));
         vcycles = step.vcycles;
         multigrid_error_ = step.estimated_relative_error;
-        for (int c = 0; c < 3; ++c) {
-            const std::span<const double> solved = solver.phi(c);
-            std::copy(solved.begin(), solved.end(), phi[c].begin());  // the host copy: radiance, saves, cuts
-        }
+        read_phi();  // the host copy: radiance, saves, cuts
     }
     for (int c = 0; c < 3; ++c) {
         if (skip[c]) {
@@ -422,6 +419,22 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multigrid(const DiffusionMa
         // update (the update only lowers the energy-norm error).
         out[c] = {vcycles, multigrid_error_[c], multigrid_error_[c] <= relative_tolerance};
     }
+    return out;
+}
+
+std::array<LiveSolverChannel, 3> LiveSolver::iterate_multigrid(const DiffusionMatrix& matrix,
+                                                               const std::array<std::vector<double>, 3>& b,
+                                                               std::array<std::vector<double>, 3>& phi,
+                                                               int iteration_budget, double relative_tolerance,
+                                                               const std::array<bool, 3>& skip) {
+    MultigridFrameSolver& solver = *multigrid_;
+    const auto out = multigrid_frame(solver, multigrid_pending_, matrix, b, phi, iteration_budget, relative_tolerance,
+                                     skip, [&] {
+                                         for (int c = 0; c < 3; ++c) {
+                                             const std::span<const double> solved = solver.phi(c);
+                                             std::copy(solved.begin(), solved.end(), phi[c].begin());
+                                         }
+                                     });
     gpu_pending_.solution = true;  // the device no longer holds this phi
     return out;
 }
@@ -512,45 +525,8 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multigrid(const Diffusi
         gpu_pending_ = PendingChanges{};  // a new device copy: the current values; b and phi to send
     }
     GpuMultigridFrameSolver& solver = *gpu_->multigrid;
-    if (gpu_pending_.all_values) {
-        std::vector<int32_t> all(matrix.size());
-        std::iota(all.begin(), all.end(), 0);
-        solver.update_values(matrix, all);
-    } else if (!gpu_pending_.rows.empty()) {
-        solver.update_values(matrix, gpu_pending_.rows);  // paint: the changed rows of every level
-    }
-    gpu_pending_.values_applied();
-    if (gpu_pending_.right_hand_sides) solver.set_right_hand_side({b[0], b[1], b[2]});
-    gpu_pending_.right_hand_sides = false;
-    if (gpu_pending_.solution) {
-        const bool zero = std::all_of(phi.begin(), phi.end(), [](const std::vector<double>& v) {
-            return std::all_of(v.begin(), v.end(), [](double x) { return x == 0.0; });
-        });
-        if (zero)
-            solver.reset();
-        else
-            solver.set_phi({phi[0], phi[1], phi[2]});
-    }
-    gpu_pending_.solution = false;
-    solver.set_relative_tolerance(relative_tolerance);
-
-    int vcycles = 0;
-    if (vcycle_budget(iteration_budget) > 0) {
-        const FrameStep step = deadline_.bounded()
-                                   ? solver.step(budget_until(deadline_, 1, vcycle_budget(iteration_budget)), clock_)
-                                   : solver.step(vcycle_budget(iteration_budget));
-        vcycles = step.vcycles;
-        multigrid_error_ = step.estimated_relative_error;
-        phi = solver.phi();  // the host copy: saves, cuts, the CPU radiance
-    }
-    std::array<LiveSolverChannel, 3> out;
-    for (int c = 0; c < 3; ++c) {
-        if (skip[c])
-            out[c] = {0, 0.0, true};
-        else
-            out[c] = {vcycles, multigrid_error_[c], multigrid_error_[c] <= relative_tolerance};
-    }
-    return out;
+    return multigrid_frame(solver, gpu_pending_, matrix, b, phi, iteration_budget, relative_tolerance, skip,
+                           [&] { phi = solver.phi(); });
 }
 
 void LiveSolver::update_multires_values(const DiffusionMatrix& matrix) {

@@ -64,6 +64,7 @@
 #include "tetops/tet_mesh.h"
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -71,6 +72,7 @@
 
 namespace waxwork {
 
+class MultigridFrameCg;
 class MultigridFrameSolver;
 class MultiresSolver;
 
@@ -217,6 +219,15 @@ private:
                                                  double relative_tolerance, const std::array<bool, 3>& skip);
     void fall_back(const std::string& reason);
     void release_gpu();
+    struct PendingChanges;
+    // A frame of either multigrid frame solver (CPU or device): sends the pending changes (values, b,
+    // phi), runs the V-cycles the budget allows, `read_phi` copies the solver's phi to the host.
+    std::array<LiveSolverChannel, 3> multigrid_frame(MultigridFrameCg& solver, PendingChanges& pending,
+                                                     const DiffusionMatrix& matrix,
+                                                     const std::array<std::vector<double>, 3>& b,
+                                                     std::array<std::vector<double>, 3>& phi, int iteration_budget,
+                                                     double relative_tolerance, const std::array<bool, 3>& skip,
+                                                     const std::function<void()>& read_phi);
     // After a multires coarse-to-fine pass: method_fallback_reason() names its skipped levels ("" when
     // none was skipped).
     void note_coarse_fallbacks(const std::string& reasons);

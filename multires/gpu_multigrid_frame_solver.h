@@ -23,8 +23,7 @@
 
 #include "multires/gpu_multigrid_preconditioner.h"
 #include "multires/hierarchy.h"
-#include "multires/multigrid_cg_state.h"
-#include "multires/multigrid_frame_solver.h"
+#include "multires/multigrid_frame_cg.h"
 #include "multires/multigrid_preconditioner.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/frame_budget.h"
@@ -39,7 +38,7 @@
 
 namespace waxwork {
 
-class GpuMultigridFrameSolver {
+class GpuMultigridFrameSolver : public MultigridFrameCg {
 public:
     // Builds the hierarchy and the preconditioner on the host (as MultigridFrameSolver) and uploads
     // them. The OpenGL context of `gl` (>= 4.3) must be current whenever the solver is used or
@@ -47,29 +46,15 @@ public:
     GpuMultigridFrameSolver(const GlApi& gl, const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                             const FrameSolverOptions& options = {});
     ~GpuMultigridFrameSolver();
-    GpuMultigridFrameSolver(const GpuMultigridFrameSolver&) = delete;
-    GpuMultigridFrameSolver& operator=(const GpuMultigridFrameSolver&) = delete;
 
-    // As MultigridFrameSolver: the residual follows the change of b on the device. Throws
-    // InvalidArgumentError on a size mismatch and AlgorithmError on non-finite values (state unchanged).
-    void set_right_hand_side(const std::array<std::span<const double>, 3>& b);
-    // At most `budget` V-cycles. Throws InvalidArgumentError without a right-hand side or for budget < 1,
-    // AlgorithmError when the matrix or preconditioner is not positive definite, GpuError on a driver
-    // error.
-    FrameStep step(int budget);
-    // Within a frame budget: V-cycles counted by budget.max_iterations (0: no limit), the time limit
-    // on `clock` checked between V-cycles (at least one runs). A budget that ran k V-cycles equals
-    // step(k). Throws as validate(FrameBudget) and step(int).
-    FrameStep step(const FrameBudget& budget, const MillisecondClock& clock = {});
-    void set_relative_tolerance(double tolerance);
-
-    // phi = 0 (forgets the warm start and the eigenvalue estimates).
-    void reset();
-    // Warm start from given solutions; as MultigridFrameSolver::set_phi.
-    void set_phi(const std::array<std::span<const double>, 3>& phi);
-    // After update_diffusion_matrix rewrote `changed_rows` (ascending, same pattern): updates the host
-    // level 0 and preconditioner and uploads the changed rows of every level.
-    void update_values(const DiffusionMatrix& matrix, std::span<const int32_t> changed_rows);
+    // As MultigridFrameCg says, on the device's vectors (a driver error throws GpuError):
+    // step(), set_relative_tolerance(), and these. The residual follows a change of b on the device;
+    // update_values updates the host level 0 and preconditioner and uploads the changed rows of every
+    // level.
+    void set_right_hand_side(const std::array<std::span<const double>, 3>& b) override;
+    void reset() override;
+    void set_phi(const std::array<std::span<const double>, 3>& phi) override;
+    void update_values(const DiffusionMatrix& matrix, std::span<const int32_t> changed_rows) override;
 
     // The current solution read back from the device, per channel.
     std::array<std::vector<double>, 3> phi() const;
@@ -77,27 +62,25 @@ public:
     const GpuBuffer& solution_buffer() const { return phi_; }
     GpuKernels& kernels() { return *kernels_; }
 
-    size_t size() const { return n_; }
     const MultiresHierarchy& hierarchy() const { return *hierarchy_; }
     const MultigridPreconditioner& preconditioner() const { return *preconditioner_; }
 
 private:
-    FrameStep step_within(int max_vcycles, const FrameDeadline& deadline);
-    void refresh_residual();
+    void precondition() override;
+    MultigridCgState::StepSums step_sums() override;
+    void set_direction(const Rgb& beta, bool restart) override;
+    Rgb multiply_direction() override;
+    void update_solution(const Rgb& alpha) override;
+    void compute_residual(bool phi_is_zero) override;
+    void steps_done() override;
     // Uploads three host channels interleaved into `target`.
     void upload(const std::array<std::span<const double>, 3>& v, GpuBuffer& target);
 
-    FrameSolverOptions options_;
-    size_t n_ = 0;
     std::unique_ptr<MultiresHierarchy> hierarchy_;
     std::unique_ptr<MultigridPreconditioner> preconditioner_;
     std::unique_ptr<GpuKernels> kernels_;
     std::unique_ptr<GpuMultigridPreconditioner> device_;
     GpuBuffer b_, r_, z_, p_, q_, phi_, scratch_;
-    bool has_b_ = false, refresh_ = true;
-    bool phi_zero_ = true;  // phi is exactly zero (a cold start): r = b needs no product
-    int updates_since_refresh_ = 0;
-    MultigridCgState cg_;
     std::vector<float> staging_;
 };
 

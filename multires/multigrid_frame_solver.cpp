@@ -59,9 +59,7 @@ inline void product_row(size_t i, const int32_t* offsets, const int32_t* columns
 
 MultigridFrameSolver::MultigridFrameSolver(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                                            const FrameSolverOptions& options)
-    : options_(options), n_(matrix.size()) {
-    if (!(options.relative_tolerance > 0) || options.residual_refresh_interval < 1)
-        throw InvalidArgumentError("frame solver: tolerance must be positive and the refresh interval >= 1");
+    : MultigridFrameCg(matrix.size(), options, "frame solver") {
     hierarchy_ = std::make_unique<MultiresHierarchy>(build_multires_hierarchy(matrix, positions, options.hierarchy));
     preconditioner_ = std::make_unique<MultigridPreconditioner>(*hierarchy_, options.multigrid);
     values_.resize(3 * matrix.nonzeros());
@@ -80,32 +78,21 @@ std::span<const double> MultigridFrameSolver::phi(int channel) const {
     return phi_[static_cast<size_t>(channel)];
 }
 
-void MultigridFrameSolver::set_relative_tolerance(double tolerance) {
-    if (!(tolerance > 0) || !std::isfinite(tolerance))
-        throw InvalidArgumentError("frame solver: tolerance " + std::to_string(tolerance) + " must be positive");
-    options_.relative_tolerance = tolerance;
-}
-
 void MultigridFrameSolver::reset() {
     for (auto& v : phi_) std::fill(v.begin(), v.end(), 0.0);
-    refresh_ = phi_zero_ = true;
-    cg_.restart();
-    cg_.forget_eigenvalues(true);
+    phi_reset();
 }
 
 void MultigridFrameSolver::set_phi(const std::array<std::span<const double>, 3>& phi) {
     check_frame_channels(phi, n_, "phi");
     for (size_t c = 0; c < 3; ++c) std::copy(phi[c].begin(), phi[c].end(), phi_[c].begin());
-    refresh_ = true;
-    cg_.restart();
-    phi_zero_ = false;
-    if (has_b_) refresh_residual();
+    phi_set();
 }
 
 void MultigridFrameSolver::set_right_hand_side(const std::array<std::span<const double>, 3>& b) {
     check_frame_channels(b, n_, "right-hand side");
     // r = b - M phi changes by exactly the change of b.
-    const bool follow = has_b_ && !refresh_;
+    const bool follow = residual_follows_b();
     for_rows(n_, kGrain, [&](size_t i) {
         for (size_t c = 0; c < 3; ++c) {
             const double value = b[c][i];
@@ -113,15 +100,12 @@ void MultigridFrameSolver::set_right_hand_side(const std::array<std::span<const 
             b_[3 * i + c] = value;
         }
     });
-    has_b_ = true;
-    cg_.restart();
+    right_hand_side_set();
 }
 
-void MultigridFrameSolver::refresh_residual() {
-    if (phi_zero_) {
+void MultigridFrameSolver::compute_residual(bool phi_is_zero) {
+    if (phi_is_zero) {
         r_ = b_;
-        refresh_ = false;
-        updates_since_refresh_ = 0;
         return;
     }
     const int32_t* offsets = hierarchy_->levels[0].offsets.data();
@@ -135,98 +119,56 @@ void MultigridFrameSolver::refresh_residual() {
         }
         for (size_t c = 0; c < 3; ++c) r_[3 * i + c] = b_[3 * i + c] - s[c];
     });
-    refresh_ = false;
-    updates_since_refresh_ = 0;
 }
 
-FrameStep MultigridFrameSolver::step(int budget) {
-    if (!has_b_) throw InvalidArgumentError("frame solver: step() before set_right_hand_side()");
-    if (budget < 1) throw InvalidArgumentError("frame solver: budget " + std::to_string(budget) + " < 1");
-    return step_within(budget, FrameDeadline{});
+void MultigridFrameSolver::precondition() { preconditioner_->apply_rgb(r_, z_); }
+
+MultigridCgState::StepSums MultigridFrameSolver::step_sums() {
+    // r . z and phi . M phi = phi . (b - r) per channel.
+    return reduce_rows<6>(n_, [&](size_t i, Sums<6>& acc) {
+        for (size_t c = 0; c < 3; ++c) {
+            const size_t e = 3 * i + c;
+            acc[c] += r_[e] * z_[e];
+            acc[3 + c] += phi_[c][i] * (b_[e] - r_[e]);
+        }
+    });
 }
 
-FrameStep MultigridFrameSolver::step(const FrameBudget& budget, const MillisecondClock& clock) {
-    validate(budget);
-    const FrameDeadline deadline = FrameDeadline::of(budget, clock);
-    return step_within(budget.limits_iterations() ? budget.max_iterations : std::numeric_limits<int>::max(), deadline);
-}
-
-FrameStep MultigridFrameSolver::step_within(int budget, const FrameDeadline& deadline) {
-    if (!has_b_) throw InvalidArgumentError("frame solver: step() before set_right_hand_side()");
-    FrameStep result;
-    if (refresh_) {
-        refresh_residual();
-        cg_.restart();
+void MultigridFrameSolver::set_direction(const Rgb& beta, bool restart) {
+    if (restart) {
+        std::swap(p_, z_);  // z is recomputed before it is read again
+        return;
     }
-    if (cg_.restarting()) cg_.begin_restart();
+    for_rows(n_, kGrain, [&](size_t i) {
+        for (size_t c = 0; c < 3; ++c) p_[3 * i + c] = z_[3 * i + c] + beta[c] * p_[3 * i + c];
+    });
+}
+
+MultigridFrameSolver::Rgb MultigridFrameSolver::multiply_direction() {
+    // q = M p and p . q.
     const int32_t* offsets = hierarchy_->levels[0].offsets.data();
     const int32_t* columns = hierarchy_->levels[0].columns.data();
-    // The deadline is read between V-cycles only (one clock read each): the first always runs.
-    for (int cycle = 0; cycle < budget && !(cycle > 0 && deadline.expired()); ++cycle) {
-        preconditioner_->apply_rgb(r_, z_);
-        ++result.vcycles;
-        // r . z and phi . M phi = phi . (b - r) per channel.
-        const Sums<6> sums = reduce_rows<6>(n_, [&](size_t i, Sums<6>& acc) {
-            for (size_t c = 0; c < 3; ++c) {
-                const size_t e = 3 * i + c;
-                acc[c] += r_[e] * z_[e];
-                acc[3 + c] += phi_[c][i] * (b_[e] - r_[e]);
-            }
-        });
-        if (cg_.estimate(sums, options_.relative_tolerance, result.estimated_relative_error, "frame solver")) {
-            result.converged = true;
-            break;
+    return reduce_rows<3>(n_, [&](size_t i, Sums<3>& acc) {
+        double* q = &q_[3 * i];
+        product_row(i, offsets, columns, values_.data(), p_.data(), q);
+        for (size_t c = 0; c < 3; ++c) acc[c] += p_[3 * i + c] * q[c];
+    });
+}
+
+void MultigridFrameSolver::update_solution(const Rgb& alpha) {
+    for_rows(n_, kGrain, [&](size_t i) {
+        for (size_t c = 0; c < 3; ++c) {
+            const size_t e = 3 * i + c;
+            phi_[c][i] += alpha[c] * p_[e];
+            r_[e] -= alpha[c] * q_[e];
         }
-        // p = z on a restart, else z + beta p (beta = new r.z / old r.z).
-        const std::array<double, 3> beta = cg_.beta(sums);
-        if (cg_.restarting()) {
-            std::swap(p_, z_);  // z is recomputed before it is read again
-        } else {
-            for_rows(n_, kGrain, [&](size_t i) {
-                for (size_t c = 0; c < 3; ++c) p_[3 * i + c] = z_[3 * i + c] + beta[c] * p_[3 * i + c];
-            });
-        }
-        // q = M p and p . q.
-        const Sums<3> pq = reduce_rows<3>(n_, [&](size_t i, Sums<3>& acc) {
-            double* q = &q_[3 * i];
-            product_row(i, offsets, columns, values_.data(), p_.data(), q);
-            for (size_t c = 0; c < 3; ++c) acc[c] += p_[3 * i + c] * q[c];
-        });
-        const std::array<double, 3> alpha = cg_.alpha(sums, pq, beta, "frame solver");
-        phi_zero_ = false;
-        for_rows(n_, kGrain, [&](size_t i) {
-            for (size_t c = 0; c < 3; ++c) {
-                const size_t e = 3 * i + c;
-                phi_[c][i] += alpha[c] * p_[e];
-                r_[e] -= alpha[c] * q_[e];
-            }
-        });
-        if (++updates_since_refresh_ >= options_.residual_refresh_interval) {
-            // The recursive residual drifts from b - M phi by rounding: recompute it and restart.
-            refresh_residual();
-            cg_.restart_after_refresh();
-        }
-    }
-    return result;
+    });
 }
 
 void MultigridFrameSolver::update_values(const DiffusionMatrix& matrix, std::span<const int32_t> changed_rows) {
-    HierarchyLevel& level0 = hierarchy_->levels[0];
-    if (matrix.size() != n_ || matrix.columns != level0.columns)
-        throw InvalidArgumentError("frame solver update_values: the matrix pattern changed (rebuild the solver)");
-    for (int32_t row : changed_rows) {
-        if (row < 0 || static_cast<size_t>(row) >= n_)
-            throw InvalidArgumentError("frame solver update_values: row " + std::to_string(row) + " out of range");
-        for (int32_t k = matrix.offsets[static_cast<size_t>(row)]; k < matrix.offsets[static_cast<size_t>(row) + 1]; ++k)
-            for (size_t c = 0; c < 3; ++c) {
-                level0.values[c][static_cast<size_t>(k)] = matrix.values[c][static_cast<size_t>(k)];
-                values_[3 * static_cast<size_t>(k) + c] = matrix.values[c][static_cast<size_t>(k)];
-            }
-    }
+    copy_changed_rows(matrix, changed_rows, hierarchy_->levels[0], &values_);
     preconditioner_->update_values(changed_rows);
-    refresh_ = true;
-    cg_.restart();
-    cg_.forget_eigenvalues(false);  // another operator: earlier estimates do not hold
+    operator_changed();
 }
 
 }  // namespace waxwork

@@ -92,8 +92,7 @@ TEST(GpuMultigridFrameSolver, WarmStartAfterALightTurnIsBackUnderOnePercentInAFe
     GpuMultigridFrameSolver solver(context->gl(), s.matrix, s.mesh.positions, frame_options(100, 1e-2));
     const auto before = testing::light_rhs(s, 0), after = testing::light_rhs(s, 10);
     solver.set_right_hand_side(spans(before));
-    FrameStep step;
-    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(4);
+    FrameStep step = testing::step_until_converged(solver, 4, 20);
     ASSERT_TRUE(step.converged);
     std::array<std::vector<double>, 3> reference;
     auto phi = solver.phi();
@@ -108,7 +107,7 @@ TEST(GpuMultigridFrameSolver, WarmStartAfterALightTurnIsBackUnderOnePercentInAFe
     phi = solver.phi();
     for (int c = 0; c < 3; ++c)
         EXPECT_LT(relative_error(phi[static_cast<size_t>(c)], reference[static_cast<size_t>(c)]), 1e-2) << "channel " << c;
-    for (int frames = 0; frames < 10 && !step.converged; ++frames) step = solver.step(1);
+    if (!step.converged) step = testing::step_until_converged(solver, 1, 10);
     EXPECT_TRUE(step.converged);
 }
 
@@ -117,13 +116,11 @@ TEST(GpuMultigridFrameSolver, FollowsPaintedValues) {
     auto s = testing::make_test_system(8);
     GpuMultigridFrameSolver solver(context->gl(), s.matrix, s.mesh.positions, frame_options(30, 1e-6));
     solver.set_right_hand_side(spans(s.b));
-    FrameStep step;
-    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(5);
+    FrameStep step = testing::step_until_converged(solver, 5, 20);
     ASSERT_TRUE(step.converged);
     const std::vector<int32_t> rows = testing::paint_test_system(s, 40, 7);
     solver.update_values(s.matrix, rows);
-    step = FrameStep{};
-    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(5);
+    step = testing::step_until_converged(solver, 5, 20);
     EXPECT_TRUE(step.converged);
     const auto phi = solver.phi();
     for (int c = 0; c < 3; ++c) {

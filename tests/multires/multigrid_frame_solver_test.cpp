@@ -85,8 +85,7 @@ TEST(MultigridFrameSolver, ATighterToleranceContinuesTheSolve) {
     const auto s = testing::make_test_system(10);
     MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(100, 1e-2));
     solver.set_right_hand_side(spans(s.b));
-    FrameStep step;
-    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(2);
+    FrameStep step = testing::step_until_converged(solver, 2, 20);
     ASSERT_TRUE(step.converged);
     const auto reference = reference_solution(s.matrix, s.b[0], 0);
     const double loose = relative_error(solver.phi(0), reference);
@@ -95,7 +94,7 @@ TEST(MultigridFrameSolver, ATighterToleranceContinuesTheSolve) {
     step = solver.step(1);
     EXPECT_FALSE(step.converged);
     EXPECT_EQ(step.vcycles, 1);
-    for (int frames = 0; frames < 50 && !step.converged; ++frames) step = solver.step(2);
+    if (!step.converged) step = testing::step_until_converged(solver, 2, 50);
     EXPECT_TRUE(step.converged);
     EXPECT_LT(relative_error(solver.phi(0), reference), std::min(1e-6, 0.01 * loose));
     EXPECT_THROW(solver.set_relative_tolerance(0), InvalidArgumentError);
@@ -112,8 +111,7 @@ TEST(MultigridFrameSolver, WarmStartAfterALightTurnIsWithinOnePercentInOneVcycle
     const auto before = testing::light_rhs(s, 0), after = testing::light_rhs(s, 10);
     solver.set_right_hand_side(spans(before));
     // The previous frames: converged on the old light.
-    FrameStep step;
-    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(4);
+    FrameStep step = testing::step_until_converged(solver, 4, 20);
     ASSERT_TRUE(step.converged);
     std::array<std::vector<double>, 3> reference;
     for (int c = 0; c < 3; ++c) {
@@ -150,13 +148,11 @@ TEST(MultigridFrameSolver, FollowsPaintedValues) {
     auto s = testing::make_test_system(8);
     MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(30, 1e-8));
     solver.set_right_hand_side(spans(s.b));
-    FrameStep step;
-    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(5);
+    FrameStep step = testing::step_until_converged(solver, 5, 20);
     ASSERT_TRUE(step.converged);
     const std::vector<int32_t> rows = testing::paint_test_system(s, 40, 7);
     solver.update_values(s.matrix, rows);
-    step = FrameStep{};
-    for (int frames = 0; frames < 20 && !step.converged; ++frames) step = solver.step(5);
+    step = testing::step_until_converged(solver, 5, 20);
     EXPECT_TRUE(step.converged);
     for (int c = 0; c < 3; ++c) {
         const auto reference = reference_solution(s.matrix, s.b[static_cast<size_t>(c)], c);

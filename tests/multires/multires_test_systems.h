@@ -1,6 +1,7 @@
 // Small assembled diffusion systems for the multires tests.
 #pragma once
 
+#include "multires/multigrid_frame_cg.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/lighting.h"
@@ -77,6 +78,13 @@ inline std::vector<int32_t> paint_test_system(TestSystem& s, int count, int stri
 }
 
 // sqrt(sum (x - reference)^2 / sum reference^2).
+// Frames of `budget` V-cycles until a frame converges, at most `max_frames`; the last frame's step.
+inline FrameStep step_until_converged(MultigridFrameCg& solver, int budget, int max_frames) {
+    FrameStep step;
+    for (int frames = 0; frames < max_frames && !step.converged; ++frames) step = solver.step(budget);
+    return step;
+}
+
 inline double relative_error(std::span<const double> x, std::span<const double> reference) {
     double e = 0, r = 0;
     for (size_t i = 0; i < x.size(); ++i) {

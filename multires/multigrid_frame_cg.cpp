@@ -1,0 +1,114 @@
+#include "multires/multigrid_frame_cg.h"
+
+#include "tetops/error.h"
+
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace waxwork {
+
+MultigridFrameCg::MultigridFrameCg(size_t n, const FrameSolverOptions& options, std::string who)
+    : options_(options), n_(n), who_(std::move(who)) {
+    if (!(options.relative_tolerance > 0) || options.residual_refresh_interval < 1)
+        throw InvalidArgumentError(who_ + ": tolerance must be positive and the refresh interval >= 1");
+}
+
+void MultigridFrameCg::set_relative_tolerance(double tolerance) {
+    if (!(tolerance > 0) || !std::isfinite(tolerance))
+        throw InvalidArgumentError(who_ + ": tolerance " + std::to_string(tolerance) + " must be positive");
+    options_.relative_tolerance = tolerance;
+}
+
+void MultigridFrameCg::phi_reset() {
+    refresh_ = phi_zero_ = true;
+    cg_.restart();
+    cg_.forget_eigenvalues(true);
+}
+
+void MultigridFrameCg::phi_set() {
+    refresh_ = true;
+    cg_.restart();
+    phi_zero_ = false;
+    if (has_b_) refresh_residual();
+}
+
+void MultigridFrameCg::right_hand_side_set() {
+    has_b_ = true;
+    cg_.restart();
+}
+
+void MultigridFrameCg::operator_changed() {
+    refresh_ = true;
+    cg_.restart();
+    cg_.forget_eigenvalues(false);  // another operator: earlier estimates do not hold
+}
+
+void MultigridFrameCg::copy_changed_rows(const DiffusionMatrix& matrix, std::span<const int32_t> changed_rows,
+                                         HierarchyLevel& level0, std::vector<double>* interleaved) const {
+    if (matrix.size() != n_ || matrix.columns != level0.columns)
+        throw InvalidArgumentError(who_ + " update_values: the matrix pattern changed (rebuild the solver)");
+    for (int32_t row : changed_rows) {
+        if (row < 0 || static_cast<size_t>(row) >= n_)
+            throw InvalidArgumentError(who_ + " update_values: row " + std::to_string(row) + " out of range");
+        for (auto k = static_cast<size_t>(matrix.offsets[static_cast<size_t>(row)]);
+             k < static_cast<size_t>(matrix.offsets[static_cast<size_t>(row) + 1]); ++k)
+            for (size_t c = 0; c < 3; ++c) {
+                level0.values[c][k] = matrix.values[c][k];
+                if (interleaved) (*interleaved)[3 * k + c] = matrix.values[c][k];
+            }
+    }
+}
+
+void MultigridFrameCg::refresh_residual() {
+    compute_residual(phi_zero_);
+    refresh_ = false;
+    updates_since_refresh_ = 0;
+}
+
+FrameStep MultigridFrameCg::step(int budget) {
+    if (!has_b_) throw InvalidArgumentError(who_ + ": step() before set_right_hand_side()");
+    if (budget < 1) throw InvalidArgumentError(who_ + ": budget " + std::to_string(budget) + " < 1");
+    return step_within(budget, FrameDeadline{});
+}
+
+FrameStep MultigridFrameCg::step(const FrameBudget& budget, const MillisecondClock& clock) {
+    validate(budget);
+    const FrameDeadline deadline = FrameDeadline::of(budget, clock);
+    return step_within(budget.limits_iterations() ? budget.max_iterations : std::numeric_limits<int>::max(), deadline);
+}
+
+FrameStep MultigridFrameCg::step_within(int budget, const FrameDeadline& deadline) {
+    if (!has_b_) throw InvalidArgumentError(who_ + ": step() before set_right_hand_side()");
+    FrameStep result;
+    if (refresh_) {
+        refresh_residual();
+        cg_.restart();
+    }
+    if (cg_.restarting()) cg_.begin_restart();
+    // The deadline is read between V-cycles only (one clock read each): the first always runs.
+    for (int cycle = 0; cycle < budget && !(cycle > 0 && deadline.expired()); ++cycle) {
+        precondition();
+        ++result.vcycles;
+        const MultigridCgState::StepSums sums = step_sums();
+        if (cg_.estimate(sums, options_.relative_tolerance, result.estimated_relative_error, who_)) {
+            result.converged = true;
+            break;
+        }
+        const Rgb beta = cg_.beta(sums);
+        set_direction(beta, cg_.restarting());
+        const Rgb pq = multiply_direction();
+        const Rgb alpha = cg_.alpha(sums, pq, beta, who_);
+        phi_zero_ = false;
+        update_solution(alpha);
+        if (++updates_since_refresh_ >= options_.residual_refresh_interval) {
+            // The recursive residual drifts from b - M phi by rounding: recompute it and restart.
+            refresh_residual();
+            cg_.restart_after_refresh();
+        }
+    }
+    steps_done();
+    return result;
+}
+
+}  // namespace waxwork
