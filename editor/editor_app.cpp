@@ -404,18 +404,24 @@ void EditorApp::start_tick() {
         if (lighting || r->frame.total_iterations() > 0) ++view_worker->solution_version;
         if (first || r->geometry_changed || lighting || r->frame.total_iterations() > 0 || view_changed) {
             progress.set_stage("radiance");
-            const SolvedScene solved = core->live->solved_scene();
-            r->input = make_render_input(mesh, solved, core->live->lighting(), settings);
+            // GPU backend in the hidden window's context (shared with this window's): the view draws E
+            // from the solver's device buffer, and the exposure is taken from a read-back of it, so E
+            // is not also computed from phi on the CPU (at 100K tets that cost more than a device
+            // frame). Not with an OSMesa context of the solver's own (when no shared context could be
+            // made): its buffers are not this window's.
+            std::vector<std::array<float, 3>> device_e;
+            std::shared_ptr<const GpuBuffer> device_buffer;
+            if (core->live->options().gl_context) device_buffer = core->live->device_radiance(&device_e);
+            const SolvedScene solved = core->live->solved_scene(/*with_radiance=*/!device_buffer);
+            r->input = make_render_input(mesh, solved, core->live->lighting(), settings,
+                                         device_buffer ? &device_e : nullptr);
             if (view.mode != ViewMode::Radiance) {
                 progress.set_stage("view");
                 r->view = view_worker->cache.get(mesh, core->live->connectivity(), mesh.materials, solved, view,
                                                  view_worker->geometry_version, view_worker->solution_version);
                 apply_view(*r->view, *r->input);
             }
-            // GPU backend in the hidden window's context (shared with this window's): the view draws E
-            // from the solver's device buffer. Not with an OSMesa context of the solver's own (when no
-            // shared context could be made): its buffers are not this window's.
-            if (core->live->options().gl_context) r->input->device_radiance = core->live->device_radiance();
+            r->input->device_radiance = device_buffer;
             if (need_bvh || r->geometry_changed) {
                 r->bvh = std::make_shared<const TriangleBvh>(r->input->positions, r->input->triangles);
                 // Each surface vertex's piece, for picking pieces to move.

@@ -310,9 +310,9 @@ std::string LiveScene::solver_description() const {
     return solver_->description();
 }
 
-std::shared_ptr<const GpuBuffer> LiveScene::device_radiance() {
+std::shared_ptr<const GpuBuffer> LiveScene::device_radiance(std::vector<std::array<float, 3>>* host_copy) {
     const std::lock_guard lock(mutex_);
-    return solver_->radiance_on_device(*mesh_, *connectivity_, q_, surface_.vertices);
+    return solver_->radiance_on_device(*mesh_, *connectivity_, q_, surface_.vertices, host_copy);
 }
 
 std::vector<std::array<float, 3>> LiveScene::radiance_factors() const {
@@ -321,7 +321,7 @@ std::vector<std::array<float, 3>> LiveScene::radiance_factors() const {
     return exitant_radiance_factors(*mesh_, *connectivity_, mesh_->materials, phi, q_);
 }
 
-SolvedScene LiveScene::solved_scene() const {
+SolvedScene LiveScene::solved_scene(bool with_radiance) const {
     SolvedScene scene;
     scene.diffusion.phi = phi();
     const std::lock_guard lock(mutex_);
@@ -329,8 +329,9 @@ SolvedScene LiveScene::solved_scene() const {
     scene.q = q_;
     scene.light_visibility = surface_visibility_;
     for (int c = 0; c < 3; ++c) scene.diffusion.estimated_relative_error[c] = error_[c];
-    scene.radiance_factor =
-        exitant_radiance_factors(*mesh_, *connectivity_, mesh_->materials, scene.diffusion.phi, scene.q);
+    if (with_radiance)
+        scene.radiance_factor =
+            exitant_radiance_factors(*mesh_, *connectivity_, mesh_->materials, scene.diffusion.phi, scene.q);
     return scene;
 }
 

@@ -124,8 +124,9 @@ public:
     std::optional<double> estimated_error() const;
 
     // A copy of the current state in the form render_pipeline.h renders (make_render_input), with the
-    // exitant radiance factors computed from the current phi. Reads the mesh.
-    SolvedScene solved_scene() const;
+    // exitant radiance factors computed from the current phi (unless `with_radiance` is false: a
+    // caller that has E from the device leaves radiance_factor empty). Reads the mesh.
+    SolvedScene solved_scene(bool with_radiance = true) const;
     // Only the exitant radiance factors E per volume vertex from the current phi (what a window
     // re-uploads each frame while the surface is unchanged). Reads the mesh.
     std::vector<std::array<float, 3>> radiance_factors() const;
@@ -145,8 +146,9 @@ public:
     std::string solver_description() const;
     // With the GPU backend running: E per surface vertex (solved_scene().surface order) on the device,
     // from the resident phi (LiveSolver::radiance_on_device), for a renderer sharing the solver's
-    // context to draw instead of the CPU's radiance_factor; else null. Reads the mesh.
-    std::shared_ptr<const GpuBuffer> device_radiance();
+    // context to draw instead of the CPU's radiance_factor; else null. Reads the mesh. `host_copy`:
+    // as LiveSolver::radiance_on_device.
+    std::shared_ptr<const GpuBuffer> device_radiance(std::vector<std::array<float, 3>>* host_copy = nullptr);
 
 private:
     void rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update);

@@ -670,7 +670,8 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multires(const Diffusio
 
 std::shared_ptr<const GpuBuffer> LiveSolver::radiance_on_device(const TetMesh& mesh, const TetConnectivity& connectivity,
                                                                 const std::vector<std::array<double, 3>>& q,
-                                                                const std::vector<int32_t>& surface_vertices) {
+                                                                const std::vector<int32_t>& surface_vertices,
+                                                                std::vector<std::array<float, 3>>* host_copy) {
     if (backend_ != LiveBackend::Gpu || !gpu_ || !context_ || surface_vertices.empty()) return nullptr;
     const size_t n = gpu_->size();
     if (mesh.vertex_count() != n || q.size() != n)
@@ -699,6 +700,12 @@ std::shared_ptr<const GpuBuffer> LiveSolver::radiance_on_device(const TetMesh& m
         const size_t m = surface_vertices.size();
         auto e = std::make_shared<GpuBuffer>(gl, 3 * m * sizeof(float));
         kernels.gather(m, gpu_->surface_index, gpu_->volume_e, *e);
+        if (host_copy) {
+            const std::vector<float> values = e->download<float>();
+            host_copy->resize(m);
+            for (size_t s = 0; s < m; ++s)
+                for (size_t c = 0; c < 3; ++c) (*host_copy)[s][c] = values[3 * s + c];
+        }
         check_gpu_error(gl, "computing the radiance on the device");
         // The main window's context reads it next: the writes must be complete (a shared object's
         // changes are visible to another context only after the writing context finished them).

@@ -168,9 +168,13 @@ public:
     // call (the renderer may still draw the previous one), complete when returned (glFinish: another
     // context reads it next). Null unless the GPU backend is running; a GPU failure here falls back
     // like iterate(). q: the incident light per volume vertex, as for the right-hand sides.
+    // `host_copy`, when given, receives the same E read back (3 floats per surface vertex: a few
+    // hundred KB at most), for what the CPU needs of it (the automatic exposure) without computing E
+    // from phi on the CPU.
     std::shared_ptr<const GpuBuffer> radiance_on_device(const TetMesh& mesh, const TetConnectivity& connectivity,
                                                         const std::vector<std::array<double, 3>>& q,
-                                                        const std::vector<int32_t>& surface_vertices);
+                                                        const std::vector<int32_t>& surface_vertices,
+                                                        std::vector<std::array<float, 3>>* host_copy = nullptr);
 
     LiveMethod method() const { return method_; }
     // The backend that solves now (Cpu after a fallback).

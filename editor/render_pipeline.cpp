@@ -172,10 +172,16 @@ float automatic_exposure(const SurfaceRenderInput& input) {
 }
 
 SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& scene, const Lighting& lighting,
-                                     const ImageSettings& settings) {
+                                     const ImageSettings& settings,
+                                     const std::vector<std::array<float, 3>>* surface_radiance) {
     const BoundarySurface& surface = scene.surface;
     SurfaceRenderInput input;
     const size_t n = surface.vertices.size();
+    if (surface_radiance ? surface_radiance->size() != n : scene.radiance_factor.size() != mesh.vertex_count())
+        throw InvalidArgumentError("render input: " +
+                                   std::to_string(surface_radiance ? surface_radiance->size() : scene.radiance_factor.size()) +
+                                   " radiance values for " + std::to_string(surface_radiance ? n : mesh.vertex_count()) +
+                                   (surface_radiance ? " surface vertices" : " vertices"));
     input.positions.resize(n);
     input.normals.resize(n);
     input.radiance_factor.resize(n);
@@ -183,7 +189,7 @@ SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& sce
     for (size_t s = 0; s < n; ++s) {
         input.positions[s] = surface.positions[s].cast<float>();
         input.normals[s] = surface.normals[s].cast<float>();
-        input.radiance_factor[s] = scene.radiance_factor[surface.vertices[s]];
+        input.radiance_factor[s] = surface_radiance ? (*surface_radiance)[s] : scene.radiance_factor[surface.vertices[s]];
         input.eta[s] = static_cast<float>(surface.eta[s]);
     }
     input.triangles = surface.triangles;

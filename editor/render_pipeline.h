@@ -86,9 +86,12 @@ float automatic_exposure(const SurfaceRenderInput& input);
 
 // The renderer's input for a solved scene: world-space boundary, normals, E, eta and the lights for
 // the highlights (point lights inside the volume dropped: they light nothing). The exposure is
-// settings.exposure or automatic_exposure.
+// settings.exposure or automatic_exposure. E comes from scene.radiance_factor (per volume vertex), or
+// from `surface_radiance` (per surface vertex, e.g. read back from the device) when given; throws
+// InvalidArgumentError when the one used does not match the surface.
 SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& scene, const Lighting& lighting,
-                                     const ImageSettings& settings);
+                                     const ImageSettings& settings,
+                                     const std::vector<std::array<float, 3>>* surface_radiance = nullptr);
 
 // Draws with an existing renderer (keep one per context when rendering many frames).
 Image render_scene(SurfaceRenderer& renderer, const SurfaceRenderInput& input);

@@ -365,6 +365,31 @@ TEST(LiveSolver, DeviceRadianceDrawsWhatTheCpuRadianceDraws) {
             }
         EXPECT_GT(largest, 0);
 
+        // The editor's GPU tick: the read-back copy of the device E feeds the automatic exposure and
+        // the render input, with no E computed from phi on the CPU; it is the buffer, value for value.
+        std::vector<std::array<float, 3>> host_copy;
+        ASSERT_TRUE(scene.device_radiance(&host_copy));
+        ASSERT_EQ(host_copy.size(), input.positions.size());
+        const SolvedScene without_e = scene.solved_scene(/*with_radiance=*/false);
+        EXPECT_TRUE(without_e.radiance_factor.empty());
+        const SurfaceRenderInput from_copy = make_render_input(doc.mesh(), without_e, key_lighting(), settings, &host_copy);
+        for (size_t i = 0; i < host_copy.size(); ++i)
+            for (size_t c = 0; c < 3; ++c) {
+                EXPECT_EQ(host_copy[i][c], e[3 * i + c]);
+                EXPECT_EQ(from_copy.radiance_factor[i][c], host_copy[i][c]);
+            }
+        EXPECT_NEAR(automatic_exposure(from_copy), automatic_exposure(input), 1e-4f * automatic_exposure(input));
+        // A copy that does not match the surface is refused, with the counts.
+        host_copy.pop_back();
+        try {
+            make_render_input(doc.mesh(), without_e, key_lighting(), settings, &host_copy);
+            ADD_FAILURE() << "a short radiance copy was accepted";
+        } catch (const InvalidArgumentError& error) {
+            EXPECT_NE(std::string(error.what()).find("surface vertices"), std::string::npos) << error.what();
+        }
+        // Without a copy, a scene solved without E is refused too (it has no E to draw).
+        EXPECT_THROW(make_render_input(doc.mesh(), without_e, key_lighting(), settings), InvalidArgumentError);
+
         SurfaceRenderer renderer(context.gl());
         const Image from_cpu = renderer.render(input);
         input.device_radiance = device;
