@@ -131,13 +131,6 @@ private:
     Fields x_;
 };
 
-ConjugateGradientOptions capped(int cap) {
-    ConjugateGradientOptions options;
-    options.relative_tolerance = 1e-15;  // never stop on the estimate: run the cap
-    options.max_iterations = cap;
-    return options;
-}
-
 }  // namespace
 
 SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& connectivity,
@@ -186,14 +179,14 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
         for (size_t c = 0; c < 3; ++c) {
             const CsrMatrixView<float> view{n, matrix.offsets.data(), matrix.columns.data(), values_f[c].data()};
             std::fill(x_f.begin(), x_f.end(), 0.0f);
-            solve_jacobi_cg<float>(view, b_f[c], x_f, capped(cap));
+            solve_jacobi_cg<float>(view, b_f[c], x_f, exact_iteration_count(cap));
             std::copy(x_f.begin(), x_f.end(), x[c].begin());
         }
     }));
     result.solvers.push_back(measurer.curve("jacobi_cg_double", [&](int cap, Fields& x) {
         for (size_t c = 0; c < 3; ++c) {
             const CsrMatrixView<double> view{n, matrix.offsets.data(), matrix.columns.data(), matrix.values[c].data()};
-            solve_jacobi_cg<double>(view, b_copy[c], x[c], capped(cap));
+            solve_jacobi_cg<double>(view, b_copy[c], x[c], exact_iteration_count(cap));
         }
     }));
 
@@ -213,7 +206,7 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
     result.multigrid_setup_ms = multigrid.setup_ms();
     result.solvers.push_back(measurer.curve("multigrid_cg", [&](int cap, Fields& x) {
         for (int c = 0; c < 3; ++c)
-            solve_multigrid_cg(multigrid, c, b_copy[static_cast<size_t>(c)], x[static_cast<size_t>(c)], capped(cap));
+            solve_multigrid_cg(multigrid, c, b_copy[static_cast<size_t>(c)], x[static_cast<size_t>(c)], exact_iteration_count(cap));
     }));
 
     // The live editor's frame solver (multigrid_frame_solver.h): the same multigrid CG with the three

@@ -1,5 +1,6 @@
 #include "multires/coarse_start_bound.h"
 
+#include "multires/multigrid_cg.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/reference_solvers.h"
 #include "tetops/error.h"
@@ -8,7 +9,9 @@
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
 
 namespace waxwork {
@@ -91,21 +94,11 @@ std::vector<double> solve_level1_galerkin(const MultiresHierarchy& hierarchy, in
     return to_std(ldlt.solve(Eigen::VectorXd(pt * as_eigen(b))));
 }
 
-int jacobi_cg_iterations_to(const MultiresHierarchy& hierarchy, const ChannelVectors& b, const ChannelVectors& start,
-                            const ChannelVectors& reference, double target_error, int max_iterations) {
-    const HierarchyLevel& fine = hierarchy.levels[0];
-    ChannelVectors x;
-    const auto error_after = [&](int iterations) {
-        for (size_t c = 0; c < 3; ++c) {
-            x[c] = start[c];
-            if (iterations == 0) continue;
-            ConjugateGradientOptions options;
-            options.relative_tolerance = 1e-15;  // never stop on the estimate: run the count
-            options.max_iterations = iterations;
-            solve_jacobi_cg<double>(fine.view(static_cast<int>(c)), b[c], x[c], options);
-        }
-        return combined_relative_error(x, reference);
-    };
+namespace {
+
+// The smallest k <= max_iterations with error_after(k) <= target_error, by doubling and bisection
+// (error_after taken as non-increasing in k); -1 when max_iterations does not reach it.
+int smallest_count_to(const std::function<double(int)>& error_after, double target_error, int max_iterations) {
     if (error_after(0) <= target_error) return 0;
     int hi = 1;
     while (error_after(hi) > target_error) {
@@ -118,6 +111,35 @@ int jacobi_cg_iterations_to(const MultiresHierarchy& hierarchy, const ChannelVec
         (error_after(mid) <= target_error ? hi : lo) = mid;
     }
     return hi;
+}
+
+}  // namespace
+
+int jacobi_cg_iterations_to(const MultiresHierarchy& hierarchy, const ChannelVectors& b, const ChannelVectors& start,
+                            const ChannelVectors& reference, double target_error, int max_iterations) {
+    const HierarchyLevel& fine = hierarchy.levels[0];
+    ChannelVectors x;
+    const auto error_after = [&](int iterations) {
+        for (size_t c = 0; c < 3; ++c) {
+            x[c] = start[c];
+            if (iterations > 0) solve_jacobi_cg<double>(fine.view(static_cast<int>(c)), b[c], x[c], exact_iteration_count(iterations));
+        }
+        return combined_relative_error(x, reference);
+    };
+    return smallest_count_to(error_after, target_error, max_iterations);
+}
+
+int multigrid_cg_iterations_to(MultigridPreconditioner& preconditioner, const ChannelVectors& b,
+                               const ChannelVectors& reference, double target_error, int max_iterations) {
+    ChannelVectors x;
+    const auto error_after = [&](int iterations) {
+        for (size_t c = 0; c < 3; ++c) {
+            x[c].assign(b[c].size(), 0.0);
+            if (iterations > 0) solve_multigrid_cg(preconditioner, static_cast<int>(c), b[c], x[c], exact_iteration_count(iterations));
+        }
+        return combined_relative_error(x, reference);
+    };
+    return smallest_count_to(error_after, target_error, max_iterations);
 }
 
 CoarseStartBound measure_coarse_start_bound(const MultiresHierarchy& hierarchy, const ChannelVectors& b,

@@ -13,13 +13,15 @@
 // is further off than the exact one). The same bound for the Galerkin system P^T M P y = P^T b (whose
 // P y is the element of range(P) closest to the solution in the M-norm) separates what Eq. 17's
 // collocation loses from what Eq. 16's interpolation itself loses: the interpolation error of the
-// exact solution's own coarse values is reported too.
+// exact solution's own coarse values is reported too. Both depend on Eq. 16's weights
+// (HierarchyOptions::weights): the bench part coarse_start measures the paper's and linear-exact ones.
 //
 // Errors are relative L2 over the three channels together, as in the solver comparison
 // (editor/solver_comparison.h): sqrt(sum_c |x_c - x*_c|^2 / sum_c |x*_c|^2).
 #pragma once
 
 #include "multires/hierarchy.h"
+#include "multires/multigrid_preconditioner.h"
 
 #include <array>
 #include <vector>
@@ -55,6 +57,12 @@ std::vector<double> solve_level1_galerkin(const MultiresHierarchy& hierarchy, in
 // error is taken as non-increasing in k); -1 when max_iterations does not reach it.
 int jacobi_cg_iterations_to(const MultiresHierarchy& hierarchy, const ChannelVectors& b, const ChannelVectors& start,
                             const ChannelVectors& reference, double target_error, int max_iterations);
+
+// The same count for CG preconditioned by the multigrid V-cycle on the same hierarchy
+// (multigrid_cg.h) from a zero start: what the hierarchy's interpolation weights
+// (HierarchyOptions::weights) give the project's fastest solver.
+int multigrid_cg_iterations_to(MultigridPreconditioner& preconditioner, const ChannelVectors& b,
+                               const ChannelVectors& reference, double target_error, int max_iterations);
 
 // sqrt(sum_c |x_c - reference_c|^2 / sum_c |reference_c|^2), the error every number here uses.
 double combined_relative_error(const ChannelVectors& x, const ChannelVectors& reference);

@@ -7,7 +7,10 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <numeric>
 #include <optional>
@@ -29,6 +32,40 @@ std::vector<T> parallel_copy(const std::vector<T>& source) {
                                     copy.begin() + static_cast<std::ptrdiff_t>(r.begin()));
                       });
     return copy;
+}
+
+// InterpolationWeights::LinearExact for one dropped vertex v at x_v: `weights` holds the paper's
+// normalised weights p_u over v's retained neighbours (in graph-row order), lambda_v their unnormalised
+// sum. Replaces them by w = p + Lambda A^T y, the minimiser of sum_u (w_u - p_u)^2 / lambda_u subject to
+// A w = (1, 0, 0, 0), where column u of A is (1, (x_u - x_v) / h): y solves (A Lambda A^T) y =
+// (0, -sum_u p_u (x_u - x_v) / h). h, the mean neighbour distance, and the scaling of Lambda by h keep
+// the 4x4 system of order one whatever the model's units. Returns false, leaving the weights alone, when
+// the system is singular (fewer than four neighbours, or all of them nearly in a plane) or a weight
+// would fall below min_weight.
+bool make_linear_exact(std::span<const int32_t> neighbours, std::span<const uint8_t> retained,
+                       std::span<const int32_t> original_vertex, std::span<const Eigen::Vector3d> positions,
+                       const Eigen::Vector3d& xv, double lambda_v, double min_weight, std::span<double> weights) {
+    const auto m = static_cast<Eigen::Index>(weights.size());
+    if (m < 4) return false;
+    const double h = static_cast<double>(m) / lambda_v;  // the harmonic mean distance
+    const Eigen::Map<const Eigen::VectorXd> paper(weights.data(), m);
+    // lambda_u h = p_u lambda_v h = p_u m: the inverse distances in units of h.
+    const Eigen::VectorXd scaled_lambda = paper * static_cast<double>(m);
+    Eigen::Matrix<double, 4, Eigen::Dynamic> a(4, m);
+    Eigen::Index k = 0;
+    for (const int32_t u : neighbours) {
+        if (!retained[static_cast<size_t>(u)]) continue;
+        a.col(k++) << 1.0, (positions[static_cast<size_t>(original_vertex[static_cast<size_t>(u)])] - xv) / h;
+    }
+    const Eigen::Matrix4d gram = a * scaled_lambda.asDiagonal() * a.transpose();
+    const Eigen::LDLT<Eigen::Matrix4d> ldlt(gram);
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.rcond() > 1e-10)) return false;
+    Eigen::Vector4d moment_error = a * paper;  // (1, scaled centroid offset of the paper's weights)
+    moment_error[0] = 0.0;
+    const Eigen::VectorXd exact = paper - scaled_lambda.cwiseProduct(a.transpose() * ldlt.solve(moment_error));
+    if (!exact.allFinite() || exact.minCoeff() < min_weight) return false;
+    Eigen::Map<Eigen::VectorXd>(weights.data(), m) = exact;
+    return true;
 }
 
 HierarchyLevel fine_level(const DiffusionMatrix& matrix) {
@@ -66,7 +103,8 @@ HierarchyLevel fine_level(const DiffusionMatrix& matrix) {
 InterpolationOperator build_interpolation(const CompressedRows& graph, std::span<const uint8_t> retained,
                                           std::span<const int32_t> coarse_index,
                                           std::span<const int32_t> original_vertex,
-                                          std::span<const Eigen::Vector3d> positions) {
+                                          std::span<const Eigen::Vector3d> positions,
+                                          const HierarchyOptions& options) {
     const size_t n = graph.row_count();
     InterpolationOperator p;
     p.offsets.assign(n + 1, 0);
@@ -83,7 +121,10 @@ InterpolationOperator build_interpolation(const CompressedRows& graph, std::span
     for (size_t v = 0; v < n; ++v) p.offsets[v + 1] += p.offsets[v];
     p.columns.resize(static_cast<size_t>(p.offsets[n]));
     p.weights.resize(p.columns.size());
+    const bool linear_exact = options.weights == InterpolationWeights::LinearExact;
+    std::atomic<int64_t> linear_exact_rows{0}, paper_weight_rows{0};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 2048), [&](const tbb::blocked_range<size_t>& r) {
+        int64_t corrected = 0, kept = 0;
         for (size_t v = r.begin(); v != r.end(); ++v) {
             auto slot = static_cast<size_t>(p.offsets[v]);
             if (retained[v]) {  // Eq. 16, first case: copy the coarse value
@@ -107,8 +148,18 @@ InterpolationOperator build_interpolation(const CompressedRows& graph, std::span
                 ++slot;
             }
             for (size_t k = first; k < slot; ++k) p.weights[k] /= total;
+            if (linear_exact) {
+                const bool made_exact = make_linear_exact(graph.row(v), retained, original_vertex, positions, xv, total,
+                                                          options.min_linear_exact_weight,
+                                                          std::span<double>(p.weights).subspan(first, slot - first));
+                ++(made_exact ? corrected : kept);
+            }
         }
+        linear_exact_rows += corrected;
+        paper_weight_rows += kept;
     });
+    p.linear_exact_rows = linear_exact_rows;
+    p.paper_weight_rows = paper_weight_rows;
     return p;
 }
 
@@ -239,7 +290,7 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
         for (size_t c = 0; c < step->coarse_to_fine.size(); ++c)
             coarse.original_vertex[c] = fine.original_vertex[static_cast<size_t>(step->coarse_to_fine[c])];
         fine.interpolation = build_interpolation(fine.graph, step->selection.retained, step->coarse_index,
-                                                 fine.original_vertex, positions);
+                                                 fine.original_vertex, positions, options);
         // P's columns are exactly each fine vertex's coarse links (independent_set.h).
         coarse.graph = build_coarse_graph(fine.graph, step->coarse_index, fine.interpolation.offsets,
                                           fine.interpolation.columns);

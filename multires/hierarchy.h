@@ -29,8 +29,30 @@
 
 namespace waxwork {
 
+// The weights lambda_ij of Eq. 16.
+//
+// InverseEdgeLength is the paper's ("currently we use the reciprocal of edge length", Sec. 4.2). Its
+// weighted average of the retained neighbours does not reproduce linear functions: a dropped vertex
+// whose retained neighbours are not centred on it gets the value of their weighted centroid, an error
+// of order h |grad phi|. Substituted into the fine equations (Eq. 17) that error is amplified by the
+// stiffness (order 1/h), which is why Eq. 17's exact level-1 solution stays about 12% from the fine
+// solution on spot whatever the material or the resolution (bench part coarse_start).
+//
+// LinearExact (beyond the paper) keeps the paper's weights p_u = lambda_u / lambda_v and changes them
+// by the least amount, in the norm sum_u (w_u - p_u)^2 / lambda_u, that makes the row reproduce linear
+// functions: sum_u w_u = 1 and sum_u w_u (x_u - x_v) = 0 (a 4x4 system per dropped vertex, Lagrange
+// multipliers). Rows where that is impossible or would extrapolate keep the paper's weights: fewer than
+// four retained neighbours, neighbours (nearly) in a plane, or a weight below min_linear_exact_weight
+// (a vertex on the boundary whose retained neighbours all lie to one side).
+enum class InterpolationWeights { InverseEdgeLength, LinearExact };
+
 struct HierarchyOptions {
     uint32_t seed = 1;                  // hash key of the independent-set codes
+    InterpolationWeights weights = InterpolationWeights::InverseEdgeLength;
+    // LinearExact: a row with a weight below this keeps the paper's weights. Mildly negative weights
+    // are what linear exactness costs at a vertex whose neighbours are lopsided; strongly negative
+    // ones extrapolate and amplify errors.
+    double min_linear_exact_weight = -0.3;
     bool enhance = true;                // the enhancement step of Sec. 4.1
     int64_t min_coarse_vertices = 1000; // do not coarsen a level smaller than this
     double max_keep_ratio = 0.8;        // discard a level keeping more than this fraction
@@ -43,6 +65,10 @@ struct InterpolationOperator {
     std::vector<int32_t> offsets{0};
     std::vector<int32_t> columns;
     std::vector<double> weights;
+    // InterpolationWeights::LinearExact: how many rows of dropped vertices got linear-exact weights and
+    // how many kept the paper's (HierarchyOptions::weights); zero with the paper's weights.
+    int64_t linear_exact_rows = 0;
+    int64_t paper_weight_rows = 0;
 
     size_t rows() const { return offsets.size() - 1; }
 };
@@ -92,11 +118,13 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
 // selections and coarse graphs only.
 std::vector<std::vector<int32_t>> hierarchy_level_vertices(const CompressedRows& graph, const HierarchyOptions& options = {});
 
-// Eq. 16 weights for one coarsening step: row v of the operator from the retained flags.
+// Eq. 16 weights for one coarsening step: row v of the operator from the retained flags, with the
+// weights `options.weights` names (InterpolationWeights).
 InterpolationOperator build_interpolation(const CompressedRows& graph, std::span<const uint8_t> retained,
                                           std::span<const int32_t> coarse_index,
                                           std::span<const int32_t> original_vertex,
-                                          std::span<const Eigen::Vector3d> positions);
+                                          std::span<const Eigen::Vector3d> positions,
+                                          const HierarchyOptions& options = {});
 
 // Eq. 17: the coarse level's matrix (all three channels) on the coarse graph's pattern.
 void build_coarse_matrix(const HierarchyLevel& fine, std::span<const int32_t> coarse_to_fine, HierarchyLevel& coarse);

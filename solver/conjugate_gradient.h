@@ -55,6 +55,15 @@ struct ConjugateGradientOptions {
     FrameDeadline deadline;
 };
 
+// Options that run exactly `iterations` iterations (the error estimate never stops them first), for
+// measuring the error reached against the work spent.
+inline ConjugateGradientOptions exact_iteration_count(int iterations) {
+    ConjugateGradientOptions options;
+    options.relative_tolerance = 1e-15;
+    options.max_iterations = iterations;
+    return options;
+}
+
 struct ConjugateGradientResult {
     int iterations = 0;
     bool converged = false;

@@ -7,6 +7,10 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <random>
+
 namespace waxwork {
 namespace {
 
@@ -136,6 +140,123 @@ TEST(Hierarchy, LevelVerticesWithoutOperatorsEqualTheFullBuild) {
         for (size_t l = 0; l < levels.size(); ++l) EXPECT_EQ(levels[l], full.levels[l + 1].original_vertex) << "level " << l + 1;
     }
     EXPECT_GE(build_multires_hierarchy(s.matrix, s.mesh.positions, variants[0]).level_count(), 3u);
+}
+
+// A cube whose interior vertices are moved by up to a fifth of the spacing (seeded): the paper's
+// inverse edge-length weights are then not linear-exact anywhere by symmetry.
+std::vector<Eigen::Vector3d> jittered(const TetMesh& mesh, double spacing) {
+    std::vector<Eigen::Vector3d> positions = mesh.positions;
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> offset(-0.2 * spacing, 0.2 * spacing);
+    for (Eigen::Vector3d& x : positions) {
+        const Eigen::Vector3d d(offset(random), offset(random), offset(random));
+        bool interior = true;
+        for (int k = 0; k < 3; ++k) interior = interior && x[k] > 1e-9 && x[k] < 4.0 - 1e-9;
+        if (interior) x += d;
+    }
+    return positions;
+}
+
+// Every dropped row of Eq. 16 with linear-exact weights either reproduces affine functions (weights
+// summing to one, weighted centroid at the vertex, no weight under the floor) or is the paper's row
+// unchanged; most rows get there, and the paper's rows are not linear-exact on this mesh.
+TEST(Hierarchy, LinearExactWeightsReproduceAffineFunctionsOrKeepThePapers) {
+    const auto s = testing::make_test_system(8, 4.0);  // spacing 0.5
+    const std::vector<Eigen::Vector3d> positions = jittered(s.mesh, 0.5);
+    HierarchyOptions options;
+    options.min_coarse_vertices = 20;
+    const MultiresHierarchy paper = build_multires_hierarchy(s.matrix, positions, options);
+    options.weights = InterpolationWeights::LinearExact;
+    const MultiresHierarchy exact = build_multires_hierarchy(s.matrix, positions, options);
+    ASSERT_EQ(paper.level_count(), exact.level_count());  // the weights do not change the selection
+    ASSERT_GE(exact.level_count(), 3u);
+    const auto affine = [](const Eigen::Vector3d& x) { return 0.7 + 1.3 * x.x() - 0.4 * x.y() + 2.1 * x.z(); };
+    for (size_t l = 0; l + 1 < exact.level_count(); ++l) {
+        const HierarchyLevel& fine = exact.levels[l];
+        const HierarchyLevel& coarse = exact.levels[l + 1];
+        const InterpolationOperator& p = fine.interpolation;
+        const InterpolationOperator& p_paper = paper.levels[l].interpolation;
+        ASSERT_EQ(p.columns, p_paper.columns) << "level " << l;
+        std::vector<double> coarse_values(coarse.size()), fine_values(fine.size()), paper_values(fine.size());
+        for (size_t c = 0; c < coarse.size(); ++c) coarse_values[c] = affine(positions[static_cast<size_t>(coarse.original_vertex[c])]);
+        interpolate(p, coarse_values, fine_values);
+        interpolate(p_paper, coarse_values, paper_values);
+        int64_t changed_rows = 0;
+        double worst_paper_error = 0;
+        for (size_t v = 0; v < fine.size(); ++v) {
+            const auto first = static_cast<size_t>(p.offsets[v]), last = static_cast<size_t>(p.offsets[v + 1]);
+            const double truth = affine(positions[static_cast<size_t>(fine.original_vertex[v])]);
+            worst_paper_error = std::max(worst_paper_error, std::abs(paper_values[v] - truth));
+            double sum = 0;
+            for (size_t k = first; k < last; ++k) sum += p.weights[k];
+            EXPECT_NEAR(sum, 1.0, 1e-12) << "level " << l << " row " << v;
+            const bool unchanged = std::equal(p.weights.begin() + static_cast<std::ptrdiff_t>(first),
+                                              p.weights.begin() + static_cast<std::ptrdiff_t>(last),
+                                              p_paper.weights.begin() + static_cast<std::ptrdiff_t>(first));
+            if (unchanged) continue;
+            ++changed_rows;
+            EXPECT_GE(last - first, 4u) << "level " << l << " row " << v;
+            EXPECT_NEAR(fine_values[v], truth, 1e-11) << "level " << l << " row " << v;
+            for (size_t k = first; k < last; ++k) EXPECT_GE(p.weights[k], options.min_linear_exact_weight);
+        }
+        // Every dropped vertex is counted once, as linear-exact or as keeping the paper's weights; a
+        // linear-exact row may equal the paper's where the paper's centroid already sits on the vertex.
+        const auto dropped = static_cast<int64_t>(fine.size() - coarse.size());
+        EXPECT_EQ(p.linear_exact_rows + p.paper_weight_rows, dropped) << "level " << l;
+        EXPECT_GE(p.linear_exact_rows, changed_rows) << "level " << l;
+        if (l == 0) {
+            EXPECT_GT(changed_rows, dropped / 3);
+        }
+        EXPECT_GT(worst_paper_error, 1e-3) << "the paper's weights are not linear-exact: level " << l;
+        EXPECT_EQ(p_paper.linear_exact_rows, 0);
+        EXPECT_EQ(p_paper.paper_weight_rows, 0);
+    }
+}
+
+// Eq. 17 holds for any P: M^{l+1} = S M^l P with the linear-exact operator as stored.
+TEST(Hierarchy, CoarseOperatorsMatchDenseEq17WithLinearExactWeights) {
+    const auto s = testing::make_test_system(5);
+    HierarchyOptions options;
+    options.min_coarse_vertices = 10;
+    options.weights = InterpolationWeights::LinearExact;
+    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, jittered(s.mesh, 0.8), options);
+    ASSERT_GE(h.level_count(), 3u);
+    for (size_t l = 0; l + 1 < h.level_count(); ++l) {
+        const HierarchyLevel& fine = h.levels[l];
+        const HierarchyLevel& coarse = h.levels[l + 1];
+        Eigen::MatrixXd p = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(fine.size()), static_cast<Eigen::Index>(coarse.size()));
+        for (size_t v = 0; v < fine.size(); ++v)
+            for (int32_t q = fine.interpolation.offsets[v]; q < fine.interpolation.offsets[v + 1]; ++q)
+                p(static_cast<Eigen::Index>(v), fine.interpolation.columns[static_cast<size_t>(q)]) +=
+                    fine.interpolation.weights[static_cast<size_t>(q)];
+        Eigen::MatrixXd select = Eigen::MatrixXd::Zero(p.cols(), p.rows());
+        for (size_t c = 0; c < coarse.size(); ++c) select(static_cast<Eigen::Index>(c), coarse.parent_vertex[c]) = 1;
+        for (int channel = 0; channel < 3; ++channel) {
+            const Eigen::MatrixXd expected = select * dense(fine, channel) * p;
+            const double scale = expected.cwiseAbs().maxCoeff();
+            EXPECT_LT((expected - dense(coarse, channel)).cwiseAbs().maxCoeff(), 1e-12 * scale) << "level " << l + 1;
+        }
+    }
+    EXPECT_GT(h.levels[0].interpolation.linear_exact_rows, 0);
+}
+
+TEST(Hierarchy, LinearExactWeightsAreDeterministicAcrossThreadCounts) {
+    const auto s = testing::make_test_system(10);
+    HierarchyOptions options;
+    options.min_coarse_vertices = 50;
+    options.weights = InterpolationWeights::LinearExact;
+    const std::vector<Eigen::Vector3d> positions = jittered(s.mesh, 0.4);
+    const MultiresHierarchy a = build_multires_hierarchy(s.matrix, positions, options);
+    MultiresHierarchy b;
+    {
+        tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+        b = build_multires_hierarchy(s.matrix, positions, options);
+    }
+    ASSERT_EQ(a.level_count(), b.level_count());
+    for (size_t l = 0; l < a.level_count(); ++l) {
+        EXPECT_EQ(a.levels[l].interpolation.weights, b.levels[l].interpolation.weights);
+        EXPECT_EQ(a.levels[l].values, b.levels[l].values);
+    }
 }
 
 TEST(Hierarchy, RejectsMismatchedPositions) {

@@ -158,9 +158,12 @@ TEST(MultigridPreconditioner, SliversFallBackToAbsoluteLumpingAndStillConverge) 
 
 TEST(MultigridCg, ConvergesToTheLevel0Solution) {
     const auto s = testing::make_test_system(12);  // 2197 vertices
-    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, small_levels(100));
-    ASSERT_GE(h.level_count(), 3u);
+    for (const InterpolationWeights weights : {InterpolationWeights::InverseEdgeLength, InterpolationWeights::LinearExact})
     for (bool single : {true, false}) {
+        HierarchyOptions hierarchy_options = small_levels(100);
+        hierarchy_options.weights = weights;
+        const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, hierarchy_options);
+        ASSERT_GE(h.level_count(), 3u);
         MultigridOptions options;
         options.single_precision = single;
         MultigridPreconditioner mg(h, options);
@@ -174,7 +177,8 @@ TEST(MultigridCg, ConvergesToTheLevel0Solution) {
             cg.relative_tolerance = 1e-9;
             const ConjugateGradientResult result = solve_multigrid_cg(mg, channel, b, x, cg);
             EXPECT_TRUE(result.converged);
-            EXPECT_LT(relative_error(x, reference), 1e-7) << "channel " << channel << " single " << single;
+            EXPECT_LT(relative_error(x, reference), 1e-7)
+                << "channel " << channel << " single " << single << " linear-exact " << (weights == InterpolationWeights::LinearExact);
             EXPECT_GT(result.smallest_eigenvalue_estimate, 0.0);
         }
     }
