@@ -1,5 +1,6 @@
 // Rebuild time of all derived connectivity (edges, one-rings, boundary, components) for spot.
 // Target (issue "Foundation"): under 150 ms at 500K tets on this 2-core machine.
+#include "bench_main.h"
 #include "bench_meshes.h"
 #include "tetops/connectivity.h"
 #include "tetops/quality.h"
@@ -30,4 +31,4 @@ BENCHMARK(BM_MeasureQuality)->Arg(500'000)->Unit(benchmark::kMillisecond)->UseRe
 }  // namespace
 }  // namespace waxwork
 
-BENCHMARK_MAIN();
+WAXWORK_BENCHMARK_MAIN()

@@ -6,6 +6,7 @@
 // worst dihedral angle for both cut modes (counters; --benchmark_format=json for the chart):
 //   ./build/bench/editing_bench
 //   ./build/bench/editing_bench --benchmark_filter=CrossSection --benchmark_format=json
+#include "bench_main.h"
 #include "bench_meshes.h"
 #include "editor/cut_study.h"
 #include "tetops/connectivity.h"
@@ -184,4 +185,4 @@ BENCHMARK(BM_PaintStroke100)->Arg(5)->Arg(10)->Arg(20)->Unit(benchmark::kMillise
 }  // namespace
 }  // namespace waxwork
 
-BENCHMARK_MAIN();
+WAXWORK_BENCHMARK_MAIN()

@@ -10,6 +10,7 @@
 // the renderer that ran.
 //
 // Run: build/bench/gpu_solver_bench [--benchmark_filter=...]
+#include "bench_main.h"
 #include "bench_meshes.h"
 #include "multires/gpu_independent_set.h"
 #include "multires/gpu_multigrid_frame_solver.h"
@@ -328,4 +329,4 @@ BENCHMARK(BM_SelectCoarseVertices)->ArgsProduct({{50000, 500000}, {0, 1}})->Unit
 }  // namespace
 }  // namespace waxwork
 
-BENCHMARK_MAIN();
+WAXWORK_BENCHMARK_MAIN()

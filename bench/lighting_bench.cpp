@@ -3,6 +3,7 @@
 // rays (the justification in solver/ray_caster.h).
 //
 //   build/bench/lighting_bench --benchmark_filter=Spot
+#include "bench_main.h"
 #include "io/surface_reader.h"
 #include "solver/lighting.h"
 #include "solver/ray_caster.h"
@@ -188,4 +189,4 @@ BENCHMARK(BM_IncidentLight_SpotVolume500K)->Unit(benchmark::kMillisecond)->UseRe
 }  // namespace
 }  // namespace waxwork
 
-BENCHMARK_MAIN();
+WAXWORK_BENCHMARK_MAIN()

@@ -7,6 +7,7 @@
 // Frame counters: median / p90 / max wall milliseconds over the frames of one sequence, and the median
 // and p90 process CPU milliseconds (all threads; on an idle two-core machine a frame's wall time lies
 // between half of it and all of it). The edit benchmarks' CPU column is the whole process too.
+#include "bench_main.h"
 #include "bench_meshes.h"
 #include "live_scene_setup.h"
 #include "editor/document.h"
@@ -190,4 +191,4 @@ BENCHMARK(BM_PaintStrokeWithRowUpdates)->Unit(benchmark::kMillisecond)->MeasureP
 }  // namespace
 }  // namespace waxwork
 
-BENCHMARK_MAIN();
+WAXWORK_BENCHMARK_MAIN()

@@ -16,6 +16,7 @@
 // max |phi - phi*| / max |phi*| after the last frame, phi* the same scene converged to 1e-8 with CPU
 // Jacobi CG, and true_error_l2: the largest per-channel sqrt(sum (phi - phi*)^2 / sum phi*^2) (final_error is
 // the solver's own estimate, which for multigrid CG lags one update: it describes phi before it).
+#include "bench_main.h"
 #include "bench_meshes.h"
 #include "live_scene_setup.h"
 #include "editor/document.h"
@@ -248,4 +249,4 @@ BENCHMARK(BM_RelightFramesWithinBudget)->DenseRange(0, 5)->Iterations(1)->Unit(b
 }  // namespace
 }  // namespace waxwork
 
-BENCHMARK_MAIN();
+WAXWORK_BENCHMARK_MAIN()

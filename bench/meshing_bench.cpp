@@ -1,5 +1,6 @@
 // Meshing spot (assets/meshes/spot.obj) to a tet count with TetGen and CGAL. Reports the tets produced
 // and the wall time of one tetrahedralize() call (which includes the target_tets search passes).
+#include "bench_main.h"
 #include "io/surface_reader.h"
 #include "tetops/tetrahedralize.h"
 
@@ -37,4 +38,4 @@ BENCHMARK(BM_CgalSpot)->Arg(50'000)->Unit(benchmark::kMillisecond)->Iterations(1
 
 }  // namespace
 
-BENCHMARK_MAIN();
+WAXWORK_BENCHMARK_MAIN()

@@ -14,6 +14,7 @@
 // updates after painting (BM_PaintUpdate); see each benchmark.
 //
 // Run: build-bench/bench/multires_bench (configure with -DWAXWORK_BUILD_BENCH=ON).
+#include "bench_main.h"
 #include "bench_meshes.h"
 #include "multires/multigrid_cg.h"
 #include "multires/multigrid_frame_solver.h"
@@ -520,4 +521,4 @@ BENCHMARK(BM_MultigridSetup)
 }  // namespace
 }  // namespace waxwork
 
-BENCHMARK_MAIN();
+WAXWORK_BENCHMARK_MAIN()

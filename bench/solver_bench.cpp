@@ -10,6 +10,7 @@
 //
 // Run: build-solver-bench/bench/solver_bench (configure with -DWAXWORK_BUILD_BENCH=ON). Three-channel
 // solves: Float runs the channels in one loop, Double one after the other (diffusion_solve.cpp says why).
+#include "bench_main.h"
 #include "bench_meshes.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
@@ -177,4 +178,4 @@ BENCHMARK(BM_DirectOneChannel)->WAXWORK_SIZES;
 }  // namespace
 }  // namespace waxwork
 
-BENCHMARK_MAIN();
+WAXWORK_BENCHMARK_MAIN()

@@ -6,6 +6,7 @@
 //
 // The views' cost does not depend on the values of phi, so the scene's phi is a smooth stand-in
 // (exp(-x) per channel) instead of a 500K-tet solve.
+#include "bench_main.h"
 #include "bench_meshes.h"
 #include "editor/view_modes.h"
 
@@ -67,4 +68,4 @@ BENCHMARK_CAPTURE(BM_ViewGeometry, levels, ViewMode::Levels)->Arg(50000)->Arg(50
 }  // namespace
 }  // namespace waxwork
 
-BENCHMARK_MAIN();
+WAXWORK_BENCHMARK_MAIN()
