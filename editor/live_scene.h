@@ -17,10 +17,11 @@
 //   lights (set_lighting)    q and the right-hand sides only; warm start
 //
 // Solver choice: Jacobi-preconditioned CG in double, warm-started, per channel. The multires solver
-// (multires/multires_solver.h) is not used per frame: on spot it does not beat Jacobi CG to 1%
-// (README, multires_bench: 2.3 vs 2.1 ms at 50K, 27.1 vs 26.8 ms at 500K) and its hierarchy build
-// (224 ms at 500K) would take half of a cut's 500 ms budget, for no gain. That is the default;
-// LiveSceneOptions::method and backend select multigrid CG or the GPU instead (live_solver.h).
+// (multires/multires_solver.h) is not the default: between rebuilds its frames are this same warm
+// Jacobi CG, and its hierarchy (82 ms at 500K, README) adds to every cut. Multigrid CG converges in
+// fewer, cheaper frames but adds its setup (hierarchy and Galerkin operators, about 280 ms at 500K) to
+// every cut, whose budget is 500 ms. LiveSceneOptions::method and backend select multigrid CG, the
+// paper's multires or the GPU instead (live_solver.h).
 //
 // Threading: every public member locks one internal mutex, so the window may call step() on a worker
 // thread while the UI thread applies edits; apply_change() and set_lighting() then wait for the
