@@ -33,6 +33,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <tuple>
 
 namespace waxwork {
 namespace {
@@ -70,8 +71,11 @@ ConjugateGradientOptions fixed_budget(int iterations) {
     return options;
 }
 
-std::unique_ptr<MultiresSolver> make_solver(const Scene& s) {
-    return std::make_unique<MultiresSolver>(s.matrix, s.mesh->positions);
+// weights: Eq. 16's, 0 the paper's inverse edge lengths, 1 linear-exact (hierarchy.h).
+std::unique_ptr<MultiresSolver> make_solver(const Scene& s, int64_t weights = 0) {
+    HierarchyOptions options;
+    options.weights = weights != 0 ? InterpolationWeights::LinearExact : InterpolationWeights::InverseEdgeLength;
+    return std::make_unique<MultiresSolver>(s.matrix, s.mesh->positions, options);
 }
 
 MultiresSolveOptions multires_budget(int iterations, int level_iterations) {
@@ -84,13 +88,14 @@ MultiresSolveOptions multires_budget(int iterations, int level_iterations) {
 
 const Scene& scene(size_t target_tets);
 
-// Level-0 iterations after the coarse-to-fine pass to reach 1%, per (size, intermediate-level budget).
-int multires_iterations(size_t target_tets, int level_iterations) {
-    static std::map<std::pair<size_t, int>, int> cache;
-    auto [it, inserted] = cache.try_emplace({target_tets, level_iterations}, 0);
+// Level-0 iterations after the coarse-to-fine pass to reach 1%, per (size, intermediate-level budget,
+// weights).
+int multires_iterations(size_t target_tets, int level_iterations, int64_t weights = 0) {
+    static std::map<std::tuple<size_t, int, int64_t>, int> cache;
+    auto [it, inserted] = cache.try_emplace({target_tets, level_iterations, weights}, 0);
     if (!inserted) return it->second;
     const Scene& s = scene(target_tets);
-    auto solver = make_solver(s);
+    auto solver = make_solver(s, weights);
     std::vector<double> x(s.b.size());
     it->second = smallest_budget(
         [&](int k) {
@@ -165,8 +170,8 @@ void BM_JacobiCgTo1Percent(benchmark::State& state) {
 void BM_MultiresTo1Percent(benchmark::State& state) {
     const Scene& s = scene(static_cast<size_t>(state.range(0)));
     const int level_iterations = static_cast<int>(state.range(1));
-    const int iterations = multires_iterations(static_cast<size_t>(state.range(0)), level_iterations);
-    auto solver = make_solver(s);
+    const int iterations = multires_iterations(static_cast<size_t>(state.range(0)), level_iterations, state.range(2));
+    auto solver = make_solver(s, state.range(2));
     std::vector<double> x(s.b.size());
     MultiresSolveReport report;
     for (auto _ : state) report = solver->solve(s.b, 1, x, multires_budget(iterations, level_iterations));
@@ -483,9 +488,10 @@ void BM_PaintUpdate(benchmark::State& state) {
     Arg(50000)->Arg(500000)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()
 BENCHMARK(BM_MultiresBuild)->WAXWORK_SIZES;
 BENCHMARK(BM_JacobiCgTo1Percent)->WAXWORK_SIZES;
-// Second argument: BiCGSTAB iterations on each intermediate level (the default is 10).
+// Second argument: BiCGSTAB iterations on each intermediate level (the default is 2); third: Eq. 16's
+// weights, 0 the paper's, 1 linear-exact (hierarchy.h).
 BENCHMARK(BM_MultiresTo1Percent)
-    ->ArgsProduct({{50000, 500000}, {2, 10}})
+    ->ArgsProduct({{50000, 500000}, {2, 10}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
