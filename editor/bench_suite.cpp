@@ -169,6 +169,7 @@ void run_coarse_start_part(const BenchSuiteOptions& o, Json& index) {
         for (const std::string& name : material_preset_names()) cases.emplace_back(name, solver_scene_mm_per_unit);
         for (const double scale : {3.0, 10.0, 100.0, 300.0}) cases.emplace_back("marble", scale);
     }
+    const double mean_edge = measure_quality(scene.mesh).mean_edge_length;  // model units
     Json sweep = Json::array();
     for (const auto& [name, scale] : cases) {
         const TetMaterial material = material_preset(name);
@@ -177,7 +178,7 @@ void run_coarse_start_part(const BenchSuiteOptions& o, Json& index) {
         for (int c = 0; c < 3; ++c) lengths.push_back(diffusion_length(material.mua[static_cast<size_t>(c)], material.musp[static_cast<size_t>(c)]));
         row["material"] = name;
         row["diffusion_length_mm"] = lengths;  // null (infinite) where mu_a = 0
-        row["mean_edge_mm"] = measure_quality(scene.mesh).mean_edge_length * scale;
+        row["mean_edge_mm"] = mean_edge * scale;
         sweep.push_back(std::move(row));
     }
     write_json(o.output_dir / "coarse_start.json", {{"mesh", "assets/meshes/spot.obj"},

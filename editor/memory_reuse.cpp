@@ -10,8 +10,8 @@ namespace waxwork {
 
 bool keep_freed_memory_for_reuse() {
 #if defined(__GLIBC__)
-    // Trim first: with the threshold at 1 GiB, a block up to that size is served from the heap, and the
-    // heap keeps up to that much free at its top.
+    // The trim threshold keeps freed memory at the heap's top; the mmap threshold makes blocks up to
+    // 1 GiB come from the heap in the first place (a mapped block is unmapped on free whatever the trim).
     if (mallopt(M_TRIM_THRESHOLD, static_cast<int>(kMemoryReuseBytes)) != 1) return false;
     return mallopt(M_MMAP_THRESHOLD, static_cast<int>(kMemoryReuseBytes)) == 1;
 #else

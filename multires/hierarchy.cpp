@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <numeric>
 #include <optional>
@@ -38,7 +39,7 @@ std::vector<T> parallel_copy(const std::vector<T>& source) {
 // normalised weights p_u over v's retained neighbours (in graph-row order), lambda_v their unnormalised
 // sum. Replaces them by w = p + Lambda A^T y, the minimiser of sum_u (w_u - p_u)^2 / lambda_u subject to
 // A w = (1, 0, 0, 0), where column u of A is (1, (x_u - x_v) / h): y solves (A Lambda A^T) y =
-// (0, -sum_u p_u (x_u - x_v) / h). h, the mean neighbour distance, and the scaling of Lambda by h keep
+// (0, -sum_u p_u (x_u - x_v) / h). h, the harmonic mean neighbour distance, and the scaling of Lambda by h keep
 // the 4x4 system of order one whatever the model's units. Returns false, leaving the weights alone, when
 // the system is singular (fewer than four neighbours, or all of them nearly in a plane) or a weight
 // would fall below min_weight.
@@ -279,6 +280,9 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
     if (positions.size() != matrix.size())
         throw InvalidArgumentError("multires hierarchy: " + std::to_string(positions.size()) + " positions for a " +
                                    std::to_string(matrix.size()) + "-vertex matrix");
+    if (!std::isfinite(options.min_linear_exact_weight))
+        throw InvalidArgumentError("multires hierarchy: the linear-exact weight floor must be a finite number (got " +
+                                   std::to_string(options.min_linear_exact_weight) + ")");
     const auto start = std::chrono::steady_clock::now();
     MultiresHierarchy hierarchy;
     hierarchy.levels.push_back(fine_level(matrix));

@@ -106,8 +106,9 @@ struct MultiresHierarchy {
 };
 
 // Builds levels 1.. from the assembled fine system. positions: the mesh vertex positions (rest frame),
-// for the inverse edge-length weights of Eq. 16. Deterministic for a given seed.
-// Throws InvalidArgumentError when positions do not match the matrix.
+// for the weights of Eq. 16. Deterministic for a given seed.
+// Throws InvalidArgumentError when positions do not match the matrix or min_linear_exact_weight is
+// not a finite number.
 MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                                            const HierarchyOptions& options = {});
 

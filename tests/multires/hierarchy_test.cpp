@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace waxwork {
@@ -263,6 +264,21 @@ TEST(Hierarchy, RejectsMismatchedPositions) {
     const auto s = testing::make_test_system(2);
     std::vector<Eigen::Vector3d> too_few(3);
     EXPECT_THROW(build_multires_hierarchy(s.matrix, too_few), InvalidArgumentError);
+}
+
+TEST(Hierarchy, RejectsANonFiniteLinearExactWeightFloor) {
+    const auto s = testing::make_test_system(3);
+    HierarchyOptions options;
+    options.weights = InterpolationWeights::LinearExact;
+    for (const double floor : {std::nan(""), -std::numeric_limits<double>::infinity()}) {
+        options.min_linear_exact_weight = floor;
+        try {
+            build_multires_hierarchy(s.matrix, s.mesh.positions, options);
+            ADD_FAILURE() << "accepted a weight floor of " << floor;
+        } catch (const InvalidArgumentError& error) {
+            EXPECT_NE(std::string(error.what()).find("weight floor"), std::string::npos) << error.what();
+        }
+    }
 }
 
 }  // namespace
