@@ -71,10 +71,15 @@ ConjugateGradientOptions fixed_budget(int iterations) {
     return options;
 }
 
-// weights: Eq. 16's, 0 the paper's inverse edge lengths, 1 linear-exact (hierarchy.h).
+// A benchmark argument naming Eq. 16's weights: 0 the paper's inverse edge lengths, 1 linear-exact
+// (hierarchy.h).
+InterpolationWeights weights_argument(int64_t argument) {
+    return argument != 0 ? InterpolationWeights::LinearExact : InterpolationWeights::InverseEdgeLength;
+}
+
 std::unique_ptr<MultiresSolver> make_solver(const Scene& s, int64_t weights = 0) {
     HierarchyOptions options;
-    options.weights = weights != 0 ? InterpolationWeights::LinearExact : InterpolationWeights::InverseEdgeLength;
+    options.weights = weights_argument(weights);
     return std::make_unique<MultiresSolver>(s.matrix, s.mesh->positions, options);
 }
 
@@ -227,7 +232,7 @@ void BM_MultigridCgTo1Percent(benchmark::State& state) {
 void BM_MultigridSetup(benchmark::State& state) {
     const Scene& s = scene(static_cast<size_t>(state.range(0)));
     HierarchyOptions hierarchy_options;
-    hierarchy_options.weights = state.range(2) != 0 ? InterpolationWeights::LinearExact : InterpolationWeights::InverseEdgeLength;
+    hierarchy_options.weights = weights_argument(state.range(2));
     const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh->positions, hierarchy_options);
     MultigridOptions options;
     options.drop_tolerance = static_cast<double>(state.range(1)) / 1000.0;
@@ -409,7 +414,7 @@ void BM_MultigridCgFrameTo1Percent(benchmark::State& state) {
     options.relative_tolerance = 1e-14;  // never stop on the estimate: run exactly the budget
     options.multigrid.smoothing_steps = static_cast<int>(state.range(1));
     options.multigrid.chebyshev_ratio = static_cast<double>(state.range(2));
-    options.hierarchy.weights = state.range(3) != 0 ? InterpolationWeights::LinearExact : InterpolationWeights::InverseEdgeLength;
+    options.hierarchy.weights = weights_argument(state.range(3));
     MultigridFrameSolver solver(s.matrix, s.mesh->positions, options);
     {
         MultigridPreconditioner mg(solver.hierarchy());

@@ -143,16 +143,17 @@ TEST(Hierarchy, LevelVerticesWithoutOperatorsEqualTheFullBuild) {
     EXPECT_GE(build_multires_hierarchy(s.matrix, s.mesh.positions, variants[0]).level_count(), 3u);
 }
 
-// A cube whose interior vertices are moved by up to a fifth of the spacing (seeded): the paper's
-// inverse edge-length weights are then not linear-exact anywhere by symmetry.
+// A cube mesh whose interior vertices are moved by up to a fifth of the spacing (seeded): the paper's
+// inverse edge-length weights are then no longer linear-exact by symmetry.
 std::vector<Eigen::Vector3d> jittered(const TetMesh& mesh, double spacing) {
     std::vector<Eigen::Vector3d> positions = mesh.positions;
+    const auto box = bounding_box(mesh);
     std::mt19937 random(11);
     std::uniform_real_distribution<double> offset(-0.2 * spacing, 0.2 * spacing);
     for (Eigen::Vector3d& x : positions) {
         const Eigen::Vector3d d(offset(random), offset(random), offset(random));
         bool interior = true;
-        for (int k = 0; k < 3; ++k) interior = interior && x[k] > 1e-9 && x[k] < 4.0 - 1e-9;
+        for (int k = 0; k < 3; ++k) interior = interior && x[k] > box[0][k] + 1e-9 && x[k] < box[1][k] - 1e-9;
         if (interior) x += d;
     }
     return positions;
