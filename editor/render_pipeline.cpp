@@ -177,11 +177,11 @@ SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& sce
     const BoundarySurface& surface = scene.surface;
     SurfaceRenderInput input;
     const size_t n = surface.vertices.size();
-    if (surface_radiance ? surface_radiance->size() != n : scene.radiance_factor.size() != mesh.vertex_count())
-        throw InvalidArgumentError("render input: " +
-                                   std::to_string(surface_radiance ? surface_radiance->size() : scene.radiance_factor.size()) +
-                                   " radiance values for " + std::to_string(surface_radiance ? n : mesh.vertex_count()) +
-                                   (surface_radiance ? " surface vertices" : " vertices"));
+    const size_t radiance_values = surface_radiance ? surface_radiance->size() : scene.radiance_factor.size();
+    const size_t expected = surface_radiance ? n : mesh.vertex_count();
+    if (radiance_values != expected)
+        throw InvalidArgumentError("render input: " + std::to_string(radiance_values) + " radiance values for " +
+                                   std::to_string(expected) + (surface_radiance ? " surface vertices" : " vertices"));
     input.positions.resize(n);
     input.normals.resize(n);
     input.radiance_factor.resize(n);
