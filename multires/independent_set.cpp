@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 
 namespace waxwork {
@@ -48,7 +49,10 @@ int run_independent_set_rounds(const CompressedRows& graph, std::span<const uint
     const size_t n = graph.row_count();
     std::vector<int32_t> active;
     for (size_t v = 0; v < n; ++v)
-        if (in_queue[v]) active.push_back(static_cast<int32_t>(v));
+        if (in_queue[v]) {
+            in_queue[v] = 1;  // 2 marks "dropped this round" below
+            active.push_back(static_cast<int32_t>(v));
+        }
     std::vector<uint8_t> selected(n, 0);
     int rounds = 0;
     while (!active.empty()) {
@@ -66,20 +70,19 @@ int run_independent_set_rounds(const CompressedRows& graph, std::span<const uint
                 selected[v] = minimum;
             }
         });
-        // Pass 2 reads the selection only: selected vertices are retained, their queued neighbours
-        // (Gamma) dropped. Each vertex writes only its own flags.
+        // Pass 2: selected vertices are retained and drop their queued neighbours (Gamma). Pushing from
+        // the few selected rows reads less than every other active vertex searching its row for a
+        // selected neighbour; two selected vertices may drop the same neighbour, hence the atomic
+        // (relaxed: the same value, read only after the pass) byte stores.
         tbb::parallel_for(tbb::blocked_range<size_t>(0, active.size(), kGrain), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t a = r.begin(); a != r.end(); ++a) {
                 const int32_t v = active[a];
-                if (selected[v]) {
-                    retained[v] = 1;
-                    continue;
+                if (!selected[v]) continue;
+                retained[v] = 1;
+                for (int32_t u : graph.row(v)) {
+                    std::atomic_ref<uint8_t> queued(in_queue[static_cast<size_t>(u)]);
+                    if (queued.load(std::memory_order_relaxed) == 1) queued.store(2, std::memory_order_relaxed);
                 }
-                for (int32_t u : graph.row(v))
-                    if (selected[u]) {
-                        in_queue[v] = 2;  // decided this round (dropped); cleared below
-                        break;
-                    }
             }
         });
         size_t kept = 0;
