@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
+#include <numeric>
 #include <queue>
+#include <random>
 #include <set>
 
 namespace waxwork {
@@ -33,6 +36,51 @@ std::vector<int> distances(const CompressedRows& g, int32_t source, int limit) {
             }
     }
     return d;
+}
+
+// A 3D lattice of side^3 vertices with 6-neighbour edges, vertex v of the lattice numbered order[v].
+CompressedRows lattice_graph(int side, const std::vector<int32_t>& order) {
+    const auto n = static_cast<size_t>(side) * static_cast<size_t>(side) * static_cast<size_t>(side);
+    std::vector<std::vector<int32_t>> rows(n);
+    auto id = [&](int x, int y, int z) { return static_cast<size_t>((z * side + y) * side + x); };
+    for (int z = 0; z < side; ++z)
+        for (int y = 0; y < side; ++y)
+            for (int x = 0; x < side; ++x) {
+                const int32_t v = order[id(x, y, z)];
+                if (x + 1 < side) rows[static_cast<size_t>(v)].push_back(order[id(x + 1, y, z)]);
+                if (x > 0) rows[static_cast<size_t>(v)].push_back(order[id(x - 1, y, z)]);
+                if (y + 1 < side) rows[static_cast<size_t>(v)].push_back(order[id(x, y + 1, z)]);
+                if (y > 0) rows[static_cast<size_t>(v)].push_back(order[id(x, y - 1, z)]);
+                if (z + 1 < side) rows[static_cast<size_t>(v)].push_back(order[id(x, y, z + 1)]);
+                if (z > 0) rows[static_cast<size_t>(v)].push_back(order[id(x, y, z - 1)]);
+            }
+    CompressedRows g;
+    g.offsets.assign(n + 1, 0);
+    for (size_t v = 0; v < n; ++v) {
+        std::sort(rows[v].begin(), rows[v].end());
+        g.offsets[v + 1] = g.offsets[v] + static_cast<int32_t>(rows[v].size());
+        g.indices.insert(g.indices.end(), rows[v].begin(), rows[v].end());
+    }
+    return g;
+}
+
+// The coarse graph by its definition: retained pairs adjacent in G or sharing a dropped neighbour.
+std::vector<std::pair<int32_t, int32_t>> coarse_edges_by_definition(const CompressedRows& g,
+                                                                    const std::vector<uint8_t>& retained,
+                                                                    const std::vector<int32_t>& index) {
+    std::vector<std::pair<int32_t, int32_t>> edges;
+    for (size_t v = 0; v < g.row_count(); ++v)
+        for (int32_t a : g.row(v)) {
+            if (!retained[static_cast<size_t>(a)]) continue;
+            if (retained[v]) edges.emplace_back(index[v], index[static_cast<size_t>(a)]);
+            else
+                for (int32_t b : g.row(v))
+                    if (b != a && retained[static_cast<size_t>(b)])
+                        edges.emplace_back(index[static_cast<size_t>(a)], index[static_cast<size_t>(b)]);
+        }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    return edges;
 }
 
 void expect_independent_and_dominating(const CompressedRows& g, const std::vector<uint8_t>& retained) {
@@ -152,6 +200,37 @@ TEST(IndependentSet, EnhancementLeavesNoLostConnection) {
             EXPECT_NE(static_cast<size_t>(d), c);
             EXPECT_TRUE(adjacent(coarse, d, static_cast<int32_t>(c)));
         }
+    }
+}
+
+// build_coarse_graph reads each row back either by scanning a bitmap over the row's span of coarse
+// indices or, when that span is long against the row's links (vertex orders without spatial
+// coherence), by walking the links again and sorting. In lattice order the spans are short; shuffled,
+// they cover most of the index range. Both must give exactly the definition, rows sorted and unique.
+TEST(IndependentSet, CoarseGraphIsTheDefinitionInAnyVertexOrder) {
+    constexpr int side = 40;
+    std::vector<int32_t> order(static_cast<size_t>(side * side * side));
+    std::iota(order.begin(), order.end(), 0);
+    for (const bool shuffled : {false, true}) {
+        if (shuffled) std::shuffle(order.begin(), order.end(), std::mt19937(5));
+        const CompressedRows g = lattice_graph(side, order);
+        const VertexSelection selection = select_coarse_vertices(g, 2);
+        const auto index = coarse_vertex_index(selection.retained);
+        const CompressedRows coarse = build_coarse_graph(g, selection.retained, index);
+        std::vector<std::pair<int32_t, int32_t>> edges;
+        std::vector<int32_t> spans;
+        for (size_t c = 0; c < coarse.row_count(); ++c) {
+            const auto row = coarse.row(c);
+            ASSERT_FALSE(row.empty());
+            EXPECT_TRUE(std::adjacent_find(row.begin(), row.end(), std::greater_equal<>()) == row.end())
+                << "row " << c << " is not strictly ascending";
+            for (int32_t d : row) edges.emplace_back(static_cast<int32_t>(c), d);
+            spans.push_back(row.back() - row.front());
+        }
+        EXPECT_EQ(edges, coarse_edges_by_definition(g, selection.retained, index)) << "shuffled: " << shuffled;
+        std::nth_element(spans.begin(), spans.begin() + static_cast<std::ptrdiff_t>(spans.size() / 2), spans.end());
+        const double median_span = static_cast<double>(spans[spans.size() / 2]) / static_cast<double>(coarse.row_count());
+        if (shuffled) { EXPECT_GT(median_span, 0.5); } else { EXPECT_LT(median_span, 0.1); }
     }
 }
 
