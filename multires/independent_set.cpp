@@ -1,5 +1,7 @@
 #include "multires/independent_set.h"
 
+#include "multires/parallel_rows.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -293,62 +295,46 @@ CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const i
     // all levels at 487K tets.
     const size_t words = (m + 63) / 64;
     tbb::enumerable_thread_specific<std::vector<uint64_t>> bitmaps([words] { return std::vector<uint64_t>(words, 0); });
-    // One walk per row into per-chunk buffers (fixed chunks: the layout does not depend on the thread
-    // count), then the rows are copied into place once the offsets are known.
-    constexpr size_t kChunk = 512;
-    const size_t chunks = (m + kChunk - 1) / kChunk;
-    std::vector<std::vector<int32_t>> buffers(chunks);
     CompressedRows coarse;
-    coarse.offsets.assign(m + 1, 0);
-    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
+    build_rows_in_chunks(m, 512, coarse.offsets, coarse.indices, [&](size_t c, std::vector<int32_t>& buffer) {
         // Raw pointers in locals: through the captured references the compiler reloads every base
         // pointer after each store into the buffer.
         uint64_t* const bits = bitmaps.local().data();
         const int32_t* const link_begin = link_offsets.data();
         const int32_t* const link = links.data();
-        std::vector<int32_t>& buffer = buffers[chunk];
-        for (size_t c = chunk * kChunk; c < std::min(m, (chunk + 1) * kChunk); ++c) {
-            const size_t first = buffer.size();
-            const auto row = graph.row(static_cast<size_t>(coarse_to_fine[c]));
-            int32_t lowest = std::numeric_limits<int32_t>::max(), highest = -1, count = 0;
+        const size_t first = buffer.size();
+        const auto row = graph.row(static_cast<size_t>(coarse_to_fine[c]));
+        int32_t lowest = std::numeric_limits<int32_t>::max(), highest = -1, count = 0;
+        for (int32_t j : row)
+            for (int32_t q = link_begin[j]; q < link_begin[j + 1]; ++q) {
+                const int32_t k = link[q];
+                bits[k >> 6] |= uint64_t{1} << (k & 63);
+                lowest = std::min(lowest, k);
+                highest = std::max(highest, k);
+                ++count;
+            }
+        if (highest < 0) return;  // an isolated vertex
+        bits[c >> 6] &= ~(uint64_t{1} << (c & 63));
+        const int32_t first_word = lowest >> 6, last_word = highest >> 6;
+        // A word read back costs about as much as one element of a small sort.
+        if (last_word - first_word <= 8 * count + 64) {
+            for (int32_t w = first_word; w <= last_word; ++w) {
+                for (uint64_t word = bits[w]; word != 0; word &= word - 1)
+                    buffer.push_back(w * 64 + std::countr_zero(word));
+                bits[w] = 0;
+            }
+        } else {
             for (int32_t j : row)
                 for (int32_t q = link_begin[j]; q < link_begin[j + 1]; ++q) {
                     const int32_t k = link[q];
-                    bits[k >> 6] |= uint64_t{1} << (k & 63);
-                    lowest = std::min(lowest, k);
-                    highest = std::max(highest, k);
-                    ++count;
-                }
-            if (highest < 0) continue;  // an isolated vertex
-            bits[c >> 6] &= ~(uint64_t{1} << (c & 63));
-            const int32_t first_word = lowest >> 6, last_word = highest >> 6;
-            // A word read back costs about as much as one element of a small sort.
-            if (last_word - first_word <= 8 * count + 64) {
-                for (int32_t w = first_word; w <= last_word; ++w) {
-                    for (uint64_t word = bits[w]; word != 0; word &= word - 1)
-                        buffer.push_back(w * 64 + std::countr_zero(word));
-                    bits[w] = 0;
-                }
-            } else {
-                for (int32_t j : row)
-                    for (int32_t q = link_begin[j]; q < link_begin[j + 1]; ++q) {
-                        const int32_t k = link[q];
-                        const uint64_t bit = uint64_t{1} << (k & 63);
-                        if (bits[k >> 6] & bit) {
-                            bits[k >> 6] &= ~bit;
-                            buffer.push_back(k);
-                        }
+                    const uint64_t bit = uint64_t{1} << (k & 63);
+                    if (bits[k >> 6] & bit) {
+                        bits[k >> 6] &= ~bit;
+                        buffer.push_back(k);
                     }
-                std::sort(buffer.begin() + static_cast<std::ptrdiff_t>(first), buffer.end());
-            }
-            coarse.offsets[c + 1] = static_cast<int32_t>(buffer.size() - first);
+                }
+            std::sort(buffer.begin() + static_cast<std::ptrdiff_t>(first), buffer.end());
         }
-    });
-    for (size_t c = 0; c < m; ++c) coarse.offsets[c + 1] += coarse.offsets[c];
-    coarse.indices.resize(static_cast<size_t>(coarse.offsets[m]));
-    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
-        std::copy(buffers[chunk].begin(), buffers[chunk].end(),
-                  coarse.indices.begin() + coarse.offsets[chunk * kChunk]);
     });
     return coarse;
 }

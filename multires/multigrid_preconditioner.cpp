@@ -244,13 +244,13 @@ void MultigridPreconditioner::build_levels() {
 
 // Per-thread sparse accumulator over the columns of one product row.
 struct MultigridPreconditioner::Accumulator {
-    std::vector<int32_t> tag;                // row currently using the column, or -1
-    std::vector<int32_t> slot;               // where the column sits in the current row
-    std::vector<int32_t> touched;            // columns of the current row in first-touch order
-    std::array<std::vector<double>, 3> sum;  // per channel, indexed by column
-    explicit Accumulator(size_t columns) : tag(columns, -1), slot(columns, -1) {
-        for (auto& v : sum) v.assign(columns, 0.0);
-    }
+    std::vector<int32_t> tag;                 // row currently using the column, or -1
+    std::vector<int32_t> slot;                // where the column sits in the current row
+    std::vector<int32_t> touched;             // columns of the current row in first-touch order
+    // Indexed by column, the three channels side by side: one cache line per touched column instead
+    // of three (the accumulation's scattered adds are its cost).
+    std::vector<std::array<double, 3>> sum;
+    explicit Accumulator(size_t columns) : tag(columns, -1), slot(columns, -1), sum(columns, {0.0, 0.0, 0.0}) {}
 };
 
 void MultigridPreconditioner::build_galerkin_operator(size_t l) {
@@ -258,35 +258,23 @@ void MultigridPreconditioner::build_galerkin_operator(size_t l) {
     Level& coarse = *levels_[l];
     const InterpolationOperator& p = *fine.p;
     const size_t n = fine.n, m = coarse.n;
-    // A P: row v reaches K through v -A- j -P- K. Two passes over the same walk (count, then fill)
-    // instead of per-row containers: no allocation per row.
+    // A P: row v reaches K through v -A- j -P- K, in first-touch order (the order the Galerkin rows and
+    // their updates sum in).
     {
-        tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
-        auto walk = [&](size_t v, Accumulator& acc, auto&& emit) {
-            const auto tag = static_cast<int32_t>(v);
+        tbb::enumerable_thread_specific<std::vector<int32_t>> tags([m] { return std::vector<int32_t>(m, -1); });
+        build_rows_in_chunks(n, 512, fine.ap_offsets, fine.ap_columns, [&](size_t v, std::vector<int32_t>& out) {
+            int32_t* const tag = tags.local().data();
+            const auto key = static_cast<int32_t>(v);
             for (int32_t e = fine.offsets[v]; e < fine.offsets[v + 1]; ++e) {
                 const auto j = static_cast<size_t>(fine.columns[static_cast<size_t>(e)]);
                 for (int32_t q = p.offsets[j]; q < p.offsets[j + 1]; ++q) {
-                    const auto k = static_cast<size_t>(p.columns[static_cast<size_t>(q)]);
-                    if (acc.tag[k] != tag) {
-                        acc.tag[k] = tag;
-                        emit(static_cast<int32_t>(k));
+                    const int32_t k = p.columns[static_cast<size_t>(q)];
+                    if (tag[k] != key) {
+                        tag[k] = key;
+                        out.push_back(k);
                     }
                 }
             }
-        };
-        fine.ap_offsets.assign(n + 1, 0);
-        for_rows(n, kGrain, [&](size_t v) {
-            int32_t count = 0;
-            walk(v, scratch.local(), [&](int32_t) { ++count; });
-            fine.ap_offsets[v + 1] = count;
-        });
-        std::partial_sum(fine.ap_offsets.begin(), fine.ap_offsets.end(), fine.ap_offsets.begin());
-        fine.ap_columns.resize(static_cast<size_t>(fine.ap_offsets[n]));
-        for (auto& acc : scratch) std::fill(acc.tag.begin(), acc.tag.end(), -1);  // pass two walks the same rows
-        for_rows(n, kGrain, [&](size_t v) {
-            auto out = static_cast<size_t>(fine.ap_offsets[v]);
-            walk(v, scratch.local(), [&](int32_t k) { fine.ap_columns[out++] = k; });
         });
         for (auto& v : fine.ap_values) v.assign(fine.ap_columns.size(), 0.0);
     }
@@ -315,62 +303,78 @@ void MultigridPreconditioner::build_galerkin_operator(size_t l) {
         }
         for (size_t ch = 0; ch < 3; ++ch) diagonal[ch][row] = sum[ch];
     });
-    tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
+    // The drop test compares |a_ik| with theta sqrt(|a_ii a_kk|), the square roots taken once per row.
     const double theta = options_.drop_tolerance;
+    std::array<std::vector<double>, 3> root_diagonal;
+    for (size_t ch = 0; ch < 3; ++ch) {
+        root_diagonal[ch].resize(m);
+        for_rows(m, kGrain, [&](size_t row) { root_diagonal[ch][row] = std::sqrt(std::abs(diagonal[ch][row])); });
+    }
     auto kept = [&](size_t row, size_t k, const Accumulator& acc) {
         if (k == row) return true;
         for (size_t ch = 0; ch < 3; ++ch)
-            if (std::abs(acc.sum[ch][k]) >= theta * std::sqrt(std::abs(diagonal[ch][row] * diagonal[ch][k]))) return true;
+            if (std::abs(acc.sum[k][ch]) >= theta * root_diagonal[ch][row] * root_diagonal[ch][k]) return true;
         return false;
     };
+    // Pattern and values in one accumulation per row, into per-chunk buffers (fixed chunks: the layout
+    // does not depend on the thread count) copied into place once the row lengths are known. What
+    // compute_galerkin_rows does for a row, with the kept columns chosen here (dropped entries lumped in
+    // first-touch order, as there: bit-identical).
+    struct ChunkRows {
+        std::vector<int32_t> columns;
+        std::vector<std::array<double, 3>> values;
+    };
+    constexpr size_t kChunk = 256;
+    const size_t chunks = (m + kChunk - 1) / kChunk;
+    std::vector<ChunkRows> buffers(chunks);
     coarse.offsets.assign(m + 1, 0);
-    for_rows(m, kGrain, [&](size_t row) {
+    coarse.diagonal.assign(m, -1);  // the slot within the row until the offsets are known
+    tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
+    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
         Accumulator& acc = scratch.local();
-        accumulate_galerkin_row(l, row, acc);
-        int32_t count = 0;
-        for (int32_t k : acc.touched) count += kept(row, static_cast<size_t>(k), acc) ? 1 : 0;
-        coarse.offsets[row + 1] = count;
-        clear(acc);
+        ChunkRows& buffer = buffers[chunk];
+        for (size_t row = chunk * kChunk; row < std::min(m, (chunk + 1) * kChunk); ++row) {
+            accumulate_galerkin_row(l, row, acc);
+            const size_t begin = buffer.columns.size();
+            std::array<double, 3> lumped{};
+            for (int32_t k : acc.touched) {
+                if (kept(row, static_cast<size_t>(k), acc)) {
+                    buffer.columns.push_back(k);
+                    continue;
+                }
+                for (size_t ch = 0; ch < 3; ++ch) {
+                    const double value = acc.sum[static_cast<size_t>(k)][ch];
+                    lumped[ch] += options_.lumping == DropLumping::Absolute ? std::abs(value) : value;
+                }
+            }
+            const auto first = buffer.columns.begin() + static_cast<std::ptrdiff_t>(begin);
+            std::sort(first, buffer.columns.end());
+            const auto diagonal_slot = std::lower_bound(first, buffer.columns.end(), static_cast<int32_t>(row)) - first;
+            coarse.diagonal[row] = static_cast<int32_t>(diagonal_slot);
+            for (auto k = first; k != buffer.columns.end(); ++k) buffer.values.push_back(acc.sum[static_cast<size_t>(*k)]);
+            for (size_t ch = 0; ch < 3; ++ch) buffer.values[begin + static_cast<size_t>(diagonal_slot)][ch] += lumped[ch];
+            coarse.offsets[row + 1] = static_cast<int32_t>(buffer.columns.size() - begin);
+            clear(acc);
+        }
     });
     std::partial_sum(coarse.offsets.begin(), coarse.offsets.end(), coarse.offsets.begin());
     coarse.columns.resize(static_cast<size_t>(coarse.offsets[m]));
-    coarse.diagonal.assign(m, -1);
-    for (auto& v : coarse.values) v.assign(coarse.columns.size(), 0.0);
-    // Pattern and values in one pass: what compute_galerkin_rows does for a row, with the kept
-    // columns chosen here (dropped entries lumped in first-touch order, as there: bit-identical).
-    for_rows(m, kGrain, [&](size_t row) {
-        Accumulator& acc = scratch.local();
-        accumulate_galerkin_row(l, row, acc);
-        const auto begin = static_cast<size_t>(coarse.offsets[row]), end = static_cast<size_t>(coarse.offsets[row + 1]);
-        size_t out = begin;
-        std::array<double, 3> lumped{};
-        for (int32_t k : acc.touched) {
-            if (kept(row, static_cast<size_t>(k), acc)) {
-                coarse.columns[out++] = k;
-                continue;
-            }
-            for (size_t ch = 0; ch < 3; ++ch) {
-                const double value = acc.sum[ch][static_cast<size_t>(k)];
-                lumped[ch] += options_.lumping == DropLumping::Absolute ? std::abs(value) : value;
-            }
-        }
-        int32_t* columns = coarse.columns.data();
-        std::sort(columns + begin, columns + end);
-        const auto diagonal_slot = static_cast<size_t>(
-            std::lower_bound(columns + begin, columns + end, static_cast<int32_t>(row)) - columns);
-        coarse.diagonal[row] = static_cast<int32_t>(diagonal_slot);
-        for (size_t ch = 0; ch < 3; ++ch) {
-            for (size_t s = begin; s < end; ++s) coarse.values[ch][s] = acc.sum[ch][static_cast<size_t>(columns[s])];
-            coarse.values[ch][diagonal_slot] += lumped[ch];
-        }
-        clear(acc);
+    for (auto& v : coarse.values) v.resize(coarse.columns.size());
+    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
+        const ChunkRows& buffer = buffers[chunk];
+        const auto out = static_cast<size_t>(coarse.offsets[chunk * kChunk]);
+        std::copy(buffer.columns.begin(), buffer.columns.end(), coarse.columns.begin() + static_cast<std::ptrdiff_t>(out));
+        for (size_t e = 0; e < buffer.values.size(); ++e)
+            for (size_t ch = 0; ch < 3; ++ch) coarse.values[ch][out + e] = buffer.values[e][ch];
+        for (size_t row = chunk * kChunk; row < std::min(m, (chunk + 1) * kChunk); ++row)
+            coarse.diagonal[row] += coarse.offsets[row];
     });
 }
 
 void MultigridPreconditioner::clear(Accumulator& acc) {
     for (int32_t k : acc.touched) {
         acc.tag[static_cast<size_t>(k)] = -1;
-        for (auto& s : acc.sum) s[static_cast<size_t>(k)] = 0.0;
+        acc.sum[static_cast<size_t>(k)] = {0.0, 0.0, 0.0};
     }
     acc.touched.clear();
 }
@@ -390,7 +394,7 @@ void MultigridPreconditioner::accumulate_galerkin_row(size_t l, size_t row, Accu
                 acc.tag[k] = tag;
                 acc.touched.push_back(static_cast<int32_t>(k));
             }
-            for (size_t ch = 0; ch < 3; ++ch) acc.sum[ch][k] += w * fine.ap_values[ch][static_cast<size_t>(e)];
+            for (size_t ch = 0; ch < 3; ++ch) acc.sum[k][ch] += w * fine.ap_values[ch][static_cast<size_t>(e)];
         }
     }
 }
@@ -438,7 +442,7 @@ void MultigridPreconditioner::compute_galerkin_rows(size_t l, std::span<const in
             const bool in_pattern = s >= static_cast<int32_t>(begin) && s < static_cast<int32_t>(end) &&
                                     coarse.columns[static_cast<size_t>(s)] == k;
             for (size_t ch = 0; ch < 3; ++ch) {
-                const double value = acc.sum[ch][static_cast<size_t>(k)];
+                const double value = acc.sum[static_cast<size_t>(k)][ch];
                 if (in_pattern)
                     coarse.values[ch][static_cast<size_t>(s)] = value;
                 else

@@ -1,11 +1,14 @@
-// Row loops of the multigrid code: each row is independent, so TBB splits the range into chunks of
+// Row loops of the multires code: each row is independent, so TBB splits the range into chunks of
 // `grain` rows (large enough that scheduling costs less than the rows themselves).
 #pragma once
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 namespace waxwork {
 
@@ -13,6 +16,33 @@ template <typename Body>
 void for_rows(size_t n, size_t grain, const Body& body) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) body(i);
+    });
+}
+
+// Compressed rows whose lengths are only known once each row is built, in one pass: rows are built
+// in fixed chunks of `chunk_rows` (so the result does not depend on the thread count), each chunk
+// appending its rows to its own buffer with append_row(row, buffer, chunk), and the buffers are
+// copied into `entries` once `offsets` (rows + 1 prefix sums) are known. Building every row twice
+// (count, then fill) would walk it twice; this walks it once and copies the entries once.
+template <typename T, typename AppendRow>
+void build_rows_in_chunks(size_t rows, size_t chunk_rows, std::vector<int32_t>& offsets, std::vector<T>& entries,
+                          const AppendRow& append_row) {
+    const size_t chunks = (rows + chunk_rows - 1) / chunk_rows;
+    std::vector<std::vector<T>> buffers(chunks);
+    offsets.assign(rows + 1, 0);
+    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
+        std::vector<T>& buffer = buffers[chunk];
+        for (size_t row = chunk * chunk_rows; row < std::min(rows, (chunk + 1) * chunk_rows); ++row) {
+            const size_t before = buffer.size();
+            append_row(row, buffer);
+            offsets[row + 1] = static_cast<int32_t>(buffer.size() - before);
+        }
+    });
+    for (size_t row = 0; row < rows; ++row) offsets[row + 1] += offsets[row];
+    entries.resize(static_cast<size_t>(offsets[rows]));
+    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
+        std::copy(buffers[chunk].begin(), buffers[chunk].end(),
+                  entries.begin() + static_cast<std::ptrdiff_t>(offsets[chunk * chunk_rows]));
     });
 }
 
