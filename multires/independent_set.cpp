@@ -1,5 +1,6 @@
 #include "multires/independent_set.h"
 
+#include "multires/link_union.h"
 #include "multires/parallel_rows.h"
 
 #include <tbb/blocked_range.h>
@@ -9,7 +10,6 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
-#include <limits>
 
 namespace waxwork {
 
@@ -286,55 +286,11 @@ CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const i
     // Row c (fine vertex i): the links of every neighbour j of i, except c itself. A retained j links
     // to itself (a fine edge between retained vertices is kept); a dropped j links to its retained
     // neighbours (the 2-ring through a dropped vertex), so each coarse neighbour comes several times.
-    // The links are set as bits in a per-thread bitmap of the coarse vertices (m / 8 bytes: it stays
-    // in L1 where a tag array of ints did not), which removes the duplicates, and the row's span of
-    // words is read back in order, which sorts it. Coarse indices keep the fine order, which is
-    // spatially coherent, so that span is short for most rows (at 97K fine vertices: a median of 10
-    // words); a row whose span is long against its link count is instead read back by walking its
-    // links again and sorted. Against a tag array of ints and std::sort per row: 19 -> 8.5 ms for
-    // all levels at 487K tets.
-    const size_t words = (m + 63) / 64;
-    tbb::enumerable_thread_specific<std::vector<uint64_t>> bitmaps([words] { return std::vector<uint64_t>(words, 0); });
+    tbb::enumerable_thread_specific<LinkUnion> unions([m] { return LinkUnion(m); });
     CompressedRows coarse;
-    build_rows_in_chunks(m, 512, coarse.offsets, coarse.indices, [&](size_t c, std::vector<int32_t>& buffer) {
-        // Raw pointers in locals: through the captured references the compiler reloads every base
-        // pointer after each store into the buffer.
-        uint64_t* const bits = bitmaps.local().data();
-        const int32_t* const link_begin = link_offsets.data();
-        const int32_t* const link = links.data();
-        const size_t first = buffer.size();
-        const auto row = graph.row(static_cast<size_t>(coarse_to_fine[c]));
-        int32_t lowest = std::numeric_limits<int32_t>::max(), highest = -1, count = 0;
-        for (int32_t j : row)
-            for (int32_t q = link_begin[j]; q < link_begin[j + 1]; ++q) {
-                const int32_t k = link[q];
-                bits[k >> 6] |= uint64_t{1} << (k & 63);
-                lowest = std::min(lowest, k);
-                highest = std::max(highest, k);
-                ++count;
-            }
-        if (highest < 0) return;  // an isolated vertex
-        bits[c >> 6] &= ~(uint64_t{1} << (c & 63));
-        const int32_t first_word = lowest >> 6, last_word = highest >> 6;
-        // A word read back costs about as much as one element of a small sort.
-        if (last_word - first_word <= 8 * count + 64) {
-            for (int32_t w = first_word; w <= last_word; ++w) {
-                for (uint64_t word = bits[w]; word != 0; word &= word - 1)
-                    buffer.push_back(w * 64 + std::countr_zero(word));
-                bits[w] = 0;
-            }
-        } else {
-            for (int32_t j : row)
-                for (int32_t q = link_begin[j]; q < link_begin[j + 1]; ++q) {
-                    const int32_t k = link[q];
-                    const uint64_t bit = uint64_t{1} << (k & 63);
-                    if (bits[k >> 6] & bit) {
-                        bits[k >> 6] &= ~bit;
-                        buffer.push_back(k);
-                    }
-                }
-            std::sort(buffer.begin() + static_cast<std::ptrdiff_t>(first), buffer.end());
-        }
+    build_rows_in_chunks(m, 512, coarse.offsets, coarse.indices, [&](size_t c, std::vector<int32_t>& row) {
+        unions.local().append(graph.row(static_cast<size_t>(coarse_to_fine[c])), link_offsets.data(), links.data(),
+                              static_cast<int32_t>(c), row);
     });
     return coarse;
 }

@@ -1,5 +1,6 @@
 #include "multires/multigrid_preconditioner.h"
 
+#include "multires/link_union.h"
 #include "multires/parallel_rows.h"
 #include "solver/reference_solvers.h"
 
@@ -258,23 +259,14 @@ void MultigridPreconditioner::build_galerkin_operator(size_t l) {
     Level& coarse = *levels_[l];
     const InterpolationOperator& p = *fine.p;
     const size_t n = fine.n, m = coarse.n;
-    // A P: row v reaches K through v -A- j -P- K, in first-touch order (the order the Galerkin rows and
+    // A P: row v reaches K through v -A- j -P- K; columns ascending (the order the Galerkin rows and
     // their updates sum in).
     {
-        tbb::enumerable_thread_specific<std::vector<int32_t>> tags([m] { return std::vector<int32_t>(m, -1); });
-        build_rows_in_chunks(n, 512, fine.ap_offsets, fine.ap_columns, [&](size_t v, std::vector<int32_t>& out) {
-            int32_t* const tag = tags.local().data();
-            const auto key = static_cast<int32_t>(v);
-            for (int32_t e = fine.offsets[v]; e < fine.offsets[v + 1]; ++e) {
-                const auto j = static_cast<size_t>(fine.columns[static_cast<size_t>(e)]);
-                for (int32_t q = p.offsets[j]; q < p.offsets[j + 1]; ++q) {
-                    const int32_t k = p.columns[static_cast<size_t>(q)];
-                    if (tag[k] != key) {
-                        tag[k] = key;
-                        out.push_back(k);
-                    }
-                }
-            }
+        tbb::enumerable_thread_specific<LinkUnion> unions([m] { return LinkUnion(m); });
+        build_rows_in_chunks(n, 512, fine.ap_offsets, fine.ap_columns, [&](size_t v, std::vector<int32_t>& row) {
+            const auto a_row = std::span<const int32_t>(fine.columns).subspan(
+                static_cast<size_t>(fine.offsets[v]), static_cast<size_t>(fine.offsets[v + 1] - fine.offsets[v]));
+            unions.local().append(a_row, p.offsets.data(), p.columns.data(), -1, row);
         });
         for (auto& v : fine.ap_values) v.assign(fine.ap_columns.size(), 0.0);
     }
