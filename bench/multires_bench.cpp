@@ -149,14 +149,22 @@ const Scene& scene(size_t target_tets) {
 void BM_MultiresBuild(benchmark::State& state) {
     const Scene& s = scene(static_cast<size_t>(state.range(0)));
     size_t levels = 0, coarse = 0;
+    HierarchyBuildTimes times;
     for (auto _ : state) {
         const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh->positions);
         levels = h.level_count();
         coarse = h.levels.back().size();
+        times = h.build_times;
     }
     state.counters["tets"] = static_cast<double>(s.mesh->tet_count());
     state.counters["levels"] = static_cast<double>(levels);
     state.counters["coarsest"] = static_cast<double>(coarse);
+    // The last build's phases (HierarchyBuildTimes), in ms.
+    state.counters["fine_ms"] = times.fine_level;
+    state.counters["select_ms"] = times.selection;
+    state.counters["interp_ms"] = times.interpolation;
+    state.counters["graph_ms"] = times.coarse_graph;
+    state.counters["eq17_ms"] = times.coarse_matrix;
 }
 
 void BM_JacobiCgTo1Percent(benchmark::State& state) {

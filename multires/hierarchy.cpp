@@ -283,10 +283,21 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
     if (!std::isfinite(options.min_linear_exact_weight))
         throw InvalidArgumentError("multires hierarchy: the linear-exact weight floor must be a finite number (got " +
                                    std::to_string(options.min_linear_exact_weight) + ")");
-    const auto start = std::chrono::steady_clock::now();
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    auto lap = start;
+    // Adds the time since the last lap to `phase`.
+    auto time = [&lap](double& phase) {
+        const auto now = Clock::now();
+        phase += std::chrono::duration<double, std::milli>(now - lap).count();
+        lap = now;
+    };
     MultiresHierarchy hierarchy;
+    HierarchyBuildTimes& times = hierarchy.build_times;
     hierarchy.levels.push_back(fine_level(matrix));
+    time(times.fine_level);
     while (std::optional<CoarseningStep> step = coarsen(hierarchy.levels.back().graph, hierarchy.levels.size(), options)) {
+        time(times.selection);
         HierarchyLevel& fine = hierarchy.levels.back();
         HierarchyLevel coarse;
         coarse.parent_vertex = step->coarse_to_fine;
@@ -295,17 +306,20 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
             coarse.original_vertex[c] = fine.original_vertex[static_cast<size_t>(step->coarse_to_fine[c])];
         fine.interpolation = build_interpolation(fine.graph, step->selection.retained, step->coarse_index,
                                                  fine.original_vertex, positions, options);
+        time(times.interpolation);
         // P's columns are exactly each fine vertex's coarse links (independent_set.h).
         coarse.graph = build_coarse_graph(fine.graph, step->coarse_index, fine.interpolation.offsets,
                                           fine.interpolation.columns);
+        time(times.coarse_graph);
         fine.independent_set_rounds = step->selection.independent_set_rounds;
         fine.enhancement_passes = step->selection.enhancement_passes;
         fine.enhancement_vertices = step->selection.enhancement_vertices;
         build_coarse_matrix(fine, step->coarse_to_fine, coarse);
         hierarchy.levels.push_back(std::move(coarse));
+        time(times.coarse_matrix);
     }
-    hierarchy.build_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    time(times.selection);  // the last selection, which ended the loop
+    hierarchy.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     return hierarchy;
 }
 

@@ -98,9 +98,19 @@ struct HierarchyLevel {
     }
 };
 
+// Where build_multires_hierarchy's time went, summed over the levels (milliseconds, wall clock).
+struct HierarchyBuildTimes {
+    double fine_level = 0;     // level 0: the copy of the matrix and G^0
+    double selection = 0;      // independent sets and enhancement (Sec. 4.1)
+    double interpolation = 0;  // Eq. 16
+    double coarse_graph = 0;   // E^{l+1}
+    double coarse_matrix = 0;  // Eq. 17
+};
+
 struct MultiresHierarchy {
     std::vector<HierarchyLevel> levels;  // levels[0] is the fine system
     double build_ms = 0;
+    HierarchyBuildTimes build_times;  // build_ms by phase
 
     size_t level_count() const { return levels.size(); }
 };

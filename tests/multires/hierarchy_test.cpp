@@ -102,6 +102,20 @@ TEST(Hierarchy, StopsAtTheSizeRuleAndShrinks) {
     EXPECT_TRUE(h.levels.back().interpolation.columns.empty());
 }
 
+// The build's time by phase: every phase of a multi-level build took some time, and together they
+// account for no more than the whole build (they are laps of one clock).
+TEST(Hierarchy, BuildTimesSplitTheBuild) {
+    const auto s = testing::make_test_system(12);
+    HierarchyOptions options;
+    options.min_coarse_vertices = 200;
+    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
+    ASSERT_GE(h.level_count(), 3u);
+    const HierarchyBuildTimes& t = h.build_times;
+    for (const double phase : {t.fine_level, t.selection, t.interpolation, t.coarse_graph, t.coarse_matrix})
+        EXPECT_GT(phase, 0.0);
+    EXPECT_LE(t.fine_level + t.selection + t.interpolation + t.coarse_graph + t.coarse_matrix, h.build_ms);
+}
+
 TEST(Hierarchy, DeterministicAcrossRunsAndThreadCounts) {
     const auto s = testing::make_test_system(10);
     HierarchyOptions options;
