@@ -10,6 +10,7 @@
 #include <Eigen/Cholesky>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <chrono>
@@ -201,18 +202,24 @@ void update_coarse_rows(const HierarchyLevel& fine, std::span<const int32_t> coa
                         std::span<const int32_t> rows) {
     const size_t m = coarse_to_fine.size();
     const InterpolationOperator& p = fine.interpolation;
-    // Per thread, the slot of each coarse column in the current row (replacing a binary search per
-    // product term). Stale entries from other rows are never read: every column a row's products reach
-    // is in its pattern (the coarse graph row plus the diagonal, see hierarchy.h).
-    tbb::enumerable_thread_specific<std::vector<int32_t>> slots([m] { return std::vector<int32_t>(m, -1); });
+    // Per thread, the position of each coarse column within the current row (replacing a binary search
+    // per product term; stale entries from other rows are never read: every column a row's products
+    // reach is in its pattern, the coarse graph row plus the diagonal, see hierarchy.h), and the row's
+    // sums with the three channels side by side, written to the three value arrays once at the end:
+    // scattered read-modify-writes into one small buffer instead of three large arrays.
+    struct RowScratch {
+        std::vector<int32_t> position;
+        std::vector<std::array<double, 3>> sums;
+    };
+    tbb::enumerable_thread_specific<RowScratch> scratch([m] { return RowScratch{std::vector<int32_t>(m, -1), {}}; });
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rows.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-        std::vector<int32_t>& slot = slots.local();
+        RowScratch& local = scratch.local();
         for (size_t index = r.begin(); index != r.end(); ++index) {
             const auto c = static_cast<size_t>(rows[index]);
             const auto begin = static_cast<size_t>(coarse.offsets[c]), end = static_cast<size_t>(coarse.offsets[c + 1]);
-            for (size_t s = begin; s < end; ++s) slot[static_cast<size_t>(coarse.columns[s])] = static_cast<int32_t>(s);
-            for (auto& v : coarse.values)
-                std::fill(v.begin() + static_cast<std::ptrdiff_t>(begin), v.begin() + static_cast<std::ptrdiff_t>(end), 0.0);
+            for (size_t s = begin; s < end; ++s)
+                local.position[static_cast<size_t>(coarse.columns[s])] = static_cast<int32_t>(s - begin);
+            local.sums.assign(end - begin, {0.0, 0.0, 0.0});
             // Eq. 17: sum over the fine row of i of M_ij P_jk into coarse column k.
             const auto i = static_cast<size_t>(coarse_to_fine[c]);
             for (int32_t e = fine.offsets[i]; e < fine.offsets[i + 1]; ++e) {
@@ -221,13 +228,16 @@ void update_coarse_rows(const HierarchyLevel& fine, std::span<const int32_t> coa
                 const double m1 = fine.values[1][static_cast<size_t>(e)];
                 const double m2 = fine.values[2][static_cast<size_t>(e)];
                 for (int32_t q = p.offsets[j]; q < p.offsets[j + 1]; ++q) {
-                    const auto s = static_cast<size_t>(slot[static_cast<size_t>(p.columns[static_cast<size_t>(q)])]);
+                    std::array<double, 3>& sum =
+                        local.sums[static_cast<size_t>(local.position[static_cast<size_t>(p.columns[static_cast<size_t>(q)])])];
                     const double w = p.weights[static_cast<size_t>(q)];
-                    coarse.values[0][s] += m0 * w;
-                    coarse.values[1][s] += m1 * w;
-                    coarse.values[2][s] += m2 * w;
+                    sum[0] += m0 * w;
+                    sum[1] += m1 * w;
+                    sum[2] += m2 * w;
                 }
             }
+            for (size_t s = begin; s < end; ++s)
+                for (size_t ch = 0; ch < 3; ++ch) coarse.values[ch][s] = local.sums[s - begin][ch];
         }
     });
 }
