@@ -21,7 +21,7 @@ void for_rows(size_t n, size_t grain, const Body& body) {
 
 // Compressed rows whose lengths are only known once each row is built, in one pass: rows are built
 // in fixed chunks of `chunk_rows` (so the result does not depend on the thread count), each chunk
-// appending its rows to its own buffer with append_row(row, buffer, chunk), and the buffers are
+// appending its rows to its own buffer with append_row(row, buffer), and the buffers are
 // copied into `entries` once `offsets` (rows + 1 prefix sums) are known. Building every row twice
 // (count, then fill) would walk it twice; this walks it once and copies the entries once.
 template <typename T, typename AppendRow>
