@@ -308,24 +308,20 @@ void MultigridPreconditioner::build_galerkin_operator(size_t l) {
             if (std::abs(acc.sum[k][ch]) >= theta * root_diagonal[ch][row] * root_diagonal[ch][k]) return true;
         return false;
     };
-    // Pattern and values in one accumulation per row, into per-chunk buffers (fixed chunks: the layout
-    // does not depend on the thread count) copied into place once the row lengths are known. What
-    // compute_galerkin_rows does for a row, with the kept columns chosen here (dropped entries lumped in
-    // first-touch order, as there: bit-identical).
+    // Pattern and values in one accumulation per row (build_rows_in_chunks). What compute_galerkin_rows
+    // does for a row, with the kept columns chosen here (dropped entries lumped in first-touch order,
+    // as there: bit-identical).
     struct ChunkRows {
         std::vector<int32_t> columns;
         std::vector<std::array<double, 3>> values;
     };
     constexpr size_t kChunk = 256;
-    const size_t chunks = (m + kChunk - 1) / kChunk;
-    std::vector<ChunkRows> buffers(chunks);
-    coarse.offsets.assign(m + 1, 0);
     coarse.diagonal.assign(m, -1);  // the slot within the row until the offsets are known
     tbb::enumerable_thread_specific<Accumulator> scratch([m] { return Accumulator(m); });
-    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
-        Accumulator& acc = scratch.local();
-        ChunkRows& buffer = buffers[chunk];
-        for (size_t row = chunk * kChunk; row < std::min(m, (chunk + 1) * kChunk); ++row) {
+    build_rows_in_chunks<ChunkRows>(
+        m, kChunk, coarse.offsets,
+        [&](size_t row, ChunkRows& buffer) {
+            Accumulator& acc = scratch.local();
             accumulate_galerkin_row(l, row, acc);
             const size_t begin = buffer.columns.size();
             std::array<double, 3> lumped{};
@@ -345,22 +341,21 @@ void MultigridPreconditioner::build_galerkin_operator(size_t l) {
             coarse.diagonal[row] = static_cast<int32_t>(diagonal_slot);
             for (auto k = first; k != buffer.columns.end(); ++k) buffer.values.push_back(acc.sum[static_cast<size_t>(*k)]);
             for (size_t ch = 0; ch < 3; ++ch) buffer.values[begin + static_cast<size_t>(diagonal_slot)][ch] += lumped[ch];
-            coarse.offsets[row + 1] = static_cast<int32_t>(buffer.columns.size() - begin);
             clear(acc);
-        }
-    });
-    std::partial_sum(coarse.offsets.begin(), coarse.offsets.end(), coarse.offsets.begin());
-    coarse.columns.resize(static_cast<size_t>(coarse.offsets[m]));
-    for (auto& v : coarse.values) v.resize(coarse.columns.size());
-    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
-        const ChunkRows& buffer = buffers[chunk];
-        const auto out = static_cast<size_t>(coarse.offsets[chunk * kChunk]);
-        std::copy(buffer.columns.begin(), buffer.columns.end(), coarse.columns.begin() + static_cast<std::ptrdiff_t>(out));
-        for (size_t e = 0; e < buffer.values.size(); ++e)
-            for (size_t ch = 0; ch < 3; ++ch) coarse.values[ch][out + e] = buffer.values[e][ch];
-        for (size_t row = chunk * kChunk; row < std::min(m, (chunk + 1) * kChunk); ++row)
-            coarse.diagonal[row] += coarse.offsets[row];
-    });
+            return buffer.columns.size() - begin;
+        },
+        [&](size_t total) {
+            coarse.columns.resize(total);
+            for (auto& v : coarse.values) v.resize(total);
+        },
+        [&](size_t chunk, const ChunkRows& buffer) {
+            const auto out = static_cast<size_t>(coarse.offsets[chunk * kChunk]);
+            std::copy(buffer.columns.begin(), buffer.columns.end(), coarse.columns.begin() + static_cast<std::ptrdiff_t>(out));
+            for (size_t e = 0; e < buffer.values.size(); ++e)
+                for (size_t ch = 0; ch < 3; ++ch) coarse.values[ch][out + e] = buffer.values[e][ch];
+            for (size_t row = chunk * kChunk; row < std::min(m, (chunk + 1) * kChunk); ++row)
+                coarse.diagonal[row] += coarse.offsets[row];
+        });
 }
 
 void MultigridPreconditioner::clear(Accumulator& acc) {

@@ -21,29 +21,41 @@ void for_rows(size_t n, size_t grain, const Body& body) {
 
 // Compressed rows whose lengths are only known once each row is built, in one pass: rows are built
 // in fixed chunks of `chunk_rows` (so the result does not depend on the thread count), each chunk
-// appending its rows to its own buffer with append_row(row, buffer), and the buffers are
-// copied into `entries` once `offsets` (rows + 1 prefix sums) are known. Building every row twice
-// (count, then fill) would walk it twice; this walks it once and copies the entries once.
+// appending its rows to its own Buffer with append_row(row, buffer), which returns the row's length;
+// once `offsets` (rows + 1 prefix sums) are known, size_entries(total) sizes the destination and
+// place_chunk(chunk, buffer) copies each chunk's entries into place, from offsets[chunk * chunk_rows] on. Building every row twice (count, then
+// fill) would walk it twice; this walks it once and copies the entries once.
+template <typename Buffer, typename AppendRow, typename SizeEntries, typename PlaceChunk>
+void build_rows_in_chunks(size_t rows, size_t chunk_rows, std::vector<int32_t>& offsets, const AppendRow& append_row,
+                          const SizeEntries& size_entries, const PlaceChunk& place_chunk) {
+    const size_t chunks = (rows + chunk_rows - 1) / chunk_rows;
+    std::vector<Buffer> buffers(chunks);
+    offsets.assign(rows + 1, 0);
+    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
+        for (size_t row = chunk * chunk_rows; row < std::min(rows, (chunk + 1) * chunk_rows); ++row)
+            offsets[row + 1] = static_cast<int32_t>(append_row(row, buffers[chunk]));
+    });
+    for (size_t row = 0; row < rows; ++row) offsets[row + 1] += offsets[row];
+    size_entries(static_cast<size_t>(offsets[rows]));
+    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) { place_chunk(chunk, static_cast<const Buffer&>(buffers[chunk])); });
+}
+
+// The same when each row's entries are one array: append_row(row, buffer) appends the row's entries
+// to a std::vector<T>.
 template <typename T, typename AppendRow>
 void build_rows_in_chunks(size_t rows, size_t chunk_rows, std::vector<int32_t>& offsets, std::vector<T>& entries,
                           const AppendRow& append_row) {
-    const size_t chunks = (rows + chunk_rows - 1) / chunk_rows;
-    std::vector<std::vector<T>> buffers(chunks);
-    offsets.assign(rows + 1, 0);
-    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
-        std::vector<T>& buffer = buffers[chunk];
-        for (size_t row = chunk * chunk_rows; row < std::min(rows, (chunk + 1) * chunk_rows); ++row) {
+    build_rows_in_chunks<std::vector<T>>(
+        rows, chunk_rows, offsets,
+        [&](size_t row, std::vector<T>& buffer) {
             const size_t before = buffer.size();
             append_row(row, buffer);
-            offsets[row + 1] = static_cast<int32_t>(buffer.size() - before);
-        }
-    });
-    for (size_t row = 0; row < rows; ++row) offsets[row + 1] += offsets[row];
-    entries.resize(static_cast<size_t>(offsets[rows]));
-    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
-        std::copy(buffers[chunk].begin(), buffers[chunk].end(),
-                  entries.begin() + static_cast<std::ptrdiff_t>(offsets[chunk * chunk_rows]));
-    });
+            return buffer.size() - before;
+        },
+        [&](size_t total) { entries.resize(total); },
+        [&](size_t chunk, const std::vector<T>& buffer) {
+            std::copy(buffer.begin(), buffer.end(), entries.begin() + static_cast<std::ptrdiff_t>(offsets[chunk * chunk_rows]));
+        });
 }
 
 }  // namespace waxwork
