@@ -41,6 +41,8 @@ LiveBackend parse_live_backend(const std::string& name) {
 
 namespace {
 
+constexpr const char* kChannelNames[] = {"red", "green", "blue"};  // in the coarse pass's fallback notes
+
 // The editor's iteration budget (Jacobi CG iterations per channel) in multigrid V-cycles, so that a
 // budget costs about the same frame time in either method: one V-cycle for the three channels costs
 // about as much as 4 Jacobi CG iterations on the three channels (bench/live_solver_bench.cpp, spot at
@@ -246,7 +248,7 @@ void LiveSolver::right_hand_sides_changed() {
 void LiveSolver::solution_changed() {
     gpu_pending_.solution = true;
     multigrid_pending_.solution = true;
-    multires_pending_.solution = true;  // the solvers keep their own warm starts: solve the new state coarse to fine
+    multires_pending_.solution = true;  // start from the new host phi, corrected coarse to fine
     forget_estimates();
 }
 
@@ -563,13 +565,16 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<s
                                                               const std::array<bool, 3>& skip) {
     std::array<LiveSolverChannel, 3> out;
     if (iteration_budget > 0 && multires_pending_.solution) {
-        multires_->reset_warm_start();  // solve_frame then runs the coarse-to-fine pass
+        // solve_frame then runs the coarse-to-fine pass: on its own from a zero phi (a new scene), as a
+        // correction of the host phi otherwise (carried through a cut, or kept through a relaxation).
+        multires_->reset_warm_start();
+        for (int c = 0; c < 3; ++c)
+            if (phi[c].size() == multires_->hierarchy().levels[0].size()) multires_->set_warm_start(c, phi[c]);
         multires_pending_.solution = false;
     }
     MultiresSolveOptions options;
     options.relative_tolerance = relative_tolerance;
     int channels_left = static_cast<int>(std::count(skip.begin(), skip.end(), false));
-    static constexpr const char* kChannels[] = {"red", "green", "blue"};
     std::string coarse_fallbacks;
     bool coarse_pass = false;
     for (int c = 0; c < 3; ++c) {
@@ -592,7 +597,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<s
         if (!report.coarse_levels.empty()) {
             coarse_pass = true;
             if (const std::string reasons = report.fallback_reasons(); !reasons.empty())
-                coarse_fallbacks += (coarse_fallbacks.empty() ? "" : "; ") + (kChannels[c] + (": " + reasons));
+                coarse_fallbacks += (coarse_fallbacks.empty() ? "" : "; ") + (kChannelNames[c] + (": " + reasons));
         }
         multires_error_[c] = report.fine.estimated_relative_error;
         out[c] = {report.fine.iterations, report.fine.estimated_relative_error, report.fine.converged};
@@ -645,7 +650,29 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multires(const Diffusio
     fine.max_iterations = iteration_budget;
     fine.use_eigenvalue_hints = true;
     std::array<ConjugateGradientResult, 3> results;
-    if (multires_pending_.solution) {
+    const bool warm = std::any_of(phi.begin(), phi.end(), [](const std::vector<double>& p) {
+        return std::any_of(p.begin(), p.end(), [](double v) { return v != 0.0; });
+    });
+    if (multires_pending_.solution && warm) {
+        // The host phi corrected coarse to fine (MultiresSolver::set_warm_start) on the host hierarchy
+        // the device copy was made from, so both backends start the frame from the same vector; the
+        // pass runs once per rebuild, and level 0 then iterates on the device.
+        multires_->reset_warm_start();
+        std::vector<std::array<double, 3>> start(phi[0].size());
+        std::string coarse_fallbacks;
+        for (int c = 0; c < 3; ++c) {
+            multires_->set_warm_start(c, phi[c]);
+            MultiresSolveReport report;
+            const std::span<const double> corrected = multires_->solve_frame(b[c], c, 0, &report);
+            for (size_t v = 0; v < start.size(); ++v) start[v][c] = corrected[v];
+            if (const std::string reasons = report.fallback_reasons(); !reasons.empty())
+                coarse_fallbacks += (coarse_fallbacks.empty() ? "" : "; ") + (kChannelNames[c] + (": " + reasons));
+        }
+        note_coarse_fallbacks(coarse_fallbacks);
+        gpu_->multires->set_solution(start);
+        results = gpu_->multires->solve_fine(fine);
+        multires_pending_.solution = false;
+    } else if (multires_pending_.solution) {
         MultiresSolveOptions options;
         options.relative_tolerance = relative_tolerance;
         options.max_iterations = iteration_budget;

@@ -47,6 +47,9 @@ public:
     // on_iteration of the level-0 CG through `fine_options` (its tolerance and budget are taken from
     // `options`).
     GpuMultiresReport solve(const MultiresSolveOptions& options = {}, GpuCgOptions fine_options = {});
+    // Replaces the resident solution (a start computed on the host, e.g. MultiresSolver's corrected
+    // warm start, for solve_frame or solve_fine to continue from).
+    void set_solution(const std::vector<std::array<double, 3>>& phi) { fine_.set_solution(phi); }
     // Level-0 CG only, at most `iteration_budget` iterations from the resident solution.
     bool solve_frame(int iteration_budget, double relative_tolerance) {
         return fine_.solve_frame(iteration_budget, relative_tolerance);

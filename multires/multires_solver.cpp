@@ -81,7 +81,26 @@ std::vector<std::vector<int32_t>> MultiresSolver::update_values(const DiffusionM
 
 void MultiresSolver::reset_warm_start() {
     for (auto& s : last_solution_) s.clear();
+    correct_last_ = {};
     eigenvalue_hint_ = {};
+}
+
+void MultiresSolver::set_warm_start(int channel, std::span<const double> start) {
+    check_channel(channel);
+    const size_t n0 = hierarchy_.levels[0].size();
+    if (start.size() != n0)
+        throw InvalidArgumentError("multires set_warm_start: a start of size " + std::to_string(start.size()) + " for " +
+                                   std::to_string(n0) + " vertices");
+    if (!std::all_of(start.begin(), start.end(), [](double v) { return std::isfinite(v); }))
+        throw InvalidArgumentError("multires set_warm_start: the start is not finite");
+    const auto c = static_cast<size_t>(channel);
+    if (std::all_of(start.begin(), start.end(), [](double v) { return v == 0.0; })) {
+        last_solution_[c].clear();  // the cold pass, exactly as the paper runs it
+        correct_last_[c] = false;
+        return;
+    }
+    last_solution_[c].assign(start.begin(), start.end());
+    correct_last_[c] = true;
 }
 
 void MultiresSolver::solve_fine(std::span<const double> b, int channel, std::span<double> x,
@@ -123,6 +142,15 @@ MultiresSolveReport MultiresSolver::solve_within(std::span<const double> b, int 
         throw InvalidArgumentError("multires solve: vectors of size " + std::to_string(b.size()) + " and " +
                                    std::to_string(x.size()) + " for " + std::to_string(n0) + " vertices");
     MultiresSolveReport report;
+    coarse_pass(b, channel, x, options, report);
+    solve_fine(b, channel, x, options, report, deadline);
+    std::vector<double>& last = last_solution_[static_cast<size_t>(channel)];
+    if (last.data() != x.data()) last.assign(x.begin(), x.end());  // solve_frame passes `last` itself
+    return report;
+}
+
+void MultiresSolver::coarse_pass(std::span<const double> b, int channel, std::span<double> x,
+                                 const MultiresSolveOptions& options, MultiresSolveReport& report) {
     const auto start = std::chrono::steady_clock::now();
     const size_t levels = hierarchy_.level_count();
     std::vector<double> coarse_x;  // the current level's iterate, starting on the coarsest level at zero
@@ -162,10 +190,28 @@ MultiresSolveReport MultiresSolver::solve_within(std::span<const double> b, int 
         std::fill(x.begin(), x.end(), 0.0);
     }
     report.coarse_ms = elapsed_ms(start);
-    solve_fine(b, channel, x, options, report, deadline);
-    std::vector<double>& last = last_solution_[static_cast<size_t>(channel)];
-    if (last.data() != x.data()) last.assign(x.begin(), x.end());  // solve_frame passes `last` itself
-    return report;
+}
+
+void MultiresSolver::correct_start(std::span<const double> b, int channel, std::span<double> x,
+                                   const MultiresSolveOptions& options, MultiresSolveReport& report) {
+    const size_t n = x.size();
+    const CsrMatrixView<double> matrix = hierarchy_.levels[0].view(channel);
+    std::vector<double> residual(n), correction(n), product(n);
+    multiply<double>(matrix, x, residual);
+    for (size_t i = 0; i < n; ++i) residual[i] = b[i] - residual[i];
+    coarse_pass(residual, channel, correction, options, report);
+    multiply<double>(matrix, correction, product);
+    double along = 0, curvature = 0;  // e.r and e.M e
+    for (size_t i = 0; i < n; ++i) {
+        along += correction[i] * residual[i];
+        curvature += correction[i] * product[i];
+    }
+    // The energy of x + alpha e falls by along^2 / (2 curvature) at this alpha; a zero (one level, or
+    // every coarse level skipped) or non-finite correction leaves x as it was.
+    const double alpha = curvature > 0 && std::isfinite(along) && std::isfinite(curvature) ? along / curvature : 0.0;
+    if (alpha != 0)
+        for (size_t i = 0; i < n; ++i) x[i] += alpha * correction[i];
+    report.start_correction = alpha;
 }
 
 std::span<const double> MultiresSolver::solve_frame(std::span<const double> b, int channel, int iteration_budget,
@@ -192,13 +238,19 @@ std::span<const double> MultiresSolver::solve_frame_within(std::span<const doubl
     budgeted.max_iterations = max_iterations;
     std::vector<double>& last = last_solution_[static_cast<size_t>(channel)];
     MultiresSolveReport local;
+    bool& correct = correct_last_[static_cast<size_t>(channel)];
     if (last.size() != hierarchy_.levels[0].size()) {
         last.assign(hierarchy_.levels[0].size(), 0.0);
+        correct = false;
         local = solve_within(b, channel, last, budgeted, deadline);
     } else {
         if (b.size() != last.size())
             throw InvalidArgumentError("multires solve_frame: right-hand side of size " + std::to_string(b.size()) +
                                        " for " + std::to_string(last.size()) + " vertices");
+        if (correct) {
+            correct = false;
+            correct_start(b, channel, last, budgeted, local);
+        }
         solve_fine(b, channel, last, budgeted, local, deadline);
     }
     if (report) *report = std::move(local);

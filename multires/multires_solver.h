@@ -11,6 +11,14 @@
 // The object keeps its hierarchy and the last solution per channel, so a frame whose matrix pattern
 // is unchanged (relighting, painting within tolerance) warm-starts from the previous frame
 // (solve_frame) instead of repeating the coarse-to-fine pass.
+//
+// Corrected warm start (beyond the paper). After a rebuild the paper starts again from zero with the
+// coarse-to-fine pass. When a close start exists (the last solution carried through a cut's vertex
+// map, or the same vertices after relaxation), set_warm_start keeps it and lets the pass correct it:
+// the pass runs on the residual equation M^0 e = b - M^0 x0 and level 0 starts at x0 + alpha e. The
+// pass leaves a fraction of the error it is given; given x0's error rather than phi itself, it leaves
+// a fraction of that. alpha = e.r / e.M^0 e minimises the energy norm of the error along e (M^0 is SPD),
+// so the start is never worse than x0 in that norm, whatever the non-symmetric coarse levels returned.
 #pragma once
 
 #include "multires/bicgstab.h"
@@ -20,6 +28,7 @@
 #include "solver/frame_budget.h"
 
 #include <array>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -54,6 +63,9 @@ struct MultiresSolveReport {
     std::string fine_failure;          // what the level-0 CG reported, if anything
     double coarse_ms = 0;
     double fine_ms = 0;
+    // A frame that corrected a warm start (set_warm_start): the step alpha taken along the coarse
+    // correction (0: the correction did not help and the start was kept as it was). Empty otherwise.
+    std::optional<double> start_correction;
 
     int fallbacks() const {
         int count = 0;
@@ -112,6 +124,11 @@ public:
 
     // Forget the previous frames' solutions (after an edit that changes the solution a lot).
     void reset_warm_start();
+    // The next solve_frame of `channel` starts from `start` corrected by the coarse-to-fine pass (see
+    // the top of this file) instead of from the pass alone; later frames warm-start from its result.
+    // An all-zero start is the cold pass itself (as after reset_warm_start). Throws
+    // InvalidArgumentError for a start whose size is not level 0's or that is not finite.
+    void set_warm_start(int channel, std::span<const double> start);
 
 private:
     MultiresSolveReport solve_within(std::span<const double> b, int channel, std::span<double> x,
@@ -121,9 +138,18 @@ private:
                                                const FrameDeadline& deadline);
     void solve_fine(std::span<const double> b, int channel, std::span<double> x, const MultiresSolveOptions& options,
                     MultiresSolveReport& report, const FrameDeadline& deadline);
+    // The coarse-to-fine pass for right-hand side b: x = the interpolated level-1 iterate (zero with one
+    // level); fills report.coarse_levels and report.coarse_ms.
+    void coarse_pass(std::span<const double> b, int channel, std::span<double> x, const MultiresSolveOptions& options,
+                     MultiresSolveReport& report);
+    // x = x + alpha e with e the coarse pass on b - M^0 x and alpha the energy-minimising step (top of
+    // this file); records alpha in report.start_correction.
+    void correct_start(std::span<const double> b, int channel, std::span<double> x, const MultiresSolveOptions& options,
+                       MultiresSolveReport& report);
 
     MultiresHierarchy hierarchy_;
     std::array<std::vector<double>, 3> last_solution_;
+    std::array<bool, 3> correct_last_{};  // set_warm_start: the next frame corrects last_solution_ first
     std::array<double, 3> eigenvalue_hint_{};
 };
 
