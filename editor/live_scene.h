@@ -18,10 +18,12 @@
 //
 // Solver choice: Jacobi-preconditioned CG in double, warm-started, per channel. The multires solver
 // (multires/multires_solver.h) is not the default: between rebuilds its frames are this same warm
-// Jacobi CG, and its hierarchy (82 ms at 500K, README) adds to every cut. Multigrid CG converges in
-// fewer, cheaper frames but adds its setup (hierarchy and Galerkin operators, about 280 ms at 500K) to
-// every cut, whose budget is 500 ms. LiveSceneOptions::method and backend select multigrid CG, the
-// paper's multires or the GPU instead (live_solver.h).
+// Jacobi CG, and its hierarchy adds to every cut. Multigrid CG converges in fewer, cheaper frames but
+// adds its setup (hierarchy and Galerkin operators) to every cut. From a cut to an image under 1%
+// error the three come out even, because the phi carried through the cut is already a close start
+// (bench/live_solver_bench.cpp BM_CutToSettledImage; README, "From a cut to a settled image").
+// LiveSceneOptions::method and backend select multigrid CG, the paper's multires or the GPU instead
+// (live_solver.h).
 //
 // Threading: every public member locks one internal mutex, so the window may call step() on a worker
 // thread while the UI thread applies edits; apply_change() and set_lighting() then wait for the

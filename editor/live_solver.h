@@ -21,7 +21,10 @@
 //   multires             multires/multires_solver.h (CPU) or multires/gpu_multires_solver.h (GPU): the
 //                        paper's own per-frame scheme (Sec. 4). The first frame after a (re)build (or a
 //                        replaced phi) solves coarse to fine (BiCGSTAB on the coarse levels of the Eq. 17
-//                        hierarchy, Eq. 16 interpolation, CG on level 0 within the frame's budget); later
+//                        hierarchy, Eq. 16 interpolation, CG on level 0 within the frame's budget): from
+//                        zero in a new scene, and as a correction of the host phi when there is one (a
+//                        cut's carried phi, a relaxation's; MultiresSolver::set_warm_start, computed on
+//                        the host for the GPU backend too, so both start from the same vector); later
 //                        frames run only the level-0 Jacobi CG, warm from the previous frame's phi (a light
 //                        change: new right-hand sides, same warm start). Painting updates the changed
 //                        level-0 rows and the coarse rows depending on them (MultiresSolver::update_values
@@ -147,7 +150,8 @@ public:
     //   CPU Jacobi CG and multires  the level-0 CG of each channel stops at its share of the time left
     //                               (remaining / channels left, so a channel that finishes early leaves
     //                               its time to the next); at least one iteration per channel. The
-    //                               multires frame after a rebuild runs its coarse-to-fine pass whole.
+    //                               multires frame after a rebuild runs its coarse-to-fine pass (or
+    //                               its correction of the carried phi) whole.
     //   CPU multigrid CG            the deadline is checked between V-cycles (at least one runs).
     //   GPU multigrid CG            as the CPU multigrid CG: the deadline is checked between V-cycles.
     //   GPU (other methods)         the device queue cannot stop part-way: the budget becomes an
@@ -274,8 +278,9 @@ private:
     // The last frame's estimates, reported by a frame of no V-cycles (1 after a change).
     std::array<double, 3> multigrid_error_{1, 1, 1};
     std::unique_ptr<MultiresSolver> multires_;
-    // Values, and `solution`: the next frame solves coarse to fine (after a rebuild or a replaced phi;
-    // the CPU's warm starts are the solver's own last solutions), on the host or the device.
+    // Values, and `solution`: the next frame solves coarse to fine (after a rebuild or a replaced phi),
+    // correcting the host phi unless it is zero; between those frames the CPU's warm starts are the
+    // solver's own last solutions, the device's its resident phi.
     PendingChanges multires_pending_;
     std::array<double, 3> multires_error_{1, 1, 1};  // reported by a frame of no iterations
     // Rows per level the device copy of the hierarchy has not received yet (ascending, unique); all of
