@@ -100,11 +100,9 @@ void run_solvers_command(const SolversCommandOptions& o) {
         {"tets", comparison.tets},
         {"vertices", comparison.vertices},
         {"levels", comparison.levels},
-        {"hierarchy_ms", comparison.hierarchy_ms},
-        {"multigrid_setup_ms", comparison.multigrid_setup_ms},
-        {"multigrid_rgb_setup_ms", comparison.multigrid_rgb_setup_ms},
-        {"time_to_1pct_ms", summary_times},
     };
+    for (const auto& [key, ms] : setup_times(comparison)) summary[key] = ms;
+    summary["time_to_1pct_ms"] = summary_times;
     if (context) summary["gpu_renderer"] = context->renderer();
     std::cout << summary.dump() << "\n";
 }

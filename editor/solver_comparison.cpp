@@ -50,6 +50,15 @@ struct Run {
     double ms = 0, error = 1;
 };
 
+// The median of three more runs of a setup whose first run the caller timed; run_ms builds it once
+// and returns its time (what it built is freed before the next run, as in an edit).
+double median_rebuild_ms(const std::function<double()>& run_ms) {
+    std::array<double, 3> ms{};
+    for (double& m : ms) m = run_ms();
+    std::sort(ms.begin(), ms.end());
+    return ms[1];
+}
+
 class Measurer {
 public:
     Measurer(const Fields& reference, const SolverComparisonOptions& options)
@@ -194,6 +203,8 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
     MultiresSolver multires(matrix, mesh.positions);
     result.levels = multires.hierarchy().level_count();
     result.hierarchy_ms = multires.hierarchy().build_ms;
+    result.hierarchy_rebuild_ms =
+        median_rebuild_ms([&] { return build_multires_hierarchy(matrix, mesh.positions).build_ms; });
     result.solvers.push_back(measurer.curve("multires", [&](int cap, Fields& x) {
         MultiresSolveOptions solve;
         solve.relative_tolerance = 1e-15;
@@ -204,6 +215,8 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
     // Multigrid-preconditioned CG on the same hierarchy (multigrid_cg.h).
     MultigridPreconditioner multigrid(multires.hierarchy());
     result.multigrid_setup_ms = multigrid.setup_ms();
+    result.multigrid_setup_rebuild_ms =
+        median_rebuild_ms([&] { return MultigridPreconditioner(multires.hierarchy()).setup_ms(); });
     result.solvers.push_back(measurer.curve("multigrid_cg", [&](int cap, Fields& x) {
         for (int c = 0; c < 3; ++c)
             solve_multigrid_cg(multigrid, c, b_copy[static_cast<size_t>(c)], x[static_cast<size_t>(c)], exact_iteration_count(cap));
@@ -220,6 +233,11 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
         const auto setup_start = std::chrono::steady_clock::now();
         MultigridFrameSolver frame(matrix, mesh.positions, frame_options);
         result.multigrid_rgb_setup_ms = elapsed_ms(setup_start);
+        result.multigrid_rgb_setup_rebuild_ms = median_rebuild_ms([&] {
+            const auto start = std::chrono::steady_clock::now();
+            const MultigridFrameSolver rebuilt(matrix, mesh.positions, frame_options);
+            return elapsed_ms(start);
+        });
         const std::array<std::span<const double>, 3> rhs{b_copy[0], b_copy[1], b_copy[2]};
         result.solvers.push_back(measurer.curve("multigrid_cg_rgb", [&](int cap, Fields& x) {
             // Cap 0 is the cold start alone (phi = 0; step() needs a budget >= 1), timed like the other
@@ -307,6 +325,15 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
     return result;
 }
 
+std::vector<std::pair<std::string, double>> setup_times(const SolverComparison& comparison) {
+    return {{"hierarchy_ms", comparison.hierarchy_ms},
+            {"hierarchy_rebuild_ms", comparison.hierarchy_rebuild_ms},
+            {"multigrid_setup_ms", comparison.multigrid_setup_ms},
+            {"multigrid_setup_rebuild_ms", comparison.multigrid_setup_rebuild_ms},
+            {"multigrid_rgb_setup_ms", comparison.multigrid_rgb_setup_ms},
+            {"multigrid_rgb_setup_rebuild_ms", comparison.multigrid_rgb_setup_rebuild_ms}};
+}
+
 void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const std::string& mesh_name,
                              const SolverComparison& comparison) {
     nlohmann::ordered_json solvers = nlohmann::ordered_json::object();
@@ -322,16 +349,14 @@ void write_solver_comparison(const std::filesystem::path& dir, const std::string
         for (const auto& [ms, error] : s.curve) line.points.emplace_back(ms, std::max(error, 1e-16));
         series.push_back(std::move(line));
     }
-    const nlohmann::ordered_json json = {
+    nlohmann::ordered_json json = {
         {"mesh", mesh_name},
         {"tets", comparison.tets},
         {"vertices", comparison.vertices},
         {"levels", comparison.levels},
-        {"hierarchy_ms", comparison.hierarchy_ms},
-        {"multigrid_setup_ms", comparison.multigrid_setup_ms},
-        {"multigrid_rgb_setup_ms", comparison.multigrid_rgb_setup_ms},
-        {"solvers", solvers},
     };
+    for (const auto& [key, ms] : setup_times(comparison)) json[key] = ms;
+    json["solvers"] = solvers;
     write_file_atomically(dir / (stem + ".json"), [&](std::ostream& out) { out << json.dump(2) << "\n"; });
 
     ChartOptions chart;

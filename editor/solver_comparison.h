@@ -16,10 +16,10 @@
 // precision floor), or after max_seconds of measuring. time_to_1pct_ms: the smallest cap with error
 // <= target_error is found by bisection between the curve's bracketing caps and timed again.
 //
-// What is timed. Per-mesh setup that a frame does not repeat is excluded and reported separately: the
-// multires hierarchy (hierarchy_ms), the multigrid Galerkin operators and coarsest factorisation
-// (multigrid_setup_ms), the frame solver's own hierarchy, Galerkin operators and interleaved matrix
-// (multigrid_rgb_setup_ms), the float copies of the matrices and the Eigen sparse matrices. Eigen's
+// What is timed. Per-mesh setup that a frame does not repeat is excluded and reported separately, as
+// its first run and as a rebuild (SolverComparison): the multires hierarchy (hierarchy_ms), the
+// multigrid Galerkin operators and coarsest factorisation (multigrid_setup_ms), the frame solver's own
+// hierarchy, Galerkin operators and interleaved matrix (multigrid_rgb_setup_ms), the float copies of the matrices and the Eigen sparse matrices. Eigen's
 // incomplete Cholesky factorisation is part of every eigen_ic_cg run (its API factorises per solve),
 // and the direct solver's time is factorisation plus solve.
 #pragma once
@@ -59,9 +59,13 @@ struct SolverCurve {
 
 struct SolverComparison {
     size_t tets = 0, vertices = 0, levels = 0;
-    double hierarchy_ms = 0;
-    double multigrid_setup_ms = 0;
-    double multigrid_rgb_setup_ms = 0;  // MultigridFrameSolver's constructor (its own hierarchy included)
+    // Per-mesh setup, each twice: its first run in the process (which also maps every fresh page it
+    // touches), and *_rebuild_ms, the median of three runs after it, which reuse the memory freed by
+    // the run before, as the editor's rebuild after a cut does (editor/memory_reuse.h).
+    double hierarchy_ms = 0, hierarchy_rebuild_ms = 0;
+    double multigrid_setup_ms = 0, multigrid_setup_rebuild_ms = 0;
+    // MultigridFrameSolver's constructor (its own hierarchy included).
+    double multigrid_rgb_setup_ms = 0, multigrid_rgb_setup_rebuild_ms = 0;
     std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, multigrid_cg_rgb,
                                        // eigen_ic_cg, [gpu_cg, gpu_multires, gpu_multigrid_cg,] direct
     std::string gpu_fallback_reason;   // options.gl given but the GPU could not run (curves left out)
@@ -74,10 +78,13 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
                                  const std::vector<TetMaterial>& materials, const Lighting& lighting,
                                  const SolverComparisonOptions& options);
 
-// Writes DIR/STEM.json, {"mesh", "tets", "vertices", "levels", "hierarchy_ms", "multigrid_setup_ms",
-// "multigrid_rgb_setup_ms", "solvers": {NAME: {"time_to_1pct_ms", "cap_to_1pct", "curve": [[ms, rel_error],
-// ...]}}}, and DIR/STEM.svg (error against time, one line per solver), atomically. `mesh_name` is
-// recorded as given.
+// The setup times as (JSON key, ms) in the order written: hierarchy_ms, hierarchy_rebuild_ms,
+// multigrid_setup_ms, multigrid_setup_rebuild_ms, multigrid_rgb_setup_ms, multigrid_rgb_setup_rebuild_ms.
+std::vector<std::pair<std::string, double>> setup_times(const SolverComparison& comparison);
+
+// Writes DIR/STEM.json, {"mesh", "tets", "vertices", "levels", setup_times..., "solvers": {NAME:
+// {"time_to_1pct_ms", "cap_to_1pct", "curve": [[ms, rel_error], ...]}}}, and DIR/STEM.svg (error against
+// time, one line per solver), atomically. `mesh_name` is recorded as given.
 void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const std::string& mesh_name,
                              const SolverComparison& comparison);
 
