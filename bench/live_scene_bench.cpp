@@ -114,21 +114,12 @@ void BM_PaintFrames(benchmark::State& state) {
 }
 BENCHMARK(BM_PaintFrames)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-PlaneCutOp middle_cut(const TetMesh& mesh) {
-    const auto box = bounding_box(mesh);
-    PlaneCutOp op;
-    op.plane.normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
-    op.plane.offset = op.plane.normal.dot(0.5 * (box[0] + box[1]));
-    op.relax.iterations = 10;
-    return op;
-}
-
 // The cut as the editor pays for it: tets removed, connectivity, 10 relaxation sweeps, undo snapshot
 // (Document::apply), then the live scene's rebuild of matrix, boundary, shadow BVH and q. Not included:
 // the solver frames after it.
 void BM_CutWithRebuild(benchmark::State& state) {
     const TetMesh& source = bench::spot_volume(kEditTets);
-    const PlaneCutOp cut = middle_cut(source);
+    const PlaneCutOp cut = bench::middle_cut(source);
     double apply_ms = 0, scene_ms = 0, undo_mib = 0;
     size_t tets_after = 0;
     for (auto _ : state) {

@@ -36,6 +36,17 @@ inline Lighting turning_light(double degrees) {
     return l;
 }
 
+// A slanted plane cut (normal (1, 0.3, 0.2)) through the middle of the bounding box, with 10
+// relaxation sweeps of the cut vertices.
+inline PlaneCutOp middle_cut(const TetMesh& mesh) {
+    const auto box = bounding_box(mesh);
+    PlaneCutOp op;
+    op.plane.normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
+    op.plane.offset = op.plane.normal.dot(0.5 * (box[0] + box[1]));
+    op.relax.iterations = 10;
+    return op;
+}
+
 // Frame f of `frames` of a paint stroke along spot's body near the top of its back: one ketchup dab
 // per frame, sigma 1% of the diagonal of the bounding box `box`.
 inline PaintOp body_stroke_dab(const std::array<Eigen::Vector3d, 2>& box, int f, int frames) {

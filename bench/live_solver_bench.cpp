@@ -162,17 +162,14 @@ BENCHMARK(BM_PaintFrames)->DenseRange(0, 5)->Iterations(1)->Unit(benchmark::kMil
 
 // The first frame after a plane cut through the middle (a new matrix): scene_ms is the scene's rebuild
 // (for multigrid CG and multires including the hierarchy), frame_ms one frame of the usual budget from
-// the cut's warm start (Jacobi CG, multigrid CG: the old phi through the vertex map; multires: its
-// coarse-to-fine pass, Sec. 4), true_error as above after that frame.
+// the cut's warm start (the old phi through the vertex map; multires corrects it with its
+// coarse-to-fine pass first, MultiresSolver::set_warm_start), true_error as above after that frame.
 void BM_FirstFrameAfterCut(benchmark::State& state) {
     const Variant& variant = kVariants[state.range(0)];
     Document doc(bench::spot_volume(kFrameTets), material_preset("marble"));
     LiveScene scene(doc.mesh(), turning_light(0), scene_options(doc.mesh(), variant));
     scene.converge();
-    const auto box = bounding_box(doc.mesh());
-    PlaneCutOp cut;
-    cut.plane.normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
-    cut.plane.offset = cut.plane.normal.dot(0.5 * (box[0] + box[1]));
+    const PlaneCutOp cut = bench::middle_cut(doc.mesh());
     double scene_ms = 0, frame_ms = 0;
     int iterations = 0;
     for (auto _ : state) {
@@ -206,10 +203,7 @@ void BM_CutToSettledImage(benchmark::State& state) {
     Document doc(bench::spot_volume(static_cast<size_t>(state.range(1))), material_preset("marble"));
     LiveScene scene(doc.mesh(), turning_light(0), scene_options(doc.mesh(), variant));
     scene.converge();
-    const auto box = bounding_box(doc.mesh());
-    PlaneCutOp cut;
-    cut.plane.normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
-    cut.plane.offset = cut.plane.normal.dot(0.5 * (box[0] + box[1]));
+    const PlaneCutOp cut = bench::middle_cut(doc.mesh());
     constexpr int kMaxFrames = 400;
     double scene_ms = 0, settle_ms = -1, converged_ms = -1;
     int frames_to_settle = -1, frames_to_converge = -1;
