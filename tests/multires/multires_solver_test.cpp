@@ -371,5 +371,18 @@ TEST(MultiresSolver, ZeroWarmStartIsTheColdPassAndBadStartsAreRejected) {
     EXPECT_THROW(b.set_warm_start(3, zero), InvalidArgumentError);
 }
 
+TEST(MultiresSolver, WithOneLevelTheWarmStartIsKeptAsItIs) {
+    const auto s = testing::make_test_system(2);  // 27 vertices: below min_coarse_vertices
+    MultiresSolver solver(s.matrix, s.mesh.positions);
+    ASSERT_EQ(solver.hierarchy().level_count(), 1u);
+    const std::vector<double> start(s.b[0].size(), 0.5);
+    solver.set_warm_start(0, start);
+    MultiresSolveReport report;
+    EXPECT_EQ(frame_start(solver, s.b[0], 0, &report), start);  // no coarse level: nothing to correct with
+    ASSERT_TRUE(report.start_correction.has_value());
+    EXPECT_EQ(*report.start_correction, 0.0);
+    EXPECT_TRUE(report.coarse_levels.empty());
+}
+
 }  // namespace
 }  // namespace waxwork
