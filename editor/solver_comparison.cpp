@@ -1,5 +1,6 @@
 #include "editor/solver_comparison.h"
 
+#include "editor/repeated_timing.h"
 #include "editor/svg_chart.h"
 #include "io/atomic_file.h"
 #include "multires/gpu_multigrid_frame_solver.h"
@@ -50,14 +51,9 @@ struct Run {
     double ms = 0, error = 1;
 };
 
-// The median of three more runs of a setup whose first run the caller timed; run_ms builds it once
-// and returns its time (what it built is freed before the next run, as in an edit).
-double median_rebuild_ms(const std::function<double()>& run_ms) {
-    std::array<double, 3> ms{};
-    for (double& m : ms) m = run_ms();
-    std::sort(ms.begin(), ms.end());
-    return ms[1];
-}
+// A setup rebuilt after its first run (which the caller timed): the median of three more runs, each
+// freeing what it built before the next, as an edit does.
+double median_rebuild_ms(const std::function<double()>& run_ms) { return median_run_ms(3, run_ms); }
 
 class Measurer {
 public:

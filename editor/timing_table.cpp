@@ -1,6 +1,7 @@
 #include "editor/timing_table.h"
 
 #include "editor/render_pipeline.h"
+#include "editor/repeated_timing.h"
 #include "io/surface_reader.h"
 #include "multires/multires_solver.h"
 #include "solver/diffusion_matrix.h"
@@ -12,8 +13,10 @@
 #include "tetops/relaxation.h"
 #include "tetops/tetrahedralize.h"
 
+#include <array>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 namespace waxwork {
@@ -24,12 +27,6 @@ using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
-
-struct SolverState {
-    TetConnectivity connectivity;
-    DiffusionMatrix matrix;
-    std::unique_ptr<MultiresSolver> solver;
-};
 
 }  // namespace
 
@@ -58,35 +55,54 @@ TimingRow measure_timing_row(const std::filesystem::path& surface_path, const Ti
     AssemblyOptions assembly;
     assembly.mm_per_unit = options.mm_per_unit;
     std::vector<TetMaterial> materials(mesh.tet_count(), material);
+    const int runs = options.runs;
 
-    auto start = Clock::now();
-    TetConnectivity connectivity = build_connectivity(mesh);
-    row.connectivity_ms = ms_since(start);
-    start = Clock::now();
-    DiffusionMatrix matrix = assemble_diffusion_matrix(mesh, connectivity, materials, assembly);
-    row.matrix_ms = ms_since(start);
-    start = Clock::now();
-    MultiresSolver solver(matrix, mesh.positions);
-    row.hierarchy_ms = ms_since(start);
+    // Each stage runs `runs` times and its median is kept; what a run built is released before the
+    // next run starts its clock, and the last run's result feeds the next stage.
+    std::optional<TetConnectivity> connectivity;
+    row.connectivity_ms = median_run_ms(runs, [&] {
+        connectivity.reset();
+        const auto start = Clock::now();
+        connectivity.emplace(build_connectivity(mesh));
+        return ms_since(start);
+    });
+    std::optional<DiffusionMatrix> matrix;
+    row.matrix_ms = median_run_ms(runs, [&] {
+        matrix.reset();
+        const auto start = Clock::now();
+        matrix.emplace(assemble_diffusion_matrix(mesh, *connectivity, materials, assembly));
+        return ms_since(start);
+    });
+    std::optional<MultiresSolver> solver;
+    row.hierarchy_ms = median_run_ms(runs, [&] {
+        solver.reset();
+        const auto start = Clock::now();
+        solver.emplace(*matrix, mesh.positions);
+        return ms_since(start);
+    });
     row.build_ms = row.connectivity_ms + row.hierarchy_ms;
-    row.levels = static_cast<int>(solver.hierarchy().level_count());
+    row.levels = static_cast<int>(solver->hierarchy().level_count());
 
     Lighting lighting;
     lighting.lights.push_back(default_key_light());
-    const std::vector<Rgb> q = incident_light(mesh, connectivity, materials, lighting);
+    const std::vector<Rgb> q = incident_light(mesh, *connectivity, materials, lighting);
+    std::array<std::vector<double>, 3> b;  // not timed: q is the lighting's share
+    for (int c = 0; c < 3; ++c) {
+        b[static_cast<size_t>(c)].resize(matrix->size());
+        diffusion_right_hand_side(*matrix, q, c, b[static_cast<size_t>(c)]);
+    }
     MultiresSolveOptions solve_options;
     solve_options.relative_tolerance = 0.01;
-    std::vector<double> b(matrix.size()), x(matrix.size());
-    double solve_ms = 0;
-    for (int c = 0; c < 3; ++c) {
-        diffusion_right_hand_side(matrix, q, c, b);  // not timed: q is the lighting's share
-        start = Clock::now();
-        solver.solve(b, c, x, solve_options);
-        solve_ms += ms_since(start);
-    }
-    row.solve_ms = solve_ms;
+    std::vector<double> x(matrix->size());
+    row.solve_ms = median_run_ms(runs, [&] {
+        const auto start = Clock::now();
+        for (int c = 0; c < 3; ++c) solver->solve(b[static_cast<size_t>(c)], c, x, solve_options);
+        return ms_since(start);
+    });
 
-    // Paint first (on the uncut mesh, as the paper's Fig. 10): a 100-point stroke across the box.
+    // Paint first (on the uncut mesh, as the paper's Fig. 10): a 100-point stroke across the box, each
+    // run on fresh copies of the mesh, matrix and hierarchy.
+    mesh.materials = materials;
     {
         const auto box = bounding_box(mesh);
         std::vector<Eigen::Vector3d> stroke;
@@ -98,30 +114,41 @@ TimingRow measure_timing_row(const std::filesystem::path& surface_path, const Ti
         PaintBrush brush;
         brush.material = material_preset("skin1");
         brush.sigma = 0.01 * (box[1] - box[0]).norm();
-        mesh.materials = materials;
-        start = Clock::now();
-        const PaintResult painted = paint_stroke(mesh, index, stroke, brush);
-        const std::vector<int32_t> rows =
-            update_diffusion_matrix(matrix, mesh, connectivity, mesh.materials, painted.changed_tets);
-        solver.update_values(matrix, rows);  // only the coarse rows that depend on the painted ones
-        row.paint_ms = ms_since(start);
-        materials = mesh.materials;
+        std::vector<TetMaterial> painted_materials;
+        row.paint_ms = median_run_ms(runs, [&] {
+            TetMesh painted = mesh;
+            DiffusionMatrix painted_matrix = *matrix;
+            MultiresSolver painted_solver = *solver;
+            const auto start = Clock::now();
+            const PaintResult result = paint_stroke(painted, index, stroke, brush);
+            const std::vector<int32_t> rows =
+                update_diffusion_matrix(painted_matrix, painted, *connectivity, painted.materials, result.changed_tets);
+            painted_solver.update_values(painted_matrix, rows);  // only the coarse rows that depend on the painted ones
+            const double ms = ms_since(start);
+            painted_materials = std::move(painted.materials);
+            return ms;
+        });
+        mesh.materials = std::move(painted_materials);
     }
 
-    // Cut: a slanted plane through the middle, relaxation, and every rebuild the next frame needs.
+    // Cut: a slanted plane through the middle, relaxation, and every rebuild the next frame needs, each
+    // run on a fresh copy of the painted mesh.
     {
         const auto box = bounding_box(mesh);
         const Eigen::Vector3d normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
         const PlaneCut plane(normal, normal.dot(0.5 * (box[0] + box[1])));
-        start = Clock::now();
-        remove_cut_away_tets(mesh, plane);
-        const TetConnectivity cut_connectivity = build_connectivity(mesh);
-        RelaxationOptions relax;
-        relax.max_iterations = 10;
-        relax_cut_vertices(mesh, cut_connectivity, plane, relax);
-        const DiffusionMatrix cut_matrix = assemble_diffusion_matrix(mesh, cut_connectivity, mesh.materials, assembly);
-        const MultiresSolver cut_solver(cut_matrix, mesh.positions);
-        row.cut_ms = ms_since(start);
+        row.cut_ms = median_run_ms(runs, [&] {
+            TetMesh cut = mesh;
+            const auto start = Clock::now();
+            remove_cut_away_tets(cut, plane);
+            const TetConnectivity cut_connectivity = build_connectivity(cut);
+            RelaxationOptions relax;
+            relax.max_iterations = 10;
+            relax_cut_vertices(cut, cut_connectivity, plane, relax);
+            const DiffusionMatrix cut_matrix = assemble_diffusion_matrix(cut, cut_connectivity, cut.materials, assembly);
+            const MultiresSolver cut_solver(cut_matrix, cut.positions);
+            return ms_since(start);
+        });
     }
     return row;
 }

@@ -48,11 +48,15 @@ struct TimingOptions {
     std::string material = "marble";
     double mm_per_unit = 30;
     size_t target_tets = 500'000;
+    int runs = 3;  // each stage's time is the median of this many runs
 };
 
 // Meshes `surface` with TetGen to about target_tets (with CGAL Mesh_3 when TetGen cannot: it keeps every
-// input triangle, so a detailed surface such as the skull needs more tets) and times each stage once
-// (first run, as an interactive user would see it). Throws what meshing and solving throw.
+// input triangle, so a detailed surface such as the skull needs more tets) and times each stage
+// options.runs times, keeping the median: single runs on this machine vary by 10-30%, and the first
+// run of a stage in a process also maps every fresh page it touches (README, "Memory between edits"),
+// which would land on whichever model comes first. The paint stroke and the cut each run on fresh
+// copies of their input (copying not timed). Throws what meshing and solving throw.
 TimingRow measure_timing_row(const std::filesystem::path& surface, const TimingOptions& options);
 
 nlohmann::ordered_json to_json(const std::vector<TimingRow>& rows);
