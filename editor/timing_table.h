@@ -55,8 +55,8 @@ struct TimingOptions {
 // input triangle, so a detailed surface such as the skull needs more tets) and times each stage
 // options.runs times, keeping the median: single runs on this machine vary by 10-30%, and the first
 // run of a stage in a process also maps every fresh page it touches (README, "Memory between edits"),
-// which would land on whichever model comes first. The paint stroke and the cut each run on fresh
-// copies of their input (copying not timed). Throws what meshing and solving throw.
+// which would land on whichever model comes first. The cut runs on a fresh copy of the painted mesh
+// each time (copying not timed). Throws what meshing and solving throw.
 TimingRow measure_timing_row(const std::filesystem::path& surface, const TimingOptions& options);
 
 nlohmann::ordered_json to_json(const std::vector<TimingRow>& rows);
