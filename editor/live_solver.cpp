@@ -623,7 +623,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multires(const Diffusio
         renderer_ = renderer ? reinterpret_cast<const char*>(renderer) : "";
         gpu_pending_ = PendingChanges{};  // a new device copy: the current values; b to send
         gpu_level_rows_.clear();
-        multires_pending_.solution = true;  // its phi starts at zero: coarse to fine
+        multires_pending_.solution = true;  // its phi starts at zero: start from the host phi (below)
     } else if (gpu_pending_.all_values) {
         // All values: every row of every level (the uploaded patterns stay).
         std::vector<std::vector<int32_t>> all(hierarchy.level_count());
