@@ -41,7 +41,13 @@ LiveBackend parse_live_backend(const std::string& name) {
 
 namespace {
 
-constexpr const char* kChannelNames[] = {"red", "green", "blue"};  // in the coarse pass's fallback notes
+// Adds channel c's skipped coarse levels, if any, to the notes of a coarse-to-fine pass ("red: level
+// 3: ...; blue: ..."), which note_coarse_fallbacks shows.
+void append_coarse_fallbacks(std::string& notes, int c, const MultiresSolveReport& report) {
+    static constexpr const char* kChannelNames[] = {"red", "green", "blue"};
+    if (const std::string reasons = report.fallback_reasons(); !reasons.empty())
+        notes += (notes.empty() ? "" : "; ") + (kChannelNames[c] + (": " + reasons));
+}
 
 // The editor's iteration budget (Jacobi CG iterations per channel) in multigrid V-cycles, so that a
 // budget costs about the same frame time in either method: one V-cycle for the three channels costs
@@ -596,8 +602,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_multires(const std::array<s
         std::copy(solved.begin(), solved.end(), phi[c].begin());  // the host copy: radiance, saves, cuts
         if (!report.coarse_levels.empty()) {
             coarse_pass = true;
-            if (const std::string reasons = report.fallback_reasons(); !reasons.empty())
-                coarse_fallbacks += (coarse_fallbacks.empty() ? "" : "; ") + (kChannelNames[c] + (": " + reasons));
+            append_coarse_fallbacks(coarse_fallbacks, c, report);
         }
         multires_error_[c] = report.fine.estimated_relative_error;
         out[c] = {report.fine.iterations, report.fine.estimated_relative_error, report.fine.converged};
@@ -650,35 +655,35 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multires(const Diffusio
     fine.max_iterations = iteration_budget;
     fine.use_eigenvalue_hints = true;
     std::array<ConjugateGradientResult, 3> results;
-    const bool warm = std::any_of(phi.begin(), phi.end(), [](const std::vector<double>& p) {
-        return std::any_of(p.begin(), p.end(), [](double v) { return v != 0.0; });
-    });
-    if (multires_pending_.solution && warm) {
-        // The host phi corrected coarse to fine (MultiresSolver::set_warm_start) on the host hierarchy
-        // the device copy was made from, so both backends start the frame from the same vector; the
-        // pass runs once per rebuild, and level 0 then iterates on the device.
-        multires_->reset_warm_start();
-        std::vector<std::array<double, 3>> start(phi[0].size());
-        std::string coarse_fallbacks;
-        for (int c = 0; c < 3; ++c) {
-            multires_->set_warm_start(c, phi[c]);
-            MultiresSolveReport report;
-            const std::span<const double> corrected = multires_->solve_frame(b[c], c, 0, &report);
-            for (size_t v = 0; v < start.size(); ++v) start[v][c] = corrected[v];
-            if (const std::string reasons = report.fallback_reasons(); !reasons.empty())
-                coarse_fallbacks += (coarse_fallbacks.empty() ? "" : "; ") + (kChannelNames[c] + (": " + reasons));
+    if (multires_pending_.solution) {
+        const bool warm = std::any_of(phi.begin(), phi.end(), [](const std::vector<double>& p) {
+            return std::any_of(p.begin(), p.end(), [](double v) { return v != 0.0; });
+        });
+        if (warm) {
+            // The host phi corrected coarse to fine (MultiresSolver::set_warm_start) on the host hierarchy
+            // the device copy was made from, so both backends start the frame from the same vector; the
+            // pass runs once per rebuild, and level 0 then iterates on the device.
+            multires_->reset_warm_start();
+            std::vector<std::array<double, 3>> start(phi[0].size());
+            std::string coarse_fallbacks;
+            for (int c = 0; c < 3; ++c) {
+                multires_->set_warm_start(c, phi[c]);
+                MultiresSolveReport report;
+                const std::span<const double> corrected = multires_->solve_frame(b[c], c, 0, &report);
+                for (size_t v = 0; v < start.size(); ++v) start[v][c] = corrected[v];
+                append_coarse_fallbacks(coarse_fallbacks, c, report);
+            }
+            note_coarse_fallbacks(coarse_fallbacks);
+            gpu_->multires->set_solution(start);
+            results = gpu_->multires->solve_fine(fine);
+        } else {
+            MultiresSolveOptions options;
+            options.relative_tolerance = relative_tolerance;
+            options.max_iterations = iteration_budget;
+            const GpuMultiresReport report = gpu_->multires->solve(options, fine);
+            results = report.fine;
+            note_coarse_fallbacks(report.fallback_reasons());
         }
-        note_coarse_fallbacks(coarse_fallbacks);
-        gpu_->multires->set_solution(start);
-        results = gpu_->multires->solve_fine(fine);
-        multires_pending_.solution = false;
-    } else if (multires_pending_.solution) {
-        MultiresSolveOptions options;
-        options.relative_tolerance = relative_tolerance;
-        options.max_iterations = iteration_budget;
-        const GpuMultiresReport report = gpu_->multires->solve(options, fine);
-        results = report.fine;
-        note_coarse_fallbacks(report.fallback_reasons());
         multires_pending_.solution = false;
     } else {
         results = gpu_->multires->solve_fine(fine);  // warm from the resident phi
