@@ -194,9 +194,9 @@ BENCHMARK(BM_FirstFrameAfterCut)->DenseRange(0, 5)->Iterations(1)->Unit(benchmar
 // budget until the true error (true_error_l2 as above, against the cut volume converged to 1e-8 with
 // CPU Jacobi CG, measured outside the timing) is under 1% (settle_ms, frames) and until the solver
 // reports convergence at the scene's tolerance (converged_ms); the document's cut itself, the same
-// for every method, is not timed. The measure behind the editor's default
-// method: a method whose rebuild costs more must win it back in fewer frames. CPU methods only (the
-// GPU ones run on llvmpipe here); range(1): tets.
+// for every method, is not timed. The measure behind the editor's default method: a method whose
+// rebuild costs more must win it back in fewer frames. CPU methods only (the GPU ones run on llvmpipe
+// here); range(1): tets.
 //   ./build/bench/live_solver_bench --benchmark_filter=BM_CutToSettledImage
 void BM_CutToSettledImage(benchmark::State& state) {
     const Variant& variant = kVariants[state.range(0)];

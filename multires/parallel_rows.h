@@ -23,8 +23,9 @@ void for_rows(size_t n, size_t grain, const Body& body) {
 // in fixed chunks of `chunk_rows` (so the result does not depend on the thread count), each chunk
 // appending its rows to its own Buffer with append_row(row, buffer), which returns the row's length;
 // once `offsets` (rows + 1 prefix sums) are known, size_entries(total) sizes the destination and
-// place_chunk(chunk, buffer) copies each chunk's entries into place, from offsets[chunk * chunk_rows] on. Building every row twice (count, then
-// fill) would walk it twice; this walks it once and copies the entries once.
+// place_chunk(chunk, buffer) copies each chunk's entries into place, from offsets[chunk * chunk_rows]
+// on. Building every row twice (count, then fill) would walk it twice; this walks it once and copies
+// the entries once.
 template <typename Buffer, typename AppendRow, typename SizeEntries, typename PlaceChunk>
 void build_rows_in_chunks(size_t rows, size_t chunk_rows, std::vector<int32_t>& offsets, const AppendRow& append_row,
                           const SizeEntries& size_entries, const PlaceChunk& place_chunk) {
@@ -37,7 +38,8 @@ void build_rows_in_chunks(size_t rows, size_t chunk_rows, std::vector<int32_t>& 
     });
     for (size_t row = 0; row < rows; ++row) offsets[row + 1] += offsets[row];
     size_entries(static_cast<size_t>(offsets[rows]));
-    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) { place_chunk(chunk, static_cast<const Buffer&>(buffers[chunk])); });
+    tbb::parallel_for(size_t{0}, chunks,
+                      [&](size_t chunk) { place_chunk(chunk, static_cast<const Buffer&>(buffers[chunk])); });
 }
 
 // The same when each row's entries are one array: append_row(row, buffer) appends the row's entries
