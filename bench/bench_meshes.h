@@ -41,24 +41,30 @@ struct LitSpot {
     std::vector<std::array<double, 3>> q;
 };
 
-inline const LitSpot& lit_spot(size_t target_tets) {
-    static std::map<size_t, std::unique_ptr<LitSpot>> cache;
-    std::unique_ptr<LitSpot>& slot = cache[target_tets];
-    if (slot) return *slot;
-    const TetMesh& mesh = spot_volume(target_tets);
-    slot = std::make_unique<LitSpot>(LitSpot{mesh, build_connectivity(mesh), {}, 1, {}, {}});
-    LitSpot& s = *slot;
-    const auto box = bounding_box(mesh);
-    s.mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();
-    s.materials.assign(mesh.tet_count(), material_preset("marble"));
+// The benches' marble, assembly and light from +z on `mesh` (spot or an edited copy of it, which must
+// outlive the result); mm_per_unit: 100 mm over the longest side of the unedited model.
+inline std::unique_ptr<LitSpot> light_spot_volume(const TetMesh& mesh, double mm_per_unit) {
+    auto s = std::make_unique<LitSpot>(LitSpot{mesh, build_connectivity(mesh), {}, mm_per_unit, {}, {}});
+    s->materials.assign(mesh.tet_count(), material_preset("marble"));
     AssemblyOptions assembly;
-    assembly.mm_per_unit = s.mm_per_unit;
-    s.matrix = assemble_diffusion_matrix(mesh, s.conn, s.materials, assembly);
+    assembly.mm_per_unit = mm_per_unit;
+    s->matrix = assemble_diffusion_matrix(mesh, s->conn, s->materials, assembly);
     Lighting lighting;
     lighting.lights.push_back(Light{LightType::Directional, Eigen::Vector3d(0, 0, -1), {1, 1, 1}});
     lighting.shadows = false;
-    s.q = incident_light(mesh, s.conn, s.materials, lighting);
+    s->q = incident_light(mesh, s->conn, s->materials, lighting);
     return s;
+}
+
+inline const LitSpot& lit_spot(size_t target_tets) {
+    static std::map<size_t, std::unique_ptr<LitSpot>> cache;
+    std::unique_ptr<LitSpot>& slot = cache[target_tets];
+    if (!slot) {
+        const TetMesh& mesh = spot_volume(target_tets);
+        const auto box = bounding_box(mesh);
+        slot = light_spot_volume(mesh, 100.0 / (box[1] - box[0]).maxCoeff());
+    }
+    return *slot;
 }
 
 }  // namespace waxwork::bench

@@ -25,6 +25,7 @@
 #include "solver/material.h"
 #include "solver/reference_solvers.h"
 #include "tetops/connectivity.h"
+#include "tetops/cut.h"
 
 #include <benchmark/benchmark.h>
 
@@ -165,6 +166,73 @@ void BM_MultiresBuild(benchmark::State& state) {
     state.counters["interp_ms"] = times.interpolation;
     state.counters["graph_ms"] = times.coarse_graph;
     state.counters["eq17_ms"] = times.coarse_matrix;
+}
+
+// spot cut by the editor benches' middle plane (bench::middle_cut's; removal only: its relaxation
+// moves vertices but changes no edge), with the uncut scene's hierarchy and the cut system's direct
+// solution.
+struct CutScene {
+    TetMesh mesh;
+    std::unique_ptr<bench::LitSpot> lit;
+    std::vector<int32_t> new_of_old;  // the cut's vertex map
+    std::vector<double> b;            // green channel
+    Eigen::VectorXd exact;
+    MultiresHierarchy before;         // the uncut scene's hierarchy
+};
+
+const CutScene& cut_scene(size_t target_tets) {
+    static std::map<size_t, std::unique_ptr<CutScene>> cache;
+    auto& slot = cache[target_tets];
+    if (slot) return *slot;
+    slot = std::make_unique<CutScene>();
+    CutScene& c = *slot;
+    const Scene& s = scene(target_tets);
+    c.before = build_multires_hierarchy(s.matrix, s.mesh->positions);
+    c.mesh = *s.mesh;
+    const auto box = bounding_box(c.mesh);
+    const Eigen::Vector3d normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
+    c.new_of_old = remove_cut_away_tets(c.mesh, PlaneCut(normal, normal.dot(0.5 * (box[0] + box[1])))).old_to_new_vertex;
+    c.lit = bench::light_spot_volume(c.mesh, bench::lit_spot(target_tets).mm_per_unit);
+    c.b.resize(c.lit->matrix.size());
+    diffusion_right_hand_side(c.lit->matrix, c.lit->q, 1, c.b);
+    const Eigen::Map<const Eigen::VectorXd> bm(c.b.data(), static_cast<Eigen::Index>(c.b.size()));
+    c.exact = DirectSolver(to_eigen_sparse(c.lit->matrix, 1)).solve(bm);
+    return c;
+}
+
+// The hierarchy after a cut: built from scratch (second argument 0) or rebuilt from the uncut one
+// (1, rebuild_multires_hierarchy: the selection is made again only around the changed rows). Times
+// the build; then reports the level sizes and the level-0 CG iterations the coarse-to-fine solve
+// needs to 1% with that hierarchy (the rebuilt selection is not the fresh one, so its quality is
+// measured, not assumed).
+void BM_HierarchyAfterCut(benchmark::State& state) {
+    const CutScene& c = cut_scene(static_cast<size_t>(state.range(0)));
+    const bool rebuild = state.range(1) != 0;
+    MultiresHierarchy h;
+    for (auto _ : state) {
+        h = rebuild ? rebuild_multires_hierarchy(c.before, c.new_of_old, c.lit->matrix, c.mesh.positions)
+                    : build_multires_hierarchy(c.lit->matrix, c.mesh.positions);
+    }
+    state.counters["tets"] = static_cast<double>(c.mesh.tet_count());
+    state.counters["levels"] = static_cast<double>(h.level_count());
+    state.counters["level1"] = static_cast<double>(h.levels.size() > 1 ? h.levels[1].size() : 0);
+    state.counters["changed0"] = static_cast<double>(h.levels[0].changed_vertices);
+    state.counters["select_ms"] = h.build_times.selection;
+    std::fprintf(stderr, "spot %zu after the cut, %s: levels (vertices/changed)", c.mesh.tet_count(),
+                 rebuild ? "rebuilt" : "fresh");
+    for (const HierarchyLevel& level : h.levels)
+        std::fprintf(stderr, " %zu/%lld", level.size(), static_cast<long long>(level.changed_vertices));
+    const HierarchyBuildTimes& t = h.build_times;
+    std::fprintf(stderr, "; ms: fine %.1f, selection %.1f, Eq. 16 %.1f, graphs %.1f, Eq. 17 %.1f\n", t.fine_level,
+                 t.selection, t.interpolation, t.coarse_graph, t.coarse_matrix);
+    MultiresSolver solver(std::move(h));
+    std::vector<double> x(c.b.size());
+    state.counters["iters0"] = smallest_budget(
+        [&](int k) {
+            solver.solve(c.b, 1, x, multires_budget(k, 2));
+            return relative_error(x, c.exact);
+        },
+        100000);
 }
 
 void BM_JacobiCgTo1Percent(benchmark::State& state) {
@@ -505,6 +573,11 @@ void BM_PaintUpdate(benchmark::State& state) {
     Arg(50000)->Arg(500000)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()
 BENCHMARK(BM_MultiresBuild)->WAXWORK_SIZES;
 BENCHMARK(BM_JacobiCgTo1Percent)->WAXWORK_SIZES;
+BENCHMARK(BM_HierarchyAfterCut)
+    ->ArgsProduct({{50000, 500000}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 // Second argument: BiCGSTAB iterations on each intermediate level (the default is 2); third: Eq. 16's
 // weights, 0 the paper's, 1 linear-exact (hierarchy.h).
 BENCHMARK(BM_MultiresTo1Percent)

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <sstream>
 
 namespace waxwork {
@@ -74,7 +75,8 @@ void LiveScene::refresh_right_hand_sides() {
     mark_unconverged();
 }
 
-void LiveScene::rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update) {
+void LiveScene::rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update,
+                            std::span<const int32_t> new_of_old_vertex) {
     if (!connectivity) {
         connectivity = std::make_shared<const TetConnectivity>(build_connectivity(*mesh_));
         update.rebuilt_connectivity = true;
@@ -85,7 +87,7 @@ void LiveScene::rebuild_all(std::shared_ptr<const TetConnectivity> connectivity,
     rebuild_surface(update);
     // Also drops the smallest-eigenvalue hints of the old matrix: a stale hint could be too large and
     // make the error estimate optimistic.
-    solver_->matrix_rebuilt(*mesh_, matrix_);
+    solver_->matrix_rebuilt(*mesh_, matrix_, new_of_old_vertex);
     for (auto& phi : phi_) phi.resize(matrix_.size(), 0.0);
 }
 
@@ -119,12 +121,15 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
         update.warm_start = mapped || from_edges;
         const bool reuse = change.connectivity && change.connectivity->vertex_tets.row_count() == mesh.vertex_count() &&
                            change.connectivity->tet_neighbors.size() == mesh.tet_count();
-        rebuild_all(reuse ? change.connectivity : nullptr, update);
+        rebuild_all(reuse ? change.connectivity : nullptr, update,
+                    mapped ? std::span<const int32_t>(change.old_to_new_vertex) : std::span<const int32_t>());
     } else if (change.positions) {
         // Same tets, moved vertices: new geometry on the same connectivity.
         matrix_ = assemble_diffusion_matrix(mesh, *connectivity_, mesh.materials, assembly_options(options_));
         update.reassembled_matrix = true;
-        solver_->matrix_rebuilt(mesh, matrix_);
+        std::vector<int32_t> same_vertices(mesh.vertex_count());
+        std::iota(same_vertices.begin(), same_vertices.end(), 0);
+        solver_->matrix_rebuilt(mesh, matrix_, same_vertices);
         rebuild_surface(update);
     } else {
         bool eta_changed = false;
@@ -308,6 +313,15 @@ std::string LiveScene::method_fallback_reason() const {
 std::string LiveScene::solver_description() const {
     const std::lock_guard lock(mutex_);
     return solver_->description();
+}
+
+std::vector<std::array<int64_t, 2>> LiveScene::multires_levels() const {
+    const std::lock_guard lock(mutex_);
+    std::vector<std::array<int64_t, 2>> levels;
+    if (const MultiresHierarchy* hierarchy = solver_->multires_hierarchy())
+        for (const HierarchyLevel& level : hierarchy->levels)
+            levels.push_back({static_cast<int64_t>(level.size()), level.changed_vertices});
+    return levels;
 }
 
 std::shared_ptr<const GpuBuffer> LiveScene::device_radiance(std::vector<std::array<float, 3>>* host_copy) {

@@ -52,6 +52,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <vector>
 
 namespace waxwork {
@@ -147,6 +148,9 @@ public:
     // Why the chosen method runs as Jacobi CG ("" if it does not; LiveSolver::method_fallback_reason).
     std::string method_fallback_reason() const;
     std::string solver_description() const;
+    // A copy of the multires method's hierarchy's level sizes and changed-row counts (level l: {vertices,
+    // HierarchyLevel::changed_vertices}); empty with other methods.
+    std::vector<std::array<int64_t, 2>> multires_levels() const;
     // With the GPU backend running: E per surface vertex (solved_scene().surface order) on the device,
     // from the resident phi (LiveSolver::radiance_on_device), for a renderer sharing the solver's
     // context to draw instead of the CPU's radiance_factor; else null. Reads the mesh. `host_copy`:
@@ -154,7 +158,9 @@ public:
     std::shared_ptr<const GpuBuffer> device_radiance(std::vector<std::array<float, 3>>* host_copy = nullptr);
 
 private:
-    void rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update);
+    // new_of_old_vertex: where the previous mesh's vertices went (a cut's map), or empty when unknown.
+    void rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update,
+                     std::span<const int32_t> new_of_old_vertex = {});
     void rebuild_surface(SceneUpdate& update);
     void relight(SceneUpdate& update);
     void refresh_right_hand_sides();

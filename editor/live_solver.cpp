@@ -170,7 +170,8 @@ void LiveSolver::PendingChanges::rows_changed(std::span<const int32_t> ascending
     rows.swap(merged);
 }
 
-void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix) {
+void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix,
+                                std::span<const int32_t> new_of_old_vertex) {
     eigenvalue_hint_ = {0, 0, 0};  // belong to the old matrix (a stale hint can be too optimistic)
     multigrid_.reset();
     forget_estimates();
@@ -189,13 +190,17 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
             method_fallback_reason_.clear();
         }
     }
-    multires_.reset();
+    const std::unique_ptr<MultiresSolver> previous = std::move(multires_);
     gpu_level_rows_.clear();
     // Built for either backend: the device copy is made from it, and a fallback keeps solving with it.
     if (method_ == LiveMethod::Multires && matrix.size() > 0) {
         if (mesh.vertex_count() != matrix.size())
             throw InvalidArgumentError("live solver: the matrix does not belong to the mesh");
-        multires_ = std::make_unique<MultiresSolver>(matrix, mesh.positions);
+        const bool carried = previous && !new_of_old_vertex.empty() &&
+                             new_of_old_vertex.size() == previous->hierarchy().levels[0].size();
+        multires_ = carried ? std::make_unique<MultiresSolver>(rebuild_multires_hierarchy(
+                                  previous->hierarchy(), new_of_old_vertex, matrix, mesh.positions))
+                            : std::make_unique<MultiresSolver>(matrix, mesh.positions);
     }
     if (gpu_) {
         try {
@@ -205,6 +210,8 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
         }
     }
 }
+
+const MultiresHierarchy* LiveSolver::multires_hierarchy() const { return multires_ ? &multires_->hierarchy() : nullptr; }
 
 void LiveSolver::build_cpu_multigrid(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix) {
     try {

@@ -78,6 +78,7 @@ namespace waxwork {
 class MultigridFrameCg;
 class MultigridFrameSolver;
 class MultiresSolver;
+struct MultiresHierarchy;
 
 enum class LiveMethod { JacobiCg, MultigridCg, Multires };
 enum class LiveBackend { Cpu, Gpu };
@@ -134,7 +135,12 @@ public:
     // What changed since the last iterate(); each only marks work for the next one.
     // A new matrix (pattern or geometry): every derived structure is rebuilt (multigrid CG: the
     // hierarchy now, its Eq. 16 weights from the mesh's rest positions; the device: at the next frame).
-    void matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix);
+    // new_of_old_vertex: per vertex of the previous matrix its vertex in this one or -1 (a cut's map;
+    // the identity after a relaxation), or empty when they are unrelated. With it the multires
+    // hierarchy is rebuilt from the previous one, selecting again only around the changed rows
+    // (rebuild_multires_hierarchy); without it, from scratch.
+    void matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix,
+                        std::span<const int32_t> new_of_old_vertex = {});
     void values_changed();                          // all values, same pattern
     void rows_changed(std::span<const int32_t> rows);  // update_diffusion_matrix's rows
     void right_hand_sides_changed();
@@ -189,6 +195,8 @@ public:
     // Why the method does not run as chosen ("" when it does): the multigrid method solving with Jacobi
     // CG instead, or the multires method's last coarse-to-fine pass skipping levels (and why).
     const std::string& method_fallback_reason() const { return method_fallback_reason_; }
+    // The multires method's hierarchy (nullptr with other methods or an empty mesh).
+    const MultiresHierarchy* multires_hierarchy() const;
     // "GPU Jacobi CG (float) (llvmpipe ...)", "CPU multigrid CG, three channels per V-cycle", ...: for the
     // panel and logs.
     std::string description() const;

@@ -12,11 +12,13 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <cmath>
 #include <chrono>
+#include <cmath>
+#include <functional>
 #include <numeric>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace waxwork {
 
@@ -266,14 +268,23 @@ struct CoarseningStep {
     std::vector<int32_t> coarse_to_fine;  // coarse -> fine
 };
 
-std::optional<CoarseningStep> coarsen(const CompressedRows& graph, size_t level_count, const HierarchyOptions& options) {
+// What a rebuild carries into one level's selection from the previous hierarchy (update_coarse_vertices).
+struct CarriedSelection {
+    std::vector<uint8_t> previous_retained;  // per vertex of the new level
+    std::vector<int32_t> changed;            // new vertices and vertices whose row changed
+};
+
+std::optional<CoarseningStep> coarsen(const CompressedRows& graph, size_t level_count, const HierarchyOptions& options,
+                                      const CarriedSelection* carried = nullptr) {
     const size_t n = graph.row_count();
     if (static_cast<int>(level_count) >= options.max_levels || static_cast<int64_t>(n) < options.min_coarse_vertices)
         return std::nullopt;
     // Each level gets its own key so that successive selections are uncorrelated.
     const uint32_t seed = options.seed * 0x9e3779b1u + static_cast<uint32_t>(level_count);
     CoarseningStep step;
-    step.selection = select_coarse_vertices(graph, seed, options.enhance);
+    step.selection = carried ? update_coarse_vertices(graph, seed, options.enhance, carried->previous_retained,
+                                                      carried->changed)
+                             : select_coarse_vertices(graph, seed, options.enhance);
     step.coarse_index = coarse_vertex_index(step.selection.retained);
     for (size_t v = 0; v < n; ++v)
         if (step.selection.retained[v]) step.coarse_to_fine.push_back(static_cast<int32_t>(v));
@@ -283,21 +294,86 @@ std::optional<CoarseningStep> coarsen(const CompressedRows& graph, size_t level_
     return step;
 }
 
-}  // namespace
+// The vertices of `graph` (a new level l) whose row is not the row of their previous vertex in
+// `previous_graph` (the previous level l) under the map, and the vertices that have none, ascending.
+// old_of_new: per new vertex its previous vertex or -1; new_of_old the inverse.
+std::vector<int32_t> changed_rows(const CompressedRows& graph, const CompressedRows& previous_graph,
+                                  std::span<const int32_t> old_of_new, std::span<const int32_t> new_of_old) {
+    const size_t n = graph.row_count();
+    std::vector<uint8_t> changed(n, 0);
+    tbb::enumerable_thread_specific<std::vector<int32_t>> buffers;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 2048), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<int32_t>& mapped = buffers.local();
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            const int32_t o = old_of_new[v];
+            if (o < 0) {
+                changed[v] = 1;
+                continue;
+            }
+            const std::span<const int32_t> row = graph.row(v), old_row = previous_graph.row(static_cast<size_t>(o));
+            if (row.size() != old_row.size()) {
+                changed[v] = 1;
+                continue;
+            }
+            mapped.clear();
+            for (const int32_t u : old_row) mapped.push_back(new_of_old[static_cast<size_t>(u)]);
+            // An edit that compacts the vertices keeps their order, so the mapped row is usually sorted.
+            if (!std::is_sorted(mapped.begin(), mapped.end())) std::sort(mapped.begin(), mapped.end());
+            changed[v] = !std::equal(mapped.begin(), mapped.end(), row.begin());
+        }
+    });
+    std::vector<int32_t> rows;
+    for (size_t v = 0; v < n; ++v)
+        if (changed[v]) rows.push_back(static_cast<int32_t>(v));
+    return rows;
+}
 
-MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
-                                           const HierarchyOptions& options) {
+// A level's fields that the build loop fills the same way whether its selection was made afresh or
+// carried: the coarse level's vertex maps and graph, and the fine level's Eq. 16 and Eq. 17 operators.
+HierarchyLevel add_coarse_level(HierarchyLevel& fine, const CoarseningStep& step,
+                                std::span<const Eigen::Vector3d> positions, const HierarchyOptions& options,
+                                HierarchyBuildTimes& times, const std::function<void(double&)>& time) {
+    HierarchyLevel coarse;
+    coarse.parent_vertex = step.coarse_to_fine;
+    coarse.original_vertex.resize(step.coarse_to_fine.size());
+    for (size_t c = 0; c < step.coarse_to_fine.size(); ++c)
+        coarse.original_vertex[c] = fine.original_vertex[static_cast<size_t>(step.coarse_to_fine[c])];
+    fine.interpolation = build_interpolation(fine.graph, step.selection.retained, step.coarse_index,
+                                             fine.original_vertex, positions, options);
+    time(times.interpolation);
+    // P's columns are exactly each fine vertex's coarse links (independent_set.h).
+    coarse.graph = build_coarse_graph(fine.graph, step.coarse_index, fine.interpolation.offsets,
+                                      fine.interpolation.columns);
+    time(times.coarse_graph);
+    fine.independent_set_rounds = step.selection.independent_set_rounds;
+    fine.enhancement_passes = step.selection.enhancement_passes;
+    fine.enhancement_vertices = step.selection.enhancement_vertices;
+    build_coarse_matrix(fine, step.coarse_to_fine, coarse);
+    time(times.coarse_matrix);
+    return coarse;
+}
+
+void check_hierarchy_inputs(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
+                            const HierarchyOptions& options) {
     if (positions.size() != matrix.size())
         throw InvalidArgumentError("multires hierarchy: " + std::to_string(positions.size()) + " positions for a " +
                                    std::to_string(matrix.size()) + "-vertex matrix");
     if (!std::isfinite(options.min_linear_exact_weight))
         throw InvalidArgumentError("multires hierarchy: the linear-exact weight floor must be a finite number (got " +
                                    std::to_string(options.min_linear_exact_weight) + ")");
+}
+
+// Builds the hierarchy's levels; with `previous` and its level-0 vertex map, carries each level's
+// selection from the previous hierarchy (rebuild_multires_hierarchy).
+MultiresHierarchy build_levels(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
+                               const HierarchyOptions& options, const MultiresHierarchy* previous,
+                               std::span<const int32_t> new_of_old_vertex) {
+    check_hierarchy_inputs(matrix, positions, options);
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     auto lap = start;
     // Adds the time since the last lap to `phase`.
-    auto time = [&lap](double& phase) {
+    const std::function<void(double&)> time = [&lap](double& phase) {
         const auto now = Clock::now();
         phase += std::chrono::duration<double, std::milli>(now - lap).count();
         lap = now;
@@ -306,31 +382,74 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
     HierarchyBuildTimes& times = hierarchy.build_times;
     hierarchy.levels.push_back(fine_level(matrix));
     time(times.fine_level);
-    while (std::optional<CoarseningStep> step = coarsen(hierarchy.levels.back().graph, hierarchy.levels.size(), options)) {
-        time(times.selection);
+    // Per vertex of the previous hierarchy's current level: its vertex in the new level (-1: none).
+    std::vector<int32_t> new_of_old;
+    if (previous) new_of_old.assign(new_of_old_vertex.begin(), new_of_old_vertex.end());
+    for (;;) {
         HierarchyLevel& fine = hierarchy.levels.back();
-        HierarchyLevel coarse;
-        coarse.parent_vertex = step->coarse_to_fine;
-        coarse.original_vertex.resize(step->coarse_to_fine.size());
-        for (size_t c = 0; c < step->coarse_to_fine.size(); ++c)
-            coarse.original_vertex[c] = fine.original_vertex[static_cast<size_t>(step->coarse_to_fine[c])];
-        fine.interpolation = build_interpolation(fine.graph, step->selection.retained, step->coarse_index,
-                                                 fine.original_vertex, positions, options);
-        time(times.interpolation);
-        // P's columns are exactly each fine vertex's coarse links (independent_set.h).
-        coarse.graph = build_coarse_graph(fine.graph, step->coarse_index, fine.interpolation.offsets,
-                                          fine.interpolation.columns);
-        time(times.coarse_graph);
-        fine.independent_set_rounds = step->selection.independent_set_rounds;
-        fine.enhancement_passes = step->selection.enhancement_passes;
-        fine.enhancement_vertices = step->selection.enhancement_vertices;
-        build_coarse_matrix(fine, step->coarse_to_fine, coarse);
-        hierarchy.levels.push_back(std::move(coarse));
-        time(times.coarse_matrix);
+        const size_t l = hierarchy.levels.size() - 1;
+        std::optional<CarriedSelection> carried;
+        if (previous && l + 1 < previous->level_count()) {
+            const HierarchyLevel& old_fine = previous->levels[l];
+            const HierarchyLevel& old_coarse = previous->levels[l + 1];
+            std::vector<uint8_t> old_retained(old_fine.graph.row_count(), 0);
+            for (const int32_t p : old_coarse.parent_vertex) old_retained[static_cast<size_t>(p)] = 1;
+            std::vector<int32_t> old_of_new(fine.graph.row_count(), -1);
+            for (size_t o = 0; o < new_of_old.size(); ++o)
+                if (new_of_old[o] >= 0) old_of_new[static_cast<size_t>(new_of_old[o])] = static_cast<int32_t>(o);
+            carried.emplace();
+            carried->previous_retained.assign(old_of_new.size(), 0);
+            for (size_t v = 0; v < old_of_new.size(); ++v)
+                if (old_of_new[v] >= 0) carried->previous_retained[v] = old_retained[static_cast<size_t>(old_of_new[v])];
+            carried->changed = changed_rows(fine.graph, old_fine.graph, old_of_new, new_of_old);
+            fine.changed_vertices = static_cast<int64_t>(carried->changed.size());
+        }
+        std::optional<CoarseningStep> step =
+            coarsen(fine.graph, hierarchy.levels.size(), options, carried ? &*carried : nullptr);
+        time(times.selection);
+        if (!step) break;
+        if (carried) {
+            // The previous coarse vertices' new indices: through their parents, when still retained.
+            const HierarchyLevel& old_coarse = previous->levels[l + 1];
+            std::vector<int32_t> next(old_coarse.parent_vertex.size(), -1);
+            for (size_t c = 0; c < next.size(); ++c) {
+                const int32_t v = new_of_old[static_cast<size_t>(old_coarse.parent_vertex[c])];
+                if (v >= 0) next[c] = step->coarse_index[static_cast<size_t>(v)];
+            }
+            new_of_old = std::move(next);
+        }
+        hierarchy.levels.push_back(add_coarse_level(fine, *step, positions, options, times, time));
     }
-    time(times.selection);  // the last selection, which ended the loop
     hierarchy.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     return hierarchy;
+}
+
+}  // namespace
+
+MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
+                                           const HierarchyOptions& options) {
+    return build_levels(matrix, positions, options, nullptr, {});
+}
+
+MultiresHierarchy rebuild_multires_hierarchy(const MultiresHierarchy& previous, std::span<const int32_t> new_of_old_vertex,
+                                             const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
+                                             const HierarchyOptions& options) {
+    if (previous.levels.empty()) return build_multires_hierarchy(matrix, positions, options);
+    const size_t old_count = previous.levels[0].size();
+    if (new_of_old_vertex.size() != old_count)
+        throw InvalidArgumentError("multires hierarchy rebuild: a vertex map of " + std::to_string(new_of_old_vertex.size()) +
+                                   " entries for a hierarchy on " + std::to_string(old_count) + " vertices");
+    std::vector<uint8_t> taken(matrix.size(), 0);
+    for (size_t o = 0; o < old_count; ++o) {
+        const int32_t v = new_of_old_vertex[o];
+        if (v < -1 || v >= static_cast<int64_t>(matrix.size()))
+            throw InvalidArgumentError("multires hierarchy rebuild: vertex " + std::to_string(o) + " maps to " +
+                                       std::to_string(v) + ", outside the " + std::to_string(matrix.size()) +
+                                       "-vertex matrix");
+        if (v >= 0 && std::exchange(taken[static_cast<size_t>(v)], uint8_t{1}))
+            throw InvalidArgumentError("multires hierarchy rebuild: two vertices map to vertex " + std::to_string(v));
+    }
+    return build_levels(matrix, positions, options, &previous, new_of_old_vertex);
 }
 
 std::vector<std::vector<int32_t>> hierarchy_level_vertices(const CompressedRows& graph, const HierarchyOptions& options) {

@@ -91,6 +91,9 @@ struct HierarchyLevel {
     int independent_set_rounds = 0;
     int enhancement_passes = 0;
     int64_t enhancement_vertices = 0;
+    // rebuild_multires_hierarchy: how many of this level's vertices had no previous vertex or a changed
+    // row, around which the selection of level l+1 was made again; -1 when it was made from scratch.
+    int64_t changed_vertices = -1;
 
     size_t size() const { return diagonal.size(); }
     CsrMatrixView<double> view(int channel) const {
@@ -121,6 +124,24 @@ struct MultiresHierarchy {
 // not a finite number.
 MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                                            const HierarchyOptions& options = {});
+
+// The hierarchy of an edited system, carrying each level's selection over from `previous` (beyond the
+// paper: it rebuilds after a cut, Sec. 5, from scratch). new_of_old_vertex: per level-0 vertex of
+// `previous`, its vertex in `matrix` or -1 when the edit removed it (a cut's vertex map; the identity
+// when only positions or values changed). Level by level, the vertices whose graph row is not their
+// previous vertex's row (or that have none) and their dropped neighbours are selected again
+// (update_coarse_vertices) and the rest keep their previous state, so the selection costs what the
+// edit touched; interpolation (Eq. 16), coarse graphs and Eq. 17 are then built as usual, and levels
+// past the previous hierarchy's depth are selected from scratch. The result has every property the
+// tests ask of a fresh build (independent-set cover, no lost connection, Eq. 17 on its own graphs)
+// but is not the fresh build's selection. When no row changed (positions or values only) every
+// selection is previous's, so a rebuild of a fresh build equals build_multires_hierarchy(matrix,
+// positions, options) exactly without selecting anything again. `options` must be the ones
+// `previous` was built with. Throws as build_multires_hierarchy, and InvalidArgumentError when the map's size is
+// not previous's level-0 size, an entry is outside [-1, matrix.size()) or two vertices map to one.
+MultiresHierarchy rebuild_multires_hierarchy(const MultiresHierarchy& previous, std::span<const int32_t> new_of_old_vertex,
+                                             const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
+                                             const HierarchyOptions& options = {});
 
 // The vertices each coarse level keeps, without building any operator: entry l-1 lists the level-0
 // vertices of level l (HierarchyLevel::original_vertex), for views and statistics. graph: G^0, the

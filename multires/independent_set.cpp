@@ -2,6 +2,7 @@
 
 #include "multires/link_union.h"
 #include "multires/parallel_rows.h"
+#include "tetops/error.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <string>
 
 namespace waxwork {
 
@@ -138,7 +140,10 @@ private:
     tbb::enumerable_thread_specific<std::vector<int32_t>> tags_;
 };
 
-LostConnections find_lost_connections(const CompressedRows& graph, std::span<const uint8_t> retained) {
+// Tests the vertices `vertex(0 .. count)` names (every vertex, or a list); the others get no partners.
+template <typename VertexAt>
+LostConnections find_lost_connections(const CompressedRows& graph, std::span<const uint8_t> retained, size_t count,
+                                      VertexAt&& vertex) {
     const size_t n = graph.row_count();
     LostConnections lost;
     lost.count.assign(n, 0);
@@ -146,8 +151,9 @@ LostConnections find_lost_connections(const CompressedRows& graph, std::span<con
     JoinedTags joined(n);
     // Each vertex tests all its dropped neighbours (the test is symmetric, so both ends of a lost edge
     // list it), and writes only its own slots.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t i = range.begin(); i != range.end(); ++i) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrain), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t a = range.begin(); a != range.end(); ++a) {
+            const size_t i = vertex(a);
             if (retained[i]) continue;
             const std::vector<int32_t>& tag = joined.tag(graph, i, [&](size_t k) { return retained[k] != 0; });
             auto out = static_cast<size_t>(graph.offsets[i]);
@@ -158,6 +164,10 @@ LostConnections find_lost_connections(const CompressedRows& graph, std::span<con
         }
     });
     return lost;
+}
+
+LostConnections find_lost_connections(const CompressedRows& graph, std::span<const uint8_t> retained) {
+    return find_lost_connections(graph, retained, graph.row_count(), [](size_t a) { return a; });
 }
 
 // The enhancement's later passes: which of `candidates` (ascending; the vertices with lost connections
@@ -202,17 +212,20 @@ std::vector<uint8_t> mark_lost_connections(const CompressedRows& graph, std::spa
     return marked;
 }
 
-VertexSelection select_coarse_vertices(const CompressedRows& graph, uint32_t seed, bool enhance) {
+namespace {
+
+int64_t count_retained(std::span<const uint8_t> retained) {
+    int64_t count = 0;
+    for (uint8_t r : retained) count += r;
+    return count;
+}
+
+// The enhancement loop (independent_set.h) from the lost connections `lost` of `selection.retained`:
+// marks their ends, runs the rounds on them, and repeats on the connections still lost.
+void enhance_selection(const CompressedRows& graph, std::span<const uint32_t> codes, LostConnections& lost,
+                       VertexSelection& selection) {
     const size_t n = graph.row_count();
-    VertexSelection selection;
-    selection.retained.assign(n, 0);
-    const std::vector<uint32_t> codes = independent_set_codes(n, seed);
-    std::vector<uint8_t> queue(n, 1);
-    selection.independent_set_rounds = run_independent_set_rounds(graph, codes, queue, selection.retained);
-    if (!enhance) return selection;
-    int64_t before = 0;
-    for (uint8_t r : selection.retained) before += r;
-    LostConnections lost = find_lost_connections(graph, selection.retained);
+    const int64_t before = count_retained(selection.retained);
     std::vector<uint8_t> marked(n, 0);
     std::vector<int32_t> candidates;
     for (size_t v = 0; v < n; ++v)
@@ -231,9 +244,74 @@ VertexSelection select_coarse_vertices(const CompressedRows& graph, uint32_t see
         candidates = std::move(next);
         for (int32_t v : candidates) marked[static_cast<size_t>(v)] = 1;
     }
-    int64_t after = 0;
-    for (uint8_t r : selection.retained) after += r;
-    selection.enhancement_vertices = after - before;
+    selection.enhancement_vertices += count_retained(selection.retained) - before;
+}
+
+}  // namespace
+
+VertexSelection select_coarse_vertices(const CompressedRows& graph, uint32_t seed, bool enhance) {
+    const size_t n = graph.row_count();
+    VertexSelection selection;
+    selection.retained.assign(n, 0);
+    const std::vector<uint32_t> codes = independent_set_codes(n, seed);
+    std::vector<uint8_t> queue(n, 1);
+    selection.independent_set_rounds = run_independent_set_rounds(graph, codes, queue, selection.retained);
+    if (!enhance) return selection;
+    LostConnections lost = find_lost_connections(graph, selection.retained);
+    enhance_selection(graph, codes, lost, selection);
+    return selection;
+}
+
+VertexSelection update_coarse_vertices(const CompressedRows& graph, uint32_t seed, bool enhance,
+                                       std::span<const uint8_t> previous_retained, std::span<const int32_t> changed) {
+    const size_t n = graph.row_count();
+    if (previous_retained.size() != n)
+        throw InvalidArgumentError("coarse vertex update: " + std::to_string(previous_retained.size()) +
+                                   " previous flags for a " + std::to_string(n) + "-vertex graph");
+    for (const int32_t v : changed)
+        if (v < 0 || static_cast<size_t>(v) >= n)
+            throw InvalidArgumentError("coarse vertex update: changed vertex " + std::to_string(v) + " is not in the " +
+                                       std::to_string(n) + "-vertex graph");
+    VertexSelection selection;
+    selection.retained.assign(previous_retained.begin(), previous_retained.end());
+    // The queue: the changed vertices and their dropped neighbours, all undecided again. A dropped
+    // vertex further away keeps the retained neighbour that covered it (neither its row nor that
+    // neighbour is touched), and two retained vertices newly adjacent both changed rows, so both are queued.
+    std::vector<uint8_t> queue(n, 0);
+    for (const int32_t v : changed) {
+        queue[static_cast<size_t>(v)] = 1;
+        for (const int32_t u : graph.row(static_cast<size_t>(v)))
+            if (!selection.retained[static_cast<size_t>(u)]) queue[static_cast<size_t>(u)] = 1;
+    }
+    for (const int32_t v : changed) selection.retained[static_cast<size_t>(v)] = 0;
+    std::vector<int32_t> queued;
+    for (size_t v = 0; v < n; ++v)
+        if (queue[v]) queued.push_back(static_cast<int32_t>(v));
+    // A queued vertex next to a vertex that stays retained is covered by it: dropped before the rounds,
+    // as if that neighbour had been selected in an earlier round. The rest run the rounds as usual.
+    for (const int32_t v : queued)
+        for (const int32_t u : graph.row(static_cast<size_t>(v)))
+            if (selection.retained[static_cast<size_t>(u)]) {
+                queue[static_cast<size_t>(v)] = 0;
+                break;
+            }
+    const std::vector<uint32_t> codes = independent_set_codes(n, seed);
+    selection.independent_set_rounds = run_independent_set_rounds(graph, codes, queue, selection.retained);
+    if (!enhance) return selection;
+    // A fine edge can lose its connection only where a row changed or a vertex changed state (the queue)
+    // or next to such a vertex (a common neighbour changed state): test the queue and its neighbours. The
+    // previous selection had no lost connection elsewhere, and nothing else changed there.
+    std::vector<uint8_t> tested(n, 0);
+    for (const int32_t v : queued) {
+        tested[static_cast<size_t>(v)] = 1;
+        for (const int32_t u : graph.row(static_cast<size_t>(v))) tested[static_cast<size_t>(u)] = 1;
+    }
+    std::vector<int32_t> region;
+    for (size_t v = 0; v < n; ++v)
+        if (tested[v]) region.push_back(static_cast<int32_t>(v));
+    LostConnections lost = find_lost_connections(graph, selection.retained, region.size(),
+                                                 [&](size_t a) { return static_cast<size_t>(region[a]); });
+    enhance_selection(graph, codes, lost, selection);
     return selection;
 }
 

@@ -54,6 +54,20 @@ struct VertexSelection {
 // self loops. Deterministic for a given seed, whatever the thread count.
 VertexSelection select_coarse_vertices(const CompressedRows& graph, uint32_t seed, bool enhance = true);
 
+// The same selection updated after an edit changed the graph in a few places (beyond the paper, for
+// the rebuild after a cut). previous_retained: the previous selection carried to this graph's vertices
+// (0 for new ones); changed: every vertex whose row differs from the graph the previous selection was
+// made on, and every new vertex. Those and their dropped neighbours are decided again by the rounds,
+// with the vertices that stay retained counting as already selected, and the enhancement runs on the
+// fine edges near them. Everything else keeps its previous state, so the cost follows the edit, not
+// the graph. The result has the properties of select_coarse_vertices' (every dropped vertex has a
+// retained neighbour, no connection is lost, the vertices the rounds add are independent) when the
+// previous selection had them on its graph; it is not the selection a fresh build would make.
+// Throws InvalidArgumentError when previous_retained's size is not the graph's or a changed vertex is
+// out of range.
+VertexSelection update_coarse_vertices(const CompressedRows& graph, uint32_t seed, bool enhance,
+                                       std::span<const uint8_t> previous_retained, std::span<const int32_t> changed);
+
 // Fine-to-coarse index (-1 for dropped vertices); coarse vertices keep their fine order.
 std::vector<int32_t> coarse_vertex_index(std::span<const uint8_t> retained);
 

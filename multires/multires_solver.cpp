@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace waxwork {
 
@@ -32,6 +33,10 @@ void check_channel(int channel) {
 MultiresSolver::MultiresSolver(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                                const HierarchyOptions& options)
     : hierarchy_(build_multires_hierarchy(matrix, positions, options)) {}
+
+MultiresSolver::MultiresSolver(MultiresHierarchy hierarchy) : hierarchy_(std::move(hierarchy)) {
+    if (hierarchy_.levels.empty()) throw InvalidArgumentError("multires solver: the hierarchy has no levels");
+}
 
 void MultiresSolver::update_values(const DiffusionMatrix& matrix) {
     HierarchyLevel& level0 = hierarchy_.levels[0];

@@ -82,6 +82,9 @@ public:
     // Builds the hierarchy from the assembled system and the mesh positions (Eq. 16 weights).
     MultiresSolver(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                    const HierarchyOptions& options = {});
+    // Takes a hierarchy built elsewhere (rebuild_multires_hierarchy after an edit). Throws
+    // InvalidArgumentError for a hierarchy with no levels.
+    explicit MultiresSolver(MultiresHierarchy hierarchy);
 
     const MultiresHierarchy& hierarchy() const { return hierarchy_; }
     // Mutable access for callers that update coarse values in place (and for fault-injection tests).

@@ -280,6 +280,35 @@ TEST(LiveSolver, MultiresCorrectsThePhiCarriedThroughACut) {
     EXPECT_NEAR(corrected_gpu, corrected, 1e-3 + 0.05 * corrected);
 }
 
+// The multires method rebuilds its hierarchy from the previous one after an edit that says where the
+// vertices went: after a cut only the rows the cut changed are selected again, after a relaxation
+// (same graph) none; a reload (no map) builds from scratch. The solution stays right throughout.
+TEST(LiveSolver, MultiresRebuildsItsHierarchyAroundACut) {
+    PlaneCutOp cut;
+    cut.plane = {Eigen::Vector3d(1, 0.3, 0.2).normalized(), 0.55};
+    Document doc(testing::make_cube_mesh(14), material_preset("marble"));
+    LiveScene scene(doc.mesh(), key_lighting(), options_for(kConfigs[3]));
+    auto levels = scene.multires_levels();
+    ASSERT_GE(levels.size(), 2u);
+    EXPECT_EQ(levels[0][1], -1);  // built from scratch
+    scene.converge();
+    scene.apply_change(doc.mesh(), doc.apply(cut));
+    levels = scene.multires_levels();
+    ASSERT_GE(levels.size(), 2u);
+    EXPECT_EQ(levels[0][0], static_cast<int64_t>(doc.mesh().vertex_count()));
+    EXPECT_GT(levels[0][1], 0);
+    EXPECT_LT(levels[0][1], levels[0][0] / 2);
+    scene.converge();
+    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
+    scene.apply_change(doc.mesh(), doc.apply(RelaxOp{cut.plane, RelaxSettings{5, 0.3, 0.5}}));
+    levels = scene.multires_levels();
+    ASSERT_GE(levels.size(), 2u);
+    EXPECT_EQ(levels[0][1], 0);  // the same graph: every selection kept
+    scene.converge();
+    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
+    EXPECT_EQ(scene.method_fallback_reason(), "");
+}
+
 TEST(LiveSolver, AFailingGpuFallsBackToTheCpuWithAReason) {
     for (const Config& config : {kConfigs[2], kConfigs[4], kConfigs[5]}) {
         Document doc(testing::make_cube_mesh(6), material_preset("marble"));

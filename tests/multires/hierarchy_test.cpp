@@ -1,5 +1,8 @@
 #include "multires/hierarchy.h"
+#include "multires/independent_set.h"
+#include "multires/multires_solver.h"
 #include "multires_test_systems.h"
+#include "tetops/cut.h"
 #include "tetops/error.h"
 
 #include <tbb/global_control.h>
@@ -10,6 +13,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
+#include <queue>
 #include <random>
 
 namespace waxwork {
@@ -22,6 +27,29 @@ Eigen::MatrixXd dense(const HierarchyLevel& level, int channel) {
         for (int32_t k = level.offsets[static_cast<size_t>(i)]; k < level.offsets[static_cast<size_t>(i) + 1]; ++k)
             m(i, level.columns[static_cast<size_t>(k)]) += level.values[static_cast<size_t>(channel)][static_cast<size_t>(k)];
     return m;
+}
+
+// The stored interpolation operator of `fine` as a dense matrix.
+Eigen::MatrixXd stored_interpolation(const HierarchyLevel& fine, const HierarchyLevel& coarse) {
+    Eigen::MatrixXd p = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(fine.size()), static_cast<Eigen::Index>(coarse.size()));
+    for (size_t v = 0; v < fine.size(); ++v)
+        for (int32_t q = fine.interpolation.offsets[v]; q < fine.interpolation.offsets[v + 1]; ++q)
+            p(static_cast<Eigen::Index>(v), fine.interpolation.columns[static_cast<size_t>(q)]) +=
+                fine.interpolation.weights[static_cast<size_t>(q)];
+    return p;
+}
+
+// Eq. 17 checked densely: M^{l+1} = S M^l P with P as stored and S the selection of the retained rows.
+void expect_coarse_matrices_match_eq17(const HierarchyLevel& fine, const HierarchyLevel& coarse, size_t level) {
+    const Eigen::MatrixXd p = stored_interpolation(fine, coarse);
+    Eigen::MatrixXd select = Eigen::MatrixXd::Zero(p.cols(), p.rows());
+    for (size_t c = 0; c < coarse.size(); ++c) select(static_cast<Eigen::Index>(c), coarse.parent_vertex[c]) = 1;
+    for (int channel = 0; channel < 3; ++channel) {
+        const Eigen::MatrixXd expected = select * dense(fine, channel) * p;
+        const double scale = expected.cwiseAbs().maxCoeff();
+        EXPECT_LT((expected - dense(coarse, channel)).cwiseAbs().maxCoeff(), 1e-12 * scale)
+            << "level " << level + 1 << " channel " << channel;
+    }
 }
 
 // Eq. 16 rebuilt densely from the mesh graph: which level-l vertices survive is read from the coarse
@@ -64,11 +92,7 @@ TEST(Hierarchy, CoarseOperatorsMatchDenseEq17) {
         const HierarchyLevel& coarse = h.levels[l + 1];
         const Eigen::MatrixXd p = dense_interpolation(fine, coarse, s.mesh.positions);
         // The stored operator is the same P.
-        Eigen::MatrixXd stored = Eigen::MatrixXd::Zero(p.rows(), p.cols());
-        for (Eigen::Index v = 0; v < p.rows(); ++v)
-            for (int32_t q = fine.interpolation.offsets[static_cast<size_t>(v)]; q < fine.interpolation.offsets[static_cast<size_t>(v) + 1]; ++q)
-                stored(v, fine.interpolation.columns[static_cast<size_t>(q)]) += fine.interpolation.weights[static_cast<size_t>(q)];
-        EXPECT_LT((stored - p).cwiseAbs().maxCoeff(), 1e-14) << "level " << l;
+        EXPECT_LT((stored_interpolation(fine, coarse) - p).cwiseAbs().maxCoeff(), 1e-14) << "level " << l;
         // Selection S of the retained rows; Eq. 17: M^{l+1} = S M^l P.
         Eigen::MatrixXd select = Eigen::MatrixXd::Zero(p.cols(), p.rows());
         for (size_t c = 0; c < coarse.size(); ++c) select(static_cast<Eigen::Index>(c), coarse.parent_vertex[c]) = 1;
@@ -237,22 +261,7 @@ TEST(Hierarchy, CoarseOperatorsMatchDenseEq17WithLinearExactWeights) {
     options.weights = InterpolationWeights::LinearExact;
     const MultiresHierarchy h = build_multires_hierarchy(s.matrix, jittered(s.mesh, 0.8), options);
     ASSERT_GE(h.level_count(), 3u);
-    for (size_t l = 0; l + 1 < h.level_count(); ++l) {
-        const HierarchyLevel& fine = h.levels[l];
-        const HierarchyLevel& coarse = h.levels[l + 1];
-        Eigen::MatrixXd p = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(fine.size()), static_cast<Eigen::Index>(coarse.size()));
-        for (size_t v = 0; v < fine.size(); ++v)
-            for (int32_t q = fine.interpolation.offsets[v]; q < fine.interpolation.offsets[v + 1]; ++q)
-                p(static_cast<Eigen::Index>(v), fine.interpolation.columns[static_cast<size_t>(q)]) +=
-                    fine.interpolation.weights[static_cast<size_t>(q)];
-        Eigen::MatrixXd select = Eigen::MatrixXd::Zero(p.cols(), p.rows());
-        for (size_t c = 0; c < coarse.size(); ++c) select(static_cast<Eigen::Index>(c), coarse.parent_vertex[c]) = 1;
-        for (int channel = 0; channel < 3; ++channel) {
-            const Eigen::MatrixXd expected = select * dense(fine, channel) * p;
-            const double scale = expected.cwiseAbs().maxCoeff();
-            EXPECT_LT((expected - dense(coarse, channel)).cwiseAbs().maxCoeff(), 1e-12 * scale) << "level " << l + 1;
-        }
-    }
+    for (size_t l = 0; l + 1 < h.level_count(); ++l) expect_coarse_matrices_match_eq17(h.levels[l], h.levels[l + 1], l);
     EXPECT_GT(h.levels[0].interpolation.linear_exact_rows, 0);
 }
 
@@ -294,6 +303,233 @@ TEST(Hierarchy, RejectsANonFiniteLinearExactWeightFloor) {
             EXPECT_NE(std::string(error.what()).find("weight floor"), std::string::npos) << error.what();
         }
     }
+}
+
+// --- Rebuilding after an edit (rebuild_multires_hierarchy) ---
+
+// A make_test_system volume after a plane cut: the cut mesh's system and the cut's vertex map.
+struct CutSystem {
+    TetMesh mesh;
+    TetConnectivity connectivity;
+    DiffusionMatrix matrix;
+    std::vector<int32_t> new_of_old;
+};
+
+CutSystem cut_system(const TetMesh& mesh, const Eigen::Vector3d& normal, double offset) {
+    CutSystem c;
+    c.mesh = mesh;
+    c.new_of_old = remove_cut_away_tets(c.mesh, PlaneCut(normal, offset)).old_to_new_vertex;
+    c.connectivity = build_connectivity(c.mesh);
+    const std::vector<TetMaterial> materials(c.mesh.tet_count(), testing::test_material());
+    c.matrix = assemble_diffusion_matrix(c.mesh, c.connectivity, materials);
+    return c;
+}
+
+// Per vertex of level l: 1 when it is retained in level l+1.
+std::vector<uint8_t> retained_flags(const MultiresHierarchy& h, size_t l) {
+    std::vector<uint8_t> retained(h.levels[l].size(), 0);
+    for (const int32_t p : h.levels[l + 1].parent_vertex) retained[static_cast<size_t>(p)] = 1;
+    return retained;
+}
+
+void expect_same_levels(const MultiresHierarchy& a, const MultiresHierarchy& b) {
+    ASSERT_EQ(a.level_count(), b.level_count());
+    for (size_t l = 0; l < a.level_count(); ++l) {
+        EXPECT_EQ(a.levels[l].original_vertex, b.levels[l].original_vertex) << "level " << l;
+        EXPECT_EQ(a.levels[l].graph.indices, b.levels[l].graph.indices) << "level " << l;
+        EXPECT_EQ(a.levels[l].columns, b.levels[l].columns) << "level " << l;
+        EXPECT_EQ(a.levels[l].values, b.levels[l].values) << "level " << l;
+        EXPECT_EQ(a.levels[l].interpolation.columns, b.levels[l].interpolation.columns) << "level " << l;
+        EXPECT_EQ(a.levels[l].interpolation.weights, b.levels[l].interpolation.weights) << "level " << l;
+    }
+}
+
+// The properties a fresh build has, on every level of `h`: each dropped vertex has a retained
+// neighbour, no fine edge lost its connection, the coarse graph is the definition's on this selection,
+// and the coarse matrices are Eq. 17 (densely, when `dense_check`).
+void expect_valid_hierarchy(const MultiresHierarchy& h, bool dense_check) {
+    for (size_t l = 0; l + 1 < h.level_count(); ++l) {
+        const HierarchyLevel& fine = h.levels[l];
+        const std::vector<uint8_t> retained = retained_flags(h, l);
+        for (size_t v = 0; v < fine.size(); ++v) {
+            if (retained[v]) continue;
+            const auto row = fine.graph.row(v);
+            EXPECT_TRUE(std::any_of(row.begin(), row.end(), [&](int32_t u) { return retained[static_cast<size_t>(u)] != 0; }))
+                << "level " << l << ": dropped vertex " << v << " has no retained neighbour";
+        }
+        const std::vector<uint8_t> lost = mark_lost_connections(fine.graph, retained);
+        EXPECT_EQ(std::count(lost.begin(), lost.end(), uint8_t{1}), 0) << "level " << l;
+        const CompressedRows graph = build_coarse_graph(fine.graph, retained, coarse_vertex_index(retained));
+        EXPECT_EQ(graph.offsets, h.levels[l + 1].graph.offsets) << "level " << l + 1;
+        EXPECT_EQ(graph.indices, h.levels[l + 1].graph.indices) << "level " << l + 1;
+        if (dense_check) expect_coarse_matrices_match_eq17(fine, h.levels[l + 1], l);
+    }
+}
+
+// Graph distance from the nearest of `sources` (-1 when unreachable).
+std::vector<int> distance_from(const CompressedRows& g, const std::vector<int32_t>& sources) {
+    std::vector<int> d(g.row_count(), -1);
+    std::queue<int32_t> queue;
+    for (const int32_t v : sources) {
+        d[static_cast<size_t>(v)] = 0;
+        queue.push(v);
+    }
+    while (!queue.empty()) {
+        const int32_t v = queue.front();
+        queue.pop();
+        for (const int32_t u : g.row(static_cast<size_t>(v)))
+            if (d[static_cast<size_t>(u)] < 0) {
+                d[static_cast<size_t>(u)] = d[static_cast<size_t>(v)] + 1;
+                queue.push(u);
+            }
+    }
+    return d;
+}
+
+// After moving vertices (a relaxation) nothing in the graphs changes: the rebuild keeps every
+// selection and equals a fresh build of the new system, operators included.
+TEST(HierarchyRebuild, WithTheSameGraphEqualsAFreshBuild) {
+    const auto s = testing::make_test_system(10);
+    HierarchyOptions options;
+    options.min_coarse_vertices = 50;
+    const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
+    ASSERT_GE(before.level_count(), 3u);
+    TetMesh moved = s.mesh;
+    moved.positions = jittered(s.mesh, 0.4);
+    const std::vector<TetMaterial> materials(moved.tet_count(), testing::test_material());
+    const DiffusionMatrix matrix = assemble_diffusion_matrix(moved, s.connectivity, materials);
+    std::vector<int32_t> identity(s.matrix.size());
+    std::iota(identity.begin(), identity.end(), 0);
+    const MultiresHierarchy rebuilt = rebuild_multires_hierarchy(before, identity, matrix, moved.positions, options);
+    expect_same_levels(rebuilt, build_multires_hierarchy(matrix, moved.positions, options));
+    for (size_t l = 0; l + 1 < rebuilt.level_count(); ++l) EXPECT_EQ(rebuilt.levels[l].changed_vertices, 0) << "level " << l;
+    EXPECT_EQ(before.levels[0].changed_vertices, -1);
+    // The new positions did reach the operators.
+    EXPECT_NE(rebuilt.levels[0].interpolation.weights, before.levels[0].interpolation.weights);
+}
+
+// After a cut: every property of a fresh build on every level, including two cuts in a row (the
+// second rebuilds a rebuilt hierarchy); on level 0 only vertices within two edges of a changed row
+// change state; the levels shrink as a fresh build's do.
+TEST(HierarchyRebuild, AfterCutsKeepsEveryPropertyAndTheSelectionAwayFromTheCut) {
+    const auto s = testing::make_test_system(8);  // 729 vertices, coordinates 0..4
+    HierarchyOptions options;
+    options.min_coarse_vertices = 20;
+    MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
+    ASSERT_GE(h.level_count(), 3u);
+    TetMesh mesh = s.mesh;
+    for (const auto& [normal, offset] : {std::pair{Eigen::Vector3d(1, 0.3, 0), 3.1}, std::pair{Eigen::Vector3d(0, -1, 0.2), -0.8}}) {
+        const CutSystem cut = cut_system(mesh, normal, offset);
+        ASSERT_LT(cut.mesh.vertex_count(), mesh.vertex_count());
+        const MultiresHierarchy rebuilt = rebuild_multires_hierarchy(h, cut.new_of_old, cut.matrix, cut.mesh.positions, options);
+        ASSERT_GE(rebuilt.level_count(), 3u);
+        expect_valid_hierarchy(rebuilt, /*dense_check=*/true);
+        // The changed rows of level 0, by their definition: new rows that are not the old row mapped.
+        std::vector<int32_t> old_of_new(cut.mesh.vertex_count(), -1);
+        for (size_t o = 0; o < cut.new_of_old.size(); ++o)
+            if (cut.new_of_old[o] >= 0) old_of_new[static_cast<size_t>(cut.new_of_old[o])] = static_cast<int32_t>(o);
+        const CompressedRows& g = rebuilt.levels[0].graph;
+        std::vector<int32_t> changed;
+        for (size_t v = 0; v < g.row_count(); ++v) {
+            std::vector<int32_t> mapped;
+            for (const int32_t u : h.levels[0].graph.row(static_cast<size_t>(old_of_new[v])))
+                mapped.push_back(cut.new_of_old[static_cast<size_t>(u)]);
+            std::sort(mapped.begin(), mapped.end());
+            const auto row = g.row(v);
+            if (!std::equal(mapped.begin(), mapped.end(), row.begin(), row.end())) changed.push_back(static_cast<int32_t>(v));
+        }
+        ASSERT_FALSE(changed.empty());
+        EXPECT_EQ(rebuilt.levels[0].changed_vertices, static_cast<int64_t>(changed.size()));
+        const std::vector<int> distance = distance_from(g, changed);
+        const std::vector<uint8_t> old_retained = retained_flags(h, 0), new_retained = retained_flags(rebuilt, 0);
+        int64_t far = 0, moved = 0;
+        for (size_t v = 0; v < g.row_count(); ++v) {
+            moved += new_retained[v] != old_retained[static_cast<size_t>(old_of_new[v])];
+            if (distance[v] >= 0 && distance[v] <= 2) continue;
+            ++far;
+            EXPECT_EQ(new_retained[v], old_retained[static_cast<size_t>(old_of_new[v])]) << "vertex " << v << " far from the cut";
+        }
+        EXPECT_GT(far, static_cast<int64_t>(g.row_count()) / 4);
+        EXPECT_GT(moved, 0);  // the cut did change the selection next to it
+        const MultiresHierarchy fresh = build_multires_hierarchy(cut.matrix, cut.mesh.positions, options);
+        for (size_t l = 1; l < std::min(rebuilt.level_count(), fresh.level_count()); ++l)
+            EXPECT_NEAR(static_cast<double>(rebuilt.levels[l].size()), static_cast<double>(fresh.levels[l].size()),
+                        0.15 * static_cast<double>(fresh.levels[l].size()))
+                << "level " << l;
+        h = rebuilt;
+        mesh = cut.mesh;
+    }
+}
+
+// The rebuilt hierarchy serves the coarse-to-fine solve as a fresh one does: the solve converges to
+// the level-0 solution, and its coarse pass starts about as close.
+TEST(HierarchyRebuild, AfterACutSolvesLikeAFreshBuild) {
+    const auto s = testing::make_test_system(14);  // 3375 vertices
+    const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions);
+    const CutSystem cut = cut_system(s.mesh, Eigen::Vector3d(1, 0.2, 0.1), 2.7);
+    std::vector<double> b(cut.mesh.vertex_count());
+    std::vector<std::array<double, 3>> q(cut.mesh.vertex_count());
+    for (size_t v = 0; v < q.size(); ++v) {
+        const double light = cut.mesh.positions[v].z() > 3.0 ? 1.0 + cut.mesh.positions[v].x() : 0.1;
+        q[v] = {light, 0.5 * light, 0.25 * light};
+    }
+    diffusion_right_hand_side(cut.matrix, q, 1, b);
+    const std::vector<double> reference = testing::reference_solution(cut.matrix, b, 1);
+    MultiresSolver rebuilt(rebuild_multires_hierarchy(before, cut.new_of_old, cut.matrix, cut.mesh.positions));
+    MultiresSolver fresh(cut.matrix, cut.mesh.positions);
+    ASSERT_GE(rebuilt.hierarchy().level_count(), 2u);
+    MultiresSolveOptions tight;
+    tight.relative_tolerance = 1e-9;
+    std::vector<double> x(reference.size());
+    const MultiresSolveReport converged = rebuilt.solve(b, 1, x, tight);
+    EXPECT_TRUE(converged.fine.converged);
+    EXPECT_LT(testing::relative_error(x, reference), 1e-6);
+    EXPECT_EQ(converged.fallbacks(), 0);
+    MultiresSolveOptions pass_only;
+    pass_only.max_iterations = 0;
+    std::vector<double> y(reference.size());
+    rebuilt.solve(b, 1, x, pass_only);
+    fresh.solve(b, 1, y, pass_only);
+    const double rebuilt_error = testing::relative_error(x, reference), fresh_error = testing::relative_error(y, reference);
+    EXPECT_LT(rebuilt_error, 0.5);
+    EXPECT_LT(rebuilt_error, 1.25 * fresh_error) << "fresh: " << fresh_error;
+}
+
+TEST(HierarchyRebuild, DeterministicAcrossThreadCounts) {
+    const auto s = testing::make_test_system(10);
+    HierarchyOptions options;
+    options.min_coarse_vertices = 50;
+    const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
+    const CutSystem cut = cut_system(s.mesh, Eigen::Vector3d(0.2, 1, 0), 2.9);
+    const MultiresHierarchy a = rebuild_multires_hierarchy(before, cut.new_of_old, cut.matrix, cut.mesh.positions, options);
+    MultiresHierarchy b;
+    {
+        tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+        b = rebuild_multires_hierarchy(before, cut.new_of_old, cut.matrix, cut.mesh.positions, options);
+    }
+    expect_same_levels(a, b);
+}
+
+TEST(HierarchyRebuild, RejectsAVertexMapThatDoesNotFit) {
+    const auto s = testing::make_test_system(4);
+    const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions);
+    std::vector<int32_t> map(s.matrix.size());
+    std::iota(map.begin(), map.end(), 0);
+    const auto expect_rejected = [&](std::vector<int32_t> bad, const std::string& words) {
+        try {
+            rebuild_multires_hierarchy(before, bad, s.matrix, s.mesh.positions);
+            ADD_FAILURE() << "accepted a map that should say: " << words;
+        } catch (const InvalidArgumentError& error) {
+            EXPECT_NE(std::string(error.what()).find(words), std::string::npos) << error.what();
+        }
+    };
+    expect_rejected(std::vector<int32_t>(map.begin(), map.end() - 1), "entries for a hierarchy");
+    std::vector<int32_t> outside = map;
+    outside[3] = static_cast<int32_t>(s.matrix.size());
+    expect_rejected(outside, "outside");
+    std::vector<int32_t> twice = map;
+    twice[3] = 4;
+    expect_rejected(twice, "two vertices map to vertex 4");
 }
 
 }  // namespace
