@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <memory>
 #include <string>
 
 namespace waxwork {
@@ -112,7 +113,10 @@ namespace {
 // slots in parallel with no counting pass.
 struct LostConnections {
     std::vector<int32_t> count;
-    std::vector<int32_t> partners;
+    // Not zero-filled: only the tested vertices' slots are written and read, and after a local update
+    // (update_coarse_vertices) those lie on a few of the array's pages; filling it would touch all
+    // of them (an array the size of the graph, for a region of a few thousand vertices).
+    std::unique_ptr<int32_t[]> partners;
 };
 
 // Per thread, tag[u] == i when u is adjacent to a "joiner" of i: a neighbour k of i that can join i to
@@ -147,7 +151,7 @@ LostConnections find_lost_connections(const CompressedRows& graph, std::span<con
     const size_t n = graph.row_count();
     LostConnections lost;
     lost.count.assign(n, 0);
-    lost.partners.resize(graph.indices.size());
+    lost.partners = std::make_unique_for_overwrite<int32_t[]>(graph.indices.size());
     JoinedTags joined(n);
     // Each vertex tests all its dropped neighbours (the test is symmetric, so both ends of a lost edge
     // list it), and writes only its own slots.

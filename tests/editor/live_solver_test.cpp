@@ -281,8 +281,8 @@ TEST(LiveSolver, MultiresCorrectsThePhiCarriedThroughACut) {
 }
 
 // The multires method rebuilds its hierarchy from the previous one after an edit that says where the
-// vertices went: after a cut only the rows the cut changed are selected again, after a relaxation
-// (same graph) none; a reload (no map) builds from scratch. The solution stays right throughout.
+// vertices went: after a cut (removal or exact) only around the rows the cut changed is the selection
+// made again, after a relaxation (same graph) nowhere. The solution stays right throughout.
 TEST(LiveSolver, MultiresRebuildsItsHierarchyAroundACut) {
     PlaneCutOp cut;
     cut.plane = {Eigen::Vector3d(1, 0.3, 0.2).normalized(), 0.55};
@@ -304,6 +304,18 @@ TEST(LiveSolver, MultiresRebuildsItsHierarchyAroundACut) {
     levels = scene.multires_levels();
     ASSERT_GE(levels.size(), 2u);
     EXPECT_EQ(levels[0][1], 0);  // the same graph: every selection kept
+    scene.converge();
+    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
+    // An exact cut maps its kept vertices through their origins; the vertices it creates are new rows.
+    PlaneCutOp exact;
+    exact.plane = {Eigen::Vector3d(0, 1, 0.1).normalized(), 0.8};
+    exact.exact = true;
+    const size_t before_exact = doc.mesh().vertex_count();
+    scene.apply_change(doc.mesh(), doc.apply(exact));
+    levels = scene.multires_levels();
+    ASSERT_GE(levels.size(), 2u);
+    EXPECT_GT(levels[0][1], 0);
+    EXPECT_LT(levels[0][1], static_cast<int64_t>(before_exact) / 2);
     scene.converge();
     EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
     EXPECT_EQ(scene.method_fallback_reason(), "");
