@@ -108,14 +108,18 @@ InterpolationOperator build_interpolation(const CompressedRows& graph, std::span
                                           std::span<const int32_t> coarse_index,
                                           std::span<const int32_t> original_vertex,
                                           std::span<const Eigen::Vector3d> positions,
-                                          const HierarchyOptions& options) {
+                                          const HierarchyOptions& options, const CarriedRows* carried,
+                                          const InterpolationOperator* previous) {
     const size_t n = graph.row_count();
     InterpolationOperator p;
     p.offsets.assign(n + 1, 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v != r.end(); ++v) {
             int32_t count = 1;
-            if (!retained[v]) {
+            if (carried && carried->kept(v)) {
+                const auto old = static_cast<size_t>(carried->previous_row[v]);
+                count = previous->offsets[old + 1] - previous->offsets[old];
+            } else if (!retained[v]) {
                 count = 0;
                 for (int32_t u : graph.row(v)) count += retained[static_cast<size_t>(u)] ? 1 : 0;
             }
@@ -131,6 +135,15 @@ InterpolationOperator build_interpolation(const CompressedRows& graph, std::span
         int64_t corrected = 0, kept = 0;
         for (size_t v = r.begin(); v != r.end(); ++v) {
             auto slot = static_cast<size_t>(p.offsets[v]);
+            if (carried && carried->kept(v)) {
+                const auto old = static_cast<size_t>(carried->previous_row[v]);
+                for (auto q = static_cast<size_t>(previous->offsets[old]); q < static_cast<size_t>(previous->offsets[old + 1]);
+                     ++q, ++slot) {
+                    p.columns[slot] = carried->new_of_old_column[static_cast<size_t>(previous->columns[q])];
+                    p.weights[slot] = previous->weights[q];
+                }
+                continue;
+            }
             if (retained[v]) {  // Eq. 16, first case: copy the coarse value
                 p.columns[slot] = coarse_index[v];
                 p.weights[slot] = 1.0;
@@ -167,7 +180,8 @@ InterpolationOperator build_interpolation(const CompressedRows& graph, std::span
     return p;
 }
 
-void build_coarse_matrix(const HierarchyLevel& fine, std::span<const int32_t> coarse_to_fine, HierarchyLevel& coarse) {
+void build_coarse_matrix(const HierarchyLevel& fine, std::span<const int32_t> coarse_to_fine, HierarchyLevel& coarse,
+                         const CarriedRows* carried, const HierarchyLevel* previous) {
     const size_t m = coarse_to_fine.size();
     const CompressedRows& g = coarse.graph;
     coarse.offsets.assign(m + 1, 0);
@@ -195,9 +209,24 @@ void build_coarse_matrix(const HierarchyLevel& fine, std::span<const int32_t> co
             }
         }
     });
-    std::vector<int32_t> all(m);
-    for (size_t c = 0; c < m; ++c) all[c] = static_cast<int32_t>(c);
-    update_coarse_rows(fine, coarse_to_fine, coarse, all);
+    std::vector<int32_t> computed;
+    computed.reserve(m);
+    for (size_t c = 0; c < m; ++c)
+        if (!carried || !carried->kept(c)) computed.push_back(static_cast<int32_t>(c));
+    if (carried) {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 1024), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t c = r.begin(); c != r.end(); ++c) {
+                if (!carried->kept(c)) continue;
+                const auto old = static_cast<size_t>(carried->previous_row[c]);
+                const auto from = static_cast<std::ptrdiff_t>(previous->offsets[old]);
+                const auto to = static_cast<std::ptrdiff_t>(previous->offsets[old + 1]);
+                for (size_t ch = 0; ch < 3; ++ch)
+                    std::copy(previous->values[ch].begin() + from, previous->values[ch].begin() + to,
+                              coarse.values[ch].begin() + coarse.offsets[c]);
+            }
+        });
+    }
+    update_coarse_rows(fine, coarse_to_fine, coarse, computed);
 }
 
 void update_coarse_rows(const HierarchyLevel& fine, std::span<const int32_t> coarse_to_fine, HierarchyLevel& coarse,
@@ -328,29 +357,109 @@ std::vector<int32_t> changed_rows(const CompressedRows& graph, const CompressedR
     return rows;
 }
 
-// A level's fields that the build loop fills the same way whether its selection was made afresh or
-// carried: the coarse level's vertex maps and graph, and the fine level's Eq. 16 and Eq. 17 operators.
+// What a rebuild copies into one coarsening step from the previous hierarchy (carried_rows.h): the
+// kept rows of Eq. 16 (per fine vertex), of the coarse graph and of Eq. 17 (per coarse vertex).
+struct CarriedOperators {
+    std::vector<uint8_t> keep_interpolation, keep_graph, keep_matrix;
+    std::vector<int32_t> previous_fine_row;    // per fine vertex: its previous vertex
+    std::vector<int32_t> previous_coarse_row;  // per coarse vertex: its previous coarse vertex (where kept)
+    std::vector<int32_t> new_of_old_coarse;    // previous coarse vertex -> new, or -1
+    const HierarchyLevel* previous_fine = nullptr;
+    const HierarchyLevel* previous_coarse = nullptr;
+
+    CarriedRows interpolation_rows() const { return {keep_interpolation, previous_fine_row, new_of_old_coarse}; }
+    CarriedRows graph_rows() const { return {keep_graph, previous_coarse_row, new_of_old_coarse}; }
+    CarriedRows matrix_rows() const { return {keep_matrix, previous_coarse_row, new_of_old_coarse}; }
+};
+
+// The coarse level of `step` and the fine level's Eq. 16 and Eq. 17 operators, computed, or with
+// `carried` partly copied from the previous hierarchy.
 HierarchyLevel add_coarse_level(HierarchyLevel& fine, const CoarseningStep& step,
                                 std::span<const Eigen::Vector3d> positions, const HierarchyOptions& options,
-                                HierarchyBuildTimes& times, const std::function<void(double&)>& time) {
+                                const CarriedOperators* carried, HierarchyBuildTimes& times,
+                                const std::function<void(double&)>& time) {
     HierarchyLevel coarse;
     coarse.parent_vertex = step.coarse_to_fine;
     coarse.original_vertex.resize(step.coarse_to_fine.size());
     for (size_t c = 0; c < step.coarse_to_fine.size(); ++c)
         coarse.original_vertex[c] = fine.original_vertex[static_cast<size_t>(step.coarse_to_fine[c])];
-    fine.interpolation = build_interpolation(fine.graph, step.selection.retained, step.coarse_index,
-                                             fine.original_vertex, positions, options);
+    std::optional<CarriedRows> interpolation_rows, graph_rows, matrix_rows;
+    if (carried) {
+        interpolation_rows = carried->interpolation_rows();
+        graph_rows = carried->graph_rows();
+        matrix_rows = carried->matrix_rows();
+    }
+    fine.interpolation = build_interpolation(fine.graph, step.selection.retained, step.coarse_index, fine.original_vertex,
+                                             positions, options, interpolation_rows ? &*interpolation_rows : nullptr,
+                                             carried ? &carried->previous_fine->interpolation : nullptr);
     time(times.interpolation);
     // P's columns are exactly each fine vertex's coarse links (independent_set.h).
     coarse.graph = build_coarse_graph(fine.graph, step.coarse_index, fine.interpolation.offsets,
-                                      fine.interpolation.columns);
+                                      fine.interpolation.columns, graph_rows ? &*graph_rows : nullptr,
+                                      carried ? &carried->previous_coarse->graph : nullptr);
     time(times.coarse_graph);
     fine.independent_set_rounds = step.selection.independent_set_rounds;
     fine.enhancement_passes = step.selection.enhancement_passes;
     fine.enhancement_vertices = step.selection.enhancement_vertices;
-    build_coarse_matrix(fine, step.coarse_to_fine, coarse);
+    build_coarse_matrix(fine, step.coarse_to_fine, coarse, matrix_rows ? &*matrix_rows : nullptr,
+                        carried ? carried->previous_coarse : nullptr);
+    if (carried)
+        coarse.copied_rows = std::count(carried->keep_matrix.begin(), carried->keep_matrix.end(), uint8_t{1});
     time(times.coarse_matrix);
     return coarse;
+}
+
+// flags | the flags of each vertex's neighbours: one ring wider.
+std::vector<uint8_t> widen(const CompressedRows& graph, std::span<const uint8_t> flags) {
+    std::vector<uint8_t> wider(flags.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, flags.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            uint8_t any = flags[v];
+            for (const int32_t u : graph.row(v)) any |= flags[static_cast<size_t>(u)];
+            wider[v] = any;
+        }
+    });
+    return wider;
+}
+
+// Which operator rows of one carried level can be copied. touched: per fine vertex, 1 when it is new,
+// its row changed, it moved (positions), or its selection state changed. An Eq. 16 row reads its
+// vertex, its neighbours' states and positions: it is copied when neither touched nor next to a
+// touched vertex (and carry_interpolation: with linear-exact weights every row is computed, for
+// its counts). A coarse graph row reads its fine vertex's neighbours' links (their Eq. 16 columns):
+// copied when the fine vertex and its neighbours have untouched Eq. 16 rows (copied or computed,
+// they equal the previous ones). An Eq. 17 row reads the same and the fine matrix row: copied when
+// the graph row is and that matrix row did not change (values_changed, per fine vertex).
+CarriedOperators carry_operators(const CompressedRows& graph, const CoarseningStep& step,
+                                 std::span<const uint8_t> touched, std::span<const uint8_t> values_changed,
+                                 std::span<const int32_t> old_of_new, std::span<const int32_t> new_of_old_coarse,
+                                 const HierarchyLevel& previous_fine, const HierarchyLevel& previous_coarse,
+                                 bool carry_interpolation) {
+    CarriedOperators carried;
+    carried.previous_fine = &previous_fine;
+    carried.previous_coarse = &previous_coarse;
+    carried.new_of_old_coarse.assign(new_of_old_coarse.begin(), new_of_old_coarse.end());
+    carried.previous_fine_row.assign(old_of_new.begin(), old_of_new.end());
+    const std::vector<uint8_t> dirty_interpolation = widen(graph, touched);
+    const std::vector<uint8_t> dirty_links = widen(graph, dirty_interpolation);
+    const size_t n = graph.row_count(), m = step.coarse_to_fine.size();
+    carried.keep_interpolation.resize(n);
+    for (size_t v = 0; v < n; ++v) carried.keep_interpolation[v] = carry_interpolation && !dirty_interpolation[v];
+    std::vector<int32_t> previous_coarse_of(previous_fine.size(), -1);
+    for (size_t c = 0; c < previous_coarse.parent_vertex.size(); ++c)
+        previous_coarse_of[static_cast<size_t>(previous_coarse.parent_vertex[c])] = static_cast<int32_t>(c);
+    carried.keep_graph.assign(m, 0);
+    carried.keep_matrix.assign(m, 0);
+    carried.previous_coarse_row.assign(m, -1);
+    for (size_t c = 0; c < m; ++c) {
+        const auto i = static_cast<size_t>(step.coarse_to_fine[c]);
+        // Not touched: i is an old vertex, retained before as now.
+        if (dirty_links[i]) continue;
+        carried.previous_coarse_row[c] = previous_coarse_of[static_cast<size_t>(old_of_new[i])];
+        carried.keep_graph[c] = 1;
+        carried.keep_matrix[c] = !values_changed[i];
+    }
+    return carried;
 }
 
 void check_hierarchy_inputs(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
@@ -363,8 +472,50 @@ void check_hierarchy_inputs(const DiffusionMatrix& matrix, std::span<const Eigen
                                    std::to_string(options.min_linear_exact_weight) + ")");
 }
 
+// Per new level-0 vertex: 1 when it has no previous vertex or its position (moved) or matrix row
+// (values_changed: pattern or values) is not its previous vertex's. Both 1 everywhere when the
+// previous positions are unknown.
+void level0_changes(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
+                    const MultiresHierarchy& previous, std::span<const int32_t> old_of_new,
+                    std::span<const int32_t> new_of_old, std::vector<uint8_t>& moved, std::vector<uint8_t>& values_changed) {
+    const size_t n = matrix.size();
+    const HierarchyLevel& old = previous.levels[0];
+    const bool known_positions = previous.positions.size() == old.size();
+    moved.assign(n, 1);
+    values_changed.assign(n, 1);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 2048), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            const int32_t o = old_of_new[v];
+            if (o < 0) continue;
+            const auto ou = static_cast<size_t>(o);
+            moved[v] = !known_positions || positions[v] != previous.positions[ou];
+            const auto begin = static_cast<size_t>(matrix.offsets[v]), end = static_cast<size_t>(matrix.offsets[v + 1]);
+            const auto old_begin = static_cast<size_t>(old.offsets[ou]), old_end = static_cast<size_t>(old.offsets[ou + 1]);
+            bool same = end - begin == old_end - old_begin;
+            for (size_t k = 0; same && k < end - begin; ++k) {
+                same = matrix.columns[begin + k] == new_of_old[static_cast<size_t>(old.columns[old_begin + k])];
+                for (size_t ch = 0; same && ch < 3; ++ch) same = matrix.values[ch][begin + k] == old.values[ch][old_begin + k];
+            }
+            values_changed[v] = !same;
+        }
+    });
+}
+
+// True when the vertices that survive keep their order (new index increasing with the old one): then
+// every level's renumbering keeps it too, and copied rows equal computed ones bit for bit.
+bool keeps_order(std::span<const int32_t> new_of_old) {
+    int32_t last = -1;
+    for (const int32_t v : new_of_old) {
+        if (v < 0) continue;
+        if (v <= last) return false;
+        last = v;
+    }
+    return true;
+}
+
 // Builds the hierarchy's levels; with `previous` and its level-0 vertex map, carries each level's
-// selection from the previous hierarchy (rebuild_multires_hierarchy).
+// selection from the previous hierarchy (rebuild_multires_hierarchy), and the operator rows the edit
+// did not reach.
 MultiresHierarchy build_levels(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                                const HierarchyOptions& options, const MultiresHierarchy* previous,
                                std::span<const int32_t> new_of_old_vertex) {
@@ -381,34 +532,46 @@ MultiresHierarchy build_levels(const DiffusionMatrix& matrix, std::span<const Ei
     MultiresHierarchy hierarchy;
     HierarchyBuildTimes& times = hierarchy.build_times;
     hierarchy.levels.push_back(fine_level(matrix));
+    hierarchy.positions.assign(positions.begin(), positions.end());
     time(times.fine_level);
     // Per vertex of the previous hierarchy's current level: its vertex in the new level (-1: none).
     std::vector<int32_t> new_of_old;
+    // Per vertex of the new current level: moved (its level-0 position) and matrix row changed.
+    std::vector<uint8_t> moved, values_changed;
+    // Operator rows are copied only under an order-preserving map, and Eq. 16's only with the paper's
+    // weights (a linear-exact row's counts must be known).
+    const bool carry_rows = previous && keeps_order(new_of_old_vertex);
+    const bool carry_interpolation = carry_rows && options.weights == InterpolationWeights::InverseEdgeLength;
     if (previous) new_of_old.assign(new_of_old_vertex.begin(), new_of_old_vertex.end());
     for (;;) {
         HierarchyLevel& fine = hierarchy.levels.back();
         const size_t l = hierarchy.levels.size() - 1;
+        const size_t n = fine.graph.row_count();
+        const bool carry = previous && l + 1 < previous->level_count();
         std::optional<CarriedSelection> carried;
-        if (previous && l + 1 < previous->level_count()) {
+        std::vector<int32_t> old_of_new;
+        if (carry) {
             const HierarchyLevel& old_fine = previous->levels[l];
             const HierarchyLevel& old_coarse = previous->levels[l + 1];
             std::vector<uint8_t> old_retained(old_fine.graph.row_count(), 0);
             for (const int32_t p : old_coarse.parent_vertex) old_retained[static_cast<size_t>(p)] = 1;
-            std::vector<int32_t> old_of_new(fine.graph.row_count(), -1);
+            old_of_new.assign(n, -1);
             for (size_t o = 0; o < new_of_old.size(); ++o)
                 if (new_of_old[o] >= 0) old_of_new[static_cast<size_t>(new_of_old[o])] = static_cast<int32_t>(o);
             carried.emplace();
-            carried->previous_retained.assign(old_of_new.size(), 0);
-            for (size_t v = 0; v < old_of_new.size(); ++v)
+            carried->previous_retained.assign(n, 0);
+            for (size_t v = 0; v < n; ++v)
                 if (old_of_new[v] >= 0) carried->previous_retained[v] = old_retained[static_cast<size_t>(old_of_new[v])];
             carried->changed = changed_rows(fine.graph, old_fine.graph, old_of_new, new_of_old);
             fine.changed_vertices = static_cast<int64_t>(carried->changed.size());
+            if (l == 0 && carry_rows) level0_changes(matrix, positions, *previous, old_of_new, new_of_old, moved, values_changed);
         }
         std::optional<CoarseningStep> step =
             coarsen(fine.graph, hierarchy.levels.size(), options, carried ? &*carried : nullptr);
         time(times.selection);
         if (!step) break;
-        if (carried) {
+        std::optional<CarriedOperators> operators;
+        if (carry) {
             // The previous coarse vertices' new indices: through their parents, when still retained.
             const HierarchyLevel& old_coarse = previous->levels[l + 1];
             std::vector<int32_t> next(old_coarse.parent_vertex.size(), -1);
@@ -416,9 +579,30 @@ MultiresHierarchy build_levels(const DiffusionMatrix& matrix, std::span<const Ei
                 const int32_t v = new_of_old[static_cast<size_t>(old_coarse.parent_vertex[c])];
                 if (v >= 0) next[c] = step->coarse_index[static_cast<size_t>(v)];
             }
+            if (carry_rows) {
+                std::vector<uint8_t> touched(n);
+                for (size_t v = 0; v < n; ++v)
+                    touched[v] = old_of_new[v] < 0 || moved[v] ||
+                                 step->selection.retained[v] != carried->previous_retained[v];
+                for (const int32_t v : carried->changed) touched[static_cast<size_t>(v)] = 1;
+                operators = carry_operators(fine.graph, *step, touched, values_changed, old_of_new, next,
+                                            previous->levels[l], old_coarse, carry_interpolation);
+            }
             new_of_old = std::move(next);
         }
-        hierarchy.levels.push_back(add_coarse_level(fine, *step, positions, options, times, time));
+        hierarchy.levels.push_back(
+            add_coarse_level(fine, *step, positions, options, operators ? &*operators : nullptr, times, time));
+        if (operators) {
+            // The next level's vertices: moved with their level-0 vertex; their matrix row changed
+            // unless its Eq. 17 row was copied.
+            std::vector<uint8_t> next_moved(step->coarse_to_fine.size()), next_changed(step->coarse_to_fine.size());
+            for (size_t c = 0; c < step->coarse_to_fine.size(); ++c) {
+                next_moved[c] = moved[static_cast<size_t>(step->coarse_to_fine[c])];
+                next_changed[c] = !operators->keep_matrix[c];
+            }
+            moved = std::move(next_moved);
+            values_changed = std::move(next_changed);
+        }
     }
     hierarchy.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     return hierarchy;

@@ -16,6 +16,7 @@
 // stops the build (a coarse level that barely shrinks costs as much as its parent and gains nothing).
 #pragma once
 
+#include "multires/carried_rows.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "tetops/connectivity.h"
@@ -94,6 +95,9 @@ struct HierarchyLevel {
     // rebuild_multires_hierarchy: how many of this level's vertices had no previous vertex or a changed
     // row, around which the selection of level l+1 was made again; -1 when it was made from scratch.
     int64_t changed_vertices = -1;
+    // rebuild_multires_hierarchy: how many of this level's Eq. 17 rows were copied from the previous
+    // hierarchy rather than computed (0 on a fresh build and on level 0).
+    int64_t copied_rows = 0;
 
     size_t size() const { return diagonal.size(); }
     CsrMatrixView<double> view(int channel) const {
@@ -112,6 +116,9 @@ struct HierarchyBuildTimes {
 
 struct MultiresHierarchy {
     std::vector<HierarchyLevel> levels;  // levels[0] is the fine system
+    // The level-0 positions Eq. 16's weights were computed from: a rebuild copies the interpolation
+    // rows of vertices that did not move.
+    std::vector<Eigen::Vector3d> positions;
     double build_ms = 0;
     HierarchyBuildTimes build_times;  // build_ms by phase
 
@@ -131,8 +138,11 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
 // when only positions or values changed). Level by level, the vertices whose graph row is not their
 // previous vertex's row (or that have none) and their dropped neighbours are selected again
 // (update_coarse_vertices) and the rest keep their previous state, so the selection costs what the
-// edit touched; interpolation (Eq. 16), coarse graphs and Eq. 17 are then built as usual, and levels
-// past the previous hierarchy's depth are selected from scratch. The result has every property the
+// edit touched. Rows of Eq. 16, of the coarse graphs and of Eq. 17 that nothing changed reaches
+// (no changed row, selection state, position or fine matrix value within their stencil) are copied
+// from `previous` and renumbered, the others computed (carried_rows.h; copies happen only when the
+// map keeps the surviving vertices' order, as a cut's compaction does, so they equal computed rows
+// bit for bit). Levels past the previous hierarchy's depth are selected from scratch. The result has every property the
 // tests ask of a fresh build (independent-set cover, no lost connection, Eq. 17 on its own graphs)
 // but is not the fresh build's selection. When no row changed (positions or values only) every
 // selection is previous's, so a rebuild of a fresh build equals build_multires_hierarchy(matrix,
@@ -152,14 +162,20 @@ std::vector<std::vector<int32_t>> hierarchy_level_vertices(const CompressedRows&
 
 // Eq. 16 weights for one coarsening step: row v of the operator from the retained flags, with the
 // weights `options.weights` names (InterpolationWeights).
+// With `carried` (a rebuild), its kept rows are copied from `previous` (carried_rows.h); only the
+// paper's weights are carried (with LinearExact every row's counts must be known, so pass none).
 InterpolationOperator build_interpolation(const CompressedRows& graph, std::span<const uint8_t> retained,
                                           std::span<const int32_t> coarse_index,
                                           std::span<const int32_t> original_vertex,
                                           std::span<const Eigen::Vector3d> positions,
-                                          const HierarchyOptions& options = {});
+                                          const HierarchyOptions& options = {}, const CarriedRows* carried = nullptr,
+                                          const InterpolationOperator* previous = nullptr);
 
 // Eq. 17: the coarse level's matrix (all three channels) on the coarse graph's pattern.
-void build_coarse_matrix(const HierarchyLevel& fine, std::span<const int32_t> coarse_to_fine, HierarchyLevel& coarse);
+// With `carried` (a rebuild), the values of its kept rows are copied from `previous` (the previous
+// coarse level, whose kept rows have the same pattern up to renumbering; carried_rows.h).
+void build_coarse_matrix(const HierarchyLevel& fine, std::span<const int32_t> coarse_to_fine, HierarchyLevel& coarse,
+                         const CarriedRows* carried = nullptr, const HierarchyLevel* previous = nullptr);
 
 // Eq. 17 for the listed coarse rows only, on the existing pattern: row c depends on fine row
 // coarse_to_fine[c] alone, so after the fine rows R changed, the rows c with coarse_to_fine[c] in R are

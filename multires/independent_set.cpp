@@ -360,7 +360,8 @@ CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const u
 }
 
 CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const int32_t> coarse_index,
-                                  std::span<const int32_t> link_offsets, std::span<const int32_t> links) {
+                                  std::span<const int32_t> link_offsets, std::span<const int32_t> links,
+                                  const CarriedRows* carried, const CompressedRows* previous) {
     std::vector<int32_t> coarse_to_fine;
     for (size_t v = 0; v < coarse_index.size(); ++v)
         if (coarse_index[v] >= 0) coarse_to_fine.push_back(static_cast<int32_t>(v));
@@ -371,6 +372,11 @@ CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const i
     tbb::enumerable_thread_specific<LinkUnion> unions([m] { return LinkUnion(m); });
     CompressedRows coarse;
     build_rows_in_chunks(m, 512, coarse.offsets, coarse.indices, [&](size_t c, std::vector<int32_t>& row) {
+        if (carried && carried->kept(c)) {
+            for (const int32_t k : previous->row(static_cast<size_t>(carried->previous_row[c])))
+                row.push_back(carried->new_of_old_column[static_cast<size_t>(k)]);
+            return;
+        }
         unions.local().append(graph.row(static_cast<size_t>(coarse_to_fine[c])), link_offsets.data(), links.data(),
                               static_cast<int32_t>(c), row);
     });

@@ -22,6 +22,7 @@
 //    (2-ring through a dropped vertex) or are adjacent in G^l.
 #pragma once
 
+#include "multires/carried_rows.h"
 #include "tetops/connectivity.h"
 
 #include <cstdint>
@@ -83,7 +84,10 @@ CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const u
 // the columns of Eq. 16's interpolation operator, which the hierarchy builds anyway. Walking a dropped
 // neighbour's links (a few entries) instead of its whole graph row (its degree, which grows on coarse
 // levels) is what makes this the cheap way.
+// With `carried` (a rebuild), its kept rows are copied from `previous` (the previous coarse graph),
+// renumbered (carried_rows.h), instead of computed.
 CompressedRows build_coarse_graph(const CompressedRows& graph, std::span<const int32_t> coarse_index,
-                                  std::span<const int32_t> link_offsets, std::span<const int32_t> links);
+                                  std::span<const int32_t> link_offsets, std::span<const int32_t> links,
+                                  const CarriedRows* carried = nullptr, const CompressedRows* previous = nullptr);
 
 }  // namespace waxwork

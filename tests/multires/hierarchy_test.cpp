@@ -346,8 +346,9 @@ void expect_same_levels(const MultiresHierarchy& a, const MultiresHierarchy& b) 
 
 // The properties a fresh build has, on every level of `h`: each dropped vertex has a retained
 // neighbour, no fine edge lost its connection, the coarse graph is the definition's on this selection,
-// and the coarse matrices are Eq. 17 (densely, when `dense_check`).
-void expect_valid_hierarchy(const MultiresHierarchy& h, bool dense_check) {
+// Eq. 16 and Eq. 17 are what the builders compute on this selection, bit for bit (a rebuild copies
+// some of their rows), and the coarse matrices are Eq. 17 densely, when `dense_check`.
+void expect_valid_hierarchy(const MultiresHierarchy& h, std::span<const Eigen::Vector3d> positions, bool dense_check) {
     for (size_t l = 0; l + 1 < h.level_count(); ++l) {
         const HierarchyLevel& fine = h.levels[l];
         const std::vector<uint8_t> retained = retained_flags(h, l);
@@ -362,6 +363,15 @@ void expect_valid_hierarchy(const MultiresHierarchy& h, bool dense_check) {
         const CompressedRows graph = build_coarse_graph(fine.graph, retained, coarse_vertex_index(retained));
         EXPECT_EQ(graph.offsets, h.levels[l + 1].graph.offsets) << "level " << l + 1;
         EXPECT_EQ(graph.indices, h.levels[l + 1].graph.indices) << "level " << l + 1;
+        const InterpolationOperator p =
+            build_interpolation(fine.graph, retained, coarse_vertex_index(retained), fine.original_vertex, positions);
+        EXPECT_EQ(p.columns, fine.interpolation.columns) << "level " << l;
+        EXPECT_EQ(p.weights, fine.interpolation.weights) << "level " << l;
+        HierarchyLevel coarse;
+        coarse.graph = h.levels[l + 1].graph;
+        build_coarse_matrix(fine, h.levels[l + 1].parent_vertex, coarse);
+        EXPECT_EQ(coarse.columns, h.levels[l + 1].columns) << "level " << l + 1;
+        EXPECT_EQ(coarse.values, h.levels[l + 1].values) << "level " << l + 1;
         if (dense_check) expect_coarse_matrices_match_eq17(fine, h.levels[l + 1], l);
     }
 }
@@ -408,11 +418,40 @@ TEST(HierarchyRebuild, WithTheSameGraphEqualsAFreshBuild) {
     EXPECT_NE(rebuilt.levels[0].interpolation.weights, before.levels[0].interpolation.weights);
 }
 
+// A relaxation moves a few vertices and painting changes a few rows: the graph is the same, the
+// rebuild copies every operator row the changes do not reach and still equals a fresh build bit for bit.
+TEST(HierarchyRebuild, AfterLocalMovesAndPaintCopiesRowsAndEqualsAFreshBuild) {
+    auto s = testing::make_test_system(12);
+    HierarchyOptions options;
+    options.min_coarse_vertices = 50;
+    const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
+    ASSERT_GE(before.level_count(), 3u);
+    TetMesh moved = s.mesh;
+    int moved_count = 0;
+    for (Eigen::Vector3d& x : moved.positions)
+        if (x.x() > 0.1 && x.x() < 0.9 && x.y() > 0.1 && x.y() < 0.9 && x.z() > 0.1 && x.z() < 0.9) {
+            x += Eigen::Vector3d(0.02, -0.01, 0.015);  // interior vertices in one corner
+            ++moved_count;
+        }
+    ASSERT_GT(moved_count, 0);
+    std::vector<TetMaterial> materials(moved.tet_count(), testing::test_material());
+    for (size_t t = moved.tet_count() - 40; t < moved.tet_count(); ++t) materials[t] = TetMaterial{{0.3, 0.02, 0.1}, {2, 1, 0.5}, 1.4};
+    const DiffusionMatrix matrix = assemble_diffusion_matrix(moved, s.connectivity, materials);
+    std::vector<int32_t> identity(s.matrix.size());
+    std::iota(identity.begin(), identity.end(), 0);
+    const MultiresHierarchy rebuilt = rebuild_multires_hierarchy(before, identity, matrix, moved.positions, options);
+    expect_same_levels(rebuilt, build_multires_hierarchy(matrix, moved.positions, options));
+    for (size_t l = 1; l < rebuilt.level_count(); ++l) {
+        EXPECT_GT(rebuilt.levels[l].copied_rows, static_cast<int64_t>(rebuilt.levels[l].size()) / 4) << "level " << l;
+        EXPECT_LT(rebuilt.levels[l].copied_rows, static_cast<int64_t>(rebuilt.levels[l].size())) << "level " << l;
+    }
+}
+
 // After a cut: every property of a fresh build on every level, including two cuts in a row (the
 // second rebuilds a rebuilt hierarchy); on level 0 only vertices within two edges of a changed row
 // change state; the levels shrink as a fresh build's do.
-TEST(HierarchyRebuild, AfterCutsKeepsEveryPropertyAndTheSelectionAwayFromTheCut) {
-    const auto s = testing::make_test_system(8);  // 729 vertices, coordinates 0..4
+void expect_rebuilds_after_cuts_keep_every_property(int cube_cells, bool dense_check) {
+    const auto s = testing::make_test_system(cube_cells);  // coordinates 0..4
     HierarchyOptions options;
     options.min_coarse_vertices = 20;
     MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
@@ -423,7 +462,8 @@ TEST(HierarchyRebuild, AfterCutsKeepsEveryPropertyAndTheSelectionAwayFromTheCut)
         ASSERT_LT(cut.mesh.vertex_count(), mesh.vertex_count());
         const MultiresHierarchy rebuilt = rebuild_multires_hierarchy(h, cut.new_of_old, cut.matrix, cut.mesh.positions, options);
         ASSERT_GE(rebuilt.level_count(), 3u);
-        expect_valid_hierarchy(rebuilt, /*dense_check=*/true);
+        expect_valid_hierarchy(rebuilt, cut.mesh.positions, dense_check);
+        EXPECT_GT(rebuilt.levels[1].copied_rows, 0);  // rows away from the cut were copied
         // The changed rows of level 0, by their definition: new rows that are not the old row mapped.
         std::vector<int32_t> old_of_new(cut.mesh.vertex_count(), -1);
         for (size_t o = 0; o < cut.new_of_old.size(); ++o)
@@ -453,12 +493,18 @@ TEST(HierarchyRebuild, AfterCutsKeepsEveryPropertyAndTheSelectionAwayFromTheCut)
         EXPECT_GT(moved, 0);  // the cut did change the selection next to it
         const MultiresHierarchy fresh = build_multires_hierarchy(cut.matrix, cut.mesh.positions, options);
         for (size_t l = 1; l < std::min(rebuilt.level_count(), fresh.level_count()); ++l)
-            EXPECT_NEAR(static_cast<double>(rebuilt.levels[l].size()), static_cast<double>(fresh.levels[l].size()),
-                        0.15 * static_cast<double>(fresh.levels[l].size()))
-                << "level " << l;
+            if (fresh.levels[l].size() >= 100)  // a level of a few dozen vertices varies by a few
+                EXPECT_NEAR(static_cast<double>(rebuilt.levels[l].size()), static_cast<double>(fresh.levels[l].size()),
+                            0.15 * static_cast<double>(fresh.levels[l].size()))
+                    << "level " << l;
         h = rebuilt;
         mesh = cut.mesh;
     }
+}
+
+TEST(HierarchyRebuild, AfterCutsKeepsEveryPropertyAndTheSelectionAwayFromTheCut) {
+    expect_rebuilds_after_cuts_keep_every_property(8, /*dense_check=*/true);    // 729 vertices
+    expect_rebuilds_after_cuts_keep_every_property(16, /*dense_check=*/false);  // 4913 vertices
 }
 
 // The rebuilt hierarchy serves the coarse-to-fine solve as a fresh one does: the solve converges to
