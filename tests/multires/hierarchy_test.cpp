@@ -493,10 +493,11 @@ void expect_rebuilds_after_cuts_keep_every_property(int cube_cells, bool dense_c
         EXPECT_GT(moved, 0);  // the cut did change the selection next to it
         const MultiresHierarchy fresh = build_multires_hierarchy(cut.matrix, cut.mesh.positions, options);
         for (size_t l = 1; l < std::min(rebuilt.level_count(), fresh.level_count()); ++l)
-            if (fresh.levels[l].size() >= 100)  // a level of a few dozen vertices varies by a few
+            if (fresh.levels[l].size() >= 100) {  // a level of a few dozen vertices varies by a few
                 EXPECT_NEAR(static_cast<double>(rebuilt.levels[l].size()), static_cast<double>(fresh.levels[l].size()),
                             0.15 * static_cast<double>(fresh.levels[l].size()))
                     << "level " << l;
+            }
         h = rebuilt;
         mesh = cut.mesh;
     }
