@@ -102,7 +102,9 @@ ViewGeometry slice_view(const TetMesh& mesh, const std::vector<std::array<double
 // Levels of each volume vertex: the index of the coarsest hierarchy level it belongs to (0: only the
 // fine level). The solver's vertex selection on the mesh graph (hierarchy_level_vertices: the levels
 // depend on the connectivity only, not on materials or operators), with a small coarsest size so that
-// even a small volume shows several levels.
+// even a small volume shows several levels. It is the selection a fresh build makes: the live
+// multires solver rebuilds its hierarchy around each cut (rebuild_multires_hierarchy), so near the
+// cuts its selection may differ.
 std::vector<int32_t> hierarchy_vertex_levels(const TetMesh& mesh, const TetConnectivity& connectivity);
 ViewGeometry levels_view(const BoundarySurface& surface, const std::vector<int32_t>& vertex_levels);
 

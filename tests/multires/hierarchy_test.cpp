@@ -557,6 +557,41 @@ TEST(HierarchyRebuild, DeterministicAcrossThreadCounts) {
     expect_same_levels(a, b);
 }
 
+// A map that does not keep the vertices' order (here the same mesh renumbered at random) still
+// carries every selection; no operator row is copied then (a copy would sum in another order), and
+// the hierarchy is valid.
+TEST(HierarchyRebuild, AShuffledMapCarriesTheSelectionButCopiesNoRow) {
+    const auto s = testing::make_test_system(10);
+    HierarchyOptions options;
+    options.min_coarse_vertices = 50;
+    const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
+    ASSERT_GE(before.level_count(), 3u);
+    std::vector<int32_t> new_of_old(s.mesh.vertex_count());
+    std::iota(new_of_old.begin(), new_of_old.end(), 0);
+    std::shuffle(new_of_old.begin(), new_of_old.end(), std::mt19937(5));
+    TetMesh shuffled = s.mesh;
+    for (size_t v = 0; v < new_of_old.size(); ++v) shuffled.positions[static_cast<size_t>(new_of_old[v])] = s.mesh.positions[v];
+    for (Tet& tet : shuffled.tets)
+        for (int32_t& v : tet) v = new_of_old[static_cast<size_t>(v)];
+    const TetConnectivity connectivity = build_connectivity(shuffled);
+    const std::vector<TetMaterial> materials(shuffled.tet_count(), testing::test_material());
+    const DiffusionMatrix matrix = assemble_diffusion_matrix(shuffled, connectivity, materials);
+    const MultiresHierarchy rebuilt = rebuild_multires_hierarchy(before, new_of_old, matrix, shuffled.positions, options);
+    ASSERT_EQ(rebuilt.level_count(), before.level_count());
+    expect_valid_hierarchy(rebuilt, shuffled.positions, /*dense_check=*/false);
+    for (size_t l = 1; l < rebuilt.level_count(); ++l) {
+        EXPECT_EQ(rebuilt.levels[l - 1].changed_vertices, 0) << "level " << l - 1;
+        EXPECT_EQ(rebuilt.levels[l].copied_rows, 0) << "level " << l;
+        // The same vertices on every level, renumbered.
+        std::vector<int32_t> expected;
+        for (const int32_t v : before.levels[l].original_vertex) expected.push_back(new_of_old[static_cast<size_t>(v)]);
+        std::sort(expected.begin(), expected.end());
+        std::vector<int32_t> actual = rebuilt.levels[l].original_vertex;
+        std::sort(actual.begin(), actual.end());
+        EXPECT_EQ(actual, expected) << "level " << l;
+    }
+}
+
 TEST(HierarchyRebuild, RejectsAVertexMapThatDoesNotFit) {
     const auto s = testing::make_test_system(4);
     const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions);
