@@ -83,6 +83,11 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
             require_tets_left_by_cut(*after, mesh_.tet_count());
             connectivity = std::make_shared<TetConnectivity>(build_connectivity(*after));
             min_dihedral_deg_ = result.min_dihedral_deg;
+            entry.snapshot_vertex.resize(result.vertex_origins.size());
+            for (size_t v = 0; v < result.vertex_origins.size(); ++v) {
+                const auto [a, b] = result.vertex_origins[v];
+                entry.snapshot_vertex[v] = a == b ? a : -1;
+            }
             report.vertex_origins = std::move(result.vertex_origins);
             report.tets_under_guard = result.tets_under_guard;
             details << result.tets_split << " tets split, " << result.tets_removed << " tets removed, "
@@ -95,6 +100,10 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
             const RelaxationReport relaxed =
                 relax_cut_vertices(*after, *connectivity, *surface, relaxation_options(relax));
             min_dihedral_deg_ = relaxed.min_dihedral_deg;
+            entry.snapshot_vertex.assign(after->vertex_count(), -1);
+            for (size_t v = 0; v < removed.old_to_new_vertex.size(); ++v)
+                if (removed.old_to_new_vertex[v] >= 0)
+                    entry.snapshot_vertex[static_cast<size_t>(removed.old_to_new_vertex[v])] = static_cast<int32_t>(v);
             report.old_to_new_vertex = std::move(removed.old_to_new_vertex);
             details << removed.tets_removed << " tets removed, " << relaxed.vertices_moved
                     << " vertices relaxed (" << relaxed.iterations << " sweeps, " << relaxed.moves_rejected
@@ -180,6 +189,7 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
     report.details = details.str();
     entry.bytes = sizeof(UndoEntry) + vector_bytes(entry.material_tets) + vector_bytes(entry.old_materials) +
                   vector_bytes(entry.moved_vertices) + vector_bytes(entry.old_positions) +
+                  vector_bytes(entry.snapshot_vertex) +
                   (entry.snapshot ? mesh_bytes(*entry.snapshot) : 0);
     report.milliseconds = milliseconds_since(start);
     return report;
@@ -225,6 +235,7 @@ std::optional<ChangeReport> Document::undo() {
     report.tets_before = mesh_.tet_count();
     report.vertices_before = mesh_.vertex_count();
     if (entry.snapshot) {
+        if (entry.snapshot_vertex.size() == mesh_.vertex_count()) report.old_to_new_vertex = std::move(entry.snapshot_vertex);
         mesh_ = *entry.snapshot;
         report.topology = true;
     } else if (entry.piece >= 0) {

@@ -59,7 +59,8 @@ struct ChangeReport {
     // Set by operations that build the new mesh's connectivity anyway (cut with relaxation): the
     // live scene reuses it instead of rebuilding. Null otherwise.
     std::shared_ptr<const TetConnectivity> connectivity;
-    // Cut only: per vertex before, its index after or -1 (lets the solver keep its warm start).
+    // Cut, and undoing a cut: per vertex before, its index after or -1 (lets the solver keep its warm
+    // start and rebuild its hierarchy around the change).
     std::vector<int32_t> old_to_new_vertex;
     // Exact cut only: per vertex after, the vertices before it comes from ({v, v}: vertex v kept;
     // {a, b}: created on edge ab).
@@ -116,6 +117,10 @@ private:
         int piece = -1;                               // move_piece
         RigidTransform old_transform;
         std::shared_ptr<const TetMesh> snapshot;      // cut, fracture, weld
+        // Cut: per vertex after the edit, its vertex in the snapshot, or -1 (made by an exact cut);
+        // undoing reports it as the change's vertex map, so the live scene keeps its warm start and
+        // rebuilds its hierarchy around the cut.
+        std::vector<int32_t> snapshot_vertex;
         double old_min_dihedral_deg = 0;
         size_t bytes = 0;
     };

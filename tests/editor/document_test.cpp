@@ -163,6 +163,45 @@ TEST(Document, ReportsWhatChanged) {
     EXPECT_GT(cut.min_dihedral_deg, 0.4);
 }
 
+// Undoing a cut reports where the cut mesh's vertices go in the restored one: each kept vertex maps
+// to the vertex it was (same position, no relaxation here), vertices an exact cut made map to -1,
+// and the map is one to one; fracture and weld undo without a map.
+TEST(Document, UndoingACutMapsTheCutMeshOntoTheRestoredOne) {
+    for (const bool exact : {false, true}) {
+        Document doc(test_cube(), material_preset("marble"));
+        PlaneCutOp cut = plane_cut(0.55);
+        cut.relax.iterations = 0;
+        cut.exact = exact;
+        doc.apply(cut);
+        const TetMesh cut_mesh = doc.mesh();
+        const ChangeReport undo = *doc.undo();
+        ASSERT_EQ(undo.old_to_new_vertex.size(), cut_mesh.vertex_count()) << "exact " << exact;
+        std::vector<uint8_t> hit(doc.mesh().vertex_count(), 0);
+        int64_t kept = 0, made = 0;
+        for (size_t w = 0; w < cut_mesh.vertex_count(); ++w) {
+            const int32_t v = undo.old_to_new_vertex[w];
+            if (v < 0) {
+                ++made;
+                continue;
+            }
+            ++kept;
+            ASSERT_LT(static_cast<size_t>(v), doc.mesh().vertex_count());
+            EXPECT_FALSE(hit[static_cast<size_t>(v)]) << "vertex " << v << " is mapped twice";
+            hit[static_cast<size_t>(v)] = 1;
+            if (!exact) {
+                EXPECT_EQ(cut_mesh.positions[w], doc.mesh().positions[static_cast<size_t>(v)]) << w;
+            }
+        }
+        EXPECT_GT(kept, 0);
+        EXPECT_EQ(made > 0, exact);  // only an exact cut makes vertices (on crossed edges)
+    }
+    Document doc(test_cube(), material_preset("marble"));
+    FractureOp fracture;
+    fracture.pieces = 2;
+    doc.apply(fracture);
+    EXPECT_TRUE(doc.undo()->old_to_new_vertex.empty());
+}
+
 TEST(Document, LongUndoRedoSequencesRetraceTheSameStates) {
     Document doc(test_cube(), material_preset("marble"));
     std::vector<TetMesh> states = {doc.mesh()};
