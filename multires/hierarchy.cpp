@@ -533,6 +533,7 @@ MultiresHierarchy build_levels(const DiffusionMatrix& matrix, std::span<const Ei
     HierarchyBuildTimes& times = hierarchy.build_times;
     hierarchy.levels.push_back(fine_level(matrix));
     hierarchy.positions.assign(positions.begin(), positions.end());
+    hierarchy.options = options;
     time(times.fine_level);
     // Per vertex of the previous hierarchy's current level: its vertex in the new level (-1: none).
     std::vector<int32_t> new_of_old;
@@ -619,6 +620,9 @@ MultiresHierarchy rebuild_multires_hierarchy(const MultiresHierarchy& previous, 
                                              const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                                              const HierarchyOptions& options) {
     if (previous.levels.empty()) return build_multires_hierarchy(matrix, positions, options);
+    if (!(previous.options == options))
+        throw InvalidArgumentError("multires hierarchy rebuild: the options differ from those the previous hierarchy "
+                                   "was built with (seed, weights, enhancement or stopping rule)");
     const size_t old_count = previous.levels[0].size();
     if (new_of_old_vertex.size() != old_count)
         throw InvalidArgumentError("multires hierarchy rebuild: a vertex map of " + std::to_string(new_of_old_vertex.size()) +

@@ -58,6 +58,8 @@ struct HierarchyOptions {
     int64_t min_coarse_vertices = 1000; // do not coarsen a level smaller than this
     double max_keep_ratio = 0.8;        // discard a level keeping more than this fraction
     int max_levels = 16;                // including level 0
+
+    friend bool operator==(const HierarchyOptions&, const HierarchyOptions&) = default;
 };
 
 // Eq. 16 as a compressed-row operator: row v (a vertex of level l) lists the level-(l+1) vertices it
@@ -119,6 +121,7 @@ struct MultiresHierarchy {
     // The level-0 positions Eq. 16's weights were computed from: a rebuild copies the interpolation
     // rows of vertices that did not move.
     std::vector<Eigen::Vector3d> positions;
+    HierarchyOptions options;  // what it was built with (a rebuild must use the same)
     double build_ms = 0;
     HierarchyBuildTimes build_times;  // build_ms by phase
 
@@ -146,9 +149,9 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
 // tests ask of a fresh build (independent-set cover, no lost connection, Eq. 17 on its own graphs)
 // but is not the fresh build's selection. When no row changed (positions or values only) every
 // selection is previous's, so a rebuild of a fresh build equals build_multires_hierarchy(matrix,
-// positions, options) exactly without selecting anything again. `options` must be the ones
-// `previous` was built with. Throws as build_multires_hierarchy, and InvalidArgumentError when the map's size is
-// not previous's level-0 size, an entry is outside [-1, matrix.size()) or two vertices map to one.
+// positions, options) exactly without selecting anything again. Throws as build_multires_hierarchy,
+// and InvalidArgumentError when `options` are not the ones `previous` was built with, the map's size
+// is not previous's level-0 size, an entry is outside [-1, matrix.size()) or two vertices map to one.
 MultiresHierarchy rebuild_multires_hierarchy(const MultiresHierarchy& previous, std::span<const int32_t> new_of_old_vertex,
                                              const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                                              const HierarchyOptions& options = {});

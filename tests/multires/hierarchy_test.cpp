@@ -666,15 +666,16 @@ TEST(HierarchyRebuild, AShuffledMapCarriesTheSelectionButCopiesNoRow) {
     }
 }
 
-TEST(HierarchyRebuild, RejectsAVertexMapThatDoesNotFit) {
+TEST(HierarchyRebuild, RejectsAVertexMapOrOptionsThatDoNotFit) {
     const auto s = testing::make_test_system(4);
     const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions);
     std::vector<int32_t> map(s.matrix.size());
     std::iota(map.begin(), map.end(), 0);
-    const auto expect_rejected = [&](std::vector<int32_t> bad, const std::string& words) {
+    const auto expect_rejected = [&](std::vector<int32_t> bad, const std::string& words,
+                                     const HierarchyOptions& options = {}) {
         try {
-            rebuild_multires_hierarchy(before, bad, s.matrix, s.mesh.positions);
-            ADD_FAILURE() << "accepted a map that should say: " << words;
+            rebuild_multires_hierarchy(before, bad, s.matrix, s.mesh.positions, options);
+            ADD_FAILURE() << "accepted a rebuild that should say: " << words;
         } catch (const InvalidArgumentError& error) {
             EXPECT_NE(std::string(error.what()).find(words), std::string::npos) << error.what();
         }
@@ -686,6 +687,9 @@ TEST(HierarchyRebuild, RejectsAVertexMapThatDoesNotFit) {
     std::vector<int32_t> twice = map;
     twice[3] = 4;
     expect_rejected(twice, "two vertices map to vertex 4");
+    HierarchyOptions other_seed;
+    other_seed.seed = 9;
+    expect_rejected(map, "options differ", other_seed);
 }
 
 }  // namespace
