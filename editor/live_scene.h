@@ -148,8 +148,8 @@ public:
     // Why the chosen method runs as Jacobi CG ("" if it does not; LiveSolver::method_fallback_reason).
     std::string method_fallback_reason() const;
     std::string solver_description() const;
-    // A copy of the multires method's hierarchy's level sizes and changed-row counts (level l: {vertices,
-    // HierarchyLevel::changed_vertices}); empty with other methods.
+    // The level sizes and changed-row counts of the hierarchy of the multires method or the CPU
+    // multigrid CG (level l: {vertices, HierarchyLevel::changed_vertices}); empty with other methods.
     std::vector<std::array<int64_t, 2>> multires_levels() const;
     // With the GPU backend running: E per surface vertex (solved_scene().surface order) on the device,
     // from the resident phi (LiveSolver::radiance_on_device), for a renderer sharing the solver's

@@ -173,7 +173,7 @@ void LiveSolver::PendingChanges::rows_changed(std::span<const int32_t> ascending
 void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix,
                                 std::span<const int32_t> new_of_old_vertex) {
     eigenvalue_hint_ = {0, 0, 0};  // belong to the old matrix (a stale hint can be too optimistic)
-    multigrid_.reset();
+    std::unique_ptr<MultigridFrameSolver> previous_multigrid = std::move(multigrid_);
     forget_estimates();
     // Every copy is rebuilt from this matrix: nothing of the old one is pending, b and phi are.
     multigrid_pending_ = multires_pending_ = gpu_pending_ = PendingChanges{};
@@ -184,7 +184,15 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
         // Built now, while the mesh is at hand (the scene borrows it only during its calls); the device
         // solver at the next GPU frame, with the context current, from a copy of the rest positions.
         if (backend_ == LiveBackend::Cpu) {
-            build_cpu_multigrid(mesh.positions, matrix);
+            // The hierarchy rebuilt around the edit from the previous solver's, which is freed before
+            // the new operators are built (at 500K tets they take hundreds of MB).
+            std::optional<MultiresHierarchy> carried;
+            if (previous_multigrid && !new_of_old_vertex.empty() &&
+                new_of_old_vertex.size() == previous_multigrid->hierarchy().levels[0].size())
+                carried = rebuild_multires_hierarchy(previous_multigrid->hierarchy(), new_of_old_vertex, matrix,
+                                                     mesh.positions);
+            previous_multigrid.reset();
+            build_cpu_multigrid(mesh.positions, matrix, std::move(carried));
         } else {
             multigrid_positions_ = mesh.positions;
             method_fallback_reason_.clear();
@@ -211,13 +219,18 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
     }
 }
 
-const MultiresHierarchy* LiveSolver::multires_hierarchy() const { return multires_ ? &multires_->hierarchy() : nullptr; }
+const MultiresHierarchy* LiveSolver::multires_hierarchy() const {
+    if (multires_) return &multires_->hierarchy();
+    return multigrid_ ? &multigrid_->hierarchy() : nullptr;
+}
 
-void LiveSolver::build_cpu_multigrid(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix) {
+void LiveSolver::build_cpu_multigrid(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix,
+                                     std::optional<MultiresHierarchy> hierarchy) {
     try {
         FrameSolverOptions frame_options;
         frame_options.multigrid = multigrid_options_;
-        multigrid_ = std::make_unique<MultigridFrameSolver>(matrix, positions, frame_options);
+        multigrid_ = hierarchy ? std::make_unique<MultigridFrameSolver>(matrix, std::move(*hierarchy), frame_options)
+                               : std::make_unique<MultigridFrameSolver>(matrix, positions, frame_options);
         multigrid_pending_ = PendingChanges{};  // a new solver: b and phi to send
         method_fallback_reason_.clear();
     } catch (const AlgorithmError& e) {

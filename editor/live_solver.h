@@ -69,6 +69,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -195,7 +196,8 @@ public:
     // Why the method does not run as chosen ("" when it does): the multigrid method solving with Jacobi
     // CG instead, or the multires method's last coarse-to-fine pass skipping levels (and why).
     const std::string& method_fallback_reason() const { return method_fallback_reason_; }
-    // The multires method's hierarchy (nullptr with other methods or an empty mesh).
+    // The hierarchy of the multires method or of the CPU multigrid CG (nullptr with other methods or
+    // backends, or an empty mesh).
     const MultiresHierarchy* multires_hierarchy() const;
     // "GPU Jacobi CG (float) (llvmpipe ...)", "CPU multigrid CG, three channels per V-cycle", ...: for the
     // panel and logs.
@@ -229,7 +231,9 @@ private:
     // The multigrid runs on the device (or will at the next GPU frame).
     bool gpu_multigrid() const { return backend_ == LiveBackend::Gpu && !multigrid_positions_.empty(); }
     // The CPU multigrid frame solver for `matrix` (sets method_fallback_reason_ when it cannot be built).
-    void build_cpu_multigrid(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix);
+    // `hierarchy`: one already built for `matrix` (rebuilt around an edit); else it is built here.
+    void build_cpu_multigrid(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix,
+                             std::optional<MultiresHierarchy> hierarchy = std::nullopt);
     std::array<LiveSolverChannel, 3> iterate_gpu(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
                                                  std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                  double relative_tolerance, const std::array<bool, 3>& skip);

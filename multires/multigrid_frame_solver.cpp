@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 namespace waxwork {
 namespace {
@@ -59,8 +60,17 @@ inline void product_row(size_t i, const int32_t* offsets, const int32_t* columns
 
 MultigridFrameSolver::MultigridFrameSolver(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                                            const FrameSolverOptions& options)
+    : MultigridFrameSolver(matrix, build_multires_hierarchy(matrix, positions, options.hierarchy), options) {}
+
+MultigridFrameSolver::MultigridFrameSolver(const DiffusionMatrix& matrix, MultiresHierarchy hierarchy,
+                                           const FrameSolverOptions& options)
     : MultigridFrameCg(matrix.size(), options, "frame solver") {
-    hierarchy_ = std::make_unique<MultiresHierarchy>(build_multires_hierarchy(matrix, positions, options.hierarchy));
+    if (hierarchy.levels.empty() || hierarchy.levels[0].size() != matrix.size())
+        throw InvalidArgumentError("frame solver: the hierarchy was not built for this " + std::to_string(matrix.size()) +
+                                   "-vertex matrix");
+    if (!(hierarchy.options == options.hierarchy))
+        throw InvalidArgumentError("frame solver: the hierarchy was built with other options");
+    hierarchy_ = std::make_unique<MultiresHierarchy>(std::move(hierarchy));
     preconditioner_ = std::make_unique<MultigridPreconditioner>(*hierarchy_, options.multigrid);
     values_.resize(3 * matrix.nonzeros());
     for_rows(matrix.nonzeros(), kGrain, [&](size_t k) {

@@ -47,6 +47,10 @@ public:
     // phi starts at zero. Throws as build_multires_hierarchy and MultigridPreconditioner.
     MultigridFrameSolver(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                          const FrameSolverOptions& options = {});
+    // The same on a hierarchy built elsewhere for this matrix with options.hierarchy
+    // (rebuild_multires_hierarchy after an edit). Throws InvalidArgumentError when its level 0 is not
+    // the matrix's size or it was built with other options.
+    MultigridFrameSolver(const DiffusionMatrix& matrix, MultiresHierarchy hierarchy, const FrameSolverOptions& options = {});
     ~MultigridFrameSolver();
 
     // As MultigridFrameCg says: step(), set_relative_tolerance(), and these on the host's vectors.

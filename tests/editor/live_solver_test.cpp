@@ -280,6 +280,26 @@ TEST(LiveSolver, MultiresCorrectsThePhiCarriedThroughACut) {
     EXPECT_NEAR(corrected_gpu, corrected, 1e-3 + 0.05 * corrected);
 }
 
+// The CPU multigrid CG rebuilds its hierarchy around a cut too (then its Galerkin operators), and
+// converges to the same phi.
+TEST(LiveSolver, MultigridRebuildsItsHierarchyAroundACut) {
+    PlaneCutOp cut;
+    cut.plane = {Eigen::Vector3d(1, 0.3, 0.2).normalized(), 0.55};
+    Document doc(testing::make_cube_mesh(14), material_preset("marble"));
+    LiveScene scene(doc.mesh(), key_lighting(), options_for(kConfigs[1]));
+    ASSERT_GE(scene.multires_levels().size(), 2u);
+    EXPECT_EQ(scene.multires_levels()[0][1], -1);
+    scene.converge();
+    scene.apply_change(doc.mesh(), doc.apply(cut));
+    const auto levels = scene.multires_levels();
+    ASSERT_GE(levels.size(), 2u);
+    EXPECT_GT(levels[0][1], 0);
+    EXPECT_LT(levels[0][1], levels[0][0] / 2);
+    scene.converge();
+    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
+    EXPECT_EQ(scene.method_fallback_reason(), "");
+}
+
 // The multires method rebuilds its hierarchy from the previous one after an edit that says where the
 // vertices went: after a cut (removal or exact) or its undo only around the rows the cut changed is
 // the selection made again, after a relaxation (same graph) nowhere. The solution stays right throughout.

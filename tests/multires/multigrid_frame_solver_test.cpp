@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -81,6 +82,31 @@ TEST(MultigridFrameSolver, ConvergesToTheDoublePrecisionSolution) {
 
 // The live editor converges a scene its frames left at a looser tolerance: a tighter tolerance set later
 // makes step() continue from where it stopped, to the tighter error.
+// Built on a given hierarchy (a rebuild's), the solver is the one it builds itself on the same
+// hierarchy; a hierarchy of another size or other options is refused.
+TEST(MultigridFrameSolver, TakesAHierarchyBuiltForItsMatrix) {
+    const auto s = testing::make_test_system(8);
+    FrameSolverOptions options;
+    MultigridFrameSolver own(s.matrix, s.mesh.positions, options);
+    MultigridFrameSolver given(s.matrix, build_multires_hierarchy(s.matrix, s.mesh.positions, options.hierarchy), options);
+    const std::array<std::span<const double>, 3> b = {s.b[0], s.b[1], s.b[2]};
+    own.set_right_hand_side(b);
+    given.set_right_hand_side(b);
+    own.step(3);
+    given.step(3);
+    for (int c = 0; c < 3; ++c) {
+        const std::span<const double> x = own.phi(c), y = given.phi(c);
+        EXPECT_TRUE(std::equal(x.begin(), x.end(), y.begin(), y.end())) << "channel " << c;
+    }
+    const auto small = testing::make_test_system(4);
+    EXPECT_THROW(MultigridFrameSolver(s.matrix, build_multires_hierarchy(small.matrix, small.mesh.positions), options),
+                 InvalidArgumentError);
+    HierarchyOptions other;
+    other.seed = 5;
+    EXPECT_THROW(MultigridFrameSolver(s.matrix, build_multires_hierarchy(s.matrix, s.mesh.positions, other), options),
+                 InvalidArgumentError);
+}
+
 TEST(MultigridFrameSolver, ATighterToleranceContinuesTheSolve) {
     const auto s = testing::make_test_system(10);
     MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(100, 1e-2));
