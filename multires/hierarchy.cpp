@@ -383,25 +383,22 @@ HierarchyLevel add_coarse_level(HierarchyLevel& fine, const CoarseningStep& step
     coarse.original_vertex.resize(step.coarse_to_fine.size());
     for (size_t c = 0; c < step.coarse_to_fine.size(); ++c)
         coarse.original_vertex[c] = fine.original_vertex[static_cast<size_t>(step.coarse_to_fine[c])];
-    std::optional<CarriedRows> interpolation_rows, graph_rows, matrix_rows;
-    if (carried) {
-        interpolation_rows = carried->interpolation_rows();
-        graph_rows = carried->graph_rows();
-        matrix_rows = carried->matrix_rows();
-    }
+    const CarriedRows interpolation_rows = carried ? carried->interpolation_rows() : CarriedRows{};
+    const CarriedRows graph_rows = carried ? carried->graph_rows() : CarriedRows{};
+    const CarriedRows matrix_rows = carried ? carried->matrix_rows() : CarriedRows{};
     fine.interpolation = build_interpolation(fine.graph, step.selection.retained, step.coarse_index, fine.original_vertex,
-                                             positions, options, interpolation_rows ? &*interpolation_rows : nullptr,
+                                             positions, options, carried ? &interpolation_rows : nullptr,
                                              carried ? &carried->previous_fine->interpolation : nullptr);
     time(times.interpolation);
     // P's columns are exactly each fine vertex's coarse links (independent_set.h).
     coarse.graph = build_coarse_graph(fine.graph, step.coarse_index, fine.interpolation.offsets,
-                                      fine.interpolation.columns, graph_rows ? &*graph_rows : nullptr,
+                                      fine.interpolation.columns, carried ? &graph_rows : nullptr,
                                       carried ? &carried->previous_coarse->graph : nullptr);
     time(times.coarse_graph);
     fine.independent_set_rounds = step.selection.independent_set_rounds;
     fine.enhancement_passes = step.selection.enhancement_passes;
     fine.enhancement_vertices = step.selection.enhancement_vertices;
-    build_coarse_matrix(fine, step.coarse_to_fine, coarse, matrix_rows ? &*matrix_rows : nullptr,
+    build_coarse_matrix(fine, step.coarse_to_fine, coarse, carried ? &matrix_rows : nullptr,
                         carried ? carried->previous_coarse : nullptr);
     if (carried)
         coarse.copied_rows = std::count(carried->keep_matrix.begin(), carried->keep_matrix.end(), uint8_t{1});
@@ -430,11 +427,12 @@ std::vector<uint8_t> widen(const CompressedRows& graph, std::span<const uint8_t>
 // copied when the fine vertex and its neighbours have untouched Eq. 16 rows (copied or computed,
 // they equal the previous ones). An Eq. 17 row reads the same and the fine matrix row: copied when
 // the graph row is and that matrix row did not change (values_changed, per fine vertex).
+// previous_coarse_index: the previous level's fine-to-coarse index (coarse_vertex_index).
 CarriedOperators carry_operators(const CompressedRows& graph, const CoarseningStep& step,
                                  std::span<const uint8_t> touched, std::span<const uint8_t> values_changed,
-                                 std::span<const int32_t> old_of_new, std::span<const int32_t> new_of_old_coarse,
-                                 const HierarchyLevel& previous_fine, const HierarchyLevel& previous_coarse,
-                                 bool carry_interpolation) {
+                                 std::span<const int32_t> old_of_new, std::span<const int32_t> previous_coarse_index,
+                                 std::span<const int32_t> new_of_old_coarse, const HierarchyLevel& previous_fine,
+                                 const HierarchyLevel& previous_coarse, bool carry_interpolation) {
     CarriedOperators carried;
     carried.previous_fine = &previous_fine;
     carried.previous_coarse = &previous_coarse;
@@ -445,9 +443,6 @@ CarriedOperators carry_operators(const CompressedRows& graph, const CoarseningSt
     const size_t n = graph.row_count(), m = step.coarse_to_fine.size();
     carried.keep_interpolation.resize(n);
     for (size_t v = 0; v < n; ++v) carried.keep_interpolation[v] = carry_interpolation && !dirty_interpolation[v];
-    std::vector<int32_t> previous_coarse_of(previous_fine.size(), -1);
-    for (size_t c = 0; c < previous_coarse.parent_vertex.size(); ++c)
-        previous_coarse_of[static_cast<size_t>(previous_coarse.parent_vertex[c])] = static_cast<int32_t>(c);
     carried.keep_graph.assign(m, 0);
     carried.keep_matrix.assign(m, 0);
     carried.previous_coarse_row.assign(m, -1);
@@ -455,7 +450,7 @@ CarriedOperators carry_operators(const CompressedRows& graph, const CoarseningSt
         const auto i = static_cast<size_t>(step.coarse_to_fine[c]);
         // Not touched: i is an old vertex, retained before as now.
         if (dirty_links[i]) continue;
-        carried.previous_coarse_row[c] = previous_coarse_of[static_cast<size_t>(old_of_new[i])];
+        carried.previous_coarse_row[c] = previous_coarse_index[static_cast<size_t>(old_of_new[i])];
         carried.keep_graph[c] = 1;
         carried.keep_matrix[c] = !values_changed[i];
     }
@@ -550,12 +545,13 @@ MultiresHierarchy build_levels(const DiffusionMatrix& matrix, std::span<const Ei
         const size_t n = fine.graph.row_count();
         const bool carry = previous && l + 1 < previous->level_count();
         std::optional<CarriedSelection> carried;
-        std::vector<int32_t> old_of_new;
+        std::vector<int32_t> old_of_new, old_coarse_index;  // previous level l -> its level l+1 (-1: dropped)
         if (carry) {
             const HierarchyLevel& old_fine = previous->levels[l];
             const HierarchyLevel& old_coarse = previous->levels[l + 1];
             std::vector<uint8_t> old_retained(old_fine.graph.row_count(), 0);
             for (const int32_t p : old_coarse.parent_vertex) old_retained[static_cast<size_t>(p)] = 1;
+            old_coarse_index = coarse_vertex_index(old_retained);
             old_of_new.assign(n, -1);
             for (size_t o = 0; o < new_of_old.size(); ++o)
                 if (new_of_old[o] >= 0) old_of_new[static_cast<size_t>(new_of_old[o])] = static_cast<int32_t>(o);
@@ -586,8 +582,8 @@ MultiresHierarchy build_levels(const DiffusionMatrix& matrix, std::span<const Ei
                     touched[v] = old_of_new[v] < 0 || moved[v] ||
                                  step->selection.retained[v] != carried->previous_retained[v];
                 for (const int32_t v : carried->changed) touched[static_cast<size_t>(v)] = 1;
-                operators = carry_operators(fine.graph, *step, touched, values_changed, old_of_new, next,
-                                            previous->levels[l], old_coarse, carry_interpolation);
+                operators = carry_operators(fine.graph, *step, touched, values_changed, old_of_new, old_coarse_index,
+                                            next, previous->levels[l], old_coarse, carry_interpolation);
             }
             new_of_old = std::move(next);
         }
