@@ -59,8 +59,8 @@ struct ChangeReport {
     // Set by operations that build the new mesh's connectivity anyway (cut with relaxation): the
     // live scene reuses it instead of rebuilding. Null otherwise.
     std::shared_ptr<const TetConnectivity> connectivity;
-    // Cut, and undoing a cut: per vertex before, its index after or -1 (lets the solver keep its warm
-    // start and rebuild its hierarchy around the change).
+    // Cut (exact or not), and undoing a cut: per vertex before, its index after or -1 (lets the solver
+    // keep its warm start and rebuild its hierarchy around the change).
     std::vector<int32_t> old_to_new_vertex;
     // Exact cut only: per vertex after, the vertices before it comes from ({v, v}: vertex v kept;
     // {a, b}: created on edge ab).

@@ -30,19 +30,6 @@ void check_materials(const TetMesh& mesh) {
                                    std::to_string(mesh.tet_count()) + " tets)");
 }
 
-// An exact cut's vertex map: per vertex before, its index after ({v, v} origins) or -1; empty when the
-// origins name a vertex twice or out of range (then nothing is carried over).
-std::vector<int32_t> kept_vertices(std::span<const std::array<int32_t, 2>> vertex_origins, size_t old_count) {
-    std::vector<int32_t> new_of_old(old_count, -1);
-    for (size_t v = 0; v < vertex_origins.size(); ++v) {
-        const auto [a, b] = vertex_origins[v];
-        if (a != b) continue;
-        if (a < 0 || static_cast<size_t>(a) >= old_count || new_of_old[static_cast<size_t>(a)] >= 0) return {};
-        new_of_old[static_cast<size_t>(a)] = static_cast<int32_t>(v);
-    }
-    return new_of_old;
-}
-
 }  // namespace
 
 LiveScene::LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSceneOptions& options)
@@ -111,13 +98,14 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
     mesh_ = &mesh;
     check_materials(mesh);
     if (change.topology) {
-        // Carry phi over where the change says where vertices went (a cut); else start cold.
+        // Carry phi over where the change says where vertices went (a cut); else start cold. An exact
+        // cut's origins also place the vertices it made on edges.
         std::array<std::vector<double>, 3> old = std::move(phi_);
         const size_t n_old = old[0].size();
         const bool mapped = !change.old_to_new_vertex.empty() && change.old_to_new_vertex.size() == n_old;
         const bool from_edges = change.vertex_origins.size() == mesh.vertex_count() && !mesh.positions.empty();
         for (int c = 0; c < 3; ++c) phi_[c].assign(mesh.vertex_count(), 0.0);
-        if (mapped) {
+        if (mapped && !from_edges) {
             for (size_t v = 0; v < change.old_to_new_vertex.size(); ++v) {
                 const int32_t to = change.old_to_new_vertex[v];
                 if (to >= 0 && static_cast<size_t>(to) < mesh.vertex_count())
@@ -134,11 +122,8 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
         update.warm_start = mapped || from_edges;
         const bool reuse = change.connectivity && change.connectivity->vertex_tets.row_count() == mesh.vertex_count() &&
                            change.connectivity->tet_neighbors.size() == mesh.tet_count();
-        // Where the old vertices went, for the structures the solver can carry over (its hierarchy).
-        const std::vector<int32_t> kept = from_edges && !mapped ? kept_vertices(change.vertex_origins, n_old)
-                                                                : std::vector<int32_t>();
         rebuild_all(reuse ? change.connectivity : nullptr, update,
-                    mapped ? std::span<const int32_t>(change.old_to_new_vertex) : std::span<const int32_t>(kept));
+                    mapped ? std::span<const int32_t>(change.old_to_new_vertex) : std::span<const int32_t>());
     } else if (change.positions) {
         // Same tets, moved vertices: new geometry on the same connectivity.
         matrix_ = assemble_diffusion_matrix(mesh, *connectivity_, mesh.materials, assembly_options(options_));

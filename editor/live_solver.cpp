@@ -98,6 +98,17 @@ std::string jacobi_instead_of_multigrid(const std::exception& e) {
     return std::string("solving with Jacobi CG instead of multigrid CG: ") + e.what();
 }
 
+// `previous` rebuilt around an edit for `matrix` (rebuild_multires_hierarchy), or nothing when there is
+// no previous hierarchy or the vertex map does not belong to it (then the caller builds from scratch).
+std::optional<MultiresHierarchy> rebuilt_hierarchy(const MultiresHierarchy* previous,
+                                                   std::span<const int32_t> new_of_old_vertex,
+                                                   const DiffusionMatrix& matrix,
+                                                   std::span<const Eigen::Vector3d> positions) {
+    if (!previous || new_of_old_vertex.empty() || new_of_old_vertex.size() != previous->levels[0].size())
+        return std::nullopt;
+    return rebuild_multires_hierarchy(*previous, new_of_old_vertex, matrix, positions);
+}
+
 }  // namespace
 
 std::shared_ptr<SolverGlContext> open_headless_solver_context() { return std::make_shared<HeadlessSolverContext>(); }
@@ -186,11 +197,8 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
         if (backend_ == LiveBackend::Cpu) {
             // The hierarchy rebuilt around the edit from the previous solver's, which is freed before
             // the new operators are built (at 500K tets they take hundreds of MB).
-            std::optional<MultiresHierarchy> carried;
-            if (previous_multigrid && !new_of_old_vertex.empty() &&
-                new_of_old_vertex.size() == previous_multigrid->hierarchy().levels[0].size())
-                carried = rebuild_multires_hierarchy(previous_multigrid->hierarchy(), new_of_old_vertex, matrix,
-                                                     mesh.positions);
+            std::optional<MultiresHierarchy> carried = rebuilt_hierarchy(
+                previous_multigrid ? &previous_multigrid->hierarchy() : nullptr, new_of_old_vertex, matrix, mesh.positions);
             previous_multigrid.reset();
             build_cpu_multigrid(mesh.positions, matrix, std::move(carried));
         } else {
@@ -204,10 +212,9 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
     if (method_ == LiveMethod::Multires && matrix.size() > 0) {
         if (mesh.vertex_count() != matrix.size())
             throw InvalidArgumentError("live solver: the matrix does not belong to the mesh");
-        const bool carried = previous && !new_of_old_vertex.empty() &&
-                             new_of_old_vertex.size() == previous->hierarchy().levels[0].size();
-        multires_ = carried ? std::make_unique<MultiresSolver>(rebuild_multires_hierarchy(
-                                  previous->hierarchy(), new_of_old_vertex, matrix, mesh.positions))
+        std::optional<MultiresHierarchy> carried =
+            rebuilt_hierarchy(previous ? &previous->hierarchy() : nullptr, new_of_old_vertex, matrix, mesh.positions);
+        multires_ = carried ? std::make_unique<MultiresSolver>(std::move(*carried))
                             : std::make_unique<MultiresSolver>(matrix, mesh.positions);
     }
     if (gpu_) {

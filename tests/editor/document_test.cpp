@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 namespace waxwork {
@@ -163,17 +164,18 @@ TEST(Document, ReportsWhatChanged) {
     EXPECT_GT(cut.min_dihedral_deg, 0.4);
 }
 
-// Undoing a cut reports where the cut mesh's vertices go in the restored one: each kept vertex maps
-// to the vertex it was (same position, no relaxation here), vertices an exact cut made map to -1,
-// and the map is one to one; fracture and weld undo without a map.
+// A cut, exact or not, reports where the vertices go, and undoing it reports the inverse: each kept
+// vertex maps back to the vertex it was (same position, no relaxation here), vertices an exact cut
+// made map to -1, and the map is one to one; fracture undoes without a map.
 TEST(Document, UndoingACutMapsTheCutMeshOntoTheRestoredOne) {
     for (const bool exact : {false, true}) {
         Document doc(test_cube(), material_preset("marble"));
         PlaneCutOp cut = plane_cut(0.55);
         cut.relax.iterations = 0;
         cut.exact = exact;
-        doc.apply(cut);
+        const ChangeReport applied = doc.apply(cut);
         const TetMesh cut_mesh = doc.mesh();
+        ASSERT_EQ(applied.old_to_new_vertex.size(), applied.vertices_before) << "exact " << exact;
         const ChangeReport undo = *doc.undo();
         ASSERT_EQ(undo.old_to_new_vertex.size(), cut_mesh.vertex_count()) << "exact " << exact;
         std::vector<uint8_t> hit(doc.mesh().vertex_count(), 0);
@@ -186,6 +188,7 @@ TEST(Document, UndoingACutMapsTheCutMeshOntoTheRestoredOne) {
             }
             ++kept;
             ASSERT_LT(static_cast<size_t>(v), doc.mesh().vertex_count());
+            EXPECT_EQ(applied.old_to_new_vertex[static_cast<size_t>(v)], static_cast<int32_t>(w));  // the cut's map, inverted
             EXPECT_FALSE(hit[static_cast<size_t>(v)]) << "vertex " << v << " is mapped twice";
             hit[static_cast<size_t>(v)] = 1;
             if (!exact) {
@@ -193,6 +196,9 @@ TEST(Document, UndoingACutMapsTheCutMeshOntoTheRestoredOne) {
             }
         }
         EXPECT_GT(kept, 0);
+        EXPECT_EQ(std::count_if(applied.old_to_new_vertex.begin(), applied.old_to_new_vertex.end(),
+                                [](int32_t to) { return to >= 0; }),
+                  kept);
         EXPECT_EQ(made > 0, exact);  // only an exact cut makes vertices (on crossed edges)
     }
     Document doc(test_cube(), material_preset("marble"));
