@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <numeric>
 #include <sstream>
 
 namespace waxwork {
@@ -285,7 +286,14 @@ void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, Ch
         options.exact = o->exact;
         options.min_piece_tets = o->min_piece_tets;
         auto after = std::make_shared<TetMesh>(mesh_);
-        const FractureResult result = fracture_voronoi(*after, seeds, options);
+        FractureResult result = fracture_voronoi(*after, seeds, options);
+        // Vertices before keep their index; the fracture only appends.
+        const size_t kept = mesh_.vertex_count();
+        report.old_to_new_vertex.resize(kept);
+        std::iota(report.old_to_new_vertex.begin(), report.old_to_new_vertex.end(), 0);
+        entry.snapshot_vertex.assign(after->vertex_count(), -1);
+        std::iota(entry.snapshot_vertex.begin(), entry.snapshot_vertex.begin() + static_cast<std::ptrdiff_t>(kept), 0);
+        report.vertex_origins = std::move(result.vertex_origins);
         entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
         mesh_ = std::move(*after);
         min_dihedral_deg_ = result.min_dihedral_deg;

@@ -59,11 +59,13 @@ struct ChangeReport {
     // Set by operations that build the new mesh's connectivity anyway (cut with relaxation): the
     // live scene reuses it instead of rebuilding. Null otherwise.
     std::shared_ptr<const TetConnectivity> connectivity;
-    // Cut (exact or not), and undoing a cut: per vertex before, its index after or -1 (lets the solver
-    // keep its warm start and rebuild its hierarchy around the change).
+    // Cut (exact or not), fracture, and undoing either: per vertex before, its index after or -1 (lets
+    // the solver keep its warm start and rebuild its hierarchy around the change).
     std::vector<int32_t> old_to_new_vertex;
-    // Exact cut only: per vertex after, the vertices before it comes from ({v, v}: vertex v kept;
-    // {a, b}: created on edge ab).
+    // Exact cut and fracture: per vertex after, where it comes from ({v, v}: vertex v; {a, b}: made on
+    // edge ab). An index below vertices_before names a vertex before the change; a fracture's appended
+    // vertices (crack copies, vertices on walls that cross earlier walls) may also name vertices after
+    // with a lower index than their own (FractureResult::vertex_origins), so read in index order.
     std::vector<std::array<int32_t, 2>> vertex_origins;
 
     bool undoable = true;       // false when the entry exceeded the whole undo budget
@@ -117,9 +119,9 @@ private:
         int piece = -1;                               // move_piece
         RigidTransform old_transform;
         std::shared_ptr<const TetMesh> snapshot;      // cut, fracture, weld
-        // Cut: per vertex after the edit, its vertex in the snapshot, or -1 (made by an exact cut);
-        // undoing reports it as the change's vertex map, so the live scene keeps its warm start and
-        // rebuilds its hierarchy around the cut.
+        // Cut and fracture: per vertex after the edit, its vertex in the snapshot, or -1 (made by the
+        // edit); undoing reports it as the change's vertex map, so the live scene keeps its warm start
+        // and rebuilds its hierarchy around the change.
         std::vector<int32_t> snapshot_vertex;
         double old_min_dihedral_deg = 0;
         size_t bytes = 0;

@@ -98,8 +98,8 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
     mesh_ = &mesh;
     check_materials(mesh);
     if (change.topology) {
-        // Carry phi over where the change says where vertices went (a cut); else start cold. An exact
-        // cut's origins also place the vertices it made on edges.
+        // Carry phi over where the change says where vertices went (a cut, a fracture); else start
+        // cold. Origins also place the vertices made on edges and a fracture's crack copies.
         std::array<std::vector<double>, 3> old = std::move(phi_);
         const size_t n_old = old[0].size();
         const bool mapped = !change.old_to_new_vertex.empty() && change.old_to_new_vertex.size() == n_old;
@@ -112,11 +112,18 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
                     for (int c = 0; c < 3; ++c) phi_[c][to] = old[c][v];
             }
         } else if (from_edges) {
-            // A vertex made on an edge starts at the mean of the edge's ends (linear along it).
+            // A vertex made on an edge starts at the mean of the edge's ends (linear along it). An
+            // origin at or above n_old is a vertex after with a lower index (ChangeReport), set already.
             for (size_t v = 0; v < change.vertex_origins.size(); ++v) {
                 const auto [a, b] = change.vertex_origins[v];
-                if (a < 0 || b < 0 || static_cast<size_t>(a) >= n_old || static_cast<size_t>(b) >= n_old) continue;
-                for (int c = 0; c < 3; ++c) phi_[c][v] = 0.5 * (old[c][a] + old[c][b]);
+                const auto known = [&](int32_t i) {
+                    return i >= 0 && (static_cast<size_t>(i) < n_old || static_cast<size_t>(i) < v);
+                };
+                if (!known(a) || !known(b)) continue;
+                for (int c = 0; c < 3; ++c) {
+                    const auto value = [&](int32_t i) { return static_cast<size_t>(i) < n_old ? old[c][i] : phi_[c][i]; };
+                    phi_[c][v] = 0.5 * (value(a) + value(b));
+                }
             }
         }
         update.warm_start = mapped || from_edges;

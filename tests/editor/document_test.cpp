@@ -167,7 +167,7 @@ TEST(Document, ReportsWhatChanged) {
 // A cut, exact or not, reports where the vertices go, and undoing it reports the inverse: each kept
 // vertex maps back to the vertex it was (same position, no relaxation here), vertices an exact cut
 // made map to -1, and the map is one to one; fracture undoes without a map.
-TEST(Document, UndoingACutMapsTheCutMeshOntoTheRestoredOne) {
+TEST(Document, UndoingACutOrAFractureMapsTheEditedMeshOntoTheRestoredOne) {
     for (const bool exact : {false, true}) {
         Document doc(test_cube(), material_preset("marble"));
         PlaneCutOp cut = plane_cut(0.55);
@@ -201,11 +201,26 @@ TEST(Document, UndoingACutMapsTheCutMeshOntoTheRestoredOne) {
                   kept);
         EXPECT_EQ(made > 0, exact);  // only an exact cut makes vertices (on crossed edges)
     }
+    // A fracture keeps every vertex's index and appends crack copies and wall vertices.
     Document doc(test_cube(), material_preset("marble"));
     FractureOp fracture;
-    fracture.pieces = 2;
-    doc.apply(fracture);
-    EXPECT_TRUE(doc.undo()->old_to_new_vertex.empty());
+    fracture.pieces = 3;
+    const ChangeReport applied = doc.apply(fracture);
+    const size_t before = applied.vertices_before, after = doc.mesh().vertex_count();
+    ASSERT_GT(after, before);
+    ASSERT_EQ(applied.old_to_new_vertex.size(), before);
+    ASSERT_EQ(applied.vertex_origins.size(), after);
+    for (size_t v = 0; v < before; ++v) {
+        EXPECT_EQ(applied.old_to_new_vertex[v], static_cast<int32_t>(v));
+        EXPECT_EQ(applied.vertex_origins[v][0], static_cast<int32_t>(v));
+        EXPECT_EQ(applied.vertex_origins[v][1], static_cast<int32_t>(v));
+    }
+    for (size_t v = before; v < after; ++v) {
+        EXPECT_LT(static_cast<size_t>(std::max(applied.vertex_origins[v][0], applied.vertex_origins[v][1])), v);
+    }
+    const ChangeReport undo = *doc.undo();
+    ASSERT_EQ(undo.old_to_new_vertex.size(), after);
+    for (size_t w = 0; w < after; ++w) EXPECT_EQ(undo.old_to_new_vertex[w], w < before ? static_cast<int32_t>(w) : -1);
 }
 
 TEST(Document, LongUndoRedoSequencesRetraceTheSameStates) {

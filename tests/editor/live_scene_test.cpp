@@ -111,6 +111,7 @@ TEST(LiveScene, FollowsFracturesMovesWeldsAndExactCuts) {
     fracture.seeds = {Eigen::Vector3d(0.3, 0.5, 0.5), Eigen::Vector3d(0.7, 0.5, 0.5)};
     SceneUpdate update = scene.apply_change(doc.mesh(), doc.apply(fracture));
     EXPECT_TRUE(update.reassembled_matrix);
+    EXPECT_TRUE(update.warm_start);  // every vertex kept, crack copies placed by their origins
     expect_matches_fresh_solve(scene, doc.mesh(), lighting, "fracture");
 
     // Pulled apart and turned: light now reaches the crack faces, shadows move; the matrix stays.
