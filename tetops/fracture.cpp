@@ -496,8 +496,12 @@ WeldResult weld_touching_pieces(TetMesh& mesh, double tolerance) {
                                  " would flatten tet " + std::to_string(t) + "; use a smaller tolerance");
     }
     welded.piece_transforms = std::move(transforms);
-    remove_tets(welded, std::vector<uint8_t>(welded.tet_count(), 0));  // drops the merged-away vertices
+    // Drops the merged-away vertices (no tet uses them any more).
+    const CutResult compacted = remove_tets(welded, std::vector<uint8_t>(welded.tet_count(), 0));
     validate(welded);
+    result.old_to_new_vertex.resize(mesh.vertex_count());
+    for (size_t v = 0; v < mesh.vertex_count(); ++v)
+        result.old_to_new_vertex[v] = target[v] == static_cast<int32_t>(v) ? compacted.old_to_new_vertex[v] : -1;
     mesh = std::move(welded);
     result.pieces_after = static_cast<int>(mesh.piece_transforms.size());
     return result;

@@ -82,6 +82,9 @@ struct WeldResult {
     int pieces_before = 0;
     int pieces_after = 0;
     size_t vertices_merged = 0;
+    // Per vertex before: its index after, or -1 when it was merged into another vertex (which keeps
+    // its own entry). The vertices left keep their order.
+    std::vector<int32_t> old_to_new_vertex;
 };
 
 // Merges pieces whose boundary faces coincide in world space (within `tolerance`, world units):

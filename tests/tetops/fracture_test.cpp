@@ -417,10 +417,27 @@ TEST(Weld, FractureThenWeldInPlaceRestoresOnePiece) {
         options.exact = exact;
         const FractureResult f = fracture_voronoi(mesh, scatter_fracture_seeds(mesh, 5, 3), options);
         ASSERT_GT(f.pieces_after, 1);
+        const TetMesh fractured = mesh;
         const WeldResult w = weld_touching_pieces(mesh, 1e-9);
         EXPECT_EQ(w.pieces_before, f.pieces_after);
         EXPECT_EQ(w.pieces_after, 1);
         EXPECT_EQ(w.vertices_merged, f.vertices_duplicated);
+        // The vertex map: merged vertices go, the others keep their order and (in place) their position.
+        ASSERT_EQ(w.old_to_new_vertex.size(), fractured.vertex_count());
+        size_t merged = 0;
+        int32_t last = -1;
+        for (size_t v = 0; v < fractured.vertex_count(); ++v) {
+            const int32_t to = w.old_to_new_vertex[v];
+            if (to < 0) {
+                ++merged;
+                continue;
+            }
+            EXPECT_EQ(to, last + 1) << v;
+            last = to;
+            EXPECT_EQ(mesh.positions[static_cast<size_t>(to)], fractured.positions[v]) << v;
+        }
+        EXPECT_EQ(merged, w.vertices_merged);
+        EXPECT_EQ(static_cast<size_t>(last + 1), mesh.vertex_count());
         const TetConnectivity c = expect_valid_conforming(mesh);
         EXPECT_EQ(c.component_count, 1);
         EXPECT_NEAR(total_volume(mesh), 1.0, 1e-12);
