@@ -50,6 +50,14 @@ RelaxationOptions relaxation_options(const RelaxSettings& r) {
     return o;
 }
 
+// Per vertex after an edit, its vertex before (-1: made by the edit), from the edit's map the other way.
+std::vector<int32_t> inverse_vertex_map(const std::vector<int32_t>& old_to_new, size_t vertices_after) {
+    std::vector<int32_t> new_to_old(vertices_after, -1);
+    for (size_t v = 0; v < old_to_new.size(); ++v)
+        if (old_to_new[v] >= 0) new_to_old[static_cast<size_t>(old_to_new[v])] = static_cast<int32_t>(v);
+    return new_to_old;
+}
+
 }  // namespace
 
 Document::Document(TetMesh mesh, const TetMaterial& default_material, size_t undo_budget_bytes)
@@ -104,10 +112,7 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
             const RelaxationReport relaxed =
                 relax_cut_vertices(*after, *connectivity, *surface, relaxation_options(relax));
             min_dihedral_deg_ = relaxed.min_dihedral_deg;
-            entry.snapshot_vertex.assign(after->vertex_count(), -1);
-            for (size_t v = 0; v < removed.old_to_new_vertex.size(); ++v)
-                if (removed.old_to_new_vertex[v] >= 0)
-                    entry.snapshot_vertex[static_cast<size_t>(removed.old_to_new_vertex[v])] = static_cast<int32_t>(v);
+            entry.snapshot_vertex = inverse_vertex_map(removed.old_to_new_vertex, after->vertex_count());
             report.old_to_new_vertex = std::move(removed.old_to_new_vertex);
             details << removed.tets_removed << " tets removed, " << relaxed.vertices_moved
                     << " vertices relaxed (" << relaxed.iterations << " sweeps, " << relaxed.moves_rejected
@@ -288,11 +293,9 @@ void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, Ch
         auto after = std::make_shared<TetMesh>(mesh_);
         FractureResult result = fracture_voronoi(*after, seeds, options);
         // Vertices before keep their index; the fracture only appends.
-        const size_t kept = mesh_.vertex_count();
-        report.old_to_new_vertex.resize(kept);
+        report.old_to_new_vertex.resize(mesh_.vertex_count());
         std::iota(report.old_to_new_vertex.begin(), report.old_to_new_vertex.end(), 0);
-        entry.snapshot_vertex.assign(after->vertex_count(), -1);
-        std::iota(entry.snapshot_vertex.begin(), entry.snapshot_vertex.begin() + static_cast<std::ptrdiff_t>(kept), 0);
+        entry.snapshot_vertex = inverse_vertex_map(report.old_to_new_vertex, after->vertex_count());
         report.vertex_origins = std::move(result.vertex_origins);
         entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
         mesh_ = std::move(*after);
@@ -313,8 +316,12 @@ void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, Ch
         details << "piece " << o->piece << " moved";
     } else if (const auto* o = std::get_if<WeldOp>(&op)) {
         auto after = std::make_shared<TetMesh>(mesh_);
-        const WeldResult result = weld_touching_pieces(*after, o->tolerance);
+        WeldResult result = weld_touching_pieces(*after, o->tolerance);
         if (result.vertices_merged > 0 || result.pieces_after != result.pieces_before || !(*after == mesh_)) {
+            if (result.old_to_new_vertex.size() == mesh_.vertex_count()) {
+                entry.snapshot_vertex = inverse_vertex_map(result.old_to_new_vertex, after->vertex_count());
+                report.old_to_new_vertex = std::move(result.old_to_new_vertex);
+            }
             entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
             mesh_ = std::move(*after);
             min_dihedral_deg_ = min_dihedral_of(mesh_);

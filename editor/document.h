@@ -59,8 +59,8 @@ struct ChangeReport {
     // Set by operations that build the new mesh's connectivity anyway (cut with relaxation): the
     // live scene reuses it instead of rebuilding. Null otherwise.
     std::shared_ptr<const TetConnectivity> connectivity;
-    // Cut (exact or not), fracture, and undoing either: per vertex before, its index after or -1 (lets
-    // the solver keep its warm start and rebuild its hierarchy around the change).
+    // Cut (exact or not), fracture, weld, and undoing any of them: per vertex before, its index after
+    // or -1 (lets the solver keep its warm start and rebuild its hierarchy around the change).
     std::vector<int32_t> old_to_new_vertex;
     // Exact cut and fracture: per vertex after, where it comes from ({v, v}: vertex v; {a, b}: made on
     // edge ab). An index below vertices_before names a vertex before the change; a fracture's appended
@@ -119,8 +119,8 @@ private:
         int piece = -1;                               // move_piece
         RigidTransform old_transform;
         std::shared_ptr<const TetMesh> snapshot;      // cut, fracture, weld
-        // Cut and fracture: per vertex after the edit, its vertex in the snapshot, or -1 (made by the
-        // edit); undoing reports it as the change's vertex map, so the live scene keeps its warm start
+        // Cut, fracture and weld: per vertex after the edit, its vertex in the snapshot, or -1 (made
+        // by the edit); undoing reports it as the change's vertex map, so the live scene keeps its warm start
         // and rebuilds its hierarchy around the change.
         std::vector<int32_t> snapshot_vertex;
         double old_min_dihedral_deg = 0;

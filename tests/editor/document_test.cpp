@@ -167,7 +167,7 @@ TEST(Document, ReportsWhatChanged) {
 // A cut, exact or not, reports where the vertices go, and undoing it reports the inverse: each kept
 // vertex maps back to the vertex it was (same position, no relaxation here), vertices an exact cut
 // made map to -1, and the map is one to one; fracture undoes without a map.
-TEST(Document, UndoingACutOrAFractureMapsTheEditedMeshOntoTheRestoredOne) {
+TEST(Document, CutsFracturesAndWeldsMapTheirVerticesBothWays) {
     for (const bool exact : {false, true}) {
         Document doc(test_cube(), material_preset("marble"));
         PlaneCutOp cut = plane_cut(0.55);
@@ -221,6 +221,21 @@ TEST(Document, UndoingACutOrAFractureMapsTheEditedMeshOntoTheRestoredOne) {
     const ChangeReport undo = *doc.undo();
     ASSERT_EQ(undo.old_to_new_vertex.size(), after);
     for (size_t w = 0; w < after; ++w) EXPECT_EQ(undo.old_to_new_vertex[w], w < before ? static_cast<int32_t>(w) : -1);
+
+    // Welding the pieces back merges the crack copies; undoing the weld maps the survivors back.
+    doc.redo();
+    const ChangeReport weld = doc.apply(WeldOp{1e-9});
+    ASSERT_EQ(weld.old_to_new_vertex.size(), after);
+    const size_t welded = doc.mesh().vertex_count();
+    EXPECT_EQ(static_cast<size_t>(std::count(weld.old_to_new_vertex.begin(), weld.old_to_new_vertex.end(), -1)),
+              after - welded);
+    const ChangeReport unweld = *doc.undo();
+    ASSERT_EQ(unweld.old_to_new_vertex.size(), welded);
+    for (size_t w = 0; w < welded; ++w) {
+        const int32_t v = unweld.old_to_new_vertex[w];
+        ASSERT_GE(v, 0) << w;  // a weld makes no vertex
+        EXPECT_EQ(weld.old_to_new_vertex[static_cast<size_t>(v)], static_cast<int32_t>(w));
+    }
 }
 
 TEST(Document, LongUndoRedoSequencesRetraceTheSameStates) {

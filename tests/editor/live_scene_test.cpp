@@ -127,8 +127,9 @@ TEST(LiveScene, FollowsFracturesMovesWeldsAndExactCuts) {
 
     scene.apply_change(doc.mesh(), *doc.undo());
     expect_matches_fresh_solve(scene, doc.mesh(), lighting, "undo move");
-    scene.apply_change(doc.mesh(), doc.apply(WeldOp{1e-9}));
+    update = scene.apply_change(doc.mesh(), doc.apply(WeldOp{1e-9}));
     EXPECT_EQ(doc.mesh().piece_transforms.size(), 1u);
+    EXPECT_TRUE(update.warm_start);  // the merged vertices' partners keep their phi
     expect_matches_fresh_solve(scene, doc.mesh(), lighting, "weld");
 
     PlaneCutOp exact;
