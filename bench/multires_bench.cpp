@@ -26,6 +26,7 @@
 #include "solver/reference_solvers.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
+#include "tetops/fracture.h"
 
 #include <benchmark/benchmark.h>
 
@@ -34,6 +35,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <tuple>
 
 namespace waxwork {
@@ -168,30 +170,38 @@ void BM_MultiresBuild(benchmark::State& state) {
     state.counters["eq17_ms"] = times.coarse_matrix;
 }
 
-// spot cut by the editor benches' middle plane (bench::middle_cut's; removal only: its relaxation
-// moves vertices but changes no edge), with the uncut scene's hierarchy and the cut system's direct
-// solution.
-struct CutScene {
+// spot after an edit, with the scene's hierarchy before it and the edited system's direct solution.
+// Edit 0: the editor benches' middle plane cut (bench::middle_cut's; removal only: its relaxation moves
+// vertices but changes no edge). Edit 1: an exact Voronoi fracture into 5 cells (scatter_fracture_seeds,
+// seed 1), whose crack walls cross the whole volume.
+struct EditScene {
     TetMesh mesh;
     std::unique_ptr<bench::LitSpot> lit;
-    std::vector<int32_t> new_of_old;  // the cut's vertex map
+    std::vector<int32_t> new_of_old;  // the edit's vertex map
     std::vector<double> b;            // green channel
     Eigen::VectorXd exact;
-    MultiresHierarchy before;         // the uncut scene's hierarchy
+    MultiresHierarchy before;         // the unedited scene's hierarchy
 };
 
-const CutScene& cut_scene(size_t target_tets) {
-    static std::map<size_t, std::unique_ptr<CutScene>> cache;
-    auto& slot = cache[target_tets];
+const EditScene& edit_scene(size_t target_tets, int64_t edit) {
+    static std::map<std::pair<size_t, int64_t>, std::unique_ptr<EditScene>> cache;
+    auto& slot = cache[{target_tets, edit}];
     if (slot) return *slot;
-    slot = std::make_unique<CutScene>();
-    CutScene& c = *slot;
+    slot = std::make_unique<EditScene>();
+    EditScene& c = *slot;
     const Scene& s = scene(target_tets);
     c.before = build_multires_hierarchy(s.matrix, s.mesh->positions);
     c.mesh = *s.mesh;
-    const auto box = bounding_box(c.mesh);
-    const Eigen::Vector3d normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
-    c.new_of_old = remove_cut_away_tets(c.mesh, PlaneCut(normal, normal.dot(0.5 * (box[0] + box[1])))).old_to_new_vertex;
+    if (edit == 0) {
+        const auto box = bounding_box(c.mesh);
+        const Eigen::Vector3d normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
+        c.new_of_old = remove_cut_away_tets(c.mesh, PlaneCut(normal, normal.dot(0.5 * (box[0] + box[1])))).old_to_new_vertex;
+    } else {
+        const size_t vertices_before = c.mesh.vertex_count();
+        fracture_voronoi(c.mesh, scatter_fracture_seeds(c.mesh, 5, 1));
+        c.new_of_old.resize(vertices_before);  // a fracture keeps every vertex's index (fracture.h)
+        std::iota(c.new_of_old.begin(), c.new_of_old.end(), 0);
+    }
     c.lit = bench::light_spot_volume(c.mesh, bench::lit_spot(target_tets).mm_per_unit);
     c.b.resize(c.lit->matrix.size());
     diffusion_right_hand_side(c.lit->matrix, c.lit->q, 1, c.b);
@@ -200,13 +210,13 @@ const CutScene& cut_scene(size_t target_tets) {
     return c;
 }
 
-// The hierarchy after a cut: built from scratch (second argument 0) or rebuilt from the uncut one
-// (1, rebuild_multires_hierarchy: the selection is made again only around the changed rows). Times
-// the build; then reports the level sizes and the level-0 CG iterations the coarse-to-fine solve
-// needs to 1% with that hierarchy (the rebuilt selection is not the fresh one, so its quality is
-// measured, not assumed).
-void BM_HierarchyAfterCut(benchmark::State& state) {
-    const CutScene& c = cut_scene(static_cast<size_t>(state.range(0)));
+// The hierarchy after an edit (third argument: 0 the cut, 1 the fracture): built from scratch (second
+// argument 0) or rebuilt from the hierarchy before it (1, rebuild_multires_hierarchy: the selection
+// is made again only around the changed rows). Times the build; then reports the level sizes and the
+// level-0 CG iterations the coarse-to-fine solve needs to 1% with that hierarchy (the rebuilt
+// selection is not the fresh one, so its quality is measured, not assumed).
+void BM_HierarchyAfterEdit(benchmark::State& state) {
+    const EditScene& c = edit_scene(static_cast<size_t>(state.range(0)), state.range(2));
     const bool rebuild = state.range(1) != 0;
     MultiresHierarchy h;
     for (auto _ : state) {
@@ -218,8 +228,8 @@ void BM_HierarchyAfterCut(benchmark::State& state) {
     state.counters["level1"] = static_cast<double>(h.levels.size() > 1 ? h.levels[1].size() : 0);
     state.counters["changed0"] = static_cast<double>(h.levels[0].changed_vertices);
     state.counters["select_ms"] = h.build_times.selection;
-    std::fprintf(stderr, "spot %zu after the cut, %s: levels (vertices/changed)", c.mesh.tet_count(),
-                 rebuild ? "rebuilt" : "fresh");
+    std::fprintf(stderr, "spot %zu after the %s, %s: levels (vertices/changed)", c.mesh.tet_count(),
+                 state.range(2) == 0 ? "cut" : "fracture", rebuild ? "rebuilt" : "fresh");
     for (const HierarchyLevel& level : h.levels)
         std::fprintf(stderr, " %zu/%lld", level.size(), static_cast<long long>(level.changed_vertices));
     const HierarchyBuildTimes& t = h.build_times;
@@ -573,8 +583,8 @@ void BM_PaintUpdate(benchmark::State& state) {
     Arg(50000)->Arg(500000)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime()
 BENCHMARK(BM_MultiresBuild)->WAXWORK_SIZES;
 BENCHMARK(BM_JacobiCgTo1Percent)->WAXWORK_SIZES;
-BENCHMARK(BM_HierarchyAfterCut)
-    ->ArgsProduct({{50000, 500000}, {0, 1}})
+BENCHMARK(BM_HierarchyAfterEdit)
+    ->ArgsProduct({{50000, 500000}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
