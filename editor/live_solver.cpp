@@ -13,6 +13,7 @@
 #include <iterator>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 namespace waxwork {
 
@@ -185,6 +186,12 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
                                 std::span<const int32_t> new_of_old_vertex) {
     eigenvalue_hint_ = {0, 0, 0};  // belong to the old matrix (a stale hint can be too optimistic)
     std::unique_ptr<MultigridFrameSolver> previous_multigrid = std::move(multigrid_);
+    // The device multigrid's hierarchy lives on the host: the one waiting for the next GPU frame, or
+    // the device solver's (released below).
+    std::optional<MultiresHierarchy> previous_device_hierarchy = std::exchange(multigrid_hierarchy_, std::nullopt);
+    const MultiresHierarchy* previous_device = previous_device_hierarchy ? &*previous_device_hierarchy
+                                               : gpu_ && gpu_->multigrid ? &gpu_->multigrid->hierarchy()
+                                                                         : nullptr;
     forget_estimates();
     // Every copy is rebuilt from this matrix: nothing of the old one is pending, b and phi are.
     multigrid_pending_ = multires_pending_ = gpu_pending_ = PendingChanges{};
@@ -203,6 +210,7 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
             build_cpu_multigrid(mesh.positions, matrix, std::move(carried));
         } else {
             multigrid_positions_ = mesh.positions;
+            multigrid_hierarchy_ = rebuilt_hierarchy(previous_device, new_of_old_vertex, matrix, mesh.positions);
             method_fallback_reason_.clear();
         }
     }
@@ -228,7 +236,9 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
 
 const MultiresHierarchy* LiveSolver::multires_hierarchy() const {
     if (multires_) return &multires_->hierarchy();
-    return multigrid_ ? &multigrid_->hierarchy() : nullptr;
+    if (multigrid_) return &multigrid_->hierarchy();
+    if (multigrid_hierarchy_) return &*multigrid_hierarchy_;
+    return gpu_ && gpu_->multigrid ? &gpu_->multigrid->hierarchy() : nullptr;
 }
 
 void LiveSolver::build_cpu_multigrid(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix,
@@ -252,6 +262,7 @@ void LiveSolver::values_changed() {
     forget_estimates();
     for (PendingChanges* pending : {&multigrid_pending_, &multires_pending_, &gpu_pending_}) pending->values_changed();
     gpu_level_rows_.clear();
+    multigrid_hierarchy_.reset();  // its level 0 holds the old values: the device solver is built afresh
 }
 
 void LiveSolver::forget_estimates() {
@@ -263,6 +274,7 @@ void LiveSolver::rows_changed(std::span<const int32_t> rows) {
     if (rows.empty()) return;
     if (gpu_) gpu_->radiance_stale_weights = true;
     forget_estimates();
+    multigrid_hierarchy_.reset();  // its level 0 holds the old values: the device solver is built afresh
     std::vector<int32_t> sorted(rows.begin(), rows.end());
     std::sort(sorted.begin(), sorted.end());
     sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
@@ -365,7 +377,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& 
     if (!multigrid_positions_.empty() && n > 0) {
         // After a GPU fallback the multigrid method goes on with the CPU multigrid CG (built here: the
         // device held the hierarchy), warm from the last read-back phi.
-        build_cpu_multigrid(multigrid_positions_, matrix);
+        build_cpu_multigrid(multigrid_positions_, matrix, std::exchange(multigrid_hierarchy_, std::nullopt));
         multigrid_positions_.clear();
     }
     if (multigrid_ && n > 0) {
@@ -495,6 +507,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu(const DiffusionMatrix& 
             // copy is written only after a successful step), until the next rebuild tries again.
             method_fallback_reason_ = jacobi_instead_of_multigrid(e);
             multigrid_positions_.clear();
+            multigrid_hierarchy_.reset();
             gpu_.reset();  // the context is current
             gpu_pending_ = PendingChanges{};
             // Its budget was counted in V-cycles, or unlimited under a deadline it no longer reads.
@@ -553,7 +566,10 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multigrid(const Diffusi
         FrameSolverOptions frame_options;
         frame_options.multigrid = multigrid_options_;
         auto gpu = std::make_unique<Gpu>();
-        gpu->multigrid = std::make_unique<GpuMultigridFrameSolver>(gl, matrix, multigrid_positions_, frame_options);
+        gpu->multigrid = multigrid_hierarchy_ ? std::make_unique<GpuMultigridFrameSolver>(
+                                                    gl, matrix, *std::exchange(multigrid_hierarchy_, std::nullopt), frame_options)
+                                              : std::make_unique<GpuMultigridFrameSolver>(gl, matrix, multigrid_positions_,
+                                                                                          frame_options);
         gpu_ = std::move(gpu);
         const GLubyte* renderer = gl.GetString(GL_RENDERER);
         renderer_ = renderer ? reinterpret_cast<const char*>(renderer) : "";

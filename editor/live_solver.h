@@ -196,8 +196,9 @@ public:
     // Why the method does not run as chosen ("" when it does): the multigrid method solving with Jacobi
     // CG instead, or the multires method's last coarse-to-fine pass skipping levels (and why).
     const std::string& method_fallback_reason() const { return method_fallback_reason_; }
-    // The hierarchy of the multires method or of the CPU multigrid CG (nullptr with other methods or
-    // backends, or an empty mesh).
+    // The hierarchy of the multires method or of the multigrid CG (on the GPU backend: the one waiting
+    // for the next GPU frame, else the device solver's; nullptr with other methods, before the first
+    // GPU frame, or on an empty mesh).
     const MultiresHierarchy* multires_hierarchy() const;
     // "GPU Jacobi CG (float) (llvmpipe ...)", "CPU multigrid CG, three channels per V-cycle", ...: for the
     // panel and logs.
@@ -287,6 +288,9 @@ private:
     // CPU multigrid after a fallback. Empty when the method is not (or no longer) run on the device;
     // the device solver takes its changes through gpu_pending_.
     std::vector<Eigen::Vector3d> multigrid_positions_;
+    // With multigrid_positions_ after an edit with a vertex map: the hierarchy rebuilt around the edit
+    // from the device solver's (or from the one still waiting here), for the solver built next.
+    std::optional<MultiresHierarchy> multigrid_hierarchy_;
     // The last frame's estimates, reported by a frame of no V-cycles (1 after a change).
     std::array<double, 3> multigrid_error_{1, 1, 1};
     std::unique_ptr<MultiresSolver> multires_;

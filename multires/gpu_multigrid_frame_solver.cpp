@@ -8,13 +8,29 @@
 #include <string>
 
 namespace waxwork {
+namespace {
+
+// The hierarchy, built once the context is known to run compute shaders: a context that cannot fails at
+// once instead of after the host setup.
+MultiresHierarchy checked_context_hierarchy(const GlApi& gl, const DiffusionMatrix& matrix,
+                                            std::span<const Eigen::Vector3d> positions, const HierarchyOptions& options) {
+    require_compute_support(gl);
+    return build_multires_hierarchy(matrix, positions, options);
+}
+
+}  // namespace
 
 GpuMultigridFrameSolver::GpuMultigridFrameSolver(const GlApi& gl, const DiffusionMatrix& matrix,
                                                  std::span<const Eigen::Vector3d> positions,
                                                  const FrameSolverOptions& options)
+    : GpuMultigridFrameSolver(gl, matrix, checked_context_hierarchy(gl, matrix, positions, options.hierarchy), options) {}
+
+GpuMultigridFrameSolver::GpuMultigridFrameSolver(const GlApi& gl, const DiffusionMatrix& matrix,
+                                                 MultiresHierarchy hierarchy, const FrameSolverOptions& options)
     : MultigridFrameCg(matrix.size(), options, "GPU frame solver") {
-    require_compute_support(gl);  // before the host setup: a context that cannot run it fails at once
-    hierarchy_ = std::make_unique<MultiresHierarchy>(build_multires_hierarchy(matrix, positions, options.hierarchy));
+    require_compute_support(gl);
+    check_hierarchy(hierarchy);
+    hierarchy_ = std::make_unique<MultiresHierarchy>(std::move(hierarchy));
     preconditioner_ = std::make_unique<MultigridPreconditioner>(*hierarchy_, options.multigrid);
     kernels_ = std::make_unique<GpuKernels>(gl, std::initializer_list<GpuMatrixFormat>{GpuMatrixFormat::SellCSigma});
     device_ = std::make_unique<GpuMultigridPreconditioner>(*kernels_, *preconditioner_);

@@ -45,6 +45,11 @@ public:
     // destroyed. Throws as MultigridFrameSolver's constructor, and GpuError when the driver fails.
     GpuMultigridFrameSolver(const GlApi& gl, const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                             const FrameSolverOptions& options = {});
+    // The same on a hierarchy built elsewhere for this matrix with options.hierarchy
+    // (rebuild_multires_hierarchy after an edit). Throws InvalidArgumentError when its level 0 is not
+    // the matrix's size or it was built with other options.
+    GpuMultigridFrameSolver(const GlApi& gl, const DiffusionMatrix& matrix, MultiresHierarchy hierarchy,
+                            const FrameSolverOptions& options = {});
     ~GpuMultigridFrameSolver();
 
     // As MultigridFrameCg says, on the device's vectors (a driver error throws GpuError):

@@ -14,6 +14,13 @@ MultigridFrameCg::MultigridFrameCg(size_t n, const FrameSolverOptions& options, 
         throw InvalidArgumentError(who_ + ": tolerance must be positive and the refresh interval >= 1");
 }
 
+void MultigridFrameCg::check_hierarchy(const MultiresHierarchy& hierarchy) const {
+    if (hierarchy.levels.empty() || hierarchy.levels[0].size() != n_)
+        throw InvalidArgumentError(who_ + ": the hierarchy was not built for this " + std::to_string(n_) + "-vertex matrix");
+    if (!(hierarchy.options == options_.hierarchy))
+        throw InvalidArgumentError(who_ + ": the hierarchy was built with other options");
+}
+
 void MultigridFrameCg::set_relative_tolerance(double tolerance) {
     if (!(tolerance > 0) || !std::isfinite(tolerance))
         throw InvalidArgumentError(who_ + ": tolerance " + std::to_string(tolerance) + " must be positive");

@@ -81,6 +81,9 @@ protected:
     // `who` prefixes the error messages ("frame solver", "GPU frame solver"). Throws
     // InvalidArgumentError for a non-positive tolerance or a refresh interval < 1.
     MultigridFrameCg(size_t n, const FrameSolverOptions& options, std::string who);
+    // Throws InvalidArgumentError unless `hierarchy` was built for a matrix of this size with
+    // options.hierarchy (a hierarchy passed in, rebuilt after an edit).
+    void check_hierarchy(const MultiresHierarchy& hierarchy) const;
 
     // The vector work of one CG step on the subclass's storage (all three channels).
     virtual void precondition() = 0;                                    // z = B r

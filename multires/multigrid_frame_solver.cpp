@@ -65,11 +65,7 @@ MultigridFrameSolver::MultigridFrameSolver(const DiffusionMatrix& matrix, std::s
 MultigridFrameSolver::MultigridFrameSolver(const DiffusionMatrix& matrix, MultiresHierarchy hierarchy,
                                            const FrameSolverOptions& options)
     : MultigridFrameCg(matrix.size(), options, "frame solver") {
-    if (hierarchy.levels.empty() || hierarchy.levels[0].size() != matrix.size())
-        throw InvalidArgumentError("frame solver: the hierarchy was not built for this " + std::to_string(matrix.size()) +
-                                   "-vertex matrix");
-    if (!(hierarchy.options == options.hierarchy))
-        throw InvalidArgumentError("frame solver: the hierarchy was built with other options");
+    check_hierarchy(hierarchy);
     hierarchy_ = std::make_unique<MultiresHierarchy>(std::move(hierarchy));
     preconditioner_ = std::make_unique<MultigridPreconditioner>(*hierarchy_, options.multigrid);
     values_.resize(3 * matrix.nonzeros());

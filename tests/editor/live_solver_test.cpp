@@ -285,19 +285,34 @@ TEST(LiveSolver, MultiresCorrectsThePhiCarriedThroughACut) {
 TEST(LiveSolver, MultigridRebuildsItsHierarchyAroundACut) {
     PlaneCutOp cut;
     cut.plane = {Eigen::Vector3d(1, 0.3, 0.2).normalized(), 0.55};
-    Document doc(testing::make_cube_mesh(14), material_preset("marble"));
-    LiveScene scene(doc.mesh(), key_lighting(), options_for(kConfigs[1]));
-    ASSERT_GE(scene.multires_levels().size(), 2u);
-    EXPECT_EQ(scene.multires_levels()[0][1], -1);
-    scene.converge();
-    scene.apply_change(doc.mesh(), doc.apply(cut));
-    const auto levels = scene.multires_levels();
-    ASSERT_GE(levels.size(), 2u);
-    EXPECT_GT(levels[0][1], 0);
-    EXPECT_LT(levels[0][1], levels[0][0] / 2);
-    scene.converge();
-    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
-    EXPECT_EQ(scene.method_fallback_reason(), "");
+    // CPU: built with the scene. GPU: at the first frame, and after the cut rebuilt on the host at once
+    // for the device solver built at the next frame.
+    for (const Config& config : {kConfigs[1], kConfigs[5]}) {
+        Document doc(testing::make_cube_mesh(14), material_preset("marble"));
+        LiveScene scene(doc.mesh(), key_lighting(), options_for(config));
+        scene.converge();
+        ASSERT_GE(scene.multires_levels().size(), 2u) << config.name;
+        EXPECT_EQ(scene.multires_levels()[0][1], -1) << config.name;
+        scene.apply_change(doc.mesh(), doc.apply(cut));
+        auto levels = scene.multires_levels();
+        ASSERT_GE(levels.size(), 2u) << config.name;
+        EXPECT_EQ(levels[0][0], static_cast<int64_t>(doc.mesh().vertex_count())) << config.name;
+        EXPECT_GT(levels[0][1], 0) << config.name;
+        EXPECT_LT(levels[0][1], levels[0][0] / 2) << config.name;
+        scene.converge();
+        EXPECT_EQ(scene.multires_levels(), levels) << config.name;  // the solver runs on that hierarchy
+        EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4) << config.name;
+        EXPECT_EQ(scene.method_fallback_reason(), "") << config.name;
+        // Painting before the next GPU frame makes a hierarchy waiting for it stale (its level 0 has the
+        // old values): the device solver is then built afresh.
+        scene.apply_change(doc.mesh(), doc.apply(RelaxOp{cut.plane, RelaxSettings{5, 0.3, 0.5}}));
+        scene.apply_change(doc.mesh(), doc.apply(paint_at({0.3, 0.5, 0.5}, "ketchup")));
+        scene.converge();
+        levels = scene.multires_levels();
+        ASSERT_GE(levels.size(), 2u) << config.name;
+        EXPECT_EQ(levels[0][1], config.backend == LiveBackend::Gpu ? -1 : 0) << config.name;
+        EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4) << config.name;
+    }
 }
 
 // The multires method rebuilds its hierarchy from the previous one after an edit that says where the

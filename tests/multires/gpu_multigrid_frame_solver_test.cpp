@@ -63,6 +63,26 @@ TEST(GpuMultigridFrameSolver, ConvergesToTheDoublePrecisionSolutionInFarFewerIte
     EXPECT_LT(4 * vcycles, jacobi_iterations);
 }
 
+// A hierarchy built elsewhere (rebuilt after an edit) gives the same device solver as its own build;
+// one built for another matrix is refused (the checks are the CPU solver's, multigrid_frame_cg.h).
+TEST(GpuMultigridFrameSolver, TakesAHierarchyBuiltForItsMatrix) {
+    WAXWORK_REQUIRE_GL(context);
+    const auto s = testing::make_test_system(8);
+    const FrameSolverOptions options;
+    GpuMultigridFrameSolver own(context->gl(), s.matrix, s.mesh.positions, options);
+    GpuMultigridFrameSolver given(context->gl(), s.matrix,
+                                  build_multires_hierarchy(s.matrix, s.mesh.positions, options.hierarchy), options);
+    own.set_right_hand_side(spans(s.b));
+    given.set_right_hand_side(spans(s.b));
+    own.step(3);
+    given.step(3);
+    EXPECT_EQ(own.phi(), given.phi());
+    const auto small = testing::make_test_system(4);
+    EXPECT_THROW(GpuMultigridFrameSolver(context->gl(), s.matrix,
+                                         build_multires_hierarchy(small.matrix, small.mesh.positions), options),
+                 InvalidArgumentError);
+}
+
 // The CPU frame solver and the device one take the same steps: after the same V-cycle budget their
 // iterates agree to float precision (the CPU runs phi, r and the products in double).
 TEST(GpuMultigridFrameSolver, FollowsTheCpuFrameSolverStepByStep) {
