@@ -13,6 +13,19 @@
 
 namespace waxwork {
 
+// True when the vertices that survive an edit keep their order (new index increasing with the old
+// one; -1: removed): then every level's renumbering keeps it too, and copied rows equal computed ones
+// bit for bit.
+inline bool keeps_vertex_order(std::span<const int32_t> new_of_old) {
+    int32_t last = -1;
+    for (const int32_t v : new_of_old) {
+        if (v < 0) continue;
+        if (v <= last) return false;
+        last = v;
+    }
+    return true;
+}
+
 struct CarriedRows {
     std::span<const uint8_t> keep;               // per row: 1 to copy the previous row
     std::span<const int32_t> previous_row;       // per row: its row in the previous operator (where kept)

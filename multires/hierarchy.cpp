@@ -496,18 +496,6 @@ void level0_changes(const DiffusionMatrix& matrix, std::span<const Eigen::Vector
     });
 }
 
-// True when the vertices that survive keep their order (new index increasing with the old one): then
-// every level's renumbering keeps it too, and copied rows equal computed ones bit for bit.
-bool keeps_order(std::span<const int32_t> new_of_old) {
-    int32_t last = -1;
-    for (const int32_t v : new_of_old) {
-        if (v < 0) continue;
-        if (v <= last) return false;
-        last = v;
-    }
-    return true;
-}
-
 // Builds the hierarchy's levels; with `previous` and its level-0 vertex map, carries each level's
 // selection from the previous hierarchy (rebuild_multires_hierarchy), and the operator rows the edit
 // did not reach.
@@ -536,7 +524,7 @@ MultiresHierarchy build_levels(const DiffusionMatrix& matrix, std::span<const Ei
     std::vector<uint8_t> moved, values_changed;
     // Operator rows are copied only under an order-preserving map, and Eq. 16's only with the paper's
     // weights (a linear-exact row's counts must be known).
-    const bool carry_rows = previous && keeps_order(new_of_old_vertex);
+    const bool carry_rows = previous && keeps_vertex_order(new_of_old_vertex);
     const bool carry_interpolation = carry_rows && options.weights == InterpolationWeights::InverseEdgeLength;
     if (previous) new_of_old.assign(new_of_old_vertex.begin(), new_of_old_vertex.end());
     for (;;) {

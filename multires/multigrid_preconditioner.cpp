@@ -1,5 +1,6 @@
 #include "multires/multigrid_preconditioner.h"
 
+#include "multires/carried_rows.h"
 #include "multires/link_union.h"
 #include "multires/parallel_rows.h"
 #include "solver/reference_solvers.h"
@@ -17,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <string>
 
 namespace waxwork {
@@ -90,6 +92,12 @@ struct MultigridPreconditioner::Level {
     // A P (this level's operator times P, all channels), kept for partial updates.
     std::vector<int32_t> ap_offsets{0}, ap_columns;
     std::array<std::vector<double>, 3> ap_values;
+    // Coarse levels: P^T A P's diagonal before dropping (the drop test's), which a rebuild compares.
+    std::array<std::vector<double>, 3> product_diagonal;
+    // Coarse levels, per row: recomputed by update_values on the kept pattern of an earlier build,
+    // which the drop test on the new values might not choose, so a rebuild copies neither the row
+    // nor rows whose drop test reads its diagonal.
+    std::vector<uint8_t> updated_on_old_pattern;
     MultigridLevelData<float> f;
     MultigridLevelData<double> d;
     MultigridRgbLevelData<float> rgb_f;
@@ -175,27 +183,67 @@ void MultigridPreconditioner::solve_coarsest_rgb(std::span<const float> b, std::
     }
 }
 
+// A level pair (l, l + 1) of the previous preconditioner, for the rebuild constructor, and the maps
+// between its vertices and the new ones (-1: none).
+struct MultigridPreconditioner::CarriedLevel {
+    const Level* old_fine = nullptr;
+    const Level* old_coarse = nullptr;
+    std::vector<int32_t> old_of_new_fine;    // new level-l vertex -> previous
+    std::vector<int32_t> old_of_new_coarse;  // new level-(l+1) vertex -> previous
+    std::vector<int32_t> new_of_old_coarse;  // previous level-(l+1) vertex -> new
+};
+
 MultigridPreconditioner::MultigridPreconditioner(const MultiresHierarchy& hierarchy, const MultigridOptions& options)
     : hierarchy_(hierarchy), options_(options) {
-    if (options.smoothing_steps < 1 || !(options.chebyshev_ratio > 1))
+    build(nullptr, {});
+}
+
+MultigridPreconditioner::MultigridPreconditioner(const MultiresHierarchy& hierarchy, const MultigridPreconditioner& previous,
+                                                 std::span<const int32_t> new_of_old_vertex, const MultigridOptions& options)
+    : hierarchy_(hierarchy), options_(options) {
+    const size_t n = hierarchy.levels.at(0).size();
+    if (new_of_old_vertex.size() != previous.rows(0))
+        throw InvalidArgumentError("multigrid rebuild: a vertex map of " + std::to_string(new_of_old_vertex.size()) +
+                                   " entries for a preconditioner on " + std::to_string(previous.rows(0)) + " vertices");
+    for (size_t o = 0; o < new_of_old_vertex.size(); ++o)
+        if (new_of_old_vertex[o] < -1 || new_of_old_vertex[o] >= static_cast<int64_t>(n))
+            throw InvalidArgumentError("multigrid rebuild: vertex " + std::to_string(o) + " maps to " +
+                                       std::to_string(new_of_old_vertex[o]) + ", outside the " + std::to_string(n) +
+                                       "-vertex hierarchy");
+    build(&previous, new_of_old_vertex);
+}
+
+void MultigridPreconditioner::build(const MultigridPreconditioner* previous, std::span<const int32_t> new_of_old_vertex) {
+    if (options_.smoothing_steps < 1 || !(options_.chebyshev_ratio > 1))
         throw InvalidArgumentError("multigrid: smoothing_steps must be >= 1 and chebyshev_ratio > 1");
     const auto start = std::chrono::steady_clock::now();
+    // Rows are copied only from a build with the same options (lumping included) under a map that
+    // keeps the vertices' order (carried_rows.h).
+    const auto source = [&]() -> const MultigridPreconditioner* {
+        return previous && previous->options_ == options_ && keeps_vertex_order(new_of_old_vertex) ? previous : nullptr;
+    };
     try {
-        build_levels();
+        build_levels(source(), new_of_old_vertex);
     } catch (const AlgorithmError& e) {
         const bool lumped_rows = options_.lumping == DropLumping::RowSum && options_.drop_tolerance > 0;
         if (!lumped_rows || !options_.fall_back_to_absolute) throw;
         lumping_fallback_reason_ = std::string(e.what()) + " with row-sum lumping; built with absolute lumping";
         options_.lumping = DropLumping::Absolute;
         levels_.clear();
-        build_levels();
+        build_levels(source(), new_of_old_vertex);
     }
     setup_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-void MultigridPreconditioner::build_levels() {
+size_t MultigridPreconditioner::copied_product_rows(size_t level) const { return copied_product_rows_.at(level); }
+size_t MultigridPreconditioner::copied_operator_rows(size_t level) const { return copied_operator_rows_.at(level); }
+
+void MultigridPreconditioner::build_levels(const MultigridPreconditioner* previous,
+                                           std::span<const int32_t> new_of_old_vertex) {
     const MultiresHierarchy& hierarchy = hierarchy_;
     const HierarchyLevel& fine = hierarchy.levels.at(0);
+    copied_product_rows_.assign(hierarchy.level_count(), 0);
+    copied_operator_rows_.assign(hierarchy.level_count(), 0);
     auto level0 = std::make_unique<Level>();
     level0->n = fine.size();
     level0->offsets = fine.offsets;
@@ -203,13 +251,42 @@ void MultigridPreconditioner::build_levels() {
     level0->diagonal = fine.diagonal;
     level0->values = fine.values;
     levels_.push_back(std::move(level0));
+    std::optional<CarriedLevel> carried;
+    if (previous) {
+        carried.emplace();
+        carried->old_of_new_fine.assign(fine.size(), -1);
+        for (size_t o = 0; o < new_of_old_vertex.size(); ++o)
+            if (new_of_old_vertex[o] >= 0) carried->old_of_new_fine[static_cast<size_t>(new_of_old_vertex[o])] = static_cast<int32_t>(o);
+    }
     for (size_t l = 0; l + 1 < hierarchy.level_count(); ++l) {
         levels_[l]->p = &hierarchy.levels[l].interpolation;
         auto next = std::make_unique<Level>();
         next->n = hierarchy.levels[l + 1].size();
         levels_[l]->pt = transpose(*levels_[l]->p, next->n);
         levels_.push_back(std::move(next));
-        build_galerkin_operator(l + 1);
+        if (carried && l + 1 < previous->levels_.size()) {
+            // The coarse vertices correspond through their parents (the retained fine vertices).
+            carried->old_fine = previous->levels_[l].get();
+            carried->old_coarse = previous->levels_[l + 1].get();
+            const std::vector<int32_t>& old_parent = previous->hierarchy_.levels[l + 1].parent_vertex;
+            const std::vector<int32_t>& new_parent = hierarchy.levels[l + 1].parent_vertex;
+            std::vector<int32_t> old_coarse_of_fine(carried->old_fine->n, -1);
+            for (size_t c = 0; c < old_parent.size(); ++c)
+                old_coarse_of_fine[static_cast<size_t>(old_parent[c])] = static_cast<int32_t>(c);
+            carried->old_of_new_coarse.assign(new_parent.size(), -1);
+            carried->new_of_old_coarse.assign(old_parent.size(), -1);
+            for (size_t c = 0; c < new_parent.size(); ++c) {
+                const int32_t o = carried->old_of_new_fine[static_cast<size_t>(new_parent[c])];
+                const int32_t old_c = o >= 0 ? old_coarse_of_fine[static_cast<size_t>(o)] : -1;
+                if (old_c < 0) continue;
+                carried->old_of_new_coarse[c] = old_c;
+                carried->new_of_old_coarse[static_cast<size_t>(old_c)] = static_cast<int32_t>(c);
+            }
+        } else {
+            carried.reset();
+        }
+        build_galerkin_operator(l + 1, carried ? &*carried : nullptr);
+        if (carried) carried->old_of_new_fine = std::move(carried->old_of_new_coarse);
     }
     for (size_t l = 0; l < levels_.size(); ++l) {
         Level& level = *levels_[l];
@@ -254,25 +331,99 @@ struct MultigridPreconditioner::Accumulator {
     explicit Accumulator(size_t columns) : tag(columns, -1), slot(columns, -1), sum(columns, {0.0, 0.0, 0.0}) {}
 };
 
-void MultigridPreconditioner::build_galerkin_operator(size_t l) {
+namespace {
+
+// Row `row` of a compressed-row operator equals row `old_row` of the previous one: the same length,
+// columns that correspond under `old_of_new_column` and the same values in every array of `values`.
+template <size_t Arrays>
+bool same_row(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
+              const std::array<const std::vector<double>*, Arrays>& values, size_t row,
+              const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
+              const std::array<const std::vector<double>*, Arrays>& old_values, size_t old_row,
+              const std::vector<int32_t>& old_of_new_column) {
+    const auto begin = static_cast<size_t>(offsets[row]), end = static_cast<size_t>(offsets[row + 1]);
+    const auto old_begin = static_cast<size_t>(old_offsets[old_row]);
+    if (end - begin != static_cast<size_t>(old_offsets[old_row + 1]) - old_begin) return false;
+    for (size_t k = begin, o = old_begin; k < end; ++k, ++o) {
+        if (old_of_new_column[static_cast<size_t>(columns[k])] != old_columns[o]) return false;
+        for (size_t a = 0; a < Arrays; ++a)
+            if ((*values[a])[k] != (*old_values[a])[o]) return false;
+    }
+    return true;
+}
+
+bool same_interpolation_row(const InterpolationOperator& p, size_t row, const InterpolationOperator& old_p,
+                            size_t old_row, const std::vector<int32_t>& old_of_new_column) {
+    return same_row<1>(p.offsets, p.columns, {&p.weights}, row, old_p.offsets, old_p.columns, {&old_p.weights}, old_row,
+                       old_of_new_column);
+}
+
+}  // namespace
+
+void MultigridPreconditioner::build_galerkin_operator(size_t l, const CarriedLevel* carried) {
     Level& fine = *levels_[l - 1];
     Level& coarse = *levels_[l];
     const InterpolationOperator& p = *fine.p;
     const size_t n = fine.n, m = coarse.n;
+    // A rebuild copies A P row v when row v of A and the P rows of its columns are unchanged up to
+    // renumbering (the sums are then the same, in the same order).
+    std::vector<uint8_t> keep_product;
+    if (carried) {
+        const Level& old_fine = *carried->old_fine;
+        std::vector<uint8_t> same_interpolation(n, 0);
+        for_rows(n, kGrain, [&](size_t j) {
+            const int32_t o = carried->old_of_new_fine[j];
+            same_interpolation[j] = o >= 0 && same_interpolation_row(p, j, *old_fine.p, static_cast<size_t>(o),
+                                                                     carried->old_of_new_coarse);
+        });
+        keep_product.assign(n, 0);
+        for_rows(n, kGrain, [&](size_t v) {
+            const int32_t o = carried->old_of_new_fine[v];
+            if (o < 0 || !same_row<3>(fine.offsets, fine.columns, {&fine.values[0], &fine.values[1], &fine.values[2]}, v,
+                                      old_fine.offsets, old_fine.columns,
+                                      {&old_fine.values[0], &old_fine.values[1], &old_fine.values[2]},
+                                      static_cast<size_t>(o), carried->old_of_new_fine))
+                return;
+            for (int32_t e = fine.offsets[v]; e < fine.offsets[v + 1]; ++e)
+                if (!same_interpolation[static_cast<size_t>(fine.columns[static_cast<size_t>(e)])]) return;
+            keep_product[v] = 1;
+        });
+    }
+    const auto kept_product = [&](size_t v) { return !keep_product.empty() && keep_product[v]; };
     // A P: row v reaches K through v -A- j -P- K; columns ascending (the order the Galerkin rows and
     // their updates sum in).
     {
         tbb::enumerable_thread_specific<LinkUnion> unions([m] { return LinkUnion(m); });
         build_rows_in_chunks(n, 512, fine.ap_offsets, fine.ap_columns, [&](size_t v, std::vector<int32_t>& row) {
+            if (kept_product(v)) {
+                const Level& old_fine = *carried->old_fine;
+                const auto o = static_cast<size_t>(carried->old_of_new_fine[v]);
+                for (int32_t e = old_fine.ap_offsets[o]; e < old_fine.ap_offsets[o + 1]; ++e)
+                    row.push_back(carried->new_of_old_coarse[static_cast<size_t>(old_fine.ap_columns[static_cast<size_t>(e)])]);
+                return;
+            }
             const auto a_row = std::span<const int32_t>(fine.columns).subspan(
                 static_cast<size_t>(fine.offsets[v]), static_cast<size_t>(fine.offsets[v + 1] - fine.offsets[v]));
             unions.local().append(a_row, p.offsets.data(), p.columns.data(), -1, row);
         });
         for (auto& v : fine.ap_values) v.assign(fine.ap_columns.size(), 0.0);
     }
-    std::vector<int32_t> all(n);
-    std::iota(all.begin(), all.end(), 0);
-    compute_product_rows(l, all);
+    std::vector<int32_t> computed;
+    for (size_t v = 0; v < n; ++v)
+        if (!kept_product(v)) computed.push_back(static_cast<int32_t>(v));
+    compute_product_rows(l, computed);
+    if (carried) {
+        const Level& old_fine = *carried->old_fine;
+        for_rows(n, kGrain, [&](size_t v) {
+            if (!keep_product[v]) return;
+            const auto o = static_cast<size_t>(carried->old_of_new_fine[v]);
+            for (size_t ch = 0; ch < 3; ++ch)
+                std::copy(old_fine.ap_values[ch].begin() + old_fine.ap_offsets[o],
+                          old_fine.ap_values[ch].begin() + old_fine.ap_offsets[o + 1],
+                          fine.ap_values[ch].begin() + fine.ap_offsets[v]);
+        });
+        copied_product_rows_[l - 1] = n - computed.size();
+    }
 
     // P^T (A P), full: accumulated row by row; then the kept pattern (see drop_tolerance) and its
     // values. The drop test needs every row's diagonal first; a diagonal entry is one column of the
@@ -295,6 +446,37 @@ void MultigridPreconditioner::build_galerkin_operator(size_t l) {
         }
         for (size_t ch = 0; ch < 3; ++ch) diagonal[ch][row] = sum[ch];
     });
+    // A rebuild copies Galerkin row I when its P^T row is unchanged up to renumbering, each A P row in
+    // it was copied, and every column those rows reach kept its diagonal (the drop test reads them).
+    std::vector<uint8_t> keep_operator;
+    if (carried) {
+        const Level& old_fine = *carried->old_fine;
+        const Level& old_coarse = *carried->old_coarse;
+        std::vector<uint8_t> same_diagonal(m, 0);
+        for_rows(m, kGrain, [&](size_t k) {
+            const int32_t o = carried->old_of_new_coarse[k];
+            if (o < 0 || old_coarse.updated_on_old_pattern[static_cast<size_t>(o)]) return;
+            bool same = true;
+            for (size_t ch = 0; ch < 3; ++ch) same = same && diagonal[ch][k] == old_coarse.product_diagonal[ch][static_cast<size_t>(o)];
+            same_diagonal[k] = same;
+        });
+        std::vector<uint8_t> settled(n, 0);  // A P row copied, every column's diagonal unchanged
+        for_rows(n, kGrain, [&](size_t v) {
+            if (!keep_product[v]) return;
+            for (int32_t e = fine.ap_offsets[v]; e < fine.ap_offsets[v + 1]; ++e)
+                if (!same_diagonal[static_cast<size_t>(fine.ap_columns[static_cast<size_t>(e)])]) return;
+            settled[v] = 1;
+        });
+        keep_operator.assign(m, 0);
+        for_rows(m, kGrain, [&](size_t row) {
+            const int32_t o = carried->old_of_new_coarse[row];
+            if (o < 0 || !same_interpolation_row(pt, row, old_fine.pt, static_cast<size_t>(o), carried->old_of_new_fine)) return;
+            for (int32_t a = pt.offsets[row]; a < pt.offsets[row + 1]; ++a)
+                if (!settled[static_cast<size_t>(pt.columns[static_cast<size_t>(a)])]) return;
+            keep_operator[row] = 1;
+        });
+        copied_operator_rows_[l] = static_cast<size_t>(std::count(keep_operator.begin(), keep_operator.end(), 1));
+    }
     // The drop test compares |a_ik| with theta sqrt(|a_ii a_kk|), the square roots taken once per row.
     const double theta = options_.drop_tolerance;
     std::array<std::vector<double>, 3> root_diagonal;
@@ -321,6 +503,17 @@ void MultigridPreconditioner::build_galerkin_operator(size_t l) {
     build_rows_in_chunks<ChunkRows>(
         m, kChunk, coarse.offsets,
         [&](size_t row, ChunkRows& buffer) {
+            if (!keep_operator.empty() && keep_operator[row]) {
+                const Level& old_coarse = *carried->old_coarse;
+                const auto o = static_cast<size_t>(carried->old_of_new_coarse[row]);
+                const auto old_begin = static_cast<size_t>(old_coarse.offsets[o]), old_end = static_cast<size_t>(old_coarse.offsets[o + 1]);
+                for (size_t s = old_begin; s < old_end; ++s) {
+                    buffer.columns.push_back(carried->new_of_old_coarse[static_cast<size_t>(old_coarse.columns[s])]);
+                    buffer.values.push_back({old_coarse.values[0][s], old_coarse.values[1][s], old_coarse.values[2][s]});
+                }
+                coarse.diagonal[row] = old_coarse.diagonal[o] - static_cast<int32_t>(old_begin);
+                return old_end - old_begin;
+            }
             Accumulator& acc = scratch.local();
             accumulate_galerkin_row(l, row, acc);
             const size_t begin = buffer.columns.size();
@@ -356,6 +549,8 @@ void MultigridPreconditioner::build_galerkin_operator(size_t l) {
             for (size_t row = chunk * kChunk; row < std::min(m, (chunk + 1) * kChunk); ++row)
                 coarse.diagonal[row] += coarse.offsets[row];
         });
+    coarse.product_diagonal = std::move(diagonal);
+    coarse.updated_on_old_pattern.assign(m, 0);
 }
 
 void MultigridPreconditioner::clear(Accumulator& acc) {
@@ -547,6 +742,7 @@ std::vector<std::vector<int32_t>> MultigridPreconditioner::update_values(std::sp
         for (size_t i = 0; i < touched.size(); ++i)
             if (touched[i]) rows.push_back(static_cast<int32_t>(i));
         compute_galerkin_rows(l, rows);
+        for (const int32_t row : rows) levels_[l]->updated_on_old_pattern[static_cast<size_t>(row)] = 1;
         prepare_smoother(l, rows);
         if (l + 1 == levels_.size() && !rows.empty()) factorize_coarsest();
         level_rows.push_back(rows);

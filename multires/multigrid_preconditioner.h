@@ -72,6 +72,8 @@ struct MultigridOptions {
     // again with Absolute lumping, which is positive definite by construction (stability study,
     // "slivers, multigrid"). false: throw the AlgorithmError instead.
     bool fall_back_to_absolute = true;
+
+    friend bool operator==(const MultigridOptions&, const MultigridOptions&) = default;
 };
 
 class MultigridPreconditioner {
@@ -80,6 +82,18 @@ public:
     // hierarchy must outlive the preconditioner (its interpolation operators are borrowed).
     // Throws AlgorithmError when a diagonal is not positive or the coarsest factorisation fails.
     explicit MultigridPreconditioner(const MultiresHierarchy& hierarchy, const MultigridOptions& options = {});
+    // The same after an edit, reusing `previous`: `hierarchy` was rebuilt (rebuild_multires_hierarchy)
+    // from the hierarchy `previous` was built on, which must still be alive, and new_of_old_vertex is
+    // the edit's level-0 vertex map. A row of A P whose matrix row and interpolation rows the edit left
+    // unchanged up to renumbering, and a Galerkin row whose P^T row, A P rows and drop-test diagonals it
+    // left unchanged, is copied from `previous` with renumbered columns instead of being accumulated
+    // again (beyond the paper; an edit changes a region, the products of the rest stay). A copied row
+    // is what the accumulation would give, bit for bit (same sums in the same order), so the result
+    // equals MultigridPreconditioner(hierarchy, options) (tested). Copies need an order-preserving map
+    // and the options `previous` ended with (its lumping after a fallback); otherwise every row is
+    // computed. Throws as the other constructor, and InvalidArgumentError when the map does not fit.
+    MultigridPreconditioner(const MultiresHierarchy& hierarchy, const MultigridPreconditioner& previous,
+                            std::span<const int32_t> new_of_old_vertex, const MultigridOptions& options = {});
     ~MultigridPreconditioner();
     MultigridPreconditioner(const MultigridPreconditioner&) = delete;
     MultigridPreconditioner& operator=(const MultigridPreconditioner&) = delete;
@@ -91,6 +105,10 @@ public:
     // Level l's operator for one channel, in double (for tests).
     CsrMatrixView<double> view(size_t level, int channel) const;
     double setup_ms() const { return setup_ms_; }
+    // The rebuild constructor's copies: rows of level l's A P (to level l + 1) and of level l's Galerkin
+    // operator taken from the previous preconditioner (zero after the other constructor).
+    size_t copied_product_rows(size_t level) const;
+    size_t copied_operator_rows(size_t level) const;
     // The lumping the operators were built with: Absolute after a RowSum setup failed, with the reason.
     DropLumping lumping() const { return options_.lumping; }
     const std::string& lumping_fallback_reason() const { return lumping_fallback_reason_; }
@@ -136,9 +154,14 @@ public:
 private:
     struct Level;
     struct Accumulator;
-    void build_levels();
-    // A P's pattern and values, then P^T A P's kept pattern and values (compute_galerkin_rows' result).
-    void build_galerkin_operator(size_t l);
+    struct CarriedLevel;
+    // build_levels, redone with absolute lumping when a row-sum build fails (MultigridOptions).
+    void build(const MultigridPreconditioner* previous, std::span<const int32_t> new_of_old_vertex);
+    // With `previous`: copies the rows the edit left unchanged (the rebuild constructor).
+    void build_levels(const MultigridPreconditioner* previous, std::span<const int32_t> new_of_old_vertex);
+    // A P's pattern and values, then P^T A P's kept pattern and values (compute_galerkin_rows' result);
+    // with `carried`, rows the edit left unchanged are copied from the previous preconditioner.
+    void build_galerkin_operator(size_t l, const CarriedLevel* carried);
     void compute_product_rows(size_t l, std::span<const int32_t> rows);
     void accumulate_galerkin_row(size_t l, size_t row, Accumulator& acc) const;
     static void clear(Accumulator& acc);
@@ -155,6 +178,7 @@ private:
     std::vector<std::unique_ptr<Level>> levels_;
     double setup_ms_ = 0;
     std::string lumping_fallback_reason_;
+    std::vector<size_t> copied_product_rows_, copied_operator_rows_;  // per level
 };
 
 }  // namespace waxwork

@@ -2,9 +2,7 @@
 #include "multires/independent_set.h"
 #include "multires/multires_solver.h"
 #include "multires_test_systems.h"
-#include "tetops/cut.h"
 #include "tetops/error.h"
-#include "tetops/relaxation.h"
 
 #include <tbb/global_control.h>
 
@@ -21,6 +19,9 @@
 
 namespace waxwork {
 namespace {
+
+using testing::CutSystem;
+using testing::cut_system;
 
 Eigen::MatrixXd dense(const HierarchyLevel& level, int channel) {
     const auto n = static_cast<Eigen::Index>(level.size());
@@ -308,31 +309,6 @@ TEST(Hierarchy, RejectsANonFiniteLinearExactWeightFloor) {
 }
 
 // --- Rebuilding after an edit (rebuild_multires_hierarchy) ---
-
-// A make_test_system volume after a plane cut: the cut mesh's system and the cut's vertex map.
-struct CutSystem {
-    TetMesh mesh;
-    TetConnectivity connectivity;
-    DiffusionMatrix matrix;
-    std::vector<int32_t> new_of_old;
-};
-
-CutSystem cut_system(const TetMesh& mesh, const Eigen::Vector3d& normal, double offset, int relax_sweeps = 0) {
-    CutSystem c;
-    c.mesh = mesh;
-    const PlaneCut plane(normal, offset);
-    c.new_of_old = remove_cut_away_tets(c.mesh, plane).old_to_new_vertex;
-    c.connectivity = build_connectivity(c.mesh);
-    if (relax_sweeps > 0) {
-        RelaxationOptions relax;
-        relax.max_iterations = relax_sweeps;
-        relax.step = 0.3;
-        relax_cut_vertices(c.mesh, c.connectivity, plane, relax);
-    }
-    const std::vector<TetMaterial> materials(c.mesh.tet_count(), testing::test_material());
-    c.matrix = assemble_diffusion_matrix(c.mesh, c.connectivity, materials);
-    return c;
-}
 
 // Per vertex of level l: 1 when it is retained in level l+1.
 std::vector<uint8_t> retained_flags(const MultiresHierarchy& h, size_t l) {

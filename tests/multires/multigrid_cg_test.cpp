@@ -5,6 +5,8 @@
 #include "solver/material.h"
 #include "solver/reference_solvers.h"
 #include "tetops/box_mesh.h"
+#include "tetops/cut.h"
+#include "tetops/relaxation.h"
 #include "tetops/sliver_maker.h"
 #include "tetops/error.h"
 
@@ -12,9 +14,11 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <random>
+#include <string>
 
 namespace waxwork {
 namespace {
@@ -273,6 +277,117 @@ TEST(MultigridPreconditioner, PartialUpdateAfterPaintingEqualsARebuild) {
     updated.apply(0, s.b[0], xa);
     rebuilt.apply(0, s.b[0], xb);
     EXPECT_EQ(xa, xb);
+}
+
+// Every level's operator of `a` equals `b`'s bit for bit: pattern, diagonal positions and values.
+void expect_same_operators(const MultigridPreconditioner& a, const MultigridPreconditioner& b, const std::string& what) {
+    ASSERT_EQ(a.level_count(), b.level_count()) << what;
+    for (size_t l = 0; l < a.level_count(); ++l) {
+        EXPECT_TRUE(std::ranges::equal(a.diagonal(l), b.diagonal(l))) << what << ", level " << l;
+        for (int channel = 0; channel < 3; ++channel) {
+            const auto x = a.view(l, channel), y = b.view(l, channel);
+            ASSERT_EQ(x.rows, y.rows) << what;
+            const auto nnz = static_cast<size_t>(x.offsets[x.rows]);
+            ASSERT_TRUE(std::equal(x.offsets, x.offsets + x.rows + 1, y.offsets)) << what << ", level " << l;
+            EXPECT_TRUE(std::equal(x.columns, x.columns + nnz, y.columns)) << what << ", level " << l;
+            EXPECT_TRUE(std::equal(x.values, x.values + nnz, y.values)) << what << ", level " << l << " channel " << channel;
+        }
+    }
+}
+
+// After a cut with relaxation, the preconditioner rebuilt from the uncut one copies the rows of A P
+// and of the Galerkin operators away from the cut and equals a fresh build on the rebuilt hierarchy
+// bit for bit, with either lumping and with exact products. Rebuilt once more after a relaxation
+// alone (the identity map, moved vertices) it still does. From a build with other options it copies
+// nothing and still equals the fresh build.
+TEST(MultigridPreconditioner, RebuiltAfterACutEqualsAFreshBuild) {
+    const auto s = testing::make_test_system(14);  // 3375 vertices
+    const HierarchyOptions levels = small_levels(30);
+    const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions, levels);
+    const testing::CutSystem cut = testing::cut_system(s.mesh, Eigen::Vector3d(1, 0.2, 0.1), 2.7, 3);
+    const MultiresHierarchy after = rebuild_multires_hierarchy(before, cut.new_of_old, cut.matrix, cut.mesh.positions, levels);
+    ASSERT_GE(after.level_count(), 3u);
+    // The cut volume relaxed once more towards the same plane: same graph, moved vertices.
+    TetMesh relaxed = cut.mesh;
+    RelaxationOptions relax;
+    relax.max_iterations = 3;
+    relax.step = 0.3;
+    ASSERT_GT(relax_cut_vertices(relaxed, cut.connectivity, PlaneCut(Eigen::Vector3d(1, 0.2, 0.1), 2.7), relax).vertices_moved, 0u);
+    const std::vector<TetMaterial> materials(relaxed.tet_count(), testing::test_material());
+    const DiffusionMatrix relaxed_matrix = assemble_diffusion_matrix(relaxed, cut.connectivity, materials);
+    std::vector<int32_t> identity(relaxed.vertex_count());
+    std::iota(identity.begin(), identity.end(), 0);
+    const MultiresHierarchy again = rebuild_multires_hierarchy(after, identity, relaxed_matrix, relaxed.positions, levels);
+
+    MultigridOptions absolute;
+    absolute.lumping = DropLumping::Absolute;
+    absolute.drop_tolerance = 0.05;
+    MultigridOptions exact;
+    exact.drop_tolerance = 0;
+    for (const MultigridOptions& options : {MultigridOptions{}, absolute, exact}) {
+        const std::string what = "drop " + std::to_string(options.drop_tolerance) +
+                                 (options.lumping == DropLumping::Absolute ? " absolute" : " row sum");
+        const MultigridPreconditioner uncut(before, options);
+        MultigridPreconditioner rebuilt(after, uncut, cut.new_of_old, options);
+        MultigridPreconditioner fresh(after, options);
+        expect_same_operators(rebuilt, fresh, what);
+        // Most fine rows lie away from the cut; the rows next to it are computed. A Galerkin row reaches
+        // three fine hops, so on this small cube fewer of level 1's rows escape the cut (101 of 744).
+        const size_t n = after.levels[0].size();
+        EXPECT_GT(rebuilt.copied_product_rows(0), n / 2) << what;
+        EXPECT_LT(rebuilt.copied_product_rows(0), n) << what;
+        EXPECT_GT(rebuilt.copied_operator_rows(1), 0u) << what;
+        EXPECT_LT(rebuilt.copied_operator_rows(1), after.levels[1].size()) << what;
+        EXPECT_EQ(fresh.copied_product_rows(0), 0u);
+        std::vector<double> xa(n, 0.0), xb(n, 0.0);
+        const std::vector<double> r = random_vector(n, 3);
+        rebuilt.apply(1, r, xa);
+        fresh.apply(1, r, xb);
+        EXPECT_EQ(xa, xb) << what;
+
+        const MultigridPreconditioner moved(again, rebuilt, identity, options);
+        expect_same_operators(moved, MultigridPreconditioner(again, options), what + ", relaxed");
+        EXPECT_GT(moved.copied_product_rows(0), n / 2) << what;
+        EXPECT_LT(moved.copied_product_rows(0), n) << what;
+
+        MultigridOptions other = options;
+        other.smoothing_steps = 3;
+        const MultigridPreconditioner unrelated(after, MultigridPreconditioner(before, other), cut.new_of_old, options);
+        expect_same_operators(unrelated, fresh, what + ", from other options");
+        for (size_t l = 0; l < after.level_count(); ++l) {
+            EXPECT_EQ(unrelated.copied_product_rows(l) + unrelated.copied_operator_rows(l), 0u) << what;
+        }
+    }
+    const std::vector<int32_t> too_short(3, 0);
+    const MultigridPreconditioner uncut(before);
+    EXPECT_THROW(MultigridPreconditioner(after, uncut, too_short), InvalidArgumentError);
+}
+
+// Painting updates a preconditioner's rows on the kept pattern of its build (update_values), which a
+// fresh build on the painted values might not choose: a rebuild after painting and a cut copies none
+// of those rows and still equals a fresh build.
+TEST(MultigridPreconditioner, RebuiltAfterPaintingAndACutEqualsAFreshBuild) {
+    auto s = testing::make_test_system(14);
+    const HierarchyOptions levels = small_levels(30);
+    MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions, levels);
+    MultigridOptions options;
+    options.drop_tolerance = 0.05;  // drops on every coarse level, so painting can move the pattern
+    MultigridPreconditioner painted(before, options);
+    const std::vector<int32_t> rows = testing::paint_test_system(s, 300, 7);
+    before.levels[0].values = s.matrix.values;
+    painted.update_values(rows);
+    // The painted materials, cut.
+    testing::CutSystem cut = testing::cut_system(s.mesh, Eigen::Vector3d(1, 0.2, 0.1), 2.7);
+    std::vector<TetMaterial> materials(s.mesh.tet_count(), testing::test_material());
+    for (size_t t = 0; t < 300; ++t) materials[7 * t] = TetMaterial{{0.3, 0.02, 0.1}, {2, 1, 0.5}, 1.4};  // as painted
+    TetMesh cut_mesh = s.mesh;
+    cut_mesh.materials = materials;
+    remove_cut_away_tets(cut_mesh, PlaneCut(Eigen::Vector3d(1, 0.2, 0.1), 2.7));
+    cut.matrix = assemble_diffusion_matrix(cut_mesh, cut.connectivity, cut_mesh.materials);
+    const MultiresHierarchy after = rebuild_multires_hierarchy(before, cut.new_of_old, cut.matrix, cut.mesh.positions, levels);
+    const MultigridPreconditioner rebuilt(after, painted, cut.new_of_old, options);
+    expect_same_operators(rebuilt, MultigridPreconditioner(after, options), "painted, then cut");
+    EXPECT_GT(rebuilt.copied_product_rows(0), 0u);
 }
 
 // The build fills the Galerkin values in the pass that chooses the kept pattern (and takes the drop

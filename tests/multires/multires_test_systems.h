@@ -6,6 +6,8 @@
 #include "solver/diffusion_matrix.h"
 #include "solver/lighting.h"
 #include "tetops/connectivity.h"
+#include "tetops/cut.h"
+#include "tetops/relaxation.h"
 #include "tetops/test_meshes.h"
 
 #include <Eigen/Geometry>
@@ -75,6 +77,31 @@ inline std::vector<int32_t> paint_test_system(TestSystem& s, int count, int stri
         materials[static_cast<size_t>(t * stride)] = TetMaterial{{0.3, 0.02, 0.1}, {2, 1, 0.5}, 1.4};
     }
     return update_diffusion_matrix(s.matrix, s.mesh, s.connectivity, materials, painted);
+}
+
+// A make_test_system volume after a plane cut: the cut mesh's system and the cut's vertex map.
+struct CutSystem {
+    TetMesh mesh;
+    TetConnectivity connectivity;
+    DiffusionMatrix matrix;
+    std::vector<int32_t> new_of_old;
+};
+
+inline CutSystem cut_system(const TetMesh& mesh, const Eigen::Vector3d& normal, double offset, int relax_sweeps = 0) {
+    CutSystem c;
+    c.mesh = mesh;
+    const PlaneCut plane(normal, offset);
+    c.new_of_old = remove_cut_away_tets(c.mesh, plane).old_to_new_vertex;
+    c.connectivity = build_connectivity(c.mesh);
+    if (relax_sweeps > 0) {
+        RelaxationOptions relax;
+        relax.max_iterations = relax_sweeps;
+        relax.step = 0.3;
+        relax_cut_vertices(c.mesh, c.connectivity, plane, relax);
+    }
+    const std::vector<TetMaterial> materials(c.mesh.tet_count(), testing::test_material());
+    c.matrix = assemble_diffusion_matrix(c.mesh, c.connectivity, materials);
+    return c;
 }
 
 // sqrt(sum (x - reference)^2 / sum reference^2).
