@@ -202,12 +202,14 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
         // Built now, while the mesh is at hand (the scene borrows it only during its calls); the device
         // solver at the next GPU frame, with the context current, from a copy of the rest positions.
         if (backend_ == LiveBackend::Cpu) {
-            // The hierarchy rebuilt around the edit from the previous solver's, which is freed before
-            // the new operators are built (at 500K tets they take hundreds of MB).
+            // The hierarchy rebuilt around the edit from the previous solver's, and the Galerkin rows
+            // the edit left unchanged copied from its preconditioner; the previous solver is freed
+            // once they are (at 500K tets the two together hold several hundred MB for a moment).
             std::optional<MultiresHierarchy> carried = rebuilt_hierarchy(
                 previous_multigrid ? &previous_multigrid->hierarchy() : nullptr, new_of_old_vertex, matrix, mesh.positions);
+            const MultigridFrameSolver* source = carried ? previous_multigrid.get() : nullptr;
+            build_cpu_multigrid(mesh.positions, matrix, std::move(carried), source, new_of_old_vertex);
             previous_multigrid.reset();
-            build_cpu_multigrid(mesh.positions, matrix, std::move(carried));
         } else {
             multigrid_positions_ = mesh.positions;
             multigrid_hierarchy_ = rebuilt_hierarchy(previous_device, new_of_old_vertex, matrix, mesh.positions);
@@ -242,11 +244,13 @@ const MultiresHierarchy* LiveSolver::multires_hierarchy() const {
 }
 
 void LiveSolver::build_cpu_multigrid(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix,
-                                     std::optional<MultiresHierarchy> hierarchy) {
+                                     std::optional<MultiresHierarchy> hierarchy, const MultigridFrameSolver* previous,
+                                     std::span<const int32_t> new_of_old_vertex) {
     try {
         FrameSolverOptions frame_options;
         frame_options.multigrid = multigrid_options_;
-        multigrid_ = hierarchy ? std::make_unique<MultigridFrameSolver>(matrix, std::move(*hierarchy), frame_options)
+        multigrid_ = hierarchy ? std::make_unique<MultigridFrameSolver>(matrix, std::move(*hierarchy), frame_options,
+                                                                        previous, new_of_old_vertex)
                                : std::make_unique<MultigridFrameSolver>(matrix, positions, frame_options);
         multigrid_pending_ = PendingChanges{};  // a new solver: b and phi to send
         method_fallback_reason_.clear();

@@ -233,8 +233,11 @@ private:
     bool gpu_multigrid() const { return backend_ == LiveBackend::Gpu && !multigrid_positions_.empty(); }
     // The CPU multigrid frame solver for `matrix` (sets method_fallback_reason_ when it cannot be built).
     // `hierarchy`: one already built for `matrix` (rebuilt around an edit); else it is built here.
+    // `previous`: the solver before that edit (new_of_old_vertex its vertex map), whose unchanged
+    // Galerkin rows the new preconditioner copies.
     void build_cpu_multigrid(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix,
-                             std::optional<MultiresHierarchy> hierarchy = std::nullopt);
+                             std::optional<MultiresHierarchy> hierarchy = std::nullopt,
+                             const MultigridFrameSolver* previous = nullptr, std::span<const int32_t> new_of_old_vertex = {});
     std::array<LiveSolverChannel, 3> iterate_gpu(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
                                                  std::array<std::vector<double>, 3>& phi, int iteration_budget,
                                                  double relative_tolerance, const std::array<bool, 3>& skip);

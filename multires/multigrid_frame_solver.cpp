@@ -63,11 +63,14 @@ MultigridFrameSolver::MultigridFrameSolver(const DiffusionMatrix& matrix, std::s
     : MultigridFrameSolver(matrix, build_multires_hierarchy(matrix, positions, options.hierarchy), options) {}
 
 MultigridFrameSolver::MultigridFrameSolver(const DiffusionMatrix& matrix, MultiresHierarchy hierarchy,
-                                           const FrameSolverOptions& options)
+                                           const FrameSolverOptions& options, const MultigridFrameSolver* previous,
+                                           std::span<const int32_t> new_of_old_vertex)
     : MultigridFrameCg(matrix.size(), options, "frame solver") {
     check_hierarchy(hierarchy);
     hierarchy_ = std::make_unique<MultiresHierarchy>(std::move(hierarchy));
-    preconditioner_ = std::make_unique<MultigridPreconditioner>(*hierarchy_, options.multigrid);
+    preconditioner_ = previous ? std::make_unique<MultigridPreconditioner>(*hierarchy_, previous->preconditioner(),
+                                                                           new_of_old_vertex, options.multigrid)
+                               : std::make_unique<MultigridPreconditioner>(*hierarchy_, options.multigrid);
     values_.resize(3 * matrix.nonzeros());
     for_rows(matrix.nonzeros(), kGrain, [&](size_t k) {
         for (size_t c = 0; c < 3; ++c) values_[3 * k + c] = matrix.values[c][k];

@@ -48,9 +48,14 @@ public:
     MultigridFrameSolver(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                          const FrameSolverOptions& options = {});
     // The same on a hierarchy built elsewhere for this matrix with options.hierarchy
-    // (rebuild_multires_hierarchy after an edit). Throws InvalidArgumentError when its level 0 is not
-    // the matrix's size or it was built with other options.
-    MultigridFrameSolver(const DiffusionMatrix& matrix, MultiresHierarchy hierarchy, const FrameSolverOptions& options = {});
+    // (rebuild_multires_hierarchy after an edit). With `previous`, the solver before that edit
+    // (new_of_old_vertex: the edit's level-0 vertex map; `hierarchy` rebuilt from previous->hierarchy()),
+    // the preconditioner copies the Galerkin rows the edit left unchanged from previous's
+    // (MultigridPreconditioner's rebuild constructor; the same operators either way). Throws
+    // InvalidArgumentError when the hierarchy's level 0 is not the matrix's size, it was built with
+    // other options, or the map does not fit `previous`.
+    MultigridFrameSolver(const DiffusionMatrix& matrix, MultiresHierarchy hierarchy, const FrameSolverOptions& options = {},
+                         const MultigridFrameSolver* previous = nullptr, std::span<const int32_t> new_of_old_vertex = {});
     ~MultigridFrameSolver();
 
     // As MultigridFrameCg says: step(), set_relative_tolerance(), and these on the host's vectors.
