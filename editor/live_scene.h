@@ -12,15 +12,16 @@
 //   piece transforms         boundary surface, shadow BVH and q (pieces shadow each other); the matrix
 //                            is invariant under rigid motion; warm start
 //   positions (relaxation)   matrix geometry and values, lighting; warm start
-//   topology (cut, ...)      connectivity (reused from the report when the edit built it), matrix,
-//                            lighting; warm start through the cut's vertex map, else cold
+//   topology (cut, fracture, connectivity (reused from the report when the edit built it), matrix,
+//   weld, their undo)        lighting; warm start through the edit's vertex map and vertex origins
+//                            (ChangeReport), else cold
 //   lights (set_lighting)    q and the right-hand sides only; warm start
 //
 // Solver choice: Jacobi-preconditioned CG in double, warm-started, per channel. The multires solver
 // (multires/multires_solver.h) is not the default: between rebuilds its frames are this same warm
 // Jacobi CG, and its hierarchy adds to every cut (rebuilt around the cut from the previous one).
 // Multigrid CG converges in fewer, cheaper frames but adds its setup (hierarchy and Galerkin
-// operators) to every cut. From a cut to an image under 1%
+// operators, both rebuilt around the cut from the previous ones) to every cut. From a cut to an image under 1%
 // error the three come out even, because the phi carried through the cut is already a close start
 // (bench/live_solver_bench.cpp BM_CutToSettledImage; README, "From a cut to a settled image").
 // LiveSceneOptions::method and backend select multigrid CG, the paper's multires or the GPU instead

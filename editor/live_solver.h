@@ -136,10 +136,11 @@ public:
     // What changed since the last iterate(); each only marks work for the next one.
     // A new matrix (pattern or geometry): every derived structure is rebuilt (multigrid CG: the
     // hierarchy now, its Eq. 16 weights from the mesh's rest positions; the device: at the next frame).
-    // new_of_old_vertex: per vertex of the previous matrix its vertex in this one or -1 (a cut's map;
-    // the identity after a relaxation), or empty when they are unrelated. With it the multires
-    // hierarchy is rebuilt from the previous one, selecting again only around the changed rows
-    // (rebuild_multires_hierarchy); without it, from scratch.
+    // new_of_old_vertex: per vertex of the previous matrix its vertex in this one or -1 (the map of a
+    // cut, fracture or weld; the identity after a relaxation), or empty when they are unrelated. With
+    // it the multires and multigrid hierarchies are rebuilt from the previous ones, selecting again
+    // only around the changed rows (rebuild_multires_hierarchy), and the CPU multigrid copies the
+    // Galerkin rows the edit left unchanged; without it, everything is built from scratch.
     void matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix,
                         std::span<const int32_t> new_of_old_vertex = {});
     void values_changed();                          // all values, same pattern
