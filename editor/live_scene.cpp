@@ -332,6 +332,16 @@ std::vector<std::array<int64_t, 2>> LiveScene::multires_levels() const {
     return levels;
 }
 
+int64_t LiveScene::multigrid_copied_rows() const {
+    const std::lock_guard lock(mutex_);
+    const MultigridPreconditioner* preconditioner = solver_->multigrid_preconditioner();
+    if (!preconditioner) return -1;
+    int64_t rows = 0;
+    for (size_t l = 0; l < preconditioner->level_count(); ++l)
+        rows += static_cast<int64_t>(preconditioner->copied_operator_rows(l));
+    return rows;
+}
+
 std::shared_ptr<const GpuBuffer> LiveScene::device_radiance(std::vector<std::array<float, 3>>* host_copy) {
     const std::lock_guard lock(mutex_);
     return solver_->radiance_on_device(*mesh_, *connectivity_, q_, surface_.vertices, host_copy);

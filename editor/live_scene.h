@@ -153,6 +153,9 @@ public:
     // The level sizes and changed-row counts of the hierarchy of the multires method or the CPU
     // multigrid CG (level l: {vertices, HierarchyLevel::changed_vertices}); empty with other methods.
     std::vector<std::array<int64_t, 2>> multires_levels() const;
+    // Galerkin rows the multigrid CG's preconditioner copied from the one before the last edit, summed
+    // over its levels (MultigridPreconditioner::copied_operator_rows); -1 without one.
+    int64_t multigrid_copied_rows() const;
     // With the GPU backend running: E per surface vertex (solved_scene().surface order) on the device,
     // from the resident phi (LiveSolver::radiance_on_device), for a renderer sharing the solver's
     // context to draw instead of the CPU's radiance_factor; else null. Reads the mesh. `host_copy`:

@@ -110,6 +110,31 @@ std::optional<MultiresHierarchy> rebuilt_hierarchy(const MultiresHierarchy* prev
     return rebuild_multires_hierarchy(*previous, new_of_old_vertex, matrix, positions);
 }
 
+// The device multigrid's host operators for `matrix` after an edit: the hierarchy rebuilt from
+// `previous_hierarchy` and the preconditioner rebuilt from `previous_preconditioner` (built on it),
+// copying the rows the edit left unchanged; nothing without a fitting vertex map (the device solver
+// then builds both). A preconditioner that cannot be built is left to the device solver's
+// construction, which fails the same way and is reported there.
+MultigridOperators rebuilt_multigrid_operators(const MultiresHierarchy* previous_hierarchy,
+                                               const MultigridPreconditioner* previous_preconditioner,
+                                               std::span<const int32_t> new_of_old_vertex, const DiffusionMatrix& matrix,
+                                               std::span<const Eigen::Vector3d> positions,
+                                               const MultigridOptions& options) {
+    MultigridOperators operators;
+    std::optional<MultiresHierarchy> hierarchy = rebuilt_hierarchy(previous_hierarchy, new_of_old_vertex, matrix, positions);
+    if (!hierarchy) return operators;
+    operators.hierarchy = std::make_unique<MultiresHierarchy>(std::move(*hierarchy));
+    if (previous_preconditioner) {
+        try {
+            operators.preconditioner = std::make_unique<MultigridPreconditioner>(
+                *operators.hierarchy, *previous_preconditioner, new_of_old_vertex, options);
+        } catch (const AlgorithmError&) {
+            operators.preconditioner.reset();
+        }
+    }
+    return operators;
+}
+
 }  // namespace
 
 std::shared_ptr<SolverGlContext> open_headless_solver_context() { return std::make_shared<HeadlessSolverContext>(); }
@@ -186,12 +211,17 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
                                 std::span<const int32_t> new_of_old_vertex) {
     eigenvalue_hint_ = {0, 0, 0};  // belong to the old matrix (a stale hint can be too optimistic)
     std::unique_ptr<MultigridFrameSolver> previous_multigrid = std::move(multigrid_);
-    // The device multigrid's hierarchy lives on the host: the one waiting for the next GPU frame, or
+    // The device multigrid's operators live on the host: the ones waiting for the next GPU frame, or
     // the device solver's (released below).
-    std::optional<MultiresHierarchy> previous_device_hierarchy = std::exchange(multigrid_hierarchy_, std::nullopt);
-    const MultiresHierarchy* previous_device = previous_device_hierarchy ? &*previous_device_hierarchy
-                                               : gpu_ && gpu_->multigrid ? &gpu_->multigrid->hierarchy()
-                                                                         : nullptr;
+    const MultigridOperators previous_waiting = std::exchange(multigrid_waiting_, MultigridOperators{});
+    const MultiresHierarchy* previous_device_hierarchy =
+        previous_waiting.hierarchy ? previous_waiting.hierarchy.get()
+        : gpu_ && gpu_->multigrid  ? &gpu_->multigrid->hierarchy()
+                                   : nullptr;
+    const MultigridPreconditioner* previous_device_preconditioner =
+        previous_waiting.hierarchy ? previous_waiting.preconditioner.get()
+        : gpu_ && gpu_->multigrid  ? &gpu_->multigrid->preconditioner()
+                                   : nullptr;
     forget_estimates();
     // Every copy is rebuilt from this matrix: nothing of the old one is pending, b and phi are.
     multigrid_pending_ = multires_pending_ = gpu_pending_ = PendingChanges{};
@@ -212,7 +242,9 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
             previous_multigrid.reset();
         } else {
             multigrid_positions_ = mesh.positions;
-            multigrid_hierarchy_ = rebuilt_hierarchy(previous_device, new_of_old_vertex, matrix, mesh.positions);
+            multigrid_waiting_ = rebuilt_multigrid_operators(previous_device_hierarchy, previous_device_preconditioner,
+                                                             new_of_old_vertex, matrix, mesh.positions,
+                                                             multigrid_options_);
             method_fallback_reason_.clear();
         }
     }
@@ -236,10 +268,16 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
     }
 }
 
+const MultigridPreconditioner* LiveSolver::multigrid_preconditioner() const {
+    if (multigrid_) return &multigrid_->preconditioner();
+    if (multigrid_waiting_.hierarchy) return multigrid_waiting_.preconditioner.get();
+    return gpu_ && gpu_->multigrid ? &gpu_->multigrid->preconditioner() : nullptr;
+}
+
 const MultiresHierarchy* LiveSolver::multires_hierarchy() const {
     if (multires_) return &multires_->hierarchy();
     if (multigrid_) return &multigrid_->hierarchy();
-    if (multigrid_hierarchy_) return &*multigrid_hierarchy_;
+    if (multigrid_waiting_.hierarchy) return multigrid_waiting_.hierarchy.get();
     return gpu_ && gpu_->multigrid ? &gpu_->multigrid->hierarchy() : nullptr;
 }
 
@@ -266,7 +304,7 @@ void LiveSolver::values_changed() {
     forget_estimates();
     for (PendingChanges* pending : {&multigrid_pending_, &multires_pending_, &gpu_pending_}) pending->values_changed();
     gpu_level_rows_.clear();
-    multigrid_hierarchy_.reset();  // its level 0 holds the old values: the device solver is built afresh
+    multigrid_waiting_ = MultigridOperators{};  // old values at level 0: the device solver builds afresh
 }
 
 void LiveSolver::forget_estimates() {
@@ -278,7 +316,7 @@ void LiveSolver::rows_changed(std::span<const int32_t> rows) {
     if (rows.empty()) return;
     if (gpu_) gpu_->radiance_stale_weights = true;
     forget_estimates();
-    multigrid_hierarchy_.reset();  // its level 0 holds the old values: the device solver is built afresh
+    multigrid_waiting_ = MultigridOperators{};  // old values at level 0: the device solver builds afresh
     std::vector<int32_t> sorted(rows.begin(), rows.end());
     std::sort(sorted.begin(), sorted.end());
     sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
@@ -381,7 +419,15 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_cpu(const DiffusionMatrix& 
     if (!multigrid_positions_.empty() && n > 0) {
         // After a GPU fallback the multigrid method goes on with the CPU multigrid CG (built here: the
         // device held the hierarchy), warm from the last read-back phi.
-        build_cpu_multigrid(multigrid_positions_, matrix, std::exchange(multigrid_hierarchy_, std::nullopt));
+        // The hierarchy waiting for the device is this matrix's; its preconditioner goes (the CPU
+        // solver builds its own).
+        std::optional<MultiresHierarchy> waiting;
+        if (multigrid_waiting_.hierarchy) {
+            multigrid_waiting_.preconditioner.reset();
+            waiting = std::move(*multigrid_waiting_.hierarchy);
+        }
+        multigrid_waiting_ = MultigridOperators{};
+        build_cpu_multigrid(multigrid_positions_, matrix, std::move(waiting));
         multigrid_positions_.clear();
     }
     if (multigrid_ && n > 0) {
@@ -511,7 +557,7 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu(const DiffusionMatrix& 
             // copy is written only after a successful step), until the next rebuild tries again.
             method_fallback_reason_ = jacobi_instead_of_multigrid(e);
             multigrid_positions_.clear();
-            multigrid_hierarchy_.reset();
+            multigrid_waiting_ = MultigridOperators{};
             gpu_.reset();  // the context is current
             gpu_pending_ = PendingChanges{};
             // Its budget was counted in V-cycles, or unlimited under a deadline it no longer reads.
@@ -570,10 +616,10 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multigrid(const Diffusi
         FrameSolverOptions frame_options;
         frame_options.multigrid = multigrid_options_;
         auto gpu = std::make_unique<Gpu>();
-        gpu->multigrid = multigrid_hierarchy_ ? std::make_unique<GpuMultigridFrameSolver>(
-                                                    gl, matrix, *std::exchange(multigrid_hierarchy_, std::nullopt), frame_options)
-                                              : std::make_unique<GpuMultigridFrameSolver>(gl, matrix, multigrid_positions_,
-                                                                                          frame_options);
+        gpu->multigrid = multigrid_waiting_.hierarchy
+                             ? std::make_unique<GpuMultigridFrameSolver>(
+                                   gl, matrix, std::exchange(multigrid_waiting_, MultigridOperators{}), frame_options)
+                             : std::make_unique<GpuMultigridFrameSolver>(gl, matrix, multigrid_positions_, frame_options);
         gpu_ = std::move(gpu);
         const GLubyte* renderer = gl.GetString(GL_RENDERER);
         renderer_ = renderer ? reinterpret_cast<const char*>(renderer) : "";

@@ -139,8 +139,9 @@ public:
     // new_of_old_vertex: per vertex of the previous matrix its vertex in this one or -1 (the map of a
     // cut, fracture or weld; the identity after a relaxation), or empty when they are unrelated. With
     // it the multires and multigrid hierarchies are rebuilt from the previous ones, selecting again
-    // only around the changed rows (rebuild_multires_hierarchy), and the CPU multigrid copies the
-    // Galerkin rows the edit left unchanged; without it, everything is built from scratch.
+    // only around the changed rows (rebuild_multires_hierarchy), and the multigrid copies the
+    // Galerkin rows the edit left unchanged (on the GPU backend both now, on the host, for the device
+    // solver built at the next frame); without it, everything is built from scratch.
     void matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix,
                         std::span<const int32_t> new_of_old_vertex = {});
     void values_changed();                          // all values, same pattern
@@ -201,6 +202,9 @@ public:
     // for the next GPU frame, else the device solver's; nullptr with other methods, before the first
     // GPU frame, or on an empty mesh).
     const MultiresHierarchy* multires_hierarchy() const;
+    // The multigrid CG's preconditioner: the CPU solver's, the one waiting for the next GPU frame, or
+    // the device solver's host copy (nullptr with other methods or before the first GPU frame).
+    const MultigridPreconditioner* multigrid_preconditioner() const;
     // "GPU Jacobi CG (float) (llvmpipe ...)", "CPU multigrid CG, three channels per V-cycle", ...: for the
     // panel and logs.
     std::string description() const;
@@ -292,9 +296,10 @@ private:
     // CPU multigrid after a fallback. Empty when the method is not (or no longer) run on the device;
     // the device solver takes its changes through gpu_pending_.
     std::vector<Eigen::Vector3d> multigrid_positions_;
-    // With multigrid_positions_ after an edit with a vertex map: the hierarchy rebuilt around the edit
-    // from the device solver's (or from the one still waiting here), for the solver built next.
-    std::optional<MultiresHierarchy> multigrid_hierarchy_;
+    // With multigrid_positions_ after an edit with a vertex map: the hierarchy and preconditioner
+    // rebuilt around the edit from the device solver's (or from the ones still waiting here), for the
+    // device solver built at the next GPU frame. Empty otherwise, and after painting (stale values).
+    MultigridOperators multigrid_waiting_;
     // The last frame's estimates, reported by a frame of no V-cycles (1 after a change).
     std::array<double, 3> multigrid_error_{1, 1, 1};
     std::unique_ptr<MultiresSolver> multires_;

@@ -27,11 +27,20 @@ GpuMultigridFrameSolver::GpuMultigridFrameSolver(const GlApi& gl, const Diffusio
 
 GpuMultigridFrameSolver::GpuMultigridFrameSolver(const GlApi& gl, const DiffusionMatrix& matrix,
                                                  MultiresHierarchy hierarchy, const FrameSolverOptions& options)
+    : GpuMultigridFrameSolver(gl, matrix, MultigridOperators{std::make_unique<MultiresHierarchy>(std::move(hierarchy)), nullptr},
+                              options) {}
+
+GpuMultigridFrameSolver::GpuMultigridFrameSolver(const GlApi& gl, const DiffusionMatrix& matrix, MultigridOperators operators,
+                                                 const FrameSolverOptions& options)
     : MultigridFrameCg(matrix.size(), options, "GPU frame solver") {
     require_compute_support(gl);
-    check_hierarchy(hierarchy);
-    hierarchy_ = std::make_unique<MultiresHierarchy>(std::move(hierarchy));
-    preconditioner_ = std::make_unique<MultigridPreconditioner>(*hierarchy_, options.multigrid);
+    if (!operators.hierarchy) throw InvalidArgumentError("GPU frame solver: no hierarchy");
+    check_hierarchy(*operators.hierarchy);
+    if (operators.preconditioner && &operators.preconditioner->hierarchy() != operators.hierarchy.get())
+        throw InvalidArgumentError("GPU frame solver: the preconditioner was built on another hierarchy");
+    hierarchy_ = std::move(operators.hierarchy);
+    preconditioner_ = operators.preconditioner ? std::move(operators.preconditioner)
+                                               : std::make_unique<MultigridPreconditioner>(*hierarchy_, options.multigrid);
     kernels_ = std::make_unique<GpuKernels>(gl, std::initializer_list<GpuMatrixFormat>{GpuMatrixFormat::SellCSigma});
     device_ = std::make_unique<GpuMultigridPreconditioner>(*kernels_, *preconditioner_);
     for (GpuBuffer* v : {&b_, &r_, &z_, &p_, &q_, &phi_, &scratch_}) *v = kernels_->vector(n_);

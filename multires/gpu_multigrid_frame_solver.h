@@ -50,6 +50,10 @@ public:
     // the matrix's size or it was built with other options.
     GpuMultigridFrameSolver(const GlApi& gl, const DiffusionMatrix& matrix, MultiresHierarchy hierarchy,
                             const FrameSolverOptions& options = {});
+    // The same on operators built on the host beforehand (a null preconditioner is built here). Throws
+    // InvalidArgumentError also when there is no hierarchy or the preconditioner was built on another.
+    GpuMultigridFrameSolver(const GlApi& gl, const DiffusionMatrix& matrix, MultigridOperators operators,
+                            const FrameSolverOptions& options = {});
     ~GpuMultigridFrameSolver();
 
     // As MultigridFrameCg says, on the device's vectors (a driver error throws GpuError):

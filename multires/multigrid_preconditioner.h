@@ -98,6 +98,8 @@ public:
     MultigridPreconditioner(const MultigridPreconditioner&) = delete;
     MultigridPreconditioner& operator=(const MultigridPreconditioner&) = delete;
 
+    // The hierarchy the operators were built on.
+    const MultiresHierarchy& hierarchy() const { return hierarchy_; }
     size_t level_count() const;
     // Rows and stored entries of level l's Galerkin operator (level 0: the fine matrix).
     size_t rows(size_t level) const;
@@ -179,6 +181,15 @@ private:
     double setup_ms_ = 0;
     std::string lumping_fallback_reason_;
     std::vector<size_t> copied_product_rows_, copied_operator_rows_;  // per level
+};
+
+// A hierarchy and the preconditioner built on it, owned together (the preconditioner borrows the
+// hierarchy): what a device solver takes over when they were built beforehand on the host (the live
+// solver builds them when an edit arrives, rebuilt from the previous ones, and hands them over at the
+// next GPU frame, when the context is current).
+struct MultigridOperators {
+    std::unique_ptr<MultiresHierarchy> hierarchy;
+    std::unique_ptr<MultigridPreconditioner> preconditioner;  // built on *hierarchy, or null
 };
 
 }  // namespace waxwork

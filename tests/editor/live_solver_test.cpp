@@ -286,21 +286,26 @@ TEST(LiveSolver, MultigridRebuildsItsHierarchyAroundACut) {
     PlaneCutOp cut;
     cut.plane = {Eigen::Vector3d(1, 0.3, 0.2).normalized(), 0.55};
     // CPU: built with the scene. GPU: at the first frame, and after the cut rebuilt on the host at once
-    // for the device solver built at the next frame.
+    // (hierarchy and Galerkin operators) for the device solver built at the next frame.
     for (const Config& config : {kConfigs[1], kConfigs[5]}) {
         Document doc(testing::make_cube_mesh(14), material_preset("marble"));
         LiveScene scene(doc.mesh(), key_lighting(), options_for(config));
         scene.converge();
         ASSERT_GE(scene.multires_levels().size(), 2u) << config.name;
         EXPECT_EQ(scene.multires_levels()[0][1], -1) << config.name;
+        EXPECT_EQ(scene.multigrid_copied_rows(), 0) << config.name;
         scene.apply_change(doc.mesh(), doc.apply(cut));
+        // The Galerkin rows away from the cut are copied from the operators before it.
+        EXPECT_GT(scene.multigrid_copied_rows(), 0) << config.name;
         auto levels = scene.multires_levels();
         ASSERT_GE(levels.size(), 2u) << config.name;
         EXPECT_EQ(levels[0][0], static_cast<int64_t>(doc.mesh().vertex_count())) << config.name;
         EXPECT_GT(levels[0][1], 0) << config.name;
         EXPECT_LT(levels[0][1], levels[0][0] / 2) << config.name;
+        const int64_t copied = scene.multigrid_copied_rows();
         scene.converge();
         EXPECT_EQ(scene.multires_levels(), levels) << config.name;  // the solver runs on that hierarchy
+        EXPECT_EQ(scene.multigrid_copied_rows(), copied) << config.name;  // and those operators
         EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4) << config.name;
         EXPECT_EQ(scene.method_fallback_reason(), "") << config.name;
         // Painting before the next GPU frame makes a hierarchy waiting for it stale (its level 0 has the
@@ -311,6 +316,9 @@ TEST(LiveSolver, MultigridRebuildsItsHierarchyAroundACut) {
         levels = scene.multires_levels();
         ASSERT_GE(levels.size(), 2u) << config.name;
         EXPECT_EQ(levels[0][1], config.backend == LiveBackend::Gpu ? -1 : 0) << config.name;
+        if (config.backend == LiveBackend::Gpu) {
+            EXPECT_EQ(scene.multigrid_copied_rows(), 0) << config.name;
+        }
         EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4) << config.name;
     }
 }

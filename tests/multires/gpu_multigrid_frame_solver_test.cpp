@@ -77,6 +77,21 @@ TEST(GpuMultigridFrameSolver, TakesAHierarchyBuiltForItsMatrix) {
     own.step(3);
     given.step(3);
     EXPECT_EQ(own.phi(), given.phi());
+    // With its preconditioner built beforehand on the host (MultigridOperators), too.
+    MultigridOperators operators;
+    operators.hierarchy =
+        std::make_unique<MultiresHierarchy>(build_multires_hierarchy(s.matrix, s.mesh.positions, options.hierarchy));
+    operators.preconditioner = std::make_unique<MultigridPreconditioner>(*operators.hierarchy, options.multigrid);
+    GpuMultigridFrameSolver prebuilt(context->gl(), s.matrix, std::move(operators), options);
+    prebuilt.set_right_hand_side(spans(s.b));
+    prebuilt.step(3);
+    EXPECT_EQ(own.phi(), prebuilt.phi());
+    MultigridOperators mismatched;
+    mismatched.hierarchy =
+        std::make_unique<MultiresHierarchy>(build_multires_hierarchy(s.matrix, s.mesh.positions, options.hierarchy));
+    mismatched.preconditioner = std::make_unique<MultigridPreconditioner>(own.hierarchy(), options.multigrid);
+    EXPECT_THROW(GpuMultigridFrameSolver(context->gl(), s.matrix, std::move(mismatched), options), InvalidArgumentError);
+    EXPECT_THROW(GpuMultigridFrameSolver(context->gl(), s.matrix, MultigridOperators{}, options), InvalidArgumentError);
     const auto small = testing::make_test_system(4);
     EXPECT_THROW(GpuMultigridFrameSolver(context->gl(), s.matrix,
                                          build_multires_hierarchy(small.matrix, small.mesh.positions), options),
