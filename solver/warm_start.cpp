@@ -1,0 +1,60 @@
+#include "solver/warm_start.h"
+
+#include "tetops/error.h"
+
+#include <string>
+
+namespace waxwork {
+
+size_t extend_to_unknown_vertices(const DiffusionMatrix& matrix, std::span<const uint8_t> known,
+                                  std::array<std::vector<double>, 3>& values) {
+    const size_t n = matrix.size();
+    if (known.size() != n)
+        throw InvalidArgumentError("warm start: " + std::to_string(known.size()) + " flags for a " + std::to_string(n) +
+                                   "-row matrix");
+    for (const auto& channel : values)
+        if (channel.size() != n)
+            throw InvalidArgumentError("warm start: " + std::to_string(channel.size()) + " values for a " +
+                                       std::to_string(n) + "-row matrix");
+    // level[v]: 0 known, k > 0 filled in the k-th pass, -1 not reached yet.
+    std::vector<int32_t> level(n);
+    std::vector<int32_t> frontier;
+    for (size_t v = 0; v < n; ++v) level[v] = known[v] ? 0 : -1;
+    for (size_t v = 0; v < n; ++v) {
+        if (level[v] == 0) continue;
+        for (int32_t k = matrix.offsets[v]; k < matrix.offsets[v + 1]; ++k)
+            if (level[static_cast<size_t>(matrix.columns[static_cast<size_t>(k)])] == 0) {
+                frontier.push_back(static_cast<int32_t>(v));
+                break;
+            }
+    }
+    size_t filled = 0;
+    for (int32_t pass = 1; !frontier.empty(); ++pass) {
+        // Means over the neighbours of earlier passes only, so the order within a pass does not matter.
+        for (const int32_t v : frontier) level[static_cast<size_t>(v)] = pass;
+        for (const int32_t v : frontier) {
+            std::array<double, 3> sum{};
+            int count = 0;
+            for (int32_t k = matrix.offsets[static_cast<size_t>(v)]; k < matrix.offsets[static_cast<size_t>(v) + 1]; ++k) {
+                const auto j = static_cast<size_t>(matrix.columns[static_cast<size_t>(k)]);
+                if (level[j] < 0 || level[j] >= pass) continue;
+                for (size_t c = 0; c < 3; ++c) sum[c] += values[c][j];
+                ++count;
+            }
+            for (size_t c = 0; c < 3; ++c) values[c][static_cast<size_t>(v)] = sum[c] / count;  // count >= 1
+        }
+        filled += frontier.size();
+        std::vector<int32_t> next;
+        for (const int32_t v : frontier)
+            for (int32_t k = matrix.offsets[static_cast<size_t>(v)]; k < matrix.offsets[static_cast<size_t>(v) + 1]; ++k) {
+                const int32_t j = matrix.columns[static_cast<size_t>(k)];
+                if (level[static_cast<size_t>(j)] != -1) continue;
+                level[static_cast<size_t>(j)] = -2;  // queued for the next pass
+                next.push_back(j);
+            }
+        frontier = std::move(next);
+    }
+    return filled;
+}
+
+}  // namespace waxwork
