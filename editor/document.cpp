@@ -50,14 +50,6 @@ RelaxationOptions relaxation_options(const RelaxSettings& r) {
     return o;
 }
 
-// Per vertex after an edit, its vertex before (-1: made by the edit), from the edit's map the other way.
-std::vector<int32_t> inverse_vertex_map(const std::vector<int32_t>& old_to_new, size_t vertices_after) {
-    std::vector<int32_t> new_to_old(vertices_after, -1);
-    for (size_t v = 0; v < old_to_new.size(); ++v)
-        if (old_to_new[v] >= 0) new_to_old[static_cast<size_t>(old_to_new[v])] = static_cast<int32_t>(v);
-    return new_to_old;
-}
-
 }  // namespace
 
 Document::Document(TetMesh mesh, const TetMaterial& default_material, size_t undo_budget_bytes)

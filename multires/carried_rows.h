@@ -1,6 +1,7 @@
 // Rows of a hierarchy operator that a rebuild copies from the previous hierarchy instead of computing
 // them again (rebuild_multires_hierarchy, beyond the paper). Used by the interpolation (Eq. 16, rows
-// are fine vertices), the coarse graph and the coarse matrix (Eq. 17, rows are coarse vertices).
+// are fine vertices), the coarse graph and the coarse matrix (Eq. 17, rows are coarse vertices), and
+// by the multigrid's rebuilt Galerkin operators (MultigridPreconditioner).
 //
 // A row may be copied only when everything it is computed from is unchanged up to renumbering: the
 // caller decides that from what the edit touched. The copy renumbers the row's coarse columns; with an
@@ -8,8 +9,11 @@
 // order) the copy equals the computed row bit for bit, in the same column order.
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 namespace waxwork {
 
@@ -24,6 +28,37 @@ inline bool keeps_vertex_order(std::span<const int32_t> new_of_old) {
         last = v;
     }
     return true;
+}
+
+// Row `row` of a compressed-row operator equals row `old_row` of the previous one: the same length,
+// columns that correspond under `old_of_new_column` (per new column, the previous one or -1) and the
+// same values in every array of `values`. What decides whether a rebuild may copy what was computed
+// from the row.
+template <size_t Arrays>
+bool same_row(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
+              const std::array<const std::vector<double>*, Arrays>& values, size_t row,
+              const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
+              const std::array<const std::vector<double>*, Arrays>& old_values, size_t old_row,
+              std::span<const int32_t> old_of_new_column) {
+    const auto begin = static_cast<size_t>(offsets[row]), end = static_cast<size_t>(offsets[row + 1]);
+    const auto old_begin = static_cast<size_t>(old_offsets[old_row]);
+    if (end - begin != static_cast<size_t>(old_offsets[old_row + 1]) - old_begin) return false;
+    for (size_t k = begin, o = old_begin; k < end; ++k, ++o) {
+        if (old_of_new_column[static_cast<size_t>(columns[k])] != old_columns[o]) return false;
+        for (size_t a = 0; a < Arrays; ++a)
+            if ((*values[a])[k] != (*old_values[a])[o]) return false;
+    }
+    return true;
+}
+
+// The same for a row of a three-channel matrix (a DiffusionMatrix, a hierarchy or multigrid level).
+inline bool same_matrix_row(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
+                            const std::array<std::vector<double>, 3>& values, size_t row,
+                            const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
+                            const std::array<std::vector<double>, 3>& old_values, size_t old_row,
+                            std::span<const int32_t> old_of_new_column) {
+    return same_row<3>(offsets, columns, {&values[0], &values[1], &values[2]}, row, old_offsets, old_columns,
+                       {&old_values[0], &old_values[1], &old_values[2]}, old_row, old_of_new_column);
 }
 
 struct CarriedRows {

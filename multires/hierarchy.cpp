@@ -1,6 +1,7 @@
 #include "multires/hierarchy.h"
 
 #include "multires/independent_set.h"
+#include "tetops/cut.h"
 #include "tetops/error.h"
 
 #include <tbb/blocked_range.h>
@@ -471,8 +472,8 @@ void check_hierarchy_inputs(const DiffusionMatrix& matrix, std::span<const Eigen
 // (values_changed: pattern or values) is not its previous vertex's. Both 1 everywhere when the
 // previous positions are unknown.
 void level0_changes(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
-                    const MultiresHierarchy& previous, std::span<const int32_t> old_of_new,
-                    std::span<const int32_t> new_of_old, std::vector<uint8_t>& moved, std::vector<uint8_t>& values_changed) {
+                    const MultiresHierarchy& previous, std::span<const int32_t> old_of_new, std::vector<uint8_t>& moved,
+                    std::vector<uint8_t>& values_changed) {
     const size_t n = matrix.size();
     const HierarchyLevel& old = previous.levels[0];
     const bool known_positions = previous.positions.size() == old.size();
@@ -484,14 +485,8 @@ void level0_changes(const DiffusionMatrix& matrix, std::span<const Eigen::Vector
             if (o < 0) continue;
             const auto ou = static_cast<size_t>(o);
             moved[v] = !known_positions || positions[v] != previous.positions[ou];
-            const auto begin = static_cast<size_t>(matrix.offsets[v]), end = static_cast<size_t>(matrix.offsets[v + 1]);
-            const auto old_begin = static_cast<size_t>(old.offsets[ou]), old_end = static_cast<size_t>(old.offsets[ou + 1]);
-            bool same = end - begin == old_end - old_begin;
-            for (size_t k = 0; same && k < end - begin; ++k) {
-                same = matrix.columns[begin + k] == new_of_old[static_cast<size_t>(old.columns[old_begin + k])];
-                for (size_t ch = 0; same && ch < 3; ++ch) same = matrix.values[ch][begin + k] == old.values[ch][old_begin + k];
-            }
-            values_changed[v] = !same;
+            values_changed[v] = !same_matrix_row(matrix.offsets, matrix.columns, matrix.values, v, old.offsets,
+                                                 old.columns, old.values, ou, old_of_new);
         }
     });
 }
@@ -540,16 +535,14 @@ MultiresHierarchy build_levels(const DiffusionMatrix& matrix, std::span<const Ei
             std::vector<uint8_t> old_retained(old_fine.graph.row_count(), 0);
             for (const int32_t p : old_coarse.parent_vertex) old_retained[static_cast<size_t>(p)] = 1;
             old_coarse_index = coarse_vertex_index(old_retained);
-            old_of_new.assign(n, -1);
-            for (size_t o = 0; o < new_of_old.size(); ++o)
-                if (new_of_old[o] >= 0) old_of_new[static_cast<size_t>(new_of_old[o])] = static_cast<int32_t>(o);
+            old_of_new = inverse_vertex_map(new_of_old, n);
             carried.emplace();
             carried->previous_retained.assign(n, 0);
             for (size_t v = 0; v < n; ++v)
                 if (old_of_new[v] >= 0) carried->previous_retained[v] = old_retained[static_cast<size_t>(old_of_new[v])];
             carried->changed = changed_rows(fine.graph, old_fine.graph, old_of_new, new_of_old);
             fine.changed_vertices = static_cast<int64_t>(carried->changed.size());
-            if (l == 0 && carry_rows) level0_changes(matrix, positions, *previous, old_of_new, new_of_old, moved, values_changed);
+            if (l == 0 && carry_rows) level0_changes(matrix, positions, *previous, old_of_new, moved, values_changed);
         }
         std::optional<CoarseningStep> step =
             coarsen(fine.graph, hierarchy.levels.size(), options, carried ? &*carried : nullptr);

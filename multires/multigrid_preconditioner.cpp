@@ -5,6 +5,7 @@
 #include "multires/parallel_rows.h"
 #include "solver/reference_solvers.h"
 
+#include "tetops/cut.h"
 #include "tetops/error.h"
 
 #include <Eigen/SparseCholesky>
@@ -254,9 +255,7 @@ void MultigridPreconditioner::build_levels(const MultigridPreconditioner* previo
     std::optional<CarriedLevel> carried;
     if (previous) {
         carried.emplace();
-        carried->old_of_new_fine.assign(fine.size(), -1);
-        for (size_t o = 0; o < new_of_old_vertex.size(); ++o)
-            if (new_of_old_vertex[o] >= 0) carried->old_of_new_fine[static_cast<size_t>(new_of_old_vertex[o])] = static_cast<int32_t>(o);
+        carried->old_of_new_fine = inverse_vertex_map(new_of_old_vertex, fine.size());
     }
     for (size_t l = 0; l + 1 < hierarchy.level_count(); ++l) {
         levels_[l]->p = &hierarchy.levels[l].interpolation;
@@ -270,18 +269,13 @@ void MultigridPreconditioner::build_levels(const MultigridPreconditioner* previo
             carried->old_coarse = previous->levels_[l + 1].get();
             const std::vector<int32_t>& old_parent = previous->hierarchy_.levels[l + 1].parent_vertex;
             const std::vector<int32_t>& new_parent = hierarchy.levels[l + 1].parent_vertex;
-            std::vector<int32_t> old_coarse_of_fine(carried->old_fine->n, -1);
-            for (size_t c = 0; c < old_parent.size(); ++c)
-                old_coarse_of_fine[static_cast<size_t>(old_parent[c])] = static_cast<int32_t>(c);
+            const std::vector<int32_t> old_coarse_of_fine = inverse_vertex_map(old_parent, carried->old_fine->n);
             carried->old_of_new_coarse.assign(new_parent.size(), -1);
-            carried->new_of_old_coarse.assign(old_parent.size(), -1);
             for (size_t c = 0; c < new_parent.size(); ++c) {
                 const int32_t o = carried->old_of_new_fine[static_cast<size_t>(new_parent[c])];
-                const int32_t old_c = o >= 0 ? old_coarse_of_fine[static_cast<size_t>(o)] : -1;
-                if (old_c < 0) continue;
-                carried->old_of_new_coarse[c] = old_c;
-                carried->new_of_old_coarse[static_cast<size_t>(old_c)] = static_cast<int32_t>(c);
+                if (o >= 0) carried->old_of_new_coarse[c] = old_coarse_of_fine[static_cast<size_t>(o)];
             }
+            carried->new_of_old_coarse = inverse_vertex_map(carried->old_of_new_coarse, old_parent.size());
         } else {
             carried.reset();
         }
@@ -333,25 +327,6 @@ struct MultigridPreconditioner::Accumulator {
 
 namespace {
 
-// Row `row` of a compressed-row operator equals row `old_row` of the previous one: the same length,
-// columns that correspond under `old_of_new_column` and the same values in every array of `values`.
-template <size_t Arrays>
-bool same_row(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
-              const std::array<const std::vector<double>*, Arrays>& values, size_t row,
-              const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
-              const std::array<const std::vector<double>*, Arrays>& old_values, size_t old_row,
-              const std::vector<int32_t>& old_of_new_column) {
-    const auto begin = static_cast<size_t>(offsets[row]), end = static_cast<size_t>(offsets[row + 1]);
-    const auto old_begin = static_cast<size_t>(old_offsets[old_row]);
-    if (end - begin != static_cast<size_t>(old_offsets[old_row + 1]) - old_begin) return false;
-    for (size_t k = begin, o = old_begin; k < end; ++k, ++o) {
-        if (old_of_new_column[static_cast<size_t>(columns[k])] != old_columns[o]) return false;
-        for (size_t a = 0; a < Arrays; ++a)
-            if ((*values[a])[k] != (*old_values[a])[o]) return false;
-    }
-    return true;
-}
-
 bool same_interpolation_row(const InterpolationOperator& p, size_t row, const InterpolationOperator& old_p,
                             size_t old_row, const std::vector<int32_t>& old_of_new_column) {
     return same_row<1>(p.offsets, p.columns, {&p.weights}, row, old_p.offsets, old_p.columns, {&old_p.weights}, old_row,
@@ -379,10 +354,8 @@ void MultigridPreconditioner::build_galerkin_operator(size_t l, const CarriedLev
         keep_product.assign(n, 0);
         for_rows(n, kGrain, [&](size_t v) {
             const int32_t o = carried->old_of_new_fine[v];
-            if (o < 0 || !same_row<3>(fine.offsets, fine.columns, {&fine.values[0], &fine.values[1], &fine.values[2]}, v,
-                                      old_fine.offsets, old_fine.columns,
-                                      {&old_fine.values[0], &old_fine.values[1], &old_fine.values[2]},
-                                      static_cast<size_t>(o), carried->old_of_new_fine))
+            if (o < 0 || !same_matrix_row(fine.offsets, fine.columns, fine.values, v, old_fine.offsets, old_fine.columns,
+                                          old_fine.values, static_cast<size_t>(o), carried->old_of_new_fine))
                 return;
             for (int32_t e = fine.offsets[v]; e < fine.offsets[v + 1]; ++e)
                 if (!same_interpolation[static_cast<size_t>(fine.columns[static_cast<size_t>(e)])]) return;

@@ -162,6 +162,13 @@ CutResult remove_cut_away_tets(TetMesh& mesh, const CuttingSurface& surface) {
     return remove_tets(mesh, remove);
 }
 
+std::vector<int32_t> inverse_vertex_map(std::span<const int32_t> old_to_new, size_t vertices_after) {
+    std::vector<int32_t> new_to_old(vertices_after, -1);
+    for (size_t v = 0; v < old_to_new.size(); ++v)
+        if (old_to_new[v] >= 0) new_to_old[static_cast<size_t>(old_to_new[v])] = static_cast<int32_t>(v);
+    return new_to_old;
+}
+
 CutResult remove_tets(TetMesh& mesh, const std::vector<uint8_t>& remove) {
     CutResult result;
     const size_t tet_count = mesh.tet_count();

@@ -11,6 +11,7 @@
 #include "tetops/tet_mesh.h"
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace waxwork {
@@ -101,6 +102,11 @@ CutResult remove_cut_away_tets(TetMesh& mesh, const CuttingSurface& surface);
 // caller keeps its mesh unchanged. An empty volume can be neither lit nor rendered, and cutting on
 // the wrong side is an easy slip of a plane's sign or a stroke's direction.
 void require_tets_left_by_cut(const TetMesh& after, size_t tets_before);
+
+// A vertex map the other way: per vertex after an edit, its vertex before (-1: none maps there), from
+// old_to_new (per vertex before, its index after or -1; CutResult::old_to_new_vertex and the maps of
+// other edits). Entries of old_to_new must be below vertices_after.
+std::vector<int32_t> inverse_vertex_map(std::span<const int32_t> old_to_new, size_t vertices_after);
 
 // Removes the tets flagged in `remove` (one flag per tet) and the vertices left without a tet, with
 // the same compaction and bookkeeping as remove_cut_away_tets (which is this with a side test).

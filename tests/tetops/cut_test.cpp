@@ -98,6 +98,15 @@ TEST(CutPlane, RemovesExactlyTheTetsWithAllVerticesCutAway) {
         if (!survived[t]) { EXPECT_TRUE(all_cut_away(before, before.tets[t], plane)) << "tet " << t << " removed wrongly"; }
     // Survivors stay in their original order, so original ids stay ascending.
     EXPECT_TRUE(std::is_sorted(mesh.original_ids.begin(), mesh.original_ids.end()));
+    // The map the other way: every vertex after has exactly the vertex before that maps to it.
+    const std::vector<int32_t> new_to_old = inverse_vertex_map(result.old_to_new_vertex, mesh.vertex_count());
+    ASSERT_EQ(new_to_old.size(), mesh.vertex_count());
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+        ASSERT_GE(new_to_old[v], 0) << v;  // a removal cut makes no vertex
+        EXPECT_EQ(result.old_to_new_vertex[static_cast<size_t>(new_to_old[v])], static_cast<int32_t>(v));
+        EXPECT_EQ(mesh.positions[v], before.positions[static_cast<size_t>(new_to_old[v])]);
+    }
+    EXPECT_EQ(inverse_vertex_map(std::vector<int32_t>{-1, 1}, 3), (std::vector<int32_t>{-1, 1, -1}));
 }
 
 TEST(CutPlane, KeepsMaterialsAndTestsPiecesInWorldSpace) {
