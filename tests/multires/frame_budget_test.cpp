@@ -51,16 +51,10 @@ double energy_error(const DiffusionMatrix& m, int channel, std::span<const doubl
     return std::sqrt(num / den);
 }
 
-HierarchyOptions small_levels() {
-    HierarchyOptions h;
-    h.min_coarse_vertices = 100;
-    return h;
-}
-
 TEST(MultiresFrameBudget, SolveFrameStopsAtTheDeadlineLikeAnIterationBudget) {
     const auto s = testing::make_test_system(10);
-    MultiresSolver timed(s.matrix, s.mesh.positions, small_levels());
-    MultiresSolver counted(s.matrix, s.mesh.positions, small_levels());
+    MultiresSolver timed(s.matrix, s.mesh.positions, testing::small_levels(100));
+    MultiresSolver counted(s.matrix, s.mesh.positions, testing::small_levels(100));
     MultiresSolveOptions options;
     options.relative_tolerance = 1e-12;  // not reached in these frames
     const double step = 1.0;
@@ -83,7 +77,7 @@ TEST(MultiresFrameBudget, SolveFrameStopsAtTheDeadlineLikeAnIterationBudget) {
 
 TEST(MultiresFrameBudget, FirstFrameRunsTheCoarsePassWholeThenOneIteration) {
     const auto s = testing::make_test_system(10);
-    MultiresSolver solver(s.matrix, s.mesh.positions, small_levels());
+    MultiresSolver solver(s.matrix, s.mesh.positions, testing::small_levels(100));
     MultiresSolveOptions options;
     options.relative_tolerance = 1e-12;
     MultiresSolveReport report;
@@ -91,7 +85,7 @@ TEST(MultiresFrameBudget, FirstFrameRunsTheCoarsePassWholeThenOneIteration) {
     // level-0 CG runs its one iteration.
     solver.solve_frame(s.b[0], 0, FrameBudget::milliseconds(1), &report, options, fake_clock(50));
     ASSERT_FALSE(report.coarse_levels.empty());
-    MultiresSolver unlimited(s.matrix, s.mesh.positions, small_levels());
+    MultiresSolver unlimited(s.matrix, s.mesh.positions, testing::small_levels(100));
     MultiresSolveReport reference;
     unlimited.solve_frame(s.b[0], 0, 1, &reference, options);
     ASSERT_EQ(report.coarse_levels.size(), reference.coarse_levels.size());
@@ -102,7 +96,7 @@ TEST(MultiresFrameBudget, FirstFrameRunsTheCoarsePassWholeThenOneIteration) {
 
 TEST(MultiresFrameBudget, IterationLimitAndTimeLimitWhicheverComesFirst) {
     const auto s = testing::make_test_system(8);
-    MultiresSolver solver(s.matrix, s.mesh.positions, small_levels());
+    MultiresSolver solver(s.matrix, s.mesh.positions, testing::small_levels(100));
     MultiresSolveOptions options;
     options.relative_tolerance = 1e-12;
     MultiresSolveReport report;
@@ -111,7 +105,7 @@ TEST(MultiresFrameBudget, IterationLimitAndTimeLimitWhicheverComesFirst) {
     solver.solve_frame(s.b[0], 0, FrameBudget::milliseconds(2.5, 30), &report, options, fake_clock(1));
     EXPECT_EQ(report.fine.iterations, iterations_within(2.5, 1));
     // An iteration-only budget is the int overload.
-    MultiresSolver a(s.matrix, s.mesh.positions, small_levels()), b(s.matrix, s.mesh.positions, small_levels());
+    MultiresSolver a(s.matrix, s.mesh.positions, testing::small_levels(100)), b(s.matrix, s.mesh.positions, testing::small_levels(100));
     const auto xa = a.solve_frame(s.b[2], 2, FrameBudget::iterations(4), nullptr, options);
     const auto xb = b.solve_frame(s.b[2], 2, 4, nullptr, options);
     EXPECT_TRUE(std::equal(xa.begin(), xa.end(), xb.begin(), xb.end()));
@@ -119,7 +113,7 @@ TEST(MultiresFrameBudget, IterationLimitAndTimeLimitWhicheverComesFirst) {
 
 TEST(MultiresFrameBudget, SuccessiveTimedFramesConverge) {
     const auto s = testing::make_test_system(10);
-    MultiresSolver solver(s.matrix, s.mesh.positions, small_levels());
+    MultiresSolver solver(s.matrix, s.mesh.positions, testing::small_levels(100));
     MultiresSolveOptions options;
     options.relative_tolerance = 1e-4;
     const auto exact = testing::reference_solution(s.matrix, s.b[0], 0);
@@ -140,7 +134,7 @@ TEST(MultiresFrameBudget, SuccessiveTimedFramesConverge) {
 
 FrameSolverOptions frame_options(double tolerance) {
     FrameSolverOptions options;
-    options.hierarchy = small_levels();
+    options.hierarchy = testing::small_levels(100);
     options.relative_tolerance = tolerance;
     return options;
 }
@@ -201,7 +195,7 @@ TEST(MultigridFrameBudget, SuccessiveTimedFramesConverge) {
 
 TEST(FrameBudgetValidation, SolversRejectInvalidBudgets) {
     const auto s = testing::make_test_system(6);
-    MultiresSolver multires(s.matrix, s.mesh.positions, small_levels());
+    MultiresSolver multires(s.matrix, s.mesh.positions, testing::small_levels(100));
     MultigridFrameSolver multigrid(s.matrix, s.mesh.positions, frame_options(1e-3));
     multigrid.set_right_hand_side(spans(s.b));
     for (const FrameBudget& bad : {FrameBudget{0, 0}, FrameBudget{-2, 5}, FrameBudget{0, std::nan("")},

@@ -18,11 +18,7 @@
 namespace waxwork {
 namespace {
 
-HierarchyOptions small_levels(int64_t min_coarse) {
-    HierarchyOptions h;
-    h.min_coarse_vertices = min_coarse;
-    return h;
-}
+using testing::small_levels;
 
 std::vector<double> random_rgb(size_t n, unsigned seed) {
     std::mt19937 rng(seed);

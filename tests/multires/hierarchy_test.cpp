@@ -86,8 +86,7 @@ Eigen::MatrixXd dense_interpolation(const HierarchyLevel& fine, const HierarchyL
 
 TEST(Hierarchy, CoarseOperatorsMatchDenseEq17) {
     const auto s = testing::make_test_system(4);  // 125 vertices
-    HierarchyOptions options;
-    options.min_coarse_vertices = 10;
+    HierarchyOptions options = testing::small_levels(10);
     const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
     ASSERT_GE(h.level_count(), 3u);
     for (size_t l = 0; l + 1 < h.level_count(); ++l) {
@@ -118,8 +117,7 @@ TEST(Hierarchy, CoarseOperatorsMatchDenseEq17) {
 
 TEST(Hierarchy, StopsAtTheSizeRuleAndShrinks) {
     const auto s = testing::make_test_system(12);  // 2197 vertices
-    HierarchyOptions options;
-    options.min_coarse_vertices = 200;
+    HierarchyOptions options = testing::small_levels(200);
     const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
     ASSERT_GE(h.level_count(), 2u);
     for (size_t l = 1; l < h.level_count(); ++l) {
@@ -133,8 +131,7 @@ TEST(Hierarchy, StopsAtTheSizeRuleAndShrinks) {
 // account for no more than the whole build (they are laps of one clock).
 TEST(Hierarchy, BuildTimesSplitTheBuild) {
     const auto s = testing::make_test_system(12);
-    HierarchyOptions options;
-    options.min_coarse_vertices = 200;
+    HierarchyOptions options = testing::small_levels(200);
     const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
     ASSERT_GE(h.level_count(), 3u);
     const HierarchyBuildTimes& t = h.build_times;
@@ -145,8 +142,7 @@ TEST(Hierarchy, BuildTimesSplitTheBuild) {
 
 TEST(Hierarchy, DeterministicAcrossRunsAndThreadCounts) {
     const auto s = testing::make_test_system(10);
-    HierarchyOptions options;
-    options.min_coarse_vertices = 50;
+    HierarchyOptions options = testing::small_levels(50);
     const MultiresHierarchy a = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
     MultiresHierarchy b;
     {
@@ -206,8 +202,7 @@ std::vector<Eigen::Vector3d> jittered(const TetMesh& mesh, double spacing) {
 TEST(Hierarchy, LinearExactWeightsReproduceAffineFunctionsOrKeepThePapers) {
     const auto s = testing::make_test_system(8, 4.0);  // spacing 0.5
     const std::vector<Eigen::Vector3d> positions = jittered(s.mesh, 0.5);
-    HierarchyOptions options;
-    options.min_coarse_vertices = 20;
+    HierarchyOptions options = testing::small_levels(20);
     const MultiresHierarchy paper = build_multires_hierarchy(s.matrix, positions, options);
     options.weights = InterpolationWeights::LinearExact;
     const MultiresHierarchy exact = build_multires_hierarchy(s.matrix, positions, options);
@@ -259,8 +254,7 @@ TEST(Hierarchy, LinearExactWeightsReproduceAffineFunctionsOrKeepThePapers) {
 // Eq. 17 holds for any P: M^{l+1} = S M^l P with the linear-exact operator as stored.
 TEST(Hierarchy, CoarseOperatorsMatchDenseEq17WithLinearExactWeights) {
     const auto s = testing::make_test_system(5);
-    HierarchyOptions options;
-    options.min_coarse_vertices = 10;
+    HierarchyOptions options = testing::small_levels(10);
     options.weights = InterpolationWeights::LinearExact;
     const MultiresHierarchy h = build_multires_hierarchy(s.matrix, jittered(s.mesh, 0.8), options);
     ASSERT_GE(h.level_count(), 3u);
@@ -270,8 +264,7 @@ TEST(Hierarchy, CoarseOperatorsMatchDenseEq17WithLinearExactWeights) {
 
 TEST(Hierarchy, LinearExactWeightsAreDeterministicAcrossThreadCounts) {
     const auto s = testing::make_test_system(10);
-    HierarchyOptions options;
-    options.min_coarse_vertices = 50;
+    HierarchyOptions options = testing::small_levels(50);
     options.weights = InterpolationWeights::LinearExact;
     const std::vector<Eigen::Vector3d> positions = jittered(s.mesh, 0.4);
     const MultiresHierarchy a = build_multires_hierarchy(s.matrix, positions, options);
@@ -385,8 +378,7 @@ std::vector<int> distance_from(const CompressedRows& g, const std::vector<int32_
 // selection and equals a fresh build of the new system, operators included.
 TEST(HierarchyRebuild, WithTheSameGraphEqualsAFreshBuild) {
     const auto s = testing::make_test_system(10);
-    HierarchyOptions options;
-    options.min_coarse_vertices = 50;
+    HierarchyOptions options = testing::small_levels(50);
     const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
     ASSERT_GE(before.level_count(), 3u);
     TetMesh moved = s.mesh;
@@ -407,8 +399,7 @@ TEST(HierarchyRebuild, WithTheSameGraphEqualsAFreshBuild) {
 // rebuild copies every operator row the changes do not reach and still equals a fresh build bit for bit.
 TEST(HierarchyRebuild, AfterLocalMovesAndPaintCopiesRowsAndEqualsAFreshBuild) {
     auto s = testing::make_test_system(12);
-    HierarchyOptions options;
-    options.min_coarse_vertices = 50;
+    HierarchyOptions options = testing::small_levels(50);
     const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
     ASSERT_GE(before.level_count(), 3u);
     TetMesh moved = s.mesh;
@@ -437,8 +428,7 @@ TEST(HierarchyRebuild, AfterLocalMovesAndPaintCopiesRowsAndEqualsAFreshBuild) {
 // change state; the levels shrink as a fresh build's do.
 void expect_rebuilds_after_cuts_keep_every_property(int cube_cells, bool dense_check) {
     const auto s = testing::make_test_system(cube_cells);  // coordinates 0..4
-    HierarchyOptions options;
-    options.min_coarse_vertices = 20;
+    HierarchyOptions options = testing::small_levels(20);
     MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
     ASSERT_GE(h.level_count(), 3u);
     TetMesh mesh = s.mesh;
@@ -594,8 +584,7 @@ TEST(HierarchyRebuild, AfterACutSolvesLikeAFreshBuild) {
 
 TEST(HierarchyRebuild, DeterministicAcrossThreadCounts) {
     const auto s = testing::make_test_system(10);
-    HierarchyOptions options;
-    options.min_coarse_vertices = 50;
+    HierarchyOptions options = testing::small_levels(50);
     const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
     const CutSystem cut = cut_system(s.mesh, Eigen::Vector3d(0.2, 1, 0), 2.9);
     const MultiresHierarchy a = rebuild_multires_hierarchy(before, cut.new_of_old, cut.matrix, cut.mesh.positions, options);
@@ -612,8 +601,7 @@ TEST(HierarchyRebuild, DeterministicAcrossThreadCounts) {
 // the hierarchy is valid.
 TEST(HierarchyRebuild, AShuffledMapCarriesTheSelectionButCopiesNoRow) {
     const auto s = testing::make_test_system(10);
-    HierarchyOptions options;
-    options.min_coarse_vertices = 50;
+    HierarchyOptions options = testing::small_levels(50);
     const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
     ASSERT_GE(before.level_count(), 3u);
     std::vector<int32_t> new_of_old(s.mesh.vertex_count());

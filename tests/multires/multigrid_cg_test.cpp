@@ -23,6 +23,8 @@
 namespace waxwork {
 namespace {
 
+using testing::small_levels;
+
 using testing::reference_solution;
 using testing::relative_error;
 
@@ -54,12 +56,6 @@ Eigen::MatrixXd dense(const InterpolationOperator& p, Eigen::Index coarse_rows) 
         for (int32_t q = p.offsets[v]; q < p.offsets[v + 1]; ++q)
             d(static_cast<Eigen::Index>(v), p.columns[static_cast<size_t>(q)]) += p.weights[static_cast<size_t>(q)];
     return d;
-}
-
-HierarchyOptions small_levels(int64_t min_coarse) {
-    HierarchyOptions h;
-    h.min_coarse_vertices = min_coarse;
-    return h;
 }
 
 TEST(MultigridPreconditioner, CoarseOperatorsAreGalerkinProducts) {

@@ -15,14 +15,10 @@
 namespace waxwork {
 namespace {
 
+using testing::small_levels;
+
 using testing::reference_solution;
 using testing::relative_error;
-
-HierarchyOptions small_levels(int64_t min_coarse) {
-    HierarchyOptions h;
-    h.min_coarse_vertices = min_coarse;
-    return h;
-}
 
 FrameSolverOptions frame_options(int64_t min_coarse, double tolerance) {
     FrameSolverOptions options;

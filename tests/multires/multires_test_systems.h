@@ -1,6 +1,7 @@
 // Small assembled diffusion systems for the multires tests.
 #pragma once
 
+#include "multires/hierarchy.h"
 #include "multires/multigrid_frame_cg.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
@@ -26,6 +27,14 @@ struct TestSystem {
     DiffusionMatrix matrix;
     std::array<std::vector<double>, 3> b;  // right-hand side per channel
 };
+
+// Default hierarchy options that keep coarsening down to `min_coarse` vertices (the test systems are
+// small, so the default stopping size would leave one or two levels).
+inline HierarchyOptions small_levels(int64_t min_coarse) {
+    HierarchyOptions options;
+    options.min_coarse_vertices = min_coarse;
+    return options;
+}
 
 // The material of every tet of make_test_system.
 inline TetMaterial test_material() { return TetMaterial{{0.01, 0.05, 0.2}, {1, 1, 1}, 1.3}; }
