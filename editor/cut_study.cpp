@@ -79,7 +79,7 @@ std::vector<CutModeResult> compare_cut_modes(const TetMesh& source, const PlaneC
         r.tets_under_guard = cut.tets_under_guard;
         std::vector<uint8_t> on_original_boundary(mesh.vertex_count(), 0);
         for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-            const auto [a, b] = cut.vertex_origins[v];
+            const auto [a, b, t] = cut.vertex_origins[v];
             on_original_boundary[v] = a == b ? before.is_boundary_vertex[a]
                                              : boundary_edges.count({std::min(a, b), std::max(a, b)}) > 0;
         }

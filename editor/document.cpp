@@ -84,13 +84,13 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
             require_tets_left_by_cut(*after, mesh_.tet_count());
             connectivity = std::make_shared<TetConnectivity>(build_connectivity(*after));
             min_dihedral_deg_ = result.min_dihedral_deg;
-            // Kept vertices ({v, v} origins) give the map both ways; vertices made on edges have none.
+            // Kept vertices (origin: vertex v) give the map both ways; vertices made on edges have none.
             entry.snapshot_vertex.resize(result.vertex_origins.size());
             report.old_to_new_vertex.assign(mesh_.vertex_count(), -1);
             for (size_t v = 0; v < result.vertex_origins.size(); ++v) {
-                const auto [a, b] = result.vertex_origins[v];
-                entry.snapshot_vertex[v] = a == b ? a : -1;
-                if (a == b) report.old_to_new_vertex[static_cast<size_t>(a)] = static_cast<int32_t>(v);
+                const VertexOrigin& origin = result.vertex_origins[v];
+                entry.snapshot_vertex[v] = origin.is_vertex() ? origin.a : -1;
+                if (origin.is_vertex()) report.old_to_new_vertex[static_cast<size_t>(origin.a)] = static_cast<int32_t>(v);
             }
             report.vertex_origins = std::move(result.vertex_origins);
             report.tets_under_guard = result.tets_under_guard;

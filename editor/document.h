@@ -24,6 +24,7 @@
 
 #include "editor/edit_operation.h"
 #include "tetops/connectivity.h"
+#include "tetops/cut.h"
 #include "tetops/tet_mesh.h"
 
 #include <array>
@@ -62,11 +63,11 @@ struct ChangeReport {
     // Cut (exact or not), fracture, weld, and undoing any of them: per vertex before, its index after
     // or -1 (lets the solver keep its warm start and rebuild its hierarchy around the change).
     std::vector<int32_t> old_to_new_vertex;
-    // Exact cut and fracture: per vertex after, where it comes from ({v, v}: vertex v; {a, b}: made on
-    // edge ab). An index below vertices_before names a vertex before the change; a fracture's appended
+    // Exact cut and fracture: per vertex after, where it comes from (vertex v, or the point of edge ab
+    // it was made on). An index below vertices_before names a vertex before the change; a fracture's appended
     // vertices (crack copies, vertices on walls that cross earlier walls) may also name vertices after
     // with a lower index than their own (FractureResult::vertex_origins), so read in index order.
-    std::vector<std::array<int32_t, 2>> vertex_origins;
+    std::vector<VertexOrigin> vertex_origins;
 
     bool undoable = true;       // false when the entry exceeded the whole undo budget
     size_t undo_entries_evicted = 0;  // oldest entries dropped to make room for this one

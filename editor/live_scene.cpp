@@ -100,45 +100,29 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
     check_materials(mesh);
     if (change.topology) {
         // Carry phi over where the change says where vertices went (a cut, a fracture, a weld, their
-        // undo); else start cold. Origins also place the vertices made on edges and a fracture's
-        // crack copies.
-        std::array<std::vector<double>, 3> old = std::move(phi_);
-        const size_t n_old = old[0].size();
+        // undo); else start cold. Origins (exact cuts, fractures) also place the vertices made on
+        // edges and a fracture's crack copies (solver/warm_start.h).
+        const size_t n_old = phi_[0].size();
         const bool mapped = !change.old_to_new_vertex.empty() && change.old_to_new_vertex.size() == n_old;
-        const bool from_edges = change.vertex_origins.size() == mesh.vertex_count() && !mesh.positions.empty();
-        for (int c = 0; c < 3; ++c) phi_[c].assign(mesh.vertex_count(), 0.0);
-        std::vector<uint8_t> placed(mesh.vertex_count(), 0);
-        if (mapped && !from_edges) {
-            for (size_t v = 0; v < change.old_to_new_vertex.size(); ++v) {
-                const int32_t to = change.old_to_new_vertex[v];
-                if (to < 0 || static_cast<size_t>(to) >= mesh.vertex_count()) continue;
-                for (int c = 0; c < 3; ++c) phi_[c][to] = old[c][v];
-                placed[static_cast<size_t>(to)] = 1;
-            }
-        } else if (from_edges) {
-            // A vertex made on an edge starts at the mean of the edge's ends (linear along it). An
-            // origin at or above n_old is a vertex after with a lower index (ChangeReport), placed already.
-            for (size_t v = 0; v < change.vertex_origins.size(); ++v) {
-                const auto [a, b] = change.vertex_origins[v];
-                const auto known = [&](int32_t i) {
-                    return i >= 0 && (static_cast<size_t>(i) < n_old || (static_cast<size_t>(i) < v && placed[static_cast<size_t>(i)]));
-                };
-                if (!known(a) || !known(b)) continue;
-                for (int c = 0; c < 3; ++c) {
-                    const auto value = [&](int32_t i) { return static_cast<size_t>(i) < n_old ? old[c][i] : phi_[c][i]; };
-                    phi_[c][v] = 0.5 * (value(a) + value(b));
-                }
-                placed[v] = 1;
-            }
+        const bool from_origins = change.vertex_origins.size() == mesh.vertex_count() && !mesh.positions.empty();
+        CarriedValues carried;
+        if (from_origins) {
+            carried = carry_through_origins(phi_, change.vertex_origins);
+        } else if (mapped) {
+            carried = carry_through_vertex_map(phi_, change.old_to_new_vertex, mesh.vertex_count());
+        } else {
+            for (auto& channel : carried.values) channel.assign(mesh.vertex_count(), 0.0);
+            carried.known.assign(mesh.vertex_count(), 0);
         }
-        update.warm_start = mapped || from_edges;
+        phi_ = std::move(carried.values);
+        update.warm_start = mapped || from_origins;
         const bool reuse = change.connectivity && change.connectivity->vertex_tets.row_count() == mesh.vertex_count() &&
                            change.connectivity->tet_neighbors.size() == mesh.tet_count();
         rebuild_all(reuse ? change.connectivity : nullptr, update,
                     mapped ? std::span<const int32_t>(change.old_to_new_vertex) : std::span<const int32_t>());
         // Vertices the change gave no value (undoing a cut or a weld restores some) start from their
         // neighbours' values instead of zero (solver/warm_start.h).
-        if (update.warm_start) extend_to_unknown_vertices(matrix_, placed, phi_);
+        if (update.warm_start) extend_to_unknown_vertices(matrix_, carried.known, phi_);
     } else if (change.positions) {
         // Same tets, moved vertices: new geometry on the same connectivity.
         matrix_ = assemble_diffusion_matrix(mesh, *connectivity_, mesh.materials, assembly_options(options_));

@@ -78,6 +78,20 @@ private:
     double sign_;           // +1: left is cut away, -1: right
 };
 
+// Where a vertex of an edited mesh comes from (an exact cut, a fracture): the point (1 - t) x_a + t x_b
+// of edge ab on which it was made, t in [0, 1] (the crossing parameter of the split); a == b and t = 0
+// for a vertex kept from, or copied from, vertex a. Per-vertex data carried across the edit are
+// interpolated the same way (the editor's warm start).
+struct VertexOrigin {
+    int32_t a = -1;
+    int32_t b = -1;
+    double t = 0;
+
+    static VertexOrigin vertex(int32_t v) { return {v, v, 0.0}; }
+    bool is_vertex() const { return a == b; }
+    friend bool operator==(const VertexOrigin&, const VertexOrigin&) = default;
+};
+
 struct CutResult {
     size_t tets_removed = 0;
     size_t vertices_removed = 0;

@@ -325,13 +325,13 @@ SplitReport split_along_field(TetMesh& mesh, std::vector<Eigen::Vector3d>& world
     mesh.positions.resize(first_new + keys.size());
     world.resize(first_new + keys.size());
     values.resize(first_new + keys.size(), 0.0);
-    report.appended_vertex_edges.resize(keys.size());
+    report.appended_vertex_origins.resize(keys.size());
     tbb::parallel_for(size_t{0}, keys.size(), [&](size_t i) {
         const auto a = static_cast<int32_t>(keys[i] >> 32), b = static_cast<int32_t>(keys[i] & 0xffffffffu);
         const double u = std::clamp(field.crossing(world[a], world[b], values[a], values[b]), 0.0, 1.0);
         mesh.positions[first_new + i] = mesh.positions[a] + u * (mesh.positions[b] - mesh.positions[a]);
         world[first_new + i] = world[a] + u * (world[b] - world[a]);
-        report.appended_vertex_edges[i] = {a, b};
+        report.appended_vertex_origins[i] = {a, b, u};
     });
     auto new_vertex = [&](int32_t a, int32_t b) {
         const uint64_t key = edge_key(a, b);
@@ -462,7 +462,7 @@ ExactCutResult cut_exact(TetMesh& mesh, const CuttingSurface& surface, const Exa
     SplitReport report = split_along_field(mesh, world, values, field, split);
     result.tets_split = report.tets_split;
     result.vertices_snapped = report.vertices_snapped;
-    result.vertices_added = report.appended_vertex_edges.size();
+    result.vertices_added = report.appended_vertex_origins.size();
     result.vertices_smoothed = report.vertices_smoothed;
 
     const CutResult removal = remove_tets(mesh, report.positive);
@@ -478,8 +478,8 @@ ExactCutResult cut_exact(TetMesh& mesh, const CuttingSurface& surface, const Exa
     for (size_t v = 0; v < removal.old_to_new_vertex.size(); ++v) {
         const int32_t n = removal.old_to_new_vertex[v];
         if (n < 0) continue;
-        result.vertex_origins[n] = v < vertices_before ? std::array<int32_t, 2>{static_cast<int32_t>(v), static_cast<int32_t>(v)}
-                                                       : report.appended_vertex_edges[v - vertices_before];
+        result.vertex_origins[n] = v < vertices_before ? VertexOrigin::vertex(static_cast<int32_t>(v))
+                                                       : report.appended_vertex_origins[v - vertices_before];
     }
     result.min_dihedral_deg = mesh_min_dihedral_deg(mesh);
     // Recounted on the cut mesh: each tet against the reference of the tet before the cut it came from.

@@ -71,8 +71,9 @@ struct SplitReport {
     std::vector<uint8_t> positive;
     // Per tet appended by the split (index tets_before + i): the tet it was cut from.
     std::vector<int32_t> appended_parents;
-    // Per vertex appended by the split: the edge (vertex indices before the split) it lies on.
-    std::vector<std::array<int32_t, 2>> appended_vertex_edges;
+    // Per vertex appended by the split: the edge (vertex indices before the split) it was made on and
+    // the crossing parameter along it.
+    std::vector<VertexOrigin> appended_vertex_origins;
     size_t tets_split = 0;
     size_t vertices_snapped = 0;
     size_t vertices_smoothed = 0;
@@ -130,9 +131,9 @@ struct ExactCutResult {
     size_t tets_under_guard = 0;
     // Per tet after the cut: the tet before the cut it is (part of).
     std::vector<int32_t> new_to_old_tet;
-    // Per vertex after the cut: {v, v} for a vertex v of the mesh before, or the edge {a, b} of the
-    // mesh before on which it was created.
-    std::vector<std::array<int32_t, 2>> vertex_origins;
+    // Per vertex after the cut: VertexOrigin::vertex(v) for a vertex v of the mesh before, or the edge
+    // ab of the mesh before on which it was created and where along it.
+    std::vector<VertexOrigin> vertex_origins;
 };
 
 // Splits every tet crossed by `surface` along it and removes the cut-away side (side() > 0). The

@@ -196,7 +196,7 @@ void make_pieces(TetMesh& mesh, const std::vector<int64_t>& label, const Fractur
             auto [it, inserted] = copies.try_emplace(key, static_cast<int32_t>(mesh.positions.size()));
             if (inserted) {
                 mesh.positions.push_back(mesh.positions[v]);
-                result.vertex_origins.push_back({v, v});
+                result.vertex_origins.push_back(VertexOrigin::vertex(v));
             }
             v = it->second;
         }
@@ -225,7 +225,7 @@ std::vector<Eigen::Vector3d> prepare(TetMesh& mesh, FractureResult& result) {
     }
     result.pieces_before = static_cast<int>(mesh.piece_transforms.size());
     result.vertex_origins.resize(mesh.vertex_count());
-    for (size_t v = 0; v < mesh.vertex_count(); ++v) result.vertex_origins[v] = {static_cast<int32_t>(v), static_cast<int32_t>(v)};
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) result.vertex_origins[v] = VertexOrigin::vertex(static_cast<int32_t>(v));
     return world_positions(mesh);
 }
 
@@ -324,8 +324,8 @@ FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> 
             SplitReport report = split_along_field(mesh, world, values, field, split);
             reference = std::move(report.reference_deg);
             result.tets_split += report.tets_split;
-            result.vertex_origins.insert(result.vertex_origins.end(), report.appended_vertex_edges.begin(),
-                                         report.appended_vertex_edges.end());
+            result.vertex_origins.insert(result.vertex_origins.end(), report.appended_vertex_origins.begin(),
+                                         report.appended_vertex_origins.end());
             for (int32_t parent : report.appended_parents) label.push_back(label[parent]);
             for (size_t t = 0; t < mesh.tet_count(); ++t)
                 if (report.positive[t]) label[t] = static_cast<int64_t>(k);
@@ -373,8 +373,8 @@ FractureResult fracture_planes(TetMesh& mesh, std::span<const Eigen::Vector4d> p
             SplitReport report = split_along_field(mesh, world, values, field, split);
             reference = std::move(report.reference_deg);
             result.tets_split += report.tets_split;
-            result.vertex_origins.insert(result.vertex_origins.end(), report.appended_vertex_edges.begin(),
-                                         report.appended_vertex_edges.end());
+            result.vertex_origins.insert(result.vertex_origins.end(), report.appended_vertex_origins.begin(),
+                                         report.appended_vertex_origins.end());
             for (int32_t parent : report.appended_parents) region.push_back(region[parent]);
             std::map<std::pair<int64_t, uint8_t>, int64_t> renumber;
             for (size_t t = 0; t < region.size(); ++t)

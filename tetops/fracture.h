@@ -8,6 +8,7 @@
 // is implemented. Signatures may gain options but not lose them.
 #pragma once
 
+#include "tetops/cut.h"
 #include "tetops/tet_mesh.h"
 
 #include <array>
@@ -46,11 +47,12 @@ struct FractureResult {
     // Exact mode: tets whose minimum dihedral angle is under min(0.5 degrees, that of the tet before
     // the fracture they come from), counted from the result; all others meet that bound.
     size_t tets_under_guard = 0;
-    // Per vertex after: where it comes from. Vertices before keep their index and have {v, v}; every
-    // vertex the fracture appends names vertices with lower indices after: {a, b} (a != b) when a wall
-    // made it on edge ab, {a, a} when it is a crack copy of vertex a. Read in index order it carries
-    // per-vertex data across the fracture (the editor's warm start).
-    std::vector<std::array<int32_t, 2>> vertex_origins;
+    // Per vertex after: where it comes from. Vertices before keep their index and have
+    // VertexOrigin::vertex(v); every vertex the fracture appends names vertices with lower indices
+    // after: edge ab (a != b) and the parameter along it when a wall made it there, vertex a when it is
+    // a crack copy of a. Read in index order it carries per-vertex data across the fracture (the
+    // editor's warm start).
+    std::vector<VertexOrigin> vertex_origins;
 };
 
 // `count` seed points scattered inside the volume (world space), deterministic for `seed`: a tet drawn

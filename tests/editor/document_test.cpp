@@ -212,11 +212,10 @@ TEST(Document, CutsFracturesAndWeldsMapTheirVerticesBothWays) {
     ASSERT_EQ(applied.vertex_origins.size(), after);
     for (size_t v = 0; v < before; ++v) {
         EXPECT_EQ(applied.old_to_new_vertex[v], static_cast<int32_t>(v));
-        EXPECT_EQ(applied.vertex_origins[v][0], static_cast<int32_t>(v));
-        EXPECT_EQ(applied.vertex_origins[v][1], static_cast<int32_t>(v));
+        EXPECT_TRUE(applied.vertex_origins[v] == VertexOrigin::vertex(static_cast<int32_t>(v))) << v;
     }
     for (size_t v = before; v < after; ++v) {
-        EXPECT_LT(static_cast<size_t>(std::max(applied.vertex_origins[v][0], applied.vertex_origins[v][1])), v);
+        EXPECT_LT(static_cast<size_t>(std::max(applied.vertex_origins[v].a, applied.vertex_origins[v].b)), v);
     }
     const ChangeReport undo = *doc.undo();
     ASSERT_EQ(undo.old_to_new_vertex.size(), after);

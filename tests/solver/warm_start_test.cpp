@@ -1,6 +1,9 @@
 // Extending a warm start over vertices without a value (solver/warm_start.h).
 #include "solver/warm_start.h"
+#include "solver_test_meshes.h"
 #include "tetops/error.h"
+#include "tetops/exact_cut.h"
+#include "tetops/fracture.h"
 
 #include <gtest/gtest.h>
 
@@ -65,6 +68,78 @@ TEST(WarmStart, NothingKnownOrEverythingKnownChangesNothingAndSizesAreChecked) {
     EXPECT_THROW(extend_to_unknown_vertices(m, std::vector<uint8_t>(4, 0), values), InvalidArgumentError);
     auto short_values = filled_with(4, 0.0);
     EXPECT_THROW(extend_to_unknown_vertices(m, std::vector<uint8_t>(5, 1), short_values), InvalidArgumentError);
+}
+
+TEST(WarmStart, AVertexMapCarriesValuesToTheVerticesItNames) {
+    auto before = filled_with(4, 0.0);
+    for (size_t c = 0; c < 3; ++c)
+        for (size_t v = 0; v < 4; ++v) before[c][v] = 10.0 * static_cast<double>(c) + static_cast<double>(v);
+    // 0 -> 2, 1 removed, 2 -> 0, 3 outside the 3 vertices after: only 0 and 2 are placed.
+    const std::vector<int32_t> map = {2, -1, 0, 3};
+    const CarriedValues after = carry_through_vertex_map(before, map, 3);
+    EXPECT_EQ(after.known, (std::vector<uint8_t>{1, 0, 1}));
+    for (size_t c = 0; c < 3; ++c) {
+        EXPECT_EQ(after.values[c][0], before[c][2]);
+        EXPECT_EQ(after.values[c][1], 0.0);
+        EXPECT_EQ(after.values[c][2], before[c][0]);
+    }
+    EXPECT_THROW(carry_through_vertex_map(before, std::vector<int32_t>{0, 1}, 3), InvalidArgumentError);
+}
+
+// Values linear in position before an edit are linear after it when the vertices made on edges sit
+// where their origins say (nothing moves them: no snapping, bending or smoothing): the carry uses each
+// vertex's crossing parameter, which an oblique cut or a Voronoi wall puts far from the edge's middle.
+TEST(WarmStart, OriginsCarryALinearFieldExactlyAcrossAnExactCutAndAFracture) {
+    const TetMesh cube = test::make_cube_mesh(6, 1.0 / 6);
+    const auto linear = [](const Eigen::Vector3d& x, size_t c) {
+        return 0.3 + static_cast<double>(c) + Eigen::Vector3d(1.0, -2.0 + static_cast<double>(c), 0.5).dot(x);
+    };
+    std::array<std::vector<double>, 3> before;
+    for (size_t c = 0; c < 3; ++c)
+        for (const Eigen::Vector3d& x : cube.positions) before[c].push_back(linear(x, c));
+    const auto expect_linear_after = [&](const TetMesh& mesh, const std::vector<VertexOrigin>& origins) {
+        const CarriedValues after = carry_through_origins(before, origins);
+        ASSERT_EQ(after.known.size(), mesh.vertex_count());
+        double off_middle = 0;
+        for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+            EXPECT_EQ(after.known[v], 1) << v;
+            for (size_t c = 0; c < 3; ++c) EXPECT_NEAR(after.values[c][v], linear(mesh.positions[v], c), 1e-12) << v;
+            if (!origins[v].is_vertex()) off_middle = std::max(off_middle, std::abs(origins[v].t - 0.5));
+        }
+        EXPECT_GT(off_middle, 0.25);  // the edges' midpoints would be off the field
+    };
+    TetMesh cut = cube;
+    ExactCutOptions fixed_cut;
+    fixed_cut.split.snap_fraction = 0;
+    fixed_cut.split.smooth_below_deg = 0;
+    const ExactCutResult cut_result = cut_exact(cut, PlaneCut(Eigen::Vector3d(1.0, 0.7, 0.45), 1.13), fixed_cut);
+    ASSERT_GT(cut_result.vertices_added, 0u);
+    expect_linear_after(cut, cut_result.vertex_origins);
+
+    TetMesh fractured = cube;
+    FractureOptions fixed_fracture;
+    fixed_fracture.snap_fraction = 0;
+    fixed_fracture.boundary_bend_deg = 0;
+    fixed_fracture.smooth_below_deg = 0;
+    const FractureResult fracture = fracture_voronoi(fractured, scatter_fracture_seeds(cube, 6, 3), fixed_fracture);
+    ASSERT_GT(fracture.tets_split, 0u);
+    ASSERT_GT(fracture.vertices_duplicated, 0u);
+    expect_linear_after(fractured, fracture.vertex_origins);
+}
+
+TEST(WarmStart, OriginsNamingVerticesWithoutAValueCarryNothing) {
+    const std::array<std::vector<double>, 3> before = filled_with(2, 4.0);
+    // 0 kept; 1 on edge 0-1 at 0.25; 2 names vertex 3, not placed yet; 3 out of range; 4 a bad
+    // parameter; 5 copies 1, placed.
+    const std::vector<VertexOrigin> origins = {VertexOrigin::vertex(0), {0, 1, 0.25}, {0, 3, 0.5}, {0, 7, 0.5},
+                                               {0, 1, std::nan("")}, VertexOrigin::vertex(1)};
+    const CarriedValues after = carry_through_origins(before, origins);
+    EXPECT_EQ(after.known, (std::vector<uint8_t>{1, 1, 0, 0, 0, 1}));
+    for (size_t c = 0; c < 3; ++c) {
+        EXPECT_EQ(after.values[c][1], 4.0);
+        EXPECT_EQ(after.values[c][2], 0.0);
+        EXPECT_EQ(after.values[c][4], 0.0);
+    }
 }
 
 }  // namespace

@@ -191,9 +191,10 @@ TEST(FractureVoronoi, CoarseCubeReportsTetsUnderTheGuard) {
     EXPECT_NEAR(total_volume(mesh), 1.0, 1e-12);
 }
 
-// Per vertex after the fracture, its origin: vertices before keep their index ({v, v}); appended
-// vertices name lower indices, a crack copy sits where its original sits in another piece, and a wall
-// vertex lies on the edge it names (exactly so when no vertex moves: no snapping, bending or smoothing).
+// Per vertex after the fracture, its origin: vertices before keep their index (origin: themselves);
+// appended vertices name lower indices, a crack copy sits where its original sits in another piece, and
+// a wall vertex lies on the edge it names at the parameter it names (exactly so when no vertex moves:
+// no snapping, bending or smoothing).
 void expect_origins_describe(const TetMesh& mesh, size_t vertices_before, const FractureResult& r, bool vertices_fixed) {
     ASSERT_EQ(r.vertex_origins.size(), mesh.vertex_count());
     std::vector<int32_t> piece(mesh.vertex_count(), -1);
@@ -201,25 +202,29 @@ void expect_origins_describe(const TetMesh& mesh, size_t vertices_before, const 
         for (int32_t v : mesh.tets[t]) piece[v] = mesh.piece_ids[t];
     size_t copies = 0, on_edges = 0;
     for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-        const auto [a, b] = r.vertex_origins[v];
+        const auto [a, b, t] = r.vertex_origins[v];
         if (v < vertices_before) {
-            EXPECT_TRUE(a == static_cast<int32_t>(v) && b == a) << v;
+            EXPECT_TRUE(r.vertex_origins[v] == VertexOrigin::vertex(static_cast<int32_t>(v))) << v;
             continue;
         }
         ASSERT_TRUE(a >= 0 && b >= 0 && static_cast<size_t>(a) < v && static_cast<size_t>(b) < v) << v;
         if (a == b) {
             ++copies;
+            EXPECT_EQ(t, 0.0) << v;
             EXPECT_EQ(mesh.positions[v], mesh.positions[a]) << v;
             EXPECT_NE(piece[v], piece[a]) << v;
             continue;
         }
         ++on_edges;
+        EXPECT_GE(t, 0.0) << v;
+        EXPECT_LE(t, 1.0) << v;
         if (!vertices_fixed) continue;
         const Eigen::Vector3d pa = mesh.positions[a], pb = mesh.positions[b], p = mesh.positions[v];
         const double s = (p - pa).dot(pb - pa) / (pb - pa).squaredNorm();
         EXPECT_GT(s, 0.0) << v;
         EXPECT_LT(s, 1.0) << v;
         EXPECT_LT((pa + s * (pb - pa) - p).norm(), 1e-12) << v;
+        EXPECT_NEAR(t, s, 1e-12) << v;
     }
     EXPECT_EQ(copies, r.vertices_duplicated);
     EXPECT_EQ(vertices_before + copies + on_edges, mesh.vertex_count());
@@ -242,7 +247,7 @@ TEST(FractureVoronoi, VertexOriginsLeadEveryVertexBackToTheVolumeBefore) {
     expect_origins_describe(mesh, before.vertex_count(), r, /*vertices_fixed=*/true);
     // Nested walls happen: some wall vertex lies on an edge made by an earlier wall.
     EXPECT_TRUE(std::any_of(r.vertex_origins.begin(), r.vertex_origins.end(), [&](const auto& o) {
-        return o[0] != o[1] && static_cast<size_t>(std::max(o[0], o[1])) >= before.vertex_count();
+        return !o.is_vertex() && static_cast<size_t>(std::max(o.a, o.b)) >= before.vertex_count();
     }));
     TetMesh snapped = before;
     expect_origins_describe(snapped, before.vertex_count(), fracture_voronoi(snapped, seeds), false);
