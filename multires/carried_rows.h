@@ -30,35 +30,58 @@ inline bool keeps_vertex_order(std::span<const int32_t> new_of_old) {
     return true;
 }
 
-// Row `row` of a compressed-row operator equals row `old_row` of the previous one: the same length,
-// columns that correspond under `old_of_new_column` (per new column, the previous one or -1) and the
-// same values in every array of `values`. What decides whether a rebuild may copy what was computed
-// from the row.
+// How row `row` of a compressed-row operator differs from row `old_row` of the previous one.
+// Pattern: another length, or columns that do not correspond under `old_of_new_column` (per new
+// column, the previous one or -1) in order. Values: the same pattern, another value in some array of
+// `values`. What decides whether a rebuild may copy what was computed from the row (and, for a matrix
+// row, whether the graph row under it changed: the pattern without the diagonal).
+enum class RowChange { None, Values, Pattern };
+
+template <size_t Arrays>
+RowChange row_change(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
+                     const std::array<const std::vector<double>*, Arrays>& values, size_t row,
+                     const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
+                     const std::array<const std::vector<double>*, Arrays>& old_values, size_t old_row,
+                     std::span<const int32_t> old_of_new_column) {
+    const auto begin = static_cast<size_t>(offsets[row]), end = static_cast<size_t>(offsets[row + 1]);
+    const auto old_begin = static_cast<size_t>(old_offsets[old_row]);
+    if (end - begin != static_cast<size_t>(old_offsets[old_row + 1]) - old_begin) return RowChange::Pattern;
+    RowChange change = RowChange::None;
+    for (size_t k = begin, o = old_begin; k < end; ++k, ++o) {
+        if (old_of_new_column[static_cast<size_t>(columns[k])] != old_columns[o]) return RowChange::Pattern;
+        for (size_t a = 0; a < Arrays && change == RowChange::None; ++a)
+            if ((*values[a])[k] != (*old_values[a])[o]) change = RowChange::Values;
+    }
+    return change;
+}
+
 template <size_t Arrays>
 bool same_row(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
               const std::array<const std::vector<double>*, Arrays>& values, size_t row,
               const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
               const std::array<const std::vector<double>*, Arrays>& old_values, size_t old_row,
               std::span<const int32_t> old_of_new_column) {
-    const auto begin = static_cast<size_t>(offsets[row]), end = static_cast<size_t>(offsets[row + 1]);
-    const auto old_begin = static_cast<size_t>(old_offsets[old_row]);
-    if (end - begin != static_cast<size_t>(old_offsets[old_row + 1]) - old_begin) return false;
-    for (size_t k = begin, o = old_begin; k < end; ++k, ++o) {
-        if (old_of_new_column[static_cast<size_t>(columns[k])] != old_columns[o]) return false;
-        for (size_t a = 0; a < Arrays; ++a)
-            if ((*values[a])[k] != (*old_values[a])[o]) return false;
-    }
-    return true;
+    return row_change<Arrays>(offsets, columns, values, row, old_offsets, old_columns, old_values, old_row,
+                              old_of_new_column) == RowChange::None;
 }
 
 // The same for a row of a three-channel matrix (a DiffusionMatrix, a hierarchy or multigrid level).
+inline RowChange matrix_row_change(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
+                                   const std::array<std::vector<double>, 3>& values, size_t row,
+                                   const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
+                                   const std::array<std::vector<double>, 3>& old_values, size_t old_row,
+                                   std::span<const int32_t> old_of_new_column) {
+    return row_change<3>(offsets, columns, {&values[0], &values[1], &values[2]}, row, old_offsets, old_columns,
+                         {&old_values[0], &old_values[1], &old_values[2]}, old_row, old_of_new_column);
+}
+
 inline bool same_matrix_row(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
                             const std::array<std::vector<double>, 3>& values, size_t row,
                             const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
                             const std::array<std::vector<double>, 3>& old_values, size_t old_row,
                             std::span<const int32_t> old_of_new_column) {
-    return same_row<3>(offsets, columns, {&values[0], &values[1], &values[2]}, row, old_offsets, old_columns,
-                       {&old_values[0], &old_values[1], &old_values[2]}, old_row, old_of_new_column);
+    return matrix_row_change(offsets, columns, values, row, old_offsets, old_columns, old_values, old_row,
+                             old_of_new_column) == RowChange::None;
 }
 
 struct CarriedRows {

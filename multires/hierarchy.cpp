@@ -469,26 +469,36 @@ void check_hierarchy_inputs(const DiffusionMatrix& matrix, std::span<const Eigen
 }
 
 // Per new level-0 vertex: 1 when it has no previous vertex or its position (moved) or matrix row
-// (values_changed: pattern or values) is not its previous vertex's. Both 1 everywhere when the
-// previous positions are unknown.
-void level0_changes(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
-                    const MultiresHierarchy& previous, std::span<const int32_t> old_of_new, std::vector<uint8_t>& moved,
-                    std::vector<uint8_t>& values_changed) {
+// (values_changed: pattern or values) is not its previous vertex's; moved is 1 everywhere when the
+// previous positions are unknown. Returns the vertices whose graph row changed or that have no
+// previous vertex (changed_rows for level 0: a graph row is its matrix row's pattern without the
+// diagonal, so one walk of the rows serves both). old_of_new must keep the vertices' order
+// (keeps_vertex_order): the columns are compared in order.
+std::vector<int32_t> level0_changes(const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
+                                    const MultiresHierarchy& previous, std::span<const int32_t> old_of_new,
+                                    std::vector<uint8_t>& moved, std::vector<uint8_t>& values_changed) {
     const size_t n = matrix.size();
     const HierarchyLevel& old = previous.levels[0];
     const bool known_positions = previous.positions.size() == old.size();
     moved.assign(n, 1);
     values_changed.assign(n, 1);
+    std::vector<uint8_t> pattern_changed(n, 1);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 2048), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v != r.end(); ++v) {
             const int32_t o = old_of_new[v];
             if (o < 0) continue;
             const auto ou = static_cast<size_t>(o);
             moved[v] = !known_positions || positions[v] != previous.positions[ou];
-            values_changed[v] = !same_matrix_row(matrix.offsets, matrix.columns, matrix.values, v, old.offsets,
-                                                 old.columns, old.values, ou, old_of_new);
+            const RowChange change = matrix_row_change(matrix.offsets, matrix.columns, matrix.values, v, old.offsets,
+                                                       old.columns, old.values, ou, old_of_new);
+            values_changed[v] = change != RowChange::None;
+            pattern_changed[v] = change == RowChange::Pattern;
         }
     });
+    std::vector<int32_t> changed;
+    for (size_t v = 0; v < n; ++v)
+        if (pattern_changed[v]) changed.push_back(static_cast<int32_t>(v));
+    return changed;
 }
 
 // Builds the hierarchy's levels; with `previous` and its level-0 vertex map, carries each level's
@@ -540,9 +550,10 @@ MultiresHierarchy build_levels(const DiffusionMatrix& matrix, std::span<const Ei
             carried->previous_retained.assign(n, 0);
             for (size_t v = 0; v < n; ++v)
                 if (old_of_new[v] >= 0) carried->previous_retained[v] = old_retained[static_cast<size_t>(old_of_new[v])];
-            carried->changed = changed_rows(fine.graph, old_fine.graph, old_of_new, new_of_old);
+            carried->changed = l == 0 && carry_rows
+                                   ? level0_changes(matrix, positions, *previous, old_of_new, moved, values_changed)
+                                   : changed_rows(fine.graph, old_fine.graph, old_of_new, new_of_old);
             fine.changed_vertices = static_cast<int64_t>(carried->changed.size());
-            if (l == 0 && carry_rows) level0_changes(matrix, positions, *previous, old_of_new, moved, values_changed);
         }
         std::optional<CoarseningStep> step =
             coarsen(fine.graph, hierarchy.levels.size(), options, carried ? &*carried : nullptr);
