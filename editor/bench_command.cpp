@@ -1,11 +1,14 @@
 // `waxwork bench`: measurements that back the README's performance claims, written as JSON and SVG.
-//   waxwork bench solvers --mesh MESH [--max-tets N] -o DIR [--backend cpu|gpu]
+//   waxwork bench solvers --mesh MESH [--max-tets N] -o DIR [--backend cpu|gpu] [--material NAME | ...]
+//                         [--mesher tetgen|cgal] [--fill-holes] [--autorefine] [...]
 // `bench` itself takes the subcommand; it is a CLI11 app with an optional subcommand so that a later
 // `waxwork bench [--quick] -o DIR` (all benchmarks) can be the parent's own action.
 #include "editor/bench_suite.h"
 #include "editor/commands.h"
+#include "editor/material_options.h"
 #include "editor/render_pipeline.h"
 #include "editor/solver_comparison.h"
+#include "editor/surface_meshing_options.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
 #include "solver/material.h"
@@ -34,6 +37,8 @@ struct SolversCommandOptions {
     std::optional<double> scale;
     double floor_error = 1e-4;
     double max_seconds = 60;
+    SurfaceMeshingOptions meshing;
+    MaterialOptions material;
 };
 
 bool is_volume_file(const std::filesystem::path& path) {
@@ -47,8 +52,8 @@ TetMesh load_or_mesh(const SolversCommandOptions& o) {
     if (is_volume_file(o.mesh)) return read_volume(o.mesh);
     if (!o.max_tets)
         throw InvalidArgumentError(o.mesh + ": a surface needs --max-tets (or pass a volume file)");
-    const LoadedSurface surface = load_closed_surface(o.mesh);
-    MeshingOptions meshing;
+    const LoadedSurface surface = load_surface_to_mesh(o.mesh, o.meshing);
+    MeshingOptions meshing = meshing_options(o.meshing);
     meshing.sizing.target_tets = o.max_tets;
     return tetrahedralize(surface.surface, meshing).mesh;
 }
@@ -67,10 +72,11 @@ void run_solvers_command(const SolversCommandOptions& o) {
         throw InvalidArgumentError("--floor must be between 0 and 1");
     if (!(o.max_seconds > 0) || !std::isfinite(o.max_seconds))
         throw InvalidArgumentError("--max-seconds must be positive");
+    const std::optional<TetMaterial> material = chosen_material(o.material);  // before the (long) meshing
     const TetMesh mesh = load_or_mesh(o);
     if (mesh.tet_count() == 0) throw InvalidArgumentError(o.mesh + ": the volume has no tets");
     const TetConnectivity connectivity = build_connectivity(mesh);
-    const std::vector<TetMaterial> materials = resolve_materials(mesh, std::nullopt);
+    const std::vector<TetMaterial> materials = resolve_materials(mesh, material);
     Lighting lighting;
     lighting.lights.push_back(default_key_light());
 
@@ -154,8 +160,11 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--floor", options->floor_error, "Stop each curve below this relative error")
         ->capture_default_str();
     cmd->add_option("--max-seconds", options->max_seconds, "Measuring time limit per solver")->capture_default_str();
+    add_surface_meshing_options(*cmd, options->meshing);
+    add_material_options(*cmd, options->material);
     cmd->footer(
-        "Materials: the volume's stored ones, else marble. Light: the default key light of waxwork render.\n"
+        "Meshing options apply to a surface. Materials: --material (or --mua, --musp, --eta) for every tet, else\n"
+        "the volume's stored ones, else marble. Light: the default key light of waxwork render.\n"
         "Error: relative L2 over the three channels against a direct solution (editor/solver_comparison.h).");
     cmd->callback([options] { run_solvers_command(*options); });
 }

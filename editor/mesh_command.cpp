@@ -1,6 +1,7 @@
 // `waxwork mesh INPUT -o OUTPUT`: surface file -> validated surface -> tetrahedral volume file.
 #include "editor/commands.h"
 #include "editor/material_options.h"
+#include "editor/surface_meshing_options.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
 #include "solver/material.h"
@@ -23,27 +24,15 @@ struct MeshCommandOptions {
     std::string output;
     std::optional<double> edge;
     std::optional<size_t> max_tets;
-    double min_dihedral = 10.0;
-    double radius_edge = 2.0;
-    std::string mesher = "tetgen";
     double scale = 1.0;
-    bool fill_holes = false;
-    bool autorefine = false;
+    SurfaceMeshingOptions meshing;
     MaterialOptions material;
 };
 
 void run_mesh_command(const MeshCommandOptions& o) {
     validate_mm_per_unit(o.scale, "--scale");  // before the (possibly long) surface checks
-    SurfaceRepairOptions repair;
-    repair.fill_holes = o.fill_holes;
-    repair.autorefine = o.autorefine;
-    const LoadedSurface loaded = load_closed_surface(o.input, repair);
-    for (const std::string& line : loaded.repairs) std::cerr << "waxwork: " << o.input << ": repaired: " << line << "\n";
-
-    MeshingOptions options;
-    options.mesher = o.mesher == "cgal" ? Mesher::Cgal : Mesher::TetGen;
-    options.min_dihedral_deg = o.min_dihedral;
-    options.max_radius_edge_ratio = o.radius_edge;
+    const LoadedSurface loaded = load_surface_to_mesh(o.input, o.meshing);
+    MeshingOptions options = meshing_options(o.meshing);
     // tetrahedralize() validates the explicit sizes (positive, finite, not absurdly many tets).
     if (o.edge) {
         options.sizing.edge_length = o.edge;
@@ -84,16 +73,9 @@ void add_mesh_command(CLI::App& app) {
     auto* edge = cmd->add_option("--edge", options->edge, "Target edge length in model units");
     auto* tets = cmd->add_option("--max-tets", options->max_tets, "About this many tets (within 20%)");
     edge->excludes(tets);
-    cmd->add_option("--min-dihedral", options->min_dihedral, "Minimum dihedral angle bound in degrees")
-        ->capture_default_str();
-    cmd->add_option("--radius-edge", options->radius_edge, "Radius-edge ratio bound")->capture_default_str();
-    cmd->add_option("--mesher", options->mesher, "tetgen or cgal")
-        ->check(CLI::IsMember({"tetgen", "cgal"}))
-        ->capture_default_str();
+    add_surface_meshing_options(*cmd, options->meshing);
     cmd->add_option("--scale", options->scale, "Millimetres per model unit (sizes the default mesh)")
         ->capture_default_str();
-    cmd->add_flag("--fill-holes", options->fill_holes, "Opt-in repair: close holes in an open surface");
-    cmd->add_flag("--autorefine", options->autorefine, "Opt-in repair: remove self-intersections");
     add_material_options(*cmd, options->material);
     cmd->footer(
         "Without --edge or --max-tets the size follows the material (default marble): tets near the surface\n"

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 namespace waxwork {
 namespace {
@@ -149,6 +150,35 @@ TEST(BenchSolversCommand, GpuBackendAddsGpuCurvesOrWarns) {
     const auto without = nlohmann::json::parse(testing::read_text(dir / "forced" / "solvers.json"));
     EXPECT_FALSE(without["solvers"].contains("gpu_cg"));
     EXPECT_TRUE(without["solvers"].contains("jacobi_cg"));
+}
+
+// A surface is meshed with the meshing options `waxwork mesh` takes, and --material fills every tet:
+// spot at 3,000 tets is below what TetGen can do while keeping its triangles (the error says to use
+// CGAL), CGAL remeshes it, and ketchup's short diffusion lengths take Jacobi CG more iterations to 1%
+// than the marble default on the same mesh (10 against 7 here).
+TEST(BenchSolversCommand, MeshesASurfaceWithTheChosenMesherAndMaterial) {
+    const auto dir = scratch_dir("bench_solvers_meshing");
+    const std::string args = "bench solvers --mesh " + std::string(WAXWORK_ASSET_DIR) +
+                             "/meshes/spot.obj --max-tets 3000 --floor 1e-2 --max-seconds 5";
+    const auto tetgen = run_waxwork(args + " -o " + (dir / "tetgen").string());
+    EXPECT_EQ(tetgen.exit_code, 1);
+    EXPECT_EQ(testing::line_count(tetgen.err), 1u) << tetgen.err;
+    EXPECT_NE(tetgen.err.find("--mesher cgal"), std::string::npos) << tetgen.err;
+    std::map<std::string, int> jacobi_caps;
+    for (const std::string material : {"marble", "ketchup"}) {
+        const auto out = dir / material;
+        const auto result = run_waxwork(args + " --mesher cgal --material " + material + " -o " + out.string());
+        ASSERT_EQ(result.exit_code, 0) << result.err;
+        const auto json = nlohmann::json::parse(testing::read_text(out / "solvers.json"));
+        EXPECT_GT(json["tets"].get<size_t>(), 2000u);
+        EXPECT_LT(json["tets"].get<size_t>(), 4000u);
+        jacobi_caps[material] = json["solvers"]["jacobi_cg"]["cap_to_1pct"].get<int>();
+    }
+    EXPECT_GT(jacobi_caps["ketchup"], jacobi_caps["marble"]);
+    const auto unknown = run_waxwork(args + " --mesher cgal --material nosuch -o " + (dir / "unknown").string());
+    EXPECT_EQ(unknown.exit_code, 1);
+    EXPECT_NE(unknown.err.find("unknown material 'nosuch'"), std::string::npos) << unknown.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "unknown"));
 }
 
 TEST(BenchSolversCommand, RejectsBadInvocationsWithOneLine) {
