@@ -96,13 +96,19 @@ void run_solvers_command(const SolversCommandOptions& o) {
     std::error_code error;
     std::filesystem::create_directories(dir, error);
     if (error) throw FileError(dir, "cannot create the directory (" + error.message() + ")");
-    write_solver_comparison(dir, "solvers", o.mesh, comparison);
+    // Named as resolve_materials chose them: the options' material, else the volume's, else marble.
+    const std::string material_name = !o.material.preset.empty() ? o.material.preset
+                                      : material                  ? "custom"
+                                      : mesh.has_materials()      ? "stored"
+                                                                  : "marble";
+    write_solver_comparison(dir, "solvers", {o.mesh, material_name, options.mm_per_unit}, comparison);
 
     nlohmann::ordered_json summary_times = nlohmann::ordered_json::object();
     for (const SolverCurve& s : comparison.solvers)
         summary_times[s.name] = s.time_to_target_ms ? nlohmann::ordered_json(*s.time_to_target_ms) : nullptr;
     nlohmann::ordered_json summary = {
         {"output", o.output},
+        {"material", material_name},
         {"tets", comparison.tets},
         {"vertices", comparison.vertices},
         {"levels", comparison.levels},

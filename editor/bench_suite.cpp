@@ -82,7 +82,8 @@ void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index
     if (!comparison.gpu_fallback_reason.empty())
         std::cerr << "warning: no GPU curves: " << comparison.gpu_fallback_reason << "\n";
     const std::string stem = "solvers_spot_" + std::to_string((target_tets + 500) / 1000) + "k";
-    write_solver_comparison(o.output_dir, stem, "assets/meshes/spot.obj", comparison);
+    write_solver_comparison(o.output_dir, stem, {"assets/meshes/spot.obj", "marble", solver_scene_mm_per_unit},
+                            comparison);
     Json& listed = index["solvers"];
     if (!listed.is_array()) listed = Json::array();
     if (std::find(listed.begin(), listed.end(), Json(stem + ".json")) == listed.end()) listed.push_back(stem + ".json");

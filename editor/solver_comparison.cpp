@@ -330,7 +330,7 @@ std::vector<std::pair<std::string, double>> setup_times(const SolverComparison& 
             {"multigrid_rgb_setup_rebuild_ms", comparison.multigrid_rgb_setup_rebuild_ms}};
 }
 
-void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const std::string& mesh_name,
+void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const ComparedScene& scene,
                              const SolverComparison& comparison) {
     nlohmann::ordered_json solvers = nlohmann::ordered_json::object();
     std::vector<ChartSeries> series;
@@ -346,7 +346,9 @@ void write_solver_comparison(const std::filesystem::path& dir, const std::string
         series.push_back(std::move(line));
     }
     nlohmann::ordered_json json = {
-        {"mesh", mesh_name},
+        {"mesh", scene.mesh},
+        {"material", scene.material},
+        {"mm_per_unit", scene.mm_per_unit},
         {"tets", comparison.tets},
         {"vertices", comparison.vertices},
         {"levels", comparison.levels},
@@ -356,8 +358,8 @@ void write_solver_comparison(const std::filesystem::path& dir, const std::string
     write_file_atomically(dir / (stem + ".json"), [&](std::ostream& out) { out << json.dump(2) << "\n"; });
 
     ChartOptions chart;
-    chart.title = "Diffusion solvers on " + std::filesystem::path(mesh_name).filename().string() + ", " +
-                  std::to_string(comparison.tets) + " tets (3 channels)";
+    chart.title = "Diffusion solvers on " + std::filesystem::path(scene.mesh).filename().string() + " (" +
+                  scene.material + "), " + std::to_string(comparison.tets) + " tets (3 channels)";
     chart.x = {"solve time (ms, log scale)", AxisScale::Log, 0, 0};  // direct is orders of magnitude slower
     chart.y = {"relative L2 error of phi vs direct reference", AxisScale::Log, 0, 0};
     write_svg_chart(dir / (stem + ".svg"), series, chart);

@@ -82,10 +82,19 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
 // multigrid_setup_ms, multigrid_setup_rebuild_ms, multigrid_rgb_setup_ms, multigrid_rgb_setup_rebuild_ms.
 std::vector<std::pair<std::string, double>> setup_times(const SolverComparison& comparison);
 
-// Writes DIR/STEM.json, {"mesh", "tets", "vertices", "levels", setup_times..., "solvers": {NAME:
-// {"time_to_1pct_ms", "cap_to_1pct", "curve": [[ms, rel_error], ...]}}}, and DIR/STEM.svg (error against
-// time, one line per solver), atomically. `mesh_name` is recorded as given.
-void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const std::string& mesh_name,
+// What a comparison solved, recorded with it: the mesh file as given, the materials (a preset's name,
+// "custom" coefficients, or "stored" for the volume's own) and the millimetres per model unit the
+// coefficients (per mm) were applied at.
+struct ComparedScene {
+    std::string mesh;
+    std::string material;
+    double mm_per_unit = 0;
+};
+
+// Writes DIR/STEM.json, {"mesh", "material", "mm_per_unit", "tets", "vertices", "levels",
+// setup_times..., "solvers": {NAME: {"time_to_1pct_ms", "cap_to_1pct", "curve": [[ms, rel_error],
+// ...]}}}, and DIR/STEM.svg (error against time, one line per solver), atomically.
+void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const ComparedScene& scene,
                              const SolverComparison& comparison);
 
 // For the GPU curves: a headless OpenGL context (OSMesa's llvmpipe unless WAXWORK_GL_DEVICE=egl finds a

@@ -74,10 +74,12 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
     const auto json = nlohmann::json::parse(testing::read_text(out / "solvers.json"));
     std::vector<std::string> keys;
     for (const auto& [key, value] : json.items()) keys.push_back(key);
-    EXPECT_EQ(keys, (std::vector<std::string>{"hierarchy_ms", "hierarchy_rebuild_ms", "levels", "mesh",
-                                              "multigrid_rgb_setup_ms", "multigrid_rgb_setup_rebuild_ms",
+    EXPECT_EQ(keys, (std::vector<std::string>{"hierarchy_ms", "hierarchy_rebuild_ms", "levels", "material", "mesh",
+                                              "mm_per_unit", "multigrid_rgb_setup_ms", "multigrid_rgb_setup_rebuild_ms",
                                               "multigrid_setup_ms", "multigrid_setup_rebuild_ms", "solvers", "tets",
                                               "vertices"}));
+    EXPECT_EQ(json["material"], "marble");  // the cube stores no materials
+    EXPECT_DOUBLE_EQ(json["mm_per_unit"].get<double>(), 100.0);  // its longest side becomes 100 mm
     for (const char* key : {"hierarchy_rebuild_ms", "multigrid_setup_rebuild_ms", "multigrid_rgb_setup_rebuild_ms"})
         EXPECT_GT(json[key].get<double>(), 0.0) << key;
     EXPECT_EQ(json["tets"].get<size_t>(), 9u * 9u * 9u * 6u);
@@ -170,6 +172,7 @@ TEST(BenchSolversCommand, MeshesASurfaceWithTheChosenMesherAndMaterial) {
         const auto result = run_waxwork(args + " --mesher cgal --material " + material + " -o " + out.string());
         ASSERT_EQ(result.exit_code, 0) << result.err;
         const auto json = nlohmann::json::parse(testing::read_text(out / "solvers.json"));
+        EXPECT_EQ(json["material"], material);
         EXPECT_GT(json["tets"].get<size_t>(), 2000u);
         EXPECT_LT(json["tets"].get<size_t>(), 4000u);
         jacobi_caps[material] = json["solvers"]["jacobi_cg"]["cap_to_1pct"].get<int>();
