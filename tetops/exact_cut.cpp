@@ -144,6 +144,12 @@ bool may_slide(const TetMesh& mesh, const std::vector<KeptFace>& faces, int32_t 
 // wall between regions only slides along an edge of those faces that stays in their planes (may_slide),
 // so the volume and earlier walls keep their shape; where no such edge reaches the surface the edges
 // are split instead.
+// A crossing this close to a boundary vertex (as a fraction of its edge) is snapped to even where the
+// boundary lets no edge slide (snap_vertices): small enough to leave the shape of the volume as it is
+// to rounding at the scale of a model (1e-6 of an edge), large enough to catch the near-degenerate
+// crossings that rounding and relaxation leave next to a wall (1e-7 of an edge and closer).
+constexpr double kHairline = 1e-6;
+
 size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::vector<double>& values,
                      const std::vector<int32_t>& crossed, const std::vector<int>& sign, const SplitField& field,
                      const SplitOptions& options, const std::vector<int32_t>& piece_of,
@@ -220,6 +226,15 @@ size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::ve
             for (size_t i = begin; i < end && !target_world; ++i)
                 if (may_slide(mesh, kept, v, candidates[i].other, options.boundary_bend_deg))
                     target_world = candidates[i].target;
+            // Where no boundary edge may slide (a corner, a crease, a bumpy part such as a relaxed
+            // cut's cross-section), a crossing a hair's breadth from the vertex would still be split
+            // off as a sliver of almost no angle (a relaxed vertex 4e-9 from a Voronoi wall left one
+            // of 3e-6 degrees). A step to it along its own edge moves the outer surface by at most
+            // kHairline of an edge, far below what a slide may (sin(bend) x snap_fraction); walls
+            // between cells keep their planes, and bend 0 keeps the surface exactly.
+            const bool on_walls = std::any_of(kept.begin(), kept.end(), [](const KeptFace& f) { return !f.on_boundary; });
+            if (!target_world && !on_walls && options.boundary_bend_deg > 0 && candidates[begin].fraction <= kHairline)
+                target_world = candidates[begin].target;
         }
         begin = end;
         if (!target_world || values[v] == 0) continue;

@@ -49,7 +49,10 @@ struct SplitOptions {
     // that edge leaves the plane of every boundary face around the vertex by at most this angle
     // (degrees): 0 keeps the shape of the volume exactly (vertices slide only within flat parts and
     // along straight creases), more trades a change of the outer surface of at most
-    // sin(bend) x snap_fraction x edge length for fewer slivers where the surface is curved.
+    // sin(bend) x snap_fraction x edge length for fewer slivers where the surface is curved. With
+    // bend > 0 a crossing within 1e-6 of an edge from the vertex is snapped to along that edge even
+    // where nothing may slide (a corner, a crease, a bumpy relaxed cross-section): split, it would
+    // leave a sliver of almost no angle.
     double boundary_bend_deg = 0;
     // Per tet: a region label (e.g. the fracture cell). Faces between tets of different labels are
     // kept in their planes like flat boundary faces (bend 0): a vertex on them snaps only by sliding
