@@ -636,9 +636,8 @@ TEST(LiveSolver, DeviceRadianceDrawsWhatTheCpuRadianceDraws) {
 }
 
 // One random edit for `doc`, valid by construction (a cut keeps most of the volume, seeds and paint
-// points lie at vertices), and its name. `last_plane`: the last cut's plane, for relaxing towards it.
-std::pair<EditOperation, std::string> random_edit(const Document& doc, std::mt19937& rng,
-                                                  std::optional<PlaneSurface>& last_plane) {
+// points lie at vertices). `last_plane`: the last cut's plane, for relaxing towards it.
+EditOperation random_edit(const Document& doc, std::mt19937& rng, std::optional<PlaneSurface>& last_plane) {
     const TetMesh& mesh = doc.mesh();
     const std::vector<Eigen::Vector3d> world = world_positions(mesh);
     const auto random_vertex = [&] { return world[std::uniform_int_distribution<size_t>(0, world.size() - 1)(rng)]; };
@@ -646,8 +645,7 @@ std::pair<EditOperation, std::string> random_edit(const Document& doc, std::mt19
     for (;;) {
         switch (std::uniform_int_distribution<int>(0, 6)(rng)) {
         case 0: {
-            PaintOp paint = testing::paint_at(random_vertex(), rng() % 2 ? "ketchup" : "skin1");
-            return {paint, "paint"};
+            return testing::paint_at(random_vertex(), rng() % 2 ? "ketchup" : "skin1");
         }
         case 1: {
             if (mesh.tet_count() < 3000) continue;  // keep enough volume for the later edits
@@ -661,18 +659,18 @@ std::pair<EditOperation, std::string> random_edit(const Document& doc, std::mt19
             cut.exact = rng() % 2;
             cut.relax.iterations = cut.exact ? 0 : 5;
             last_plane = cut.plane;
-            return {cut, cut.exact ? "exact cut" : "cut"};
+            return cut;
         }
         case 2: {
             if (!last_plane) continue;
-            return {RelaxOp{*last_plane, RelaxSettings{3, 0.2, 0.5}}, "relax"};
+            return RelaxOp{*last_plane, RelaxSettings{3, 0.2, 0.5}};
         }
         case 3: {
             if (mesh.piece_transforms.size() > 3) continue;
             FractureOp fracture;
             fracture.seeds = {random_vertex(), random_vertex()};
             fracture.exact = rng() % 2;
-            return {fracture, fracture.exact ? "exact fracture" : "fracture"};
+            return fracture;
         }
         case 4: {
             if (mesh.piece_transforms.size() < 2) continue;
@@ -680,32 +678,50 @@ std::pair<EditOperation, std::string> random_edit(const Document& doc, std::mt19
             move.piece = static_cast<int>(rng() % mesh.piece_transforms.size());
             move.transform = mesh.piece_transforms[static_cast<size_t>(move.piece)];
             move.transform.translation += 0.05 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
-            return {move, "move piece"};
+            return move;
         }
         case 5:
             if (mesh.piece_transforms.size() < 2) continue;
-            return {WeldOp{1e-9}, "weld"};
+            return WeldOp{1e-9};
         default:
-            return {SetMaterialOp{material_preset(rng() % 2 ? "marble" : "skin2"), std::nullopt}, "set material"};
+            return SetMaterialOp{material_preset(rng() % 2 ? "marble" : "skin2"), std::nullopt};
         }
     }
 }
 
+// A positive whole number from the environment, else `fallback` (the soak runs below).
+int environment_count(const char* name, int fallback) {
+    const char* text = std::getenv(name);
+    const int value = text ? std::atoi(text) : 0;
+    return value > 0 ? value : fallback;
+}
+
 // Random sequences of edits, undos and redos with a few frames between them, as a user makes them: the
 // edits' maps and origins carry phi, the hierarchies and Galerkin operators are rebuilt or updated
-// around them (multires, multigrid), and every method still converges to what a fresh scene gives on
-// the volume reached, without falling back. Seed 17 found an exact fracture whose wall passed 4e-9 from
-// a vertex of a relaxed cut's cross-section: split there, the tets kept a 3e-6 degree angle and Jacobi
-// CG could not reach the test's 1e-9 (the snap at a hair's breadth in tetops/exact_cut.h; 0.014 now).
+// around them (multires, multigrid, on both backends), and every method still converges to what a
+// fresh scene gives on the volume reached, on its backend and without falling back. Seed 17 found an
+// exact fracture whose wall passed 4e-9 from a vertex of a relaxed cut's cross-section: split there,
+// the tets kept a 3e-6 degree angle and Jacobi CG could not reach the test's 1e-9 (the snap at a
+// hair's breadth in tetops/exact_cut.h; 0.014 degrees now, from a crossing 1e-3 of an edge away). The
+// GPU methods solve in float, whose floor is near 1e-6 on clean meshes and 7e-5 with that sliver (GPU
+// CG, seed 17): they converge to 1e-4 and are compared within 1e-3, enough to catch a stale row or
+// operator after an edit (errors of percents). Longer soaks:
+// WAXWORK_EDIT_FIRST_SEED, WAXWORK_EDIT_SEQUENCES (20 per CPU method, a quarter of that per GPU method)
+// and WAXWORK_EDIT_STEPS (10).
 TEST(LiveSolver, RandomEditSequencesConvergeToTheFreshSolution) {
-    for (const Config& config : {kConfigs[0], kConfigs[1], kConfigs[3]}) {
-        for (uint32_t seed = 1; seed <= 20; ++seed) {
-            std::mt19937 rng(seed);
+    const int first_seed = environment_count("WAXWORK_EDIT_FIRST_SEED", 1);
+    const int sequences = environment_count("WAXWORK_EDIT_SEQUENCES", 20);
+    const int steps = environment_count("WAXWORK_EDIT_STEPS", 10);
+    for (Config config : kConfigs) {
+        const bool gpu = config.backend == LiveBackend::Gpu;
+        if (gpu) config.tolerance = 1e-4;
+        for (int seed = first_seed; seed < first_seed + (gpu ? std::max(1, sequences / 4) : sequences); ++seed) {
+            std::mt19937 rng(static_cast<uint32_t>(seed));
             Document doc(testing::make_cube_mesh(12), material_preset("marble"));
             LiveScene scene(doc.mesh(), key_lighting(), options_for(config));
             std::optional<PlaneSurface> last_plane;
             std::string log;
-            for (int step = 0; step < 10; ++step) {
+            for (int step = 0; step < steps; ++step) {
                 std::optional<ChangeReport> change;
                 const int choice = std::uniform_int_distribution<int>(0, 9)(rng);
                 if (choice == 0 && doc.can_undo()) {
@@ -713,17 +729,25 @@ TEST(LiveSolver, RandomEditSequencesConvergeToTheFreshSolution) {
                 } else if (choice == 1 && doc.can_redo()) {
                     change = doc.redo();
                 } else {
-                    auto [op, name] = random_edit(doc, rng, last_plane);
-                    change = doc.apply(op);
+                    change = doc.apply(random_edit(doc, rng, last_plane));
                 }
                 log += change->name + " (min " + std::to_string(doc.min_dihedral_deg()) + " deg); ";
                 SCOPED_TRACE(std::string(config.name) + ", seed " + std::to_string(seed) + ": " + log);
                 ASSERT_NO_THROW(scene.apply_change(doc.mesh(), *change));
                 scene.step(static_cast<int>(rng() % 3) * 2);
-                if (step % 5 == 4) {
+                if (step % 5 == 4 || step == steps - 1) {
                     ASSERT_NO_THROW(scene.converge());
-                    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), 1e-4);
-                    EXPECT_EQ(scene.method_fallback_reason(), "");
+                    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), gpu ? 1e-3 : 1e-4);
+                    EXPECT_EQ(scene.backend(), config.backend) << scene.gpu_fallback_reason();
+                    // The paper's coarse-to-fine pass may skip a coarse level whose BiCGSTAB diverges
+                    // (Eq. 17's operators are not symmetric; 4 of 250 soak sequences of 20 steps), which
+                    // level-0 CG makes up for; no other fallback is expected.
+                    const std::string reason = scene.method_fallback_reason();
+                    if (config.method == LiveMethod::Multires && !reason.empty()) {
+                        EXPECT_NE(reason.find("the coarse-to-fine pass skipped"), std::string::npos) << reason;
+                    } else {
+                        EXPECT_EQ(reason, "");
+                    }
                 }
             }
         }
