@@ -30,58 +30,41 @@ inline bool keeps_vertex_order(std::span<const int32_t> new_of_old) {
     return true;
 }
 
-// How row `row` of a compressed-row operator differs from row `old_row` of the previous one.
-// Pattern: another length, or columns that do not correspond under `old_of_new_column` (per new
-// column, the previous one or -1) in order. Values: the same pattern, another value in some array of
-// `values`. What decides whether a rebuild may copy what was computed from the row (and, for a matrix
-// row, whether the graph row under it changed: the pattern without the diagonal).
+// One compressed-row operator as row_change reads it: offsets, columns and `Arrays` value arrays with
+// one value per entry (a matrix's three channels, an interpolation's weights).
+template <size_t Arrays>
+struct OperatorRows {
+    const std::vector<int32_t>& offsets;
+    const std::vector<int32_t>& columns;
+    std::array<const std::vector<double>*, Arrays> values;
+};
+
+// The rows of a three-channel matrix (a DiffusionMatrix, a hierarchy or multigrid level).
+inline OperatorRows<3> matrix_rows(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
+                                   const std::array<std::vector<double>, 3>& values) {
+    return {offsets, columns, {&values[0], &values[1], &values[2]}};
+}
+
+// How row `row` of an operator differs from row `old_row` of the previous one. Pattern: another
+// length, or columns that do not correspond under `old_of_new_column` (per new column, the previous
+// one or -1) in order. Values: the same pattern, another value in some array. What decides whether a
+// rebuild may copy what was computed from the row (None), and, for a matrix row, whether the graph
+// row under it changed (Pattern: the graph row is the pattern without the diagonal).
 enum class RowChange { None, Values, Pattern };
 
 template <size_t Arrays>
-RowChange row_change(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
-                     const std::array<const std::vector<double>*, Arrays>& values, size_t row,
-                     const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
-                     const std::array<const std::vector<double>*, Arrays>& old_values, size_t old_row,
+RowChange row_change(const OperatorRows<Arrays>& now, size_t row, const OperatorRows<Arrays>& before, size_t old_row,
                      std::span<const int32_t> old_of_new_column) {
-    const auto begin = static_cast<size_t>(offsets[row]), end = static_cast<size_t>(offsets[row + 1]);
-    const auto old_begin = static_cast<size_t>(old_offsets[old_row]);
-    if (end - begin != static_cast<size_t>(old_offsets[old_row + 1]) - old_begin) return RowChange::Pattern;
+    const auto begin = static_cast<size_t>(now.offsets[row]), end = static_cast<size_t>(now.offsets[row + 1]);
+    const auto old_begin = static_cast<size_t>(before.offsets[old_row]);
+    if (end - begin != static_cast<size_t>(before.offsets[old_row + 1]) - old_begin) return RowChange::Pattern;
     RowChange change = RowChange::None;
     for (size_t k = begin, o = old_begin; k < end; ++k, ++o) {
-        if (old_of_new_column[static_cast<size_t>(columns[k])] != old_columns[o]) return RowChange::Pattern;
+        if (old_of_new_column[static_cast<size_t>(now.columns[k])] != before.columns[o]) return RowChange::Pattern;
         for (size_t a = 0; a < Arrays && change == RowChange::None; ++a)
-            if ((*values[a])[k] != (*old_values[a])[o]) change = RowChange::Values;
+            if ((*now.values[a])[k] != (*before.values[a])[o]) change = RowChange::Values;
     }
     return change;
-}
-
-template <size_t Arrays>
-bool same_row(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
-              const std::array<const std::vector<double>*, Arrays>& values, size_t row,
-              const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
-              const std::array<const std::vector<double>*, Arrays>& old_values, size_t old_row,
-              std::span<const int32_t> old_of_new_column) {
-    return row_change<Arrays>(offsets, columns, values, row, old_offsets, old_columns, old_values, old_row,
-                              old_of_new_column) == RowChange::None;
-}
-
-// The same for a row of a three-channel matrix (a DiffusionMatrix, a hierarchy or multigrid level).
-inline RowChange matrix_row_change(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
-                                   const std::array<std::vector<double>, 3>& values, size_t row,
-                                   const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
-                                   const std::array<std::vector<double>, 3>& old_values, size_t old_row,
-                                   std::span<const int32_t> old_of_new_column) {
-    return row_change<3>(offsets, columns, {&values[0], &values[1], &values[2]}, row, old_offsets, old_columns,
-                         {&old_values[0], &old_values[1], &old_values[2]}, old_row, old_of_new_column);
-}
-
-inline bool same_matrix_row(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns,
-                            const std::array<std::vector<double>, 3>& values, size_t row,
-                            const std::vector<int32_t>& old_offsets, const std::vector<int32_t>& old_columns,
-                            const std::array<std::vector<double>, 3>& old_values, size_t old_row,
-                            std::span<const int32_t> old_of_new_column) {
-    return matrix_row_change(offsets, columns, values, row, old_offsets, old_columns, old_values, old_row,
-                             old_of_new_column) == RowChange::None;
 }
 
 struct CarriedRows {

@@ -483,14 +483,15 @@ std::vector<int32_t> level0_changes(const DiffusionMatrix& matrix, std::span<con
     moved.assign(n, 1);
     values_changed.assign(n, 1);
     std::vector<uint8_t> pattern_changed(n, 1);
+    const OperatorRows<3> rows = matrix_rows(matrix.offsets, matrix.columns, matrix.values);
+    const OperatorRows<3> old_rows = matrix_rows(old.offsets, old.columns, old.values);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 2048), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v != r.end(); ++v) {
             const int32_t o = old_of_new[v];
             if (o < 0) continue;
             const auto ou = static_cast<size_t>(o);
             moved[v] = !known_positions || positions[v] != previous.positions[ou];
-            const RowChange change = matrix_row_change(matrix.offsets, matrix.columns, matrix.values, v, old.offsets,
-                                                       old.columns, old.values, ou, old_of_new);
+            const RowChange change = row_change(rows, v, old_rows, ou, old_of_new);
             values_changed[v] = change != RowChange::None;
             pattern_changed[v] = change == RowChange::Pattern;
         }

@@ -329,8 +329,8 @@ namespace {
 
 bool same_interpolation_row(const InterpolationOperator& p, size_t row, const InterpolationOperator& old_p,
                             size_t old_row, const std::vector<int32_t>& old_of_new_column) {
-    return same_row<1>(p.offsets, p.columns, {&p.weights}, row, old_p.offsets, old_p.columns, {&old_p.weights}, old_row,
-                       old_of_new_column);
+    return row_change<1>({p.offsets, p.columns, {&p.weights}}, row, {old_p.offsets, old_p.columns, {&old_p.weights}},
+                         old_row, old_of_new_column) == RowChange::None;
 }
 
 }  // namespace
@@ -352,10 +352,11 @@ void MultigridPreconditioner::build_galerkin_operator(size_t l, const CarriedLev
                                                                      carried->old_of_new_coarse);
         });
         keep_product.assign(n, 0);
+        const OperatorRows<3> rows = matrix_rows(fine.offsets, fine.columns, fine.values);
+        const OperatorRows<3> old_rows = matrix_rows(old_fine.offsets, old_fine.columns, old_fine.values);
         for_rows(n, kGrain, [&](size_t v) {
             const int32_t o = carried->old_of_new_fine[v];
-            if (o < 0 || !same_matrix_row(fine.offsets, fine.columns, fine.values, v, old_fine.offsets, old_fine.columns,
-                                          old_fine.values, static_cast<size_t>(o), carried->old_of_new_fine))
+            if (o < 0 || row_change(rows, v, old_rows, static_cast<size_t>(o), carried->old_of_new_fine) != RowChange::None)
                 return;
             for (int32_t e = fine.offsets[v]; e < fine.offsets[v + 1]; ++e)
                 if (!same_interpolation[static_cast<size_t>(fine.columns[static_cast<size_t>(e)])]) return;
