@@ -704,8 +704,10 @@ int environment_count(const char* name, int fallback) {
 // the tets kept a 3e-6 degree angle and Jacobi CG could not reach the test's 1e-9 (the snap at a
 // hair's breadth in tetops/exact_cut.h; 0.014 degrees now, from a crossing 1e-3 of an edge away). The
 // GPU methods solve in float, whose floor is near 1e-6 on clean meshes and 7e-5 with that sliver (GPU
-// CG, seed 17): they converge to 1e-4 and are compared within 1e-3, enough to catch a stale row or
-// operator after an edit (errors of percents). Longer soaks:
+// CG, seed 17), so they converge to 1e-4. That bound is on the D-norm error (conjugate_gradient.h);
+// the max-norm difference checked here can be 50 times larger (seed 38 after 14 steps: 5e-3, near
+// slivers of 1.2 degrees and in specks of 6 vertices that no light reaches), so they are compared
+// within 2e-2: a matrix row or light the device did not get after an edit is off by far more. Longer soaks:
 // WAXWORK_EDIT_FIRST_SEED, WAXWORK_EDIT_SEQUENCES (20 per CPU method, a quarter of that per GPU method)
 // and WAXWORK_EDIT_STEPS (10).
 TEST(LiveSolver, RandomEditSequencesConvergeToTheFreshSolution) {
@@ -737,7 +739,7 @@ TEST(LiveSolver, RandomEditSequencesConvergeToTheFreshSolution) {
                 scene.step(static_cast<int>(rng() % 3) * 2);
                 if (step % 5 == 4 || step == steps - 1) {
                     ASSERT_NO_THROW(scene.converge());
-                    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), gpu ? 1e-3 : 1e-4);
+                    EXPECT_LT(relative_difference(scene.phi(), reference_phi(doc.mesh())), gpu ? 2e-2 : 1e-4);
                     EXPECT_EQ(scene.backend(), config.backend) << scene.gpu_fallback_reason();
                     // The paper's coarse-to-fine pass may skip a coarse level whose BiCGSTAB diverges
                     // (Eq. 17's operators are not symmetric; 4 of 250 soak sequences of 20 steps), which
