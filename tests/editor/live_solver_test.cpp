@@ -635,9 +635,33 @@ TEST(LiveSolver, DeviceRadianceDrawsWhatTheCpuRadianceDraws) {
     }
 }
 
+// A cut by a bent stroke seen edge-on from a random side, through the volume's middle, that cuts away
+// the side with fewer vertices, exact or relaxed.
+StrokeCutOp random_stroke_cut(const std::vector<Eigen::Vector3d>& world, std::mt19937& rng) {
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    const Eigen::Vector3d n = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized();
+    const Eigen::Vector3d across = n.unitOrthogonal(), along = n.cross(across);
+    Eigen::Vector3d middle = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& x : world) middle += x / static_cast<double>(world.size());
+    middle += 0.25 * n;
+    StrokeCutOp cut;
+    cut.stroke.eye = middle + 3.0 * across;
+    cut.stroke.view_direction = -across;
+    cut.stroke.points = {middle - along, middle + 0.1 * unit(rng) * n, middle + along};
+    cut.exact = rng() % 2;
+    cut.relax.iterations = cut.exact ? 0 : 5;
+    const StrokeCut surface(cut.stroke.eye, cut.stroke.view_direction, cut.stroke.points);
+    size_t cut_away = 0;
+    for (const Eigen::Vector3d& x : world) cut_away += surface.side(x) > 0 ? 1 : 0;
+    cut.stroke.flip = 2 * cut_away > world.size();
+    return cut;
+}
+
 // One random edit for `doc`, valid by construction (a cut keeps most of the volume, seeds and paint
-// points lie at vertices). `last_plane`: the last cut's plane, for relaxing towards it.
-EditOperation random_edit(const Document& doc, std::mt19937& rng, std::optional<PlaneSurface>& last_plane) {
+// points lie at vertices). `last_plane`: the last plane cut's plane, for relaxing towards it. With
+// `strokes`, half the cuts are stroke cuts (random_stroke_cut).
+EditOperation random_edit(const Document& doc, std::mt19937& rng, std::optional<PlaneSurface>& last_plane,
+                          bool strokes) {
     const TetMesh& mesh = doc.mesh();
     const std::vector<Eigen::Vector3d> world = world_positions(mesh);
     const auto random_vertex = [&] { return world[std::uniform_int_distribution<size_t>(0, world.size() - 1)(rng)]; };
@@ -649,6 +673,7 @@ EditOperation random_edit(const Document& doc, std::mt19937& rng, std::optional<
         }
         case 1: {
             if (mesh.tet_count() < 3000) continue;  // keep enough volume for the later edits
+            if (strokes && rng() % 2) return random_stroke_cut(world, rng);
             // Cut away the 20% of vertices furthest along a random direction.
             PlaneCutOp cut;
             cut.plane.normal = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized();
@@ -708,11 +733,11 @@ int environment_count(const char* name, int fallback) {
 // the max-norm difference checked here can be 50 times larger (seed 38 after 14 steps: 5e-3, near
 // slivers of 1.2 degrees and in specks of 6 vertices that no light reaches), so they are compared
 // within 2e-2: a matrix row or light the device did not get after an edit is off by far more. Longer soaks:
-// WAXWORK_EDIT_FIRST_SEED, WAXWORK_EDIT_SEQUENCES (20 per CPU method, a quarter of that per GPU method)
-// and WAXWORK_EDIT_STEPS (10).
-TEST(LiveSolver, RandomEditSequencesConvergeToTheFreshSolution) {
+// WAXWORK_EDIT_FIRST_SEED, WAXWORK_EDIT_SEQUENCES (20 per CPU method, a quarter of that per GPU method;
+// 8 with stroke cuts) and WAXWORK_EDIT_STEPS (10). The seeds above are those of the plane-cut mix.
+void check_random_edit_sequences(bool strokes, int default_sequences) {
     const int first_seed = environment_count("WAXWORK_EDIT_FIRST_SEED", 1);
-    const int sequences = environment_count("WAXWORK_EDIT_SEQUENCES", 20);
+    const int sequences = environment_count("WAXWORK_EDIT_SEQUENCES", default_sequences);
     const int steps = environment_count("WAXWORK_EDIT_STEPS", 10);
     for (Config config : kConfigs) {
         const bool gpu = config.backend == LiveBackend::Gpu;
@@ -731,7 +756,7 @@ TEST(LiveSolver, RandomEditSequencesConvergeToTheFreshSolution) {
                 } else if (choice == 1 && doc.can_redo()) {
                     change = doc.redo();
                 } else {
-                    change = doc.apply(random_edit(doc, rng, last_plane));
+                    change = doc.apply(random_edit(doc, rng, last_plane, strokes));
                 }
                 log += change->name + " (min " + std::to_string(doc.min_dihedral_deg()) + " deg); ";
                 SCOPED_TRACE(std::string(config.name) + ", seed " + std::to_string(seed) + ": " + log);
@@ -755,6 +780,10 @@ TEST(LiveSolver, RandomEditSequencesConvergeToTheFreshSolution) {
         }
     }
 }
+
+TEST(LiveSolver, RandomEditSequencesConvergeToTheFreshSolution) { check_random_edit_sequences(false, 20); }
+
+TEST(LiveSolver, RandomEditSequencesWithStrokeCutsConvergeToTheFreshSolution) { check_random_edit_sequences(true, 8); }
 
 TEST(LiveSolver, NamesParseAndBadNamesAreRejected) {
     EXPECT_EQ(parse_live_method(live_method_name(LiveMethod::MultigridCg)), LiveMethod::MultigridCg);
