@@ -138,18 +138,18 @@ bool may_slide(const TetMesh& mesh, const std::vector<KeptFace>& faces, int32_t 
     return along_a_face;
 }
 
-// Moves vertices whose crossing is within snap_fraction of them onto the surface when the guard on
-// their star allows it. Sequential in vertex order (deterministic); only vertices next to the
-// surface are involved, a small fraction of the mesh. A vertex on the boundary of the volume or on a
-// wall between regions only slides along an edge of those faces that stays in their planes (may_slide),
-// so the volume and earlier walls keep their shape; where no such edge reaches the surface the edges
-// are split instead.
 // A crossing this close to a boundary vertex (as a fraction of its edge) is snapped to even where the
 // boundary lets no edge slide (snap_vertices): small enough to leave the shape of the volume as it is
 // to rounding at the scale of a model (1e-6 of an edge), large enough to catch the near-degenerate
 // crossings that rounding and relaxation leave next to a wall (1e-7 of an edge and closer).
 constexpr double kHairline = 1e-6;
 
+// Moves vertices whose crossing is within snap_fraction of them onto the surface when the guard on
+// their star allows it. Sequential in vertex order (deterministic); only vertices next to the
+// surface are involved, a small fraction of the mesh. A vertex on the boundary of the volume or on a
+// wall between regions only slides along an edge of those faces that stays in their planes (may_slide),
+// so the volume and earlier walls keep their shape; where no such edge reaches the surface the edges
+// are split instead, unless the crossing lies within kHairline of a boundary vertex.
 size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::vector<double>& values,
                      const std::vector<int32_t>& crossed, const std::vector<int>& sign, const SplitField& field,
                      const SplitOptions& options, const std::vector<int32_t>& piece_of,
