@@ -30,6 +30,23 @@ inline bool keeps_vertex_order(std::span<const int32_t> new_of_old) {
     return true;
 }
 
+// How a rebuilt level's coarse vertices correspond to the previous hierarchy's. A coarse vertex is its
+// fine parent (HierarchyLevel::parent_vertex), so previous coarse vertex c is the new coarse vertex
+// whose parent is the new vertex of c's parent, or none (-1) when that parent was removed or is no
+// longer retained. new_of_old_fine: per previous fine vertex, its new one or -1; new_coarse_of_fine:
+// per new fine vertex, its coarse index or -1 (coarse_vertex_index). Returns per previous coarse
+// vertex its new one (the next level's new_of_old_fine).
+inline std::vector<int32_t> new_of_old_coarse_vertices(std::span<const int32_t> old_parent,
+                                                       std::span<const int32_t> new_of_old_fine,
+                                                       std::span<const int32_t> new_coarse_of_fine) {
+    std::vector<int32_t> new_of_old(old_parent.size(), -1);
+    for (size_t c = 0; c < old_parent.size(); ++c) {
+        const int32_t v = new_of_old_fine[static_cast<size_t>(old_parent[c])];
+        if (v >= 0) new_of_old[c] = new_coarse_of_fine[static_cast<size_t>(v)];
+    }
+    return new_of_old;
+}
+
 // One compressed-row operator as row_change reads it: offsets, columns and `Arrays` value arrays with
 // one value per entry (a matrix's three channels, an interpolation's weights).
 template <size_t Arrays>

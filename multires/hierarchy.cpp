@@ -562,13 +562,8 @@ MultiresHierarchy build_levels(const DiffusionMatrix& matrix, std::span<const Ei
         if (!step) break;
         std::optional<CarriedOperators> operators;
         if (carry) {
-            // The previous coarse vertices' new indices: through their parents, when still retained.
             const HierarchyLevel& old_coarse = previous->levels[l + 1];
-            std::vector<int32_t> next(old_coarse.parent_vertex.size(), -1);
-            for (size_t c = 0; c < next.size(); ++c) {
-                const int32_t v = new_of_old[static_cast<size_t>(old_coarse.parent_vertex[c])];
-                if (v >= 0) next[c] = step->coarse_index[static_cast<size_t>(v)];
-            }
+            std::vector<int32_t> next = new_of_old_coarse_vertices(old_coarse.parent_vertex, new_of_old, step->coarse_index);
             if (carry_rows) {
                 std::vector<uint8_t> touched(n);
                 for (size_t v = 0; v < n; ++v)

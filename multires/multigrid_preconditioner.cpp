@@ -190,6 +190,7 @@ struct MultigridPreconditioner::CarriedLevel {
     const Level* old_fine = nullptr;
     const Level* old_coarse = nullptr;
     std::vector<int32_t> old_of_new_fine;    // new level-l vertex -> previous
+    std::vector<int32_t> new_of_old_fine;    // previous level-l vertex -> new
     std::vector<int32_t> old_of_new_coarse;  // new level-(l+1) vertex -> previous
     std::vector<int32_t> new_of_old_coarse;  // previous level-(l+1) vertex -> new
 };
@@ -255,6 +256,7 @@ void MultigridPreconditioner::build_levels(const MultigridPreconditioner* previo
     std::optional<CarriedLevel> carried;
     if (previous) {
         carried.emplace();
+        carried->new_of_old_fine.assign(new_of_old_vertex.begin(), new_of_old_vertex.end());
         carried->old_of_new_fine = inverse_vertex_map(new_of_old_vertex, fine.size());
     }
     for (size_t l = 0; l + 1 < hierarchy.level_count(); ++l) {
@@ -267,20 +269,19 @@ void MultigridPreconditioner::build_levels(const MultigridPreconditioner* previo
             // The coarse vertices correspond through their parents (the retained fine vertices).
             carried->old_fine = previous->levels_[l].get();
             carried->old_coarse = previous->levels_[l + 1].get();
-            const std::vector<int32_t>& old_parent = previous->hierarchy_.levels[l + 1].parent_vertex;
             const std::vector<int32_t>& new_parent = hierarchy.levels[l + 1].parent_vertex;
-            const std::vector<int32_t> old_coarse_of_fine = inverse_vertex_map(old_parent, carried->old_fine->n);
-            carried->old_of_new_coarse.assign(new_parent.size(), -1);
-            for (size_t c = 0; c < new_parent.size(); ++c) {
-                const int32_t o = carried->old_of_new_fine[static_cast<size_t>(new_parent[c])];
-                if (o >= 0) carried->old_of_new_coarse[c] = old_coarse_of_fine[static_cast<size_t>(o)];
-            }
-            carried->new_of_old_coarse = inverse_vertex_map(carried->old_of_new_coarse, old_parent.size());
+            carried->new_of_old_coarse =
+                new_of_old_coarse_vertices(previous->hierarchy_.levels[l + 1].parent_vertex, carried->new_of_old_fine,
+                                           inverse_vertex_map(new_parent, levels_[l]->n));
+            carried->old_of_new_coarse = inverse_vertex_map(carried->new_of_old_coarse, new_parent.size());
         } else {
             carried.reset();
         }
         build_galerkin_operator(l + 1, carried ? &*carried : nullptr);
-        if (carried) carried->old_of_new_fine = std::move(carried->old_of_new_coarse);
+        if (carried) {
+            carried->old_of_new_fine = std::move(carried->old_of_new_coarse);
+            carried->new_of_old_fine = std::move(carried->new_of_old_coarse);
+        }
     }
     for (size_t l = 0; l < levels_.size(); ++l) {
         Level& level = *levels_[l];
