@@ -214,14 +214,15 @@ void LiveSolver::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matr
     // The device multigrid's operators live on the host: the ones waiting for the next GPU frame, or
     // the device solver's (released below).
     const MultigridOperators previous_waiting = std::exchange(multigrid_waiting_, MultigridOperators{});
-    const MultiresHierarchy* previous_device_hierarchy =
-        previous_waiting.hierarchy ? previous_waiting.hierarchy.get()
-        : gpu_ && gpu_->multigrid  ? &gpu_->multigrid->hierarchy()
-                                   : nullptr;
-    const MultigridPreconditioner* previous_device_preconditioner =
-        previous_waiting.hierarchy ? previous_waiting.preconditioner.get()
-        : gpu_ && gpu_->multigrid  ? &gpu_->multigrid->preconditioner()
-                                   : nullptr;
+    const MultiresHierarchy* previous_device_hierarchy = nullptr;
+    const MultigridPreconditioner* previous_device_preconditioner = nullptr;
+    if (previous_waiting.hierarchy) {
+        previous_device_hierarchy = previous_waiting.hierarchy.get();
+        previous_device_preconditioner = previous_waiting.preconditioner.get();
+    } else if (gpu_ && gpu_->multigrid) {
+        previous_device_hierarchy = &gpu_->multigrid->hierarchy();
+        previous_device_preconditioner = &gpu_->multigrid->preconditioner();
+    }
     forget_estimates();
     // Every copy is rebuilt from this matrix: nothing of the old one is pending, b and phi are.
     multigrid_pending_ = multires_pending_ = gpu_pending_ = PendingChanges{};
