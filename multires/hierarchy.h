@@ -95,7 +95,8 @@ struct HierarchyLevel {
     int enhancement_passes = 0;
     int64_t enhancement_vertices = 0;
     // rebuild_multires_hierarchy: how many of this level's vertices had no previous vertex or a changed
-    // row, around which the selection of level l+1 was made again; -1 when it was made from scratch.
+    // row, around which the selection of level l+1 was made again (from scratch when they are more
+    // than half); -1 when no row was compared (a fresh build, the levels below a level made from scratch).
     int64_t changed_vertices = -1;
     // rebuild_multires_hierarchy: how many of this level's Eq. 17 rows were copied from the previous
     // hierarchy rather than computed (0 on a fresh build and on level 0).
@@ -145,9 +146,10 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
 // (no changed row, selection state, position or fine matrix value within their stencil) are copied
 // from `previous` and renumbered, the others computed (carried_rows.h; copies happen only when the
 // map keeps the surviving vertices' order, as a cut's compaction does, so they equal computed rows
-// bit for bit). Levels past the previous hierarchy's depth are selected from scratch. The result has every property the
-// tests ask of a fresh build (independent-set cover, no lost connection, Eq. 17 on its own graphs)
-// but is not the fresh build's selection. When no row changed (positions or values only) every
+// bit for bit). Levels past the previous hierarchy's depth are selected from scratch, and so are the
+// first level where more than half of the rows changed and every coarser one (little would be left
+// to carry). The result has every property the tests ask of a fresh build (independent-set cover, no
+// lost connection, Eq. 17 on its own graphs) but is not the fresh build's selection. When no row changed (positions or values only) every
 // selection is previous's, so a rebuild of a fresh build equals build_multires_hierarchy(matrix,
 // positions, options) exactly without selecting anything again. Throws as build_multires_hierarchy,
 // and InvalidArgumentError when `options` are not the ones `previous` was built with, the map's size

@@ -630,6 +630,49 @@ TEST(HierarchyRebuild, AShuffledMapCarriesTheSelectionButCopiesNoRow) {
     }
 }
 
+// Where more than half of a level's rows changed, that level and every coarser one are selected from
+// scratch (nothing copied, no rows compared below it); with the change on level 0 the rebuild is a
+// fresh build bit for bit. The edit here keeps the first `kept` vertices and gives the others no
+// previous vertex (as if they were new), on the same mesh.
+TEST(HierarchyRebuild, SelectsFromScratchFromTheFirstLevelWhereMostRowsChanged) {
+    const auto s = testing::make_test_system(12);
+    const HierarchyOptions options = testing::small_levels(50);
+    const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions, options);
+    ASSERT_GE(before.level_count(), 3u);
+    const size_t n = s.matrix.size();
+    const auto rebuild_keeping = [&](size_t kept) {
+        std::vector<int32_t> new_of_old(n, -1);
+        std::iota(new_of_old.begin(), new_of_old.begin() + static_cast<std::ptrdiff_t>(kept), 0);
+        return rebuild_multires_hierarchy(before, new_of_old, s.matrix, s.mesh.positions, options);
+    };
+    // The levels below the first one with a majority of changed rows were not carried.
+    const auto expect_fresh_below_a_majority = [](const MultiresHierarchy& h) {
+        bool fresh = false;
+        for (size_t l = 0; l < h.level_count(); ++l) {
+            if (fresh) {
+                EXPECT_EQ(h.levels[l].copied_rows, 0) << "level " << l;
+                EXPECT_EQ(h.levels[l].changed_vertices, -1) << "level " << l;
+            }
+            fresh = fresh || 2 * h.levels[l].changed_vertices > static_cast<int64_t>(h.levels[l].size());
+        }
+    };
+    const MultiresHierarchy mostly_new = rebuild_keeping(n * 2 / 5);
+    EXPECT_GT(2 * mostly_new.levels[0].changed_vertices, static_cast<int64_t>(n));
+    expect_fresh_below_a_majority(mostly_new);
+    expect_same_levels(mostly_new, build_multires_hierarchy(s.matrix, s.mesh.positions, options));
+
+    const MultiresHierarchy mostly_kept = rebuild_keeping(n * 4 / 5);
+    EXPECT_LT(2 * mostly_kept.levels[0].changed_vertices, static_cast<int64_t>(n));
+    EXPECT_GT(mostly_kept.levels[1].copied_rows, 0);  // level 0 was carried
+    expect_fresh_below_a_majority(mostly_kept);
+    expect_valid_hierarchy(mostly_kept, s.mesh.positions, /*dense_check=*/false);
+    // Here a coarse level changed in the majority (the fixed-size change is a larger share of it).
+    bool coarse_majority = false;
+    for (size_t l = 1; l < mostly_kept.level_count(); ++l)
+        coarse_majority = coarse_majority || 2 * mostly_kept.levels[l].changed_vertices > static_cast<int64_t>(mostly_kept.levels[l].size());
+    EXPECT_TRUE(coarse_majority);
+}
+
 TEST(HierarchyRebuild, RejectsAVertexMapOrOptionsThatDoNotFit) {
     const auto s = testing::make_test_system(4);
     const MultiresHierarchy before = build_multires_hierarchy(s.matrix, s.mesh.positions);
