@@ -1,6 +1,8 @@
 #include "io/surface_reader.h"
 #include "tetops/error.h"
 #include "tetops/quality.h"
+#include "tetops/size_field.h"
+#include "tetops/tetgen_mesher.h"
 #include "tetops/tetrahedralize.h"
 
 #include <gtest/gtest.h>
@@ -187,6 +189,37 @@ TEST(TetrahedralizeTest, TargetTetCountWithinTwentyPercent) {
     const MeshingResult cgal = tetrahedralize(spot, options);
     EXPECT_NEAR(double(cgal.mesh.tet_count()), 5'000, 1'000);
     EXPECT_TRUE(find_invariant_violations(cgal.mesh).empty());
+}
+
+// A target TetGen cannot reach while keeping the surface's triangles is refused with the count it
+// needs: below its bare tetrahedralization of the surface (no quality bound) at once, after that one
+// run alone; between that and the coarsest quality mesh after the quality runs, naming the coarsest.
+TEST(TetrahedralizeTest, RefusesATargetBelowTetGensFloorNamingTheFloor) {
+    const TriangleSurface spot = asset_surface("spot.obj");
+    TetGenSettings settings;
+    settings.size = SizeField::unbounded();
+    settings.quality = false;
+    const size_t bare = tetgen_tetrahedralize(spot, settings).tet_count();
+    settings.quality = true;
+    const size_t coarsest = tetgen_tetrahedralize(spot, settings).tet_count();
+    ASSERT_LT(2 * bare, coarsest);  // room for a target between the two
+    const auto refusal = [&](size_t target) {
+        MeshingOptions options;
+        options.sizing.target_tets = target;
+        try {
+            tetrahedralize(spot, options);
+        } catch (const InvalidArgumentError& error) {
+            EXPECT_NE(std::string(error.what()).find("--mesher cgal"), std::string::npos) << error.what();
+            return std::string(error.what());
+        }
+        ADD_FAILURE() << "a target of " << target << " tets was not refused";
+        return std::string();
+    };
+    const std::string below_bare = refusal(bare / 2);
+    EXPECT_NE(below_bare.find("more than " + std::to_string(bare) + " tets"), std::string::npos) << below_bare;
+    EXPECT_NE(below_bare.find("without quality bounds"), std::string::npos) << below_bare;
+    const std::string below_quality = refusal(bare + (coarsest - bare) / 4);
+    EXPECT_NE(below_quality.find("at least " + std::to_string(coarsest) + " tets"), std::string::npos) << below_quality;
 }
 
 TEST(TetrahedralizeTest, CgalGivesValidPositiveMeshes) {
