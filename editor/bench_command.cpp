@@ -55,7 +55,7 @@ TetMesh load_or_mesh(const SolversCommandOptions& o) {
     const LoadedSurface surface = load_surface_to_mesh(o.mesh, o.meshing);
     MeshingOptions meshing = meshing_options(o.meshing);
     meshing.sizing.target_tets = o.max_tets;
-    return tetrahedralize(surface.surface, meshing).mesh;
+    return tetrahedralize_surface_file(o.mesh, surface.surface, meshing).mesh;
 }
 
 // The longest side of the bounding box becomes 100 mm unless --scale says otherwise.

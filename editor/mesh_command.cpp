@@ -42,7 +42,7 @@ void run_mesh_command(const MeshCommandOptions& o) {
         const TetMaterial material = chosen_material(o.material).value_or(material_preset("marble"));
         options.sizing = default_mesh_sizing(loaded.surface, material, o.scale);
     }
-    MeshingResult result = tetrahedralize(loaded.surface, options);
+    MeshingResult result = tetrahedralize_surface_file(o.input, loaded.surface, options);
     if (const auto material = chosen_material(o.material))
         result.mesh.materials.assign(result.mesh.tet_count(), *material);
     write_volume(result.mesh, o.output);

@@ -4,6 +4,7 @@
 #include "editor/live_scene.h"
 #include "editor/live_solver_choice.h"
 #include "editor/render_pipeline.h"
+#include "editor/surface_meshing_options.h"
 #include "io/atomic_file.h"
 #include "io/image_io.h"
 #include "io/surface_reader.h"
@@ -323,7 +324,7 @@ TetMesh load_session_input(const Session& session) {
     } else {
         meshing.sizing = default_mesh_sizing(loaded.surface, session.material, session.scale);
     }
-    return tetrahedralize(loaded.surface, meshing).mesh;
+    return tetrahedralize_surface_file(session.input.surface, loaded.surface, meshing).mesh;
 }
 
 FrameBudget session_frame_budget(const Session& session, const SessionRunOptions& run_options) {

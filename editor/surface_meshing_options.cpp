@@ -1,5 +1,7 @@
 #include "editor/surface_meshing_options.h"
 
+#include "tetops/error.h"
+
 #include <CLI/CLI.hpp>
 
 #include <iostream>
@@ -32,6 +34,19 @@ MeshingOptions meshing_options(const SurfaceMeshingOptions& options) {
     meshing.min_dihedral_deg = options.min_dihedral;
     meshing.max_radius_edge_ratio = options.radius_edge;
     return meshing;
+}
+
+MeshingResult tetrahedralize_surface_file(const std::filesystem::path& path, const TriangleSurface& surface,
+                                          const MeshingOptions& options) {
+    try {
+        return tetrahedralize(surface, options);
+    } catch (const InvalidArgumentError& error) {
+        throw InvalidArgumentError(path.string() + ": " + error.what());
+    } catch (const InvalidMeshError& error) {
+        throw InvalidMeshError(path.string() + ": " + error.what());
+    } catch (const AlgorithmError& error) {
+        throw AlgorithmError(path.string() + ": " + error.what());
+    }
 }
 
 }  // namespace waxwork

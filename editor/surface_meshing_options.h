@@ -7,6 +7,7 @@
 #include "io/surface_reader.h"
 #include "tetops/tetrahedralize.h"
 
+#include <filesystem>
 #include <string>
 
 namespace CLI {
@@ -33,5 +34,10 @@ LoadedSurface load_surface_to_mesh(const std::string& path, const SurfaceMeshing
 // The mesher and quality bounds of the options; the caller sets the sizing. tetrahedralize() validates
 // them.
 MeshingOptions meshing_options(const SurfaceMeshingOptions& options);
+
+// tetrahedralize(surface, options) for the surface read from `path`: its errors name the file
+// ("PATH: PROBLEM", the same error type), since the meshers' own messages know no file.
+MeshingResult tetrahedralize_surface_file(const std::filesystem::path& path, const TriangleSurface& surface,
+                                          const MeshingOptions& options);
 
 }  // namespace waxwork

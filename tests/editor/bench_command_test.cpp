@@ -166,6 +166,7 @@ TEST(BenchSolversCommand, MeshesASurfaceWithTheChosenMesherAndMaterial) {
     EXPECT_EQ(tetgen.exit_code, 1);
     EXPECT_EQ(testing::line_count(tetgen.err), 1u) << tetgen.err;
     EXPECT_NE(tetgen.err.find("--mesher cgal"), std::string::npos) << tetgen.err;
+    EXPECT_NE(tetgen.err.find("spot.obj: "), std::string::npos) << tetgen.err;
     std::map<std::string, int> jacobi_caps;
     for (const std::string material : {"marble", "ketchup"}) {
         const auto out = dir / material;

@@ -131,5 +131,17 @@ TEST(Cli, AbsurdParametersAreRejected) {
     EXPECT_FALSE(fs::exists(dir / "x.vtu"));
 }
 
+// A size the mesher refuses for this surface is reported with the surface file's name: spot's
+// triangles, which TetGen keeps, need more than 3,000 tets.
+TEST(Cli, AMeshingRefusalNamesTheSurfaceFile) {
+    const auto dir = scratch_dir("cli_refusal");
+    const std::string surface = kAssets + "/meshes/spot.obj";
+    const auto r = run_waxwork("mesh " + surface + " -o " + (dir / "x.vtu").string() + " --max-tets 3000");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(surface + ": meshing option sizing.target_tets = 3000"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "x.vtu"));
+}
+
 }  // namespace
 }  // namespace waxwork
