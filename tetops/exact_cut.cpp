@@ -140,9 +140,12 @@ bool may_slide(const TetMesh& mesh, const std::vector<KeptFace>& faces, int32_t 
 
 // A crossing this close to a boundary vertex (as a fraction of its edge) is snapped to even where the
 // boundary lets no edge slide (snap_vertices): small enough to leave the shape of the volume as it is
-// to rounding at the scale of a model (1e-6 of an edge), large enough to catch the near-degenerate
-// crossings that rounding and relaxation leave next to a wall (1e-7 of an edge and closer).
-constexpr double kHairline = 1e-6;
+// to the eye (1e-3 of an edge, 68 times less than a slide at the default bend may move it), large
+// enough to catch the near-degenerate crossings that rounding, relaxation and earlier cuts leave next
+// to a corner or a wall. Random edit sequences found 4e-9 of an edge (a 3e-6 degree sliver), 3e-6 next
+// to a cube's corner (0.004 degrees) and 1e-3 next to a relaxed cross-section (0.014 degrees);
+// LiveSolver.RandomEditSequences* in tests/editor/live_solver_test.cpp.
+constexpr double kHairline = 1e-3;
 
 // Moves vertices whose crossing is within snap_fraction of them onto the surface when the guard on
 // their star allows it. Sequential in vertex order (deterministic); only vertices next to the
@@ -228,10 +231,9 @@ size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::ve
                     target_world = candidates[i].target;
             // Where no boundary edge may slide (a corner, a crease, a bumpy part such as a relaxed
             // cut's cross-section), a crossing a hair's breadth from the vertex would still be split
-            // off as a sliver of almost no angle (a relaxed vertex 4e-9 from a Voronoi wall left one
-            // of 3e-6 degrees). A step to it along its own edge moves the outer surface by at most
-            // kHairline of an edge, far below what a slide may (sin(bend) x snap_fraction); walls
-            // between cells keep their planes, and bend 0 keeps the surface exactly.
+            // off as a sliver of almost no angle. A step to it along its own edge moves the outer
+            // surface by at most kHairline of an edge, far below what a slide may (sin(bend) x
+            // snap_fraction); walls between cells keep their planes, and bend 0 keeps the surface exactly.
             const bool on_walls = std::any_of(kept.begin(), kept.end(), [](const KeptFace& f) { return !f.on_boundary; });
             if (!target_world && !on_walls && options.boundary_bend_deg > 0 && candidates[begin].fraction <= kHairline)
                 target_world = candidates[begin].target;

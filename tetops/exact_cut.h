@@ -50,7 +50,7 @@ struct SplitOptions {
     // (degrees): 0 keeps the shape of the volume exactly (vertices slide only within flat parts and
     // along straight creases), more trades a change of the outer surface of at most
     // sin(bend) x snap_fraction x edge length for fewer slivers where the surface is curved. With
-    // bend > 0 a crossing within 1e-6 of an edge from the vertex is snapped to along that edge even
+    // bend > 0 a crossing within 1e-3 of an edge from the vertex is snapped to along that edge even
     // where nothing may slide (a corner, a crease, a bumpy relaxed cross-section): split, it would
     // leave a sliver of almost no angle.
     double boundary_bend_deg = 0;

@@ -727,9 +727,10 @@ int environment_count(const char* name, int fallback) {
 // fresh scene gives on the volume reached, on its backend and without falling back. Seed 17 found an
 // exact fracture whose wall passed 4e-9 from a vertex of a relaxed cut's cross-section: split there,
 // the tets kept a 3e-6 degree angle and Jacobi CG could not reach the test's 1e-9 (the snap at a
-// hair's breadth in tetops/exact_cut.h; 0.014 degrees now, from a crossing 1e-3 of an edge away). The
-// GPU methods solve in float, whose floor is near 1e-6 on clean meshes and 7e-5 with that sliver (GPU
-// CG, seed 17), so they converge to 1e-4. That bound is on the D-norm error (conjugate_gradient.h);
+// hair's breadth in tetops/exact_cut.h). Seeds 17 and 570 (20 steps) found crossings 1e-3 and 3e-6 of
+// an edge from a stuck vertex, 0.014 and 0.004 degrees when split, on which GPU CG in float stalled at
+// 7e-5 and 6e-4; the snap reaches 1e-3 of an edge since. The GPU methods solve in float, whose floor
+// is near 1e-6 on clean meshes, so they converge to 1e-4. That bound is on the D-norm error (conjugate_gradient.h);
 // the max-norm difference checked here can be 50 times larger (seed 38 after 14 steps: 5e-3, near
 // slivers of 1.2 degrees and in specks of 6 vertices that no light reaches), so they are compared
 // within 2e-2: a matrix row or light the device did not get after an edit is off by far more. Longer soaks:

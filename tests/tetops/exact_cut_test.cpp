@@ -161,36 +161,46 @@ TEST(ExactCut, BoundaryBendZeroKeepsACurvedSurfaceExactly) {
     EXPECT_THROW(cut_exact(bent, plane, options), InvalidArgumentError);
 }
 
-// A boundary vertex where nothing may slide (a bump of 26 degrees on a cube face) lies 1e-9 past the
-// plane. Split there, its edges would leave tets of almost no angle (a 0 degree minimum); with a bend
-// allowance it steps onto the plane instead (1e-9 of the surface moved), and with bend 0 the surface
-// is kept exactly and the sliver is counted under the guard.
+// A boundary vertex where nothing may slide (a bump of 26 degrees on a cube face) lies a hair past the
+// plane: 1e-9, and 1e-4 (6e-4 of its edges along x, 1/6 long). Split there, its edges would leave tets
+// of almost no angle; with a bend allowance it steps onto the plane instead (the surface moves by at
+// most 1e-3 of an edge), and with bend 0 the surface is kept exactly and the sliver is counted under
+// the guard. 5e-4 past it (3e-3 of an edge) the vertex stays where it is and the edges are split.
 TEST(ExactCut, ACrossingAHairFromAStuckBoundaryVertexIsSnappedNotSplit) {
-    TetMesh before = make_cube_mesh(6);
-    int32_t bumped = -1;
-    for (size_t v = 0; v < before.vertex_count(); ++v)
-        if ((before.positions[v] - Eigen::Vector3d(0.5, 0, 0.5)).norm() < 1e-12) bumped = static_cast<int32_t>(v);
-    ASSERT_GE(bumped, 0);
-    before.positions[static_cast<size_t>(bumped)] += Eigen::Vector3d(1e-9, -0.08, 0);
-    const double angle_before = measure_quality(before).min_dihedral_deg;
-    const PlaneCut plane(Eigen::Vector3d(1, 0, 0), 0.5);
+    for (const double past : {1e-9, 1e-4, 5e-4}) {
+        SCOPED_TRACE("the vertex " + std::to_string(past) + " past the plane");
+        TetMesh before = make_cube_mesh(6);
+        int32_t bumped = -1;
+        for (size_t v = 0; v < before.vertex_count(); ++v)
+            if ((before.positions[v] - Eigen::Vector3d(0.5, 0, 0.5)).norm() < 1e-12) bumped = static_cast<int32_t>(v);
+        ASSERT_GE(bumped, 0);
+        before.positions[static_cast<size_t>(bumped)] += Eigen::Vector3d(past, -0.08, 0);
+        const double angle_before = measure_quality(before).min_dihedral_deg;
+        const PlaneCut plane(Eigen::Vector3d(1, 0, 0), 0.5);
 
-    TetMesh snapped = before;
-    const ExactCutResult r = cut_exact(snapped, plane);
-    EXPECT_EQ(r.vertices_added, 0u);
-    EXPECT_EQ(r.tets_under_guard, 0u);
-    EXPECT_NEAR(r.min_dihedral_deg, angle_before, 1e-6);
-    for (const auto& p : snapped.positions) EXPECT_LE(plane.side(p), 1e-14);
-    expect_valid_conforming(snapped);
+        TetMesh snapped = before;
+        const ExactCutResult r = cut_exact(snapped, plane);
+        for (const auto& p : snapped.positions) EXPECT_LE(plane.side(p), 1e-14);
+        expect_valid_conforming(snapped);
+        EXPECT_EQ(r.tets_under_guard, 0u);
+        if (past < 1e-3 / 6) {
+            EXPECT_EQ(r.vertices_added, 0u);
+            EXPECT_GT(r.min_dihedral_deg, 0.9 * angle_before);  // the bump, not a sliver
+        } else {
+            EXPECT_GT(r.vertices_added, 0u);
+        }
 
-    TetMesh exact_shape = before;
-    ExactCutOptions keep_shape;
-    keep_shape.split.boundary_bend_deg = 0;
-    const ExactCutResult kept = cut_exact(exact_shape, plane, keep_shape);
-    EXPECT_GT(kept.vertices_added, 0u);
-    EXPECT_GE(kept.tets_under_guard, 1u);
-    EXPECT_LT(kept.min_dihedral_deg, 1e-3);
-    for (const auto& p : exact_shape.positions) EXPECT_LE(plane.side(p), 1e-14);
+        TetMesh exact_shape = before;
+        ExactCutOptions keep_shape;
+        keep_shape.split.boundary_bend_deg = 0;
+        const ExactCutResult kept = cut_exact(exact_shape, plane, keep_shape);
+        EXPECT_GT(kept.vertices_added, 0u);
+        if (past < 1e-3 / 6) {
+            EXPECT_GE(kept.tets_under_guard, 1u);
+            EXPECT_LT(kept.min_dihedral_deg, 0.5);
+        }
+        for (const auto& p : exact_shape.positions) EXPECT_LE(plane.side(p), 1e-14);
+    }
 }
 
 TEST(ExactCut, PlanesThroughVerticesAndEdges) {
