@@ -124,20 +124,22 @@ struct LostConnections {
 // exactly when tag[j] == i. Tagging the rows of i's few joiners reads contiguous rows; intersecting
 // per-vertex lists of retained neighbours for every pair instead (the first version) reads two
 // scattered lists per pair and took 1.7x as long at 97K vertices.
+// One selection keeps its tags through all its tests: a tag left by an earlier test names a joiner
+// that is still retained (the retained set only grows), so it can only say "joined", which stays true.
 class JoinedTags {
 public:
     explicit JoinedTags(size_t vertex_count) : tags_([vertex_count] { return std::vector<int32_t>(vertex_count, -1); }) {}
 
-    // Tags, on the calling thread, the neighbours of each neighbour k of i with is_joiner(k); returns
-    // the thread's tags.
+    // The calling thread's tags, to fetch once per range (each fetch is a thread-local lookup).
+    std::vector<int32_t>& local() { return tags_.local(); }
+
+    // Tags in `tags` the neighbours of each neighbour k of i with is_joiner(k).
     template <typename IsJoiner>
-    const std::vector<int32_t>& tag(const CompressedRows& graph, size_t i, IsJoiner&& is_joiner) {
-        std::vector<int32_t>& tag = tags_.local();
+    static void tag(const CompressedRows& graph, size_t i, IsJoiner&& is_joiner, std::vector<int32_t>& tags) {
         const auto key = static_cast<int32_t>(i);
         for (int32_t k : graph.row(i))
             if (is_joiner(static_cast<size_t>(k)))
-                for (int32_t u : graph.row(static_cast<size_t>(k))) tag[static_cast<size_t>(u)] = key;
-        return tag;
+                for (int32_t u : graph.row(static_cast<size_t>(k))) tags[static_cast<size_t>(u)] = key;
     }
 
 private:
@@ -147,19 +149,19 @@ private:
 // Tests the vertices `vertex(0 .. count)` names (every vertex, or a list); the others get no partners.
 template <typename VertexAt>
 LostConnections find_lost_connections(const CompressedRows& graph, std::span<const uint8_t> retained, size_t count,
-                                      VertexAt&& vertex) {
+                                      VertexAt&& vertex, JoinedTags& joined) {
     const size_t n = graph.row_count();
     LostConnections lost;
     lost.count.assign(n, 0);
     lost.partners = std::make_unique_for_overwrite<int32_t[]>(graph.indices.size());
-    JoinedTags joined(n);
     // Each vertex tests all its dropped neighbours (the test is symmetric, so both ends of a lost edge
     // list it), and writes only its own slots.
     tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrain), [&](const tbb::blocked_range<size_t>& range) {
+        std::vector<int32_t>& tag = joined.local();
         for (size_t a = range.begin(); a != range.end(); ++a) {
             const size_t i = vertex(a);
             if (retained[i]) continue;
-            const std::vector<int32_t>& tag = joined.tag(graph, i, [&](size_t k) { return retained[k] != 0; });
+            JoinedTags::tag(graph, i, [&](size_t k) { return retained[k] != 0; }, tag);
             auto out = static_cast<size_t>(graph.offsets[i]);
             for (int32_t j : graph.row(i))
                 if (!retained[static_cast<size_t>(j)] && tag[static_cast<size_t>(j)] != static_cast<int32_t>(i))
@@ -170,8 +172,9 @@ LostConnections find_lost_connections(const CompressedRows& graph, std::span<con
     return lost;
 }
 
-LostConnections find_lost_connections(const CompressedRows& graph, std::span<const uint8_t> retained) {
-    return find_lost_connections(graph, retained, graph.row_count(), [](size_t a) { return a; });
+LostConnections find_lost_connections(const CompressedRows& graph, std::span<const uint8_t> retained,
+                                      JoinedTags& joined) {
+    return find_lost_connections(graph, retained, graph.row_count(), [](size_t a) { return a; }, joined);
 }
 
 // The enhancement's later passes: which of `candidates` (ascending; the vertices with lost connections
@@ -182,14 +185,14 @@ LostConnections find_lost_connections(const CompressedRows& graph, std::span<con
 // lists are compacted in place to the edges still lost.
 std::vector<int32_t> still_lost(const CompressedRows& graph, std::span<const uint8_t> retained,
                                 std::span<const uint8_t> fresh, std::span<const int32_t> candidates,
-                                LostConnections& lost) {
-    JoinedTags joined(graph.row_count());
+                                LostConnections& lost, JoinedTags& joined) {
     std::vector<uint8_t> is_lost(candidates.size(), 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<int32_t>& tag = joined.local();
         for (size_t a = r.begin(); a != r.end(); ++a) {
             const auto i = static_cast<size_t>(candidates[a]);
             if (retained[i]) continue;
-            const std::vector<int32_t>& tag = joined.tag(graph, i, [&](size_t k) { return fresh[k] != 0; });
+            JoinedTags::tag(graph, i, [&](size_t k) { return fresh[k] != 0; }, tag);
             const auto first = static_cast<size_t>(graph.offsets[i]);
             size_t kept = first;
             for (size_t q = first; q < first + static_cast<size_t>(lost.count[i]); ++q) {
@@ -210,7 +213,8 @@ std::vector<int32_t> still_lost(const CompressedRows& graph, std::span<const uin
 }  // namespace
 
 std::vector<uint8_t> mark_lost_connections(const CompressedRows& graph, std::span<const uint8_t> retained) {
-    const LostConnections lost = find_lost_connections(graph, retained);
+    JoinedTags joined(graph.row_count());
+    const LostConnections lost = find_lost_connections(graph, retained, joined);
     std::vector<uint8_t> marked(lost.count.size());
     for (size_t v = 0; v < marked.size(); ++v) marked[v] = lost.count[v] > 0;
     return marked;
@@ -227,7 +231,7 @@ int64_t count_retained(std::span<const uint8_t> retained) {
 // The enhancement loop (independent_set.h) from the lost connections `lost` of `selection.retained`:
 // marks their ends, runs the rounds on them, and repeats on the connections still lost.
 void enhance_selection(const CompressedRows& graph, std::span<const uint32_t> codes, LostConnections& lost,
-                       VertexSelection& selection) {
+                       JoinedTags& joined, VertexSelection& selection) {
     const size_t n = graph.row_count();
     const int64_t before = count_retained(selection.retained);
     std::vector<uint8_t> marked(n, 0);
@@ -243,7 +247,7 @@ void enhance_selection(const CompressedRows& graph, std::span<const uint32_t> co
         run_independent_set_rounds(graph, codes, marked, selection.retained);  // clears `marked`
         // Only candidates were queued, so the candidates now retained are the pass's new vertices.
         for (int32_t v : candidates) fresh[static_cast<size_t>(v)] = selection.retained[static_cast<size_t>(v)];
-        std::vector<int32_t> next = still_lost(graph, selection.retained, fresh, candidates, lost);
+        std::vector<int32_t> next = still_lost(graph, selection.retained, fresh, candidates, lost, joined);
         for (int32_t v : candidates) fresh[static_cast<size_t>(v)] = 0;
         candidates = std::move(next);
         for (int32_t v : candidates) marked[static_cast<size_t>(v)] = 1;
@@ -261,8 +265,9 @@ VertexSelection select_coarse_vertices(const CompressedRows& graph, uint32_t see
     std::vector<uint8_t> queue(n, 1);
     selection.independent_set_rounds = run_independent_set_rounds(graph, codes, queue, selection.retained);
     if (!enhance) return selection;
-    LostConnections lost = find_lost_connections(graph, selection.retained);
-    enhance_selection(graph, codes, lost, selection);
+    JoinedTags joined(n);
+    LostConnections lost = find_lost_connections(graph, selection.retained, joined);
+    enhance_selection(graph, codes, lost, joined, selection);
     return selection;
 }
 
@@ -313,9 +318,10 @@ VertexSelection update_coarse_vertices(const CompressedRows& graph, uint32_t see
     std::vector<int32_t> region;
     for (size_t v = 0; v < n; ++v)
         if (tested[v]) region.push_back(static_cast<int32_t>(v));
+    JoinedTags joined(n);
     LostConnections lost = find_lost_connections(graph, selection.retained, region.size(),
-                                                 [&](size_t a) { return static_cast<size_t>(region[a]); });
-    enhance_selection(graph, codes, lost, selection);
+                                                 [&](size_t a) { return static_cast<size_t>(region[a]); }, joined);
+    enhance_selection(graph, codes, lost, joined, selection);
     return selection;
 }
 
