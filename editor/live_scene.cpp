@@ -263,9 +263,21 @@ FrameReport LiveScene::converge(int max_iterations) {
     const std::lock_guard lock(mutex_);
     FrameReport report = iterate(max_iterations);
     if (!report.converged) {
+        // A channel that stopped inside its budget met its precision's floor (conjugate_gradient.h):
+        // more iterations would not help, another precision might. A multigrid budget counts V-cycles.
+        const int budget = options_.method == LiveMethod::MultigridCg ? std::max(1, max_iterations / 4) : max_iterations;
+        bool at_floor = false;
+        for (int c = 0; c < 3; ++c)
+            at_floor = at_floor || (!converged_[c] && report.iterations[c] < budget);
         std::ostringstream msg;
-        msg << "live scene: the diffusion solve did not reach relative error " << options_.relative_tolerance
-            << " in " << max_iterations << " iterations (estimated " << report.max_error() << ")";
+        msg << "live scene: the diffusion solve did not reach relative error " << options_.relative_tolerance;
+        if (at_floor) {
+            msg << ": it stopped at an estimated " << report.max_error() << ", the precision floor of "
+                << solver_->description() << " on this volume";
+            if (solver_->backend() == LiveBackend::Gpu) msg << "; the CPU backend solves in double";
+        } else {
+            msg << " in " << max_iterations << " iterations (estimated " << report.max_error() << ")";
+        }
         throw AlgorithmError(msg.str());
     }
     return report;

@@ -557,6 +557,31 @@ TEST(LiveSolver, GpuMultigridThatCannotBeBuiltFallsBackToGpuJacobiWithAReason) {
     }
 }
 
+// A tolerance below what float can reach on a volume of slivers: GPU CG stops at its precision floor
+// (within its budget, not after it) and converge() says so, naming the float GPU and the double CPU
+// backend; the CPU backend reaches the same tolerance.
+TEST(LiveSolver, ConvergingBelowTheFloatFloorOnTheGpuSaysWhy) {
+    TetMesh mesh = make_box_mesh({10, 10, 10}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(1));
+    flatten_into_slivers(mesh, build_connectivity(mesh), 6, 1e-5);
+    Document doc(mesh, material_preset("marble"));
+    Config gpu = kConfigs[2];  // GPU Jacobi CG
+    gpu.tolerance = 1e-8;
+    LiveScene scene(doc.mesh(), key_lighting(), options_for(gpu));
+    ASSERT_EQ(scene.backend(), LiveBackend::Gpu) << scene.gpu_fallback_reason();
+    try {
+        scene.converge();
+        ADD_FAILURE() << "float CG reached 1e-8 on slivers of 1e-5";
+    } catch (const AlgorithmError& error) {
+        const std::string what = error.what();
+        EXPECT_NE(what.find("precision floor of GPU Jacobi CG"), std::string::npos) << what;
+        EXPECT_NE(what.find("the CPU backend solves in double"), std::string::npos) << what;
+    }
+    Config cpu = kConfigs[0];
+    cpu.tolerance = 1e-8;
+    LiveScene on_cpu(doc.mesh(), key_lighting(), options_for(cpu));
+    EXPECT_TRUE(on_cpu.converge().converged);
+}
+
 // The renderer reading E from the GPU solver's buffer draws what it draws from the CPU's E.
 TEST(LiveSolver, DeviceRadianceDrawsWhatTheCpuRadianceDraws) {
     // Every device solver: Jacobi CG, the multigrid CG and the multires hierarchy keep phi resident.
