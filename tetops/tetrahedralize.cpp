@@ -31,7 +31,7 @@ constexpr double kTargetPromise = 0.20;
 constexpr int kMaxTargetPasses = 4;
 // TetGen's bare constrained Delaunay tetrahedralization (the surface's triangles, no quality bound)
 // has 1.4-2.8 tets per surface triangle on the shared meshes; a target below this many per triangle
-// may be out of reach and is checked against it first.
+// may be out of reach and is checked against it, then against the coarsest quality mesh, first.
 constexpr double kBareCheckTetsPerTriangle = 4.0;
 
 std::string to_string(double value) {
@@ -176,11 +176,8 @@ TetMesh run_mesher(const TriangleSurface& surface, const MeshingOptions& options
 // Delaunay tetrahedralization costs a fraction of a quality run (skull, 100K triangles: 284,411 tets
 // in 3.6 s, where the coarsest quality mesh has 1,732,676 and takes 66 s), and the quality bounds only
 // add vertices to it (1.4-6x the tets on the shared meshes): when it alone is over the promise, the
-// target is refused at once rather than after two quality runs (mesh_to_target's own floor check).
+// target is refused at once.
 void check_tetgen_bare_floor(const TriangleSurface& surface, const MeshingOptions& options, size_t target) {
-    if (options.mesher != Mesher::TetGen ||
-        (1 + kTargetPromise) * double(target) >= kBareCheckTetsPerTriangle * double(surface.triangles.size()))
-        return;
     TetGenSettings bare;
     bare.size = SizeField::unbounded();
     bare.quality = false;
@@ -193,39 +190,51 @@ void check_tetgen_bare_floor(const TriangleSurface& surface, const MeshingOption
 }
 
 // About `target` tets: a uniform edge length from V / target, then secant steps on log(count) against
-// log(edge) (count ~ edge^-3 where the size bound, not the surface, decides the mesh).
+// log(edge) (count ~ edge^-3 where the size bound, not the surface, decides the mesh). With TetGen,
+// the quality mesh without a size bound is the coarsest it can make (it keeps every input triangle):
+// a target the first pass overshoots, or one under kBareCheckTetsPerTriangle tets per triangle, is
+// checked against it (for the latter first, after the bare check: a pass at the target's edge would
+// only overshoot too, so a refusal costs one quality run instead of two).
 TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& options, size_t target,
                        double volume) {
-    check_tetgen_bare_floor(surface, options, target);
-    const double log_target = std::log(double(target));
-    double edge = std::cbrt(kTetsPerRegularVolume * 6 * std::sqrt(2.0) * volume / double(target));
-    double slope = 3;  // -d log(count) / d log(edge)
-    double previous_log_edge = 0;
-    double previous_log_count = 0;
+    const bool tetgen = options.mesher == Mesher::TetGen;
+    const bool small_target = tetgen && (1 + kTargetPromise) * double(target) <
+                                            kBareCheckTetsPerTriangle * double(surface.triangles.size());
     TetMesh best;
     double best_error = INFINITY;
-    for (int pass = 0; pass < kMaxTargetPasses; ++pass) {
-        TetMesh mesh = run_mesher(surface, options, SizeField::uniform(edge));
-        const double log_count = std::log(double(mesh.tet_count()));
+    const auto consider = [&](TetMesh mesh) {
         const double error = std::abs(double(mesh.tet_count()) - double(target)) / double(target);
         if (error < best_error) {
             best_error = error;
             best = std::move(mesh);
         }
+    };
+    bool floor_checked = false;
+    const auto check_quality_floor = [&] {
+        floor_checked = true;
+        TetMesh coarsest = run_mesher(surface, options, SizeField::unbounded());
+        if (double(coarsest.tet_count()) > (1 + kTargetPromise) * double(target))
+            refuse_tetgen_target(target, "at least " + std::to_string(coarsest.tet_count()) +
+                                             " tets on this surface at this quality");
+        consider(std::move(coarsest));
+    };
+    if (small_target) {
+        check_tetgen_bare_floor(surface, options, target);
+        check_quality_floor();
+        if (best_error <= kTargetTolerance) return best;
+    }
+    const double log_target = std::log(double(target));
+    double edge = std::cbrt(kTetsPerRegularVolume * 6 * std::sqrt(2.0) * volume / double(target));
+    double slope = 3;  // -d log(count) / d log(edge)
+    double previous_log_edge = 0;
+    double previous_log_count = 0;
+    for (int pass = 0; pass < kMaxTargetPasses; ++pass) {
+        TetMesh mesh = run_mesher(surface, options, SizeField::uniform(edge));
+        const double log_count = std::log(double(mesh.tet_count()));
+        consider(std::move(mesh));
         if (best_error <= kTargetTolerance) break;
-        if (pass == 0 && options.mesher == Mesher::TetGen && log_count > log_target) {
-            // TetGen keeps every input triangle: the quality mesh without a size bound is the coarsest
-            // it can make. Below that the target is out of reach.
-            TetMesh coarsest = run_mesher(surface, options, SizeField::unbounded());
-            const double coarsest_count = double(coarsest.tet_count());
-            if (coarsest_count > (1 + kTargetPromise) * double(target))
-                refuse_tetgen_target(target, "at least " + std::to_string(coarsest.tet_count()) +
-                                                 " tets on this surface at this quality");
-            const double coarsest_error = std::abs(coarsest_count - double(target)) / double(target);
-            if (coarsest_error < best_error) {
-                best_error = coarsest_error;
-                best = std::move(coarsest);
-            }
+        if (pass == 0 && tetgen && !floor_checked && log_count > log_target) {
+            check_quality_floor();
             if (best_error <= kTargetTolerance) break;
         }
         const double log_edge = std::log(edge);
