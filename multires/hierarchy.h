@@ -149,11 +149,12 @@ MultiresHierarchy build_multires_hierarchy(const DiffusionMatrix& matrix, std::s
 // bit for bit). Levels past the previous hierarchy's depth are selected from scratch, and so are the
 // first level where more than half of the rows changed and every coarser one (little would be left
 // to carry). The result has every property the tests ask of a fresh build (independent-set cover, no
-// lost connection, Eq. 17 on its own graphs) but is not the fresh build's selection. When no row changed (positions or values only) every
-// selection is previous's, so a rebuild of a fresh build equals build_multires_hierarchy(matrix,
-// positions, options) exactly without selecting anything again. Throws as build_multires_hierarchy,
-// and InvalidArgumentError when `options` are not the ones `previous` was built with, the map's size
-// is not previous's level-0 size, an entry is outside [-1, matrix.size()) or two vertices map to one.
+// lost connection, Eq. 17 on its own graphs) but is not the fresh build's selection. When no row
+// changed (positions or values only) every selection is previous's, so a rebuild of a fresh build
+// equals build_multires_hierarchy(matrix, positions, options) exactly without selecting anything
+// again. Throws as build_multires_hierarchy, and InvalidArgumentError when `options` are not the ones
+// `previous` was built with, the map's size is not previous's level-0 size, an entry is outside
+// [-1, matrix.size()) or two vertices map to one.
 MultiresHierarchy rebuild_multires_hierarchy(const MultiresHierarchy& previous, std::span<const int32_t> new_of_old_vertex,
                                              const DiffusionMatrix& matrix, std::span<const Eigen::Vector3d> positions,
                                              const HierarchyOptions& options = {});

@@ -668,8 +668,10 @@ TEST(HierarchyRebuild, SelectsFromScratchFromTheFirstLevelWhereMostRowsChanged) 
     expect_valid_hierarchy(mostly_kept, s.mesh.positions, /*dense_check=*/false);
     // Here a coarse level changed in the majority (the fixed-size change is a larger share of it).
     bool coarse_majority = false;
-    for (size_t l = 1; l < mostly_kept.level_count(); ++l)
-        coarse_majority = coarse_majority || 2 * mostly_kept.levels[l].changed_vertices > static_cast<int64_t>(mostly_kept.levels[l].size());
+    for (size_t l = 1; l < mostly_kept.level_count(); ++l) {
+        const HierarchyLevel& level = mostly_kept.levels[l];
+        coarse_majority = coarse_majority || 2 * level.changed_vertices > static_cast<int64_t>(level.size());
+    }
     EXPECT_TRUE(coarse_majority);
 }
 
