@@ -261,23 +261,39 @@ FrameReport LiveScene::step_for(double milliseconds, int chunk_iterations) {
 
 FrameReport LiveScene::converge(int max_iterations) {
     const std::lock_guard lock(mutex_);
-    FrameReport report = iterate(max_iterations);
-    if (!report.converged) {
-        // A channel that stopped inside its budget met its precision's floor (conjugate_gradient.h):
-        // more iterations would not help, another precision might. A multigrid budget counts V-cycles.
-        const int budget = options_.method == LiveMethod::MultigridCg ? std::max(1, max_iterations / 4) : max_iterations;
-        bool at_floor = false;
+    // A channel that stopped inside its budget met its precision's floor (conjugate_gradient.h):
+    // more iterations would not help, another precision might. A multigrid budget counts V-cycles.
+    const int budget = options_.method == LiveMethod::MultigridCg ? std::max(1, max_iterations / 4) : max_iterations;
+    const auto at_floor = [&](const FrameReport& report) {
         for (int c = 0; c < 3; ++c)
-            at_floor = at_floor || (!converged_[c] && report.iterations[c] < budget);
+            if (!converged_[c] && report.iterations[c] < budget) return true;
+        return false;
+    };
+    FrameReport report = iterate(max_iterations);
+    if (!report.converged && at_floor(report) && solver_->backend() == LiveBackend::Gpu) {
+        // The GPU solves in float; a tolerance below its floor on this volume (slivers raise it) is
+        // reached in double on the CPU, from the GPU's phi, and the switch is reported like a driver's.
+        std::ostringstream reason;
+        reason << "GPU solver: float stopped at an estimated relative error of " << report.max_error()
+               << ", above the tolerance " << options_.relative_tolerance
+               << " (its precision floor on this volume); the CPU solves in double from here";
+        solver_->fall_back_to_cpu(reason.str());
+        const FrameReport on_cpu = iterate(max_iterations);
+        for (int c = 0; c < 3; ++c) {
+            report.iterations[c] += on_cpu.iterations[c];
+            report.estimated_relative_error[c] = on_cpu.estimated_relative_error[c];
+        }
+        report.converged = on_cpu.converged;
+        report.milliseconds += on_cpu.milliseconds;
+    }
+    if (!report.converged) {
         std::ostringstream msg;
         msg << "live scene: the diffusion solve did not reach relative error " << options_.relative_tolerance;
-        if (at_floor) {
+        if (at_floor(report))
             msg << ": it stopped at an estimated " << report.max_error() << ", the precision floor of "
                 << solver_->description() << " on this volume";
-            if (solver_->backend() == LiveBackend::Gpu) msg << "; the CPU backend solves in double";
-        } else {
+        else
             msg << " in " << max_iterations << " iterations (estimated " << report.max_error() << ")";
-        }
         throw AlgorithmError(msg.str());
     }
     return report;

@@ -122,7 +122,10 @@ public:
     // little convergence against one longer run; at least one chunk runs). Multigrid CG runs max(1, chunk / 4)
     // V-cycles per chunk and resumes its CG across chunks instead.
     FrameReport step_for(double milliseconds, int chunk_iterations = 4);
-    // Iterates until the tolerance (or `max_iterations` per channel: AlgorithmError if not reached).
+    // Iterates until the tolerance (or `max_iterations` per channel: AlgorithmError if not reached,
+    // naming the precision floor when the solve stopped at it). On the GPU backend, a tolerance below
+    // float's floor on this volume is reached in double on the CPU, which solves from then on
+    // (LiveSolver::fall_back_to_cpu; gpu_fallback_reason() says why).
     FrameReport converge(int max_iterations = 10000);
     bool converged() const;
     // The estimated relative error of phi (max over channels) after the last step(), or nullopt when

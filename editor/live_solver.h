@@ -195,6 +195,12 @@ public:
     LiveBackend requested_backend() const { return requested_backend_; }
     // Why the GPU backend was given up ("" when it was not requested or runs).
     const std::string& gpu_fallback_reason() const { return gpu_fallback_reason_; }
+    // Gives the GPU backend up for good, as after a driver failure, with `reason`: the CPU method goes on
+    // from the host phi (the last read-back). For a tolerance below float's floor on this volume
+    // (LiveScene::converge). Nothing happens on the CPU backend.
+    void fall_back_to_cpu(const std::string& reason) {
+        if (backend_ == LiveBackend::Gpu) fall_back(reason);
+    }
     // Why the method does not run as chosen ("" when it does): the multigrid method solving with Jacobi
     // CG instead, or the multires method's last coarse-to-fine pass skipping levels (and why).
     const std::string& method_fallback_reason() const { return method_fallback_reason_; }
