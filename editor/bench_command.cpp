@@ -96,11 +96,7 @@ void run_solvers_command(const SolversCommandOptions& o) {
     std::error_code error;
     std::filesystem::create_directories(dir, error);
     if (error) throw FileError(dir, "cannot create the directory (" + error.message() + ")");
-    // Named as resolve_materials chose them: the options' material, else the volume's, else marble.
-    const std::string material_name = !o.material.preset.empty() ? o.material.preset
-                                      : material                  ? "custom"
-                                      : mesh.has_materials()      ? "stored"
-                                                                  : "marble";
+    const std::string material_name = resolved_materials_name(mesh, material);
     write_solver_comparison(dir, "solvers", {o.mesh, material_name, options.mm_per_unit}, comparison);
 
     nlohmann::ordered_json summary_times = nlohmann::ordered_json::object();

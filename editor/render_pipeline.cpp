@@ -84,6 +84,11 @@ Light parse_light_spec(std::string_view spec) {
     return light;
 }
 
+std::string resolved_materials_name(const TetMesh& mesh, const std::optional<TetMaterial>& override) {
+    if (override) return material_label(*override);
+    return mesh.has_materials() ? "stored" : "marble";
+}
+
 std::vector<TetMaterial> resolve_materials(const TetMesh& mesh, const std::optional<TetMaterial>& override) {
     if (override) {
         validate_material(*override);

@@ -40,6 +40,9 @@ Light parse_light_spec(std::string_view spec);
 // the marble preset. Every material is validated (validate_material); a stored one that fails names
 // its tet.
 std::vector<TetMaterial> resolve_materials(const TetMesh& mesh, const std::optional<TetMaterial>& override);
+// What resolve_materials(mesh, override) fills the tets with, by name: the override's preset name
+// ("custom" for other coefficients; material_label), "stored" for the volume's own, else "marble".
+std::string resolved_materials_name(const TetMesh& mesh, const std::optional<TetMaterial>& override);
 
 // True when `point` (world space) lies inside or on a tet of the volume (piece transforms applied).
 bool point_inside_volume(const TetMesh& mesh, const Eigen::Vector3d& point);

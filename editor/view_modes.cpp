@@ -51,13 +51,6 @@ const std::vector<Colour>& level_palette() {
 
 double luminance(const std::array<double, 3>& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
-// A preset's name when `material` equals one, else "custom".
-std::string material_label(const TetMaterial& material) {
-    for (const std::string& name : material_preset_names())
-        if (material_preset(name) == material) return name;
-    return "custom";
-}
-
 }  // namespace
 
 const std::vector<ViewMode>& all_view_modes() {

@@ -126,4 +126,10 @@ TetMaterial material_preset(std::string_view name) {
     throw InvalidArgumentError("unknown material '" + std::string(name) + "' (known: " + known.str() + ")");
 }
 
+std::string material_label(const TetMaterial& material) {
+    for (const Preset& p : kJensen2001)
+        if (TetMaterial{p.mua, p.musp, p.eta} == material) return std::string(p.name);
+    return "custom";
+}
+
 }  // namespace waxwork

@@ -58,5 +58,7 @@ void validate_mm_per_unit(double mm_per_unit, std::string_view what = "scale");
 std::vector<std::string> material_preset_names();
 // Throws InvalidArgumentError naming the known presets when `name` is not one of them.
 TetMaterial material_preset(std::string_view name);
+// A preset's name when `material` equals one, else "custom".
+std::string material_label(const TetMaterial& material);
 
 }  // namespace waxwork
