@@ -1,5 +1,6 @@
 #include "multires/gpu_multigrid_frame_solver.h"
 
+#include "multires/parallel_rows.h"
 #include "tetops/error.h"
 
 #include <algorithm>
@@ -9,6 +10,8 @@
 
 namespace waxwork {
 namespace {
+
+constexpr size_t kResidualGrain = 2048;  // rows per TBB task of the host residual
 
 // The hierarchy, built once the context is known to run compute shaders: a context that cannot fails at
 // once instead of after the host setup.
@@ -89,6 +92,7 @@ void GpuMultigridFrameSolver::set_right_hand_side(const std::array<std::span<con
         kernels_->axpby(n_, {1, 1, 1}, scratch_, {1, 1, 1}, r_);
     }
     upload(b, b_);
+    for (size_t c = 0; c < 3; ++c) host_b_[c].assign(b[c].begin(), b[c].end());
     right_hand_side_set();
 }
 
@@ -97,8 +101,22 @@ void GpuMultigridFrameSolver::compute_residual(bool phi_is_zero) {
         r_.copy_from(b_);
         return;
     }
-    // Row sums in double on the device (the z it also writes, D^-1 r, is not used).
-    kernels_->residual(device_->matrix(0), b_, phi_, device_->inverse_diagonal(0), r_, scratch_);
+    // On the host in double from the double level-0 matrix (the header's "Precision"): the device's
+    // float copy of M would measure the float system. One read-back of phi and one upload of r.
+    const std::vector<float> phi = phi_.download<float>();
+    const HierarchyLevel& level0 = hierarchy_->levels[0];
+    const int32_t* offsets = level0.offsets.data();
+    const int32_t* columns = level0.columns.data();
+    for_rows(n_, kResidualGrain, [&](size_t i) {
+        for (size_t c = 0; c < 3; ++c) {
+            const double* values = level0.values[c].data();
+            double product = 0;
+            for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k)
+                product += values[k] * static_cast<double>(phi[3 * static_cast<size_t>(columns[k]) + c]);
+            staging_[3 * i + c] = static_cast<float>(host_b_[c][i] - product);
+        }
+    });
+    r_.write(0, staging_.size() * sizeof(float), staging_.data());
 }
 
 void GpuMultigridFrameSolver::precondition() { device_->apply(r_, z_); }

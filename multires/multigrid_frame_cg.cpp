@@ -2,11 +2,22 @@
 
 #include "tetops/error.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
 
 namespace waxwork {
+namespace {
+
+// Refuted claims of convergence after which a solve stops at its precision floor even while each
+// refutation still halves the error (the Jacobi CG's limit on residual replacements).
+constexpr int kMaxRefutedClaims = 8;
+// CG updates between two estimates from recomputed residuals (periodic refreshes) over which a
+// healthy solve at least halves the error: fewer say nothing about a floor.
+constexpr int kMinUpdatesToHalve = 10;
+
+}  // namespace
 
 MultigridFrameCg::MultigridFrameCg(size_t n, const FrameSolverOptions& options, std::string who)
     : options_(options), n_(n), who_(std::move(who)) {
@@ -27,13 +38,37 @@ void MultigridFrameCg::set_relative_tolerance(double tolerance) {
     options_.relative_tolerance = tolerance;
 }
 
+void MultigridFrameCg::forget_refuted_claims() {
+    confirming_ = false;
+    last_true_estimate_ = std::numeric_limits<double>::infinity();
+    updates_since_true_estimate_ = 0;
+    refuted_claims_ = 0;
+}
+
+bool MultigridFrameCg::stopped_at_floor(const Rgb& estimates) {
+    // As the Jacobi CG's confirmation (solver/cg_channel_state.h): an estimate from a recomputed
+    // residual that no longer halves the previous one says the updates' precision is spent. After a
+    // refuted claim of convergence that holds at once (the Jacobi rule); after a periodic refresh only
+    // across enough updates for CG to have halved a healthy error, and then it catches a floor that
+    // the channels never all get under together, so no claim is ever made.
+    const bool refuted_claim = std::exchange(confirming_, false);
+    if (!refuted_claim && updates_since_true_estimate_ < kMinUpdatesToHalve) return false;
+    const double error = std::max({estimates[0], estimates[1], estimates[2]});
+    const bool stagnating = error > 0.5 * last_true_estimate_;
+    last_true_estimate_ = error;
+    updates_since_true_estimate_ = 0;
+    return stagnating || (refuted_claim && ++refuted_claims_ > kMaxRefutedClaims);
+}
+
 void MultigridFrameCg::phi_reset() {
+    forget_refuted_claims();
     refresh_ = phi_zero_ = true;
     cg_.restart();
     cg_.forget_eigenvalues(true);
 }
 
 void MultigridFrameCg::phi_set() {
+    forget_refuted_claims();
     refresh_ = true;
     cg_.restart();
     phi_zero_ = false;
@@ -41,11 +76,13 @@ void MultigridFrameCg::phi_set() {
 }
 
 void MultigridFrameCg::right_hand_side_set() {
+    forget_refuted_claims();
     has_b_ = true;
     cg_.restart();
 }
 
 void MultigridFrameCg::operator_changed() {
+    forget_refuted_claims();
     refresh_ = true;
     cg_.restart();
     cg_.forget_eigenvalues(false);  // another operator: earlier estimates do not hold
@@ -98,10 +135,25 @@ FrameStep MultigridFrameCg::step_within(int budget, const FrameDeadline& deadlin
         precondition();
         ++result.vcycles;
         const MultigridCgState::StepSums sums = step_sums();
+        // The estimate is the true residual's when r was recomputed since the last update.
+        const bool from_true_residual = updates_since_refresh_ == 0;
         if (cg_.estimate(sums, options_.relative_tolerance, result.estimated_relative_error, who_)) {
-            result.converged = true;
+            if (from_true_residual || !confirms_convergence()) {
+                confirming_ = false;
+                result.converged = true;
+                break;
+            }
+            // Confirm: recompute r = b - M phi; the next V-cycle's estimate decides.
+            refresh_residual();
+            cg_.restart_after_refresh();
+            confirming_ = true;
+            continue;
+        }
+        if (from_true_residual && stopped_at_floor(result.estimated_relative_error)) {
+            result.at_precision_floor = true;
             break;
         }
+        ++updates_since_true_estimate_;
         const Rgb beta = cg_.beta(sums);
         set_direction(beta, cg_.restarting());
         const Rgb pq = multiply_direction();

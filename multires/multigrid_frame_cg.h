@@ -4,6 +4,9 @@
 // the three rgb channels at once: per V-cycle z = B r, the sums r . z and phi . M phi for the error
 // estimate and stopping rule (multigrid_cg_state.h), p = z + beta p, q = M p with p . q, phi += alpha p,
 // r -= alpha q, and every residual_refresh_interval updates r = b - M phi recomputed and CG restarted.
+// A claim of convergence from the recursive residual is confirmed with a recomputed one where the
+// backend asks (confirms_convergence), and estimates from recomputed residuals that stop halving stop
+// the solve at its precision floor instead of spending the budget.
 // This class owns that loop, its budgets (V-cycles or milliseconds, solver/frame_budget.h) and the
 // bookkeeping of what a new b, phi or operator invalidates; a subclass supplies the vector operations
 // on its own storage, so one stopping rule and one restart policy serve both backends by construction.
@@ -16,6 +19,7 @@
 #include "solver/frame_budget.h"
 
 #include <array>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -33,6 +37,10 @@ struct FrameStep {
     std::array<double, 3> estimated_relative_error{};  // per channel (multigrid_frame_solver.h)
     int vcycles = 0;                                    // V-cycles run (<= budget)
     bool converged = false;                             // every estimate <= tolerance, of the current phi
+    // Stopped early, above the tolerance: the true residual refuted a claim of convergence and the
+    // refutations stopped halving the error (the backend's precision floor on this matrix, see
+    // confirms_convergence). More V-cycles would not help; a more precise backend might.
+    bool at_precision_floor = false;
 };
 
 class MultigridFrameCg {
@@ -94,6 +102,15 @@ protected:
     virtual void compute_residual(bool phi_is_zero) = 0;                // r = b - M phi (r = b when zero)
     // After the V-cycles of a step (the GPU checks its driver's error state here).
     virtual void steps_done() {}
+    // Whether an estimate within the tolerance from the recursive residual must be confirmed with a
+    // recomputed r = b - M phi before the solver stops. A backend whose updates are less precise than
+    // its recomputed residual says yes: the GPU updates r in float from a float copy of M but computes
+    // b - M phi in double from the double matrix, so its recursive estimate measures the float system,
+    // which on sliver meshes lies far from the double one (1.6e-4 at 1e-5 caps), while the confirmed
+    // one measures the system the CPU solves. The refreshed residual then also corrects phi towards the
+    // double solution (mixed-precision iterative refinement). The CPU updates in double: only for
+    // tight tolerances. A refuted claim counts towards the precision floor (at_precision_floor).
+    virtual bool confirms_convergence() const = 0;
 
     // What the subclasses' setters invalidate.
     // phi was set to zero (reset): the warm start and the eigenvalue estimates are gone.
@@ -119,11 +136,23 @@ protected:
 
 private:
     FrameStep step_within(int max_vcycles, const FrameDeadline& deadline);
+    // A new system or start: earlier refuted claims of convergence say nothing about it.
+    void forget_refuted_claims();
+    // Given the estimates from a recomputed residual, above the tolerance: whether the solve stops at
+    // its precision floor (FrameStep::at_precision_floor).
+    bool stopped_at_floor(const Rgb& estimates);
 
     std::string who_;
     bool has_b_ = false, refresh_ = true;
     bool phi_zero_ = true;  // phi is exactly zero (a cold start): r = b needs no product
     int updates_since_refresh_ = 0;
+    // A claim of convergence is being confirmed (the residual was recomputed; the next V-cycle's
+    // estimate decides); the largest channel estimate from the last recomputed residual this solve
+    // judged (infinity: none) and the CG updates since; the claims refuted so far.
+    bool confirming_ = false;
+    double last_true_estimate_ = std::numeric_limits<double>::infinity();
+    int updates_since_true_estimate_ = 0;
+    int refuted_claims_ = 0;
     MultigridCgState cg_;  // the scalars, the stopping rule and the Lanczos estimate of lambda_min
 };
 

@@ -5,6 +5,9 @@
 #include "multires_test_systems.h"
 #include "solver/gpu_conjugate_gradient.h"
 #include "solver/gpu_test_context.h"
+#include "solver/material.h"
+#include "tetops/box_mesh.h"
+#include "tetops/sliver_maker.h"
 #include "tetops/error.h"
 
 #include <gtest/gtest.h>
@@ -144,6 +147,52 @@ TEST(GpuMultigridFrameSolver, WarmStartAfterALightTurnIsBackUnderOnePercentInAFe
         EXPECT_LT(relative_error(phi[static_cast<size_t>(c)], reference[static_cast<size_t>(c)]), 1e-2) << "channel " << c;
     if (!step.converged) step = testing::step_until_converged(solver, 1, 10);
     EXPECT_TRUE(step.converged);
+}
+
+// On a box whose interior is pushed into caps of relative height 1e-5, the device's float copy of M
+// solves a system about 2e-4 from the double one. The residual the device solver trusts is the double
+// system's: a tolerance float reaches is met against the double solution, and one below float's floor
+// on this mesh stops early, saying so, with phi refined towards the double solution all the same.
+TEST(GpuMultigridFrameSolver, OnSliversMeasuresTheDoubleSystemAndStopsAtItsFloor) {
+    WAXWORK_REQUIRE_GL(context);
+    TetMesh mesh = make_box_mesh({10, 10, 10}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(1));
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    flatten_into_slivers(mesh, connectivity, 6, 1e-5);
+    const std::vector<TetMaterial> materials(mesh.tet_count(), material_preset("marble"));
+    const DiffusionMatrix matrix = assemble_diffusion_matrix(mesh, connectivity, materials);
+    std::array<std::vector<double>, 3> b;
+    for (auto& channel : b) channel.assign(matrix.size(), 0.0);
+    for (const int32_t v : connectivity.boundary_vertices)
+        for (size_t c = 0; c < 3; ++c) b[c][static_cast<size_t>(v)] = (1.0 + 0.1 * mesh.positions[v].x()) * double(c + 1);
+    MultigridFrameSolver cpu(matrix, mesh.positions, frame_options(64, 1e-10));
+    cpu.set_right_hand_side(spans(b));
+    ASSERT_TRUE(cpu.step(500).converged);
+
+    constexpr int kBudget = 2000;
+    for (const double tolerance : {1e-4, 1e-8}) {
+        SCOPED_TRACE(tolerance);
+        FrameSolverOptions options;
+        options.relative_tolerance = tolerance;
+        GpuMultigridFrameSolver gpu(context->gl(), matrix, mesh.positions, options);
+        gpu.set_right_hand_side(spans(b));
+        const FrameStep step = gpu.step(kBudget);
+        const auto phi = gpu.phi();
+        for (int c = 0; c < 3; ++c) {
+            const std::span<const double> reference = cpu.phi(c);
+            const double error = relative_error(phi[static_cast<size_t>(c)], {reference.begin(), reference.end()});
+            if (tolerance == 1e-4) EXPECT_LT(error, tolerance) << "channel " << c;
+            else EXPECT_LT(error, 1e-6) << "channel " << c;  // refined towards the double solution
+        }
+        if (tolerance == 1e-4) {
+            EXPECT_TRUE(step.converged);
+            EXPECT_FALSE(step.at_precision_floor);
+        } else {
+            EXPECT_FALSE(step.converged);
+            EXPECT_TRUE(step.at_precision_floor);
+            EXPECT_LT(step.vcycles, kBudget);
+            for (double e : step.estimated_relative_error) EXPECT_GT(e, tolerance);
+        }
+    }
 }
 
 TEST(GpuMultigridFrameSolver, FollowsPaintedValues) {

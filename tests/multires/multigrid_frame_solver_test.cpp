@@ -76,6 +76,24 @@ TEST(MultigridFrameSolver, ConvergesToTheDoublePrecisionSolution) {
     }
 }
 
+// Asked for less than double can give, the solver stops early at its floor and says so: the estimates
+// from its periodically recomputed residual stop halving. It does not spend its budget.
+TEST(MultigridFrameSolver, StopsAtDoublesFloorInsteadOfSpendingItsBudget) {
+    const auto s = testing::make_test_system(12);
+    MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(100, 1e-18));
+    solver.set_right_hand_side(spans(s.b));
+    constexpr int kBudget = 5000;
+    const FrameStep step = solver.step(kBudget);
+    EXPECT_FALSE(step.converged);
+    EXPECT_TRUE(step.at_precision_floor);
+    EXPECT_LT(step.vcycles, 500);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_GT(step.estimated_relative_error[static_cast<size_t>(c)], 1e-18);
+        const auto reference = reference_solution(s.matrix, s.b[static_cast<size_t>(c)], c);
+        EXPECT_LT(relative_error(solver.phi(c), reference), 1e-9) << "channel " << c;
+    }
+}
+
 // The live editor converges a scene its frames left at a looser tolerance: a tighter tolerance set later
 // makes step() continue from where it stopped, to the tighter error.
 // Built on a given hierarchy (a rebuild's), the solver is the one it builds itself on the same
