@@ -96,27 +96,34 @@ void GpuMultigridFrameSolver::set_right_hand_side(const std::array<std::span<con
     right_hand_side_set();
 }
 
-void GpuMultigridFrameSolver::compute_residual(bool phi_is_zero) {
+std::array<double, 6> GpuMultigridFrameSolver::compute_residual(bool phi_is_zero) {
     if (phi_is_zero) {
         r_.copy_from(b_);
-        return;
+        return {};
     }
     // On the host in double from the double level-0 matrix (the header's "Precision"): the device's
-    // float copy of M would measure the float system. One read-back of phi and one upload of r.
+    // float copy of M would measure the float system. Read-backs of phi and of the r it replaces (for
+    // residual_drift), one upload of r.
     const std::vector<float> phi = phi_.download<float>();
+    const std::vector<float> old_r = r_.download<float>();
     const HierarchyLevel& level0 = hierarchy_->levels[0];
     const int32_t* offsets = level0.offsets.data();
     const int32_t* columns = level0.columns.data();
-    for_rows(n_, kResidualGrain, [&](size_t i) {
+    const std::array<double, 6> sums = reduce_rows<6>(n_, kResidualGrain, [&](size_t i, std::array<double, 6>& acc) {
+        const auto diagonal = static_cast<size_t>(level0.diagonal[i]);
         for (size_t c = 0; c < 3; ++c) {
             const double* values = level0.values[c].data();
             double product = 0;
             for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k)
                 product += values[k] * static_cast<double>(phi[3 * static_cast<size_t>(columns[k]) + c]);
-            staging_[3 * i + c] = static_cast<float>(host_b_[c][i] - product);
+            const double r = host_b_[c][i] - product, moved = r - static_cast<double>(old_r[3 * i + c]);
+            acc[c] += moved * moved / values[diagonal];  // residual_drift's sums, in the D^-1 norm
+            acc[3 + c] += r * r / values[diagonal];
+            staging_[3 * i + c] = static_cast<float>(r);
         }
     });
     r_.write(0, staging_.size() * sizeof(float), staging_.data());
+    return sums;
 }
 
 void GpuMultigridFrameSolver::precondition() { device_->apply(r_, z_); }

@@ -87,7 +87,7 @@ private:
     void set_direction(const Rgb& beta, bool restart) override;
     Rgb multiply_direction() override;
     void update_solution(const Rgb& alpha) override;
-    void compute_residual(bool phi_is_zero) override;
+    std::array<double, 6> compute_residual(bool phi_is_zero) override;
     void steps_done() override;
     bool confirms_convergence() const override { return true; }
     // Uploads three host channels interleaved into `target`.

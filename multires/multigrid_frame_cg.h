@@ -43,6 +43,11 @@ struct FrameStep {
     bool at_precision_floor = false;
 };
 
+// How far a recomputed residual r moved from the recursive one it replaced, r_old: the largest over
+// the channels of ||r - r_old|| / ||r|| in the D^-1 norm, from the per-channel sums ||r - r_old||^2
+// (sums[0..2]) and ||r||^2 (sums[3..5]). 0 when nothing moved, infinity when r = 0 but r_old was not.
+double residual_drift(const std::array<double, 6>& sums);
+
 class MultigridFrameCg {
 public:
     virtual ~MultigridFrameCg() = default;
@@ -99,7 +104,9 @@ protected:
     virtual void set_direction(const Rgb& beta, bool restart) = 0;      // p = z (restart) or z + beta p
     virtual Rgb multiply_direction() = 0;                               // q = M p; returns p . q
     virtual void update_solution(const Rgb& alpha) = 0;                 // phi += alpha p, r -= alpha q
-    virtual void compute_residual(bool phi_is_zero) = 0;                // r = b - M phi (r = b when zero)
+    // r = b - M phi (r = b when zero). Returns the per-channel sums residual_drift takes, of the new r
+    // against the one it replaced (zeros when phi is zero: r = b exactly).
+    virtual std::array<double, 6> compute_residual(bool phi_is_zero) = 0;
     // After the V-cycles of a step (the GPU checks its driver's error state here).
     virtual void steps_done() {}
     // Whether an estimate within the tolerance from the recursive residual must be confirmed with a
@@ -124,8 +131,8 @@ protected:
     // After the operator's values changed (painting): r is stale and the eigenvalue estimates no
     // longer hold.
     void operator_changed();
-    // r = b - M phi now.
-    void refresh_residual();
+    // r = b - M phi now; returns residual_drift of the replaced r.
+    double refresh_residual();
     // For update_values: checks `matrix` against level 0's pattern and the rows against its size, then
     // copies the rows' values into `level0` (and into `interleaved`, 3 per stored entry, when given).
     void copy_changed_rows(const DiffusionMatrix& matrix, std::span<const int32_t> changed_rows,

@@ -5,10 +5,6 @@
 #include "solver/conjugate_gradient.h"
 #include "tetops/error.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
-#include <tbb/partitioner.h>
 
 #include <algorithm>
 #include <cmath>
@@ -24,21 +20,6 @@ constexpr size_t kGrain = 2048;
 template <size_t N>
 using Sums = std::array<double, N>;
 
-// Fixed chunks and a fixed combination order: bit-identical sums on any thread count.
-template <size_t N, typename Body>
-Sums<N> reduce_rows(size_t n, const Body& body) {
-    return tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<size_t>(0, n, kGrain), Sums<N>{},
-        [&](const tbb::blocked_range<size_t>& r, Sums<N> acc) {
-            for (size_t i = r.begin(); i != r.end(); ++i) body(i, acc);
-            return acc;
-        },
-        [](Sums<N> a, const Sums<N>& b) {
-            for (size_t k = 0; k < N; ++k) a[k] += b[k];
-            return a;
-        },
-        tbb::simple_partitioner());
-}
 
 // out[c] = (M_c x)_i for the three channels of row i; x interleaved.
 inline void product_row(size_t i, const int32_t* offsets, const int32_t* columns, const double* values,
@@ -112,21 +93,28 @@ void MultigridFrameSolver::set_right_hand_side(const std::array<std::span<const 
     right_hand_side_set();
 }
 
-void MultigridFrameSolver::compute_residual(bool phi_is_zero) {
+std::array<double, 6> MultigridFrameSolver::compute_residual(bool phi_is_zero) {
     if (phi_is_zero) {
         r_ = b_;
-        return;
+        return {};
     }
-    const int32_t* offsets = hierarchy_->levels[0].offsets.data();
-    const int32_t* columns = hierarchy_->levels[0].columns.data();
-    for_rows(n_, kGrain, [&](size_t i) {
+    const HierarchyLevel& level0 = hierarchy_->levels[0];
+    const int32_t* offsets = level0.offsets.data();
+    const int32_t* columns = level0.columns.data();
+    return reduce_rows<6>(n_, kGrain, [&](size_t i, Sums<6>& acc) {
         double s[3] = {0, 0, 0};
         for (int32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
             const double* v = &values_[3 * static_cast<size_t>(k)];
             const auto j = static_cast<size_t>(columns[k]);
             for (size_t c = 0; c < 3; ++c) s[c] += v[c] * phi_[c][j];
         }
-        for (size_t c = 0; c < 3; ++c) r_[3 * i + c] = b_[3 * i + c] - s[c];
+        const double* diagonal = &values_[3 * static_cast<size_t>(level0.diagonal[i])];
+        for (size_t c = 0; c < 3; ++c) {
+            const double r = b_[3 * i + c] - s[c], moved = r - r_[3 * i + c];
+            acc[c] += moved * moved / diagonal[c];  // residual_drift's sums, in the D^-1 norm
+            acc[3 + c] += r * r / diagonal[c];
+            r_[3 * i + c] = r;
+        }
     });
 }
 
@@ -134,7 +122,7 @@ void MultigridFrameSolver::precondition() { preconditioner_->apply_rgb(r_, z_); 
 
 MultigridCgState::StepSums MultigridFrameSolver::step_sums() {
     // r . z and phi . M phi = phi . (b - r) per channel.
-    return reduce_rows<6>(n_, [&](size_t i, Sums<6>& acc) {
+    return reduce_rows<6>(n_, kGrain, [&](size_t i, Sums<6>& acc) {
         for (size_t c = 0; c < 3; ++c) {
             const size_t e = 3 * i + c;
             acc[c] += r_[e] * z_[e];
@@ -157,7 +145,7 @@ MultigridFrameSolver::Rgb MultigridFrameSolver::multiply_direction() {
     // q = M p and p . q.
     const int32_t* offsets = hierarchy_->levels[0].offsets.data();
     const int32_t* columns = hierarchy_->levels[0].columns.data();
-    return reduce_rows<3>(n_, [&](size_t i, Sums<3>& acc) {
+    return reduce_rows<3>(n_, kGrain, [&](size_t i, Sums<3>& acc) {
         double* q = &q_[3 * i];
         product_row(i, offsets, columns, values_.data(), p_.data(), q);
         for (size_t c = 0; c < 3; ++c) acc[c] += p_[3 * i + c] * q[c];

@@ -76,10 +76,11 @@ private:
     void set_direction(const Rgb& beta, bool restart) override;
     Rgb multiply_direction() override;
     void update_solution(const Rgb& alpha) override;
-    void compute_residual(bool phi_is_zero) override;
+    std::array<double, 6> compute_residual(bool phi_is_zero) override;
     // The double recursive residual drifts from b - M phi by rounding of order u * cond(M), which
-    // matters only for tight tolerances (slivers push cond(M) to 1e8): those claims are confirmed, the
-    // one extra V-cycle being small against the many they take; a frame's 1e-2 is not.
+    // matters only for tight tolerances (slivers push cond(M) to 1e8): those claims are confirmed (a
+    // product with M, and a V-cycle when r moved), small against the many V-cycles they take; a
+    // frame's 1e-2 is not.
     bool confirms_convergence() const override { return options_.relative_tolerance < 1e-6; }
 
     std::unique_ptr<MultiresHierarchy> hierarchy_;

@@ -4,8 +4,11 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/partitioner.h>
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -17,6 +20,24 @@ void for_rows(size_t n, size_t grain, const Body& body) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) body(i);
     });
+}
+
+// N sums over rows, body(i, sums) adding row i's terms: fixed chunks of `grain` rows and a fixed
+// combination order, so the sums are bit-identical on any thread count.
+template <size_t N, typename Body>
+std::array<double, N> reduce_rows(size_t n, size_t grain, const Body& body) {
+    using Sums = std::array<double, N>;
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<size_t>(0, n, grain), Sums{},
+        [&](const tbb::blocked_range<size_t>& r, Sums acc) {
+            for (size_t i = r.begin(); i != r.end(); ++i) body(i, acc);
+            return acc;
+        },
+        [](Sums a, const Sums& b) {
+            for (size_t k = 0; k < N; ++k) a[k] += b[k];
+            return a;
+        },
+        tbb::simple_partitioner());
 }
 
 // Compressed rows whose lengths are only known once each row is built, in one pass: rows are built
