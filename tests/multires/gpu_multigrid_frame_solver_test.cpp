@@ -31,6 +31,18 @@ std::array<std::span<const double>, 3> spans(const std::array<std::vector<double
     return {v[0], v[1], v[2]};
 }
 
+// The device frame solver and the CPU one on the same system, with the same options and b.
+struct BothBackends {
+    GpuMultigridFrameSolver gpu;
+    MultigridFrameSolver cpu;
+    BothBackends(const GlApi& gl, const testing::TestSystem& s, const FrameSolverOptions& options)
+        : gpu(gl, s.matrix, s.mesh.positions, options), cpu(s.matrix, s.mesh.positions, options) {}
+    void set_right_hand_side(const std::array<std::vector<double>, 3>& b) {
+        gpu.set_right_hand_side(spans(b));
+        cpu.set_right_hand_side(spans(b));
+    }
+};
+
 // The bound the other GPU tests hold float solvers to against the double solution.
 constexpr double kFloatSolutionBound = 1e-4;
 
@@ -106,20 +118,17 @@ TEST(GpuMultigridFrameSolver, TakesAHierarchyBuiltForItsMatrix) {
 TEST(GpuMultigridFrameSolver, FollowsTheCpuFrameSolverStepByStep) {
     WAXWORK_REQUIRE_GL(context);
     const auto s = testing::make_test_system(10);
-    const FrameSolverOptions options = frame_options(60, 1e-8);
-    GpuMultigridFrameSolver gpu(context->gl(), s.matrix, s.mesh.positions, options);
-    MultigridFrameSolver cpu(s.matrix, s.mesh.positions, options);
-    gpu.set_right_hand_side(spans(s.b));
-    cpu.set_right_hand_side(spans(s.b));
+    BothBackends both(context->gl(), s, frame_options(60, 1e-8));
+    both.set_right_hand_side(s.b);
     for (int frame = 0; frame < 3; ++frame) {
-        const FrameStep g = gpu.step(2), c = cpu.step(2);
+        const FrameStep g = both.gpu.step(2), c = both.cpu.step(2);
         EXPECT_EQ(g.vcycles, c.vcycles);
-        const auto phi = gpu.phi();
+        const auto phi = both.gpu.phi();
         for (int ch = 0; ch < 3; ++ch) {
             const auto cu = static_cast<size_t>(ch);
             EXPECT_NEAR(g.estimated_relative_error[cu], c.estimated_relative_error[cu],
                         1e-3 * c.estimated_relative_error[cu] + 1e-6);
-            EXPECT_LT(relative_error(phi[cu], cpu.phi(ch)), kFloatSolutionBound) << "frame " << frame;
+            EXPECT_LT(relative_error(phi[cu], both.cpu.phi(ch)), kFloatSolutionBound) << "frame " << frame;
         }
     }
 }
@@ -129,14 +138,10 @@ TEST(GpuMultigridFrameSolver, FollowsTheCpuFrameSolverStepByStep) {
 TEST(GpuMultigridFrameSolver, ConfirmsAFramesClaimWithoutAnExtraVcycle) {
     WAXWORK_REQUIRE_GL(context);
     const auto s = testing::make_test_system(16);
-    const FrameSolverOptions options = frame_options(100, 1e-2);
-    GpuMultigridFrameSolver gpu(context->gl(), s.matrix, s.mesh.positions, options);
-    MultigridFrameSolver cpu(s.matrix, s.mesh.positions, options);
+    BothBackends both(context->gl(), s, frame_options(100, 1e-2));
     for (const double degrees : {0.0, 10.0}) {
-        const auto b = testing::light_rhs(s, degrees);
-        gpu.set_right_hand_side(spans(b));
-        cpu.set_right_hand_side(spans(b));
-        const FrameStep g = gpu.step(50), c = cpu.step(50);
+        both.set_right_hand_side(testing::light_rhs(s, degrees));
+        const FrameStep g = both.gpu.step(50), c = both.cpu.step(50);
         EXPECT_TRUE(g.converged);
         EXPECT_TRUE(c.converged);
         EXPECT_EQ(g.vcycles, c.vcycles) << degrees;
