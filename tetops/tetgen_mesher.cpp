@@ -61,7 +61,8 @@ std::string format_number(double value) {
 }
 
 // -p: the input is a PLC; -z: zero-based indices; -q: quality; -a: volume bound; -m: sizes from the
-// metric of the background mesh. No -V (verbose) ever: TetGen would print per element.
+// metric of the background mesh; -S: a limit on added points. No -V (verbose) ever: TetGen would
+// print per element.
 std::string make_switches(const TetGenSettings& settings, bool volume_bound, bool metric) {
     std::string switches = "pz";
     if (settings.quality) {
@@ -70,6 +71,7 @@ std::string make_switches(const TetGenSettings& settings, bool volume_bound, boo
     }
     if (volume_bound) switches += "a" + format_number(tetgen_volume_bound_for_edge(settings.size.max_edge));
     if (metric) switches += "m";
+    if (settings.max_added_points >= 0) switches += "S" + std::to_string(settings.max_added_points);
     if (settings.quiet) switches += "Q";
     return switches;
 }
@@ -125,8 +127,10 @@ double tetgen_volume_bound_for_edge(double edge) {
     return kVolumeBoundPerRegularVolume * edge * edge * edge / (6 * std::sqrt(2.0));
 }
 
-TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettings& settings) {
+TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettings& settings,
+                              bool* stopped_at_point_limit) {
     const SizeField& size = settings.size;
+    if (stopped_at_point_limit) *stopped_at_point_limit = false;
     if (!size.is_bounded() || size.is_uniform()) {
         TetGenSettings uniform = settings;
         uniform.size.max_edge = std::min(size.surface_edge, size.max_edge);
@@ -134,9 +138,14 @@ TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettin
         tetgenio out;
         fill_plc(surface, in);
         run_tetgen(make_switches(uniform, std::isfinite(uniform.size.max_edge), false), in, out, nullptr);
+        if (stopped_at_point_limit && settings.max_added_points >= 0)
+            *stopped_at_point_limit = out.numberofpoints - in.numberofpoints >= settings.max_added_points;
         return to_tet_mesh(out);
     }
 
+    // A point limit would cut the background mesh short too: the graded runs have none.
+    TetGenSettings graded = settings;
+    graded.max_added_points = -1;
     // Graded: the background mesh is a quality mesh at the coarsest size; each of its vertices gets
     // the wanted circumradius bound at its depth, and TetGen interpolates it linearly inside its tets,
     // which reproduces edge(d) exactly where it is linear.
@@ -144,7 +153,7 @@ TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettin
     {
         tetgenio in;
         fill_plc(surface, in);
-        run_tetgen(make_switches(settings, std::isfinite(size.max_edge), false), in, background, nullptr);
+        run_tetgen(make_switches(graded, std::isfinite(size.max_edge), false), in, background, nullptr);
     }
     const SurfaceDistance distance(surface);
     background.numberofpointmtrs = 1;
@@ -159,7 +168,7 @@ TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettin
     in.numberofpointmtrs = 1;
     in.pointmtrlist = new REAL[in.numberofpoints];
     for (int i = 0; i < in.numberofpoints; ++i) in.pointmtrlist[i] = kMetricPerEdge * size.surface_edge;
-    run_tetgen(make_switches(settings, false, true), in, out, &background);
+    run_tetgen(make_switches(graded, false, true), in, out, &background);
     return to_tet_mesh(out);
 }
 

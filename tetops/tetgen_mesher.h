@@ -14,12 +14,18 @@ struct TetGenSettings {
     double min_dihedral_deg = 10.0;      // -q /angle
     bool quality = true;                 // false: the bare constrained Delaunay tetrahedralization
     bool quiet = true;                   // -Q
+    // -S: the points TetGen may add to the surface's (boundary recovery and refinement; -1: no limit).
+    // Honoured by the unbounded and uniform sizes only (one run); a graded size ignores it.
+    long max_added_points = -1;
 };
 
 // Uniform size: one run with a volume bound (-a). Graded size: a first quality run at max_edge gives
 // a background mesh whose vertices carry edge(depth) (-m), then a second run from the surface
 // refines to it. Throws AlgorithmError with TetGen's reason when it gives up.
-TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettings& settings);
+// With settings.max_added_points, `stopped_at_point_limit` (when given) says whether TetGen added
+// that many points, so that the mesh is its refinement cut short rather than a finished one.
+TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettings& settings,
+                              bool* stopped_at_point_limit = nullptr);
 
 // The TetGen volume bound (-a) that gives tets of mean edge length `edge`: a regular tet of edge L has
 // volume L^3 / (6 sqrt 2); TetGen's tets under a bound a have mean volume ~0.31 a and mean edge

@@ -218,8 +218,23 @@ TEST(TetrahedralizeTest, RefusesATargetBelowTetGensFloorNamingTheFloor) {
     const std::string below_bare = refusal(bare / 2);
     EXPECT_NE(below_bare.find("more than " + std::to_string(bare) + " tets"), std::string::npos) << below_bare;
     EXPECT_NE(below_bare.find("without quality bounds"), std::string::npos) << below_bare;
-    const std::string below_quality = refusal(bare + (coarsest - bare) / 4);
-    EXPECT_NE(below_quality.find("at least " + std::to_string(coarsest) + " tets"), std::string::npos) << below_quality;
+    // Far under the quality floor, TetGen's refinement is stopped once it has added points for more tets
+    // than the target allows (a part of the finished run's time), and the refusal says how many it had.
+    const size_t far_target = bare + (coarsest - bare) / 4;
+    const std::string far_below = refusal(far_target);
+    EXPECT_NE(far_below.find("stopped, unfinished"), std::string::npos) << far_below;
+    const size_t at = far_below.find("more than ");
+    ASSERT_NE(at, std::string::npos) << far_below;
+    const size_t had = std::stoul(far_below.substr(at + 10));
+    EXPECT_GT(double(had), 1.2 * double(far_target));
+    EXPECT_LE(had, coarsest);
+    // Just under it the refinement finishes, and the refusal names the coarsest mesh's count.
+    const std::string just_below = refusal(size_t(double(coarsest) / 1.25));
+    EXPECT_NE(just_below.find("at least " + std::to_string(coarsest) + " tets"), std::string::npos) << just_below;
+    // At the floor, the target is met.
+    MeshingOptions at_floor;
+    at_floor.sizing.target_tets = coarsest;
+    EXPECT_NEAR(double(tetrahedralize(spot, at_floor).mesh.tet_count()), double(coarsest), 0.2 * double(coarsest));
 }
 
 TEST(TetrahedralizeTest, CgalGivesValidPositiveMeshes) {
