@@ -152,7 +152,7 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--mesh", options->mesh, "Surface (OBJ, OFF, PLY, STL) or volume file")
         ->required()
         ->check(CLI::ExistingFile);
-    cmd->add_option("--max-tets", options->max_tets, "Mesh a surface with about this many tets");
+    add_max_tets_option(*cmd, options->max_tets, "Mesh a surface with about this many tets");
     cmd->add_option("-o,--output", options->output, "Output directory")->required();
     cmd->add_option("--backend", options->backend,
                     "cpu, or gpu: also the GPU solvers (gpu_cg, gpu_multires) on OpenGL compute shaders")

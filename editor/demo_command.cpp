@@ -5,6 +5,7 @@
 #include "editor/editor_app.h"
 #include "editor/render_pipeline.h"
 #include "editor/session.h"
+#include "editor/surface_meshing_options.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
 #include "solver/material.h"
@@ -243,7 +244,7 @@ void add_demo_command(CLI::App& app) {
     cmd->add_option("-o,--output", options->output, "Directory to write into")->capture_default_str();
     cmd->add_option("--scale", options->scale, "Millimetres per model unit (Spot is about 1.7 units long)")
         ->capture_default_str();
-    cmd->add_option("--max-tets", options->max_tets, "About this many tets (default: sized by marble's diffusion length)");
+    add_max_tets_option(*cmd, options->max_tets, "About this many tets (default: sized by marble's diffusion length)");
     cmd->add_option("--width", options->width, "Image width in pixels")->capture_default_str();
     cmd->add_flag("--no-editor", options->no_editor, "Do not open the interactive editor even when a display is present");
     cmd->add_option("--height", options->height, "Image height in pixels")->capture_default_str();

@@ -5,6 +5,7 @@
 #include "editor/editor_app.h"
 #include "editor/live_solver_choice.h"
 #include "editor/material_options.h"
+#include "editor/surface_meshing_options.h"
 #include "solver/material.h"
 #include "tetops/error.h"
 
@@ -108,7 +109,7 @@ void add_edit_command(CLI::App& app) {
     cmd->add_flag("--hide-ui", options->hide_ui, "Show the 3D view alone (Tab toggles it)");
     cmd->add_option("--width", options->width, "Window width")->capture_default_str();
     cmd->add_option("--height", options->height, "Window height")->capture_default_str();
-    cmd->add_option("--max-tets", options->max_tets, "Meshing a surface: about this many tets");
+    add_max_tets_option(*cmd, options->max_tets, "Meshing a surface: about this many tets");
     add_material_options(*cmd, options->material);
     cmd->add_option("--light", options->lights, "dir:X,Y,Z[:R,G,B] or point:X,Y,Z[:R,G,B], as for render")
         ->expected(1)

@@ -17,7 +17,8 @@ nlohmann::ordered_json read_json_file(const std::filesystem::path& path) {
     const std::string text = read_file_contents(path);
     try {
         return nlohmann::ordered_json::parse(text);
-    } catch (const nlohmann::json::parse_error& e) {
+    } catch (const nlohmann::json::exception& e) {
+        // parse_error, and out_of_range for a number no double holds (1e400).
         throw FileError(path.string(), std::string("not valid JSON: ") + e.what());
     }
 }

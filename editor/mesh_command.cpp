@@ -71,7 +71,7 @@ void add_mesh_command(CLI::App& app) {
     cmd->add_option("input", options->input, "Surface file")->required()->check(CLI::ExistingFile);
     cmd->add_option("-o,--output", options->output, "Volume file (.vtu, .msh, .mesh, .node)")->required();
     auto* edge = cmd->add_option("--edge", options->edge, "Target edge length in model units");
-    auto* tets = cmd->add_option("--max-tets", options->max_tets, "About this many tets (within 20%)");
+    auto* tets = add_max_tets_option(*cmd, options->max_tets, "About this many tets (within 20%)");
     edge->excludes(tets);
     add_surface_meshing_options(*cmd, options->meshing);
     cmd->add_option("--scale", options->scale, "Millimetres per model unit (sizes the default mesh)")

@@ -8,6 +8,16 @@
 
 namespace waxwork {
 
+CLI::Option* add_max_tets_option(CLI::App& command, std::optional<size_t>& max_tets, const std::string& description) {
+    const CLI::Validator positive_count(
+        [](std::string& text) -> std::string {
+            const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+            return digits && text.find_first_not_of('0') != std::string::npos ? "" : "must be a positive whole number of tets";
+        },
+        "COUNT");
+    return command.add_option("--max-tets", max_tets, description)->check(positive_count);
+}
+
 void add_surface_meshing_options(CLI::App& command, SurfaceMeshingOptions& options) {
     command.add_option("--mesher", options.mesher, "tetgen (keeps the surface's triangles) or cgal (remeshes it)")
         ->check(CLI::IsMember({"tetgen", "cgal"}))

@@ -7,11 +7,14 @@
 #include "io/surface_reader.h"
 #include "tetops/tetrahedralize.h"
 
+#include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 namespace CLI {
 class App;
+class Option;
 }
 
 namespace waxwork {
@@ -26,6 +29,10 @@ struct SurfaceMeshingOptions {
 
 // Registers the options on `command`.
 void add_surface_meshing_options(CLI::App& command, SurfaceMeshingOptions& options);
+
+// Registers --max-tets N (about N tets) on `command`, every command's the same way: N must be a
+// positive whole number (CLI11 reads -1 into an unsigned option as 2^64 - 1).
+CLI::Option* add_max_tets_option(CLI::App& command, std::optional<size_t>& max_tets, const std::string& description);
 
 // Reads and validates the surface with the repairs the options allow (load_closed_surface); each
 // repair made is reported on stderr as "waxwork: PATH: repaired: WHAT".

@@ -161,6 +161,13 @@ void sync_directory(const std::filesystem::path& directory) {
 }  // namespace
 
 void write_files_atomically(const std::vector<FileWriter>& files) {
+    // A target that is a directory cannot be replaced: refused before any file is, not halfway
+    // through the renames (the .ele of a pair after its .node was replaced).
+    for (const auto& file : files) {
+        std::error_code error;
+        if (std::filesystem::is_directory(file.first, error))
+            throw FileError(file.first.string(), "cannot replace: it is a directory");
+    }
     std::vector<TemporaryFile> temporaries;
     temporaries.reserve(files.size());
     try {

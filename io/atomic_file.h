@@ -23,9 +23,10 @@ void write_file_atomically(const std::filesystem::path& path,
 using FileWriter = std::pair<std::filesystem::path, std::function<void(std::ostream&)>>;
 
 // Several files that belong together (TetGen's .node and .ele): every temporary is written and
-// synced before the first rename, so a failure while producing any of them leaves all targets intact.
-// Each file is replaced atomically; the set as a whole is not (a crash between two renames can leave
-// one new and one old file), which no POSIX file system can offer.
+// synced before the first rename, so a failure while producing any of them leaves all targets intact,
+// and so does a target that is a directory (refused before the first rename). Each file is replaced
+// atomically; the set as a whole is not (a crash or an I/O error between two renames can leave one
+// new and one old file), which no POSIX file system can offer.
 void write_files_atomically(const std::vector<FileWriter>& files);
 
 }  // namespace waxwork

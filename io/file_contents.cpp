@@ -10,9 +10,11 @@ namespace waxwork {
 
 std::string read_file_contents(const std::filesystem::path& path) {
     std::error_code status_error;
-    if (std::filesystem::is_directory(path, status_error)) {
-        throw FileError(path.string(), "is a directory, not a file");
-    }
+    const auto status = std::filesystem::status(path, status_error);
+    if (std::filesystem::is_directory(status)) throw FileError(path.string(), "is a directory, not a file");
+    // A pipe or a device would block the read or never end (a FIFO nobody writes, /dev/zero).
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+        throw FileError(path.string(), "not a regular file (a pipe, socket or device)");
     std::ifstream stream(path, std::ios::binary);
     if (!stream) throw FileError(path.string(), std::string("cannot open: ") + std::strerror(errno));
     stream.seekg(0, std::ios::end);

@@ -7,7 +7,8 @@
 
 namespace waxwork {
 
-// The bytes of `path`. Throws FileError naming the file when it is missing, a directory, or unreadable.
+// The bytes of `path`. Throws FileError naming the file when it is missing, a directory, not a regular
+// file (a pipe or device, which could block or never end), or unreadable.
 std::string read_file_contents(const std::filesystem::path& path);
 
 }  // namespace waxwork

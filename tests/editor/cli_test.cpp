@@ -129,6 +129,13 @@ TEST(Cli, AbsurdParametersAreRejected) {
         EXPECT_EQ(line_count(r.err), 1u) << args << ": " << r.err;
     }
     EXPECT_FALSE(fs::exists(dir / "x.vtu"));
+    // A negative count is refused as such, not read into an unsigned option as 2^64 - 1.
+    for (const std::string& command : {"mesh " + in, "bench solvers --mesh " + kAssets + "/meshes/cube.obj -o " + dir.string()}) {
+        const auto r = run_waxwork(command + " --max-tets=-1");
+        EXPECT_NE(r.exit_code, 0) << command;
+        EXPECT_NE(r.err.find("--max-tets: must be a positive whole number"), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("18446744073709551615"), std::string::npos) << r.err;
+    }
 }
 
 // A size the mesher refuses for this surface is reported with the surface file's name: spot's

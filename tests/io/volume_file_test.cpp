@@ -506,6 +506,27 @@ TEST_F(VolumeFileTest, AtomicWriteOfSeveralFilesIsAllOrNothingOnWriterFailure) {
     EXPECT_EQ(file_count(), 2u);
 }
 
+// A .node/.ele pair whose .ele is a directory: refused before the .node is replaced.
+TEST_F(VolumeFileTest, AtomicWriteOfSeveralFilesChecksEveryTargetBeforeReplacingAny) {
+    write_volume(make_test_mesh(), path("v.node"));
+    const std::string node_before = read_text(path("v.node"));
+    fs::remove(path("v.ele"));
+    fs::create_directory(path("v.ele"));
+    const std::string message = error_of([&] { write_volume(make_test_mesh(), path("v.node")); });
+    EXPECT_NE(message.find("v.ele"), std::string::npos) << message;
+    EXPECT_NE(message.find("directory"), std::string::npos) << message;
+    EXPECT_EQ(read_text(path("v.node")), node_before);
+    EXPECT_EQ(file_count(), 2u) << "a temporary file was left";
+}
+
+// A pipe (or a device) is refused by name instead of blocking the reader.
+TEST_F(VolumeFileTest, APipeIsNotReadAsAVolume) {
+    ASSERT_EQ(::mkfifo(path("pipe.vtu").c_str(), 0600), 0);
+    const std::string message = error_of([&] { read_volume(path("pipe.vtu")); });
+    EXPECT_NE(message.find("pipe.vtu"), std::string::npos) << message;
+    EXPECT_NE(message.find("not a regular file"), std::string::npos) << message;
+}
+
 TEST_F(VolumeFileTest, AtomicWriteIntoMissingDirectoryIsAFileError) {
     const fs::path target = path("no/such/dir/volume.vtu");
     const std::string message = error_of([&] { write_volume(make_test_mesh(), target); });
