@@ -1,6 +1,7 @@
 #include "tetops/cgal_mesher.h"
 
 #include "tetops/error.h"
+#include "tetops/mesher_scale.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
@@ -90,6 +91,13 @@ TetMesh to_tet_mesh(const Complex& complex) {
 }  // namespace
 
 TetMesh cgal_tetrahedralize(const TriangleSurface& surface, const CgalSettings& settings) {
+    if (const int exponent = mesher_scale_exponent(surface); exponent != 0) {
+        CgalSettings scaled = settings;
+        scaled.size = scaled_size_field(settings.size, exponent);
+        TetMesh mesh = cgal_tetrahedralize(scaled_surface(surface, exponent), scaled);
+        scale_positions(mesh, -exponent);
+        return mesh;
+    }
     SizeField size = settings.size;
     if (!size.is_bounded()) {
         // Mesh_3 needs a size bound to terminate; a twentieth of the bounding-box diagonal is coarse.

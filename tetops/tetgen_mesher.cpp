@@ -1,6 +1,7 @@
 #include "tetops/tetgen_mesher.h"
 
 #include "tetops/error.h"
+#include "tetops/mesher_scale.h"
 
 #include <tetgen.h>
 
@@ -129,6 +130,13 @@ double tetgen_volume_bound_for_edge(double edge) {
 
 TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettings& settings,
                               bool* stopped_at_point_limit) {
+    if (const int exponent = mesher_scale_exponent(surface); exponent != 0) {
+        TetGenSettings scaled = settings;
+        scaled.size = scaled_size_field(settings.size, exponent);
+        TetMesh mesh = tetgen_tetrahedralize(scaled_surface(surface, exponent), scaled, stopped_at_point_limit);
+        scale_positions(mesh, -exponent);
+        return mesh;
+    }
     const SizeField& size = settings.size;
     if (stopped_at_point_limit) *stopped_at_point_limit = false;
     if (!size.is_bounded() || size.is_uniform()) {

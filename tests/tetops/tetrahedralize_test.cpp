@@ -5,9 +5,11 @@
 #include "tetops/tetgen_mesher.h"
 #include "tetops/tetrahedralize.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -235,6 +237,45 @@ TEST(TetrahedralizeTest, RefusesATargetBelowTetGensFloorNamingTheFloor) {
     MeshingOptions at_floor;
     at_floor.sizing.target_tets = coarsest;
     EXPECT_NEAR(double(tetrahedralize(spot, at_floor).mesh.tet_count()), double(coarsest), 0.2 * double(coarsest));
+}
+
+// Both meshers work to some absolute tolerances: a surface far from unit size is meshed as a copy
+// scaled by a power of two (tetops/mesher_scale.h). Before, CGAL died of a division by zero in GMP on
+// the cube at 1e-30 and left 0-degree tets at 1e20. Now spot at any of these scales gets the mesh it
+// gets scaled to a diagonal in [1, 2), scaled back, and its surface vertices keep their coordinates.
+TEST(TetrahedralizeTest, TinyAndHugeSurfacesAreMeshedAsAtUnitSize) {
+    TriangleSurface spot = asset_surface("spot.obj");
+    Eigen::AlignedBox3d box;
+    for (const auto& p : spot.points) box.extend(p);
+    int exponent = 0;
+    std::frexp(box.diagonal().norm(), &exponent);
+    for (auto& p : spot.points) p *= std::ldexp(1.0, 1 - exponent);  // diagonal in [1, 2): meshed as it is
+    for (const Mesher mesher : {Mesher::TetGen, Mesher::Cgal}) {
+        MeshingOptions options;
+        options.mesher = mesher;
+        options.sizing.edge_length = 0.1;
+        const MeshingResult unit = tetrahedralize(spot, options);
+        for (const double factor : {0x1p-100, 0x1p-50, 0x1p40, 0x1p66}) {
+            SCOPED_TRACE(std::to_string(factor) + (mesher == Mesher::Cgal ? " cgal" : " tetgen"));
+            TriangleSurface scaled = spot;
+            for (auto& p : scaled.points) p *= factor;
+            MeshingOptions scaled_options = options;
+            scaled_options.sizing.edge_length = 0.1 * factor;
+            const MeshingResult result = tetrahedralize(scaled, scaled_options);
+            EXPECT_TRUE(find_invariant_violations(result.mesh).empty());
+            EXPECT_EQ(result.mesh.tet_count(), unit.mesh.tet_count());
+            EXPECT_EQ(result.quality.min_dihedral_deg, unit.quality.min_dihedral_deg);
+            EXPECT_NEAR(total_volume(result.mesh), total_volume(unit.mesh) * factor * factor * factor,
+                        1e-9 * total_volume(unit.mesh) * factor * factor * factor);
+            if (mesher == Mesher::TetGen) {  // TetGen keeps the input points: exactly, after the round trip
+                std::map<std::array<double, 3>, int> surface_points;
+                for (const auto& p : scaled.points) surface_points[{p.x(), p.y(), p.z()}] = 0;
+                size_t found = 0;
+                for (const auto& p : result.mesh.positions) found += surface_points.count({p.x(), p.y(), p.z()});
+                EXPECT_EQ(found, scaled.points.size());
+            }
+        }
+    }
 }
 
 TEST(TetrahedralizeTest, CgalGivesValidPositiveMeshes) {
