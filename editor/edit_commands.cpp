@@ -168,11 +168,16 @@ void run_fracture_command(const FractureCommandOptions& o) {
     const size_t tets_before = mesh.tet_count();
     const size_t vertices_before = mesh.vertex_count();
     const auto start = Clock::now();
-    const std::vector<Eigen::Vector3d> seeds = scatter_fracture_seeds(mesh, o.pieces, o.seed);
     FractureOptions options;
     options.exact = o.exact;
     options.min_piece_tets = o.min_piece_tets;
-    const FractureResult result = fracture_voronoi(mesh, seeds, options);
+    FractureResult result;
+    try {
+        const std::vector<Eigen::Vector3d> seeds = scatter_fracture_seeds(mesh, o.pieces, o.seed);
+        result = fracture_voronoi(mesh, seeds, options);
+    } catch (const InvalidArgumentError& error) {
+        throw InvalidArgumentError(o.input + ": " + error.what());  // what the volume does not allow
+    }
     const double elapsed = milliseconds_since(start);
     write_volume(mesh, o.output);
     nlohmann::ordered_json summary = {

@@ -69,6 +69,9 @@ std::vector<Eigen::Vector3d> scatter_fracture_seeds(const TetMesh& mesh, int cou
 // a concave volume in several parts gives one piece per part). Exact mode builds the diagram one seed
 // at a time, so walls of earlier seeds that a later cell swallows stay as (harmless) extra splits
 // inside that piece.
+// Throws InvalidArgumentError for more seeds than the tets allow pieces of min_piece_tets, and when the
+// exact split grows the mesh past 32 times its tets and 100,000 more (many pieces of a coarse volume); the mesh is
+// then partly split, so callers that keep theirs fracture a copy.
 FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> seeds,
                                 const FractureOptions& options = {});
 

@@ -357,6 +357,39 @@ TEST(FractureVoronoi, DustIsMergedAndBadInputRejected) {
     EXPECT_EQ(m, before);
 }
 
+// More pieces than the tets allow pieces of min_piece_tets are refused up front, and an exact split
+// that multiplies the tets past 32 times and 100,000 more (each wall splitting what earlier walls
+// split) stops with an error naming the growth, instead of running for minutes into 1e-5-degree
+// slivers.
+TEST(FractureVoronoi, TooManyPiecesForTheVolumeAreRefused) {
+    const TetMesh cube = make_cube_mesh(6);  // 1,296 tets
+    TetMesh mesh = cube;
+    try {
+        fracture_voronoi(mesh, scatter_fracture_seeds(cube, 163, 1));
+        ADD_FAILURE() << "163 pieces of 8 tets from 1,296 tets";
+    } catch (const InvalidArgumentError& error) {
+        EXPECT_NE(std::string(error.what()).find("so at most 162"), std::string::npos) << error.what();
+    }
+    EXPECT_EQ(mesh, cube);
+    mesh = cube;
+    try {
+        fracture_voronoi(mesh, scatter_fracture_seeds(cube, 160, 1));
+        ADD_FAILURE() << "160 exact pieces of a 1,296-tet cube";
+    } catch (const InvalidArgumentError& error) {
+        EXPECT_NE(std::string(error.what()).find("more than 32 times the 1296 it started with and 100000 more"),
+                  std::string::npos)
+            << error.what();
+        EXPECT_NE(std::string(error.what()).find("--no-exact"), std::string::npos) << error.what();
+    }
+    EXPECT_LE(mesh.tet_count(), 2 * (32 * cube.tet_count() + 100'000));  // stopped soon after the limit
+    mesh = cube;  // the same pieces along tet faces
+    FractureOptions faces;
+    faces.exact = false;
+    EXPECT_GT(fracture_voronoi(mesh, scatter_fracture_seeds(cube, 160, 1), faces).pieces_after, 1);
+    mesh = cube;
+    EXPECT_EQ(fracture_voronoi(mesh, scatter_fracture_seeds(cube, 8, 1)).pieces_after, 8);
+}
+
 TEST(FracturePlanes, TwoPlanesFourPiecesWithExactVolumes) {
     TetMesh mesh = make_cube_mesh(5);
     const std::vector<Eigen::Vector4d> planes = {{1, 0, 0, 0.43}, {0, 2, 0, 2 * 0.31}};
