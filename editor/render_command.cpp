@@ -98,7 +98,12 @@ void run_render_command(const RenderCommandOptions& o) {
     const TetMesh mesh = read_volume(o.volume);
     if (mesh.tet_count() == 0) throw InvalidArgumentError(o.volume + ": the volume has no tets to render");
     const TetConnectivity connectivity = build_connectivity(mesh);
-    const std::vector<TetMaterial> materials = resolve_materials(mesh, chosen);
+    std::vector<TetMaterial> materials;
+    try {
+        materials = resolve_materials(mesh, chosen);
+    } catch (const InvalidArgumentError& error) {
+        throw InvalidArgumentError(o.volume + ": " + error.what());  // a stored material no solve can use
+    }
 
     // One OpenGL context for the GPU solve and the renderer (the same device).
     HeadlessGlContext context;

@@ -90,6 +90,10 @@ private:
     std::unordered_map<std::string, int> counts_;
 };
 
+// Coordinates beyond this overflow the products of volumes and quality measures (1e100 cubed is
+// 1e300, near double's largest).
+constexpr double kMaxCoordinate = 1e100;
+
 bool finite_material(const TetMaterial& m) {
     for (int c = 0; c < 3; ++c)
         if (!std::isfinite(m.mua[c]) || !std::isfinite(m.musp[c]) || m.mua[c] < 0 || m.musp[c] < 0) return false;
@@ -111,8 +115,12 @@ std::vector<std::string> find_invariant_violations(const TetMesh& mesh) {
     if (!mesh.materials.empty() && mesh.materials.size() != n_tets)
         log.add("size", "materials has " + std::to_string(mesh.materials.size()) + " entries for " +
                             std::to_string(n_tets) + " tets");
-    for (size_t v = 0; v < mesh.positions.size(); ++v)
-        if (!mesh.positions[v].allFinite()) log.add("coordinates", "vertex " + std::to_string(v) + " is not finite");
+    for (size_t v = 0; v < mesh.positions.size(); ++v) {
+        if (!mesh.positions[v].allFinite())
+            log.add("coordinates", "vertex " + std::to_string(v) + " is not finite");
+        else if (mesh.positions[v].cwiseAbs().maxCoeff() > kMaxCoordinate)
+            log.add("coordinates", "vertex " + std::to_string(v) + " lies beyond 1e100 (volumes would overflow)");
+    }
     for (size_t i = 0; i < mesh.piece_transforms.size(); ++i) {
         const RigidTransform& x = mesh.piece_transforms[i];
         const bool orthonormal =
@@ -120,6 +128,8 @@ std::vector<std::string> find_invariant_violations(const TetMesh& mesh) {
             x.rotation.determinant() > 0;
         if (!x.rotation.allFinite() || !x.translation.allFinite() || !orthonormal)
             log.add("transform", "piece transform " + std::to_string(i) + " is not a finite rigid motion");
+        else if (x.translation.cwiseAbs().maxCoeff() > kMaxCoordinate)
+            log.add("transform", "piece transform " + std::to_string(i) + " moves beyond 1e100");
     }
 
     std::vector<uint8_t> referenced(mesh.positions.size(), 0);
@@ -152,25 +162,44 @@ std::vector<std::string> find_invariant_violations(const TetMesh& mesh) {
         if (!referenced[v]) log.add("unreferenced", "vertex " + std::to_string(v) + " belongs to no tet");
 
     if (indices_ok) {
-        // A face shared by three or more tets means overlapping or non-manifold tets.
+        // A face shared by three or more tets means overlapping or non-manifold tets, and so does a
+        // face whose two tets lie on the same side of it (a tet listed twice, a tet folded over its
+        // neighbour): in a positively oriented tet, the face opposite vertex f has vertices
+        // (f+1, f+2, f+3) mod 4 turning outward for even f and inward for odd f, and sorting them
+        // flips that with the sort's parity, so the two tets of a face must disagree.
         struct FaceKey {
             std::array<int32_t, 3> v;
+            bool outward = false;  // the sorted order turns outward of its tet
+            int32_t tet = 0;
             bool operator<(const FaceKey& o) const { return v < o.v; }
-            bool operator==(const FaceKey& o) const { return v == o.v; }
+            bool same_face(const FaceKey& o) const { return v == o.v; }
         };
         std::vector<FaceKey> faces;
         faces.reserve(4 * n_tets);
-        for (const Tet& tet : mesh.tets)
+        for (size_t t = 0; t < n_tets; ++t) {
+            const Tet& tet = mesh.tets[t];
             for (int f = 0; f < 4; ++f) {
                 std::array<int32_t, 3> k = {tet[(f + 1) % 4], tet[(f + 2) % 4], tet[(f + 3) % 4]};
+                // Parity of the sort of three values: odd when they were not in a cyclic order.
+                const bool cyclic = (k[0] < k[1]) + (k[1] < k[2]) + (k[2] < k[0]) == 2;
                 std::sort(k.begin(), k.end());
-                faces.push_back({k});
+                faces.push_back({k, (f % 2 == 0) == cyclic, static_cast<int32_t>(t)});
             }
+        }
         std::sort(faces.begin(), faces.end());
-        for (size_t i = 0; i + 2 < faces.size(); ++i)
-            if (faces[i] == faces[i + 2])
-                log.add("face", "face (" + std::to_string(faces[i].v[0]) + ", " + std::to_string(faces[i].v[1]) +
-                                    ", " + std::to_string(faces[i].v[2]) + ") is shared by more than two tets");
+        const auto face_name = [](const FaceKey& face) {
+            return "face (" + std::to_string(face.v[0]) + ", " + std::to_string(face.v[1]) + ", " +
+                   std::to_string(face.v[2]) + ")";
+        };
+        for (size_t i = 0; i + 1 < faces.size(); ++i) {
+            if (!faces[i].same_face(faces[i + 1])) continue;
+            if (i + 2 < faces.size() && faces[i].same_face(faces[i + 2]))
+                log.add("face", face_name(faces[i]) + " is shared by more than two tets");
+            else if (faces[i].outward == faces[i + 1].outward)
+                log.add("overlap", "tets " + std::to_string(std::min(faces[i].tet, faces[i + 1].tet)) + " and " +
+                                       std::to_string(std::max(faces[i].tet, faces[i + 1].tet)) +
+                                       " overlap: both lie on the same side of their shared " + face_name(faces[i]));
+        }
     }
     return log.finish();
 }

@@ -1,5 +1,7 @@
 // The command-line contract: subcommands, --help, errors, and the mesh/info pipeline end to end.
 #include "editor/cli_run.h"
+#include "io/volume_file.h"
+#include "tetops/test_meshes.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -48,6 +50,19 @@ TEST(Cli, MissingAndCorruptFilesNameTheFile) {
     EXPECT_NE(g.exit_code, 0);
     EXPECT_EQ(line_count(g.err), 1u) << g.err;
     EXPECT_NE(g.err.find("garbage.vtu"), std::string::npos) << g.err;
+
+    // A stored material the file format allows but no solve can use (no scattering), and fracture
+    // pieces the volume cannot hold: the errors name the file.
+    TetMesh cube = testing::make_cube_mesh(3);
+    cube.materials.assign(cube.tet_count(), TetMaterial{{0.1, 0.1, 0.1}, {0, 1, 1}, 1.3});
+    const fs::path clear = dir / "clear.vtu";
+    write_volume(cube, clear);
+    const auto m = run_waxwork("render " + clear.string() + " -o " + (dir / "clear.png").string());
+    EXPECT_NE(m.exit_code, 0);
+    EXPECT_NE(m.err.find("clear.vtu: stored material of tet 0: mu_s'"), std::string::npos) << m.err;
+    const auto f = run_waxwork("fracture " + clear.string() + " -o " + (dir / "f.vtu").string() + " --pieces 100");
+    EXPECT_NE(f.exit_code, 0);
+    EXPECT_NE(f.err.find("clear.vtu: fracture: 100 pieces of a volume of 162 tets"), std::string::npos) << f.err;
 }
 
 TEST(Cli, MeshThenInfoOnTheEmbeddedCube) {

@@ -74,6 +74,38 @@ TEST(TetMesh, ValidateFindsEveryKindOfViolation) {
     triple_face.original_ids.resize(triple_face.tets.size(), 0);
     triple_face.piece_ids.resize(triple_face.tets.size(), 0);
     EXPECT_FALSE(find_invariant_violations(triple_face).empty());
+
+    const auto has = [](const std::vector<std::string>& violations, const std::string& text) {
+        for (const std::string& v : violations)
+            if (v.find(text) != std::string::npos) return true;
+        return false;
+    };
+    // A tet listed twice: every face is shared by two tets, but both lie on the same side of it.
+    TetMesh twice = good;
+    twice.tets.push_back(good.tets[3]);
+    twice.original_ids.push_back(0);
+    twice.piece_ids.push_back(0);
+    EXPECT_TRUE(has(find_invariant_violations(twice), "tets 3 and " + std::to_string(good.tet_count()) + " overlap"));
+    // A tet folded over its neighbour's face (positively oriented, on the neighbour's side of it).
+    TetMesh folded;
+    folded.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.2, 0.2, 0.2}};
+    folded.tets = {{0, 1, 2, 3}, {0, 1, 2, 4}};  // vertex 4 is on vertex 3's side of face (0, 1, 2)
+    folded.original_ids = {0, 1};
+    folded.piece_ids = {0, 0};
+    folded.piece_transforms = {RigidTransform{}};
+    ASSERT_GT(signed_volume(folded, 1), 0);
+    EXPECT_TRUE(has(find_invariant_violations(folded), "both lie on the same side of their shared face (0, 1, 2)"));
+    folded.positions[4] = {0.2, 0.2, -0.2};  // the other side: a valid pair
+    folded.tets[1] = {0, 2, 1, 4};
+    ASSERT_GT(signed_volume(folded, 1), 0);
+    EXPECT_TRUE(find_invariant_violations(folded).empty());
+    // Coordinates and moves whose volumes would overflow.
+    TetMesh far = good;
+    far.positions[0].x() = 1e300;
+    EXPECT_TRUE(has(find_invariant_violations(far), "lies beyond 1e100"));
+    TetMesh far_move = good;
+    far_move.piece_transforms[0].translation.x() = 1e300;
+    EXPECT_TRUE(has(find_invariant_violations(far_move), "moves beyond 1e100"));
 }
 
 TEST(TetMesh, ValidateReportIsBoundedForBadlyBrokenMeshes) {
