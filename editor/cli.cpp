@@ -5,9 +5,33 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <iostream>
+#include <string>
 
 namespace waxwork {
+namespace {
+
+// An error message as one line of text: messages quote what they could not read, which in a binary
+// file is raw bytes (terminal control codes, invalid UTF-8); every byte outside printable ASCII is
+// shown as \xNN.
+std::string printable(const std::string& message) {
+    std::string out;
+    out.reserve(message.size());
+    for (const char c : message) {
+        const auto byte = static_cast<unsigned char>(c);
+        if (byte >= 0x20 && byte < 0x7f) {
+            out += c;
+        } else {
+            char escaped[5];
+            std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
+            out += escaped;
+        }
+    }
+    return out;
+}
+
+}  // namespace
 
 int run_cli(int argc, char** argv) {
     CLI::App app{"Waxwork: carve, fracture and paint translucent solids with live subsurface light.", "waxwork"};
@@ -39,10 +63,10 @@ int run_cli(int argc, char** argv) {
         std::cerr << "waxwork: " << e.what() << " (see --help)\n";
         return 2;
     } catch (const Error& e) {
-        std::cerr << "waxwork: " << e.what() << "\n";
+        std::cerr << "waxwork: " << printable(e.what()) << "\n";
         return 1;
     } catch (const std::exception& e) {
-        std::cerr << "waxwork: internal error: " << e.what() << "\n";
+        std::cerr << "waxwork: internal error: " << printable(e.what()) << "\n";
         return 1;
     }
     return 0;

@@ -235,7 +235,8 @@ void check_count_fits(const std::filesystem::path& path, const std::string& what
 
 unsigned long long parse_count(const std::filesystem::path& path, const std::string& token) {
     if (token.empty() || token.find_first_not_of("0123456789") != std::string::npos)
-        throw FileError(path.string(), "malformed header: '" + token + "' is not an element count");
+        throw FileError(path.string(), "malformed header: '" + token.substr(0, 40) + (token.size() > 40 ? "..." : "") +
+                                           "' is not an element count");
     try {
         return std::stoull(token);
     } catch (const std::out_of_range&) {

@@ -18,9 +18,14 @@ std::string light_name(size_t index, const Light& light) {
            (light.type == LightType::Directional ? "directional" : "point") + ")";
 }
 
-bool finite_non_negative(const Rgb& c) {
+// Intensities and light vectors beyond this overflow the solver's sums of squares (1e100 squared,
+// summed over a million vertices, is still finite; 1e308 is not) and the normalisation of directions.
+constexpr double kMaxLightValue = 1e100;
+
+// Non-negative and at most kMaxLightValue (so finite).
+bool valid_light_value(const Rgb& c) {
     for (double x : c) {
-        if (!std::isfinite(x) || x < 0) return false;
+        if (!(x >= 0 && x <= kMaxLightValue)) return false;
     }
     return true;
 }
@@ -38,20 +43,20 @@ void validate(const Lighting& lighting) {
         if (light.type != LightType::Directional && light.type != LightType::Point) {
             throw InvalidArgumentError(light_name(i, light) + ": unknown light type");
         }
-        if (!light.vector.allFinite()) {
+        if (!light.vector.allFinite() || light.vector.cwiseAbs().maxCoeff() > kMaxLightValue) {
             throw InvalidArgumentError(light_name(i, light) +
                                        (light.type == LightType::Directional ? ": direction" : ": position") +
-                                       " has a non-finite component");
+                                       " has a non-finite component or one beyond 1e100");
         }
         if (light.type == LightType::Directional && light.vector.squaredNorm() == 0.0) {
             throw InvalidArgumentError(light_name(i, light) + ": direction is the zero vector");
         }
-        if (!finite_non_negative(light.intensity)) {
-            throw InvalidArgumentError(light_name(i, light) + ": intensity must be finite and non-negative");
+        if (!valid_light_value(light.intensity)) {
+            throw InvalidArgumentError(light_name(i, light) + ": intensity must be non-negative and at most 1e100");
         }
     }
-    if (!finite_non_negative(lighting.ambient)) {
-        throw InvalidArgumentError("ambient light must be finite and non-negative");
+    if (!valid_light_value(lighting.ambient)) {
+        throw InvalidArgumentError("ambient light must be non-negative and at most 1e100");
     }
 }
 

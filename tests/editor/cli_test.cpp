@@ -51,6 +51,16 @@ TEST(Cli, MissingAndCorruptFilesNameTheFile) {
     EXPECT_EQ(line_count(g.err), 1u) << g.err;
     EXPECT_NE(g.err.find("garbage.vtu"), std::string::npos) << g.err;
 
+    // Raw bytes a message quotes from a binary file are shown as \xNN: the error stays one line of text.
+    const fs::path binary = dir / "binary.off";
+    { std::ofstream(binary, std::ios::binary) << "OFF\n9M\xff\x1b[2J\x07 1 2\n"; }
+    const auto b = run_waxwork("mesh " + binary.string() + " -o " + (dir / "b.vtu").string());
+    EXPECT_NE(b.exit_code, 0);
+    EXPECT_EQ(line_count(b.err), 1u) << b.err;
+    EXPECT_NE(b.err.find("binary.off"), std::string::npos) << b.err;
+    EXPECT_TRUE(std::all_of(b.err.begin(), b.err.end(), [](char c) { return c == '\n' || (c >= 0x20 && c < 0x7f); }))
+        << b.err;
+
     // A stored material the file format allows but no solve can use (no scattering), and fracture
     // pieces the volume cannot hold: the errors name the file.
     TetMesh cube = testing::make_cube_mesh(3);

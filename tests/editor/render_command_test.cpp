@@ -272,6 +272,19 @@ TEST_F(Render, BadInputIsAOneLineError) {
         EXPECT_EQ(line_count(r.err), 1u) << args << ": " << r.err;
         EXPECT_EQ(r.err.rfind("waxwork: ", 0), 0u) << r.err;
     }
+    // Values whose squares overflow are refused by what they are, not by a solver failing on them.
+    for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+             {" --tol 1e-300", "--tol must be a relative tolerance in [1e-15, 1)"},
+             {" --ambient 1e308", "--ambient must be non-negative and at most 1e100"},
+             {" --light dir:1,0,0:1e308,1,1", "intensity must be non-negative and at most 1e100"},
+             {" --light point:1e308,0,0", "position has a non-finite component or one beyond 1e100"}}) {
+        const auto r = run_waxwork(base + args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+    }
+    // A huge view direction is still a direction.
+    EXPECT_EQ(run_waxwork(base + " --view 1e308,1e308,1e308").exit_code, 0);
+    fs::remove(image);
     const auto light = run_waxwork(base + " --light dir:1,0");
     EXPECT_NE(light.err.find("dir:1,0"), std::string::npos) << light.err;
     EXPECT_FALSE(fs::exists(image));
