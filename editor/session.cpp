@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -113,7 +114,12 @@ Json camera_to_json(const CameraSettings& c) {
 std::string output_name(FieldReader& in, const std::string& key) {
     const Json& v = in.at(key);
     if (!v.is_string() || v.get<std::string>().empty()) fail_json(in.field(key), "expected a file name");
-    return v.get<std::string>();
+    // Outputs go to the run's output directory: a session from elsewhere writes nothing outside it.
+    const fs::path name(v.get<std::string>());
+    const bool climbs = std::any_of(name.begin(), name.end(), [](const fs::path& part) { return part == ".."; });
+    if (name.is_absolute() || climbs)
+        fail_json(in.field(key), "'" + name.string() + "' must stay inside the output directory (a relative path without '..')");
+    return name.string();
 }
 
 int count_from(FieldReader& in, const std::string& key) {

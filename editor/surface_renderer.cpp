@@ -240,12 +240,16 @@ struct FrameResources {
     }
 };
 
-void check_framebuffer(const GlApi& gl, const char* which) {
+// An incomplete framebuffer at a size the driver accepts is an allocation it could not make (llvmpipe
+// at 16384 x 16384 with 4x MSAA needs 4 GiB of colour and depth): said with the size and the way out.
+void check_framebuffer(const GlApi& gl, const char* which, int width, int height, int samples) {
     const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE) {
         char code[16];
         std::snprintf(code, sizeof code, "0x%04X", status);
-        throw Error(std::string("surface renderer: the ") + which + " framebuffer is incomplete (status " + code + ")");
+        throw Error(std::string("surface renderer: the driver could not make the ") + which + " framebuffer of " +
+                    std::to_string(width) + "x" + std::to_string(height) + " pixels, " + std::to_string(samples) +
+                    " samples (status " + code + ", usually out of memory); render a smaller image");
     }
 }
 
@@ -511,11 +515,11 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
     gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, input.width, input.height);
     gl.BindFramebuffer(GL_FRAMEBUFFER, r.framebuffers[1]);
     gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, r.renderbuffers[2]);
-    check_framebuffer(gl, "resolve");
+    check_framebuffer(gl, "resolve", input.width, input.height, 1);
     gl.BindFramebuffer(GL_FRAMEBUFFER, r.framebuffers[0]);
     gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, r.renderbuffers[0]);
     gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, r.renderbuffers[1]);
-    check_framebuffer(gl, "multisampled");
+    check_framebuffer(gl, "multisampled", input.width, input.height, samples);
 
     gl.Viewport(0, 0, input.width, input.height);
     gl.ClearColor(input.background[0] / 255.0f, input.background[1] / 255.0f, input.background[2] / 255.0f, 1.0f);

@@ -93,6 +93,10 @@ TEST(Session, ErrorsNameTheFileAndTheStep) {
     EXPECT_NE(e.find("bad.json: field 'scale': must be a length in mm per model unit"), std::string::npos) << e;
     e = session_error(R"({"input": {"volume": "v.vtu"}, "steps": [})");
     EXPECT_NE(e.find("bad.json: not valid JSON"), std::string::npos) << e;
+    for (const std::string name : {"../escape.png", "/tmp/escape.png", "a/../../b.vtu"}) {  // outside -o
+        e = session_error(R"({"input": {"volume": "v.vtu"}, "steps": [{"render": ")" + name + R"("}]})");
+        EXPECT_NE(e.find("must stay inside the output directory"), std::string::npos) << e;
+    }
     e = session_error(R"({"input": {"volume": "v.vtu"}, "scale": 1e400, "steps": []})");  // no double holds it
     EXPECT_NE(e.find("bad.json: not valid JSON"), std::string::npos) << e;
     EXPECT_NE(e.find("1e400"), std::string::npos) << e;
