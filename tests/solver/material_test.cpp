@@ -115,6 +115,12 @@ TEST(Material, ValidationRejectsBadCoefficients) {
     m.eta = 40;
     expect_bad(m, "eta");
     m = good;
+    m.eta = 1e308;
+    expect_bad(m, "eta = 1e+308 is outside");  // not 309 digits
+    m = good;
+    m.mua[0] = -1e300;
+    expect_bad(m, "mu_a = -1e+300 is negative");
+    m = good;
     m.musp[0] = 1e7;
     expect_bad(m, "per millimetre");
     m = good;
