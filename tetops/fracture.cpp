@@ -123,8 +123,9 @@ void check_options(const FractureOptions& options) {
         throw InvalidArgumentError("fracture: the smoothing target must be in [0, 70) degrees");
 }
 
-// The exact Voronoi split keeps the walls of earlier cells that a later cell swallows, and each wall
-// splits the tets earlier walls split, so the tet count grows much faster than the pieces (spot,
+// The exact Voronoi split builds the cells one seed at a time and each wall splits the tets earlier
+// walls split (reordering the seeds does not help: in four orders, 30 pieces of spot made 67,553 to
+// 75,413 tets), so the tet count grows much faster than the pieces (spot,
 // 11,705 tets: 10 pieces 1.9x, 30 pieces 5.8x, 100 pieces 27x in 3.8 s, 300 pieces 142x and
 // 0.00004-degree tets in 25 s). Past this growth (plus an allowance that lets small volumes grow
 // into a few hundred thousand tets, which costs little) the fracture stops with an error instead of
