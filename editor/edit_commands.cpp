@@ -171,13 +171,9 @@ void run_fracture_command(const FractureCommandOptions& o) {
     FractureOptions options;
     options.exact = o.exact;
     options.min_piece_tets = o.min_piece_tets;
-    FractureResult result;
-    try {
-        const std::vector<Eigen::Vector3d> seeds = scatter_fracture_seeds(mesh, o.pieces, o.seed);
-        result = fracture_voronoi(mesh, seeds, options);
-    } catch (const InvalidArgumentError& error) {
-        throw InvalidArgumentError(o.input + ": " + error.what());  // what the volume does not allow
-    }
+    const FractureResult result = naming_context(o.input, [&] {  // what the volume does not allow
+        return fracture_voronoi(mesh, scatter_fracture_seeds(mesh, o.pieces, o.seed), options);
+    });
     const double elapsed = milliseconds_since(start);
     write_volume(mesh, o.output);
     nlohmann::ordered_json summary = {

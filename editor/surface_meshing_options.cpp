@@ -48,15 +48,7 @@ MeshingOptions meshing_options(const SurfaceMeshingOptions& options) {
 
 MeshingResult tetrahedralize_surface_file(const std::filesystem::path& path, const TriangleSurface& surface,
                                           const MeshingOptions& options) {
-    try {
-        return tetrahedralize(surface, options);
-    } catch (const InvalidArgumentError& error) {
-        throw InvalidArgumentError(path.string() + ": " + error.what());
-    } catch (const InvalidMeshError& error) {
-        throw InvalidMeshError(path.string() + ": " + error.what());
-    } catch (const AlgorithmError& error) {
-        throw AlgorithmError(path.string() + ": " + error.what());
-    }
+    return naming_context(path.string(), [&] { return tetrahedralize(surface, options); });
 }
 
 }  // namespace waxwork

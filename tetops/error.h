@@ -47,4 +47,19 @@ public:
     using Error::Error;
 };
 
+// Runs `work` and gives its argument, parameter and algorithm errors "context: " (a file name) before
+// their message, keeping their type: for callers that know the file a library call works on.
+template <typename Work>
+decltype(auto) naming_context(const std::string& context, Work&& work) {
+    try {
+        return work();
+    } catch (const InvalidArgumentError& error) {
+        throw InvalidArgumentError(context + ": " + error.what());
+    } catch (const InvalidMeshError& error) {
+        throw InvalidMeshError(context + ": " + error.what());
+    } catch (const AlgorithmError& error) {
+        throw AlgorithmError(context + ": " + error.what());
+    }
+}
+
 }  // namespace waxwork
