@@ -22,7 +22,7 @@
 // residual_refresh_interval updates), and a claim of convergence from the float recursive residual is
 // confirmed with it before the solver stops (MultigridFrameCg::confirms_convergence). So the estimate
 // measures the double system the CPU solves, not the float copy of M on the device, which on sliver
-// meshes lies far from it (1.6e-4 relative at 1e-5 caps); each refresh corrects phi towards the double
+// meshes lies far from it (about 2e-4 relative at 1e-5 caps); each refresh corrects phi towards the double
 // solution (mixed-precision iterative refinement). Where float phi cannot get within the tolerance,
 // step() stops early with at_precision_floor. On well-shaped meshes the result agrees with the CPU
 // double solution to ~1e-6 relative.

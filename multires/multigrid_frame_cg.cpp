@@ -154,22 +154,19 @@ FrameStep MultigridFrameCg::step_within(int budget, const FrameDeadline& deadlin
         // The estimate is the true residual's when r was recomputed since the last update.
         const bool from_true_residual = updates_since_refresh_ == 0;
         if (cg_.estimate(sums, options_.relative_tolerance, result.estimated_relative_error, who_)) {
-            if (from_true_residual || !confirms_convergence()) {
-                confirming_ = false;
+            bool confirmed = from_true_residual || !confirms_convergence();
+            if (!confirmed) {
+                // Confirm: recompute r = b - M phi. Where it barely moved (kTrustedResidualDrift) the
+                // estimate stands; otherwise the next V-cycle's estimate from r decides (and CG goes
+                // on from it).
+                confirmed = refresh_residual() <= kTrustedResidualDrift;
+                cg_.restart_after_refresh();
+            }
+            confirming_ = !confirmed;
+            if (confirmed) {
                 result.converged = true;
                 break;
             }
-            // Confirm: recompute r = b - M phi. Where it barely moved (kTrustedResidualDrift) the
-            // estimate stands; otherwise the next V-cycle's estimate from r decides (and CG goes on
-            // from it).
-            const double drift = refresh_residual();
-            cg_.restart_after_refresh();
-            if (drift <= kTrustedResidualDrift) {
-                confirming_ = false;
-                result.converged = true;
-                break;
-            }
-            confirming_ = true;
             continue;
         }
         if (from_true_residual && stopped_at_floor(result.estimated_relative_error)) {

@@ -113,7 +113,7 @@ protected:
     // recomputed r = b - M phi before the solver stops. A backend whose updates are less precise than
     // its recomputed residual says yes: the GPU updates r in float from a float copy of M but computes
     // b - M phi in double from the double matrix, so its recursive estimate measures the float system,
-    // which on sliver meshes lies far from the double one (1.6e-4 at 1e-5 caps), while the confirmed
+    // which on sliver meshes lies far from the double one (about 2e-4 at 1e-5 caps), while the confirmed
     // one measures the system the CPU solves. The refreshed residual then also corrects phi towards the
     // double solution (mixed-precision iterative refinement). The CPU updates in double: only for
     // tight tolerances. A refuted claim counts towards the precision floor (at_precision_floor).
