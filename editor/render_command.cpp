@@ -4,6 +4,7 @@
 #include "editor/render_pipeline.h"
 #include "editor/view_modes.h"
 #include "io/volume_file.h"
+#include "solver/lighting.h"
 #include "solver/material.h"
 #include "tetops/connectivity.h"
 #include "tetops/error.h"
@@ -68,7 +69,7 @@ void check_options(const RenderCommandOptions& o) {
     validate_mm_per_unit(o.scale, "--scale");
     // Below about 1e-15 a relative error is under double's rounding: no solver can report it reached.
     if (!(o.tolerance >= 1e-15 && o.tolerance < 1)) fail("--tol must be a relative tolerance in [1e-15, 1)");
-    if (!(o.ambient >= 0 && o.ambient <= 1e100)) fail("--ambient must be non-negative and at most 1e100");
+    if (!(o.ambient >= 0 && o.ambient <= kMaxLightValue)) fail("--ambient must be non-negative and at most 1e100");
     if (o.exposure && (!std::isfinite(*o.exposure) || *o.exposure <= 0))
         fail("--exposure must be finite and positive");
     if (!o.view.empty()) {
@@ -100,12 +101,8 @@ void run_render_command(const RenderCommandOptions& o) {
     const TetMesh mesh = read_volume(o.volume);
     if (mesh.tet_count() == 0) throw InvalidArgumentError(o.volume + ": the volume has no tets to render");
     const TetConnectivity connectivity = build_connectivity(mesh);
-    std::vector<TetMaterial> materials;
-    try {
-        materials = resolve_materials(mesh, chosen);
-    } catch (const InvalidArgumentError& error) {
-        throw InvalidArgumentError(o.volume + ": " + error.what());  // a stored material no solve can use
-    }
+    // A stored material no solve can use is the file's problem.
+    const std::vector<TetMaterial> materials = naming_context(o.volume, [&] { return resolve_materials(mesh, chosen); });
 
     // One OpenGL context for the GPU solve and the renderer (the same device).
     HeadlessGlContext context;

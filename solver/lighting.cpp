@@ -18,10 +18,6 @@ std::string light_name(size_t index, const Light& light) {
            (light.type == LightType::Directional ? "directional" : "point") + ")";
 }
 
-// Intensities and light vectors beyond this overflow the solver's sums of squares (1e100 squared,
-// summed over a million vertices, is still finite; 1e308 is not) and the normalisation of directions.
-constexpr double kMaxLightValue = 1e100;
-
 // Non-negative and at most kMaxLightValue (so finite).
 bool valid_light_value(const Rgb& c) {
     for (double x : c) {

@@ -50,8 +50,13 @@ struct Lighting {
     bool shadows = true;
 };
 
-// Throws InvalidArgumentError naming the light for non-finite components, a zero direction or
-// negative intensities / ambient.
+// The largest light intensity, ambient or light-vector component: beyond it the solver's sums of
+// squares overflow (1e100 squared, summed over a million vertices, is still finite; 1e308 is not),
+// and so does the normalisation of directions.
+constexpr double kMaxLightValue = 1e100;
+
+// Throws InvalidArgumentError naming the light for non-finite components or ones beyond
+// kMaxLightValue, a zero direction, or negative intensities / ambient.
 void validate(const Lighting& lighting);
 
 // The boundary of a volume in world space, as the lighting and the renderer see it. Surface vertex s
