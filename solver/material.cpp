@@ -91,17 +91,6 @@ void validate_mm_per_unit(double mm_per_unit, std::string_view what) {
                                got.str() + ")");
 }
 
-namespace {
-
-// A coefficient in a message: %g, so 1e308 prints as such rather than as 309 digits.
-std::string coefficient_text(double value) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%g", value);
-    return text;
-}
-
-}  // namespace
-
 void validate_material(const TetMaterial& m, std::string_view context) {
     if (material_is_valid(m)) return;
     auto fail = [&](const std::string& problem) {
@@ -112,16 +101,16 @@ void validate_material(const TetMaterial& m, std::string_view context) {
         const double mua = m.mua[c], musp = m.musp[c];
         if (!std::isfinite(mua)) fail("mu_a is not finite" + channel);
         if (!std::isfinite(musp)) fail("mu_s' is not finite" + channel);
-        if (mua < 0) fail("mu_a = " + coefficient_text(mua) + " is negative" + channel);
+        if (mua < 0) fail("mu_a = " + number_text(mua) + " is negative" + channel);
         if (musp <= 0)
-            fail("mu_s' = " + coefficient_text(musp) +
+            fail("mu_s' = " + number_text(musp) +
                  " must be positive (the diffusion approximation needs scattering)" + channel);
         if (mua > kMaxCoefficientPerMm || musp > kMaxCoefficientPerMm)
             fail("coefficient above 1e4 per mm" + channel + "; coefficients are per millimetre");
     }
     if (!std::isfinite(m.eta)) fail("eta is not finite");
     if (m.eta < kMinEta || m.eta > kMaxEta)
-        fail("eta = " + coefficient_text(m.eta) + " is outside [1, 3] (relative index of refraction)");
+        fail("eta = " + number_text(m.eta) + " is outside [1, 3] (relative index of refraction)");
 }
 
 std::vector<std::string> material_preset_names() {

@@ -5,6 +5,7 @@
 // the file (when there is one) and the problem, e.g. "bad_cow.obj: 1 non-manifold vertex (vertex 17)".
 #pragma once
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -46,6 +47,13 @@ class AlgorithmError : public Error {
 public:
     using Error::Error;
 };
+
+// A number in a message, as %g: 1e308 prints as such rather than as 309 digits, 0.001 not as 0.001000.
+inline std::string number_text(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", value);
+    return text;
+}
 
 // Runs `work` and gives its argument, parameter and algorithm errors "context: " (a file name) before
 // their message, keeping their type: for callers that know the file a library call works on.

@@ -13,7 +13,7 @@ namespace waxwork {
 FragmentRemoval remove_small_fragments(TetMesh& mesh, double max_volume_fraction) {
     if (!(max_volume_fraction >= 0 && max_volume_fraction < 1))
         throw InvalidArgumentError("remove fragments: the volume fraction must be in [0, 1), got " +
-                                   std::to_string(max_volume_fraction));
+                                   number_text(max_volume_fraction));
     FragmentRemoval result;
     const TetConnectivity connectivity = build_connectivity(mesh);
     std::vector<double> part_volume(static_cast<size_t>(connectivity.component_count), 0.0);

@@ -38,28 +38,22 @@ constexpr double kBareCheckTetsPerTriangle = 4.0;
 // any of them the run stopped there has more tets than allowed.
 constexpr double kTetsPerAddedPointForFloorCheck = 3.0;
 
-std::string to_string(double value) {
-    char buffer[64];
-    std::snprintf(buffer, sizeof buffer, "%g", value);
-    return buffer;
-}
-
 void validate_options(const MeshingOptions& options) {
     if (options.mesher != Mesher::TetGen && options.mesher != Mesher::Cgal) {
         throw InvalidArgumentError("meshing option mesher: unknown mesher");
     }
     if (!(options.max_radius_edge_ratio >= 1.0) || !std::isfinite(options.max_radius_edge_ratio)) {
         throw InvalidArgumentError("meshing option max_radius_edge_ratio = " +
-                                   to_string(options.max_radius_edge_ratio) + ": must be finite and >= 1");
+                                   number_text(options.max_radius_edge_ratio) + ": must be finite and >= 1");
     }
     if (!(options.min_dihedral_deg > 0 && options.min_dihedral_deg <= 30)) {
-        throw InvalidArgumentError("meshing option min_dihedral_deg = " + to_string(options.min_dihedral_deg) +
+        throw InvalidArgumentError("meshing option min_dihedral_deg = " + number_text(options.min_dihedral_deg) +
                                    ": must be in (0, 30] degrees");
     }
     const MeshSizing& sizing = options.sizing;
     if (sizing.edge_length) {
         if (!(*sizing.edge_length > 0) || !std::isfinite(*sizing.edge_length)) {
-            throw InvalidArgumentError("meshing option sizing.edge_length = " + to_string(*sizing.edge_length) +
+            throw InvalidArgumentError("meshing option sizing.edge_length = " + number_text(*sizing.edge_length) +
                                        ": must be a positive length");
         }
     } else if (sizing.target_tets) {
@@ -70,16 +64,16 @@ void validate_options(const MeshingOptions& options) {
         }
     } else {
         if (!(sizing.surface_edge > 0) || !std::isfinite(sizing.surface_edge)) {
-            throw InvalidArgumentError("meshing option sizing.surface_edge = " + to_string(sizing.surface_edge) +
+            throw InvalidArgumentError("meshing option sizing.surface_edge = " + number_text(sizing.surface_edge) +
                                        ": must be a positive length (or set sizing.edge_length or "
                                        "sizing.target_tets)");
         }
         if (!(sizing.grading >= 0) || !std::isfinite(sizing.grading)) {
-            throw InvalidArgumentError("meshing option sizing.grading = " + to_string(sizing.grading) +
+            throw InvalidArgumentError("meshing option sizing.grading = " + number_text(sizing.grading) +
                                        ": must be finite and >= 0");
         }
         if (!(sizing.max_edge == 0 || (sizing.max_edge >= sizing.surface_edge && std::isfinite(sizing.max_edge)))) {
-            throw InvalidArgumentError("meshing option sizing.max_edge = " + to_string(sizing.max_edge) +
+            throw InvalidArgumentError("meshing option sizing.max_edge = " + number_text(sizing.max_edge) +
                                        ": must be 0 (no cap) or at least sizing.surface_edge");
         }
     }
@@ -149,9 +143,9 @@ double predicted_tets(const SizeField& size, double volume, double area) {
 void check_predicted_size(const SizeField& size, double volume, double area, const std::string& option) {
     const double predicted = predicted_tets(size, volume, area);
     if (predicted > kMaxPredictedTets) {
-        throw InvalidArgumentError("meshing option " + option + ": about " + to_string(predicted) +
-                                   " tets predicted for a volume of " + to_string(volume) +
-                                   ", above the limit of " + to_string(kMaxPredictedTets) +
+        throw InvalidArgumentError("meshing option " + option + ": about " + number_text(predicted) +
+                                   " tets predicted for a volume of " + number_text(volume) +
+                                   ", above the limit of " + number_text(kMaxPredictedTets) +
                                    "; use a larger edge length");
     }
 }
@@ -307,14 +301,14 @@ MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOption
     const MeshSizing& sizing = options.sizing;
     if (sizing.edge_length) {
         const SizeField size = SizeField::uniform(*sizing.edge_length);
-        check_predicted_size(size, volume, area, "sizing.edge_length = " + to_string(*sizing.edge_length));
+        check_predicted_size(size, volume, area, "sizing.edge_length = " + number_text(*sizing.edge_length));
         result.mesh = run_mesher(surface, options, size);
     } else if (sizing.target_tets) {
         result.mesh = mesh_to_target(surface, options, *sizing.target_tets, volume);
     } else {
         SizeField size{sizing.surface_edge, sizing.grading,
                        sizing.max_edge > 0 ? sizing.max_edge : SizeField::unbounded().max_edge};
-        check_predicted_size(size, volume, area, "sizing.surface_edge = " + to_string(sizing.surface_edge));
+        check_predicted_size(size, volume, area, "sizing.surface_edge = " + number_text(sizing.surface_edge));
         result.mesh = run_mesher(surface, options, size);
     }
     sort_spatially(result.mesh);
