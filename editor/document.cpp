@@ -4,6 +4,7 @@
 #include "tetops/error.h"
 #include "tetops/exact_cut.h"
 #include "tetops/fracture.h"
+#include "tetops/fragments.h"
 #include "tetops/paint.h"
 #include "tetops/quality.h"
 #include "tetops/relaxation.h"
@@ -179,6 +180,19 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
         }
         report.changed_material_tets = entry.material_tets;
         details << report.changed_material_tets.size() << " tets changed";
+    } else if (const auto* o = std::get_if<RemoveFragmentsOp>(&op)) {
+        auto after = std::make_shared<TetMesh>(mesh_);
+        FragmentRemoval removal = remove_small_fragments(*after, o->max_volume_fraction);
+        if (removal.fragments_removed > 0) {
+            entry.snapshot_vertex = inverse_vertex_map(removal.removed.old_to_new_vertex, after->vertex_count());
+            report.old_to_new_vertex = std::move(removal.removed.old_to_new_vertex);
+            entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
+            mesh_ = std::move(*after);
+            min_dihedral_deg_ = min_dihedral_of(mesh_);
+            report.topology = true;
+        }
+        details << removal.fragments_removed << " fragments removed (" << removal.removed.tets_removed << " tets), "
+                << removal.parts_kept << (removal.parts_kept == 1 ? " part" : " parts") << " kept";
     } else {
         run_piece_operation(op, entry, report, details);
     }

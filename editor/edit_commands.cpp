@@ -1,6 +1,7 @@
 // `waxwork cut`, `waxwork fracture` and `waxwork paint`: the editing operations of TransCut Sec. 5 (and
 // issue 6's exact cut and fracture) from the command line.
 //   waxwork cut VOLUME -o OUT --plane=NX,NY,NZ,D [--relax ITERS] [--no-guard] [--exact]
+//               [--remove-fragments FRACTION]
 //   waxwork fracture VOLUME -o OUT --pieces N [--seed K] [--exact|--no-exact] [--min-piece-tets M]
 //   waxwork paint VOLUME -o OUT --at "X,Y,Z;X,Y,Z" (--material NAME | --mua R,G,B --musp R,G,B --eta N)
 //                 --sigma S [--base NAME]
@@ -13,6 +14,7 @@
 #include "tetops/error.h"
 #include "tetops/exact_cut.h"
 #include "tetops/fracture.h"
+#include "tetops/fragments.h"
 #include "tetops/paint.h"
 #include "tetops/quality.h"
 #include "tetops/relaxation.h"
@@ -28,6 +30,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -74,7 +77,20 @@ struct CutCommandOptions {
     int relax_iterations = 10;
     bool no_guard = false;
     bool exact = false;
+    std::optional<double> remove_fragments;  // volume fraction (tetops/fragments.h)
 };
+
+// After the cut: drops the parts under the fraction, if asked, and reports them in the summary
+// (whose "components" then counts the parts kept).
+void remove_fragments_after_cut(const CutCommandOptions& o, TetMesh& mesh, nlohmann::ordered_json& summary) {
+    if (!o.remove_fragments) return;
+    const FragmentRemoval removal = remove_small_fragments(mesh, *o.remove_fragments);
+    summary["fragments_removed"] = removal.fragments_removed;
+    summary["fragment_tets_removed"] = removal.removed.tets_removed;
+    summary["components"] = removal.parts_kept;
+    summary["tets_after"] = mesh.tet_count();
+    summary["vertices_after"] = mesh.vertex_count();
+}
 
 // Exact mode: tets crossed by the plane are split along it, so no relaxation is needed.
 void run_exact_cut(const CutCommandOptions& o, const PlaneCut& plane) {
@@ -85,8 +101,6 @@ void run_exact_cut(const CutCommandOptions& o, const PlaneCut& plane) {
     const ExactCutResult cut = cut_exact(mesh, plane);
     require_tets_left_by_cut(mesh, tets_before);
     const TetConnectivity connectivity = build_connectivity(mesh);
-    const double elapsed = milliseconds_since(start);
-    write_volume(mesh, o.output);
     nlohmann::ordered_json summary = {
         {"output", o.output},
         {"mode", "exact"},
@@ -102,14 +116,19 @@ void run_exact_cut(const CutCommandOptions& o, const PlaneCut& plane) {
         {"vertices_smoothed", cut.vertices_smoothed},
         {"min_dihedral_deg", cut.min_dihedral_deg},
         {"tets_under_guard", cut.tets_under_guard},
-        {"milliseconds", elapsed},
     };
+    remove_fragments_after_cut(o, mesh, summary);
+    summary["milliseconds"] = milliseconds_since(start);
+    write_volume(mesh, o.output);
     std::cout << summary.dump() << "\n";
 }
 
 void run_cut_command(const CutCommandOptions& o) {
     const std::vector<double> p = parse_numbers(o.plane, 4, "cut --plane");
     const PlaneCut plane(Eigen::Vector3d(p[0], p[1], p[2]), p[3]);
+    if (o.remove_fragments && !(*o.remove_fragments >= 0 && *o.remove_fragments < 1))
+        throw InvalidArgumentError("cut --remove-fragments: the volume fraction must be in [0, 1), got " +
+                                   number_text(*o.remove_fragments));
     if (o.exact) return run_exact_cut(o, plane);
     if (o.relax_iterations < 0) throw InvalidArgumentError("cut --relax: the iteration count must be >= 0");
 
@@ -125,9 +144,6 @@ void run_cut_command(const CutCommandOptions& o) {
     relax.max_iterations = o.relax_iterations;
     relax.min_dihedral_guard_deg = o.no_guard ? 0.0 : relax.min_dihedral_guard_deg;
     const RelaxationReport report = relax_cut_vertices(mesh, connectivity, plane, relax);
-    const double elapsed = milliseconds_since(start);
-
-    write_volume(mesh, o.output);
     nlohmann::ordered_json summary = {
         {"output", o.output},
         {"mode", "relax"},
@@ -142,8 +158,10 @@ void run_cut_command(const CutCommandOptions& o) {
         {"moves_rejected", report.moves_rejected},
         {"guard_deg", relax.min_dihedral_guard_deg},
         {"min_dihedral_deg", report.min_dihedral_deg},
-        {"milliseconds", elapsed},
     };
+    remove_fragments_after_cut(o, mesh, summary);
+    summary["milliseconds"] = milliseconds_since(start);
+    write_volume(mesh, o.output);
     std::cout << summary.dump() << "\n";
 }
 
@@ -273,6 +291,9 @@ void add_cut_command(CLI::App& app) {
     cmd->add_flag("--exact", options->exact,
                   "Split the tets crossed by the plane along it instead of relaxing (--relax and --no-guard are "
                   "then unused)");
+    cmd->add_option("--remove-fragments", options->remove_fragments,
+                    "Then drop the detached parts smaller than this fraction of the volume (0.001: 0.1%), such as "
+                    "the caps a plane grazing a concave shape leaves floating; the largest part always stays");
     cmd->footer("Tets with all four vertices on the side n.x > D are removed (TransCut Sec. 5); vertices left there\n"
                 "then move toward their one-ring average, never across the plane and never below the guard.\n"
                 "--exact: vertices within 20% of an edge from the plane snap onto it (when no tet of their star\n"

@@ -16,6 +16,10 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
+// Listed in errors about a missing or unknown "op".
+constexpr const char* kOperationNames =
+    "plane_cut, stroke_cut, relax, fracture, move_piece, weld, remove_fragments, paint, set_material";
+
 Json relax_to_json(const RelaxSettings& r) {
     return Json{{"iterations", r.iterations}, {"step", r.step}, {"guard_deg", r.guard_deg}};
 }
@@ -130,6 +134,9 @@ struct ToJson {
                     {"translation", vector_to_json(op.transform.translation)}};
     }
     Json operator()(const WeldOp& op) const { return Json{{"op", "weld"}, {"tolerance", op.tolerance}}; }
+    Json operator()(const RemoveFragmentsOp& op) const {
+        return Json{{"op", "remove_fragments"}, {"max_volume_fraction", op.max_volume_fraction}};
+    }
     Json operator()(const PaintOp& op) const {
         return Json{{"op", "paint"},
                     {"points", points_to_json(op.points)},
@@ -204,8 +211,7 @@ Json to_json(const EditOperation& op) { return std::visit(ToJson{}, op); }
 EditOperation edit_operation_from_json(const Json& json, const std::string& context) {
     if (!json.is_object()) fail_json(context, "an edit operation must be a JSON object with an \"op\" field");
     if (!json.contains("op") || !json.at("op").is_string())
-        fail_json(context, "missing field 'op' (plane_cut, stroke_cut, relax, fracture, move_piece, weld, paint, "
-                      "set_material)");
+        fail_json(context, std::string("missing field 'op' (") + kOperationNames + ")");
     const std::string name = json.at("op").get<std::string>();
     FieldReader in(json, prefixed(context, name));
     in.ignore("op");
@@ -271,6 +277,12 @@ EditOperation edit_operation_from_json(const Json& json, const std::string& cont
         op.tolerance = in.number("tolerance", op.tolerance);
         if (op.tolerance < 0) fail_json(in.field("tolerance"), "must be non-negative");
         result = op;
+    } else if (name == "remove_fragments") {
+        RemoveFragmentsOp op;
+        op.max_volume_fraction = in.number("max_volume_fraction", op.max_volume_fraction);
+        if (!(op.max_volume_fraction >= 0 && op.max_volume_fraction < 1))
+            fail_json(in.field("max_volume_fraction"), "must be in [0, 1) (a fraction of the whole volume)");
+        result = op;
     } else if (name == "paint") {
         PaintOp op;
         op.points = in.points("points");
@@ -291,8 +303,7 @@ EditOperation edit_operation_from_json(const Json& json, const std::string& cont
         }
         result = op;
     } else {
-        fail_json(context, "unknown op '" + name +
-                          "' (plane_cut, stroke_cut, relax, fracture, move_piece, weld, paint, set_material)");
+        fail_json(context, "unknown op '" + name + "' (" + kOperationNames + ")");
     }
     in.finish();
     return result;

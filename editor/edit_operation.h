@@ -15,6 +15,7 @@
 //    "min_piece_tets": 8
 //   {"op": "move_piece", "piece": 1, "rotation": [[3x3 rows]], "translation": [...]}
 //   {"op": "weld", "tolerance": 1e-6}
+//   {"op": "remove_fragments", "max_volume_fraction": 0.001}
 //   {"op": "paint", "points": [[...], ...], "material": ..., "sigma": 0.05, "cutoff_weight": 0.001}
 //   {"op": "set_material", "material": ..., "piece": 2}          (no "piece": the whole volume)
 // with "relax": {"iterations": 10, "step": 0.1, "guard_deg": 0.5}.
@@ -100,6 +101,13 @@ struct WeldOp {
     friend bool operator==(const WeldOp&, const WeldOp&) = default;
 };
 
+// Drops the face-connected parts smaller than a fraction of the volume (tetops/fragments.h): the
+// specks a cut of a concave shape can leave floating.
+struct RemoveFragmentsOp {
+    double max_volume_fraction = 1e-3;
+    friend bool operator==(const RemoveFragmentsOp&, const RemoveFragmentsOp&) = default;
+};
+
 // Gaussian brush stroke (tetops/paint.h).
 struct PaintOp {
     std::vector<Eigen::Vector3d> points;  // world space
@@ -116,8 +124,8 @@ struct SetMaterialOp {
     friend bool operator==(const SetMaterialOp&, const SetMaterialOp&) = default;
 };
 
-using EditOperation =
-    std::variant<PlaneCutOp, StrokeCutOp, RelaxOp, FractureOp, MovePieceOp, WeldOp, PaintOp, SetMaterialOp>;
+using EditOperation = std::variant<PlaneCutOp, StrokeCutOp, RelaxOp, FractureOp, MovePieceOp, WeldOp,
+                                   RemoveFragmentsOp, PaintOp, SetMaterialOp>;
 
 // The "op" name of an operation ("plane_cut", "paint", ...).
 std::string operation_name(const EditOperation& op);

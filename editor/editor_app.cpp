@@ -318,6 +318,7 @@ void EditorApp::on_key(int key, int mods) {
     case GLFW_KEY_X: select_tool(Tool::ExactCut); break;
     case GLFW_KEY_R: select_tool(Tool::Relax); break;
     case GLFW_KEY_F: select_tool(Tool::Fracture); break;
+    case GLFW_KEY_D: remove_fragments(); break;
     case GLFW_KEY_M: select_tool(Tool::MovePiece); break;
     case GLFW_KEY_P: select_tool(Tool::Paint); break;
     case GLFW_KEY_L: select_tool(Tool::Light); break;
@@ -591,6 +592,10 @@ bool EditorApp::can_redo() const { return scene_->can_redo; }
 
 void EditorApp::undo() { queue_history_step(false); }
 void EditorApp::redo() { queue_history_step(true); }
+
+void EditorApp::remove_fragments() {
+    queue_edit(RemoveFragmentsOp{static_cast<double>(fragment_percent_) / 100.0});
+}
 
 void EditorApp::queue_history_step(bool redo) {
     queue_job(redo ? "redo" : "undo", [redo](SceneCore& core) {

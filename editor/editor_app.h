@@ -203,6 +203,7 @@ private:
     void undo();
     void redo();
     void queue_history_step(bool redo);
+    void remove_fragments();
     bool can_undo() const;
     bool can_redo() const;
     void set_whole_material(const TetMaterial& material, const std::string& name);
@@ -259,6 +260,7 @@ private:
     bool lighting_dirty_ = false;                                // send lighting_ with the next tick
     std::optional<std::variant<PlaneSurface, StrokeSurface>> last_cut_;  // what Relax relaxes towards
     int fracture_pieces_ = 5;
+    float fragment_percent_ = 0.1f;  // Edit > Remove fragments: parts under this % of the volume go
     uint32_t fracture_seed_ = 1;
 
     ViewportTools tools_;

@@ -118,6 +118,12 @@ void EditorApp::draw_menu_bar() {
     if (ImGui::BeginMenu("Edit")) {
         if (ImGui::MenuItem("Undo", "Ctrl+Z", false, can_undo())) undo();
         if (ImGui::MenuItem("Redo", "Ctrl+Shift+Z", false, can_redo())) redo();
+        ImGui::Separator();
+        // Specks a cut of a concave shape leaves floating (tetops/fragments.h); the size is the user's.
+        if (ImGui::MenuItem("Remove fragments", "D", false, scene_->core != nullptr)) remove_fragments();
+        ImGui::SetNextItemWidth(ImGui::GetFontSize() * 8);
+        ImGui::SliderFloat("% of the volume", &fragment_percent_, 0.01f, 10.0f, "under %.3g",
+                           ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
         ImGui::EndMenu();
     }
     if (ImGui::BeginMenu("Tools")) {

@@ -44,6 +44,7 @@ const std::vector<std::string>& control_lines() {
         "Esc: cancel the stroke or drag, else back to Orbit",
         "Shift while cutting: cut away the right side instead",
         "Ctrl+Z / Ctrl+Shift+Z: undo / redo   Tab: hide the panels",
+        "D: remove the fragments under a size set in the Edit menu (0.1% of the volume at first)",
     };
     return lines;
 }

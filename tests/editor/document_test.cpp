@@ -237,6 +237,55 @@ TEST(Document, CutsFracturesAndWeldsMapTheirVerticesBothWays) {
     }
 }
 
+// A U of 7 x 6 x 2 cells with a long arm (i = 0) and a short one (i = 6, two cells up): cutting its
+// bridge away (y < 1.5) leaves the short arm as a fragment of 1/6 of the volume.
+TetMesh u_with_a_short_arm() {
+    return testing::make_cell_mesh(7, 6, 2, [](int i, int j, int) { return j == 0 || i == 0 || (i == 6 && j <= 1); });
+}
+
+PlaneCutOp cut_the_bridge() {
+    PlaneCutOp op;
+    op.plane = {-Eigen::Vector3d::UnitY(), -1.5};
+    op.relax.iterations = 0;
+    return op;
+}
+
+TEST(Document, RemovingFragmentsDropsTheSpeckAndUndoesBitForBit) {
+    Document doc(u_with_a_short_arm(), material_preset("marble"));
+    doc.apply(cut_the_bridge());
+    const TetMesh cut = doc.mesh();
+    ASSERT_EQ(cut.tet_count(), 6u * 12u);
+
+    // Under the arm's 1/6: nothing to remove, nothing changes.
+    const ChangeReport none = doc.apply(RemoveFragmentsOp{0.1});
+    EXPECT_FALSE(none.anything_changed());
+    EXPECT_EQ(doc.mesh(), cut);
+    EXPECT_NE(none.details.find("0 fragments removed"), std::string::npos) << none.details;
+
+    const ChangeReport removed = doc.apply(RemoveFragmentsOp{0.2});
+    EXPECT_TRUE(removed.topology);
+    EXPECT_EQ(removed.tets_after, 6u * 10u);
+    EXPECT_NE(removed.details.find("1 fragments removed (12 tets), 1 part kept"), std::string::npos)
+        << removed.details;
+    ASSERT_EQ(removed.old_to_new_vertex.size(), cut.vertex_count());
+    for (size_t v = 0; v < cut.vertex_count(); ++v) {
+        const int32_t w = removed.old_to_new_vertex[v];
+        if (w >= 0) {
+            EXPECT_EQ(doc.mesh().positions[static_cast<size_t>(w)], cut.positions[v]);
+        } else {
+            EXPECT_GT(cut.positions[v].x(), 5.0) << v;  // only the short arm's vertices go
+        }
+    }
+    const TetMesh after = doc.mesh();
+    ASSERT_TRUE(doc.undo());
+    EXPECT_EQ(doc.mesh(), cut);
+    ASSERT_TRUE(doc.redo());
+    EXPECT_EQ(doc.mesh(), after);
+
+    EXPECT_THROW(doc.apply(RemoveFragmentsOp{1.0}), InvalidArgumentError);
+    EXPECT_EQ(doc.mesh(), after);
+}
+
 TEST(Document, LongUndoRedoSequencesRetraceTheSameStates) {
     Document doc(test_cube(), material_preset("marble"));
     std::vector<TetMesh> states = {doc.mesh()};

@@ -38,7 +38,8 @@ std::vector<EditOperation> one_of_each() {
     paint.sigma = 0.07;
     SetMaterialOp all{material_preset("skin1"), std::nullopt};
     SetMaterialOp one{material_preset("marble"), 3};
-    return {plane, stroke, relax_plane, relax_stroke, scattered, seeded, move, WeldOp{1e-5}, paint, all, one};
+    return {plane,        stroke,      relax_plane, relax_stroke, scattered, seeded,
+            move,         WeldOp{1e-5}, RemoveFragmentsOp{0.0025}, paint, all,   one};
 }
 
 TEST(EditOperation, EveryKindRoundTripsThroughJsonText) {

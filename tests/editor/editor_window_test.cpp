@@ -6,6 +6,7 @@
 #include "io/image_io.h"
 #include "io/volume_file.h"
 #include "solver/material.h"
+#include "tetops/test_meshes.h"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -336,6 +337,31 @@ TEST_F(EditorWindow, ShortcutKeysSelectToolsAndUndo) {
     const TetMesh loaded = read_volume(dir / "loaded.vtu");
     EXPECT_LT(read_volume(dir / "cut.vtu").tet_count(), loaded.tet_count());
     EXPECT_TRUE(read_volume(dir / "undone.vtu") == loaded);
+}
+
+TEST_F(EditorWindow, KeyDRemovesFragmentsUnderTheSizeSetAndUndoRestoresThem) {
+    const fs::path dir = scratch_dir("editor_fragments");
+    // A cube of 1296 tets and, apart from it, a speck of 6 tets and 0.0125% of the volume (under the
+    // default 0.1%).
+    const TetMesh volume = testing::concatenate(testing::make_cube_mesh(6, Eigen::Vector3d::Constant(-1), 2.0),
+                                                testing::make_cube_mesh(1, Eigen::Vector3d(1.5, 0, 0), 0.1));
+    write_volume(volume, dir / "speck.vtu");
+    std::ofstream(dir / "input.json") << R"([
+        {"frame": 2, "event": "key", "key": "D"},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "removed.vtu"},
+        {"event": "key", "key": "Z", "mods": ["ctrl"]},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "undone.vtu"},
+        {"event": "idle"}])";
+    const auto r = run_under_xvfb("edit " + (dir / "speck.vtu").string() + kCubeView + " --input " +
+                                  (dir / "input.json").string() + " --frames 2 --screenshot " +
+                                  (dir / "shot.png").string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const TetMesh removed = read_volume(dir / "removed.vtu");
+    EXPECT_EQ(removed.tet_count(), 1296u);
+    for (const Eigen::Vector3d& p : removed.positions) EXPECT_LE(p.x(), 1.0);
+    EXPECT_EQ(read_volume(dir / "undone.vtu").tet_count(), volume.tet_count());
 }
 
 TEST_F(EditorWindow, LightDragZoomAndPanAreWhatASavedSessionRecords) {

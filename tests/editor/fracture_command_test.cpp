@@ -5,6 +5,7 @@
 #include "tetops/connectivity.h"
 #include "tetops/quality.h"
 #include "tetops/tet_mesh.h"
+#include "tetops/test_meshes.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -139,6 +140,48 @@ TEST(CutCommand, ACutThatLeavesNothingIsAnErrorAndWritesNothing) {
         EXPECT_EQ(line_count(r.err), 1u) << r.err;
         EXPECT_NE(r.err.find("nothing would be left"), std::string::npos) << r.err;
         EXPECT_FALSE(fs::exists(out)) << mode;
+    }
+}
+
+TEST(CutCommand, RemoveFragmentsDropsTheShortArmACutLeavesOfAU) {
+    const auto dir = scratch_dir("cut_fragments_cli");
+    // A U of 7 x 6 x 2 cells: a bridge along y in [0, 1], a long arm at x in [0, 1] up to y = 6 and a
+    // short one at x in [6, 7] up to y = 2. Cutting the bridge away (y < 1.5) leaves the arms apart.
+    const auto in = dir / "u.vtu";
+    write_volume(testing::make_cell_mesh(7, 6, 2, [](int i, int j, int) { return j == 0 || i == 0 || (i == 6 && j <= 1); }),
+                 in);
+    const auto out = dir / "cut.vtu";
+    const std::string cut = "cut " + in.string() + " -o " + out.string() + " --plane=0,-1,0,-1.5";
+    for (const std::string mode : {"", " --exact"}) {
+        SCOPED_TRACE(mode);
+        const auto kept = run_waxwork(cut + mode);
+        ASSERT_EQ(kept.exit_code, 0) << kept.err;
+        EXPECT_EQ(nlohmann::json::parse(kept.out)["components"], 2);
+        EXPECT_FALSE(nlohmann::json::parse(kept.out).contains("fragments_removed"));
+
+        const auto r = run_waxwork(cut + mode + " --remove-fragments 0.2");
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const auto summary = nlohmann::json::parse(r.out);
+        EXPECT_EQ(summary["fragments_removed"], 1);
+        EXPECT_EQ(summary["components"], 1);
+        const TetMesh mesh = read_volume(out.string());
+        EXPECT_EQ(summary["tets_after"], mesh.tet_count());
+        // Whole cells: the short arm's 12 tets go (an exact cut leaves half a cell of it, split).
+        if (mode.empty()) {
+            EXPECT_EQ(summary["fragment_tets_removed"], 12);
+        }
+        EXPECT_EQ(mesh.tet_count() + size_t(summary["fragment_tets_removed"]),
+                  size_t(nlohmann::json::parse(kept.out)["tets_after"]));
+        for (const auto& p : mesh.positions) EXPECT_LE(p.x(), 1.0);
+        EXPECT_EQ(build_connectivity(mesh).component_count, 1);
+    }
+    fs::remove(out);
+    for (const std::string bad : {"1", "-0.5", "nan"}) {
+        const auto r = run_waxwork(cut + " --remove-fragments " + bad);
+        EXPECT_NE(r.exit_code, 0) << bad;
+        EXPECT_EQ(line_count(r.err), 1u) << r.err;
+        EXPECT_NE(r.err.find("--remove-fragments"), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(out)) << bad;
     }
 }
 

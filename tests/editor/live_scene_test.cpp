@@ -140,6 +140,25 @@ TEST(LiveScene, FollowsFracturesMovesWeldsAndExactCuts) {
     expect_matches_fresh_solve(scene, doc.mesh(), lighting, "exact cut");
 }
 
+TEST(LiveScene, FollowsTheRemovalOfAFragmentFromAWarmStart) {
+    // A U whose bridge a cut removes, leaving a short arm (1/6 of the volume) beside the long one.
+    Document doc(testing::make_cell_mesh(7, 6, 2, [](int i, int j, int) { return j == 0 || i == 0 || (i == 6 && j <= 1); }),
+                 material_preset("marble"));
+    const Lighting lighting = key_lighting();
+    LiveScene scene(doc.mesh(), lighting, options());
+    PlaneCutOp cut;
+    cut.plane = {-Eigen::Vector3d::UnitY(), -1.5};
+    cut.relax.iterations = 0;
+    scene.apply_change(doc.mesh(), doc.apply(cut));
+    scene.converge();
+    const SceneUpdate update = scene.apply_change(doc.mesh(), doc.apply(RemoveFragmentsOp{0.2}));
+    EXPECT_TRUE(update.reassembled_matrix);
+    EXPECT_TRUE(update.warm_start);  // the long arm's vertices keep their phi
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "remove fragments");
+    scene.apply_change(doc.mesh(), *doc.undo());
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "undo remove fragments");
+}
+
 TEST(LiveScene, PaintRewritesExactlyTheRowsOfThePaintedTets) {
     Document doc(testing::make_cube_mesh(7), material_preset("marble"));
     LiveScene scene(doc.mesh(), key_lighting(), options());

@@ -744,6 +744,8 @@ EditOperation random_edit(const Document& doc, std::mt19937& rng, std::optional<
         }
         case 5:
             if (mesh.piece_transforms.size() < 2) continue;
+            // Weld the pieces that touch, or drop the parts under 30% of the volume (the smaller pieces).
+            if (rng() % 2) return RemoveFragmentsOp{0.3};
             return WeldOp{1e-9};
         default:
             return SetMaterialOp{material_preset(rng() % 2 ? "marble" : "skin2"), std::nullopt};
