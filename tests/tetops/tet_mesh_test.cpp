@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <numeric>
@@ -225,6 +226,25 @@ TEST(Quality, CornerTetAnglesAndReport) {
     EXPECT_NEAR(q.max_dihedral_deg, 90.0, 1e-9);
     EXPECT_EQ(q.tets_below_5_deg, 0u);
     EXPECT_NEAR(q.min_edge_length, 0.5, 1e-12);
+}
+
+TEST(Quality, MinimumAngleIsTheSmallestOfTheSix) {
+    // min_dihedral_angle_deg takes one acos of the smallest cosine: the same as the smallest of
+    // dihedral_angles_deg, on random tets, slivers (a point pulled onto the opposite face) and
+    // degenerate ones (0).
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    for (int i = 0; i < 2000; ++i) {
+        Eigen::Vector3d p[4];
+        for (auto& x : p) x = Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+        if (i % 3 == 0) p[3] = (p[0] + p[1] + p[2]) / 3 + std::pow(10.0, -1 - i % 12) * (p[3] - p[0]);
+        const auto angles = dihedral_angles_deg(p[0], p[1], p[2], p[3]);
+        EXPECT_NEAR(min_dihedral_angle_deg(p[0], p[1], p[2], p[3]), *std::min_element(angles.begin(), angles.end()),
+                    1e-9)
+            << i;
+    }
+    const Eigen::Vector3d o = Eigen::Vector3d::Zero(), x = Eigen::Vector3d::UnitX();
+    EXPECT_EQ(min_dihedral_angle_deg(o, x, 2 * x, Eigen::Vector3d::UnitY()), 0.0);
 }
 
 TEST(Quality, SliverIsCounted) {
