@@ -205,6 +205,7 @@ void run_fracture_command(const FractureCommandOptions& o) {
         {"pieces_before", result.pieces_before},
         {"pieces", result.pieces_after},
         {"tets_split", result.tets_split},
+        {"vertices_collapsed", result.vertices_collapsed},
         {"vertices_duplicated", result.vertices_duplicated},
         {"min_dihedral_deg", result.min_dihedral_deg},
         {"tets_under_guard", result.tets_under_guard},

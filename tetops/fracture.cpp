@@ -5,6 +5,7 @@
 #include "tetops/error.h"
 #include "tetops/exact_cut.h"
 #include "tetops/quality.h"
+#include "tetops/split_coarsening.h"
 #include "tetops/split_quality.h"
 
 #include <nanoflann.hpp>
@@ -125,13 +126,17 @@ void check_options(const FractureOptions& options) {
 
 // The exact Voronoi split builds the cells one seed at a time and each wall splits the tets earlier
 // walls split (reordering the seeds does not help: in four orders, 30 pieces of spot made 67,553 to
-// 75,413 tets), so the tet count grows much faster than the pieces (spot,
-// 11,705 tets: 10 pieces 1.9x, 30 pieces 5.8x, 100 pieces 27x in 3.8 s, 300 pieces 142x and
-// 0.00004-degree tets in 25 s). Past this growth (plus an allowance that lets small volumes grow
+// 75,413 tets), so the tet count grows much faster than the pieces even after the swallowed walls
+// are collapsed (spot, 11,705 tets: 10 pieces 1.8x, 30 pieces 4.7x, 100 pieces 22x in 2.0 s; without
+// the guard 300 pieces gave 142x and 0.00004-degree tets in 25 s). Past this growth (plus an allowance that lets small volumes grow
 // into a few hundred thousand tets, which costs little) the fracture stops with an error instead of
 // running for minutes into slivers no solver converges on.
 constexpr size_t kMaxFractureGrowth = 32;
 constexpr size_t kFractureGrowthAllowance = 100'000;
+
+// Collapsing the vertices of swallowed walls may lower the worst angle around a vertex, but not under
+// this (the angle under which the split's guarded optimisation starts; SplitOptions::smooth_below_deg).
+constexpr double kCollapseKeepsAngleDeg = 5;
 
 void check_fracture_growth(size_t tets_now, size_t tets_before, size_t walls_done, size_t seeds) {
     if (tets_now <= kMaxFractureGrowth * tets_before + kFractureGrowthAllowance) return;
@@ -301,7 +306,7 @@ FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> 
     FractureResult result;
     std::vector<Eigen::Vector3d> world = prepare(mesh, result);
     if (mesh.tets.empty()) return result;
-    const size_t tets_before = mesh.tet_count();
+    const size_t tets_before = mesh.tet_count(), vertices_before = mesh.vertex_count();
     if (options.min_piece_tets > 0 && seeds.size() * static_cast<size_t>(options.min_piece_tets) > tets_before)
         throw InvalidArgumentError("fracture: " + std::to_string(seeds.size()) + " pieces of a volume of " +
                                    std::to_string(tets_before) + " tets: a piece needs at least " +
@@ -366,6 +371,13 @@ FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> 
                     for (size_t j = 0; j <= k; ++j) best[v] = std::min(best[v], (world[v] - seeds[j]).squaredNorm());
                 }
             });
+        }
+        // Walls that later cells swallowed are no cracks: collapse the vertices they left inside cells.
+        if (options.collapse_swallowed_walls) {
+            result.vertices_collapsed =
+                collapse_unneeded_split_vertices(mesh, label, reference, result.vertex_origins, vertices_before,
+                                                 kCollapseKeepsAngleDeg, split.min_dihedral_guard_deg)
+                    .vertices_collapsed;
         }
     } else {
         // Each tet goes to the cell of its centroid; cracks follow tet faces.

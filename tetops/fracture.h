@@ -36,6 +36,11 @@ struct FractureOptions {
     // (degrees) are optimised within the walls and the boundary, guarded (SplitOptions::
     // smooth_below_deg, split_quality.h); 0 leaves the split as the case table made it.
     double smooth_below_deg = 5;
+    // Exact mode: vertices that walls of earlier cells left inside a later cell (no crack) are
+    // collapsed into a neighbour where no tet ends up under min(5 degrees, the worst around the vertex
+    // before) (split_coarsening.h); false keeps every split, so that no vertex moves and the
+    // children of each tet add up to it when snapping and smoothing are off too.
+    bool collapse_swallowed_walls = true;
 };
 
 struct FractureResult {
@@ -43,6 +48,7 @@ struct FractureResult {
     int pieces_after = 0;
     size_t vertices_duplicated = 0;  // vertices added on crack faces
     size_t tets_split = 0;           // tets split along cell walls (exact mode)
+    size_t vertices_collapsed = 0;   // made on walls later cells swallowed, collapsed again (split_coarsening.h)
     double min_dihedral_deg = 0;     // of the whole mesh afterwards
     // Exact mode: tets whose minimum dihedral angle is under min(0.5 degrees, that of the tet before
     // the fracture they come from), counted from the result; all others meet that bound.
@@ -67,8 +73,9 @@ std::vector<Eigen::Vector3d> scatter_fracture_seeds(const TetMesh& mesh, int cou
 // holds exactly the pieces after (empty pieces are dropped). A cell can give fewer pieces than seeds
 // (a seed whose cell holds fewer than min_piece_tets tets is merged as dust) or more (a cell that meets
 // a concave volume in several parts gives one piece per part). Exact mode builds the diagram one seed
-// at a time, so walls of earlier seeds that a later cell swallows stay as (harmless) extra splits
-// inside that piece.
+// at a time; the vertices that walls of earlier seeds left inside a later cell are collapsed again
+// where that keeps the angles (FractureOptions::collapse_swallowed_walls), the rest stay as extra
+// splits inside that piece.
 // Throws InvalidArgumentError for more seeds than the tets allow pieces of min_piece_tets, and when the
 // exact split grows the mesh past 32 times its tets and 100,000 more (many pieces of a coarse volume); the mesh is
 // then partly split, so callers that keep theirs fracture a copy.

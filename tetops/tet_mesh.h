@@ -44,7 +44,9 @@ struct TetMesh {
     std::vector<Tet> tets;
     // One material per tet, or empty when the volume stores none (the renderer then picks one).
     std::vector<TetMaterial> materials;
-    // Per tet: its index in the mesh before any edit. Paint and undo key on it.
+    // Per tet: its index in the mesh before any edit; the tets an exact cut or fracture splits keep
+    // their parent's, and cuts (and the fracture's collapse of swallowed walls) can leave an id with no
+    // tet. Saved with the volume and listed by `info --cells`, so a tet can be traced to its ancestor.
     std::vector<int32_t> original_ids;
     // Per tet: the piece it belongs to, an index into piece_transforms.
     std::vector<int32_t> piece_ids;

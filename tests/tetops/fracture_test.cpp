@@ -57,11 +57,12 @@ TEST(FractureVoronoi, ExactCellsArePiecesWithFlatCracks) {
     TetMesh mesh = before;
     // Four well separated seeds: every cell holds plenty of tets, so exactly four pieces.
     const std::vector<Eigen::Vector3d> seeds = {{0.2, 0.3, 0.25}, {0.8, 0.2, 0.3}, {0.3, 0.75, 0.7}, {0.7, 0.8, 0.65}};
-    // Without snapping nor the guarded optimisation no vertex moves, so children add up exactly to
-    // their parents (below).
+    // Without snapping, the guarded optimisation or the collapse of swallowed walls no vertex moves, so
+    // children add up exactly to their parents (below).
     FractureOptions options;
     options.snap_fraction = 0;
     options.smooth_below_deg = 0;
+    options.collapse_swallowed_walls = false;
     const FractureResult r = fracture_voronoi(mesh, seeds, options);
     EXPECT_EQ(r.pieces_before, 1);
     EXPECT_EQ(r.pieces_after, 4);
@@ -242,6 +243,7 @@ TEST(FractureVoronoi, VertexOriginsLeadEveryVertexBackToTheVolumeBefore) {
     fixed.snap_fraction = 0;
     fixed.boundary_bend_deg = 0;
     fixed.smooth_below_deg = 0;
+    fixed.collapse_swallowed_walls = false;
     TetMesh mesh = before;
     const FractureResult r = fracture_voronoi(mesh, seeds, fixed);
     expect_origins_describe(mesh, before.vertex_count(), r, /*vertices_fixed=*/true);
@@ -276,11 +278,34 @@ TEST(FractureVoronoi, ScatteredSeedsDeterministicAndVolumePreserving) {
     EXPECT_EQ(c.component_count, ra.pieces_after);
     EXPECT_NEAR(total_volume(a), 1.0, 1e-12);
     for (size_t t = 0; t < a.tet_count(); ++t) EXPECT_GT(signed_volume(a, t), 0.0);
-    // Snapping moves vertices but never loses a tet: every original id is still there.
-    const auto ids_before = volume_by_original_id(before), ids_after = volume_by_original_id(a);
-    ASSERT_EQ(ids_before.size(), ids_after.size());
-    EXPECT_TRUE(std::equal(ids_before.begin(), ids_before.end(), ids_after.begin(),
+    // Snapping moves vertices but never loses a tet: every original id is still there unless the
+    // collapse of swallowed walls reshaped its region into tets of other ids.
+    TetMesh all_splits = before;
+    FractureOptions keep_splits;
+    keep_splits.collapse_swallowed_walls = false;
+    const FractureResult rk = fracture_voronoi(all_splits, seeds, keep_splits);
+    const auto ids_before = volume_by_original_id(before), ids_kept = volume_by_original_id(all_splits);
+    ASSERT_EQ(ids_before.size(), ids_kept.size());
+    EXPECT_TRUE(std::equal(ids_before.begin(), ids_before.end(), ids_kept.begin(),
                            [](const auto& x, const auto& y) { return x.first == y.first; }));
+    for (const auto& [id, volume] : volume_by_original_id(a)) EXPECT_TRUE(ids_before.contains(id)) << id;
+    // The collapse: fewer tets, the same pieces, no worse angle and no more tets under the guard.
+    EXPECT_GT(ra.vertices_collapsed, 0u);
+    EXPECT_EQ(rk.vertices_collapsed, 0u);
+    EXPECT_LT(a.tet_count(), all_splits.tet_count());
+    EXPECT_EQ(ra.pieces_after, rk.pieces_after);
+    EXPECT_GE(ra.min_dihedral_deg, rk.min_dihedral_deg);
+    EXPECT_LE(ra.tets_under_guard, rk.tets_under_guard);
+    // Vertices move only inside a cell: the pieces' volumes are the same.
+    const auto piece_volumes = [](const TetMesh& mesh) {
+        std::vector<double> volume(mesh.piece_transforms.size(), 0.0);
+        for (size_t t = 0; t < mesh.tet_count(); ++t) volume[static_cast<size_t>(mesh.piece_ids[t])] += signed_volume(mesh, t);
+        std::sort(volume.begin(), volume.end());
+        return volume;
+    };
+    const std::vector<double> with = piece_volumes(a), without = piece_volumes(all_splits);
+    ASSERT_EQ(with.size(), without.size());
+    for (size_t p = 0; p < with.size(); ++p) EXPECT_NEAR(with[p], without[p], 1e-12) << p;
     EXPECT_GT(ra.tets_split, 0u);
     // Snapping avoids slivers: the worst angle is better than with every crossed edge split.
     TetMesh unsnapped = before;
