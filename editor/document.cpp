@@ -111,6 +111,12 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
                     << " vertices relaxed (" << relaxed.iterations << " sweeps, " << relaxed.moves_rejected
                     << " moves rejected by the guard)";
         }
+        // A cut of a concave shape can leave specks floating: say so, and what drops them.
+        const FragmentSurvey fragments = survey_fragments(*after, *connectivity, kDefaultFragmentFraction);
+        if (fragments.small_parts > 0)
+            details << "; left " << fragments.small_parts << " detached "
+                    << (fragments.small_parts == 1 ? "part" : "parts") << " under " << 100 * kDefaultFragmentFraction
+                    << "% of the volume (" << fragments.small_part_tets << " tets; Edit > Remove fragments drops them)";
         entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
         mesh_ = std::move(*after);
         report.topology = true;

@@ -21,6 +21,7 @@
 // with "relax": {"iterations": 10, "step": 0.1, "guard_deg": 0.5}.
 #pragma once
 
+#include "tetops/fragments.h"
 #include "tetops/tet_mesh.h"
 
 #include <nlohmann/json_fwd.hpp>
@@ -104,7 +105,7 @@ struct WeldOp {
 // Drops the face-connected parts smaller than a fraction of the volume (tetops/fragments.h): the
 // specks a cut of a concave shape can leave floating.
 struct RemoveFragmentsOp {
-    double max_volume_fraction = 1e-3;
+    double max_volume_fraction = kDefaultFragmentFraction;
     friend bool operator==(const RemoveFragmentsOp&, const RemoveFragmentsOp&) = default;
 };
 

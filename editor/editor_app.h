@@ -260,7 +260,8 @@ private:
     bool lighting_dirty_ = false;                                // send lighting_ with the next tick
     std::optional<std::variant<PlaneSurface, StrokeSurface>> last_cut_;  // what Relax relaxes towards
     int fracture_pieces_ = 5;
-    float fragment_percent_ = 0.1f;  // Edit > Remove fragments: parts under this % of the volume go
+    // Edit > Remove fragments: parts under this % of the volume go.
+    float fragment_percent_ = static_cast<float>(100 * kDefaultFragmentFraction);
     uint32_t fracture_seed_ = 1;
 
     ViewportTools tools_;

@@ -250,6 +250,25 @@ PlaneCutOp cut_the_bridge() {
     return op;
 }
 
+TEST(Document, ACutThatLeavesASpeckSaysSoInItsDetails) {
+    // A cube of 1296 tets and, apart from it, a speck of 0.0125% of the volume; a cut of the cube
+    // leaves the speck, and the details point at Remove fragments.
+    Document doc(testing::concatenate(testing::make_cube_mesh(6), testing::make_cube_mesh(1, Eigen::Vector3d(-3, 0, 0), 0.05)),
+                 material_preset("marble"));
+    for (const bool exact : {false, true}) {
+        PlaneCutOp cut = plane_cut(0.55);
+        cut.exact = exact;
+        const ChangeReport report = doc.apply(cut);
+        EXPECT_NE(report.details.find("left 1 detached part under 0.1% of the volume (6 tets; Edit > Remove fragments"),
+                  std::string::npos)
+            << report.details;
+        doc.undo();
+    }
+    // Without the speck, no such note.
+    Document plain(test_cube(), material_preset("marble"));
+    EXPECT_EQ(plain.apply(plane_cut(0.55)).details.find("detached"), std::string::npos);
+}
+
 TEST(Document, RemovingFragmentsDropsTheSpeckAndUndoesBitForBit) {
     Document doc(u_with_a_short_arm(), material_preset("marble"));
     doc.apply(cut_the_bridge());

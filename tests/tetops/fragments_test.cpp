@@ -30,6 +30,14 @@ TetMesh body_and_speck() {
 TEST(RemoveSmallFragments, DropsAPartUnderTheFractionAndKeepsTheRestWithTheirData) {
     TetMesh mesh = body_and_speck();
     const TetMesh before = mesh;
+    // The survey tells what the removal then drops, and changes nothing.
+    const FragmentSurvey survey = survey_fragments(mesh, build_connectivity(mesh), 0.01);
+    EXPECT_EQ(survey.parts, 2u);
+    EXPECT_EQ(survey.small_parts, 1u);
+    EXPECT_EQ(survey.small_part_tets, 6u);
+    EXPECT_NEAR(survey.small_part_volume, 0.001, 1e-12);
+    EXPECT_EQ(mesh, before);
+    EXPECT_THROW(survey_fragments(mesh, build_connectivity(make_cube_mesh(1)), 0.01), InvalidArgumentError);
     const FragmentRemoval result = remove_small_fragments(mesh, 0.01);
     EXPECT_EQ(result.fragments_removed, 1u);
     EXPECT_EQ(result.parts_kept, 1u);
