@@ -12,6 +12,31 @@
 
 namespace waxwork {
 
+namespace {
+
+// Cosine of the smallest interior dihedral angle of a tet (the largest cosine over its six edges):
+// the same geometry as dihedral_angles_deg without the six arc cosines, so a whole-mesh minimum costs
+// one acos instead of six per tet. A degenerate face gives 1 (a zero angle).
+double max_dihedral_cosine(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
+                           const Eigen::Vector3d& p3) {
+    const std::array<const Eigen::Vector3d*, 4> p = {&p0, &p1, &p2, &p3};
+    std::array<Eigen::Vector3d, 4> normal;
+    std::array<double, 4> length;
+    for (int k = 0; k < 4; ++k) {
+        const auto& f = kTetFaces[k];
+        normal[k] = (*p[f[1]] - *p[f[0]]).cross(*p[f[2]] - *p[f[0]]);
+        length[k] = normal[k].norm();
+        if (!(length[k] > 0)) return 1.0;
+    }
+    double worst = -1.0;
+    // Edge (i, j) is between the faces opposite the other two vertices; interior cosine = -n_k.n_l.
+    for (int k = 0; k < 4; ++k)
+        for (int l = k + 1; l < 4; ++l) worst = std::max(worst, -normal[k].dot(normal[l]) / (length[k] * length[l]));
+    return std::min(worst, 1.0);
+}
+
+}  // namespace
+
 std::array<double, 6> dihedral_angles_deg(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
                                           const Eigen::Vector3d& p2, const Eigen::Vector3d& p3) {
     const std::array<const Eigen::Vector3d*, 4> p = {&p0, &p1, &p2, &p3};
@@ -42,23 +67,11 @@ std::array<double, 6> dihedral_angles_deg(const Eigen::Vector3d& p0, const Eigen
 
 double min_dihedral_angle_deg(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
                               const Eigen::Vector3d& p3) {
-    // As dihedral_angles_deg, but the angle grows with the cosine between the outward normals, so
-    // the smallest cosine gives the smallest angle: one acos instead of six (the quality passes of
-    // the exact split and of the fracture call this for every candidate move).
-    const std::array<const Eigen::Vector3d*, 4> p = {&p0, &p1, &p2, &p3};
-    std::array<Eigen::Vector3d, 4> normal;
-    std::array<double, 4> length;
-    for (int k = 0; k < 4; ++k) {
-        const auto& f = kTetFaces[k];
-        normal[k] = (*p[f[1]] - *p[f[0]]).cross(*p[f[2]] - *p[f[0]]);
-        length[k] = normal[k].norm();
-        if (!(length[k] > 0)) return 0;  // degenerate face: the worst possible angle
-    }
-    double smallest = 1.0;
-    for (int k = 0; k < 4; ++k)
-        for (int l = k + 1; l < 4; ++l)
-            smallest = std::min(smallest, std::clamp(normal[k].dot(normal[l]) / (length[k] * length[l]), -1.0, 1.0));
-    return 180.0 - std::acos(smallest) * 180.0 / std::numbers::pi;
+    // The angle grows with the cosine between the outward normals, so the largest interior cosine
+    // gives the smallest angle: one acos instead of dihedral_angles_deg's six (the quality passes of
+    // the exact split and of the fracture call this for every candidate move). Same arithmetic as
+    // dihedral_angles_deg's smallest angle: 180 degrees minus the angle between outward normals.
+    return 180.0 - std::acos(-max_dihedral_cosine(p0, p1, p2, p3)) * 180.0 / std::numbers::pi;
 }
 
 double radius_edge_ratio(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
@@ -84,30 +97,6 @@ std::vector<double> min_dihedral_angles_deg(const TetMesh& mesh) {
     return result;
 }
 
-namespace {
-
-// Cosine of the smallest interior dihedral angle of a tet (the largest cosine over its six edges):
-// the same geometry as dihedral_angles_deg without the six arc cosines, so a whole-mesh minimum costs
-// one acos instead of six per tet. A degenerate face gives 1 (a zero angle).
-double max_dihedral_cosine(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
-                           const Eigen::Vector3d& p3) {
-    const std::array<const Eigen::Vector3d*, 4> p = {&p0, &p1, &p2, &p3};
-    std::array<Eigen::Vector3d, 4> normal;
-    std::array<double, 4> length;
-    for (int k = 0; k < 4; ++k) {
-        const auto& f = kTetFaces[k];
-        normal[k] = (*p[f[1]] - *p[f[0]]).cross(*p[f[2]] - *p[f[0]]);
-        length[k] = normal[k].norm();
-        if (!(length[k] > 0)) return 1.0;
-    }
-    double worst = -1.0;
-    // Edge (i, j) is between the faces opposite the other two vertices; interior cosine = -n_k.n_l.
-    for (int k = 0; k < 4; ++k)
-        for (int l = k + 1; l < 4; ++l) worst = std::max(worst, -normal[k].dot(normal[l]) / (length[k] * length[l]));
-    return std::min(worst, 1.0);
-}
-
-}  // namespace
 
 double mesh_min_dihedral_deg(const TetMesh& mesh) {
     if (mesh.tets.empty()) return 0;
