@@ -315,7 +315,8 @@ void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, Ch
         report.topology = true;
         report.tets_under_guard = result.tets_under_guard;
         details << result.pieces_before << " -> " << result.pieces_after << " pieces, " << result.tets_split
-                << " tets split, " << result.vertices_duplicated << " crack vertices duplicated, "
+                << " tets split, " << result.vertices_collapsed << " vertices of swallowed walls collapsed, "
+                << result.vertices_duplicated << " crack vertices duplicated, "
                 << result.tets_under_guard << " tets under the angle guard";
     } else if (const auto* o = std::get_if<MovePieceOp>(&op)) {
         if (o->piece < 0 || static_cast<size_t>(o->piece) >= mesh_.piece_transforms.size())

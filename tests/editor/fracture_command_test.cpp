@@ -57,7 +57,7 @@ TEST(FractureCommand, BreaksIntoPiecesAndSummarises) {
         ASSERT_EQ(line_count(r.out), 1u) << r.out;
         const auto summary = nlohmann::json::parse(r.out);
         for (const char* key : {"tets_before", "vertices_before", "tets_after", "vertices_after", "pieces",
-                                "min_dihedral_deg", "tets_under_guard", "milliseconds"})
+                                "min_dihedral_deg", "tets_under_guard", "vertices_collapsed", "milliseconds"})
             EXPECT_TRUE(summary.contains(key)) << key;
         EXPECT_EQ(summary["tets_before"], before.tet_count());
         const TetMesh mesh = read_volume(out.string());
@@ -74,6 +74,7 @@ TEST(FractureCommand, BreaksIntoPiecesAndSummarises) {
         EXPECT_EQ(build_connectivity(mesh).component_count, int(summary["pieces"])) << mode;
         if (mode == "--no-exact") {
             EXPECT_EQ(mesh.tet_count(), before.tet_count());
+            EXPECT_EQ(summary["vertices_collapsed"], 0);  // nothing split, nothing to collapse
         }
     }
     // The same seed gives the same file.
