@@ -3,6 +3,7 @@
 //   waxwork cut VOLUME -o OUT --plane=NX,NY,NZ,D [--relax ITERS] [--no-guard] [--exact]
 //               [--remove-fragments FRACTION]
 //   waxwork fracture VOLUME -o OUT --pieces N [--seed K] [--exact|--no-exact] [--min-piece-tets M]
+//                    [--collapse|--no-collapse]
 //   waxwork paint VOLUME -o OUT --at "X,Y,Z;X,Y,Z" (--material NAME | --mua R,G,B --musp R,G,B --eta N)
 //                 --sigma S [--base NAME]
 // Each prints a one-line JSON summary on stdout.
@@ -172,6 +173,7 @@ struct FractureCommandOptions {
     uint32_t seed = 1;
     bool exact = true;
     int min_piece_tets = FractureOptions{}.min_piece_tets;
+    bool collapse = FractureOptions{}.collapse_swallowed_walls;
 };
 
 // More cells than this is not a fracture but a re-meshing; the passes cost O(pieces x tets).
@@ -189,6 +191,7 @@ void run_fracture_command(const FractureCommandOptions& o) {
     FractureOptions options;
     options.exact = o.exact;
     options.min_piece_tets = o.min_piece_tets;
+    options.collapse_swallowed_walls = o.collapse;
     const FractureResult result = naming_context(o.input, [&] {  // what the volume does not allow
         return fracture_voronoi(mesh, scatter_fracture_seeds(mesh, o.pieces, o.seed), options);
     });
@@ -314,6 +317,9 @@ void add_fracture_command(CLI::App& app) {
                   "Split tets along the cell walls (flat cracks; default) or keep whole tets (cracks on tet faces)");
     cmd->add_option("--min-piece-tets", options->min_piece_tets, "Smaller pieces join their largest neighbour")
         ->capture_default_str();
+    cmd->add_flag("--collapse,!--no-collapse", options->collapse,
+                  "Exact mode: collapse the vertices that walls of earlier cells left inside later ones (default), "
+                  "or keep every split (to compare)");
     cmd->footer("Seeds are scattered uniformly in the volume; each cell's part of each piece becomes a piece (a cell\n"
                 "cut in two by a concave volume gives two), with the crack vertices duplicated so pieces move apart.");
     cmd->callback([options] { run_fracture_command(*options); });

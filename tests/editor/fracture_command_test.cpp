@@ -77,6 +77,19 @@ TEST(FractureCommand, BreaksIntoPiecesAndSummarises) {
             EXPECT_EQ(summary["vertices_collapsed"], 0);  // nothing split, nothing to collapse
         }
     }
+    // --no-collapse keeps every split the walls made; the default collapses what swallowed walls left.
+    const auto kept = dir / "kept.vtu", collapsed = dir / "collapsed.vtu";
+    const auto k = run_waxwork("fracture " + in.string() + " -o " + kept.string() + " --pieces 12 --seed 3 --no-collapse");
+    const auto c = run_waxwork("fracture " + in.string() + " -o " + collapsed.string() + " --pieces 12 --seed 3");
+    ASSERT_EQ(k.exit_code, 0) << k.err;
+    ASSERT_EQ(c.exit_code, 0) << c.err;
+    const auto kept_summary = nlohmann::json::parse(k.out), collapsed_summary = nlohmann::json::parse(c.out);
+    EXPECT_EQ(kept_summary["vertices_collapsed"], 0);
+    EXPECT_GT(int(collapsed_summary["vertices_collapsed"]), 0);
+    EXPECT_LT(read_volume(collapsed.string()).tet_count(), read_volume(kept.string()).tet_count());
+    EXPECT_EQ(kept_summary["pieces"], collapsed_summary["pieces"]);
+    EXPECT_GE(double(collapsed_summary["min_dihedral_deg"]), double(kept_summary["min_dihedral_deg"]));
+
     // The same seed gives the same file.
     const auto a = dir / "a.vtu", b = dir / "b.vtu";
     ASSERT_EQ(run_waxwork("fracture " + in.string() + " -o " + a.string() + " --pieces 4 --seed 9").exit_code, 0);
