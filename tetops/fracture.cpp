@@ -127,7 +127,7 @@ void check_options(const FractureOptions& options) {
 // The exact Voronoi split builds the cells one seed at a time and each wall splits the tets earlier
 // walls split (reordering the seeds does not help: in four orders, 30 pieces of spot made 67,553 to
 // 75,413 tets), so the tet count grows much faster than the pieces even after the swallowed walls
-// are collapsed (spot, 11,705 tets: 10 pieces 1.8x, 30 pieces 4.7x, 100 pieces 22x in 2.0 s; without
+// are collapsed (spot, 11,705 tets: 10 pieces 1.8x, 30 pieces 4.7x, 100 pieces 22x in 2 to 3 s; without
 // the guard 300 pieces gave 142x and 0.00004-degree tets in 25 s). Past this growth (plus an allowance that lets small volumes grow
 // into a few hundred thousand tets, which costs little) the fracture stops with an error instead of
 // running for minutes into slivers no solver converges on.
