@@ -116,6 +116,8 @@ private:
 
 void check_options(const FractureOptions& options) {
     if (options.min_piece_tets < 0) throw InvalidArgumentError("fracture: min_piece_tets must be >= 0");
+    if (!(options.min_piece_volume >= 0 && options.min_piece_volume < 1))
+        throw InvalidArgumentError("fracture: min_piece_volume must be in [0, 1) (of the mean cell's volume)");
     if (!(options.snap_fraction >= 0 && options.snap_fraction < 0.5))
         throw InvalidArgumentError("fracture: the snap fraction must be in [0, 0.5)");
     if (!(options.boundary_bend_deg >= 0 && options.boundary_bend_deg < 90))
@@ -164,17 +166,30 @@ void make_pieces(TetMesh& mesh, const std::vector<int64_t>& label, const Fractur
                 parts.unite(static_cast<int32_t>(t), u);
         }
 
-    // Dust: each part under min_piece_tets joins the neighbouring part it shares most faces with,
-    // smallest parts first; rounds repeat (sizes change) until no part is both small and next to
-    // another part (an isolated small component stays a piece). Each round is one pass over the faces.
-    if (options.min_piece_tets > 1) {
+    // Dust: each part under min_piece_tets, or under min_piece_volume of the mean cell's volume,
+    // joins the neighbouring part it shares most faces with, smallest parts first; rounds repeat
+    // (sizes change) until no part is both small and next to another part (an isolated small
+    // component stays a piece). Each round is one pass over the faces.
+    std::vector<double> tet_volume(n);
+    double total_volume = 0;
+    for (size_t t = 0; t < n; ++t) total_volume += tet_volume[t] = std::abs(signed_volume(mesh, t));
+    std::vector<int64_t> cells(label.begin(), label.end());
+    std::sort(cells.begin(), cells.end());
+    const auto cell_count = static_cast<double>(std::unique(cells.begin(), cells.end()) - cells.begin());
+    const double min_volume = options.min_piece_volume * total_volume / std::max(cell_count, 1.0);
+    if (options.min_piece_tets > 1 || min_volume > 0) {
         for (bool merged = true; merged;) {
             merged = false;
             std::vector<int32_t> root(n), size(n, 0);
-            for (size_t t = 0; t < n; ++t) ++size[root[t] = parts.find(static_cast<int32_t>(t))];
+            std::vector<double> volume(n, 0.0);
+            for (size_t t = 0; t < n; ++t) {
+                root[t] = parts.find(static_cast<int32_t>(t));
+                ++size[root[t]];
+                volume[root[t]] += tet_volume[t];
+            }
             std::map<std::pair<int32_t, int32_t>, int32_t> shared;  // (dust part, neighbour part) -> faces
             for (size_t t = 0; t < n; ++t) {
-                if (size[root[t]] >= options.min_piece_tets) continue;
+                if (size[root[t]] >= options.min_piece_tets && !(volume[root[t]] < min_volume)) continue;
                 for (int f = 0; f < 4; ++f) {
                     const int32_t u = neighbors[t][f];
                     if (u >= 0 && root[u] != root[t]) ++shared[{root[t], root[u]}];

@@ -359,6 +359,29 @@ TEST(FractureVoronoi, OneSeedGivesOnePieceAndFracturesEachExistingPiece) {
     EXPECT_NEAR(total_volume(two), 2.0, 1e-12);
 }
 
+TEST(FractureVoronoi, PiecesOfAlmostNoVolumeAreDustWhateverTheirTets) {
+    // A seed off the cube's corner owns the corner beyond x + y + z = 2.925: 7e-5 of the volume,
+    // under 1e-3 of the mean cell's (0.5), however many tets the exact split makes of it.
+    const TetMesh before = make_cube_mesh(4);
+    const std::vector<Eigen::Vector3d> seeds = {{0.5, 0.5, 0.5}, {1.45, 1.45, 1.45}};
+    FractureOptions by_tets_only;
+    by_tets_only.min_piece_tets = 0;
+    by_tets_only.min_piece_volume = 0;
+    TetMesh kept = before;
+    EXPECT_EQ(fracture_voronoi(kept, seeds, by_tets_only).pieces_after, 2);
+    FractureOptions by_volume = by_tets_only;
+    by_volume.min_piece_volume = FractureOptions{}.min_piece_volume;
+    TetMesh merged = before;
+    EXPECT_EQ(fracture_voronoi(merged, seeds, by_volume).pieces_after, 1);
+    EXPECT_NEAR(total_volume(merged), 1.0, 1e-12);
+    FractureOptions bad;
+    for (double fraction : {-0.1, 1.0, std::numeric_limits<double>::quiet_NaN()}) {
+        bad.min_piece_volume = fraction;
+        TetMesh mesh = before;
+        EXPECT_THROW(fracture_voronoi(mesh, seeds, bad), InvalidArgumentError) << fraction;
+    }
+}
+
 TEST(FractureVoronoi, DustIsMergedAndBadInputRejected) {
     const TetMesh before = make_cube_mesh(4);
     // A seed just outside a corner owns a sliver of the cube: fewer tets than the dust limit.
