@@ -31,7 +31,7 @@ void run_run_command(const RunCommandOptions& o) {
     if (!result.method_fallback_reason.empty())
         std::cerr << "warning: " << result.method_fallback_reason << "\n";
     std::cout << std::fixed << std::setprecision(1) << "loaded the input in " << result.load_ms << " ms ("
-              << (result.steps.empty() ? result.mesh.tet_count() : result.steps.front().tets) << " tets)\n";
+              << result.input_tets << " tets)\n";
     for (size_t i = 0; i < result.steps.size(); ++i) {
         const StepMetrics& m = result.steps[i];
         std::cout << "step " << i << " " << m.name << ": " << m.milliseconds << " ms, " << m.tets << " tets, "

@@ -347,6 +347,7 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
     const auto load_start = std::chrono::steady_clock::now();
     Document document(load_session_input(session), session.material);
     result.load_ms = milliseconds_since(load_start);
+    result.input_tets = document.mesh().tet_count();
     LiveSceneOptions scene_options;
     scene_options.mm_per_unit = session.scale;
     scene_options.relative_tolerance = session.tolerance;
@@ -449,6 +450,7 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
     const FrameBudget budget = session_frame_budget(session, run_options);
     const Json summary{{"session", session.name},
                        {"load_milliseconds", result.load_ms},
+                       {"input_tets", result.input_tets},
                        {"undo_bytes", document.undo_bytes()},
                        {"undo_entries_evicted", document.evicted_undo_count()},
                        {"solver_backend", live_backend_name(scene.backend())},

@@ -125,6 +125,7 @@ struct SessionResult {
     TetMesh mesh;  // the final volume
     std::vector<StepMetrics> steps;
     double load_ms = 0;  // meshing or reading the input
+    size_t input_tets = 0;  // as loaded, before the first step
     std::vector<std::filesystem::path> written;  // images and volumes, in order
     LiveBackend solver_backend = LiveBackend::Cpu;  // that solved the last step (Cpu after a fallback)
     std::string gpu_fallback_reason;                // why the GPU was given up ("" if it was not)

@@ -113,5 +113,19 @@ TEST(SessionBackend, RunAcceptsTheMultiresMethod) {
     EXPECT_NE(bad.err.find("method"), std::string::npos) << bad.err;
 }
 
+// The run's first line and metrics.json give the volume as loaded, not as the first step left it.
+TEST(SessionBackend, RunReportsTheInputAsLoaded) {
+    const fs::path dir = scratch("input_tets");
+    write_volume(testing::make_cube_mesh(6), dir / "cube.vtu");  // 1296 tets
+    std::ofstream(dir / "s.json") << R"({"input": {"volume": "cube.vtu"}, "image": {"width": 32, "height": 24},
+        "steps": [{"op": "plane_cut", "normal": [1, 0, 0], "offset": 0.5}, {"save": "cut.vtu"}]})";
+    const auto run = run_waxwork("run " + (dir / "s.json").string() + " -o " + (dir / "out").string());
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_EQ(run.out.rfind("loaded the input in ", 0), 0u) << run.out;
+    EXPECT_NE(run.out.substr(0, run.out.find('\n')).find("(1296 tets)"), std::string::npos) << run.out;
+    EXPECT_EQ(read_metrics(dir / "out" / "metrics.json").at("input_tets"), 1296);
+    EXPECT_LT(read_volume(dir / "out" / "cut.vtu").tet_count(), 1296u);
+}
+
 }  // namespace
 }  // namespace waxwork
