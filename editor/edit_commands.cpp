@@ -32,6 +32,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -127,9 +128,6 @@ void run_exact_cut(const CutCommandOptions& o, const PlaneCut& plane) {
 void run_cut_command(const CutCommandOptions& o) {
     const std::vector<double> p = parse_numbers(o.plane, 4, "cut --plane");
     const PlaneCut plane(Eigen::Vector3d(p[0], p[1], p[2]), p[3]);
-    if (o.remove_fragments && !(*o.remove_fragments >= 0 && *o.remove_fragments < 1))
-        throw InvalidArgumentError("cut --remove-fragments: the volume fraction must be in [0, 1), got " +
-                                   number_text(*o.remove_fragments));
     if (o.exact) return run_exact_cut(o, plane);
     if (o.relax_iterations < 0) throw InvalidArgumentError("cut --relax: the iteration count must be >= 0");
 
@@ -295,9 +293,19 @@ void add_cut_command(CLI::App& app) {
     cmd->add_flag("--exact", options->exact,
                   "Split the tets crossed by the plane along it instead of relaxing (--relax and --no-guard are "
                   "then unused)");
+    // Checked on the text: CLI11 would take an empty value for no option at all, and read "nan".
+    const CLI::Validator fraction_check(
+        [](std::string& text) {
+            std::istringstream in(text);
+            double fraction = 0;
+            if (!(in >> fraction) || !(in >> std::ws).eof()) return "'" + text + "' is not a volume fraction";
+            return fraction >= 0 && fraction < 1 ? std::string() : "'" + text + "' is not in [0, 1)";
+        },
+        "FRACTION", "volume fraction");
     cmd->add_option("--remove-fragments", options->remove_fragments,
                     "Then drop the detached parts smaller than this fraction of the volume (0.001: 0.1%), such as "
-                    "the caps a plane grazing a concave shape leaves floating; the largest part always stays");
+                    "the caps a plane grazing a concave shape leaves floating; the largest part always stays")
+        ->check(fraction_check);
     cmd->footer("Tets with all four vertices on the side n.x > D are removed (TransCut Sec. 5); vertices left there\n"
                 "then move toward their one-ring average, never across the plane and never below the guard.\n"
                 "--exact: vertices within 20% of an edge from the plane snap onto it (when no tet of their star\n"

@@ -190,7 +190,7 @@ TEST(CutCommand, RemoveFragmentsDropsTheShortArmACutLeavesOfAU) {
         EXPECT_EQ(build_connectivity(mesh).component_count, 1);
     }
     fs::remove(out);
-    for (const std::string bad : {"1", "-0.5", "nan"}) {
+    for (const std::string bad : {"1", "-0.5", "nan", "\"\"", "0.1x"}) {
         const auto r = run_waxwork(cut + " --remove-fragments " + bad);
         EXPECT_NE(r.exit_code, 0) << bad;
         EXPECT_EQ(line_count(r.err), 1u) << r.err;
