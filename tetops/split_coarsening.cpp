@@ -44,7 +44,7 @@ SplitCoarsening collapse_unneeded_split_vertices(TetMesh& mesh, std::vector<int6
     std::vector<std::vector<int32_t>> vertex_tets(vertex_count);
     for (size_t t = 0; t < tet_count; ++t)
         for (int32_t v : mesh.tets[t]) vertex_tets[static_cast<size_t>(v)].push_back(static_cast<int32_t>(t));
-    std::vector<uint8_t> tet_alive(tet_count, 1), vertex_alive(vertex_count, 1);
+    std::vector<uint8_t> tet_alive(tet_count, 1);
 
     std::vector<int32_t> targets;
     std::vector<double> references;
@@ -106,7 +106,6 @@ SplitCoarsening collapse_unneeded_split_vertices(TetMesh& mesh, std::vector<int6
             Tet& tet = mesh.tets[t];
             if (contains(tet, best_target)) {
                 tet_alive[static_cast<size_t>(t)] = 0;
-                ++result.tets_removed;
                 continue;
             }
             std::replace(tet.begin(), tet.end(), v, best_target);
@@ -114,47 +113,32 @@ SplitCoarsening collapse_unneeded_split_vertices(TetMesh& mesh, std::vector<int6
             reference_deg[static_cast<size_t>(t)] = references[i];
         }
         star.clear();
-        vertex_alive[index] = 0;
         --named[static_cast<size_t>(origin.a)];
         --named[static_cast<size_t>(origin.b)];
         ++result.vertices_collapsed;
     }
     if (result.vertices_collapsed == 0) return result;
 
-    // Compaction, in order.
-    std::vector<int32_t> new_vertex(vertex_count, -1);
-    size_t kept_vertices = 0;
+    // Compaction, in order: the collapsed vertices are left without a tet, so remove_tets drops them
+    // with the dead tets; the arrays the mesh does not hold follow its maps.
+    std::vector<uint8_t> dead(tet_count);
+    for (size_t t = 0; t < tet_count; ++t) dead[t] = !tet_alive[t];
+    const CutResult removed = remove_tets(mesh, dead);
+    result.tets_removed = removed.tets_removed;
+    for (size_t t = 0; t < removed.new_to_old_tet.size(); ++t) {
+        labels[t] = labels[static_cast<size_t>(removed.new_to_old_tet[t])];
+        reference_deg[t] = reference_deg[static_cast<size_t>(removed.new_to_old_tet[t])];
+    }
+    labels.resize(mesh.tet_count());
+    reference_deg.resize(mesh.tet_count());
     for (size_t v = 0; v < vertex_count; ++v) {
-        if (!vertex_alive[v]) continue;
-        new_vertex[v] = static_cast<int32_t>(kept_vertices);
-        mesh.positions[kept_vertices] = mesh.positions[v];
-        VertexOrigin o = vertex_origins[v];
-        o.a = new_vertex[static_cast<size_t>(o.a)];
-        o.b = new_vertex[static_cast<size_t>(o.b)];
-        vertex_origins[kept_vertices] = o;
-        ++kept_vertices;
+        const int32_t w = removed.old_to_new_vertex[v];
+        if (w < 0) continue;
+        const VertexOrigin& o = vertex_origins[v];
+        vertex_origins[static_cast<size_t>(w)] = {removed.old_to_new_vertex[static_cast<size_t>(o.a)],
+                                                  removed.old_to_new_vertex[static_cast<size_t>(o.b)], o.t};
     }
-    mesh.positions.resize(kept_vertices);
-    vertex_origins.resize(kept_vertices);
-    size_t kept_tets = 0;
-    for (size_t t = 0; t < tet_count; ++t) {
-        if (!tet_alive[t]) continue;
-        Tet tet = mesh.tets[t];
-        for (int32_t& v : tet) v = new_vertex[static_cast<size_t>(v)];
-        mesh.tets[kept_tets] = tet;
-        if (mesh.has_materials()) mesh.materials[kept_tets] = mesh.materials[t];
-        mesh.original_ids[kept_tets] = mesh.original_ids[t];
-        mesh.piece_ids[kept_tets] = mesh.piece_ids[t];
-        labels[kept_tets] = labels[t];
-        reference_deg[kept_tets] = reference_deg[t];
-        ++kept_tets;
-    }
-    mesh.tets.resize(kept_tets);
-    if (mesh.has_materials()) mesh.materials.resize(kept_tets);
-    mesh.original_ids.resize(kept_tets);
-    mesh.piece_ids.resize(kept_tets);
-    labels.resize(kept_tets);
-    reference_deg.resize(kept_tets);
+    vertex_origins.resize(mesh.vertex_count());
     return result;
 }
 
