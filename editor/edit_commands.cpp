@@ -32,7 +32,6 @@
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -60,8 +59,9 @@ std::vector<double> parse_numbers(const std::string& text, size_t count, const s
             return std::isspace(static_cast<unsigned char>(c)) != 0;
         });
         if (field.empty() || stop == field.c_str() || !blank_rest || errno == ERANGE || !std::isfinite(value))
-            throw InvalidArgumentError(what + ": \"" + text + "\" is not " + std::to_string(count) +
-                                       " comma-separated finite numbers");
+            throw InvalidArgumentError(what + ": \"" + text + "\" is not " +
+                                       (count == 1 ? std::string("a finite number")
+                                                   : std::to_string(count) + " comma-separated finite numbers"));
         values.push_back(value);
         if (end == std::string::npos) break;
         begin = end + 1;
@@ -293,13 +293,15 @@ void add_cut_command(CLI::App& app) {
     cmd->add_flag("--exact", options->exact,
                   "Split the tets crossed by the plane along it instead of relaxing (--relax and --no-guard are "
                   "then unused)");
-    // Checked on the text: CLI11 would take an empty value for no option at all, and read "nan".
+    // Checked on the text (parse_numbers): CLI11 would take an empty value for no option at all.
     const CLI::Validator fraction_check(
         [](std::string& text) {
-            std::istringstream in(text);
-            double fraction = 0;
-            if (!(in >> fraction) || !(in >> std::ws).eof()) return "'" + text + "' is not a volume fraction";
-            return fraction >= 0 && fraction < 1 ? std::string() : "'" + text + "' is not in [0, 1)";
+            try {
+                const double fraction = parse_numbers(text, 1, "the volume fraction")[0];
+                return fraction >= 0 && fraction < 1 ? std::string() : "'" + text + "' is not in [0, 1)";
+            } catch (const InvalidArgumentError& error) {
+                return std::string(error.what());
+            }
         },
         "FRACTION", "volume fraction");
     cmd->add_option("--remove-fragments", options->remove_fragments,
