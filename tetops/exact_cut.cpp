@@ -206,8 +206,7 @@ size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::ve
             if (!(signed_volume(p[0], p[1], p[2], p[3]) > 0)) return false;
             const double after = min_dihedral_angle_deg(p[0], p[1], p[2], p[3]);
             if (after >= options.min_dihedral_guard_deg) continue;
-            const double before = min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]],
-                                                         mesh.positions[tet[2]], mesh.positions[tet[3]]);
+            const double before = min_dihedral_angle_deg(mesh, tet);
             const double floor =
                 guard_floor_deg(options.min_dihedral_guard_deg, std::isnan(reference[t]) ? before : reference[t]);
             if (after < floor && after < before) return false;
@@ -245,8 +244,7 @@ size_t snap_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world, std::ve
         for (int32_t t : star[slot[v]]) {
             if (std::isnan(reference[t])) {
                 const Tet& tet = mesh.tets[t];
-                reference[t] = min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]],
-                                                      mesh.positions[tet[2]], mesh.positions[tet[3]]);
+                reference[t] = min_dihedral_angle_deg(mesh, tet);
             }
             touched[t] = 1;
         }
@@ -370,8 +368,7 @@ SplitReport split_along_field(TetMesh& mesh, std::vector<Eigen::Vector3d>& world
     for (int32_t t : crossed) {
         if (std::isnan(reference[t])) {
             const Tet& tet = mesh.tets[t];
-            reference[t] = min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]],
-                                                  mesh.positions[tet[2]], mesh.positions[tet[3]]);
+            reference[t] = min_dihedral_angle_deg(mesh, tet);
         }
         touched[t] = 1;
     }

@@ -74,6 +74,11 @@ double min_dihedral_angle_deg(const Eigen::Vector3d& p0, const Eigen::Vector3d& 
     return 180.0 - std::acos(-max_dihedral_cosine(p0, p1, p2, p3)) * 180.0 / std::numbers::pi;
 }
 
+double min_dihedral_angle_deg(const TetMesh& mesh, const Tet& tet) {
+    return min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]], mesh.positions[tet[2]],
+                                  mesh.positions[tet[3]]);
+}
+
 double radius_edge_ratio(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
                          const Eigen::Vector3d& p3) {
     const Eigen::Vector3d a = p1 - p0, b = p2 - p0, c = p3 - p0;
@@ -91,8 +96,7 @@ std::vector<double> min_dihedral_angles_deg(const TetMesh& mesh) {
     std::vector<double> result(mesh.tets.size());
     tbb::parallel_for(size_t{0}, mesh.tets.size(), [&](size_t t) {
         const Tet& tet = mesh.tets[t];
-        result[t] = min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]], mesh.positions[tet[2]],
-                                           mesh.positions[tet[3]]);
+        result[t] = min_dihedral_angle_deg(mesh, tet);
     });
     return result;
 }
@@ -116,8 +120,7 @@ double mesh_min_dihedral_deg(const TetMesh& mesh) {
         },
         [](const Worst& a, const Worst& b) { return b.first > a.first || (b.first == a.first && b.second < a.second) ? b : a; });
     const Tet& tet = mesh.tets[worst.second];
-    return min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]], mesh.positions[tet[2]],
-                                  mesh.positions[tet[3]]);
+    return min_dihedral_angle_deg(mesh, tet);
 }
 
 namespace {

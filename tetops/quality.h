@@ -13,6 +13,8 @@ std::array<double, 6> dihedral_angles_deg(const Eigen::Vector3d& p0, const Eigen
                                           const Eigen::Vector3d& p2, const Eigen::Vector3d& p3);
 double min_dihedral_angle_deg(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
                               const Eigen::Vector3d& p2, const Eigen::Vector3d& p3);
+// The same for a tet of `mesh` (its vertex indices need not be one of mesh.tets: a candidate tet).
+double min_dihedral_angle_deg(const TetMesh& mesh, const Tet& tet);
 
 // Circumradius divided by the shortest edge (sqrt(6)/4 ~ 0.612 for the regular tet; infinite for
 // degenerate tets).

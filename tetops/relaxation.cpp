@@ -105,8 +105,7 @@ RelaxationReport relax_cut_vertices(TetMesh& mesh, const TetConnectivity& connec
                 const double after = min_dihedral_angle_deg(p[0], p[1], p[2], p[3]);
                 if (after < guard) {
                     const Tet& tet = mesh.tets[tet_index];
-                    const double before = min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]],
-                                                                 mesh.positions[tet[2]], mesh.positions[tet[3]]);
+                    const double before = min_dihedral_angle_deg(mesh, tet);
                     if (after < before) return Outcome::Rejected;
                 }
             }

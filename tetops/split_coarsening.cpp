@@ -13,11 +13,6 @@
 namespace waxwork {
 namespace {
 
-double tet_angle(const TetMesh& mesh, const Tet& tet) {
-    return min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]], mesh.positions[tet[2]],
-                                  mesh.positions[tet[3]]);
-}
-
 bool contains(const Tet& tet, int32_t v) { return std::find(tet.begin(), tet.end(), v) != tet.end(); }
 
 }  // namespace
@@ -63,7 +58,7 @@ SplitCoarsening collapse_unneeded_split_vertices(TetMesh& mesh, std::vector<int6
         double worst_before = std::numeric_limits<double>::infinity();
         references.clear();
         for (int32_t t : star) {
-            const double angle = tet_angle(mesh, mesh.tets[t]);
+            const double angle = min_dihedral_angle_deg(mesh, mesh.tets[t]);
             worst_before = std::min(worst_before, angle);
             const double r = reference_deg[static_cast<size_t>(t)];
             references.push_back(std::isnan(r) ? angle : r);
@@ -88,7 +83,7 @@ SplitCoarsening collapse_unneeded_split_vertices(TetMesh& mesh, std::vector<int6
                 const double angle =
                     signed_volume(mesh.positions[tet[0]], mesh.positions[tet[1]], mesh.positions[tet[2]],
                                   mesh.positions[tet[3]]) > 0
-                        ? tet_angle(mesh, tet)
+                        ? min_dihedral_angle_deg(mesh, tet)
                         : -1.0;
                 // A target whose worst angle cannot beat the best so far is dropped at once.
                 valid = angle >= floor_deg && angle >= guard_floor_deg(guard_deg, references[i]) && angle > best_worst;

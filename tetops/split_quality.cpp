@@ -48,11 +48,6 @@ std::vector<KeptFace> kept_faces_at(const TetMesh& mesh, const std::vector<int32
 
 namespace {
 
-double tet_angle(const TetMesh& mesh, const Tet& tet) {
-    return min_dihedral_angle_deg(mesh.positions[tet[0]], mesh.positions[tet[1]], mesh.positions[tet[2]],
-                                  mesh.positions[tet[3]]);
-}
-
 // Angle and volume sign of `tet` with vertex v at x.
 std::array<Eigen::Vector3d, 4> moved_corners(const TetMesh& mesh, const Tet& tet, int32_t v, const Eigen::Vector3d& x) {
     std::array<Eigen::Vector3d, 4> p;
@@ -91,7 +86,7 @@ size_t count_tets_under_guard(const TetMesh& mesh, const std::vector<double>& re
         [&](const tbb::blocked_range<size_t>& range, size_t count) {
             for (size_t t = range.begin(); t != range.end(); ++t)
                 if (!std::isnan(reference_deg[t]) && (!only || (*only)[t]) &&
-                    tet_angle(mesh, mesh.tets[t]) < guard_floor_deg(guard_deg, reference_deg[t]))
+                    min_dihedral_angle_deg(mesh, mesh.tets[t]) < guard_floor_deg(guard_deg, reference_deg[t]))
                     ++count;
             return count;
         },
@@ -116,7 +111,7 @@ size_t smooth_split_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world,
     std::vector<uint8_t> poor(tet_count, 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tet_count, 4096), [&](const auto& range) {
         for (size_t t = range.begin(); t != range.end(); ++t)
-            poor[t] = start[t] && tet_angle(mesh, mesh.tets[t]) < target;
+            poor[t] = start[t] && min_dihedral_angle_deg(mesh, mesh.tets[t]) < target;
     });
     std::vector<int32_t> slot(vertex_count, -1);
     std::vector<VertexState> states;
@@ -227,7 +222,7 @@ size_t smooth_split_vertices(TetMesh& mesh, std::vector<Eigen::Vector3d>& world,
         double worst = std::numeric_limits<double>::infinity();
         size_t worst_index = 0;
         for (size_t k = 0; k < s.star.size(); ++k) {
-            current[k] = tet_angle(mesh, mesh.tets[s.star[k]]);
+            current[k] = min_dihedral_angle_deg(mesh, mesh.tets[s.star[k]]);
             if (current[k] < worst) worst = current[k], worst_index = k;
         }
         if (!(worst < target)) return false;
