@@ -31,6 +31,18 @@ std::string printable(const std::string& message) {
     return out;
 }
 
+// CLI11 reads an empty value ("--relax ''") as the option's default instead of refusing it, so a
+// script that lost a variable would silently run with defaults. No option of ours means anything by
+// empty text: every option that takes a value, in every command, refuses it.
+void refuse_empty_values(CLI::App& app) {
+    const CLI::Validator non_empty(
+        [](std::string& text) { return text.empty() ? std::string("an empty value is not allowed") : std::string(); },
+        "", "non-empty");
+    for (CLI::Option* option : app.get_options())
+        if (option->get_type_size_max() > 0) option->check(non_empty);
+    for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; })) refuse_empty_values(*command);
+}
+
 }  // namespace
 
 int run_cli(int argc, char** argv) {
@@ -39,6 +51,7 @@ int run_cli(int argc, char** argv) {
     app.require_subcommand(1);
     app.failure_message([](const CLI::App*, const CLI::Error& e) { return std::string("waxwork: ") + e.what() + "\n"; });
     register_commands(app);
+    refuse_empty_values(app);
     // CLI11 reports an unknown first word as a missing subcommand; name it instead.
     const auto is_command = [&app](const char* word) {
         try {

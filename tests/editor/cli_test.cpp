@@ -38,6 +38,33 @@ TEST(Cli, UnknownCommandAndOptionAreOneLineErrors) {
     }
 }
 
+// CLI11 alone reads an empty value as the option's default: a script whose variable came out empty
+// would run silently with defaults. Every option that takes a value refuses it, naming the option.
+TEST(Cli, EmptyOptionValuesAreRefusedNamingTheOption) {
+    const auto dir = scratch_dir("cli_empty");
+    const fs::path volume = dir / "cube.vtu";
+    write_volume(testing::make_cube_mesh(3), volume);
+    const std::string in = volume.string(), out = (dir / "out.vtu").string();
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"cut " + in + " -o " + out + " --plane=1,0,0,0 --relax ''", "--relax"},
+        {"cut " + in + " -o " + out + " --plane ''", "--plane"},
+        {"fracture " + in + " -o " + out + " --pieces ''", "--pieces"},
+        {"render " + in + " -o " + (dir / "a.png").string() + " --width ''", "--width"},
+        {"render " + in + " -o ''", "--output"},
+        {"info ''", "volume"},
+    };
+    for (const auto& [args, option] : cases) {
+        const auto r = run_waxwork(args);
+        EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
+        EXPECT_EQ(line_count(r.err), 1u) << args << ": " << r.err;
+        EXPECT_NE(r.err.find(option), std::string::npos) << args << ": " << r.err;
+        EXPECT_NE(r.err.find("empty value"), std::string::npos) << args << ": " << r.err;
+    }
+    EXPECT_FALSE(fs::exists(out));
+    // The same options with values still run.
+    EXPECT_EQ(run_waxwork("cut " + in + " -o " + out + " --plane=1,0,0,0 --relax 2").exit_code, 0);
+}
+
 TEST(Cli, MissingAndCorruptFilesNameTheFile) {
     const auto dir = scratch_dir("cli_corrupt");
     const auto r = run_waxwork("info " + (dir / "absent.vtu").string());
