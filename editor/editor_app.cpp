@@ -425,13 +425,14 @@ void EditorApp::start_tick() {
             r->input->device_radiance = device_buffer;
             if (need_bvh || r->geometry_changed) {
                 r->bvh = std::make_shared<const TriangleBvh>(r->input->positions, r->input->triangles);
-                // Each surface vertex's piece, for picking pieces to move.
+                // Each drawn (shading) vertex's piece, for picking pieces to move.
                 std::vector<int32_t> vertex_piece(mesh.vertex_count(), 0);
                 for (size_t t = 0; t < mesh.tet_count(); ++t)
                     for (int32_t v : mesh.tets[t]) vertex_piece[v] = mesh.piece_ids[t];
-                r->surface_piece.resize(solved.surface.vertices.size());
-                for (size_t i = 0; i < solved.surface.vertices.size(); ++i)
-                    r->surface_piece[i] = vertex_piece[solved.surface.vertices[i]];
+                const ShadingSurface& shading = solved.shading;
+                r->surface_piece.resize(shading.size());
+                for (size_t d = 0; d < shading.size(); ++d)
+                    r->surface_piece[d] = vertex_piece[solved.surface.vertices[shading.surface_vertex[d]]];
             }
         }
         r->piece_transforms = mesh.piece_transforms;

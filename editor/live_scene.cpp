@@ -41,6 +41,9 @@ LiveScene::LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSc
     if (!(options.relative_tolerance > 0) || !(options.relative_tolerance < 1))
         throw InvalidArgumentError("live scene: the relative tolerance must be in (0, 1)");
     validate(lighting_);
+    if (!(options.crease_angle_degrees >= 0 && options.crease_angle_degrees <= 180))
+        throw InvalidArgumentError("live scene: crease angle " + number_text(options.crease_angle_degrees) +
+                                   " degrees: must be between 0 and 180");
     check_materials(mesh);
     solver_ = std::make_unique<LiveSolver>(
         LiveSolverOptions{options.method, options.backend, options.gl_context, options.clock, options.multigrid});
@@ -56,15 +59,29 @@ void LiveScene::mark_unconverged() {
 void LiveScene::rebuild_surface(SceneUpdate& update) {
     surface_ = extract_boundary_surface(*mesh_, *connectivity_, mesh_->materials);
     shadow_bvh_ = build_shadow_bvh(surface_);
+    shading_ = split_at_creases(surface_, options_.crease_angle_degrees);
     update.rebuilt_surface = true;
     relight(update);
 }
 
 void LiveScene::relight(SceneUpdate& update) {
     surface_q_ = incident_light(surface_, shadow_bvh_, lighting_, &surface_visibility_);
-    q_ = to_volume_vertices(surface_, surface_q_, mesh_->vertex_count());
+    q_ = to_volume_vertices(surface_, surface_q_, matrix_.size());  // a row per vertex
+    shading_light_ = shading_light(surface_, shading_, shadow_bvh_, lighting_, surface_q_, surface_visibility_);
     update.recomputed_light = true;
     refresh_right_hand_sides();
+}
+
+void LiveScene::set_crease_angle(double degrees) {
+    if (!(degrees >= 0 && degrees <= 180))
+        throw InvalidArgumentError("live scene: crease angle " + number_text(degrees) +
+                                   " degrees: must be between 0 and 180");
+    const std::lock_guard lock(mutex_);
+    if (degrees == options_.crease_angle_degrees) return;
+    options_.crease_angle_degrees = degrees;
+    // The image only: the solve's q, matrix and phi do not depend on it.
+    shading_ = split_at_creases(surface_, degrees);
+    shading_light_ = shading_light(surface_, shading_, shadow_bvh_, lighting_, surface_q_, surface_visibility_);
 }
 
 void LiveScene::refresh_right_hand_sides() {
@@ -168,6 +185,8 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
                 // included), not on the whole surface.
                 update_incident_light(surface_, shadow_bvh_, lighting_, changed, surface_q_);
                 for (const int32_t s : changed) q_[surface_.vertices[s]] = surface_q_[s];
+                shading_light_ =
+                    shading_light(surface_, shading_, shadow_bvh_, lighting_, surface_q_, surface_visibility_);
                 update.recomputed_light = true;
             }
         }
@@ -367,13 +386,13 @@ int64_t LiveScene::multigrid_copied_rows() const {
 
 std::shared_ptr<const GpuBuffer> LiveScene::device_radiance(std::vector<std::array<float, 3>>* host_copy) {
     const std::lock_guard lock(mutex_);
-    return solver_->radiance_on_device(*mesh_, *connectivity_, q_, surface_.vertices, host_copy);
+    return solver_->radiance_on_device(surface_, shading_, shading_light_.q, host_copy);
 }
 
 std::vector<std::array<float, 3>> LiveScene::radiance_factors() const {
     const std::vector<std::array<double, 3>> phi = this->phi();
     const std::lock_guard lock(mutex_);
-    return exitant_radiance_factors(*mesh_, *connectivity_, mesh_->materials, phi, q_);
+    return shading_radiance_factors(surface_, shading_, phi, shading_light_.q);
 }
 
 SolvedScene LiveScene::solved_scene(bool with_radiance) const {
@@ -381,12 +400,13 @@ SolvedScene LiveScene::solved_scene(bool with_radiance) const {
     scene.diffusion.phi = phi();
     const std::lock_guard lock(mutex_);
     scene.surface = surface_;
+    scene.shading = shading_;
+    scene.shading_light = shading_light_;
     scene.q = q_;
-    scene.light_visibility = surface_visibility_;
     for (int c = 0; c < 3; ++c) scene.diffusion.estimated_relative_error[c] = error_[c];
     if (with_radiance)
         scene.radiance_factor =
-            exitant_radiance_factors(*mesh_, *connectivity_, mesh_->materials, scene.diffusion.phi, scene.q);
+            shading_radiance_factors(scene.surface, scene.shading, scene.diffusion.phi, scene.shading_light.q);
     return scene;
 }
 

@@ -32,11 +32,11 @@
 // running step() to finish (one frame). The TetMesh passed to the constructor and apply_change() is
 // borrowed: it must outlive the scene and must not be modified while any member runs (the document
 // changes it only inside Document::apply/undo/redo: call those and apply_change() under the same
-// external lock or on the same thread, and never concurrently with solved_scene() or
-// radiance_factors(), which read it). step(), step_for(), converge() and phi() never read the mesh.
+// external lock or on the same thread). Only the constructor and apply_change() read the mesh: the
+// other members work from the scene's own surface, shading and phi.
 // A window's loop, for example:
 //   UI thread:     { lock edit_mutex; report = document.apply(op); scene.apply_change(document.mesh(), report); }
-//   solver thread: scene.step(FrameBudget::milliseconds(12)); { lock edit_mutex; E = scene.radiance_factors(); }
+//   solver thread: scene.step(FrameBudget::milliseconds(12)); E = scene.radiance_factors();
 //                  upload E
 #pragma once
 
@@ -47,6 +47,7 @@
 #include "solver/diffusion_solve.h"
 #include "solver/lighting.h"
 #include "solver/ray_caster.h"
+#include "solver/shading_surface.h"
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
@@ -71,6 +72,8 @@ struct LiveSceneOptions {
     // The clock of step(FrameBudget)'s time limits (LiveSolverOptions::clock); empty: steady_clock.
     MillisecondClock clock;
     MultigridOptions multigrid;  // LiveSolverOptions::multigrid
+    // Where the image splits the surface's shading (solver/shading_surface.h), in [0, 180] degrees.
+    double crease_angle_degrees = kDefaultCreaseAngleDegrees;
 };
 
 // One frame of the solve.
@@ -109,6 +112,9 @@ public:
     // After Document::apply/undo/redo changed `mesh` (the document's mesh, same object or not).
     SceneUpdate apply_change(const TetMesh& mesh, const ChangeReport& change);
     SceneUpdate set_lighting(const Lighting& lighting);
+    // Splits the shading at creases of more than `degrees` from now on (the image only; phi, q and the
+    // matrix are untouched). Throws InvalidArgumentError outside [0, 180].
+    void set_crease_angle(double degrees);
 
     // At most `iteration_budget` CG iterations per channel, from the current phi. Channels already
     // within the tolerance are not iterated (an idle scene costs nothing).
@@ -134,10 +140,10 @@ public:
 
     // A copy of the current state in the form render_pipeline.h renders (make_render_input), with the
     // exitant radiance factors computed from the current phi (unless `with_radiance` is false: a
-    // caller that has E from the device leaves radiance_factor empty). Reads the mesh.
+    // caller that has E from the device leaves radiance_factor empty).
     SolvedScene solved_scene(bool with_radiance = true) const;
-    // Only the exitant radiance factors E per volume vertex from the current phi (what a window
-    // re-uploads each frame while the surface is unchanged). Reads the mesh.
+    // Only the exitant radiance factors E per shading vertex (solved_scene().shading) from the current
+    // phi (what a window re-uploads each frame while the surface is unchanged).
     std::vector<std::array<float, 3>> radiance_factors() const;
 
     Lighting lighting() const;
@@ -159,10 +165,10 @@ public:
     // Galerkin rows the multigrid CG's preconditioner copied from the one before the last edit, summed
     // over its levels (MultigridPreconditioner::copied_operator_rows); -1 without one.
     int64_t multigrid_copied_rows() const;
-    // With the GPU backend running: E per surface vertex (solved_scene().surface order) on the device,
+    // With the GPU backend running: E per shading vertex (solved_scene().shading order) on the device,
     // from the resident phi (LiveSolver::radiance_on_device), for a renderer sharing the solver's
-    // context to draw instead of the CPU's radiance_factor; else null. Reads the mesh. `host_copy`:
-    // as LiveSolver::radiance_on_device.
+    // context to draw instead of the CPU's radiance_factor; else null. `host_copy`: as
+    // LiveSolver::radiance_on_device.
     std::shared_ptr<const GpuBuffer> device_radiance(std::vector<std::array<float, 3>>* host_copy = nullptr);
 
 private:
@@ -185,7 +191,9 @@ private:
     BoundarySurface surface_;
     TriangleBvh shadow_bvh_;
     std::vector<Rgb> surface_q_;                // per surface vertex
-    std::vector<float> surface_visibility_;     // per surface vertex and light (SolvedScene::light_visibility)
+    std::vector<float> surface_visibility_;     // per surface vertex and light (incident_light)
+    ShadingSurface shading_;                    // the surface split at creases (options_.crease_angle_degrees)
+    ShadingLight shading_light_;                // q and visibility per shading vertex
     std::vector<Rgb> q_;                        // per volume vertex
     std::array<std::vector<double>, 3> b_;      // right-hand side per channel
     std::array<std::vector<double>, 3> phi_;    // current fluence per channel

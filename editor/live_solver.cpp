@@ -149,12 +149,12 @@ struct LiveSolver::Gpu {
     std::unique_ptr<GpuMultigridFrameSolver> multigrid;
     std::unique_ptr<GpuMultiresSolver> multires;
     std::vector<std::array<double, 3>> staging;  // interleaved phi for uploads and read-backs
-    // Device radiance: weights from the boundary eta (reset when materials change), q (re-sent when
-    // the right-hand sides change), E per volume vertex, and the surface's volume-vertex index.
+    // Device radiance per shading vertex, with the rows, eta and q it was built and lit with: rebuilt
+    // or re-lit when those differ (a new surface or shading, a painted eta, a new light).
     std::unique_ptr<GpuRadiance> radiance;
-    bool radiance_stale_weights = true, radiance_light_stale = true;
-    GpuBuffer volume_e, surface_index;
-    std::vector<int32_t> surface_vertices;  // what surface_index holds
+    std::vector<int32_t> radiance_rows;
+    std::vector<double> radiance_eta;
+    std::vector<std::array<double, 3>> radiance_q;
 
     size_t size() const { return solver ? solver->size() : multigrid ? multigrid->size() : multires->size(); }
     GpuKernels& kernels() { return solver ? solver->kernels() : multigrid ? multigrid->kernels() : multires->kernels(); }
@@ -301,7 +301,6 @@ void LiveSolver::build_cpu_multigrid(std::span<const Eigen::Vector3d> positions,
 // Material changes keep the eigenvalue hints, as the CPU path always did: the stopping rule confirms
 // convergence with the true residual anyway (conjugate_gradient.h).
 void LiveSolver::values_changed() {
-    if (gpu_) gpu_->radiance_stale_weights = true;  // the boundary eta may have changed
     forget_estimates();
     for (PendingChanges* pending : {&multigrid_pending_, &multires_pending_, &gpu_pending_}) pending->values_changed();
     gpu_level_rows_.clear();
@@ -315,7 +314,6 @@ void LiveSolver::forget_estimates() {
 
 void LiveSolver::rows_changed(std::span<const int32_t> rows) {
     if (rows.empty()) return;
-    if (gpu_) gpu_->radiance_stale_weights = true;
     forget_estimates();
     multigrid_waiting_ = MultigridOperators{};  // old values at level 0: the device solver builds afresh
     std::vector<int32_t> sorted(rows.begin(), rows.end());
@@ -331,7 +329,6 @@ void LiveSolver::right_hand_sides_changed() {
     gpu_pending_.right_hand_sides = true;
     multigrid_pending_.right_hand_sides = true;
     forget_estimates();
-    if (gpu_) gpu_->radiance_light_stale = true;
 }
 void LiveSolver::solution_changed() {
     gpu_pending_.solution = true;
@@ -794,38 +791,42 @@ std::array<LiveSolverChannel, 3> LiveSolver::iterate_gpu_multires(const Diffusio
     return out;
 }
 
-std::shared_ptr<const GpuBuffer> LiveSolver::radiance_on_device(const TetMesh& mesh, const TetConnectivity& connectivity,
-                                                                const std::vector<std::array<double, 3>>& q,
-                                                                const std::vector<int32_t>& surface_vertices,
+std::shared_ptr<const GpuBuffer> LiveSolver::radiance_on_device(const BoundarySurface& surface,
+                                                                const ShadingSurface& shading,
+                                                                const std::vector<std::array<double, 3>>& shading_q,
                                                                 std::vector<std::array<float, 3>>* host_copy) {
-    if (backend_ != LiveBackend::Gpu || !gpu_ || !context_ || surface_vertices.empty()) return nullptr;
-    const size_t n = gpu_->size();
-    if (mesh.vertex_count() != n || q.size() != n)
-        throw InvalidArgumentError("live solver: radiance_on_device needs the mesh and light of the solved matrix");
+    if (backend_ != LiveBackend::Gpu || !gpu_ || !context_ || shading.size() == 0) return nullptr;
+    const size_t n = gpu_->size(), m = shading.size();
+    if (shading_q.size() != m || surface.eta.size() != surface.vertices.size())
+        throw InvalidArgumentError("live solver: radiance_on_device needs one light value per shading vertex");
+    std::vector<int32_t> rows(m);
+    std::vector<double> eta(m);
+    for (size_t d = 0; d < m; ++d) {
+        const int32_t s = shading.surface_vertex[d];
+        if (s < 0 || static_cast<size_t>(s) >= surface.vertices.size() || surface.vertices[s] < 0 ||
+            static_cast<size_t>(surface.vertices[s]) >= n)
+            throw InvalidArgumentError("live solver: shading vertex " + std::to_string(d) +
+                                       " is not a vertex of the solved matrix");
+        rows[d] = surface.vertices[s];
+        eta[d] = surface.eta[s];
+    }
     try {
         const CurrentContext current(*context_);
         const GlApi& gl = context_->gl();
         GpuKernels& kernels = gpu_->kernels();
-        if (!gpu_->radiance || gpu_->radiance_stale_weights) {
+        if (!gpu_->radiance || gpu_->radiance_rows != rows || gpu_->radiance_eta != eta) {
             gpu_->radiance.reset();  // frees its buffers with the context current
-            gpu_->radiance = std::make_unique<GpuRadiance>(kernels, mesh, connectivity, mesh.materials);
-            gpu_->radiance_stale_weights = false;
-            gpu_->radiance_light_stale = true;
+            gpu_->radiance = std::make_unique<GpuRadiance>(kernels, rows, eta, n);
+            gpu_->radiance_rows = std::move(rows);
+            gpu_->radiance_eta = std::move(eta);
+            gpu_->radiance_q.clear();
         }
-        if (gpu_->radiance_light_stale) gpu_->radiance->set_light(q);
-        gpu_->radiance_light_stale = false;
-        if (gpu_->volume_e.bytes() != 3 * n * sizeof(float)) gpu_->volume_e = kernels.vector(n);
-        gpu_->radiance->compute(gpu_->solution_buffer(), gpu_->volume_e);
-        if (gpu_->surface_vertices != surface_vertices) {
-            for (const int32_t v : surface_vertices)
-                if (v < 0 || static_cast<size_t>(v) >= n)
-                    throw InvalidArgumentError("live solver: surface vertex " + std::to_string(v) + " out of range");
-            gpu_->surface_index = GpuBuffer::from<int32_t>(gl, surface_vertices);
-            gpu_->surface_vertices = surface_vertices;
+        if (gpu_->radiance_q != shading_q) {
+            gpu_->radiance->set_light(shading_q);
+            gpu_->radiance_q = shading_q;
         }
-        const size_t m = surface_vertices.size();
         auto e = std::make_shared<GpuBuffer>(gl, 3 * m * sizeof(float));
-        kernels.gather(m, gpu_->surface_index, gpu_->volume_e, *e);
+        gpu_->radiance->compute(gpu_->solution_buffer(), *e);
         if (host_copy) {
             const std::vector<float> values = e->download<float>();
             host_copy->resize(m);

@@ -63,6 +63,7 @@
 #include "solver/gl_context.h"
 #include "solver/gpu_compute.h"
 #include "solver/iteration_time_predictor.h"
+#include "solver/shading_surface.h"
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
@@ -174,19 +175,18 @@ public:
     // The GPU backend's measured cost per iteration (what turns a time budget into iterations there).
     const IterationTimePredictor& gpu_iteration_time() const { return gpu_iteration_time_; }
 
-    // The exitant radiance factor E (Eq. 3 without F_t, gpu_radiance.h) of every surface vertex, computed
-    // on the device from the resident phi and gathered into surface order (`surface_vertices`: the
-    // volume vertex of each surface vertex), 3 floats per vertex: what a renderer in the context's
-    // share group binds as its radiance attribute instead of uploading a CPU copy. A new buffer per
-    // call (the renderer may still draw the previous one), complete when returned (glFinish: another
-    // context reads it next). Null unless the GPU backend is running; a GPU failure here falls back
-    // like iterate(). q: the incident light per volume vertex, as for the right-hand sides.
-    // `host_copy`, when given, receives the same E read back (3 floats per surface vertex: a few
-    // hundred KB at most), for what the CPU needs of it (the automatic exposure) without computing E
-    // from phi on the CPU.
-    std::shared_ptr<const GpuBuffer> radiance_on_device(const TetMesh& mesh, const TetConnectivity& connectivity,
-                                                        const std::vector<std::array<double, 3>>& q,
-                                                        const std::vector<int32_t>& surface_vertices,
+    // The exitant radiance factor E (Eq. 3 without F_t, gpu_radiance.h) of every shading vertex
+    // (solver/shading_surface.h: the boundary `surface` split at its creases), computed on the device
+    // from the resident phi of each copy's volume vertex and the copy's own q (`shading_q`), 3 floats
+    // per shading vertex: what a renderer in the context's share group binds as its radiance attribute
+    // instead of uploading a CPU copy. A new buffer per call (the renderer may still draw the previous
+    // one), complete when returned (glFinish: another context reads it next). Null unless the GPU
+    // backend is running; a GPU failure here falls back like iterate(). The rows and weights are
+    // rebuilt when the shading or an eta changed since the last call, q re-sent when it changed.
+    // `host_copy`, when given, receives the same E read back (a few hundred KB at most), for what the
+    // CPU needs of it (the automatic exposure) without computing E from phi on the CPU.
+    std::shared_ptr<const GpuBuffer> radiance_on_device(const BoundarySurface& surface, const ShadingSurface& shading,
+                                                        const std::vector<std::array<double, 3>>& shading_q,
                                                         std::vector<std::array<float, 3>>* host_copy = nullptr);
 
     LiveMethod method() const { return method_; }

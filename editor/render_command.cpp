@@ -37,6 +37,7 @@ struct RenderCommandOptions {
     double tolerance = 1e-2;
     double scale = 1.0;
     double ambient = 0.02;
+    double crease_angle = kDefaultCreaseAngleDegrees;
     std::vector<double> view;
     std::optional<double> exposure;
     std::string backend = "cpu";
@@ -70,6 +71,7 @@ void check_options(const RenderCommandOptions& o) {
     // Below about 1e-15 a relative error is under double's rounding: no solver can report it reached.
     if (!(o.tolerance >= 1e-15 && o.tolerance < 1)) fail("--tol must be a relative tolerance in [1e-15, 1)");
     if (!(o.ambient >= 0 && o.ambient <= kMaxLightValue)) fail("--ambient must be non-negative and at most 1e100");
+    if (!(o.crease_angle >= 0 && o.crease_angle <= 180)) fail("--crease-angle must be between 0 and 180 degrees");
     if (o.exposure && (!std::isfinite(*o.exposure) || *o.exposure <= 0))
         fail("--exposure must be finite and positive");
     if (!o.view.empty()) {
@@ -114,7 +116,7 @@ void run_render_command(const RenderCommandOptions& o) {
         diffusion.backend = SolverBackend::Gpu;
         diffusion.gl = &context.gl();
     }
-    const SolvedScene scene = solve_scene(mesh, connectivity, materials, lighting, diffusion);
+    const SolvedScene scene = solve_scene(mesh, connectivity, materials, lighting, diffusion, o.crease_angle);
     if (!scene.diffusion.gpu_fallback_reason.empty())
         std::cerr << "warning: solving on the CPU instead: " << scene.diffusion.gpu_fallback_reason << "\n";
 
@@ -151,6 +153,8 @@ void run_render_command(const RenderCommandOptions& o) {
         {"iterations", s.iterations},
         {"estimated_error", s.estimated_relative_error},
         {"exposure", input.exposure},
+        {"crease_angle_deg", o.crease_angle},
+        {"shading_copies", scene.shading.size() - scene.surface.vertices.size()},
         {"lighting_ms", scene.lighting_ms},
         {"assembly_ms", s.assembly_ms},
         {"solve_ms", s.solve_ms},
@@ -190,6 +194,10 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--scale", options->scale, "Millimetres per model unit (coefficients are per mm)")
         ->capture_default_str();
     cmd->add_option("--ambient", options->ambient, "Ambient irradiance added to every boundary vertex")
+        ->capture_default_str();
+    cmd->add_option("--crease-angle", options->crease_angle,
+                    "Shade the surface as folded where neighbouring triangles turn by more than this many "
+                    "degrees (box edges, cut rims); 180 shades every vertex with one averaged normal")
         ->capture_default_str();
     cmd->add_option("--view", options->view, "Direction from the object towards the camera, X,Y,Z")
         ->delimiter(',')

@@ -121,16 +121,27 @@ bool point_inside_volume(const TetMesh& mesh, const Eigen::Vector3d& point) {
     return false;
 }
 
+void shade_surface(SolvedScene& scene, const TriangleBvh& bvh, const Lighting& lighting,
+                   const std::vector<Rgb>& surface_q, const std::vector<float>& surface_visibility,
+                   double crease_angle_degrees) {
+    scene.shading = split_at_creases(scene.surface, crease_angle_degrees);
+    scene.shading_light = shading_light(scene.surface, scene.shading, bvh, lighting, surface_q, surface_visibility);
+}
+
 SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity,
                         const std::vector<TetMaterial>& materials, const Lighting& lighting,
-                        const DiffusionOptions& options) {
+                        const DiffusionOptions& options, double crease_angle_degrees) {
     SolvedScene scene;
     const auto lighting_start = std::chrono::steady_clock::now();
-    // The surface is extracted once and shared by the lighting and the renderer (the 4-argument
-    // incident_light would extract it again).
+    validate(lighting);
+    // The surface and its shadow BVH are built once and shared by the lighting of the solve, the
+    // shading's copies and the renderer.
     scene.surface = extract_boundary_surface(mesh, connectivity, materials);
-    scene.q = to_volume_vertices(scene.surface, incident_light(scene.surface, lighting, &scene.light_visibility),
-                                 mesh.vertex_count());
+    const TriangleBvh bvh = lighting.shadows ? build_shadow_bvh(scene.surface) : TriangleBvh();
+    std::vector<float> visibility;
+    const std::vector<Rgb> surface_q = incident_light(scene.surface, bvh, lighting, &visibility);
+    scene.q = to_volume_vertices(scene.surface, surface_q, mesh.vertex_count());
+    shade_surface(scene, bvh, lighting, surface_q, visibility, crease_angle_degrees);
     scene.lighting_ms = milliseconds_since(lighting_start);
 
     scene.diffusion = solve_diffusion(mesh, connectivity, materials, scene.q, options);
@@ -140,11 +151,13 @@ SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity
                 throw AlgorithmError("the diffusion solve gave a non-finite fluence at vertex " + std::to_string(v));
         }
     }
-    scene.radiance_factor = exitant_radiance_factors(mesh, connectivity, materials, scene.diffusion.phi, scene.q);
-    for (size_t v = 0; v < scene.radiance_factor.size(); ++v) {
+    scene.radiance_factor =
+        shading_radiance_factors(scene.surface, scene.shading, scene.diffusion.phi, scene.shading_light.q);
+    for (size_t d = 0; d < scene.radiance_factor.size(); ++d) {
         for (int c = 0; c < 3; ++c) {
-            if (!std::isfinite(scene.radiance_factor[v][c]))
-                throw AlgorithmError("non-finite exitant radiance at vertex " + std::to_string(v) +
+            if (!std::isfinite(scene.radiance_factor[d][c]))
+                throw AlgorithmError("non-finite exitant radiance at vertex " +
+                                     std::to_string(scene.surface.vertices[scene.shading.surface_vertex[d]]) +
                                      " (float overflow: are the light intensities absurd?)");
         }
     }
@@ -178,26 +191,26 @@ float automatic_exposure(const SurfaceRenderInput& input) {
 
 SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& scene, const Lighting& lighting,
                                      const ImageSettings& settings,
-                                     const std::vector<std::array<float, 3>>* surface_radiance) {
+                                     const std::vector<std::array<float, 3>>* shading_radiance) {
     const BoundarySurface& surface = scene.surface;
+    const ShadingSurface& shading = scene.shading;
     SurfaceRenderInput input;
-    const size_t n = surface.vertices.size();
-    const size_t radiance_values = surface_radiance ? surface_radiance->size() : scene.radiance_factor.size();
-    const size_t expected = surface_radiance ? n : mesh.vertex_count();
-    if (radiance_values != expected)
-        throw InvalidArgumentError("render input: " + std::to_string(radiance_values) + " radiance values for " +
-                                   std::to_string(expected) + (surface_radiance ? " surface vertices" : " vertices"));
+    const size_t n = shading.size();
+    const std::vector<std::array<float, 3>>& radiance = shading_radiance ? *shading_radiance : scene.radiance_factor;
+    if (radiance.size() != n || shading.normals.size() != n)
+        throw InvalidArgumentError("render input: " + std::to_string(radiance.size()) + " radiance values for " +
+                                   std::to_string(n) + " shading vertices");
     input.positions.resize(n);
     input.normals.resize(n);
-    input.radiance_factor.resize(n);
+    input.radiance_factor = radiance;
     input.eta.resize(n);
-    for (size_t s = 0; s < n; ++s) {
-        input.positions[s] = surface.positions[s].cast<float>();
-        input.normals[s] = surface.normals[s].cast<float>();
-        input.radiance_factor[s] = surface_radiance ? (*surface_radiance)[s] : scene.radiance_factor[surface.vertices[s]];
-        input.eta[s] = static_cast<float>(surface.eta[s]);
+    for (size_t d = 0; d < n; ++d) {
+        const int32_t s = shading.surface_vertex[d];
+        input.positions[d] = surface.positions[s].cast<float>();
+        input.normals[d] = shading.normals[d].cast<float>();
+        input.eta[d] = static_cast<float>(surface.eta[s]);
     }
-    input.triangles = surface.triangles;
+    input.triangles = shading.triangles;
     // Highlights: the same lights as the subsurface term, minus point lights inside the volume (they
     // reach no surface from outside), each shadowed by the visibility its shadow rays found.
     input.lighting.ambient = lighting.ambient;
@@ -211,11 +224,12 @@ SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& sce
         kept.push_back(l);
     }
     const size_t solved_lights = lighting.lights.size();
-    if (!kept.empty() && scene.light_visibility.size() == n * solved_lights) {
+    const std::vector<float>& visibility = scene.shading_light.visibility;
+    if (!kept.empty() && visibility.size() == n * solved_lights) {
         input.light_visibility.resize(n * kept.size());
-        for (size_t s = 0; s < n; ++s)
+        for (size_t d = 0; d < n; ++d)
             for (size_t k = 0; k < kept.size(); ++k)
-                input.light_visibility[s * kept.size() + k] = scene.light_visibility[s * solved_lights + kept[k]];
+                input.light_visibility[d * kept.size() + k] = visibility[d * solved_lights + kept[k]];
     }
     input.width = settings.width;
     input.height = settings.height;
@@ -239,13 +253,14 @@ void write_fields_csv(const std::filesystem::path& path, const TetMesh& mesh, co
             const bool boundary = connectivity.is_boundary_vertex[v] != 0;
             const Rgb& q = scene.q[v];
             const auto& phi = scene.diffusion.phi[v];
-            const auto& e = scene.radiance_factor[v];
-            // lo = F_t(1, eta) E: exitant_radiance along the normal, from the same E the image shows.
-            const double ft = boundary ? fresnel_transmittance(1.0, eta[v]) : 0.0;
+            // lo: exitant_radiance along the vertex's (averaged) normal, from the q the solve used.
+            double lo[3] = {0, 0, 0};
+            if (boundary)
+                for (int c = 0; c < 3; ++c) lo[c] = exitant_radiance(phi[c], q[c], eta[v], 1.0);
             out << world[v].x() << ',' << world[v].y() << ',' << world[v].z() << ',' << (boundary ? 1 : 0);
             for (int c = 0; c < 3; ++c) out << ',' << (boundary ? q[c] : 0.0);
             for (int c = 0; c < 3; ++c) out << ',' << phi[c];
-            for (int c = 0; c < 3; ++c) out << ',' << ft * e[c];
+            for (int c = 0; c < 3; ++c) out << ',' << lo[c];
             out << '\n';
         }
     });

@@ -5,7 +5,8 @@
 //   materials   per tet: an override, else the volume's stored ones, else marble
 //   lighting    q at the boundary with shadows (solver/lighting.h)
 //   diffusion   phi at every vertex (solver/diffusion_solve.h)
-//   radiance    E per boundary vertex, L_o = F_t(theta_o) E (solver/radiance.h)
+//   shading     the boundary split at its creases, q per copy (solver/shading_surface.h)
+//   radiance    E per shading vertex, L_o = F_t(theta_o) E (solver/radiance.h)
 //   image       SurfaceRenderer on the world-space boundary (editor/surface_renderer.h), exposed
 //               automatically unless an exposure is given
 #pragma once
@@ -14,6 +15,7 @@
 #include "io/image_io.h"
 #include "solver/diffusion_solve.h"
 #include "solver/lighting.h"
+#include "solver/shading_surface.h"
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
@@ -47,23 +49,31 @@ std::string resolved_materials_name(const TetMesh& mesh, const std::optional<Tet
 // True when `point` (world space) lies inside or on a tet of the volume (piece transforms applied).
 bool point_inside_volume(const TetMesh& mesh, const Eigen::Vector3d& point);
 
-// Everything the solve produced for one scene, per volume vertex unless said otherwise.
+// Everything the solve produced for one scene.
 struct SolvedScene {
     BoundarySurface surface;                           // world space, with per-vertex eta
-    std::vector<Rgb> q;                                // incident diffuse light (0 inside)
-    DiffusionSolution diffusion;                       // phi and solver statistics
-    std::vector<std::array<float, 3>> radiance_factor; // E (0 inside)
-    // Per surface vertex and light of the lighting solved with, vertex-major: the shadow rays'
-    // visibility (incident_light), so the renderer can shadow the highlights. Empty: all visible.
-    std::vector<float> light_visibility;
-    double lighting_ms = 0;                            // surface extraction, shadow BVH and q
+    // The surface split at its creases (solver/shading_surface.h): what the image shades, with q and
+    // the shadow rays' visibility per shading vertex (the renderer shadows each light's highlight by it).
+    ShadingSurface shading;
+    ShadingLight shading_light;
+    std::vector<Rgb> q;                                // incident diffuse light per volume vertex (0 inside): the solve's
+    DiffusionSolution diffusion;                       // phi per volume vertex and solver statistics
+    std::vector<std::array<float, 3>> radiance_factor; // E per shading vertex (shading_radiance_factors)
+    double lighting_ms = 0;                            // surface extraction, shadow BVH, q and the shading's light
 };
 
+// Extracts nothing: splits `surface` at creases of more than `crease_angle_degrees` and lights the
+// copies (shading_light) from the surface's q and visibility. What solve_scene and the live scene do
+// after every change of the surface or the light.
+void shade_surface(SolvedScene& scene, const TriangleBvh& bvh, const Lighting& lighting,
+                   const std::vector<Rgb>& surface_q, const std::vector<float>& surface_visibility,
+                   double crease_angle_degrees);
+
 // Runs lighting, diffusion and radiance. Throws AlgorithmError when phi or E is not finite (never a
-// NaN image), InvalidArgumentError for bad materials, lights or options.
+// NaN image), InvalidArgumentError for bad materials, lights, options or crease angle.
 SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity,
                         const std::vector<TetMaterial>& materials, const Lighting& lighting,
-                        const DiffusionOptions& options);
+                        const DiffusionOptions& options, double crease_angle_degrees = kDefaultCreaseAngleDegrees);
 
 // How the image is framed and exposed.
 struct ImageSettings {
@@ -87,14 +97,14 @@ inline constexpr double kExposurePercentile = 0.95;
 inline constexpr double kExposureTarget = 0.6;
 float automatic_exposure(const SurfaceRenderInput& input);
 
-// The renderer's input for a solved scene: world-space boundary, normals, E, eta and the lights for
-// the highlights (point lights inside the volume dropped: they light nothing). The exposure is
-// settings.exposure or automatic_exposure. E comes from scene.radiance_factor (per volume vertex), or
-// from `surface_radiance` (per surface vertex, e.g. read back from the device) when given; throws
-// InvalidArgumentError when the one used does not match the surface.
+// The renderer's input for a solved scene, one vertex per shading vertex: world-space positions, the
+// shading normals, E, eta and the lights for the highlights (point lights inside the volume dropped:
+// they light nothing). The exposure is settings.exposure or automatic_exposure. E comes from
+// scene.radiance_factor, or from `shading_radiance` (e.g. read back from the device) when given; both
+// are per shading vertex. Throws InvalidArgumentError when the one used does not match the shading.
 SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& scene, const Lighting& lighting,
                                      const ImageSettings& settings,
-                                     const std::vector<std::array<float, 3>>* surface_radiance = nullptr);
+                                     const std::vector<std::array<float, 3>>* shading_radiance = nullptr);
 
 // Draws with an existing renderer (keep one per context when rendering many frames).
 Image render_scene(SurfaceRenderer& renderer, const SurfaceRenderInput& input);

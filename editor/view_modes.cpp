@@ -369,21 +369,36 @@ ViewGeometry levels_view(const BoundarySurface& surface, const std::vector<int32
     return view;
 }
 
+ViewGeometry on_shading_vertices(ViewGeometry view, const ShadingSurface& shading) {
+    if (view.shading != SurfaceShading::VertexColour) return view;
+    std::vector<std::array<float, 3>> colours(shading.size());
+    for (size_t d = 0; d < shading.size(); ++d) {
+        const auto s = static_cast<size_t>(shading.surface_vertex[d]);
+        if (s >= view.colours.size()) throw InvalidArgumentError("on_shading_vertices: the view was built for another surface");
+        colours[d] = view.colours[s];
+    }
+    view.colours = std::move(colours);
+    return view;
+}
+
 ViewGeometry build_view_geometry(const TetMesh& mesh, const TetConnectivity& connectivity,
                                  const std::vector<TetMaterial>& materials, const SolvedScene& scene,
                                  const ViewOptions& options) {
     validate(options);
-    switch (options.mode) {
-        case ViewMode::Radiance: return ViewGeometry{};
-        case ViewMode::Materials: return materials_view(scene.surface, materials);
-        case ViewMode::Quality:
-            return options.quality_interior ? interior_quality_view(mesh, scene.surface, options)
-                                            : quality_view(mesh, scene.surface);
-        case ViewMode::Wireframe: return wireframe_view(mesh, connectivity);
-        case ViewMode::Slice: return slice_view(mesh, scene.diffusion.phi, options);
-        case ViewMode::Levels: return levels_view(scene.surface, hierarchy_vertex_levels(mesh, connectivity));
-    }
-    return ViewGeometry{};
+    const auto on_surface = [&]() -> ViewGeometry {
+        switch (options.mode) {
+            case ViewMode::Radiance: return ViewGeometry{};
+            case ViewMode::Materials: return materials_view(scene.surface, materials);
+            case ViewMode::Quality:
+                return options.quality_interior ? interior_quality_view(mesh, scene.surface, options)
+                                                : quality_view(mesh, scene.surface);
+            case ViewMode::Wireframe: return wireframe_view(mesh, connectivity);
+            case ViewMode::Slice: return slice_view(mesh, scene.diffusion.phi, options);
+            case ViewMode::Levels: return levels_view(scene.surface, hierarchy_vertex_levels(mesh, connectivity));
+        }
+        return ViewGeometry{};
+    };
+    return on_shading_vertices(on_surface(), scene.shading);
 }
 
 void apply_view(const ViewGeometry& view, SurfaceRenderInput& input) {
@@ -414,7 +429,7 @@ std::shared_ptr<const ViewGeometry> ViewGeometryCache::get(const TetMesh& mesh, 
             levels_version_ = geometry_version;
         }
         validate(options);
-        view_ = std::make_shared<const ViewGeometry>(levels_view(scene.surface, levels_));
+        view_ = std::make_shared<const ViewGeometry>(on_shading_vertices(levels_view(scene.surface, levels_), scene.shading));
     } else {
         view_ = std::make_shared<const ViewGeometry>(build_view_geometry(mesh, connectivity, materials, scene, options));
     }

@@ -89,8 +89,9 @@ std::array<float, 3> fluence_colour(double t);
 // A material's display colour: its albedo per channel scaled so the largest channel is 0.9.
 std::array<float, 3> material_colour(const TetMaterial& material);
 
-// The individual views. `surface` is the scene's boundary (SolvedScene::surface), so colours line up
-// with make_render_input's vertices and triangles.
+// The individual views. `surface` is the scene's boundary (SolvedScene::surface): vertex colours are
+// per surface vertex, triangle colours line up with make_render_input's triangles (on_shading_vertices
+// puts vertex colours on its vertices).
 ViewGeometry materials_view(const BoundarySurface& surface, const std::vector<TetMaterial>& materials);
 ViewGeometry quality_view(const TetMesh& mesh, const BoundarySurface& surface);
 // quality_view plus the slice plane's cross-section coloured per tet, the surface clipped as for the
@@ -108,7 +109,12 @@ ViewGeometry slice_view(const TetMesh& mesh, const std::vector<std::array<double
 std::vector<int32_t> hierarchy_vertex_levels(const TetMesh& mesh, const TetConnectivity& connectivity);
 ViewGeometry levels_view(const BoundarySurface& surface, const std::vector<int32_t>& vertex_levels);
 
-// The view `options.mode` asks for; Radiance gives an empty geometry. materials: one per tet (as
+// A view of vertex colours per surface vertex with its colours copied to the shading vertices
+// (scene.shading: make_render_input's vertices); other views as they are. Throws InvalidArgumentError
+// when the view was built for another surface.
+ViewGeometry on_shading_vertices(ViewGeometry view, const ShadingSurface& shading);
+
+// The view `options.mode` asks for, on make_render_input's vertices; Radiance gives an empty geometry. materials: one per tet (as
 // solved). Throws InvalidArgumentError for bad options.
 ViewGeometry build_view_geometry(const TetMesh& mesh, const TetConnectivity& connectivity,
                                  const std::vector<TetMaterial>& materials, const SolvedScene& scene,

@@ -3,32 +3,62 @@
 #include "solver/material.h"
 #include "tetops/error.h"
 
+#include <cmath>
 #include <numbers>
 #include <string>
 
 namespace waxwork {
+namespace {
 
-GpuRadiance::GpuRadiance(GpuKernels& kernels, const TetMesh& mesh, const TetConnectivity& connectivity,
-                         const std::vector<TetMaterial>& materials)
-    : kernels_(&kernels), rows_(mesh.vertex_count()) {
-    const std::vector<double> eta = boundary_vertex_eta(mesh, connectivity, materials);
-    std::vector<float> a(rows_, 0.0f), c(rows_, 0.0f);
-    for (int32_t v : connectivity.boundary_vertices) {
+std::vector<int32_t> shading_row_vertices(const BoundarySurface& surface, const ShadingSurface& shading) {
+    std::vector<int32_t> rows(shading.size());
+    for (size_t d = 0; d < rows.size(); ++d) rows[d] = surface.vertices.at(shading.surface_vertex[d]);
+    return rows;
+}
+
+std::vector<double> shading_row_eta(const BoundarySurface& surface, const ShadingSurface& shading) {
+    std::vector<double> eta(shading.size());
+    for (size_t d = 0; d < eta.size(); ++d) eta[d] = surface.eta.at(shading.surface_vertex[d]);
+    return eta;
+}
+
+}  // namespace
+
+GpuRadiance::GpuRadiance(GpuKernels& kernels, const std::vector<int32_t>& row_vertex,
+                         const std::vector<double>& row_eta, size_t phi_rows)
+    : kernels_(&kernels), rows_(row_vertex.size()), phi_rows_(phi_rows) {
+    if (row_eta.size() != rows_)
+        throw InvalidArgumentError("GPU radiance: " + std::to_string(row_eta.size()) + " eta values for " +
+                                   std::to_string(rows_) + " rows");
+    std::vector<float> a(rows_), c(rows_);
+    for (size_t r = 0; r < rows_; ++r) {
+        if (row_vertex[r] < 0 || static_cast<size_t>(row_vertex[r]) >= phi_rows)
+            throw InvalidArgumentError("GPU radiance: row " + std::to_string(r) + " reads vertex " +
+                                       std::to_string(row_vertex[r]) + " of " + std::to_string(phi_rows));
+        if (!(row_eta[r] >= 1.0) || !std::isfinite(row_eta[r]))
+            throw InvalidArgumentError("GPU radiance: row " + std::to_string(r) + " has eta " +
+                                       number_text(row_eta[r]));
         // exitant_radiance_factor's coefficients (Eq. 3), linear in phi and q.
-        const double fdr = diffuse_fresnel_reflectance(eta[v]);
+        const double fdr = diffuse_fresnel_reflectance(row_eta[r]);
         const double big_a = (1.0 + fdr) / (1.0 - fdr);
-        a[v] = static_cast<float>((1.0 + 1.0 / big_a) / (4.0 * std::numbers::pi));
-        c[v] = static_cast<float>(4.0 / (1.0 + fdr) / (4.0 * std::numbers::pi));
+        a[r] = static_cast<float>((1.0 + 1.0 / big_a) / (4.0 * std::numbers::pi));
+        c[r] = static_cast<float>(4.0 / (1.0 + fdr) / (4.0 * std::numbers::pi));
     }
+    row_vertex_ = GpuBuffer::from<int32_t>(kernels.gl(), row_vertex);
     phi_weight_ = GpuBuffer::from<float>(kernels.gl(), a);
     q_weight_ = GpuBuffer::from<float>(kernels.gl(), c);
     q_ = kernels.vector(rows_);
+    row_phi_ = kernels.vector(rows_);
 }
+
+GpuRadiance::GpuRadiance(GpuKernels& kernels, const BoundarySurface& surface, const ShadingSurface& shading,
+                         size_t phi_rows)
+    : GpuRadiance(kernels, shading_row_vertices(surface, shading), shading_row_eta(surface, shading), phi_rows) {}
 
 void GpuRadiance::set_light(const std::vector<std::array<double, 3>>& q) {
     if (q.size() != rows_)
         throw InvalidArgumentError("GPU radiance: " + std::to_string(q.size()) + " light values for " +
-                                   std::to_string(rows_) + " vertices");
+                                   std::to_string(rows_) + " rows");
     std::vector<float> data(3 * rows_);
     for (size_t i = 0; i < rows_; ++i)
         for (int k = 0; k < 3; ++k) data[3 * i + k] = static_cast<float>(q[i][k]);
@@ -36,7 +66,11 @@ void GpuRadiance::set_light(const std::vector<std::array<double, 3>>& q) {
 }
 
 void GpuRadiance::compute(const GpuBuffer& phi, GpuBuffer& e, const RadianceOptions& options) {
-    kernels_->radiance(rows_, phi_weight_, q_weight_, phi, q_, e, options.clamp_negative);
+    if (phi.bytes() < 3 * phi_rows_ * sizeof(float) || e.bytes() < 3 * rows_ * sizeof(float))
+        throw InvalidArgumentError("GPU radiance: the phi or E buffer is too small");
+    if (rows_ == 0) return;
+    kernels_->gather(rows_, row_vertex_, phi, row_phi_);
+    kernels_->radiance(rows_, phi_weight_, q_weight_, row_phi_, q_, e, options.clamp_negative);
 }
 
 }  // namespace waxwork

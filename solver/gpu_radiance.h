@@ -2,36 +2,42 @@
 // F_t) computed on the device from the resident fluence, so a renderer on the same context can read E
 // without a round trip through the CPU:
 //     E = max( (1 + 1/A) / (4 pi) phi - 4 / ((1 + F_dr) 4 pi) q, 0 )
-// The two weights depend only on the boundary vertex's eta (boundary_vertex_eta), so they are
-// uploaded once per material change; they are zero at interior vertices (E = 0 there, as on the CPU).
+// at chosen rows, each reading phi at one volume vertex: the renderer's shading vertices
+// (shading_surface.h), several of which read the same vertex where the surface is split at a crease,
+// each with its own q. The two weights depend only on the row's eta, so they are uploaded once per
+// shading or material change.
 #pragma once
 
 #include "solver/gpu_kernels.h"
 #include "solver/radiance.h"
-#include "tetops/connectivity.h"
-#include "tetops/tet_mesh.h"
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 namespace waxwork {
 
 class GpuRadiance {
 public:
-    GpuRadiance(GpuKernels& kernels, const TetMesh& mesh, const TetConnectivity& connectivity,
-                const std::vector<TetMaterial>& materials);
+    // Row r reads phi at volume vertex row_vertex[r] (< phi_rows) with relative index row_eta[r].
+    // Throws InvalidArgumentError for mismatched sizes, a vertex out of range or an eta that is not
+    // finite and at least 1.
+    GpuRadiance(GpuKernels& kernels, const std::vector<int32_t>& row_vertex, const std::vector<double>& row_eta,
+                size_t phi_rows);
+    // The shading vertices of `surface` split as `shading`, for phi over `phi_rows` volume vertices.
+    GpuRadiance(GpuKernels& kernels, const BoundarySurface& surface, const ShadingSurface& shading, size_t phi_rows);
 
-    // q per vertex (volume order), uploaded once per lighting change.
+    // q per row, uploaded once per lighting change.
     void set_light(const std::vector<std::array<double, 3>>& q);
-    // e = E per vertex, rgb interleaved (a buffer of kernels.vector(rows)); phi from the solver
+    // e = E per row, rgb interleaved (3 floats per row); phi per volume vertex from the solver
     // (GpuDiffusionSolver::solution_buffer).
     void compute(const GpuBuffer& phi, GpuBuffer& e, const RadianceOptions& options = {});
     size_t size() const { return rows_; }
 
 private:
     GpuKernels* kernels_;
-    size_t rows_;
-    GpuBuffer phi_weight_, q_weight_, q_;
+    size_t rows_, phi_rows_;
+    GpuBuffer row_vertex_, phi_weight_, q_weight_, q_, row_phi_;
 };
 
 }  // namespace waxwork

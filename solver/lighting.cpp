@@ -139,8 +139,8 @@ void check_lighting_inputs(const BoundarySurface& surface, const TriangleBvh& bv
     }
 }
 
-// Shadow-ray offset per surface vertex: kShadowOffset times its mean incident edge length (zero
-// without shadows).
+}  // namespace
+
 std::vector<double> shadow_ray_offsets(const BoundarySurface& surface, const Lighting& lighting) {
     const size_t n = surface.positions.size();
     std::vector<double> offset(n, 0.0);
@@ -161,14 +161,10 @@ std::vector<double> shadow_ray_offsets(const BoundarySurface& surface, const Lig
     return offset;
 }
 
-// q at surface vertex s.
-// `visibility`, when not null, receives V_il for each light (lights.size() entries).
-Rgb incident_light_at(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
-                      double offset, size_t s, float* visibility = nullptr) {
+Rgb incident_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta,
+                      double shadow_offset, const TriangleBvh& bvh, const Lighting& lighting, float* visibility) {
     Rgb sum = lighting.ambient;
-    const Eigen::Vector3d& p = surface.positions[s];
-    const Eigen::Vector3d& normal = surface.normals[s];
-    const Eigen::Vector3f origin = (p + offset * normal).cast<float>();
+    const Eigen::Vector3f origin = (position + shadow_offset * normal).cast<float>();
     for (size_t l = 0; l < lighting.lights.size(); ++l) {
         const Light& light = lighting.lights[l];
         if (visibility) visibility[l] = 1.0f;
@@ -178,7 +174,7 @@ Rgb incident_light_at(const BoundarySurface& surface, const TriangleBvh& bvh, co
         if (light.type == LightType::Directional) {
             to_light = -light.vector.normalized();
         } else {
-            to_light = light.vector - p;
+            to_light = light.vector - position;
             distance = to_light.norm();
             if (!(distance > 0)) continue;  // light on the vertex: no direction
             to_light /= distance;
@@ -196,13 +192,11 @@ Rgb incident_light_at(const BoundarySurface& surface, const TriangleBvh& bvh, co
                 continue;
             }
         }
-        const double factor = scale * cos_theta * fresnel_transmittance(cos_theta, surface.eta[s]);
+        const double factor = scale * cos_theta * fresnel_transmittance(cos_theta, eta);
         for (int c = 0; c < 3; ++c) sum[c] += light.intensity[c] * factor;
     }
     return sum;
 }
-
-}  // namespace
 
 std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
                                 std::vector<float>* visibility) {
@@ -215,7 +209,7 @@ std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBv
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t s = range.begin(); s != range.end(); ++s) {
             float* v = visibility ? visibility->data() + s * lights : nullptr;
-            q[s] = incident_light_at(surface, bvh, lighting, offset[s], s, v);
+            q[s] = incident_light_at(surface.positions[s], surface.normals[s], surface.eta[s], offset[s], bvh, lighting, v);
         }
     });
     return q;
@@ -235,7 +229,8 @@ void update_incident_light(const BoundarySurface& surface, const TriangleBvh& bv
                       [&](const tbb::blocked_range<size_t>& range) {
                           for (size_t i = range.begin(); i != range.end(); ++i) {
                               const size_t s = static_cast<size_t>(surface_vertices[i]);
-                              q[s] = incident_light_at(surface, bvh, lighting, offset[s], s);
+                              q[s] = incident_light_at(surface.positions[s], surface.normals[s], surface.eta[s], offset[s], bvh,
+                                                         lighting);
                           }
                       });
 }

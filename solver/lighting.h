@@ -106,6 +106,17 @@ std::vector<Rgb> incident_light(const BoundarySurface& surface, const Lighting& 
 std::vector<Rgb> incident_light(const TetMesh& mesh, const TetConnectivity& connectivity,
                                 const std::vector<TetMaterial>& materials, const Lighting& lighting);
 
+// q at one point of the surface with outward unit `normal` and relative index `eta`; the shadow ray
+// starts `shadow_offset` along the normal. `visibility`, when not null, receives V_il for each light
+// (lights.size() entries). incident_light is this at every surface vertex; `lighting` must be valid
+// (validate).
+Rgb incident_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta, double shadow_offset,
+                      const TriangleBvh& bvh, const Lighting& lighting, float* visibility = nullptr);
+
+// The shadow-ray offset per surface vertex: kShadowOffset times its mean incident edge length (zero
+// without shadows), clear of the triangles the vertex lies on.
+std::vector<double> shadow_ray_offsets(const BoundarySurface& surface, const Lighting& lighting);
+
 // Scatters per-surface-vertex values to volume vertices (zero elsewhere).
 std::vector<Rgb> to_volume_vertices(const BoundarySurface& surface, const std::vector<Rgb>& values,
                                     size_t volume_vertex_count);

@@ -58,4 +58,27 @@ std::vector<std::array<float, 3>> exitant_radiance_factors(const TetMesh& mesh, 
     return out;
 }
 
+std::vector<std::array<float, 3>> shading_radiance_factors(const BoundarySurface& surface,
+                                                           const ShadingSurface& shading,
+                                                           const std::vector<std::array<double, 3>>& phi,
+                                                           const std::vector<std::array<double, 3>>& shading_q,
+                                                           const RadianceOptions& options) {
+    if (shading_q.size() != shading.size() || surface.eta.size() != surface.vertices.size())
+        throw InvalidArgumentError("shading_radiance_factors: " + std::to_string(shading_q.size()) +
+                                   " light values for " + std::to_string(shading.size()) + " shading vertices");
+    std::vector<std::array<float, 3>> out(shading.size());
+    for (size_t d = 0; d < shading.size(); ++d) {
+        const int32_t s = shading.surface_vertex[d];
+        const int32_t v = surface.vertices[s];
+        if (static_cast<size_t>(v) >= phi.size())
+            throw InvalidArgumentError("shading_radiance_factors: phi has " + std::to_string(phi.size()) +
+                                       " values; surface vertex " + std::to_string(s) + " is volume vertex " +
+                                       std::to_string(v));
+        for (int c = 0; c < 3; ++c)
+            out[d][c] = static_cast<float>(
+                exitant_radiance_factor(phi[v][c], shading_q[d][c], surface.eta[s], options.clamp_negative));
+    }
+    return out;
+}
+
 }  // namespace waxwork

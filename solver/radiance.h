@@ -9,6 +9,7 @@
 // the factor is clamped at zero by default (RadianceOptions::clamp_negative).
 #pragma once
 
+#include "solver/shading_surface.h"
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
@@ -37,6 +38,15 @@ std::vector<std::array<float, 3>> exitant_radiance_factors(const TetMesh& mesh, 
                                                            const std::vector<TetMaterial>& materials,
                                                            const std::vector<std::array<double, 3>>& phi,
                                                            const std::vector<std::array<double, 3>>& q,
+                                                           const RadianceOptions& options = {});
+
+// E per shading vertex (shading_surface.h): phi of its volume vertex (surface.vertices of its surface
+// vertex), its own q (ShadingLight::q) and its surface vertex's eta. Equal to exitant_radiance_factors
+// at the copies of vertices that are not split. Throws InvalidArgumentError for mismatched sizes.
+std::vector<std::array<float, 3>> shading_radiance_factors(const BoundarySurface& surface,
+                                                           const ShadingSurface& shading,
+                                                           const std::vector<std::array<double, 3>>& phi,
+                                                           const std::vector<std::array<double, 3>>& shading_q,
                                                            const RadianceOptions& options = {});
 
 }  // namespace waxwork

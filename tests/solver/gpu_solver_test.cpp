@@ -336,7 +336,7 @@ TEST(GpuDiffusionSolver, ShaderFailureFallsBackToTheCpuWithTheDriverLog) {
     EXPECT_FALSE(solution.gpu_fallback_reason.empty());
 }
 
-TEST(GpuRadiance, ExitantRadianceFactorsMatchTheCpu) {
+TEST(GpuRadiance, ExitantRadianceFactorsMatchTheCpuPerShadingVertex) {
     WAXWORK_REQUIRE_GL(context);
     const System& s = spot_system();
     GpuDiffusionSolver solver(context->gl(), s.matrix);
@@ -345,13 +345,26 @@ TEST(GpuRadiance, ExitantRadianceFactorsMatchTheCpu) {
     options.relative_tolerance = 1e-4;
     solver.solve(options);
     const auto phi = solver.solution();
-    GpuRadiance radiance(solver.kernels(), s.mesh, s.conn, s.materials);
-    radiance.set_light(s.q);
+    // Shading vertices: spot's boundary split at a small crease angle, so that many surface vertices
+    // have copies; each copy gets its own q (here: its vertex's scaled by the copy's rank), several
+    // rows then read the same phi.
+    const BoundarySurface surface = extract_boundary_surface(s.mesh, s.conn, s.materials);
+    const ShadingSurface shading = split_at_creases(surface, 10.0);
+    ASSERT_GT(shading.size(), surface.vertices.size());
+    std::vector<Rgb> q(shading.size());
+    for (size_t d = 0; d < shading.size(); ++d) {
+        const Rgb& vertex_q = s.q[surface.vertices[shading.surface_vertex[d]]];
+        const double scale = d < surface.vertices.size() ? 1.0 : 0.25;
+        for (int c = 0; c < 3; ++c) q[d][c] = scale * vertex_q[c];
+    }
+    GpuRadiance radiance(solver.kernels(), surface, shading, s.matrix.size());
+    ASSERT_EQ(radiance.size(), shading.size());
+    radiance.set_light(q);
     for (const bool clamp : {true, false}) {
-        GpuBuffer e = solver.kernels().vector(s.matrix.size());
+        GpuBuffer e = solver.kernels().vector(shading.size());
         radiance.compute(solver.solution_buffer(), e, RadianceOptions{clamp});
         const std::vector<float> gpu = e.download<float>();
-        const auto cpu = exitant_radiance_factors(s.mesh, s.conn, s.materials, phi, s.q, RadianceOptions{clamp});
+        const auto cpu = shading_radiance_factors(surface, shading, phi, q, RadianceOptions{clamp});
         double peak = 0, diff = 0;
         for (size_t i = 0; i < cpu.size(); ++i)
             for (int c = 0; c < 3; ++c) {
@@ -361,6 +374,11 @@ TEST(GpuRadiance, ExitantRadianceFactorsMatchTheCpu) {
         ASSERT_GT(peak, 0);
         EXPECT_LT(diff, 1e-5 * peak) << (clamp ? "clamped" : "unclamped");
     }
+    // Rows that read no vertex of phi, or whose eta no material has, are refused.
+    EXPECT_THROW(GpuRadiance(solver.kernels(), {0, static_cast<int32_t>(s.matrix.size())}, {1.3, 1.3}, s.matrix.size()),
+                 InvalidArgumentError);
+    EXPECT_THROW(GpuRadiance(solver.kernels(), {0}, {std::nan("")}, s.matrix.size()), InvalidArgumentError);
+    EXPECT_THROW(GpuRadiance(solver.kernels(), {0, 1}, {1.3}, s.matrix.size()), InvalidArgumentError);
 }
 
 // WAXWORK_GL_DEVICE=egl: the path to a real GPU without a display. Here EGL finds llvmpipe again

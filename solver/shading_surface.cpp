@@ -1,0 +1,174 @@
+#include "solver/shading_surface.h"
+
+#include "tetops/error.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+#include <string>
+
+namespace waxwork {
+namespace {
+
+// Triangles around each surface vertex (compressed rows), in triangle order.
+struct VertexTriangles {
+    std::vector<int32_t> offsets, triangles;
+};
+
+VertexTriangles vertex_triangles(size_t vertex_count, const std::vector<std::array<int32_t, 3>>& triangles) {
+    VertexTriangles fans;
+    fans.offsets.assign(vertex_count + 1, 0);
+    for (const auto& t : triangles)
+        for (const int32_t v : t) ++fans.offsets[v + 1];
+    std::partial_sum(fans.offsets.begin(), fans.offsets.end(), fans.offsets.begin());
+    fans.triangles.resize(fans.offsets.back());
+    std::vector<int32_t> cursor(fans.offsets.begin(), fans.offsets.end() - 1);
+    for (size_t t = 0; t < triangles.size(); ++t)
+        for (const int32_t v : triangles[t]) fans.triangles[cursor[v]++] = static_cast<int32_t>(t);
+    return fans;
+}
+
+// Union-find over the few triangles of one vertex (a dozen or so): by index, path halving.
+int32_t find_root(std::vector<int32_t>& parent, int32_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+}
+
+}  // namespace
+
+ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_angle_degrees) {
+    if (!(crease_angle_degrees >= 0.0 && crease_angle_degrees <= 180.0))
+        throw InvalidArgumentError("crease angle " + number_text(crease_angle_degrees) +
+                                   " degrees: must be between 0 and 180");
+    const size_t n = surface.positions.size();
+    if (surface.normals.size() != n)
+        throw InvalidArgumentError("split_at_creases: " + std::to_string(surface.normals.size()) + " normals for " +
+                                   std::to_string(n) + " vertices");
+    for (size_t t = 0; t < surface.triangles.size(); ++t)
+        for (const int32_t v : surface.triangles[t])
+            if (v < 0 || static_cast<size_t>(v) >= n)
+                throw InvalidArgumentError("split_at_creases: triangle " + std::to_string(t) + " names vertex " +
+                                           std::to_string(v) + " of a surface of " + std::to_string(n));
+
+    ShadingSurface shading;
+    shading.surface_vertex.resize(n);
+    std::iota(shading.surface_vertex.begin(), shading.surface_vertex.end(), 0);
+    shading.normals = surface.normals;
+    shading.triangles = surface.triangles;
+    if (crease_angle_degrees >= 180.0) return shading;  // every pair of normals is within 180 degrees
+
+    // Twice-area normals: zero for a degenerate triangle, which then joins any fan it touches.
+    std::vector<Eigen::Vector3d> face_normal(surface.triangles.size());
+    tbb::parallel_for(size_t{0}, surface.triangles.size(), [&](size_t t) {
+        const auto& [a, b, c] = surface.triangles[t];
+        face_normal[t] = (surface.positions[b] - surface.positions[a]).cross(surface.positions[c] - surface.positions[a]);
+    });
+    const double min_cos = std::cos(crease_angle_degrees * std::numbers::pi / 180.0);
+    const auto smooth = [&](int32_t t, int32_t u) {
+        const double lengths = face_normal[t].norm() * face_normal[u].norm();
+        return !(lengths > 0) || face_normal[t].dot(face_normal[u]) >= min_cos * lengths;
+    };
+
+    // Per vertex: the fans are the classes of "shares an edge through the vertex and is smooth with".
+    // Written here rather than with OpenMesh's halfedge normals because the boundary of a tet mesh can be
+    // non-manifold (two tets meeting at an edge or a vertex only), which a halfedge mesh cannot hold,
+    // and because the renderer needs the map from each copy back to its surface vertex.
+    const VertexTriangles fans = vertex_triangles(n, surface.triangles);
+    std::vector<int32_t> parent, fan_of;
+    std::vector<Eigen::Vector3d> fan_normal;
+    for (size_t v = 0; v < n; ++v) {
+        const int32_t begin = fans.offsets[v], count = fans.offsets[v + 1] - begin;
+        if (count < 2) continue;
+        const int32_t* around = fans.triangles.data() + begin;
+        parent.resize(count);
+        std::iota(parent.begin(), parent.end(), 0);
+        // The other two corners of each triangle around v: triangles sharing one share an edge with v.
+        const auto others = [&](int32_t t) {
+            const auto& tri = surface.triangles[t];
+            const int k = tri[0] == static_cast<int32_t>(v) ? 0 : tri[1] == static_cast<int32_t>(v) ? 1 : 2;
+            return std::array<int32_t, 2>{tri[(k + 1) % 3], tri[(k + 2) % 3]};
+        };
+        for (int32_t i = 0; i < count; ++i) {
+            const auto oi = others(around[i]);
+            for (int32_t j = i + 1; j < count; ++j) {
+                const auto oj = others(around[j]);
+                const bool share_edge = oi[0] == oj[0] || oi[0] == oj[1] || oi[1] == oj[0] || oi[1] == oj[1];
+                if (share_edge && smooth(around[i], around[j]))
+                    parent[find_root(parent, i)] = find_root(parent, j);
+            }
+        }
+        // Fans numbered by their first triangle; the first keeps the surface vertex's index.
+        fan_of.assign(count, -1);
+        int32_t fan_count = 0;
+        for (int32_t i = 0; i < count; ++i) {
+            const int32_t root = find_root(parent, i);
+            if (fan_of[root] < 0) fan_of[root] = fan_count++;
+            fan_of[i] = fan_of[root];
+        }
+        if (fan_count == 1) continue;
+        fan_normal.assign(fan_count, Eigen::Vector3d::Zero());
+        for (int32_t i = 0; i < count; ++i) fan_normal[fan_of[i]] += face_normal[around[i]];
+        const int32_t first_copy = static_cast<int32_t>(shading.surface_vertex.size());
+        for (int32_t f = 0; f < fan_count; ++f) {
+            const double length = fan_normal[f].norm();
+            // A fan of degenerate triangles only has no normal of its own: it keeps the vertex's.
+            const Eigen::Vector3d normal = length > 0 ? Eigen::Vector3d(fan_normal[f] / length) : surface.normals[v];
+            const int32_t copy = f == 0 ? static_cast<int32_t>(v) : first_copy + f - 1;
+            if (f == 0) {
+                shading.normals[v] = normal;
+            } else {
+                shading.surface_vertex.push_back(static_cast<int32_t>(v));
+                shading.normals.push_back(normal);
+            }
+            shading.split_copies.push_back(copy);
+        }
+        for (int32_t i = 0; i < count; ++i) {
+            if (fan_of[i] == 0) continue;
+            auto& tri = shading.triangles[around[i]];
+            for (int32_t& corner : tri)
+                if (corner == static_cast<int32_t>(v)) corner = first_copy + fan_of[i] - 1;
+        }
+    }
+    std::sort(shading.split_copies.begin(), shading.split_copies.end());
+    return shading;
+}
+
+ShadingLight shading_light(const BoundarySurface& surface, const ShadingSurface& shading, const TriangleBvh& bvh,
+                           const Lighting& lighting, const std::vector<Rgb>& surface_q,
+                           const std::vector<float>& surface_visibility) {
+    validate(lighting);
+    const size_t n = surface.positions.size(), lights = lighting.lights.size();
+    if (surface_q.size() != n || shading.normals.size() != shading.size() || shading.size() < n)
+        throw InvalidArgumentError("shading_light: " + std::to_string(surface_q.size()) + " light values and " +
+                                   std::to_string(shading.size()) + " shading vertices for a surface of " +
+                                   std::to_string(n) + " vertices");
+    if (!surface_visibility.empty() && surface_visibility.size() != n * lights)
+        throw InvalidArgumentError("shading_light: " + std::to_string(surface_visibility.size()) +
+                                   " visibility values for " + std::to_string(n) + " vertices and " +
+                                   std::to_string(lights) + " lights");
+    if (lighting.shadows && bvh.triangle_count() != surface.triangles.size())
+        throw InvalidArgumentError("shading_light: the shadow BVH was not built from this surface");
+
+    ShadingLight light;
+    light.q.resize(shading.size());
+    std::copy(surface_q.begin(), surface_q.end(), light.q.begin());
+    if (!surface_visibility.empty()) {
+        light.visibility.assign(shading.size() * lights, 1.0f);
+        std::copy(surface_visibility.begin(), surface_visibility.end(), light.visibility.begin());
+    }
+    if (shading.split_copies.empty()) return light;
+    const std::vector<double> offset = shadow_ray_offsets(surface, lighting);
+    tbb::parallel_for(size_t{0}, shading.split_copies.size(), [&](size_t i) {
+        const int32_t copy = shading.split_copies[i];
+        const int32_t s = shading.surface_vertex[copy];
+        float* visibility = light.visibility.empty() ? nullptr : light.visibility.data() + copy * lights;
+        light.q[copy] = incident_light_at(surface.positions[s], shading.normals[copy], surface.eta[s], offset[s], bvh,
+                                          lighting, visibility);
+    });
+    return light;
+}
+
+}  // namespace waxwork
