@@ -3,8 +3,11 @@
 // the UI never waits for a hierarchy build or the slice of a large volume.
 #include "editor/editor_app.h"
 
+#include "tetops/error.h"
+
 #include <imgui.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -104,6 +107,20 @@ void EditorApp::draw_view_mode_panel() {
             view_dirty_ = true;
         }
     }
+    // Where the surface shades as folded (solver/shading_surface.h): the image only, so the solve goes on.
+    float crease = static_cast<float>(live_options_.crease_angle_degrees);
+    if (ImGui::SliderFloat("crease angle", &crease, 0.0f, 180.0f, "%.0f deg")) {
+        live_options_.crease_angle_degrees = std::clamp(static_cast<double>(crease), 0.0, 180.0);
+        const double degrees = live_options_.crease_angle_degrees;
+        if (scene_->core)
+            queue_job("crease angle", [degrees](SceneCore& core) {
+                core.live->set_crease_angle(degrees);
+                return "Shading split where the surface folds by more than " + number_text(degrees) + " degrees";
+            });
+    }
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("Box edges and cut rims shade as folded where neighbouring triangles turn by more than\n"
+                          "this; 180 shades every vertex with one averaged normal");
     if (view_options_.mode != ViewMode::Radiance) {
         if (view_geometry_ && view_geometry_->mode == view_options_.mode) {
             draw_legend(view_geometry_->legend);

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <set>
 
 namespace waxwork {
@@ -25,13 +26,13 @@ LiveSceneOptions options() {
 
 // The live scene, converged, against a from-scratch solve_scene of the same mesh and lights.
 void expect_matches_fresh_solve(LiveScene& scene, const TetMesh& mesh, const Lighting& lighting,
-                                const std::string& what) {
+                                const std::string& what, double crease_angle = kDefaultCreaseAngleDegrees) {
     scene.converge();
     const TetConnectivity connectivity = build_connectivity(mesh);
     DiffusionOptions diffusion;
     diffusion.mm_per_unit = options().mm_per_unit;
     diffusion.relative_tolerance = kTolerance;
-    const SolvedScene fresh = solve_scene(mesh, connectivity, mesh.materials, lighting, diffusion);
+    const SolvedScene fresh = solve_scene(mesh, connectivity, mesh.materials, lighting, diffusion, crease_angle);
     const auto live = scene.phi();
     ASSERT_EQ(live.size(), fresh.diffusion.phi.size()) << what;
     double largest = 0, difference = 0;
@@ -44,6 +45,7 @@ void expect_matches_fresh_solve(LiveScene& scene, const TetMesh& mesh, const Lig
     EXPECT_LT(difference, 1e-6 * largest) << what;
     // The radiance the renderer gets follows phi.
     const SolvedScene snapshot = scene.solved_scene();
+    ASSERT_EQ(snapshot.shading.surface_vertex, fresh.shading.surface_vertex) << what;
     ASSERT_EQ(snapshot.radiance_factor.size(), fresh.radiance_factor.size());
     EXPECT_EQ(scene.radiance_factors(), snapshot.radiance_factor);
     for (size_t v = 0; v < fresh.radiance_factor.size(); ++v)
@@ -99,6 +101,40 @@ TEST(LiveScene, FollowsEveryKindOfChangeToTheFreshSolution) {
         scene.apply_change(doc.mesh(), *report);
         expect_matches_fresh_solve(scene, doc.mesh(), lighting, report->name);
     }
+}
+
+// The crease angle is the image's: changing it re-splits the shading and leaves the solve alone,
+// and it holds through later edits.
+TEST(LiveScene, TheCreaseAngleChangesTheShadingOnly) {
+    Document doc(testing::make_cube_mesh(7), material_preset("marble"));
+    const Lighting lighting = key_lighting();
+    LiveScene scene(doc.mesh(), lighting, options());
+    scene.converge();
+    const auto phi = scene.phi();
+    const size_t surface_vertices = scene.solved_scene().surface.vertices.size();
+    EXPECT_GT(scene.solved_scene().shading.size(), surface_vertices);  // a cube's edges split
+
+    scene.set_crease_angle(180.0);
+    EXPECT_TRUE(scene.converged());
+    EXPECT_EQ(scene.phi(), phi);
+    EXPECT_EQ(scene.options().crease_angle_degrees, 180.0);
+    EXPECT_EQ(scene.solved_scene().shading.size(), surface_vertices);
+    EXPECT_EQ(scene.radiance_factors().size(), surface_vertices);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "unsplit", 180.0);
+
+    PlaneCutOp cut;
+    cut.plane = {Eigen::Vector3d(1, 0.3, 0.2), 0.6};
+    scene.apply_change(doc.mesh(), doc.apply(cut));
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "cut, unsplit", 180.0);
+    scene.set_crease_angle(30.0);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "cut, split at 30 degrees", 30.0);
+
+    for (const double bad : {-1.0, 180.5, std::numeric_limits<double>::quiet_NaN()})
+        EXPECT_THROW(scene.set_crease_angle(bad), InvalidArgumentError) << bad;
+    EXPECT_EQ(scene.options().crease_angle_degrees, 30.0);
+    LiveSceneOptions bad_options = options();
+    bad_options.crease_angle_degrees = 200;
+    EXPECT_THROW(LiveScene(doc.mesh(), lighting, bad_options), InvalidArgumentError);
 }
 
 TEST(LiveScene, FollowsFracturesMovesWeldsAndExactCuts) {

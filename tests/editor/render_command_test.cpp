@@ -1,6 +1,7 @@
 // `waxwork render` and `waxwork demo` end to end: the binary meshes, solves, renders and writes files.
 #include "editor/cli_run.h"
 #include "io/image_io.h"
+#include "solver/shading_surface.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -258,6 +259,22 @@ TEST_F(Render, PointLightInsideTheObjectLightsNothing) {
         for (int c = 0; c < 3; ++c) EXPECT_EQ(row.lo[c], 0);
 }
 
+// The cube's edges are creases: the summary counts the copies the image shades them with, and 180
+// degrees (one normal per vertex) makes none; the solve is the same either way.
+TEST_F(Render, CreaseAngleSplitsTheCubesEdgesForTheImageOnly) {
+    const std::string base = "render " + volume_.string() + " --width 64 --height 48 -o " + (dir_ / "crease.png").string();
+    const auto split = run_waxwork(base);
+    const auto unsplit = run_waxwork(base + " --crease-angle 180");
+    ASSERT_EQ(split.exit_code, 0) << split.err;
+    ASSERT_EQ(unsplit.exit_code, 0) << unsplit.err;
+    const auto a = nlohmann::json::parse(split.out), b = nlohmann::json::parse(unsplit.out);
+    EXPECT_EQ(a["crease_angle_deg"], kDefaultCreaseAngleDegrees);
+    EXPECT_GT(a["shading_copies"].get<int>(), 0);
+    EXPECT_EQ(b["shading_copies"], 0);
+    EXPECT_EQ(a["iterations"], b["iterations"]);
+    EXPECT_EQ(a["estimated_error"], b["estimated_error"]);
+}
+
 TEST_F(Render, BadInputIsAOneLineError) {
     const fs::path image = dir_ / "bad.png";
     const std::string base = "render " + volume_.string() + " -o " + image.string() + " --width 32 --height 24";
@@ -277,7 +294,9 @@ TEST_F(Render, BadInputIsAOneLineError) {
              {" --tol 1e-300", "--tol must be a relative tolerance in [1e-15, 1)"},
              {" --ambient 1e308", "--ambient must be non-negative and at most 1e100"},
              {" --light dir:1,0,0:1e308,1,1", "intensity must be non-negative and at most 1e100"},
-             {" --light point:1e308,0,0", "position has a non-finite component or one beyond 1e100"}}) {
+             {" --light point:1e308,0,0", "position has a non-finite component or one beyond 1e100"},
+             {" --crease-angle 181", "--crease-angle must be between 0 and 180 degrees"},
+             {" --crease-angle nan", "--crease-angle must be between 0 and 180 degrees"}}) {
         const auto r = run_waxwork(base + args);
         EXPECT_NE(r.exit_code, 0) << args;
         EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
