@@ -121,13 +121,6 @@ bool point_inside_volume(const TetMesh& mesh, const Eigen::Vector3d& point) {
     return false;
 }
 
-void shade_surface(SolvedScene& scene, const TriangleBvh& bvh, const Lighting& lighting,
-                   const std::vector<Rgb>& surface_q, const std::vector<float>& surface_visibility,
-                   double crease_angle_degrees) {
-    scene.shading = split_at_creases(scene.surface, crease_angle_degrees);
-    scene.shading_light = shading_light(scene.surface, scene.shading, bvh, lighting, surface_q, surface_visibility);
-}
-
 SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity,
                         const std::vector<TetMaterial>& materials, const Lighting& lighting,
                         const DiffusionOptions& options, double crease_angle_degrees) {
@@ -141,7 +134,8 @@ SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity
     std::vector<float> visibility;
     const std::vector<Rgb> surface_q = incident_light(scene.surface, bvh, lighting, &visibility);
     scene.q = to_volume_vertices(scene.surface, surface_q, mesh.vertex_count());
-    shade_surface(scene, bvh, lighting, surface_q, visibility, crease_angle_degrees);
+    scene.shading = split_at_creases(scene.surface, crease_angle_degrees);
+    scene.shading_light = shading_light(scene.surface, scene.shading, bvh, lighting, surface_q, visibility);
     scene.lighting_ms = milliseconds_since(lighting_start);
 
     scene.diffusion = solve_diffusion(mesh, connectivity, materials, scene.q, options);

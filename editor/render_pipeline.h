@@ -62,13 +62,6 @@ struct SolvedScene {
     double lighting_ms = 0;                            // surface extraction, shadow BVH, q and the shading's light
 };
 
-// Extracts nothing: splits `surface` at creases of more than `crease_angle_degrees` and lights the
-// copies (shading_light) from the surface's q and visibility. What solve_scene and the live scene do
-// after every change of the surface or the light.
-void shade_surface(SolvedScene& scene, const TriangleBvh& bvh, const Lighting& lighting,
-                   const std::vector<Rgb>& surface_q, const std::vector<float>& surface_visibility,
-                   double crease_angle_degrees);
-
 // Runs lighting, diffusion and radiance. Throws AlgorithmError when phi or E is not finite (never a
 // NaN image), InvalidArgumentError for bad materials, lights, options or crease angle.
 SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity,
