@@ -3,10 +3,12 @@
 // rays (the justification in solver/ray_caster.h).
 //
 //   build/bench/lighting_bench --benchmark_filter=Spot
+//   build/bench/lighting_bench --benchmark_filter='SplitAtCreases|ShadingLight' 
 #include "bench_main.h"
 #include "io/surface_reader.h"
 #include "solver/lighting.h"
 #include "solver/ray_caster.h"
+#include "solver/shading_surface.h"
 #include "tetops/connectivity.h"
 #include "tetops/tetrahedralize.h"
 
@@ -185,6 +187,33 @@ void BM_IncidentLight_SpotVolume500K(benchmark::State& state) {
     state.counters["boundary_vertices"] = static_cast<double>(surface.positions.size());
 }
 BENCHMARK(BM_IncidentLight_SpotVolume500K)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The image's shading at creases (solver/shading_surface.h), on the subdivided spot (its own 77-degree
+// folds at horn and ear tips survive subdivision): the split at the default angle and at 20 degrees
+// (many more copies), then the copies' light (their own shadow rays) from the surface's q.
+void BM_SplitAtCreases_Spot(benchmark::State& state) {
+    const double angle = static_cast<double>(state.range(0));
+    size_t copies = 0;
+    for (auto _ : state) {
+        const ShadingSurface shading = split_at_creases(spot(), angle);
+        copies = shading.size() - spot().positions.size();
+        benchmark::DoNotOptimize(shading.normals.data());
+    }
+    state.counters["copies"] = static_cast<double>(copies);
+}
+BENCHMARK(BM_SplitAtCreases_Spot)->Arg(40)->Arg(20)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_ShadingLight_Spot(benchmark::State& state) {
+    const double angle = static_cast<double>(state.range(0));
+    const TriangleBvh bvh = build_shadow_bvh(spot());
+    const Lighting lighting = key_light();
+    std::vector<float> visibility;
+    const std::vector<Rgb> q = incident_light(spot(), bvh, lighting, &visibility);
+    const ShadingSurface shading = split_at_creases(spot(), angle);
+    for (auto _ : state) benchmark::DoNotOptimize(shading_light(spot(), shading, bvh, lighting, q, visibility).q.data());
+    state.counters["split_copies"] = static_cast<double>(shading.split_copies.size());
+}
+BENCHMARK(BM_ShadingLight_Spot)->Arg(40)->Arg(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace waxwork

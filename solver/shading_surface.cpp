@@ -2,6 +2,7 @@
 
 #include "tetops/error.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -60,16 +61,19 @@ ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_an
     shading.triangles = surface.triangles;
     if (crease_angle_degrees >= 180.0) return shading;  // every pair of normals is within 180 degrees
 
-    // Twice-area normals: zero for a degenerate triangle, which then joins any fan it touches.
-    std::vector<Eigen::Vector3d> face_normal(surface.triangles.size());
+    // Twice-area normals (the fans' normals weigh them by area) and unit ones (the angle test); a
+    // degenerate triangle has a zero unit normal and joins any fan it touches.
+    std::vector<Eigen::Vector3d> face_normal(surface.triangles.size()), unit_normal(surface.triangles.size());
     tbb::parallel_for(size_t{0}, surface.triangles.size(), [&](size_t t) {
         const auto& [a, b, c] = surface.triangles[t];
         face_normal[t] = (surface.positions[b] - surface.positions[a]).cross(surface.positions[c] - surface.positions[a]);
+        const double length = face_normal[t].norm();
+        unit_normal[t] = length > 0 ? Eigen::Vector3d(face_normal[t] / length) : Eigen::Vector3d::Zero();
     });
     const double min_cos = std::cos(crease_angle_degrees * std::numbers::pi / 180.0);
     const auto smooth = [&](int32_t t, int32_t u) {
-        const double lengths = face_normal[t].norm() * face_normal[u].norm();
-        return !(lengths > 0) || face_normal[t].dot(face_normal[u]) >= min_cos * lengths;
+        return unit_normal[t].isZero(0.0) || unit_normal[u].isZero(0.0) ||
+               unit_normal[t].dot(unit_normal[u]) >= min_cos;
     };
 
     // Per vertex: the fans are the classes of "shares an edge through the vertex and is smooth with".
@@ -77,61 +81,78 @@ ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_an
     // non-manifold (two tets meeting at an edge or a vertex only), which a halfedge mesh cannot hold,
     // and because the renderer needs the map from each copy back to its surface vertex.
     const VertexTriangles fans = vertex_triangles(n, surface.triangles);
-    std::vector<int32_t> parent, fan_of;
-    std::vector<Eigen::Vector3d> fan_normal;
+    // Pass 1, parallel over vertices: the fan of each triangle around each vertex (corner_fan, aligned
+    // with fans.triangles), numbered by first triangle, and the fan count per vertex.
+    std::vector<int32_t> corner_fan(fans.triangles.size(), 0), fan_count(n, 1);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& range) {
+        std::vector<int32_t> parent, fan_of;
+        std::vector<std::array<int32_t, 2>> others;
+        for (size_t v = range.begin(); v != range.end(); ++v) {
+            const int32_t begin = fans.offsets[v], count = fans.offsets[v + 1] - begin;
+            if (count < 2) continue;
+            const int32_t* around = fans.triangles.data() + begin;
+            // The other two corners of each triangle around v: triangles sharing one share an edge with v.
+            others.resize(count);
+            for (int32_t i = 0; i < count; ++i) {
+                const auto& tri = surface.triangles[around[i]];
+                const int k = tri[0] == static_cast<int32_t>(v) ? 0 : tri[1] == static_cast<int32_t>(v) ? 1 : 2;
+                others[i] = {tri[(k + 1) % 3], tri[(k + 2) % 3]};
+            }
+            parent.resize(count);
+            std::iota(parent.begin(), parent.end(), 0);
+            for (int32_t i = 0; i < count; ++i) {
+                const auto& oi = others[i];
+                for (int32_t j = i + 1; j < count; ++j) {
+                    const auto& oj = others[j];
+                    const bool share_edge = oi[0] == oj[0] || oi[0] == oj[1] || oi[1] == oj[0] || oi[1] == oj[1];
+                    if (share_edge && smooth(around[i], around[j]))
+                        parent[find_root(parent, i)] = find_root(parent, j);
+                }
+            }
+            fan_of.assign(count, -1);
+            int32_t fans_here = 0;
+            for (int32_t i = 0; i < count; ++i) {
+                const int32_t root = find_root(parent, i);
+                if (fan_of[root] < 0) fan_of[root] = fans_here++;
+                corner_fan[begin + i] = fan_of[root];
+            }
+            fan_count[v] = fans_here;
+        }
+    });
+    // Where each split vertex's further copies start (after the surface's vertices, in vertex order).
+    std::vector<int32_t> first_copy(n, -1);
+    int32_t next = static_cast<int32_t>(n);
     for (size_t v = 0; v < n; ++v) {
-        const int32_t begin = fans.offsets[v], count = fans.offsets[v + 1] - begin;
-        if (count < 2) continue;
-        const int32_t* around = fans.triangles.data() + begin;
-        parent.resize(count);
-        std::iota(parent.begin(), parent.end(), 0);
-        // The other two corners of each triangle around v: triangles sharing one share an edge with v.
-        const auto others = [&](int32_t t) {
-            const auto& tri = surface.triangles[t];
-            const int k = tri[0] == static_cast<int32_t>(v) ? 0 : tri[1] == static_cast<int32_t>(v) ? 1 : 2;
-            return std::array<int32_t, 2>{tri[(k + 1) % 3], tri[(k + 2) % 3]};
-        };
-        for (int32_t i = 0; i < count; ++i) {
-            const auto oi = others(around[i]);
-            for (int32_t j = i + 1; j < count; ++j) {
-                const auto oj = others(around[j]);
-                const bool share_edge = oi[0] == oj[0] || oi[0] == oj[1] || oi[1] == oj[0] || oi[1] == oj[1];
-                if (share_edge && smooth(around[i], around[j]))
-                    parent[find_root(parent, i)] = find_root(parent, j);
-            }
-        }
-        // Fans numbered by their first triangle; the first keeps the surface vertex's index.
-        fan_of.assign(count, -1);
-        int32_t fan_count = 0;
-        for (int32_t i = 0; i < count; ++i) {
-            const int32_t root = find_root(parent, i);
-            if (fan_of[root] < 0) fan_of[root] = fan_count++;
-            fan_of[i] = fan_of[root];
-        }
-        if (fan_count == 1) continue;
-        fan_normal.assign(fan_count, Eigen::Vector3d::Zero());
-        for (int32_t i = 0; i < count; ++i) fan_normal[fan_of[i]] += face_normal[around[i]];
-        const int32_t first_copy = static_cast<int32_t>(shading.surface_vertex.size());
-        for (int32_t f = 0; f < fan_count; ++f) {
-            const double length = fan_normal[f].norm();
-            // A fan of degenerate triangles only has no normal of its own: it keeps the vertex's.
-            const Eigen::Vector3d normal = length > 0 ? Eigen::Vector3d(fan_normal[f] / length) : surface.normals[v];
-            const int32_t copy = f == 0 ? static_cast<int32_t>(v) : first_copy + f - 1;
-            if (f == 0) {
-                shading.normals[v] = normal;
-            } else {
-                shading.surface_vertex.push_back(static_cast<int32_t>(v));
-                shading.normals.push_back(normal);
-            }
-            shading.split_copies.push_back(copy);
-        }
-        for (int32_t i = 0; i < count; ++i) {
-            if (fan_of[i] == 0) continue;
-            auto& tri = shading.triangles[around[i]];
-            for (int32_t& corner : tri)
-                if (corner == static_cast<int32_t>(v)) corner = first_copy + fan_of[i] - 1;
-        }
+        if (fan_count[v] < 2) continue;
+        first_copy[v] = next;
+        shading.split_copies.push_back(static_cast<int32_t>(v));
+        for (int32_t f = 1; f < fan_count[v]; ++f) shading.split_copies.push_back(next++);
     }
+    shading.surface_vertex.resize(next);
+    shading.normals.resize(next);
+    // Pass 2, parallel over split vertices: their copies' normals and the triangles' corners. Each
+    // corner is written by its own vertex only.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& range) {
+        std::vector<Eigen::Vector3d> fan_normal;
+        for (size_t v = range.begin(); v != range.end(); ++v) {
+            if (fan_count[v] < 2) continue;
+            const int32_t begin = fans.offsets[v], count = fans.offsets[v + 1] - begin;
+            const auto copy = [&](int32_t f) { return f == 0 ? static_cast<int32_t>(v) : first_copy[v] + f - 1; };
+            fan_normal.assign(fan_count[v], Eigen::Vector3d::Zero());
+            for (int32_t i = 0; i < count; ++i) fan_normal[corner_fan[begin + i]] += face_normal[fans.triangles[begin + i]];
+            for (int32_t f = 0; f < fan_count[v]; ++f) {
+                const double length = fan_normal[f].norm();
+                // A fan of degenerate triangles only has no normal of its own: it keeps the vertex's.
+                shading.normals[copy(f)] = length > 0 ? Eigen::Vector3d(fan_normal[f] / length) : surface.normals[v];
+                shading.surface_vertex[copy(f)] = static_cast<int32_t>(v);
+            }
+            for (int32_t i = 0; i < count; ++i) {
+                if (corner_fan[begin + i] == 0) continue;
+                for (int32_t& corner : shading.triangles[fans.triangles[begin + i]])
+                    if (corner == static_cast<int32_t>(v)) corner = copy(corner_fan[begin + i]);
+            }
+        }
+    });
     std::sort(shading.split_copies.begin(), shading.split_copies.end());
     return shading;
 }
