@@ -144,6 +144,7 @@ std::shared_ptr<SceneCore> make_core(TetMesh mesh, Session setup, LiveSceneOptio
     core->document = std::make_shared<Document>(std::move(mesh), setup.material);
     live.mm_per_unit = setup.scale;
     live.relative_tolerance = setup.tolerance;
+    live.crease_angle_degrees = setup.crease_angle_degrees;
     core->live = std::make_shared<LiveScene>(core->document->mesh(), setup.lighting, live);
     core->setup = std::move(setup);
     return core;
@@ -167,6 +168,7 @@ void EditorApp::open_file(const fs::path& path) {
     setup.material = options_.material.value_or(material_preset("marble"));
     setup.scale = live_options_.mm_per_unit;
     setup.tolerance = live_options_.relative_tolerance;
+    setup.crease_angle_degrees = live_options_.crease_angle_degrees;
     setup.lighting = lighting_;
     setup.camera = options_.camera;
     setup.frame_iterations = frame_iterations_;
@@ -218,6 +220,7 @@ void EditorApp::install_core(std::shared_ptr<SceneCore> core, const fs::path& pa
     lighting_ = core->setup.lighting;
     live_options_.mm_per_unit = core->setup.scale;
     live_options_.relative_tolerance = core->setup.tolerance;
+    live_options_.crease_angle_degrees = core->setup.crease_angle_degrees;
     options_.camera = core->setup.camera;
     camera_.reset();
     current_file_ = path;
@@ -264,10 +267,12 @@ void EditorApp::save_session(const fs::path& path) {
     current.height = view_h_;
     current.frame_iterations = frame_iterations_;  // the budget as the panel has it now
     if (frame_budget_in_ms_) current.frame_ms = frame_ms_;
+    current.crease_angle_degrees = live_options_.crease_angle_degrees;
     queue_job("save session", [path, current](SceneCore& core) {
         Session setup = core.setup;
         setup.frame_iterations = current.frame_iterations;
         setup.frame_ms = current.frame_ms;
+        setup.crease_angle_degrees = current.crease_angle_degrees;
         setup.lighting = current.lighting;
         setup.camera = current.camera;
         setup.width = current.width;

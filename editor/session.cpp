@@ -261,6 +261,9 @@ Session parse_session(const Json& json, const fs::path& base_directory, const st
         const std::string problem = frame_ms_problem(*session.frame_ms);
         if (!problem.empty()) fail_json(in.field("frame_ms"), problem);
     }
+    session.crease_angle_degrees = in.number("crease_angle", session.crease_angle_degrees);
+    if (!(session.crease_angle_degrees >= 0 && session.crease_angle_degrees <= 180))
+        fail_json(in.field("crease_angle"), "must be between 0 and 180 degrees");
     const Json& steps = in.at("steps");
     if (!steps.is_array()) fail_json(in.field("steps"), "expected an array of steps");
     for (size_t i = 0; i < steps.size(); ++i)
@@ -293,6 +296,7 @@ Json session_to_json(const Session& session) {
     j["tolerance"] = session.tolerance;
     j["frame_iterations"] = session.frame_iterations;
     if (session.frame_ms) j["frame_ms"] = *session.frame_ms;
+    j["crease_angle"] = session.crease_angle_degrees;
     Json steps = Json::array();
     for (const SessionStep& step : session.steps) steps.push_back(step_to_json(step, session));
     j["steps"] = steps;
@@ -351,6 +355,7 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
     LiveSceneOptions scene_options;
     scene_options.mm_per_unit = session.scale;
     scene_options.relative_tolerance = session.tolerance;
+    scene_options.crease_angle_degrees = session.crease_angle_degrees;
     scene_options.method = run_options.method;
     scene_options.backend = run_options.backend;
     // One GL context for the whole session, created at the first render (or now, for the GPU solver,

@@ -16,6 +16,8 @@
 //     "frame_iterations": 10,              CG iterations per channel of one live frame
 //     "frame_ms": 10,                      optional: a live frame's time budget in ms instead (solver/
 //                                          frame_budget.h); renders after "frames" then vary with the machine
+//     "crease_angle": 40,                  optional: degrees in [0, 180] past which the image shades the
+//                                          surface as folded (solver/shading_surface.h; 180: never)
 //     "steps": [
 //       {"op": "plane_cut", ...},          any edit operation (edit_operation.h)
 //       {"render": "cut.png"},             a converged frame; {"render": "f.png", "frames": 3}: the frame
@@ -35,6 +37,7 @@
 #include "editor/live_solver.h"
 #include "editor/surface_renderer.h"
 #include "solver/lighting.h"
+#include "solver/shading_surface.h"
 #include "tetops/tet_mesh.h"
 #include "tetops/tetrahedralize.h"
 
@@ -90,6 +93,7 @@ struct Session {
     double tolerance = 1e-3;
     int frame_iterations = 10;
     std::optional<double> frame_ms;  // nullopt: frames are budgeted by frame_iterations
+    double crease_angle_degrees = kDefaultCreaseAngleDegrees;
     std::vector<SessionStep> steps;
 };
 

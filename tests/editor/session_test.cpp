@@ -1,4 +1,5 @@
 #include "editor/session.h"
+#include "io/image_io.h"
 #include "io/volume_file.h"
 #include "solver/material.h"
 #include "tetops/error.h"
@@ -100,6 +101,33 @@ TEST(Session, ErrorsNameTheFileAndTheStep) {
     e = session_error(R"({"input": {"volume": "v.vtu"}, "scale": 1e400, "steps": []})");  // no double holds it
     EXPECT_NE(e.find("bad.json: not valid JSON"), std::string::npos) << e;
     EXPECT_NE(e.find("1e400"), std::string::npos) << e;
+}
+
+// The crease angle is the session's: it round-trips, a bad one names the field, and it reaches the
+// rendered frames (a cube's edges shade as folded at 40 degrees and as one normal per vertex at 180).
+TEST(Session, CreaseAngleRoundTripsAndReachesTheFrames) {
+    const fs::path dir = scratch("crease");
+    write_volume(testing::make_cube_mesh(4), dir / "cube.vtu");
+    const auto session_with = [&](const std::string& angle) {
+        return parse_session(Json::parse(R"({"input": {"volume": "cube.vtu"}, "crease_angle": )" + angle +
+                                         R"(, "lights": [{"direction": [1, -1, -1]}], "ambient": [0.02, 0.02, 0.02],
+                                             "image": {"width": 96, "height": 72}, "steps": [{"render": "a.png"}]})"),
+                             dir, "s.json");
+    };
+    const Session folded = session_with("40"), round = session_with("180");
+    EXPECT_EQ(folded.crease_angle_degrees, 40.0);
+    EXPECT_EQ(parse_session(session_to_json(round), dir, "again").crease_angle_degrees, 180.0);
+    EXPECT_EQ(parse_session(Json::parse(R"({"input": {"volume": "cube.vtu"}, "steps": []})"), dir, "s.json")
+                  .crease_angle_degrees,
+              kDefaultCreaseAngleDegrees);
+    const std::string e = session_error(R"({"input": {"volume": "v.vtu"}, "crease_angle": 200, "steps": []})");
+    EXPECT_NE(e.find("bad.json: field 'crease_angle': must be between 0 and 180 degrees"), std::string::npos) << e;
+
+    run_session(folded, dir / "folded");
+    run_session(round, dir / "round");
+    const Image a = read_png(dir / "folded" / "a.png"), b = read_png(dir / "round" / "a.png");
+    ASSERT_EQ(a.rgba.size(), b.rgba.size());
+    EXPECT_NE(a.rgba, b.rgba);
 }
 
 TEST(Session, RunErrorsNameTheStep) {
