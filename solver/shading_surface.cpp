@@ -70,7 +70,10 @@ ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_an
         const double length = face_normal[t].norm();
         unit_normal[t] = length > 0 ? Eigen::Vector3d(face_normal[t] / length) : Eigen::Vector3d::Zero();
     });
-    const double min_cos = std::cos(crease_angle_degrees * std::numbers::pi / 180.0);
+    // Within rounding of the angle counts as under it: the two halves of a planar quad meet at a
+    // cosine of 1 - 1e-16 rather than 1, and at 0 degrees must still be one fan (1e-9 in the cosine
+    // is 0.003 degrees at 0).
+    const double min_cos = std::cos(crease_angle_degrees * std::numbers::pi / 180.0) - 1e-9;
     const auto smooth = [&](int32_t t, int32_t u) {
         return unit_normal[t].isZero(0.0) || unit_normal[u].isZero(0.0) ||
                unit_normal[t].dot(unit_normal[u]) >= min_cos;

@@ -51,7 +51,7 @@ struct ShadingSurface {
 
 // Splits `surface` at its creases. crease_angle_degrees in [0, 180]: 180 splits nothing (the surface's
 // own numbering, normals and triangles), 0 splits wherever neighbouring triangles are not coplanar
-// (faceted shading). Triangles of zero area join whichever fan they touch (they have no normal).
+// (faceted shading; coplanar within rounding, 1e-9 in the cosine, stays one fan). Triangles of zero area join whichever fan they touch (they have no normal).
 // Below 180, fans of a vertex that touch only at the vertex (two cones tip to tip) are copies too.
 // Throws InvalidArgumentError for an angle outside [0, 180] or NaN, and for triangles indexing outside
 // the surface.

@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -127,6 +129,18 @@ TEST(ShadingSurface, AStraightAngleSplitsNothingAndSmoothModelsKeepTheirNormals)
     size_t corners = 0;
     for (const auto& t : ball.triangles) corners += t.size();
     EXPECT_EQ(faceted.size(), corners);
+}
+
+// Coplanar triangles whose normals differ only by rounding (a cube turned by an arbitrary rotation)
+// stay one fan even at 0 degrees: the cube splits at 0 exactly as at 40.
+TEST(ShadingSurface, RoundingDoesNotSplitCoplanarTrianglesAtZeroDegrees) {
+    BoundarySurface cube = surface_of(test::make_cube_mesh(4));
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    for (Eigen::Vector3d& p : cube.positions) p = turn * p + Eigen::Vector3d(1e3, -2e3, 0.5);
+    cube.normals = area_weighted_normals(cube.positions, cube.triangles);
+    const ShadingSurface at_zero = split_at_creases(cube, 0.0), at_forty = split_at_creases(cube);
+    EXPECT_EQ(at_zero.surface_vertex, at_forty.surface_vertex);
+    EXPECT_EQ(at_zero.triangles, at_forty.triangles);
 }
 
 // A hand-made surface: vertex 0 at the centre of a flat fan of four triangles, one of them of zero
