@@ -188,7 +188,8 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--tol", options->tolerance, "Relative tolerance of the diffusion solve")->capture_default_str();
     cmd->add_option("--backend", options->backend,
                     "Diffusion solver: cpu, or gpu (float CG on OpenGL 4.3 compute shaders in the render context; "
-                    "falls back to the CPU with a warning when the driver cannot run it)")
+                    "falls back to the CPU with a warning when the driver cannot run it, and finishes in double on "
+                    "the CPU when float cannot reach --tol)")
         ->check(CLI::IsMember({"cpu", "gpu"}))
         ->capture_default_str();
     cmd->add_option("--scale", options->scale, "Millimetres per model unit (coefficients are per mm)")

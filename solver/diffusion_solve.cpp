@@ -274,7 +274,7 @@ void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std
     // channels (28 bytes per nonzero) no longer fit in that cache and the fused loop was measured
     // slower (bench/solver_bench.cpp, BM_JacobiCg<Double> vs 3x BM_JacobiCgDoubleOneChannel).
     std::array<ConjugateGradientResult, 3> results;
-    bool solved = false;
+    bool solved = false, gpu_stopped_short = false;
     solution.backend = SolverBackend::Cpu;
     solution.gpu_fallback_reason.clear();
     if (options.backend == SolverBackend::Gpu) {
@@ -287,9 +287,22 @@ void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std
             gpu_solver.set_right_hand_side(b);
             gpu_solver.set_solution(solution.phi);  // the warm start
             results = gpu_solver.solve(gpu);
-            solution.phi = gpu_solver.solution();
-            solution.backend = SolverBackend::Gpu;
-            solved = true;
+            solution.phi = gpu_solver.solution();  // also the CPU's warm start if it has to take over
+            solved = std::all_of(results.begin(), results.end(), [](const auto& r) { return r.converged; });
+            if (solved) {
+                solution.backend = SolverBackend::Gpu;
+            } else {
+                // Float CG cannot reach every tolerance on every volume (a tight one, or coefficients
+                // scaled to the edge of float's range); double CG on the CPU can, from where it stopped.
+                const auto worst = std::max_element(results.begin(), results.end(), [](const auto& a, const auto& b) {
+                    return a.estimated_relative_error < b.estimated_relative_error;
+                });
+                gpu_stopped_short = true;
+                std::ostringstream reason;
+                reason << "float CG on the GPU stopped at an estimated error of " << worst->estimated_relative_error
+                       << " (tolerance " << options.relative_tolerance << "): finished in double on the CPU";
+                solution.gpu_fallback_reason = reason.str();
+            }
         } catch (const GpuError& e) {
             solution.gpu_fallback_reason = e.what();
         }
@@ -297,7 +310,7 @@ void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std
     const bool float_path = options.precision == SolverPrecision::Float || solution.backend == SolverBackend::Gpu;
     if (solved) {
         // phi came from the GPU
-    } else if (options.precision == SolverPrecision::Float) {
+    } else if (options.precision == SolverPrecision::Float && !gpu_stopped_short) {
         results = solve_rgb<float>(matrix, b, options, solution.phi);
     } else {
         ConjugateGradientOptions cg;

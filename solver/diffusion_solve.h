@@ -26,8 +26,9 @@ enum class SolverPrecision {
 enum class SolverBackend {
     Cpu,
     // Jacobi CG in float on OpenGL 4.3 compute shaders (solver/gpu_conjugate_gradient.h), on the
-    // context of DiffusionOptions::gl. Falls back to the CPU when the GPU path cannot run (see
-    // DiffusionSolution::gpu_fallback_reason); `precision` does not apply (always float).
+    // context of DiffusionOptions::gl. Falls back to the CPU when the GPU path cannot run, and
+    // finishes in double on the CPU, from the GPU's phi, when float CG stops short of the tolerance
+    // (see DiffusionSolution::gpu_fallback_reason); `precision` does not apply (always float).
     Gpu,
 };
 

@@ -210,6 +210,24 @@ TEST_F(Render, GpuBackendAgreesWithTheCpuAndFallsBackWithAWarning) {
     EXPECT_EQ(line_count(fallback.err), 1u) << fallback.err;
     EXPECT_NE(fallback.err.find("warning: solving on the CPU instead"), std::string::npos) << fallback.err;
     EXPECT_NE(fallback.err.find("failed to compile"), std::string::npos) << fallback.err;
+
+    // A tolerance float CG cannot reach: the CPU finishes in double from the GPU's phi, with one
+    // warning line, and reaches the CPU's answer.
+    const auto tight = run_waxwork("render " + common + " --tol 1e-12 --backend gpu -o " + (dir_ / "t.png").string() +
+                                   " --fields " + (dir_ / "t.csv").string());
+    ASSERT_EQ(tight.exit_code, 0) << tight.err;
+    EXPECT_EQ(nlohmann::json::parse(tight.out)["backend"], "cpu");
+    EXPECT_EQ(line_count(tight.err), 1u) << tight.err;
+    EXPECT_NE(tight.err.find("float CG on the GPU stopped at an estimated error of"), std::string::npos) << tight.err;
+    const Fields t = read_fields(dir_ / "t.csv");
+    for (int ch = 0; ch < 3; ++ch) {
+        double diff = 0, peak = 0;
+        for (size_t v = 0; v < c.rows.size(); ++v) {
+            diff = std::max(diff, std::abs(c.rows[v].phi[ch] - t.rows[v].phi[ch]));
+            peak = std::max(peak, std::abs(c.rows[v].phi[ch]));
+        }
+        EXPECT_LT(diff / peak, 1e-6) << "channel " << ch;
+    }
 }
 
 TEST_F(Render, StoredMaterialsAreUsedWithoutAMaterialOption) {
