@@ -1,5 +1,7 @@
 #include "solver/shading_surface.h"
 
+#include "tetops/connectivity.h"
+#include "tetops/disjoint_sets.h"
 #include "tetops/error.h"
 
 #include <tbb/blocked_range.h>
@@ -9,36 +11,10 @@
 #include <cmath>
 #include <numbers>
 #include <numeric>
+#include <span>
 #include <string>
 
 namespace waxwork {
-namespace {
-
-// Triangles around each surface vertex (compressed rows), in triangle order.
-struct VertexTriangles {
-    std::vector<int32_t> offsets, triangles;
-};
-
-VertexTriangles vertex_triangles(size_t vertex_count, const std::vector<std::array<int32_t, 3>>& triangles) {
-    VertexTriangles fans;
-    fans.offsets.assign(vertex_count + 1, 0);
-    for (const auto& t : triangles)
-        for (const int32_t v : t) ++fans.offsets[v + 1];
-    std::partial_sum(fans.offsets.begin(), fans.offsets.end(), fans.offsets.begin());
-    fans.triangles.resize(fans.offsets.back());
-    std::vector<int32_t> cursor(fans.offsets.begin(), fans.offsets.end() - 1);
-    for (size_t t = 0; t < triangles.size(); ++t)
-        for (const int32_t v : triangles[t]) fans.triangles[cursor[v]++] = static_cast<int32_t>(t);
-    return fans;
-}
-
-// Union-find over the few triangles of one vertex (a dozen or so): by index, path halving.
-int32_t find_root(std::vector<int32_t>& parent, int32_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-}
-
-}  // namespace
 
 ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_angle_degrees) {
     if (!(crease_angle_degrees >= 0.0 && crease_angle_degrees <= 180.0))
@@ -83,17 +59,17 @@ ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_an
     // Written here rather than with OpenMesh's halfedge normals because the boundary of a tet mesh can be
     // non-manifold (two tets meeting at an edge or a vertex only), which a halfedge mesh cannot hold,
     // and because the renderer needs the map from each copy back to its surface vertex.
-    const VertexTriangles fans = vertex_triangles(n, surface.triangles);
+    const CompressedRows vertex_triangles = vertex_elements(surface.triangles, n);
     // Pass 1, parallel over vertices: the fan of each triangle around each vertex (corner_fan, aligned
-    // with fans.triangles), numbered by first triangle, and the fan count per vertex.
-    std::vector<int32_t> corner_fan(fans.triangles.size(), 0), fan_count(n, 1);
+    // with vertex_triangles.indices), numbered by first triangle, and the fan count per vertex.
+    std::vector<int32_t> corner_fan(vertex_triangles.indices.size(), 0), fan_count(n, 1);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 512), [&](const tbb::blocked_range<size_t>& range) {
-        std::vector<int32_t> parent, fan_of;
+        DisjointSets fans_around;  // over the triangles around one vertex, reused
         std::vector<std::array<int32_t, 2>> others;
         for (size_t v = range.begin(); v != range.end(); ++v) {
-            const int32_t begin = fans.offsets[v], count = fans.offsets[v + 1] - begin;
+            const int32_t begin = vertex_triangles.offsets[v], count = vertex_triangles.offsets[v + 1] - begin;
             if (count < 2) continue;
-            const int32_t* around = fans.triangles.data() + begin;
+            const int32_t* around = vertex_triangles.indices.data() + begin;
             // The other two corners of each triangle around v: triangles sharing one share an edge with v.
             others.resize(count);
             for (int32_t i = 0; i < count; ++i) {
@@ -101,25 +77,16 @@ ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_an
                 const int k = tri[0] == static_cast<int32_t>(v) ? 0 : tri[1] == static_cast<int32_t>(v) ? 1 : 2;
                 others[i] = {tri[(k + 1) % 3], tri[(k + 2) % 3]};
             }
-            parent.resize(count);
-            std::iota(parent.begin(), parent.end(), 0);
+            fans_around.reset(count);
             for (int32_t i = 0; i < count; ++i) {
                 const auto& oi = others[i];
                 for (int32_t j = i + 1; j < count; ++j) {
                     const auto& oj = others[j];
                     const bool share_edge = oi[0] == oj[0] || oi[0] == oj[1] || oi[1] == oj[0] || oi[1] == oj[1];
-                    if (share_edge && smooth(around[i], around[j]))
-                        parent[find_root(parent, i)] = find_root(parent, j);
+                    if (share_edge && smooth(around[i], around[j])) fans_around.unite(i, j);
                 }
             }
-            fan_of.assign(count, -1);
-            int32_t fans_here = 0;
-            for (int32_t i = 0; i < count; ++i) {
-                const int32_t root = find_root(parent, i);
-                if (fan_of[root] < 0) fan_of[root] = fans_here++;
-                corner_fan[begin + i] = fan_of[root];
-            }
-            fan_count[v] = fans_here;
+            fan_count[v] = fans_around.label_classes(std::span<int32_t>(corner_fan.data() + begin, count));
         }
     });
     // Where each split vertex's further copies start (after the surface's vertices, in vertex order).
@@ -139,10 +106,10 @@ ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_an
         std::vector<Eigen::Vector3d> fan_normal;
         for (size_t v = range.begin(); v != range.end(); ++v) {
             if (fan_count[v] < 2) continue;
-            const int32_t begin = fans.offsets[v], count = fans.offsets[v + 1] - begin;
+            const int32_t begin = vertex_triangles.offsets[v], count = vertex_triangles.offsets[v + 1] - begin;
             const auto copy = [&](int32_t f) { return f == 0 ? static_cast<int32_t>(v) : first_copy[v] + f - 1; };
             fan_normal.assign(fan_count[v], Eigen::Vector3d::Zero());
-            for (int32_t i = 0; i < count; ++i) fan_normal[corner_fan[begin + i]] += face_normal[fans.triangles[begin + i]];
+            for (int32_t i = 0; i < count; ++i) fan_normal[corner_fan[begin + i]] += face_normal[vertex_triangles.indices[begin + i]];
             for (int32_t f = 0; f < fan_count[v]; ++f) {
                 const double length = fan_normal[f].norm();
                 // A fan of degenerate triangles only has no normal of its own: it keeps the vertex's.
@@ -151,7 +118,7 @@ ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_an
             }
             for (int32_t i = 0; i < count; ++i) {
                 if (corner_fan[begin + i] == 0) continue;
-                for (int32_t& corner : shading.triangles[fans.triangles[begin + i]])
+                for (int32_t& corner : shading.triangles[vertex_triangles.indices[begin + i]])
                     if (corner == static_cast<int32_t>(v)) corner = copy(corner_fan[begin + i]);
             }
         }

@@ -1,5 +1,6 @@
 #include "tetops/connectivity.h"
 
+#include "tetops/disjoint_sets.h"
 #include "tetops/error.h"
 
 #include <tbb/parallel_for.h>
@@ -16,20 +17,6 @@ std::vector<int32_t> offsets_from_counts(const std::vector<int32_t>& counts) {
     std::vector<int32_t> offsets(counts.size() + 1, 0);
     std::inclusive_scan(counts.begin(), counts.end(), offsets.begin() + 1);
     return offsets;
-}
-
-// Vertex -> tets by counting sort; each row comes out sorted because tets are visited in order.
-CompressedRows build_vertex_tets(const TetMesh& mesh) {
-    std::vector<int32_t> counts(mesh.vertex_count(), 0);
-    for (const Tet& tet : mesh.tets)
-        for (int32_t v : tet) ++counts[v];
-    CompressedRows rows;
-    rows.offsets = offsets_from_counts(counts);
-    rows.indices.resize(rows.offsets.back());
-    std::vector<int32_t> cursor(rows.offsets.begin(), rows.offsets.end() - 1);
-    for (size_t t = 0; t < mesh.tets.size(); ++t)
-        for (int32_t v : mesh.tets[t]) rows.indices[cursor[v]++] = static_cast<int32_t>(t);
-    return rows;
 }
 
 // Face neighbours, each face matched exactly once at its smallest vertex: the faces of that vertex's
@@ -150,32 +137,14 @@ std::vector<BoundaryFace> build_boundary_faces(const TetMesh& mesh,
     return faces;
 }
 
-int32_t find_root(std::vector<int32_t>& parent, int32_t x) {
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];  // path halving
-        x = parent[x];
-    }
-    return x;
-}
-
 void label_components(const std::vector<std::array<int32_t, 4>>& neighbors, TetConnectivity& out) {
     const auto n = static_cast<int32_t>(neighbors.size());
-    std::vector<int32_t> parent(n);
-    std::iota(parent.begin(), parent.end(), 0);
+    DisjointSets components(n);
     for (int32_t t = 0; t < n; ++t)
         for (int32_t o : neighbors[t])
-            if (o > t) {
-                const int32_t a = find_root(parent, t), b = find_root(parent, o);
-                if (a != b) parent[std::max(a, b)] = std::min(a, b);  // the root stays the lowest tet
-            }
+            if (o > t) components.unite(t, o);
     out.tet_component.assign(n, -1);
-    std::vector<int32_t> label_of_root(n, -1);
-    out.component_count = 0;
-    for (int32_t t = 0; t < n; ++t) {
-        const int32_t root = find_root(parent, t);
-        if (label_of_root[root] < 0) label_of_root[root] = out.component_count++;
-        out.tet_component[t] = label_of_root[root];
-    }
+    out.component_count = components.label_classes(out.tet_component);  // numbered by lowest tet
 }
 
 void check_vertex_indices(const TetMesh& mesh) {
@@ -189,15 +158,32 @@ void check_vertex_indices(const TetMesh& mesh) {
 
 }  // namespace
 
+// Counting sort; each row comes out sorted because the elements are visited in order.
+template <size_t N>
+CompressedRows vertex_elements(const std::vector<std::array<int32_t, N>>& elements, size_t vertex_count) {
+    std::vector<int32_t> counts(vertex_count, 0);
+    for (const auto& element : elements)
+        for (int32_t v : element) ++counts[v];
+    CompressedRows rows;
+    rows.offsets = offsets_from_counts(counts);
+    rows.indices.resize(rows.offsets.back());
+    std::vector<int32_t> cursor(rows.offsets.begin(), rows.offsets.end() - 1);
+    for (size_t e = 0; e < elements.size(); ++e)
+        for (int32_t v : elements[e]) rows.indices[cursor[v]++] = static_cast<int32_t>(e);
+    return rows;
+}
+template CompressedRows vertex_elements(const std::vector<std::array<int32_t, 3>>&, size_t);
+template CompressedRows vertex_elements(const std::vector<std::array<int32_t, 4>>&, size_t);
+
 std::vector<std::array<int32_t, 4>> build_face_neighbors(const TetMesh& mesh) {
     check_vertex_indices(mesh);
-    return build_tet_neighbors(mesh, build_vertex_tets(mesh));
+    return build_tet_neighbors(mesh, vertex_elements(mesh.tets, mesh.vertex_count()));
 }
 
 TetConnectivity build_connectivity(const TetMesh& mesh) {
     check_vertex_indices(mesh);
     TetConnectivity c;
-    c.vertex_tets = build_vertex_tets(mesh);
+    c.vertex_tets = vertex_elements(mesh.tets, mesh.vertex_count());
     c.tet_neighbors = build_tet_neighbors(mesh, c.vertex_tets);
     build_edges_and_one_rings(mesh, c);
     c.boundary_faces = build_boundary_faces(mesh, c.tet_neighbors);

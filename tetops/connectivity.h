@@ -23,6 +23,11 @@ struct CompressedRows {
     }
 };
 
+// The elements (triangles, N = 3; tets, N = 4) around each vertex: row v lists, ascending, the
+// elements that name v. Indices must lie in [0, vertex_count).
+template <size_t N>
+CompressedRows vertex_elements(const std::vector<std::array<int32_t, N>>& elements, size_t vertex_count);
+
 // A triangle on the boundary of the volume, oriented counter-clockwise seen from outside.
 struct BoundaryFace {
     std::array<int32_t, 3> vertices;

@@ -2,6 +2,7 @@
 
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
+#include "tetops/disjoint_sets.h"
 #include "tetops/error.h"
 #include "tetops/exact_cut.h"
 #include "tetops/quality.h"
@@ -32,23 +33,6 @@ struct PointCloud {
 };
 using KdTree =
     nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloud>, PointCloud, 3, uint32_t>;
-
-// Union-find with path halving; unions keep the smaller index as the root so results are deterministic.
-class DisjointSets {
-public:
-    explicit DisjointSets(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-    int32_t find(int32_t x) {
-        while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
-        return x;
-    }
-    void unite(int32_t a, int32_t b) {
-        a = find(a), b = find(b);
-        if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-    }
-
-private:
-    std::vector<int32_t> parent_;
-};
 
 Eigen::Vector3d tet_centroid(const std::vector<Eigen::Vector3d>& points, const Tet& tet) {
     return 0.25 * (points[tet[0]] + points[tet[1]] + points[tet[2]] + points[tet[3]]);
