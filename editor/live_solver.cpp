@@ -152,8 +152,7 @@ struct LiveSolver::Gpu {
     // Device radiance per shading vertex, with the rows, eta and q it was built and lit with: rebuilt
     // or re-lit when those differ (a new surface or shading, a painted eta, a new light).
     std::unique_ptr<GpuRadiance> radiance;
-    std::vector<int32_t> radiance_rows;
-    std::vector<double> radiance_eta;
+    RadianceRows radiance_rows;
     std::vector<std::array<double, 3>> radiance_q;
 
     size_t size() const { return solver ? solver->size() : multigrid ? multigrid->size() : multires->size(); }
@@ -797,28 +796,17 @@ std::shared_ptr<const GpuBuffer> LiveSolver::radiance_on_device(const BoundarySu
                                                                 std::vector<std::array<float, 3>>* host_copy) {
     if (backend_ != LiveBackend::Gpu || !gpu_ || !context_ || shading.size() == 0) return nullptr;
     const size_t n = gpu_->size(), m = shading.size();
-    if (shading_q.size() != m || surface.eta.size() != surface.vertices.size())
+    if (shading_q.size() != m)
         throw InvalidArgumentError("live solver: radiance_on_device needs one light value per shading vertex");
-    std::vector<int32_t> rows(m);
-    std::vector<double> eta(m);
-    for (size_t d = 0; d < m; ++d) {
-        const int32_t s = shading.surface_vertex[d];
-        if (s < 0 || static_cast<size_t>(s) >= surface.vertices.size() || surface.vertices[s] < 0 ||
-            static_cast<size_t>(surface.vertices[s]) >= n)
-            throw InvalidArgumentError("live solver: shading vertex " + std::to_string(d) +
-                                       " is not a vertex of the solved matrix");
-        rows[d] = surface.vertices[s];
-        eta[d] = surface.eta[s];
-    }
+    RadianceRows rows = shading_radiance_rows(surface, shading);
     try {
         const CurrentContext current(*context_);
         const GlApi& gl = context_->gl();
         GpuKernels& kernels = gpu_->kernels();
-        if (!gpu_->radiance || gpu_->radiance_rows != rows || gpu_->radiance_eta != eta) {
+        if (!gpu_->radiance || gpu_->radiance_rows != rows) {
             gpu_->radiance.reset();  // frees its buffers with the context current
-            gpu_->radiance = std::make_unique<GpuRadiance>(kernels, rows, eta, n);
+            gpu_->radiance = std::make_unique<GpuRadiance>(kernels, rows, n);
             gpu_->radiance_rows = std::move(rows);
-            gpu_->radiance_eta = std::move(eta);
             gpu_->radiance_q.clear();
         }
         if (gpu_->radiance_q != shading_q) {

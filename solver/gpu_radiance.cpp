@@ -8,25 +8,25 @@
 #include <string>
 
 namespace waxwork {
-namespace {
-
-std::vector<int32_t> shading_row_vertices(const BoundarySurface& surface, const ShadingSurface& shading) {
-    std::vector<int32_t> rows(shading.size());
-    for (size_t d = 0; d < rows.size(); ++d) rows[d] = surface.vertices.at(shading.surface_vertex[d]);
+RadianceRows shading_radiance_rows(const BoundarySurface& surface, const ShadingSurface& shading) {
+    RadianceRows rows;
+    rows.vertex.resize(shading.size());
+    rows.eta.resize(shading.size());
+    for (size_t d = 0; d < shading.size(); ++d) {
+        const int32_t s = shading.surface_vertex[d];
+        if (s < 0 || static_cast<size_t>(s) >= surface.vertices.size() || surface.eta.size() != surface.vertices.size())
+            throw InvalidArgumentError("GPU radiance: shading vertex " + std::to_string(d) +
+                                       " copies no vertex of the surface");
+        rows.vertex[d] = surface.vertices[s];
+        rows.eta[d] = surface.eta[s];
+    }
     return rows;
 }
 
-std::vector<double> shading_row_eta(const BoundarySurface& surface, const ShadingSurface& shading) {
-    std::vector<double> eta(shading.size());
-    for (size_t d = 0; d < eta.size(); ++d) eta[d] = surface.eta.at(shading.surface_vertex[d]);
-    return eta;
-}
-
-}  // namespace
-
-GpuRadiance::GpuRadiance(GpuKernels& kernels, const std::vector<int32_t>& row_vertex,
-                         const std::vector<double>& row_eta, size_t phi_rows)
-    : kernels_(&kernels), rows_(row_vertex.size()), phi_rows_(phi_rows) {
+GpuRadiance::GpuRadiance(GpuKernels& kernels, const RadianceRows& rows, size_t phi_rows)
+    : kernels_(&kernels), rows_(rows.vertex.size()), phi_rows_(phi_rows) {
+    const std::vector<int32_t>& row_vertex = rows.vertex;
+    const std::vector<double>& row_eta = rows.eta;
     if (row_eta.size() != rows_)
         throw InvalidArgumentError("GPU radiance: " + std::to_string(row_eta.size()) + " eta values for " +
                                    std::to_string(rows_) + " rows");
@@ -50,10 +50,6 @@ GpuRadiance::GpuRadiance(GpuKernels& kernels, const std::vector<int32_t>& row_ve
     q_ = kernels.vector(rows_);
     row_phi_ = kernels.vector(rows_);
 }
-
-GpuRadiance::GpuRadiance(GpuKernels& kernels, const BoundarySurface& surface, const ShadingSurface& shading,
-                         size_t phi_rows)
-    : GpuRadiance(kernels, shading_row_vertices(surface, shading), shading_row_eta(surface, shading), phi_rows) {}
 
 void GpuRadiance::set_light(const std::vector<std::array<double, 3>>& q) {
     if (q.size() != rows_)

@@ -17,15 +17,22 @@
 
 namespace waxwork {
 
+// What each row of E reads: row r takes phi at volume vertex `vertex[r]` with relative index `eta[r]`.
+struct RadianceRows {
+    std::vector<int32_t> vertex;
+    std::vector<double> eta;
+    bool operator==(const RadianceRows&) const = default;
+};
+
+// The rows of the shading vertices of `surface` split as `shading`: each copy reads its surface
+// vertex's volume vertex and eta. Throws InvalidArgumentError for a copy of no surface vertex.
+RadianceRows shading_radiance_rows(const BoundarySurface& surface, const ShadingSurface& shading);
+
 class GpuRadiance {
 public:
-    // Row r reads phi at volume vertex row_vertex[r] (< phi_rows) with relative index row_eta[r].
-    // Throws InvalidArgumentError for mismatched sizes, a vertex out of range or an eta that is not
-    // finite and at least 1.
-    GpuRadiance(GpuKernels& kernels, const std::vector<int32_t>& row_vertex, const std::vector<double>& row_eta,
-                size_t phi_rows);
-    // The shading vertices of `surface` split as `shading`, for phi over `phi_rows` volume vertices.
-    GpuRadiance(GpuKernels& kernels, const BoundarySurface& surface, const ShadingSurface& shading, size_t phi_rows);
+    // E at `rows`, for phi over `phi_rows` volume vertices. Throws InvalidArgumentError for mismatched
+    // sizes, a vertex out of range or an eta that is not finite and at least 1.
+    GpuRadiance(GpuKernels& kernels, const RadianceRows& rows, size_t phi_rows);
 
     // q per row, uploaded once per lighting change.
     void set_light(const std::vector<std::array<double, 3>>& q);

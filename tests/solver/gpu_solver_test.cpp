@@ -357,7 +357,7 @@ TEST(GpuRadiance, ExitantRadianceFactorsMatchTheCpuPerShadingVertex) {
         const double scale = d < surface.vertices.size() ? 1.0 : 0.25;
         for (int c = 0; c < 3; ++c) q[d][c] = scale * vertex_q[c];
     }
-    GpuRadiance radiance(solver.kernels(), surface, shading, s.matrix.size());
+    GpuRadiance radiance(solver.kernels(), shading_radiance_rows(surface, shading), s.matrix.size());
     ASSERT_EQ(radiance.size(), shading.size());
     radiance.set_light(q);
     for (const bool clamp : {true, false}) {
@@ -375,10 +375,17 @@ TEST(GpuRadiance, ExitantRadianceFactorsMatchTheCpuPerShadingVertex) {
         EXPECT_LT(diff, 1e-5 * peak) << (clamp ? "clamped" : "unclamped");
     }
     // Rows that read no vertex of phi, or whose eta no material has, are refused.
-    EXPECT_THROW(GpuRadiance(solver.kernels(), {0, static_cast<int32_t>(s.matrix.size())}, {1.3, 1.3}, s.matrix.size()),
+    const auto rows = [](std::vector<int32_t> vertex, std::vector<double> eta) {
+        return RadianceRows{std::move(vertex), std::move(eta)};
+    };
+    EXPECT_THROW(GpuRadiance(solver.kernels(), rows({0, static_cast<int32_t>(s.matrix.size())}, {1.3, 1.3}),
+                             s.matrix.size()),
                  InvalidArgumentError);
-    EXPECT_THROW(GpuRadiance(solver.kernels(), {0}, {std::nan("")}, s.matrix.size()), InvalidArgumentError);
-    EXPECT_THROW(GpuRadiance(solver.kernels(), {0, 1}, {1.3}, s.matrix.size()), InvalidArgumentError);
+    EXPECT_THROW(GpuRadiance(solver.kernels(), rows({0}, {std::nan("")}), s.matrix.size()), InvalidArgumentError);
+    EXPECT_THROW(GpuRadiance(solver.kernels(), rows({0, 1}, {1.3}), s.matrix.size()), InvalidArgumentError);
+    ShadingSurface stray = shading;
+    stray.surface_vertex.back() = static_cast<int32_t>(surface.vertices.size());
+    EXPECT_THROW(shading_radiance_rows(surface, stray), InvalidArgumentError);
 }
 
 // WAXWORK_GL_DEVICE=egl: the path to a real GPU without a display. Here EGL finds llvmpipe again
