@@ -40,10 +40,7 @@ LiveScene::LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSc
         throw InvalidArgumentError("live scene: mm_per_unit must be positive");
     if (!(options.relative_tolerance > 0) || !(options.relative_tolerance < 1))
         throw InvalidArgumentError("live scene: the relative tolerance must be in (0, 1)");
-    validate(lighting_);
-    if (!(options.crease_angle_degrees >= 0 && options.crease_angle_degrees <= 180))
-        throw InvalidArgumentError("live scene: crease angle " + number_text(options.crease_angle_degrees) +
-                                   " degrees: must be between 0 and 180");
+    validate(lighting_);  // the crease angle is checked by the first split_at_creases
     check_materials(mesh);
     solver_ = std::make_unique<LiveSolver>(
         LiveSolverOptions{options.method, options.backend, options.gl_context, options.clock, options.multigrid});
@@ -67,21 +64,23 @@ void LiveScene::rebuild_surface(SceneUpdate& update) {
 void LiveScene::relight(SceneUpdate& update) {
     surface_q_ = incident_light(surface_, shadow_bvh_, lighting_, &surface_visibility_);
     q_ = to_volume_vertices(surface_, surface_q_, matrix_.size());  // a row per vertex
-    shading_light_ = shading_light(surface_, shading_, shadow_bvh_, lighting_, surface_q_, surface_visibility_);
+    light_shading();
     update.recomputed_light = true;
     refresh_right_hand_sides();
 }
 
+void LiveScene::light_shading() {
+    shading_light_ = shading_light(surface_, shading_, shadow_bvh_, lighting_, surface_q_, surface_visibility_);
+}
+
 void LiveScene::set_crease_angle(double degrees) {
-    if (!(degrees >= 0 && degrees <= 180))
-        throw InvalidArgumentError("live scene: crease angle " + number_text(degrees) +
-                                   " degrees: must be between 0 and 180");
     const std::lock_guard lock(mutex_);
     if (degrees == options_.crease_angle_degrees) return;
-    options_.crease_angle_degrees = degrees;
-    // The image only: the solve's q, matrix and phi do not depend on it.
+    // The image only: the solve's q, matrix and phi do not depend on it. Split first: a bad angle
+    // throws before anything changes.
     shading_ = split_at_creases(surface_, degrees);
-    shading_light_ = shading_light(surface_, shading_, shadow_bvh_, lighting_, surface_q_, surface_visibility_);
+    options_.crease_angle_degrees = degrees;
+    light_shading();
 }
 
 void LiveScene::refresh_right_hand_sides() {
@@ -185,8 +184,7 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
                 // included), not on the whole surface.
                 update_incident_light(surface_, shadow_bvh_, lighting_, changed, surface_q_);
                 for (const int32_t s : changed) q_[surface_.vertices[s]] = surface_q_[s];
-                shading_light_ =
-                    shading_light(surface_, shading_, shadow_bvh_, lighting_, surface_q_, surface_visibility_);
+                light_shading();
                 update.recomputed_light = true;
             }
         }

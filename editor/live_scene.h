@@ -177,6 +177,8 @@ private:
                      std::span<const int32_t> new_of_old_vertex = {});
     void rebuild_surface(SceneUpdate& update);
     void relight(SceneUpdate& update);
+    // q and visibility of the shading's copies from the surface's (after either changed).
+    void light_shading();
     void refresh_right_hand_sides();
     void mark_unconverged();
     // `time_budget` (optional) replaces the iteration budget.

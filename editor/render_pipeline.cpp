@@ -132,7 +132,6 @@ SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity
                         const DiffusionOptions& options, double crease_angle_degrees) {
     SolvedScene scene;
     const auto lighting_start = std::chrono::steady_clock::now();
-    validate(lighting);
     // The surface and its shadow BVH are built once and shared by the lighting of the solve, the
     // shading's copies and the renderer.
     scene.surface = extract_boundary_surface(mesh, connectivity, materials);
