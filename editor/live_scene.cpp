@@ -63,7 +63,6 @@ void LiveScene::rebuild_surface(SceneUpdate& update) {
 
 void LiveScene::relight(SceneUpdate& update) {
     surface_q_ = incident_light(surface_, shadow_bvh_, lighting_, &surface_visibility_);
-    q_ = to_volume_vertices(surface_, surface_q_, matrix_.size());  // a row per vertex
     light_shading();
     update.recomputed_light = true;
     refresh_right_hand_sides();
@@ -71,16 +70,22 @@ void LiveScene::relight(SceneUpdate& update) {
 
 void LiveScene::light_shading() {
     shading_light_ = shading_light(surface_, shading_, shadow_bvh_, lighting_, surface_q_, surface_visibility_);
+    q_ = to_volume_vertices(surface_, source_light(surface_, shading_, shading_light_.q), matrix_.size());
 }
 
-void LiveScene::set_crease_angle(double degrees) {
+SceneUpdate LiveScene::set_crease_angle(double degrees) {
     const std::lock_guard lock(mutex_);
-    if (degrees == options_.crease_angle_degrees) return;
-    // The image only: the solve's q, matrix and phi do not depend on it. Split first: a bad angle
-    // throws before anything changes.
+    const auto start = std::chrono::steady_clock::now();
+    SceneUpdate update;
+    if (degrees == options_.crease_angle_degrees) return update;
+    // Split first: a bad angle throws before anything changes.
     shading_ = split_at_creases(surface_, degrees);
     options_.crease_angle_degrees = degrees;
     light_shading();
+    update.recomputed_light = true;
+    refresh_right_hand_sides();
+    update.milliseconds = milliseconds_since(start);
+    return update;
 }
 
 void LiveScene::refresh_right_hand_sides() {
@@ -183,7 +188,6 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
                 // Only those vertices' Fresnel transmittance changed: recompute q there (shadow rays
                 // included), not on the whole surface.
                 update_incident_light(surface_, shadow_bvh_, lighting_, changed, surface_q_);
-                for (const int32_t s : changed) q_[surface_.vertices[s]] = surface_q_[s];
                 light_shading();
                 update.recomputed_light = true;
             }

@@ -112,9 +112,11 @@ public:
     // After Document::apply/undo/redo changed `mesh` (the document's mesh, same object or not).
     SceneUpdate apply_change(const TetMesh& mesh, const ChangeReport& change);
     SceneUpdate set_lighting(const Lighting& lighting);
-    // Splits the shading at creases of more than `degrees` from now on (the image only; phi, q and the
-    // matrix are untouched). Throws InvalidArgumentError outside [0, 180].
-    void set_crease_angle(double degrees);
+    // Splits the surface at creases of more than `degrees` from now on: the image shades each side as
+    // itself, and the solve's q integrates each side's light (source_light), so the right-hand sides
+    // change and the solve goes on warm from the current phi, as after a light change (the matrix is
+    // untouched). Throws InvalidArgumentError outside [0, 180], before anything changes.
+    SceneUpdate set_crease_angle(double degrees);
 
     // At most `iteration_budget` CG iterations per channel, from the current phi. Channels already
     // within the tolerance are not iterated (an idle scene costs nothing).
@@ -177,7 +179,8 @@ private:
                      std::span<const int32_t> new_of_old_vertex = {});
     void rebuild_surface(SceneUpdate& update);
     void relight(SceneUpdate& update);
-    // q and visibility of the shading's copies from the surface's (after either changed).
+    // q and visibility of the shading's copies from the surface's (after either changed), and the
+    // solve's q from the copies' (source_light); the caller refreshes the right-hand sides.
     void light_shading();
     void refresh_right_hand_sides();
     void mark_unconverged();

@@ -197,8 +197,8 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--ambient", options->ambient, "Ambient irradiance added to every boundary vertex")
         ->capture_default_str();
     cmd->add_option("--crease-angle", options->crease_angle,
-                    "Shade the surface as folded where neighbouring triangles turn by more than this many "
-                    "degrees (box edges, cut rims); 180 shades every vertex with one averaged normal")
+                    "Shade and light the surface as folded where neighbouring triangles turn by more than "
+                    "this many degrees (box edges, cut rims); 180 uses one averaged normal per vertex")
         ->capture_default_str();
     cmd->add_option("--view", options->view, "Direction from the object towards the camera, X,Y,Z")
         ->delimiter(',')

@@ -138,9 +138,10 @@ SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity
     const TriangleBvh bvh = lighting.shadows ? build_shadow_bvh(scene.surface) : TriangleBvh();
     std::vector<float> visibility;
     const std::vector<Rgb> surface_q = incident_light(scene.surface, bvh, lighting, &visibility);
-    scene.q = to_volume_vertices(scene.surface, surface_q, mesh.vertex_count());
     scene.shading = split_at_creases(scene.surface, crease_angle_degrees);
     scene.shading_light = shading_light(scene.surface, scene.shading, bvh, lighting, surface_q, visibility);
+    scene.q = to_volume_vertices(scene.surface, source_light(scene.surface, scene.shading, scene.shading_light.q),
+                                 mesh.vertex_count());
     scene.lighting_ms = milliseconds_since(lighting_start);
 
     scene.diffusion = solve_diffusion(mesh, connectivity, materials, scene.q, options);
@@ -252,7 +253,8 @@ void write_fields_csv(const std::filesystem::path& path, const TetMesh& mesh, co
             const bool boundary = connectivity.is_boundary_vertex[v] != 0;
             const Rgb& q = scene.q[v];
             const auto& phi = scene.diffusion.phi[v];
-            // lo: exitant_radiance along the vertex's (averaged) normal, from the q the solve used.
+            // lo: exitant_radiance along the vertex's (averaged) normal, from the q the solve used (at a
+            // crease, its sides' light weighed by their areas; the image shades each side with its own).
             double lo[3] = {0, 0, 0};
             if (boundary)
                 for (int c = 0; c < 3; ++c) lo[c] = exitant_radiance(phi[c], q[c], eta[v], 1.0);

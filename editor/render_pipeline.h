@@ -56,7 +56,7 @@ struct SolvedScene {
     // the shadow rays' visibility per shading vertex (the renderer shadows each light's highlight by it).
     ShadingSurface shading;
     ShadingLight shading_light;
-    std::vector<Rgb> q;                                // incident diffuse light per volume vertex (0 inside): the solve's
+    std::vector<Rgb> q;                                // the solve's light per volume vertex (0 inside): source_light
     DiffusionSolution diffusion;                       // phi per volume vertex and solver statistics
     std::vector<std::array<float, 3>> radiance_factor; // E per shading vertex (shading_radiance_factors)
     double lighting_ms = 0;                            // surface extraction, shadow BVH, q and the shading's light

@@ -16,8 +16,8 @@
 //     "frame_iterations": 10,              CG iterations per channel of one live frame
 //     "frame_ms": 10,                      optional: a live frame's time budget in ms instead (solver/
 //                                          frame_budget.h); renders after "frames" then vary with the machine
-//     "crease_angle": 40,                  optional: degrees in [0, 180] past which the image shades the
-//                                          surface as folded (solver/shading_surface.h; 180: never)
+//     "crease_angle": 40,                  optional: degrees in [0, 180] past which the surface is shaded
+//                                          and lit as folded (solver/shading_surface.h; 180: never)
 //     "steps": [
 //       {"op": "plane_cut", ...},          any edit operation (edit_operation.h)
 //       {"render": "cut.png"},             a converged frame; {"render": "f.png", "frames": 3}: the frame

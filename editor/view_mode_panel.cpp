@@ -107,7 +107,8 @@ void EditorApp::draw_view_mode_panel() {
             view_dirty_ = true;
         }
     }
-    // Where the surface shades as folded (solver/shading_surface.h): the image only, so the solve goes on.
+    // Where the surface folds (solver/shading_surface.h): each side is shaded and lit as itself, so the
+    // right-hand sides change and the solve goes on warm, as after a light change.
     float crease = static_cast<float>(live_options_.crease_angle_degrees);
     if (ImGui::SliderFloat("crease angle", &crease, 0.0f, 180.0f, "%.0f deg")) {
         live_options_.crease_angle_degrees = std::clamp(static_cast<double>(crease), 0.0, 180.0);
@@ -115,12 +116,12 @@ void EditorApp::draw_view_mode_panel() {
         if (scene_->core)
             queue_job("crease angle", [degrees](SceneCore& core) {
                 core.live->set_crease_angle(degrees);
-                return "Shading split where the surface folds by more than " + number_text(degrees) + " degrees";
+                return "Surface split where it folds by more than " + number_text(degrees) + " degrees";
             });
     }
     if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("Box edges and cut rims shade as folded where neighbouring triangles turn by more than\n"
-                          "this; 180 shades every vertex with one averaged normal");
+        ImGui::SetTooltip("Box edges and cut rims are shaded and lit as folded where neighbouring triangles turn\n"
+                          "by more than this; 180 uses one averaged normal per vertex");
     if (view_options_.mode != ViewMode::Radiance) {
         if (view_geometry_ && view_geometry_->mode == view_options_.mode) {
             draw_legend(view_geometry_->legend);

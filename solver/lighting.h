@@ -102,7 +102,10 @@ void update_incident_light(const BoundarySurface& surface, const TriangleBvh& bv
 std::vector<Rgb> incident_light(const BoundarySurface& surface, const Lighting& lighting,
                                 std::vector<float>* visibility = nullptr);
 
-// q per volume vertex (zero at interior vertices): the form solve_diffusion takes.
+// q per volume vertex (zero at interior vertices), with one averaged normal per vertex: the form
+// solve_diffusion takes, and the fixed systems the solver benchmarks and tests solve. The scenes
+// Waxwork renders and edits integrate the light per crease fan instead (shading_surface.h:
+// source_light), which differs only at vertices where the surface folds by more than the crease angle.
 std::vector<Rgb> incident_light(const TetMesh& mesh, const TetConnectivity& connectivity,
                                 const std::vector<TetMaterial>& materials, const Lighting& lighting);
 

@@ -162,4 +162,49 @@ ShadingLight shading_light(const BoundarySurface& surface, const ShadingSurface&
     return light;
 }
 
+std::vector<Rgb> source_light(const BoundarySurface& surface, const ShadingSurface& shading,
+                              const std::vector<Rgb>& shading_q) {
+    const size_t n = surface.positions.size();
+    if (shading_q.size() != shading.size() || shading.size() < n || shading.triangles.size() != surface.triangles.size())
+        throw InvalidArgumentError("source_light: " + std::to_string(shading_q.size()) + " light values, " +
+                                   std::to_string(shading.size()) + " shading vertices and " +
+                                   std::to_string(shading.triangles.size()) + " shading triangles for a surface of " +
+                                   std::to_string(n) + " vertices and " + std::to_string(surface.triangles.size()) +
+                                   " triangles");
+    std::vector<Rgb> q(shading_q.begin(), shading_q.begin() + static_cast<std::ptrdiff_t>(n));
+    if (shading.split_copies.empty()) return q;
+
+    // The fans' areas (the lumped S_f / 3 per corner; the 1/3 cancels in the mean). Only copies of
+    // split vertices are read, so only triangles with such a corner are measured: along creases.
+    std::vector<uint8_t> split(shading.size(), 0);
+    for (const int32_t copy : shading.split_copies) split[static_cast<size_t>(copy)] = 1;
+    std::vector<double> fan_area(shading.size(), 0.0);
+    for (size_t t = 0; t < shading.triangles.size(); ++t) {
+        const auto& corners = shading.triangles[t];
+        if (!split[static_cast<size_t>(corners[0])] && !split[static_cast<size_t>(corners[1])] &&
+            !split[static_cast<size_t>(corners[2])])
+            continue;
+        const auto& [a, b, c] = surface.triangles[t];
+        const double area =
+            0.5 * (surface.positions[b] - surface.positions[a]).cross(surface.positions[c] - surface.positions[a]).norm();
+        for (const int32_t copy : corners) fan_area[static_cast<size_t>(copy)] += area;
+    }
+    // Every copy of a split vertex is listed, the first one being the vertex itself (< n).
+    std::vector<Rgb> weighted(n, Rgb{0, 0, 0});
+    std::vector<double> area(n, 0.0);
+    for (const int32_t copy : shading.split_copies) {
+        const auto s = static_cast<size_t>(shading.surface_vertex[copy]);
+        const double w = fan_area[static_cast<size_t>(copy)];
+        for (int ch = 0; ch < 3; ++ch) weighted[s][ch] += w * shading_q[static_cast<size_t>(copy)][ch];
+        area[s] += w;
+    }
+    for (const int32_t copy : shading.split_copies) {
+        if (static_cast<size_t>(copy) >= n) continue;  // each split vertex once, at its first copy
+        const auto s = static_cast<size_t>(copy);
+        if (area[s] > 0)  // else only degenerate triangles: no area to weigh by, keep the first copy's q
+            for (int ch = 0; ch < 3; ++ch) q[s][ch] = weighted[s][ch] / area[s];
+    }
+    return q;
+}
+
 }  // namespace waxwork

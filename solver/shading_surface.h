@@ -11,8 +11,11 @@
 // copies, q, the shadow visibility, E and the highlight are evaluated per fan (shading_light below,
 // radiance.h: shading_radiance_factors), so each face shades as itself up to its edge.
 //
-// The diffusion solve keeps its one q per vertex: its right-hand side weighs q by the vertex's whole
-// boundary area (Eq. 12), to which the split adds nothing the image needs.
+// The diffusion solve integrates the same light fan by fan (source_light below): its right-hand side
+// weighs q_i by the boundary area S_i of vertex i (Eq. 12), and at a crease that area lies on both
+// sides, so q evaluated once with the averaged normal over-lights the rim of a lit face and lights
+// the rim of a face turned away (on a cube lit head-on, q at 45 degrees over a third of each edge
+// vertex's area instead of q at 0 and nothing).
 #pragma once
 
 #include "solver/lighting.h"
@@ -69,5 +72,17 @@ struct ShadingLight {
 ShadingLight shading_light(const BoundarySurface& surface, const ShadingSurface& shading, const TriangleBvh& bvh,
                            const Lighting& lighting, const std::vector<Rgb>& surface_q,
                            const std::vector<float>& surface_visibility);
+
+// The light the diffusion solve takes per surface vertex: q_i of Eq. 12, whose source S_i q_i stands
+// for the integral of q over the vertex's boundary area (the lumped S_f / 3 of each of its triangles).
+// At a split vertex it is the mean of its copies' q weighted by their fans' areas, sum_c S_c q_c / S_i,
+// so each side of a crease contributes the light it receives; a vertex that is not split keeps its q
+// bit for bit, so on a surface without creases this is incident_light's q. The weights are areas only:
+// where the triangles around a split vertex belong to tets of different refractive index (a painted
+// border along a crease), Eq. 12 also weighs each face by its own 1/(A (1 - F_dr)), which this mean
+// does not. `shading_q` is per shading vertex (ShadingLight::q); throws InvalidArgumentError on
+// mismatched sizes.
+std::vector<Rgb> source_light(const BoundarySurface& surface, const ShadingSurface& shading,
+                              const std::vector<Rgb>& shading_q);
 
 }  // namespace waxwork

@@ -103,9 +103,10 @@ TEST(LiveScene, FollowsEveryKindOfChangeToTheFreshSolution) {
     }
 }
 
-// The crease angle is the image's: changing it re-splits the shading and leaves the solve alone,
-// and it holds through later edits.
-TEST(LiveScene, TheCreaseAngleChangesTheShadingOnly) {
+// The crease angle decides which sides of a fold are shaded and lit as themselves: changing it
+// re-splits the shading and the solve's source (source_light) and leaves the matrix alone; the solve
+// goes on warm to the fresh solution at that angle, and the angle holds through later edits.
+TEST(LiveScene, TheCreaseAngleReachesTheShadingAndTheSource) {
     Document doc(testing::make_cube_mesh(7), material_preset("marble"));
     const Lighting lighting = key_lighting();
     LiveScene scene(doc.mesh(), lighting, options());
@@ -114,13 +115,17 @@ TEST(LiveScene, TheCreaseAngleChangesTheShadingOnly) {
     const size_t surface_vertices = scene.solved_scene().surface.vertices.size();
     EXPECT_GT(scene.solved_scene().shading.size(), surface_vertices);  // a cube's edges split
 
-    scene.set_crease_angle(180.0);
-    EXPECT_TRUE(scene.converged());
-    EXPECT_EQ(scene.phi(), phi);
+    const SceneUpdate update = scene.set_crease_angle(180.0);
+    EXPECT_TRUE(update.recomputed_light);
+    EXPECT_FALSE(update.reassembled_matrix);
+    EXPECT_FALSE(scene.converged());
+    EXPECT_EQ(scene.phi(), phi);  // warm: the next steps start from it
     EXPECT_EQ(scene.options().crease_angle_degrees, 180.0);
     EXPECT_EQ(scene.solved_scene().shading.size(), surface_vertices);
     EXPECT_EQ(scene.radiance_factors().size(), surface_vertices);
     expect_matches_fresh_solve(scene, doc.mesh(), lighting, "unsplit", 180.0);
+    EXPECT_NE(scene.phi(), phi);  // the averaged normals light the cube's rims differently
+    EXPECT_FALSE(scene.set_crease_angle(180.0).recomputed_light);  // the same angle: nothing to do
 
     PlaneCutOp cut;
     cut.plane = {Eigen::Vector3d(1, 0.3, 0.2), 0.6};

@@ -3,6 +3,7 @@
 #include "io/image_io.h"
 #include "solver/shading_surface.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -278,19 +279,38 @@ TEST_F(Render, PointLightInsideTheObjectLightsNothing) {
 }
 
 // The cube's edges are creases: the summary counts the copies the image shades them with, and 180
-// degrees (one normal per vertex) makes none; the solve is the same either way.
-TEST_F(Render, CreaseAngleSplitsTheCubesEdgesForTheImageOnly) {
+// degrees (one normal per vertex) makes none. The solve's light differs exactly along the edges, where
+// the split integrates each face's own light (source_light).
+TEST_F(Render, CreaseAngleSplitsTheCubesEdgesForTheImageAndTheSource) {
     const std::string base = "render " + volume_.string() + " --width 64 --height 48 -o " + (dir_ / "crease.png").string();
-    const auto split = run_waxwork(base);
-    const auto unsplit = run_waxwork(base + " --crease-angle 180");
+    const fs::path split_fields = dir_ / "split.csv", unsplit_fields = dir_ / "unsplit.csv";
+    const auto split = run_waxwork(base + " --fields " + split_fields.string());
+    const auto unsplit = run_waxwork(base + " --crease-angle 180 --fields " + unsplit_fields.string());
     ASSERT_EQ(split.exit_code, 0) << split.err;
     ASSERT_EQ(unsplit.exit_code, 0) << unsplit.err;
     const auto a = nlohmann::json::parse(split.out), b = nlohmann::json::parse(unsplit.out);
     EXPECT_EQ(a["crease_angle_deg"], kDefaultCreaseAngleDegrees);
     EXPECT_GT(a["shading_copies"].get<int>(), 0);
     EXPECT_EQ(b["shading_copies"], 0);
-    EXPECT_EQ(a["iterations"], b["iterations"]);
-    EXPECT_EQ(a["estimated_error"], b["estimated_error"]);
+
+    const Fields fa = read_fields(split_fields), fb = read_fields(unsplit_fields);
+    ASSERT_EQ(fa.rows.size(), fb.rows.size());
+    Eigen::AlignedBox3d box;
+    for (const auto& r : fa.rows) box.extend(Eigen::Vector3d(r.x, r.y, r.z));
+    size_t moved = 0;
+    for (size_t v = 0; v < fa.rows.size(); ++v) {
+        const FieldRow &ra = fa.rows[v], &rb = fb.rows[v];
+        const Eigen::Vector3d p(ra.x, ra.y, ra.z);
+        int faces = 0;  // the cube's faces the vertex lies on
+        for (int k = 0; k < 3; ++k)
+            faces += std::abs(p[k] - box.min()[k]) < 1e-6 * box.diagonal().norm() ||
+                     std::abs(p[k] - box.max()[k]) < 1e-6 * box.diagonal().norm();
+        if (ra.q != rb.q) {
+            ++moved;
+            EXPECT_GE(faces, 2) << "light moved off the edges at " << p.transpose();
+        }
+    }
+    EXPECT_GT(moved, 0u);
 }
 
 TEST_F(Render, BadInputIsAOneLineError) {

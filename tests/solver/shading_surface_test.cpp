@@ -294,6 +294,65 @@ TEST(ShadingLight, SplitCopiesCastTheirOwnShadowRays) {
     EXPECT_EQ(floor_copies, 2u);  // z = 0 and z = 1
 }
 
+// The light Eq. 12's source S_i q_i carries into the volume, summed over the surface: the lumped
+// integral of q (S_i = a third of the area of each triangle at vertex i).
+double source_power(const BoundarySurface& surface, const std::vector<Rgb>& q, int channel) {
+    std::vector<double> area(surface.positions.size(), 0.0);
+    for (const auto& [a, b, c] : surface.triangles) {
+        const double third =
+            (surface.positions[b] - surface.positions[a]).cross(surface.positions[c] - surface.positions[a]).norm() / 6;
+        area[a] += third;
+        area[b] += third;
+        area[c] += third;
+    }
+    double power = 0;
+    for (size_t s = 0; s < q.size(); ++s) power += area[s] * q[s][channel];
+    return power;
+}
+
+TEST(SourceLight, IntegratesEachSideOfACreaseWithItsOwnLight) {
+    // A 3-unit cube lit from straight above: the exact integral of q is the top's 9 units of area at
+    // full light, plus the ambient over all 54. With the averaged normals the vertices along the top's
+    // rim carry light at 45 degrees into the sides' share of their area as well.
+    const LitCube cube;
+    const TriangleBvh bvh = build_shadow_bvh(cube.surface);
+    std::vector<float> visibility;
+    const std::vector<Rgb> q = incident_light(cube.surface, bvh, cube.lighting, &visibility);
+    const ShadingSurface shading = split_at_creases(cube.surface);
+    const ShadingLight light = shading_light(cube.surface, shading, bvh, cube.lighting, q, visibility);
+    const std::vector<Rgb> source = source_light(cube.surface, shading, light.q);
+    ASSERT_EQ(source.size(), q.size());
+
+    const double top = 2 * fresnel_transmittance(1.0, 1.3);
+    const double exact = 9 * top + 54 * 0.01;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(source_power(cube.surface, source, c), exact, 1e-12 * exact);
+    const double averaged = source_power(cube.surface, q, 0);
+    std::cout << "cube lit from above: the averaged normals carry " << averaged / exact
+              << " times the light the faces receive\n";
+    EXPECT_GT(averaged, 1.1 * exact);
+
+    for (size_t s = 0; s < q.size(); ++s) {
+        if (!is_split_copy(shading, static_cast<int32_t>(s))) {
+            EXPECT_EQ(source[s], q[s]);  // bit for bit away from creases
+            continue;
+        }
+        // The side copies receive the ambient only, so a split vertex's light lies between the
+        // ambient and the top's, and below what its averaged normal received.
+        EXPECT_GE(source[s][0], 0.01 - 1e-15);
+        EXPECT_LE(source[s][0], q[s][0] + 1e-15);
+    }
+
+    // Nothing split, nothing changed: at 180 degrees the solve's light is incident_light's.
+    const ShadingSurface unsplit = split_at_creases(cube.surface, 180.0);
+    EXPECT_EQ(source_light(cube.surface, unsplit, shading_light(cube.surface, unsplit, bvh, cube.lighting, q, visibility).q),
+              q);
+
+    std::vector<Rgb> short_q = light.q;
+    short_q.pop_back();
+    EXPECT_THROW(source_light(cube.surface, shading, short_q), InvalidArgumentError);
+    EXPECT_THROW(source_light(cube.surface, shading, q), InvalidArgumentError);  // per surface vertex, not copy
+}
+
 TEST(ShadingRadiance, EqualsTheVertexRadianceWhereNotSplitAndUsesTheCopysLightWhereSplit) {
     const LitCube cube;
     TetMesh mesh = test::make_cube_mesh(3);
