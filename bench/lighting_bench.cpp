@@ -3,7 +3,7 @@
 // rays (the justification in solver/ray_caster.h).
 //
 //   build/bench/lighting_bench --benchmark_filter=Spot
-//   build/bench/lighting_bench --benchmark_filter='SplitAtCreases|ShadingLight' 
+//   build/bench/lighting_bench --benchmark_filter='SplitAtCreases|ShadingLight|SourceLight' 
 #include "bench_main.h"
 #include "io/surface_reader.h"
 #include "solver/lighting.h"
@@ -214,6 +214,20 @@ void BM_ShadingLight_Spot(benchmark::State& state) {
     state.counters["split_copies"] = static_cast<double>(shading.split_copies.size());
 }
 BENCHMARK(BM_ShadingLight_Spot)->Arg(40)->Arg(20)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The solve's light from the copies' (source_light): one pass over the triangles at split vertices.
+void BM_SourceLight_Spot(benchmark::State& state) {
+    const double angle = static_cast<double>(state.range(0));
+    const TriangleBvh bvh = build_shadow_bvh(spot());
+    const Lighting lighting = key_light();
+    std::vector<float> visibility;
+    const std::vector<Rgb> q = incident_light(spot(), bvh, lighting, &visibility);
+    const ShadingSurface shading = split_at_creases(spot(), angle);
+    const ShadingLight light = shading_light(spot(), shading, bvh, lighting, q, visibility);
+    for (auto _ : state) benchmark::DoNotOptimize(source_light(spot(), shading, light.q).data());
+    state.counters["split_copies"] = static_cast<double>(shading.split_copies.size());
+}
+BENCHMARK(BM_SourceLight_Spot)->Arg(40)->Arg(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace waxwork
