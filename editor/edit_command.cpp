@@ -32,6 +32,7 @@ struct EditCommandOptions {
     MaterialOptions material;
     std::vector<std::string> lights;
     double scale = 1.0;
+    double crease_angle = kDefaultCreaseAngleDegrees;
     std::vector<double> view;
     std::string show = "radiance";
     std::string slice_normal;
@@ -45,6 +46,8 @@ void run_edit_command(const EditCommandOptions& o) {
         throw InvalidArgumentError("--width/--height must be between 64 and " + std::to_string(kMaxImageSide));
     if (o.frames < 1 || o.frames > 100000) throw InvalidArgumentError("--frames must be between 1 and 100000");
     validate_mm_per_unit(o.scale, "--scale");
+    if (!(o.crease_angle >= 0 && o.crease_angle <= 180))
+        throw InvalidArgumentError("--crease-angle must be between 0 and 180 degrees");
     EditorOptions options;
     options.view.mode = parse_view_mode(o.show);
     if (!o.slice_normal.empty()) options.view.slice_normal = parse_slice_normal(o.slice_normal);
@@ -61,6 +64,7 @@ void run_edit_command(const EditCommandOptions& o) {
     options.max_tets = o.max_tets;
     options.material = chosen_material(o.material);
     options.scale = o.scale;
+    options.crease_angle_degrees = o.crease_angle;
     options.solver_backend = parse_live_backend(o.solver.backend);
     options.solver_method = parse_live_method(o.solver.method);
     options.frame_ms = o.solver.frame_ms;
@@ -115,6 +119,10 @@ void add_edit_command(CLI::App& app) {
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
     cmd->add_option("--scale", options->scale, "Millimetres per model unit")->capture_default_str();
+    cmd->add_option("--crease-angle", options->crease_angle,
+                    "Shade and light the surface as folded where neighbouring triangles turn by more than "
+                    "this many degrees, as for render (a session's own value wins)")
+        ->capture_default_str();
     cmd->add_option("--view", options->view, "Direction from the object towards the camera, X,Y,Z")
         ->delimiter(',')
         ->expected(3);

@@ -76,6 +76,7 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
     lighting_.lights = options.lights.empty() ? std::vector<Light>{default_key_light()} : options.lights;
     lighting_.ambient = {0.02, 0.02, 0.02};  // `waxwork render`'s default --ambient
     live_options_.mm_per_unit = options.scale;
+    live_options_.crease_angle_degrees = options.crease_angle_degrees;
     choose_solver(options.solver_method, options.solver_backend);
     if (options.frame_ms) {
         frame_budget_in_ms_ = true;
@@ -229,6 +230,7 @@ void EditorApp::install_core(std::shared_ptr<SceneCore> core, const fs::path& pa
               std::to_string(scene_->vertices) + " vertices";
     glfwSetWindowTitle(window_, ("Waxwork - " + path.filename().string()).c_str());
     lighting_dirty_ = false;
+    crease_angle_dirty_ = false;
 }
 
 void EditorApp::queue_job(std::string label, SceneJob job) {
@@ -337,8 +339,16 @@ void EditorApp::request_solve() {
     if (scene_->core) lighting_dirty_ = true;
 }
 
+void EditorApp::set_crease_angle(double degrees) {
+    if (!(degrees >= 0 && degrees <= 180))
+        throw InvalidArgumentError("crease angle " + number_text(degrees) + " degrees: must be between 0 and 180");
+    live_options_.crease_angle_degrees = degrees;
+    if (scene_->core) crease_angle_dirty_ = true;
+}
+
 bool EditorApp::idle() const {
-    if (load_task_.busy() || tick_task_.busy() || !pending_jobs_.empty() || lighting_dirty_) return false;
+    if (load_task_.busy() || tick_task_.busy() || !pending_jobs_.empty() || lighting_dirty_ || crease_angle_dirty_)
+        return false;
     return !scene_->core || (scene_->converged && scene_->render_input && scene_->exposure_locked && !view_dirty_);
 }
 
@@ -350,6 +360,9 @@ void EditorApp::start_tick() {
     std::optional<Lighting> lighting;
     if (lighting_dirty_) lighting = lighting_;
     lighting_dirty_ = false;
+    std::optional<double> crease_angle;
+    if (crease_angle_dirty_) crease_angle = live_options_.crease_angle_degrees;
+    crease_angle_dirty_ = false;
     const FrameBudget budget = frame_budget();
     const bool first = !scene_->render_input;
     const bool need_bvh = !scene_->surface_bvh;
@@ -387,8 +400,8 @@ void EditorApp::start_tick() {
         LiveBackend backend = LiveBackend::Cpu;
         std::string solver_description, gpu_fallback_reason, method_fallback_reason;
     };
-    tick_task_.start(label, [this, target, core, jobs, lighting, budget, first, need_bvh, settings, view, view_changed,
-                             view_worker](TaskProgress& progress) {
+    tick_task_.start(label, [this, target, core, jobs, lighting, crease_angle, budget, first, need_bvh, settings, view,
+                             view_changed, view_worker](TaskProgress& progress) {
         const auto start = std::chrono::steady_clock::now();
         auto r = std::make_shared<Result>();
         for (auto& [name, job] : *jobs) {
@@ -399,6 +412,12 @@ void EditorApp::start_tick() {
             } catch (const std::exception& e) {
                 r->errors.push_back(name + ": " + e.what());
             }
+        }
+        if (crease_angle) {
+            progress.set_stage("crease angle");
+            core->live->set_crease_angle(*crease_angle);  // checked by set_crease_angle above
+            r->messages.push_back("Surface split where it folds by more than " + number_text(*crease_angle) + " degrees");
+            r->geometry_changed = true;  // the shading's vertices
         }
         if (lighting) core->live->set_lighting(*lighting);
         progress.set_stage("solving");
@@ -506,7 +525,8 @@ void EditorApp::poll_tasks() {
     }
     // Keep one tick running while there is anything to do.
     if (scene_->core && !tick_task_.busy() && !load_task_.busy() &&
-        (!pending_jobs_.empty() || lighting_dirty_ || !scene_->converged || !scene_->render_input || view_dirty_))
+        (!pending_jobs_.empty() || lighting_dirty_ || crease_angle_dirty_ || !scene_->converged ||
+         !scene_->render_input || view_dirty_))
         start_tick();
 }
 

@@ -51,6 +51,7 @@ struct EditorOptions {
     int height = 800;
     std::vector<Light> lights;           // empty: default_key_light
     double scale = 1.0;                  // millimetres per model unit
+    double crease_angle_degrees = kDefaultCreaseAngleDegrees;  // where the surface folds (--crease-angle)
     CameraSettings camera;               // the first view (as `waxwork render --view`)
     ViewOptions view;                    // what the 3D view shows (as `waxwork render --show`)
     std::optional<InputScript> input;    // replayed into the window once the object shows (--input)
@@ -168,6 +169,10 @@ public:
     void select_tool(Tool tool);
     // The material panel's preset `name` becomes the brush's material (as clicking it in the panel).
     void select_brush_material(const std::string& name);
+    // The View panel's crease angle (solver/shading_surface.h): sent to the live scene with the next
+    // tick, the latest value only when several arrive while a tick runs (a dragged slider). Throws
+    // InvalidArgumentError outside [0, 180].
+    void set_crease_angle(double degrees);
     void save_session(const std::filesystem::path& path);
 
 private:
@@ -258,6 +263,7 @@ private:
     BackgroundTask tick_task_;
     std::deque<std::pair<std::string, SceneJob>> pending_jobs_;  // for the next tick, in order
     bool lighting_dirty_ = false;                                // send lighting_ with the next tick
+    bool crease_angle_dirty_ = false;                            // send live_options_'s crease angle too
     std::optional<std::variant<PlaneSurface, StrokeSurface>> last_cut_;  // what Relax relaxes towards
     int fracture_pieces_ = 5;
     // Edit > Remove fragments: parts under this % of the volume go.

@@ -168,6 +168,11 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
         }
         e.material = m.get<std::string>();
         events.push_back(e);
+    } else if (kind == "crease_angle") {
+        e.action = ScriptAction::SetCreaseAngle;
+        e.degrees = in.number("degrees");
+        if (!(e.degrees >= 0 && e.degrees <= 180)) fail_json(in.field("degrees"), "must be between 0 and 180");
+        events.push_back(e);
     } else if (kind == "idle") {
         e.action = ScriptAction::WaitIdle;
         events.push_back(e);
@@ -179,8 +184,8 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
         events.push_back(e);
     } else {
         fail_json(entry, "unknown event \"" + kind +
-                             "\" (expected press, move, release, drag, scroll, key, tool, idle, save_session, "
-                             "save_volume)");
+                             "\" (expected press, move, release, drag, scroll, key, tool, material, crease_angle, "
+                             "idle, save_session, save_volume)");
     }
     in.finish();
 }
@@ -221,6 +226,7 @@ void InputScriptPlayer::advance(ScriptTarget& target) {
         case ScriptAction::Key: target.key(e.key, e.mods); break;
         case ScriptAction::SelectTool: target.select_tool(e.tool); break;
         case ScriptAction::SelectMaterial: target.select_material(e.material); break;
+        case ScriptAction::SetCreaseAngle: target.set_crease_angle(e.degrees); break;
         case ScriptAction::WaitIdle: break;
         case ScriptAction::SaveSession: target.save_session(e.file); break;
         case ScriptAction::SaveVolume: target.save_volume(e.file); break;

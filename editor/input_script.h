@@ -5,6 +5,7 @@
 //   [
 //     {"event": "tool", "tool": "cut"},                       select a tool (ids: tool_infos())
 //     {"event": "material", "material": "ketchup"},           the brush's material (a measured preset)
+//     {"event": "crease_angle", "degrees": 180},              as the View panel's slider (0 to 180)
 //     {"frame": 3, "event": "press", "x": 200, "y": 300, "button": "left", "mods": ["shift"]},
 //     {"event": "move", "x": 260, "y": 310},
 //     {"event": "release", "x": 420, "y": 320, "button": "left"},
@@ -36,7 +37,9 @@
 
 namespace waxwork {
 
-enum class ScriptAction { Move, Press, Release, Scroll, Key, SelectTool, SelectMaterial, WaitIdle, SaveSession, SaveVolume };
+enum class ScriptAction {
+    Move, Press, Release, Scroll, Key, SelectTool, SelectMaterial, SetCreaseAngle, WaitIdle, SaveSession, SaveVolume
+};
 
 struct ScriptEvent {
     ScriptAction action = ScriptAction::Move;
@@ -48,6 +51,7 @@ struct ScriptEvent {
     int key = 0;               // GLFW_KEY_*
     Tool tool = Tool::Orbit;
     std::string material;        // SelectMaterial: a preset name (material_preset_names())
+    double degrees = 0;          // SetCreaseAngle: in [0, 180]
     std::filesystem::path file;  // SaveSession, SaveVolume (absolute after parsing)
     std::string context;         // "SCRIPT: entry N (kind)" for messages
 };
@@ -80,6 +84,7 @@ public:
     virtual void key(int key, int mods) = 0;  // press and release
     virtual void select_tool(Tool tool) = 0;
     virtual void select_material(const std::string& preset) = 0;  // as a click in the material panel
+    virtual void set_crease_angle(double degrees) = 0;            // as the View panel's slider
     virtual void save_session(const std::filesystem::path& file) = 0;
     virtual void save_volume(const std::filesystem::path& file) = 0;
 };

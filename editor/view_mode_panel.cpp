@@ -111,13 +111,7 @@ void EditorApp::draw_view_mode_panel() {
     // right-hand sides change and the solve goes on warm, as after a light change.
     float crease = static_cast<float>(live_options_.crease_angle_degrees);
     if (ImGui::SliderFloat("crease angle", &crease, 0.0f, 180.0f, "%.0f deg")) {
-        live_options_.crease_angle_degrees = std::clamp(static_cast<double>(crease), 0.0, 180.0);
-        const double degrees = live_options_.crease_angle_degrees;
-        if (scene_->core)
-            queue_job("crease angle", [degrees](SceneCore& core) {
-                core.live->set_crease_angle(degrees);
-                return "Surface split where it folds by more than " + number_text(degrees) + " degrees";
-            });
+        set_crease_angle(std::clamp(static_cast<double>(crease), 0.0, 180.0));
     }
     if (ImGui::IsItemHovered())
         ImGui::SetTooltip("Box edges and cut rims are shaded and lit as folded where neighbouring triangles turn\n"

@@ -228,6 +228,7 @@ public:
     }
     void select_tool(Tool tool) override { app_.select_tool(tool); }
     void select_material(const std::string& preset) override { app_.select_brush_material(preset); }
+    void set_crease_angle(double degrees) override { app_.set_crease_angle(degrees); }
     void save_session(const std::filesystem::path& file) override { app_.save_session(file); }
     void save_volume(const std::filesystem::path& file) override { app_.save_volume(file); }
 

@@ -129,6 +129,42 @@ TEST(EditorWithoutDisplay, BadViewOptionsAreRefusedWithOneLine) {
     }
 }
 
+// The crease angle decides which vertices are split and which light the solve integrates, so the
+// editor must show what `waxwork render --crease-angle` writes whether the angle comes from the command
+// line or from the View panel while the scene is open (a scripted slider change, solved on warm), and a
+// saved session must keep it.
+TEST_F(EditorWindow, CreaseAngleFromTheCommandLineOrTheViewPanelEqualsWaxworkRender) {
+    const fs::path dir = scratch_dir("editor_crease_angle");
+    const fs::path cube = dir / "cube.vtu", volume = dir / "cut.vtu";
+    ASSERT_EQ(run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + cube.string() + " --max-tets 4000").exit_code, 0);
+    ASSERT_EQ(run_waxwork("cut " + cube.string() + " -o " + volume.string() + " --plane=1,1,1,1.2 --exact").exit_code, 0);
+    const std::string scene = volume.string() + " --width 240 --height 180";
+    const fs::path folded = dir / "render40.png", smooth = dir / "render180.png";
+    ASSERT_EQ(run_waxwork("render " + scene + " -o " + folded.string()).exit_code, 0);
+    ASSERT_EQ(run_waxwork("render " + scene + " --crease-angle 180 -o " + smooth.string()).exit_code, 0);
+    const Image render40 = read_png(folded), render180 = read_png(smooth);
+    ASSERT_GT(max_channel_difference(render40, render180), 20) << "the angle should show on a cut cube";
+
+    const fs::path from_option = dir / "option.png";
+    const auto option = run_under_xvfb("edit " + scene + " --crease-angle 180 --hide-ui --frames 2 --screenshot " +
+                                       from_option.string());
+    ASSERT_EQ(option.exit_code, 0) << option.err;
+    EXPECT_LE(max_channel_difference(read_png(from_option), render180), 2);
+
+    const fs::path script = dir / "input.json", from_panel = dir / "panel.png";
+    std::ofstream(script) << R"([{"event": "idle"}, {"event": "crease_angle", "degrees": 180}, {"event": "idle"},
+                                {"event": "save_session", "file": "session.json"}, {"event": "idle"}])";
+    const auto panel = run_under_xvfb("edit " + scene + " --hide-ui --input " + script.string() +
+                                      " --frames 2 --screenshot " + from_panel.string());
+    ASSERT_EQ(panel.exit_code, 0) << panel.err;
+    EXPECT_LE(max_channel_difference(read_png(from_panel), render180), 2);
+    EXPECT_EQ(nlohmann::json::parse(testing::read_text(dir / "session.json"))["crease_angle"], 180.0);
+
+    const auto bad = run_waxwork("edit " + scene + " --crease-angle 200 --screenshot " + (dir / "bad.png").string());
+    EXPECT_NE(bad.exit_code, 0);
+    EXPECT_NE(bad.err.find("--crease-angle must be between 0 and 180 degrees"), std::string::npos) << bad.err;
+}
+
 TEST_F(EditorWindow, ReplayedSessionEqualsWaxworkRun) {
     // The editor replays a session's edits through Document and LiveScene on its worker; its converged
     // view must show what the headless `waxwork run` renders for the same session.

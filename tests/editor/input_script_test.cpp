@@ -35,8 +35,9 @@ TEST(InputScript, ParsesEveryEventKind) {
         {"event": "key", "key": "home", "mods": ["ctrl"]},
         {"event": "idle"},
         {"event": "save_session", "file": "out/s.json"},
-        {"event": "save_volume", "file": "/tmp/v.vtu"}])");
-    ASSERT_EQ(s.events.size(), 9u);
+        {"event": "save_volume", "file": "/tmp/v.vtu"},
+        {"event": "crease_angle", "degrees": 180}])");
+    ASSERT_EQ(s.events.size(), 10u);
     EXPECT_EQ(s.events[0].action, ScriptAction::SelectTool);
     EXPECT_EQ(s.events[0].tool, Tool::ExactCut);
     EXPECT_FALSE(s.events[0].frame);
@@ -55,6 +56,8 @@ TEST(InputScript, ParsesEveryEventKind) {
     EXPECT_EQ(s.events[6].action, ScriptAction::WaitIdle);
     EXPECT_EQ(s.events[7].file, std::filesystem::path("/scripts/out/s.json"));
     EXPECT_EQ(s.events[8].file, std::filesystem::path("/tmp/v.vtu"));
+    EXPECT_EQ(s.events[9].action, ScriptAction::SetCreaseAngle);
+    EXPECT_EQ(s.events[9].degrees, 180.0);
 }
 
 TEST(InputScript, DragExpandsIntoPressMovesAndRelease) {
@@ -103,6 +106,9 @@ TEST(InputScript, BadScriptsGetOneLineErrorsNamingTheFileAndEntry) {
         {R"([{"event": "drag", "from": [0, 0], "to": [1, 1], "steps": 0}])", "field 'steps'"},
         {R"([{"event": "save_volume", "file": ""}])", "s.json: entry 0 (save_volume): field 'file'"},
         {R"([{"event": "scroll", "x": 1, "y": 1}])", "missing field 'dy'"},
+        {R"([{"event": "crease_angle", "degrees": 181}])", "s.json: entry 0 (crease_angle): field 'degrees': must be between 0 and 180"},
+        {R"([{"event": "crease_angle", "degrees": -1}])", "field 'degrees': must be between 0 and 180"},
+        {R"([{"event": "crease_angle"}])", "missing field 'degrees'"},
     };
     for (const auto& [text, expected] : cases) {
         const std::string message = parse_error(text);
@@ -138,6 +144,7 @@ public:
     void key(int key, int) override { add("key " + std::to_string(key)); }
     void select_tool(Tool tool) override { add("tool " + std::to_string(static_cast<int>(tool))); }
     void select_material(const std::string& preset) override { add("material " + preset); }
+    void set_crease_angle(double degrees) override { add("crease " + std::to_string(int(degrees))); }
     void save_session(const std::filesystem::path& f) override { add("session " + f.filename().string()); }
     void save_volume(const std::filesystem::path& f) override { add("volume " + f.filename().string()); }
 
@@ -148,21 +155,21 @@ private:
 TEST(InputScriptPlayer, FiresInOrderOnePerFrameFromTheFirstReadyFrame) {
     InputScriptPlayer player(parse(R"([{"event": "tool", "tool": "cut"}, {"event": "material", "material": "ketchup"},
         {"frame": 3, "event": "drag", "from": [0, 0], "to": [10, 0], "steps": 1},
-        {"event": "idle"}, {"event": "save_volume", "file": "v.vtu"}])"));
+        {"event": "idle"}, {"event": "save_volume", "file": "v.vtu"}, {"event": "crease_angle", "degrees": 90}])"));
     FakeTarget target;
     // Not ready: nothing fires and frames do not count.
     for (target.frame = 0; target.frame < 3; ++target.frame) player.advance(target);
     EXPECT_TRUE(target.log.empty());
     target.is_ready = true;
-    for (; target.frame < 13; ++target.frame) {
+    for (; target.frame < 14; ++target.frame) {
         target.is_idle = target.frame >= 10;  // the cut is being applied until window frame 10
         player.advance(target);
-        EXPECT_EQ(player.done(), target.frame >= 11) << target.frame;
+        EXPECT_EQ(player.done(), target.frame >= 12) << target.frame;
     }
     // Ready at window frame 3 = script frame 0; the press waits for script frame 3 (window frame 6);
     // one event per frame after it; the save waits for idle (frame 10) and fires one frame later.
     const std::vector<std::string> expected = {"3: tool 1",      "4: material ketchup", "6: cursor 0,0",  "6: press 0",     "7: cursor 10,0",
-                                               "8: cursor 10,0", "8: release 0",   "11: volume v.vtu"};
+                                               "8: cursor 10,0", "8: release 0",   "11: volume v.vtu", "12: crease 90"};
     EXPECT_EQ(target.log, expected);
 }
 
