@@ -203,29 +203,30 @@ void BM_SplitAtCreases_Spot(benchmark::State& state) {
 }
 BENCHMARK(BM_SplitAtCreases_Spot)->Arg(40)->Arg(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-void BM_ShadingLight_Spot(benchmark::State& state) {
-    const double angle = static_cast<double>(state.range(0));
-    const TriangleBvh bvh = build_shadow_bvh(spot());
-    const Lighting lighting = key_light();
+// The subdivided spot's light and its split at `angle`, as the renderer makes them.
+struct SpotShading {
+    TriangleBvh bvh = build_shadow_bvh(spot());
+    Lighting lighting = key_light();
     std::vector<float> visibility;
-    const std::vector<Rgb> q = incident_light(spot(), bvh, lighting, &visibility);
-    const ShadingSurface shading = split_at_creases(spot(), angle);
-    for (auto _ : state) benchmark::DoNotOptimize(shading_light(spot(), shading, bvh, lighting, q, visibility).q.data());
-    state.counters["split_copies"] = static_cast<double>(shading.split_copies.size());
+    std::vector<Rgb> q = incident_light(spot(), bvh, lighting, &visibility);
+    ShadingSurface shading;
+    explicit SpotShading(double angle) : shading(split_at_creases(spot(), angle)) {}
+};
+
+void BM_ShadingLight_Spot(benchmark::State& state) {
+    const SpotShading s(static_cast<double>(state.range(0)));
+    for (auto _ : state)
+        benchmark::DoNotOptimize(shading_light(spot(), s.shading, s.bvh, s.lighting, s.q, s.visibility).q.data());
+    state.counters["split_copies"] = static_cast<double>(s.shading.split_copies.size());
 }
 BENCHMARK(BM_ShadingLight_Spot)->Arg(40)->Arg(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The solve's light from the copies' (source_light): one pass over the triangles at split vertices.
 void BM_SourceLight_Spot(benchmark::State& state) {
-    const double angle = static_cast<double>(state.range(0));
-    const TriangleBvh bvh = build_shadow_bvh(spot());
-    const Lighting lighting = key_light();
-    std::vector<float> visibility;
-    const std::vector<Rgb> q = incident_light(spot(), bvh, lighting, &visibility);
-    const ShadingSurface shading = split_at_creases(spot(), angle);
-    const ShadingLight light = shading_light(spot(), shading, bvh, lighting, q, visibility);
-    for (auto _ : state) benchmark::DoNotOptimize(source_light(spot(), shading, light.q).data());
-    state.counters["split_copies"] = static_cast<double>(shading.split_copies.size());
+    const SpotShading s(static_cast<double>(state.range(0)));
+    const ShadingLight light = shading_light(spot(), s.shading, s.bvh, s.lighting, s.q, s.visibility);
+    for (auto _ : state) benchmark::DoNotOptimize(source_light(spot(), s.shading, light.q).data());
+    state.counters["split_copies"] = static_cast<double>(s.shading.split_copies.size());
 }
 BENCHMARK(BM_SourceLight_Spot)->Arg(40)->Arg(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 

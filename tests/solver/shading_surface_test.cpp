@@ -227,13 +227,24 @@ struct LitCube {
     }
 };
 
+// A surface's light, its split at the default angle and the copies' light, as the renderer makes them.
+struct LitShading {
+    TriangleBvh bvh;
+    std::vector<float> visibility;
+    std::vector<Rgb> q;
+    ShadingSurface shading;
+    ShadingLight light;
+    LitShading(const BoundarySurface& surface, const Lighting& lighting)
+        : bvh(build_shadow_bvh(surface)),
+          q(incident_light(surface, bvh, lighting, &visibility)),
+          shading(split_at_creases(surface)),
+          light(shading_light(surface, shading, bvh, lighting, q, visibility)) {}
+};
+
 TEST(ShadingLight, EachCopyIsLitWithItsOwnNormal) {
     const LitCube cube;
-    const TriangleBvh bvh = build_shadow_bvh(cube.surface);
-    std::vector<float> visibility;
-    const std::vector<Rgb> q = incident_light(cube.surface, bvh, cube.lighting, &visibility);
-    const ShadingSurface shading = split_at_creases(cube.surface);
-    const ShadingLight light = shading_light(cube.surface, shading, bvh, cube.lighting, q, visibility);
+    const LitShading lit(cube.surface, cube.lighting);
+    const auto& [bvh, visibility, q, shading, light] = lit;
     ASSERT_EQ(light.q.size(), shading.size());
     ASSERT_EQ(light.visibility.size(), shading.size());
     const double top = 0.01 + 2 * fresnel_transmittance(1.0, 1.3);
@@ -275,11 +286,8 @@ TEST(ShadingLight, SplitCopiesCastTheirOwnShadowRays) {
     Lighting lighting;
     lighting.lights.push_back({LightType::Directional, Eigen::Vector3d(1, -0.3, 0), {1, 1, 1}});
     lighting.ambient = {0.01, 0.01, 0.01};
-    const TriangleBvh bvh = build_shadow_bvh(surface);
-    std::vector<float> visibility;
-    const std::vector<Rgb> q = incident_light(surface, bvh, lighting, &visibility);
-    const ShadingSurface shading = split_at_creases(surface);
-    const ShadingLight light = shading_light(surface, shading, bvh, lighting, q, visibility);
+    const LitShading lit(surface, lighting);
+    const auto& [bvh, visibility, q, shading, light] = lit;
     size_t floor_copies = 0;
     for (size_t d = 0; d < shading.size(); ++d) {
         const int32_t s = shading.surface_vertex[d];
@@ -315,11 +323,8 @@ TEST(SourceLight, IntegratesEachSideOfACreaseWithItsOwnLight) {
     // full light, plus the ambient over all 54. With the averaged normals the vertices along the top's
     // rim carry light at 45 degrees into the sides' share of their area as well.
     const LitCube cube;
-    const TriangleBvh bvh = build_shadow_bvh(cube.surface);
-    std::vector<float> visibility;
-    const std::vector<Rgb> q = incident_light(cube.surface, bvh, cube.lighting, &visibility);
-    const ShadingSurface shading = split_at_creases(cube.surface);
-    const ShadingLight light = shading_light(cube.surface, shading, bvh, cube.lighting, q, visibility);
+    const LitShading lit(cube.surface, cube.lighting);
+    const auto& [bvh, visibility, q, shading, light] = lit;
     const std::vector<Rgb> source = source_light(cube.surface, shading, light.q);
     ASSERT_EQ(source.size(), q.size());
 
