@@ -60,6 +60,17 @@ struct CgChannelState {
         }
         return est;
     }
+    // Whether an estimate at or under the tolerance after iteration k may stop a system of `unknowns`.
+    // A Ritz value from one or two Lanczos steps can lie arbitrarily far above lambda_min (one step gives
+    // the Rayleigh quotient of the first search direction), so without a floor from the caller or an
+    // earlier restart the estimate stops nothing before kTrustedLanczosSteps, or before the Krylov space
+    // is the whole space. A single tet 1e-3 degrees flat stopped after one iteration with three of its
+    // four vertices at 3e-5 of their value (ConjugateGradient.FewLanczosStepsDoNotStopAColdSolve); cold solves
+    // of real meshes take tens of iterations, so this costs them nothing.
+    static constexpr int kTrustedLanczosSteps = 3;
+    bool may_stop(int k, size_t unknowns) const {
+        return std::isfinite(ritz_floor) || k + 1 >= kTrustedLanczosSteps || static_cast<size_t>(k + 1) >= unknowns;
+    }
     // The true residual confirmed or refuted convergence (est_true with the same lam). Returns true
     // when the channel stops (converged, or restarts stopped halving the error: the precision floor);
     // otherwise prepares a restart from the true residual (the caller sets p = z).

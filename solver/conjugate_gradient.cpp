@@ -222,7 +222,7 @@ ConjugateGradientResult solve_jacobi_cg(const CsrMatrixView<Scalar>& m, std::spa
         double lam = 0;
         const double est = st.current_estimate(k, tol, static_cast<bool>(options.on_iteration), lam);
         if (options.on_iteration) options.on_iteration(k + 1, est);
-        if (est <= tol) {
+        if (est <= tol && st.may_stop(k, n)) {
             // Confirm with the true residual: the recursive one drifts (far, in float).
             const double rz_true = true_residual(m, b.data(), x.data(), inv_diag.data(), r.data(), z.data());
             if (!std::isfinite(rz_true)) breakdown(k, "the true residual is not finite");

@@ -226,7 +226,7 @@ std::array<ConjugateGradientResult, 3> solve_rgb(const DiffusionMatrix& m, const
             beta[c] = st.record_step(alpha[c], upd.v[2 * c], upd.v[2 * c + 1]);
             double lam = 0;
             const double est = st.current_estimate(k, tol, false, lam);
-            if (est <= tol) {
+            if (est <= tol && st.may_stop(k, n)) {
                 // Confirm with the true residual: the recursive one drifts (far, in float).
                 const double rz_true = s.true_residual(c);
                 if (!std::isfinite(rz_true)) breakdown(k, "the true residual is not finite");

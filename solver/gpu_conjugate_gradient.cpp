@@ -168,7 +168,7 @@ std::array<ConjugateGradientResult, 3> GpuDiffusionSolver::solve(const GpuCgOpti
             const double beta = st.record_step(alpha[c], upd[2 * c], upd[2 * c + 1]);
             const double est = st.current_estimate(k, tol, static_cast<bool>(options.on_iteration), lams[c]);
             errors[c] = est;
-            if (est <= tol) {
+            if (est <= tol && st.may_stop(k, n)) {
                 confirm[c] = true;
             } else {
                 st.result.estimated_relative_error = est;

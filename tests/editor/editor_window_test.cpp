@@ -132,17 +132,24 @@ TEST(EditorWithoutDisplay, BadViewOptionsAreRefusedWithOneLine) {
 // The crease angle decides which vertices are split and which light the solve integrates, so the
 // editor must show what `waxwork render --crease-angle` writes whether the angle comes from the command
 // line or from the View panel while the scene is open (a scripted slider change, solved on warm), and a
-// saved session must keep it.
+// saved session must keep it. The editor keeps the exposure of its first converged image, so after
+// the change it is compared with render at that image's exposure.
 TEST_F(EditorWindow, CreaseAngleFromTheCommandLineOrTheViewPanelEqualsWaxworkRender) {
     const fs::path dir = scratch_dir("editor_crease_angle");
     const fs::path cube = dir / "cube.vtu", volume = dir / "cut.vtu";
     ASSERT_EQ(run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + cube.string() + " --max-tets 4000").exit_code, 0);
     ASSERT_EQ(run_waxwork("cut " + cube.string() + " -o " + volume.string() + " --plane=1,1,1,1.2 --exact").exit_code, 0);
     const std::string scene = volume.string() + " --width 240 --height 180";
-    const fs::path folded = dir / "render40.png", smooth = dir / "render180.png";
-    ASSERT_EQ(run_waxwork("render " + scene + " -o " + folded.string()).exit_code, 0);
+    const fs::path folded = dir / "render40.png", smooth = dir / "render180.png", kept = dir / "render180_kept.png";
+    const auto first = run_waxwork("render " + scene + " -o " + folded.string());
+    ASSERT_EQ(first.exit_code, 0) << first.err;
+    const double exposure40 = nlohmann::json::parse(first.out)["exposure"].get<double>();
     ASSERT_EQ(run_waxwork("render " + scene + " --crease-angle 180 -o " + smooth.string()).exit_code, 0);
-    const Image render40 = read_png(folded), render180 = read_png(smooth);
+    ASSERT_EQ(run_waxwork("render " + scene + " --crease-angle 180 --exposure " + std::to_string(exposure40) + " -o " +
+                          kept.string())
+                  .exit_code,
+              0);
+    const Image render40 = read_png(folded), render180 = read_png(smooth), render180_kept = read_png(kept);
     ASSERT_GT(max_channel_difference(render40, render180), 20) << "the angle should show on a cut cube";
 
     const fs::path from_option = dir / "option.png";
@@ -157,7 +164,7 @@ TEST_F(EditorWindow, CreaseAngleFromTheCommandLineOrTheViewPanelEqualsWaxworkRen
     const auto panel = run_under_xvfb("edit " + scene + " --hide-ui --input " + script.string() +
                                       " --frames 2 --screenshot " + from_panel.string());
     ASSERT_EQ(panel.exit_code, 0) << panel.err;
-    EXPECT_LE(max_channel_difference(read_png(from_panel), render180), 2);
+    EXPECT_LE(max_channel_difference(read_png(from_panel), render180_kept), 2);
     EXPECT_EQ(nlohmann::json::parse(testing::read_text(dir / "session.json"))["crease_angle"], 180.0);
 
     const auto bad = run_waxwork("edit " + scene + " --crease-angle 200 --screenshot " + (dir / "bad.png").string());

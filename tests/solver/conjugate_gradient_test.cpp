@@ -1,5 +1,6 @@
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
+#include "solver/diffusion_solve.h"
 #include "solver/material.h"
 #include "solver/reference_solvers.h"
 #include "lit_block_system.h"
@@ -94,6 +95,48 @@ TEST(ConjugateGradient, StoppingRuleDeliversTheRequestedAccuracy) {
         const auto r = solve_jacobi_cg<double>(s.view(v), s.b, x, options);
         EXPECT_TRUE(r.converged);
         EXPECT_LE(s.d_error(x, exact), tol) << "tolerance " << tol;
+    }
+}
+
+// A Ritz value from one Lanczos step is the Rayleigh quotient of the first search direction and can
+// lie far above lambda_min. A single tet with its apex `height` above its base (dihedral angles of
+// 1e-3 and 1e-5 degrees) lit all over: Jacobi scaling makes the first step all but ignore the three
+// vertices the flat tet couples strongly, and the one-step estimate called that converged at 1e-2
+// (their phi at 3e-5 of its value). Cold solves now take at least three steps before the estimate may
+// stop them (CgChannelState::may_stop), on every Jacobi CG path.
+TEST(ConjugateGradient, FewLanczosStepsDoNotStopAColdSolve) {
+    for (const double height : {1e-5, 1e-7}) {
+        System s(make_tet_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.5, 0.5, height}}, {{0, 1, 2, 3}}));
+        const std::vector<std::array<double, 3>> q(4, {1, 1, 1});
+        diffusion_right_hand_side(s.matrix, q, 0, s.b);
+        const Eigen::VectorXd exact = s.exact();
+        for (const double tol : {1e-2, 1e-3}) {
+            std::vector<double> x(4, 0.0);
+            ConjugateGradientOptions options;
+            options.relative_tolerance = tol;
+            const auto r = solve_jacobi_cg<double>(s.view(), s.b, x, options);
+            EXPECT_TRUE(r.converged);
+            EXPECT_GE(r.iterations, 3);
+            EXPECT_LE(s.d_error(x, exact), tol) << "height " << height << ", tolerance " << tol;
+        }
+        // The rgb solves stop by the same rule: double solves it; float either solves it or, where its
+        // rounding cannot (the flatter tet), says so, never returning the one-step answer.
+        for (const SolverPrecision precision : {SolverPrecision::Double, SolverPrecision::Float}) {
+            DiffusionOptions options;
+            options.precision = precision;
+            options.relative_tolerance = 1e-2;
+            DiffusionSolution solution;
+            try {
+                solution = solve_diffusion(s.mesh, s.conn, s.materials, q, options);
+            } catch (const AlgorithmError& e) {
+                EXPECT_EQ(precision, SolverPrecision::Float) << e.what();
+                std::printf("height %g, float: %s\n", height, e.what());
+                continue;
+            }
+            for (size_t v = 0; v < 4; ++v)
+                EXPECT_NEAR(solution.phi[v][0], exact[static_cast<Eigen::Index>(v)], 2e-2 * exact.maxCoeff())
+                    << "height " << height << ", vertex " << v;
+        }
     }
 }
 
