@@ -14,8 +14,8 @@
 // The diffusion solve integrates the same light fan by fan (source_light below): its right-hand side
 // weighs q_i by the boundary area S_i of vertex i (Eq. 12), and at a crease that area lies on both
 // sides, so q evaluated once with the averaged normal over-lights the rim of a lit face and lights
-// the rim of a face turned away (on a cube lit head-on, q at 45 degrees over a third of each edge
-// vertex's area instead of q at 0 and nothing).
+// the rim of a face turned away (on a cube lit head-on, an edge vertex received q at 45 degrees over
+// its whole area instead of q at 0 degrees on the lit side and nothing on the grazed one).
 #pragma once
 
 #include "solver/lighting.h"
@@ -80,8 +80,10 @@ ShadingLight shading_light(const BoundarySurface& surface, const ShadingSurface&
 // bit for bit, so on a surface without creases this is incident_light's q. The weights are areas only:
 // where the triangles around a split vertex belong to tets of different refractive index (a painted
 // border along a crease), Eq. 12 also weighs each face by its own 1/(A (1 - F_dr)), which this mean
-// does not. `shading_q` is per shading vertex (ShadingLight::q); throws InvalidArgumentError on
-// mismatched sizes.
+// does not. Exact for the lumped source; the FEM variant's consistent boundary mass also carries a
+// vertex's q into its neighbours' rows, where a per-face-corner source would be needed
+// (tests/solver/crease_source_accuracy_test.cpp measures both). `shading_q` is per shading vertex
+// (ShadingLight::q); throws InvalidArgumentError on mismatched sizes.
 std::vector<Rgb> source_light(const BoundarySurface& surface, const ShadingSurface& shading,
                               const std::vector<Rgb>& shading_q);
 
