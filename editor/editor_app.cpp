@@ -73,8 +73,8 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
     renderer_ = std::make_unique<SurfaceRenderer>(gl_);
     view_cache_ = std::make_unique<ViewCache>(gl_);
 
-    lighting_.lights = options.lights.empty() ? std::vector<Light>{default_key_light()} : options.lights;
-    lighting_.ambient = {0.02, 0.02, 0.02};  // `waxwork render`'s default --ambient
+    lighting_ = default_lighting();
+    if (!options.lights.empty()) lighting_.lights = options.lights;
     live_options_.mm_per_unit = options.scale;
     live_options_.crease_angle_degrees = options.crease_angle_degrees;
     choose_solver(options.solver_method, options.solver_backend);

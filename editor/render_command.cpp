@@ -36,7 +36,7 @@ struct RenderCommandOptions {
     // fluence itself is typically closer than 1e-2.
     double tolerance = 1e-2;
     double scale = 1.0;
-    double ambient = 0.02;
+    double ambient = kDefaultAmbient;
     double crease_angle = kDefaultCreaseAngleDegrees;
     std::vector<double> view;
     std::optional<double> exposure;

@@ -50,6 +50,14 @@ Light default_key_light() {
     return light;
 }
 
+Lighting default_lighting() {
+    Lighting lighting;
+    lighting.lights = {default_key_light()};
+    lighting.ambient = {kDefaultAmbient, kDefaultAmbient, kDefaultAmbient};
+    lighting.shadows = true;
+    return lighting;
+}
+
 Light parse_light_spec(std::string_view spec) {
     const auto fail = [&](const std::string& why) {
         throw InvalidArgumentError("bad light spec '" + std::string(spec) + "': " + why);

@@ -31,6 +31,10 @@ namespace waxwork {
 // a y-up model facing +z (travelling along (1, -1, -1)), so the default 3/4 camera (front right) sees
 // lit faces next to faces in shade, and translucency shows in the gradient between them.
 Light default_key_light();
+// The ambient irradiance per channel where none is given (`render --ambient`, the editor, sessions).
+inline constexpr double kDefaultAmbient = 0.02;
+// The lighting of a scene that names none: default_key_light, kDefaultAmbient, shadows.
+Lighting default_lighting();
 
 // Parses "dir:X,Y,Z[:R,G,B]" (direction of travel) or "point:X,Y,Z[:R,G,B]" (position in model units);
 // the intensity defaults to 1,1,1. Throws InvalidArgumentError("bad light spec 'SPEC': WHY") for

@@ -8,7 +8,8 @@
 //     "material": "marble" | {"mua": [..], "musp": [..], "eta": 1.3},   (tets without a stored material)
 //     "scale": 30,                         millimetres per model unit
 //     "lights": [{"direction": [1,-1,-1], "intensity": [1,1,1]}, {"position": [0,2,0]}],
-//     "ambient": [0.02, 0.02, 0.02], "shadows": true,
+//     "ambient": [0.02, 0.02, 0.02], "shadows": true,   optional: without "lights" (or "ambient"),
+//                                          render's key light (and ambient); "lights": [] is no light
 //     "camera": {"eye_direction": [0.75,0.5,-1], "up": [0,1,0], "fov_y_deg": 30, "margin": 1.1,
 //                "target_offset": [0,0,0]},    margin: framing distance factor (zoom); offset: pan
 //     "image": {"width": 640, "height": 480},
@@ -35,6 +36,7 @@
 #include "editor/document.h"
 #include "editor/edit_operation.h"
 #include "editor/live_solver.h"
+#include "editor/render_pipeline.h"
 #include "editor/surface_renderer.h"
 #include "solver/lighting.h"
 #include "solver/shading_surface.h"
@@ -86,7 +88,9 @@ struct Session {
     SessionInput input;
     TetMaterial material;
     double scale = 30;
-    Lighting lighting;
+    // Without "lights" / "ambient": `waxwork render`'s key light and ambient (an empty "lights" list
+    // is no light).
+    Lighting lighting = default_lighting();
     CameraSettings camera;
     int width = 640;
     int height = 480;

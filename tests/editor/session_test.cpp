@@ -130,6 +130,38 @@ TEST(Session, CreaseAngleRoundTripsAndReachesTheFrames) {
     EXPECT_NE(a.rgba, b.rgba);
 }
 
+// A session that names no lights is lit as `waxwork render` lights a volume (key light, ambient,
+// shadows) rather than rendered black; an explicit empty list is no light, and an "ambient" alone
+// keeps the key light.
+TEST(Session, WithoutLightsItIsLitAsRenderLightsIt) {
+    const fs::path dir = scratch("default_lights");
+    write_volume(testing::make_cube_mesh(4), dir / "cube.vtu");
+    const auto parse = [&](const std::string& fields) {
+        return parse_session(Json::parse(R"({"input": {"volume": "cube.vtu"}, )" + fields +
+                                         R"("image": {"width": 64, "height": 48}, "steps": [{"render": "a.png"}]})"),
+                             dir, "s.json");
+    };
+    const Lighting expected = default_lighting();
+    const Session plain = parse("");
+    ASSERT_EQ(plain.lighting.lights.size(), 1u);
+    EXPECT_EQ(plain.lighting.lights[0].vector, expected.lights[0].vector);
+    EXPECT_EQ(plain.lighting.ambient, expected.ambient);
+    EXPECT_TRUE(plain.lighting.shadows);
+    EXPECT_TRUE(parse(R"("lights": [], )").lighting.lights.empty());
+    const Session ambient_only = parse(R"("ambient": [0, 0, 0], )");
+    EXPECT_EQ(ambient_only.lighting.lights.size(), 1u);
+    EXPECT_EQ(ambient_only.lighting.ambient, (Rgb{0, 0, 0}));
+
+    // The frame shows the object: brighter than the background somewhere.
+    run_session(plain, dir / "out");
+    const Image image = read_png(dir / "out" / "a.png");
+    const auto brightness = [&](int x, int y) { return image.pixel(x, y)[0] + image.pixel(x, y)[1] + image.pixel(x, y)[2]; };
+    int brightest = 0;
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) brightest = std::max(brightest, brightness(x, y));
+    EXPECT_GT(brightest, brightness(0, 0) + 100);
+}
+
 TEST(Session, RunErrorsNameTheStep) {
     const fs::path dir = scratch("run_errors");
     write_volume(testing::make_cube_mesh(3), dir / "cube.vtu");
