@@ -152,8 +152,9 @@ struct QualityAccumulator {
 QualityReport measure_quality(const TetMesh& mesh) {
     QualityReport report;
     if (mesh.tets.empty()) return report;
-    const QualityAccumulator total = tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, mesh.tets.size()), QualityAccumulator{},
+    // Deterministic: the means are sums, which must not depend on how the threads split the tets.
+    const QualityAccumulator total = tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<size_t>(0, mesh.tets.size(), 2048), QualityAccumulator{},
         [&](const tbb::blocked_range<size_t>& r, QualityAccumulator acc) {
             for (size_t t = r.begin(); t != r.end(); ++t) {
                 const Tet& tet = mesh.tets[t];

@@ -48,8 +48,9 @@ TetMesh make_tet_mesh(std::vector<Eigen::Vector3d> positions, std::vector<Tet> t
 }
 
 double total_volume(const TetMesh& mesh) {
-    return tbb::parallel_reduce(
-        tbb::blocked_range<size_t>(0, mesh.tets.size()), 0.0,
+    // Deterministic: the same sum in the same order whatever the threads (`info` prints it).
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<size_t>(0, mesh.tets.size(), 4096), 0.0,
         [&](const tbb::blocked_range<size_t>& r, double sum) {
             for (size_t t = r.begin(); t != r.end(); ++t) sum += signed_volume(mesh, t);
             return sum;

@@ -6,6 +6,7 @@
 #include "tetops/test_meshes.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -264,6 +265,28 @@ TEST(Quality, SliverIsCounted) {
 
 namespace waxwork {
 namespace {
+
+// `info` prints the volume and the mean edge and radius-edge ratio: their sums must not depend on how
+// many threads split the tets (they differed in the last digits from run to run).
+TEST(Quality, SumsDoNotDependOnTheThreads) {
+    TetMesh mesh = make_cube_mesh(24);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> jitter(-0.2, 0.2);
+    for (Eigen::Vector3d& p : mesh.positions) p += Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng)) / 24;
+    const auto measure = [&](int threads) {
+        tbb::task_arena arena(threads);
+        std::pair<double, QualityReport> out;
+        arena.execute([&] { out = {total_volume(mesh), measure_quality(mesh)}; });
+        return out;
+    };
+    const auto [volume, quality] = measure(1);
+    for (const int threads : {2, 3, 8}) {
+        const auto [v, q] = measure(threads);
+        EXPECT_EQ(v, volume) << threads << " threads";
+        EXPECT_EQ(q.mean_edge_length, quality.mean_edge_length) << threads << " threads";
+        EXPECT_EQ(q.mean_radius_edge_ratio, quality.mean_radius_edge_ratio) << threads << " threads";
+    }
+}
 
 TEST(SpatialOrder, KeepsTheMeshAndImprovesLocality) {
     // Scramble a structured cube, then sort it back into spatial order.
