@@ -28,7 +28,7 @@ double CuttingSurface::step_to_surface(const Eigen::Vector3d& from, const Eigen:
 PlaneCut::PlaneCut(const Eigen::Vector3d& normal, double offset) {
     if (!normal.allFinite() || !std::isfinite(offset))
         throw InvalidArgumentError("cutting plane: normal and offset must be finite numbers");
-    const double length = normal.norm();
+    const double length = normal.stableNorm();  // no overflow for huge components (1e300)
     if (!(length > 0) || !std::isfinite(length))
         throw InvalidArgumentError("cutting plane: the normal must not be the zero vector");
     normal_ = normal / length;

@@ -95,10 +95,18 @@ private:
 // 1e300, near double's largest).
 constexpr double kMaxCoordinate = 1e100;
 
-bool finite_material(const TetMaterial& m) {
-    for (int c = 0; c < 3; ++c)
-        if (!std::isfinite(m.mua[c]) || !std::isfinite(m.musp[c]) || m.mua[c] < 0 || m.musp[c] < 0) return false;
-    return std::isfinite(m.eta) && m.eta > 0;
+// What is wrong with a stored material's numbers ("" when nothing): a non-finite or negative
+// coefficient, or an eta that is not a positive number.
+std::string material_number_problem(const TetMaterial& m) {
+    constexpr const char* kChannel[3] = {"red", "green", "blue"};
+    for (int c = 0; c < 3; ++c) {
+        if (!std::isfinite(m.mua[c]) || m.mua[c] < 0)
+            return std::string("mu_a (") + kChannel[c] + ") = " + number_text(m.mua[c]) + " is not a non-negative number";
+        if (!std::isfinite(m.musp[c]) || m.musp[c] < 0)
+            return std::string("mu_s' (") + kChannel[c] + ") = " + number_text(m.musp[c]) + " is not a non-negative number";
+    }
+    if (!std::isfinite(m.eta) || !(m.eta > 0)) return "eta = " + number_text(m.eta) + " is not a positive number";
+    return "";
 }
 
 }  // namespace
@@ -156,8 +164,9 @@ std::vector<std::string> find_invariant_violations(const TetMesh& mesh) {
             (mesh.piece_ids[t] < 0 || static_cast<size_t>(mesh.piece_ids[t]) >= mesh.piece_transforms.size()))
             log.add("piece", "tet " + std::to_string(t) + " has piece id " + std::to_string(mesh.piece_ids[t]) +
                                  " without a transform");
-        if (t < mesh.materials.size() && !finite_material(mesh.materials[t]))
-            log.add("material", "tet " + std::to_string(t) + " has a non-finite or negative material");
+        if (t < mesh.materials.size())
+            if (const std::string problem = material_number_problem(mesh.materials[t]); !problem.empty())
+                log.add("material", "tet " + std::to_string(t) + "'s material: " + problem);
     }
     for (size_t v = 0; v < referenced.size(); ++v)
         if (!referenced[v]) log.add("unreferenced", "vertex " + std::to_string(v) + " belongs to no tet");

@@ -29,6 +29,9 @@ TEST(PlaneCut, RejectsBadPlanes) {
     EXPECT_THROW(PlaneCut(Eigen::Vector3d::Zero(), 1.0), InvalidArgumentError);
     EXPECT_THROW(PlaneCut(Eigen::Vector3d(std::nan(""), 0, 1), 0.0), InvalidArgumentError);
     EXPECT_THROW(PlaneCut(Eigen::Vector3d(0, 0, 1), std::numeric_limits<double>::infinity()), InvalidArgumentError);
+    // Huge but finite components are a direction like any other (their squares overflow).
+    const PlaneCut huge(Eigen::Vector3d(1e300, 0, 0), 0.5e300);
+    EXPECT_DOUBLE_EQ(huge.side(Eigen::Vector3d(1, 0, 0)), 0.5);
     const PlaneCut plane(Eigen::Vector3d(0, 0, 2), 1.0);  // z > 0.5
     EXPECT_NEAR(plane.side(Eigen::Vector3d(0, 0, 1)), 0.5, 1e-15);
     EXPECT_FALSE(plane.cuts_away(Eigen::Vector3d(3, 3, 0.5)));  // on the plane: kept

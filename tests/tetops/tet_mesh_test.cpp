@@ -58,7 +58,16 @@ TEST(TetMesh, ValidateFindsEveryKindOfViolation) {
     bad_material.materials.assign(good.tet_count(), TetMaterial{{0.1, 0.1, 0.1}, {1, 1, 1}, 1.3});
     EXPECT_TRUE(find_invariant_violations(bad_material).empty());
     bad_material.materials[2].musp[1] = -1;
-    EXPECT_FALSE(find_invariant_violations(bad_material).empty());
+    ASSERT_FALSE(find_invariant_violations(bad_material).empty());
+    EXPECT_NE(find_invariant_violations(bad_material)[0].find("tet 2's material: mu_s' (green) = -1 is not a non-negative number"),
+              std::string::npos)
+        << find_invariant_violations(bad_material)[0];
+    bad_material.materials[2].musp[1] = 1;
+    bad_material.materials[1].eta = 0;  // zero is finite and not negative, and still no index
+    ASSERT_FALSE(find_invariant_violations(bad_material).empty());
+    EXPECT_NE(find_invariant_violations(bad_material)[0].find("tet 1's material: eta = 0 is not a positive number"),
+              std::string::npos)
+        << find_invariant_violations(bad_material)[0];
 
     TetMesh short_ids = good;
     short_ids.original_ids.pop_back();
