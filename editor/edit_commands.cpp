@@ -174,9 +174,6 @@ struct FractureCommandOptions {
     bool collapse = FractureOptions{}.collapse_swallowed_walls;
 };
 
-// More cells than this is not a fracture but a re-meshing; the passes cost O(pieces x tets).
-constexpr int kMaxFracturePieces = 1000;
-
 void run_fracture_command(const FractureCommandOptions& o) {
     if (o.pieces < 1 || o.pieces > kMaxFracturePieces)
         throw InvalidArgumentError("fracture --pieces: must be between 1 and " + std::to_string(kMaxFracturePieces) +

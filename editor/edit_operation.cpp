@@ -4,6 +4,7 @@
 
 #include "solver/material.h"
 #include "tetops/error.h"
+#include "tetops/fracture.h"
 
 #include <nlohmann/json.hpp>
 
@@ -250,7 +251,8 @@ EditOperation edit_operation_from_json(const Json& json, const std::string& cont
             if (in.has("pieces") || in.has("seed")) fail_json(in.context(), "give either 'seeds' or 'pieces' and 'seed'");
         } else {
             const int64_t pieces = in.integer("pieces");
-            if (pieces < 1 || pieces > 100000) fail_json(in.field("pieces"), "must be between 1 and 100000");
+            if (pieces < 1 || pieces > kMaxFracturePieces)
+                fail_json(in.field("pieces"), "must be between 1 and " + std::to_string(kMaxFracturePieces));
             op.pieces = static_cast<int>(pieces);
             const int64_t seed = in.integer("seed", 0);
             if (seed < 0 || seed > int64_t{UINT32_MAX}) fail_json(in.field("seed"), "must be in [0, 2^32)");

@@ -65,6 +65,10 @@ struct FractureResult {
     std::vector<VertexOrigin> vertex_origins;
 };
 
+// More cells than this is not a fracture but a re-meshing (the exact split's passes cost O(pieces x
+// tets)): the command line and sessions refuse it (the editor's slider stops at 12).
+inline constexpr int kMaxFracturePieces = 1000;
+
 // `count` seed points scattered inside the volume (world space), deterministic for `seed`: a tet drawn
 // with probability proportional to its volume, then a uniform point in it (std::mt19937).
 // Throws InvalidArgumentError for count < 1, count > tet count or an empty mesh.

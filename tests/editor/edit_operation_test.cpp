@@ -90,6 +90,10 @@ TEST(EditOperation, ErrorsNameTheContextAndTheField) {
     EXPECT_NE(error_of(R"({"op":"move_piece","piece":0,"rotation":[[2,0,0],[0,1,0],[0,0,1]]})").find("rotation"),
               std::string::npos);
     EXPECT_NE(error_of(R"({"op":"fracture","pieces":3,"seeds":[[0,0,0]]})").find("either"), std::string::npos);
+    // The command line's limit (tetops/fracture.h), not a looser one of its own.
+    EXPECT_NE(error_of(R"({"op":"fracture","pieces":1001})").find("field 'pieces': must be between 1 and 1000"),
+              std::string::npos)
+        << error_of(R"({"op":"fracture","pieces":1001})");
     EXPECT_NE(error_of(R"({"op":"relax","relax":{}})").find("exactly one of"), std::string::npos);
 }
 
