@@ -179,8 +179,9 @@ StudyTable study_slivers(const StudySize& size) {
     table.what_waxwork_does =
         "weights are computed relative to each tet's first vertex, which keeps both forms and both precisions "
         "accurate down to 0.01 degrees on these meshes (the table); if float cannot reach the tolerance it "
-        "reports AlgorithmError rather than a wrong image; double precision is the default; meshing and "
-        "relaxation keep angles above 0.5 degrees, so slivers only arrive in imported volumes";
+        "reports AlgorithmError rather than a wrong image; double precision is the default; the meshers aim "
+        "at 10 degrees (TetGen's bound away from the input triangles, CGAL's perturber and exuder) and "
+        "relaxation keeps angles above 0.5 degrees, so slivers like these arrive in imported volumes";
     table.columns = {"flatness", "min_dihedral_deg", "precision", "form", "outcome", "iterations", "rel_error"};
     const int n = size.quick ? 6 : 8;
     const std::vector<double> flatness = size.quick ? std::vector<double>{0.1, 1e-3, 1e-4}

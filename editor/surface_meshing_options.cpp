@@ -22,7 +22,8 @@ void add_surface_meshing_options(CLI::App& command, SurfaceMeshingOptions& optio
     command.add_option("--mesher", options.mesher, "tetgen (keeps the surface's triangles) or cgal (remeshes it)")
         ->check(CLI::IsMember({"tetgen", "cgal"}))
         ->capture_default_str();
-    command.add_option("--min-dihedral", options.min_dihedral, "Minimum dihedral angle bound in degrees")
+    command.add_option("--min-dihedral", options.min_dihedral, "Minimum dihedral angle in degrees: TetGen's bound (away from the input's triangles), "
+                       "the target of CGAL's sliver perturber and exuder")
         ->capture_default_str();
     command.add_option("--radius-edge", options.radius_edge, "Radius-edge ratio bound")->capture_default_str();
     command.add_flag("--fill-holes", options.fill_holes, "Opt-in repair: close holes in an open surface");

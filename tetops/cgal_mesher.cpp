@@ -121,8 +121,11 @@ TetMesh cgal_tetrahedralize(const TriangleSurface& surface, const CgalSettings& 
             params::facet_distance = kFacetDistancePerEdge * size.surface_edge,
             params::cell_radius_edge_ratio = std::max(settings.max_radius_edge_ratio, 2.0),
             params::cell_size = GradedSize{&size, &distance, kCellSizePerEdge});
+        // Perturb, then exude, both towards the sliver bound and without a time limit, so that the
+        // mesh does not depend on the machine's speed.
         const Complex complex = CGAL::make_mesh_3<Complex>(
-            domain, criteria, params::no_perturb(), params::exude(params::sliver_bound = settings.min_dihedral_deg));
+            domain, criteria, params::perturb(params::sliver_bound = settings.min_dihedral_deg),
+            params::exude(params::sliver_bound = settings.min_dihedral_deg));
         return to_tet_mesh(complex);
     } catch (const Error&) {
         throw;
