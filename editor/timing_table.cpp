@@ -94,9 +94,14 @@ TimingRow measure_timing_row(const std::filesystem::path& surface_path, const Ti
     MultiresSolveOptions solve_options;
     solve_options.relative_tolerance = 0.01;
     std::vector<double> x(matrix->size());
+    bool first_solve = true;
     row.solve_ms = median_run_ms(runs, [&] {
         const auto start = Clock::now();
-        for (int c = 0; c < 3; ++c) solver->solve(b[static_cast<size_t>(c)], c, x, solve_options);
+        for (int c = 0; c < 3; ++c) {
+            const MultiresSolveReport report = solver->solve(b[static_cast<size_t>(c)], c, x, solve_options);
+            if (first_solve) row.solve_level0_iterations[static_cast<size_t>(c)] = report.fine.iterations;
+        }
+        first_solve = false;
         return ms_since(start);
     });
 
@@ -165,6 +170,7 @@ nlohmann::ordered_json to_json(const std::vector<TimingRow>& rows) {
                        {"Tb_ms", r.build_ms},
                        {"Tm_ms", r.matrix_ms},
                        {"Ts_ms", r.solve_ms},
+                       {"Ts_level0_iterations", r.solve_level0_iterations},
                        {"cut_ms", r.cut_ms},
                        {"paint_ms", r.paint_ms}});
     return out;

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -40,6 +41,7 @@ struct TimingRow {
     double build_ms = 0;           // T_b = connectivity + hierarchy
     double matrix_ms = 0;          // T_m: three channels and the source term
     double solve_ms = 0;           // T_s: the paper's multires scheme, rgb, from zeros to 1% estimated error
+    std::array<int, 3> solve_level0_iterations{};  // T_s's level-0 CG iterations per channel, first run
     double cut_ms = 0;             // plane cut + 10 relaxation sweeps + connectivity, matrix and hierarchy
     double paint_ms = 0;           // 100-point stroke + matrix row updates + coarse level updates
 };
