@@ -24,7 +24,6 @@
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <set>
 
 namespace waxwork {
 namespace {
@@ -41,15 +40,8 @@ struct SolversCommandOptions {
     MaterialOptions material;
 };
 
-bool is_volume_file(const std::filesystem::path& path) {
-    static const std::set<std::string> volume = {".vtu", ".msh", ".mesh", ".node"};
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return volume.count(ext) > 0;
-}
-
 TetMesh load_or_mesh(const SolversCommandOptions& o) {
-    if (is_volume_file(o.mesh)) return read_volume(o.mesh);
+    if (is_volume_path(o.mesh)) return read_volume(o.mesh);
     if (!o.max_tets)
         throw InvalidArgumentError(o.mesh + ": a surface needs --max-tets (or pass a volume file)");
     const LoadedSurface surface = load_surface_to_mesh(o.mesh, o.meshing);

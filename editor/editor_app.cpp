@@ -40,12 +40,6 @@ double ms_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-bool is_volume_file(const fs::path& path) {
-    std::string e = path.extension().string();
-    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return e == ".vtu" || e == ".msh" || e == ".mesh" || e == ".node" || e == ".ele";
-}
-
 EditorApp* app_of(GLFWwindow* window) { return static_cast<EditorApp*>(glfwGetWindowUserPointer(window)); }
 
 void* gl_proc_address(const char* name) { return reinterpret_cast<void*>(glfwGetProcAddress(name)); }
@@ -164,7 +158,7 @@ void EditorApp::open_file(const fs::path& path) {
     }
     Session setup;
     setup.name = path.filename().string();
-    (is_volume_file(path) ? setup.input.volume : setup.input.surface) = fs::absolute(path);
+    (is_volume_path(path) ? setup.input.volume : setup.input.surface) = fs::absolute(path);
     setup.input.max_tets = options_.max_tets;
     setup.material = options_.material.value_or(material_preset("marble"));
     setup.scale = live_options_.mm_per_unit;

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -136,10 +137,17 @@ SessionStep step_from_json(const Json& json, const std::string& context, const S
     if (in.has("render")) {
         RenderStep r;
         r.file = output_name(in, "render");
+        std::string extension = fs::path(r.file).extension().string();
+        std::transform(extension.begin(), extension.end(), extension.begin(),
+                       [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+        if (extension != ".png") fail_json(in.field("render"), "'" + r.file + "' must be a .png");
         if (in.has("frames")) r.frames = count_from(in, "frames");
         step = r;
     } else if (in.has("save")) {
         step = SaveStep{output_name(in, "save")};
+        if (!is_volume_path(std::get<SaveStep>(step).file))
+            fail_json(in.field("save"), "'" + std::get<SaveStep>(step).file +
+                                            "' must name a volume format (.vtu keeps pieces and materials; .msh, .mesh, .node)");
     } else if (in.has("light")) {
         LightStep l{session.lighting};
         FieldReader light(in.at("light"), in.field("light"));

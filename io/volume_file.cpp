@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <optional>
 #include <string>
 
 namespace waxwork {
@@ -15,7 +16,7 @@ namespace {
 
 enum class VolumeFormat { Vtu, Gmsh, Medit, TetGen };
 
-VolumeFormat format_of(const std::filesystem::path& path) {
+std::optional<VolumeFormat> format_named_by(const std::filesystem::path& path) {
     std::string extension = path.extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -23,11 +24,18 @@ VolumeFormat format_of(const std::filesystem::path& path) {
     if (extension == ".msh") return VolumeFormat::Gmsh;
     if (extension == ".mesh") return VolumeFormat::Medit;
     if (extension == ".node" || extension == ".ele") return VolumeFormat::TetGen;
+    return std::nullopt;
+}
+
+VolumeFormat format_of(const std::filesystem::path& path) {
+    if (const std::optional<VolumeFormat> format = format_named_by(path)) return *format;
     throw FileError(path.string(), "unknown volume file extension '" + path.extension().string() +
                                        "' (expected .vtu, .msh, .mesh, .node or .ele)");
 }
 
 }  // namespace
+
+bool is_volume_path(const std::filesystem::path& path) { return format_named_by(path).has_value(); }
 
 TetMesh read_volume(const std::filesystem::path& path) {
     switch (format_of(path)) {

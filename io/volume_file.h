@@ -15,6 +15,10 @@
 
 namespace waxwork {
 
+// Whether the extension names one of the formats above (case-insensitive), so that read_volume and
+// write_volume accept the path: what a surface or any other file is not.
+bool is_volume_path(const std::filesystem::path& path);
+
 // Throws FileError ("PATH: problem") when the file is missing, malformed, truncated, inconsistent
 // or describes an invalid mesh, or when the extension is not one of the above.
 TetMesh read_volume(const std::filesystem::path& path);

@@ -98,6 +98,11 @@ TEST(Session, ErrorsNameTheFileAndTheStep) {
         e = session_error(R"({"input": {"volume": "v.vtu"}, "steps": [{"render": ")" + name + R"("}]})");
         EXPECT_NE(e.find("must stay inside the output directory"), std::string::npos) << e;
     }
+    // Output formats are checked when the session is read, before any step has written anything.
+    e = session_error(head + R"({"render": "b.txt"}]})");
+    EXPECT_NE(e.find("bad.json: step 1: field 'render': 'b.txt' must be a .png"), std::string::npos) << e;
+    e = session_error(head + R"({"save": "b.obj"}]})");
+    EXPECT_NE(e.find("bad.json: step 1: field 'save': 'b.obj' must name a volume format"), std::string::npos) << e;
     e = session_error(R"({"input": {"volume": "v.vtu"}, "scale": 1e400, "steps": []})");  // no double holds it
     EXPECT_NE(e.find("bad.json: not valid JSON"), std::string::npos) << e;
     EXPECT_NE(e.find("1e400"), std::string::npos) << e;

@@ -123,6 +123,13 @@ void expect_same_geometry(const TetMesh& expected, const TetMesh& actual) {
 // ---------------------------------------------------------------------------------------------
 // Round trips.
 
+// The one list of volume extensions the editor, `bench solvers` and sessions ask before reading or
+// saving (they each kept their own, and one forgot .ele).
+TEST(VolumePath, NamesExactlyTheFormatsReadVolumeReads) {
+    for (const char* name : {"a.vtu", "b.MSH", "c.mesh", "d.node", "e.ele", "dir/f.Vtu"}) EXPECT_TRUE(is_volume_path(name)) << name;
+    for (const char* name : {"a.obj", "b.stl", "c.vtk", "d", "e.vtu.bak", ".vtu"}) EXPECT_FALSE(is_volume_path(name)) << name;
+}
+
 TEST_F(VolumeFileTest, VtuRoundTripIsBitExact) {
     const TetMesh mesh = make_test_mesh();
     write_volume(mesh, path("volume.vtu"));
