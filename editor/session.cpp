@@ -350,6 +350,18 @@ FrameBudget session_frame_budget(const Session& session, const SessionRunOptions
     return ms ? FrameBudget::milliseconds(*ms) : FrameBudget::iterations(session.frame_iterations);
 }
 
+namespace {
+
+// An output named "frames/f1.png" gets its folder inside the output directory (output_name keeps it
+// there); FileError naming the folder when it cannot be made (a file of that name, say).
+void create_parent_directory(const fs::path& path) {
+    std::error_code ec;
+    fs::create_directories(path.parent_path(), ec);
+    if (ec) throw FileError(path.parent_path().string(), "cannot create the directory: " + ec.message());
+}
+
+}  // namespace
+
 SessionResult run_session(const Session& session, const fs::path& output_directory, const SessionRunOptions& run_options) {
     std::error_code ec;
     fs::create_directories(output_directory, ec);
@@ -413,10 +425,12 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
                 const Image picture =
                     render_scene(*renderer, make_render_input(document.mesh(), solved, scene.lighting(), image));
                 const fs::path path = output_directory / r->file;
+                create_parent_directory(path);
                 write_png(picture, path);
                 result.written.push_back(path);
             } else if (const auto* s = std::get_if<SaveStep>(&step)) {
                 const fs::path path = output_directory / s->file;
+                create_parent_directory(path);
                 write_volume(document.mesh(), path);
                 result.written.push_back(path);
             } else if (const auto* l = std::get_if<LightStep>(&step)) {

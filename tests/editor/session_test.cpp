@@ -167,6 +167,19 @@ TEST(Session, WithoutLightsItIsLitAsRenderLightsIt) {
     EXPECT_GT(brightest, brightness(0, 0) + 100);
 }
 
+// Outputs in sub-folders of the output directory get their folders.
+TEST(Session, OutputsInSubfoldersCreateThem) {
+    const fs::path dir = scratch("subfolders");
+    write_volume(testing::make_cube_mesh(3), dir / "cube.vtu");
+    const Session session = parse_session(
+        Json::parse(R"({"input": {"volume": "cube.vtu"}, "image": {"width": 32, "height": 24},
+                        "steps": [{"render": "frames/a.png"}, {"save": "volumes/deep/b.vtu"}]})"),
+        dir, "s.json");
+    run_session(session, dir / "out");
+    EXPECT_TRUE(fs::exists(dir / "out" / "frames" / "a.png"));
+    EXPECT_EQ(read_volume(dir / "out" / "volumes" / "deep" / "b.vtu").tet_count(), testing::make_cube_mesh(3).tet_count());
+}
+
 TEST(Session, RunErrorsNameTheStep) {
     const fs::path dir = scratch("run_errors");
     write_volume(testing::make_cube_mesh(3), dir / "cube.vtu");
