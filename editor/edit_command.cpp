@@ -46,7 +46,7 @@ void run_edit_command(const EditCommandOptions& o) {
         throw InvalidArgumentError("--width/--height must be between 64 and " + std::to_string(kMaxImageSide));
     if (o.frames < 1 || o.frames > 100000) throw InvalidArgumentError("--frames must be between 1 and 100000");
     validate_mm_per_unit(o.scale, "--scale");
-    if (!(o.crease_angle >= 0 && o.crease_angle <= 180))
+    if (!is_crease_angle(o.crease_angle))
         throw InvalidArgumentError("--crease-angle must be between 0 and 180 degrees");
     EditorOptions options;
     options.view.mode = parse_view_mode(o.show);

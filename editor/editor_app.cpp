@@ -334,7 +334,7 @@ void EditorApp::request_solve() {
 }
 
 void EditorApp::set_crease_angle(double degrees) {
-    if (!(degrees >= 0 && degrees <= 180))
+    if (!is_crease_angle(degrees))
         throw InvalidArgumentError("crease angle " + number_text(degrees) + " degrees: must be between 0 and 180");
     live_options_.crease_angle_degrees = degrees;
     if (scene_->core) crease_angle_dirty_ = true;

@@ -2,6 +2,7 @@
 
 #include "editor/json_fields.h"
 #include "solver/material.h"
+#include "solver/shading_surface.h"
 #include "tetops/error.h"
 
 #include <GLFW/glfw3.h>
@@ -171,7 +172,7 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
     } else if (kind == "crease_angle") {
         e.action = ScriptAction::SetCreaseAngle;
         e.degrees = in.number("degrees");
-        if (!(e.degrees >= 0 && e.degrees <= 180)) fail_json(in.field("degrees"), "must be between 0 and 180");
+        if (!is_crease_angle(e.degrees)) fail_json(in.field("degrees"), "must be between 0 and 180");
         events.push_back(e);
     } else if (kind == "idle") {
         e.action = ScriptAction::WaitIdle;

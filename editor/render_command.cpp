@@ -71,7 +71,7 @@ void check_options(const RenderCommandOptions& o) {
     // Below about 1e-15 a relative error is under double's rounding: no solver can report it reached.
     if (!(o.tolerance >= 1e-15 && o.tolerance < 1)) fail("--tol must be a relative tolerance in [1e-15, 1)");
     if (!(o.ambient >= 0 && o.ambient <= kMaxLightValue)) fail("--ambient must be non-negative and at most 1e100");
-    if (!(o.crease_angle >= 0 && o.crease_angle <= 180)) fail("--crease-angle must be between 0 and 180 degrees");
+    if (!is_crease_angle(o.crease_angle)) fail("--crease-angle must be between 0 and 180 degrees");
     if (o.exposure && (!std::isfinite(*o.exposure) || *o.exposure <= 0))
         fail("--exposure must be finite and positive");
     if (!o.view.empty()) {

@@ -6,6 +6,7 @@
 #include "editor/render_pipeline.h"
 #include "editor/surface_meshing_options.h"
 #include "io/atomic_file.h"
+#include "io/file_extension.h"
 #include "io/image_io.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
@@ -17,7 +18,6 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -137,10 +137,7 @@ SessionStep step_from_json(const Json& json, const std::string& context, const S
     if (in.has("render")) {
         RenderStep r;
         r.file = output_name(in, "render");
-        std::string extension = fs::path(r.file).extension().string();
-        std::transform(extension.begin(), extension.end(), extension.begin(),
-                       [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-        if (extension != ".png") fail_json(in.field("render"), "'" + r.file + "' must be a .png");
+        if (lower_extension(r.file) != ".png") fail_json(in.field("render"), "'" + r.file + "' must be a .png");
         if (in.has("frames")) r.frames = count_from(in, "frames");
         step = r;
     } else if (in.has("save")) {
@@ -270,7 +267,7 @@ Session parse_session(const Json& json, const fs::path& base_directory, const st
         if (!problem.empty()) fail_json(in.field("frame_ms"), problem);
     }
     session.crease_angle_degrees = in.number("crease_angle", session.crease_angle_degrees);
-    if (!(session.crease_angle_degrees >= 0 && session.crease_angle_degrees <= 180))
+    if (!is_crease_angle(session.crease_angle_degrees))
         fail_json(in.field("crease_angle"), "must be between 0 and 180 degrees");
     const Json& steps = in.at("steps");
     if (!steps.is_array()) fail_json(in.field("steps"), "expected an array of steps");

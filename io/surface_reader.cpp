@@ -1,5 +1,7 @@
 #include "io/surface_reader.h"
 
+#include "io/file_extension.h"
+
 #include "tetops/error.h"
 
 #include <CGAL/IO/OFF.h>
@@ -137,12 +139,6 @@ private:
 std::mutex& reader_mutex() {
     static std::mutex mutex;
     return mutex;
-}
-
-std::string lower_extension(const std::filesystem::path& path) {
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext;
 }
 
 std::string format_name(const std::string& ext) {

@@ -1,13 +1,12 @@
 #include "io/volume_file.h"
 
+#include "io/file_extension.h"
 #include "io/gmsh_format.h"
 #include "io/medit_format.h"
 #include "io/tetgen_format.h"
 #include "io/vtu_format.h"
 #include "tetops/error.h"
 
-#include <algorithm>
-#include <cctype>
 #include <optional>
 #include <string>
 
@@ -17,9 +16,7 @@ namespace {
 enum class VolumeFormat { Vtu, Gmsh, Medit, TetGen };
 
 std::optional<VolumeFormat> format_named_by(const std::filesystem::path& path) {
-    std::string extension = path.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string extension = lower_extension(path);
     if (extension == ".vtu") return VolumeFormat::Vtu;
     if (extension == ".msh") return VolumeFormat::Gmsh;
     if (extension == ".mesh") return VolumeFormat::Medit;

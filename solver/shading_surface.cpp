@@ -17,7 +17,7 @@
 namespace waxwork {
 
 ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_angle_degrees) {
-    if (!(crease_angle_degrees >= 0.0 && crease_angle_degrees <= 180.0))
+    if (!is_crease_angle(crease_angle_degrees))
         throw InvalidArgumentError("crease angle " + number_text(crease_angle_degrees) +
                                    " degrees: must be between 0 and 180");
     const size_t n = surface.positions.size();

@@ -36,6 +36,10 @@ namespace waxwork {
 // degrees (ShadingSurface.SmoothModelsSplitAlmostNothingAtTheDefaultAngle prints the counts).
 inline constexpr double kDefaultCreaseAngleDegrees = 40.0;
 
+// Whether `degrees` is a crease angle split_at_creases takes: in [0, 180] (NaN is not). Every option,
+// session field and script event that sets the angle checks it with this.
+inline bool is_crease_angle(double degrees) { return degrees >= 0.0 && degrees <= 180.0; }
+
 struct ShadingSurface {
     // The surface vertex each shading vertex copies. Shading vertex s < the surface's vertex count
     // copies surface vertex s (the fan of its first triangle); the further copies of split vertices
