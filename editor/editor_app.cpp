@@ -172,7 +172,7 @@ void EditorApp::open_file(const fs::path& path) {
     status_ = "Loading " + path.string();
     load_task_.start(path.filename().string(), [this, path, setup, material_name, solver = live_options_](TaskProgress& progress) {
         progress.set_stage(setup.input.volume.empty() ? "meshing the surface" : "reading the volume");
-        TetMesh mesh = load_session_input(setup);
+        TetMesh mesh = read_session_input(setup);
         progress.set_stage("building the document and the live scene");
         auto core = make_core(std::move(mesh), setup, solver);
         return BackgroundTask::Apply([this, path, core, material_name] { install_core(core, path, material_name, {}); });

@@ -327,7 +327,7 @@ Session record_session(const Session& setup, const Document& document, const std
     return session;
 }
 
-TetMesh load_session_input(const Session& session) {
+TetMesh read_session_input(const Session& session) {
     if (!session.input.volume.empty()) return read_volume(session.input.volume);
     const LoadedSurface loaded = load_closed_surface(session.input.surface);
     MeshingOptions meshing;
@@ -340,6 +340,15 @@ TetMesh load_session_input(const Session& session) {
         meshing.sizing = default_mesh_sizing(loaded.surface, session.material, session.scale);
     }
     return tetrahedralize_surface_file(session.input.surface, loaded.surface, meshing).mesh;
+}
+
+TetMesh load_session_input(const Session& session) {
+    const std::string context = session.name + ": input";
+    try {
+        return naming_context(context, [&] { return read_session_input(session); });
+    } catch (const FileError& e) {  // still "PATH: PROBLEM" with path() the input; the session follows
+        throw FileError(e.path(), e.problem() + " (" + context + ")");
+    }
 }
 
 FrameBudget session_frame_budget(const Session& session, const SessionRunOptions& run_options) {

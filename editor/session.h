@@ -118,7 +118,12 @@ void write_session(const std::filesystem::path& path, const Session& session);
 Session record_session(const Session& setup, const Document& document,
                        const std::vector<SessionStep>& extra_steps = {});
 
-// The volume a session starts from (meshing the surface, or reading the volume).
+// The volume a session starts from (meshing the surface, or reading the volume); errors name the input
+// file only. For a session that is not a file: the editor opening a mesh.
+TetMesh read_session_input(const Session& session);
+
+// As read_session_input, with the session before every error ("s.json: input: bad.stl: no faces"): a
+// session's input is often a path relative to it, and the user runs the session, not the mesh.
 TetMesh load_session_input(const Session& session);
 
 struct StepMetrics {

@@ -108,6 +108,32 @@ TEST(Session, ErrorsNameTheFileAndTheStep) {
     EXPECT_NE(e.find("1e400"), std::string::npos) << e;
 }
 
+// An input that fails to load names the session as well as the input, whichever error type it raises: the
+// input is a path relative to the session, and the user ran the session.
+TEST(Session, InputErrorsNameTheSession) {
+    const fs::path dir = scratch("input_errors");
+    std::ofstream(dir / "empty.stl") << "solid x\nendsolid x\n";
+    std::ofstream(dir / "open.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";  // one triangle: not closed
+    const auto run_error = [&](const std::string& input) -> std::string {
+        std::ofstream(dir / "s.json") << R"({"input": )" + input + R"(, "steps": []})";
+        try {
+            run_session(read_session(dir / "s.json"), dir / "out");
+        } catch (const Error& e) {
+            return e.what();
+        }
+        return "(no error)";
+    };
+    std::string e = run_error(R"({"volume": "missing.vtu"})");
+    EXPECT_NE(e.find("missing.vtu: cannot open"), std::string::npos) << e;
+    EXPECT_NE(e.find("s.json: input)"), std::string::npos) << e;
+    e = run_error(R"({"surface": "empty.stl"})");
+    EXPECT_NE(e.find("empty.stl"), std::string::npos) << e;
+    EXPECT_NE(e.find("s.json: input"), std::string::npos) << e;
+    e = run_error(R"({"surface": "open.obj"})");
+    EXPECT_NE(e.find("open.obj"), std::string::npos) << e;
+    EXPECT_NE(e.find("s.json: input"), std::string::npos) << e;
+}
+
 // The crease angle is the session's: it round-trips, a bad one names the field, and it reaches the
 // rendered frames (a cube's edges shade as folded at 40 degrees and as one normal per vertex at 180).
 TEST(Session, CreaseAngleRoundTripsAndReachesTheFrames) {
