@@ -70,7 +70,9 @@ void LiveScene::relight(SceneUpdate& update) {
 
 void LiveScene::light_shading() {
     shading_light_ = shading_light(surface_, shading_, shadow_bvh_, lighting_, surface_q_, surface_visibility_);
-    q_ = to_volume_vertices(surface_, source_light(surface_, shading_, shading_light_.q), matrix_.size());
+    const std::vector<Rgb> surface_source_q = source_light(surface_, shading_, shading_light_.q);
+    corners_ = corner_light(surface_, shading_, shading_light_.q, surface_source_q);
+    q_ = to_volume_vertices(surface_, surface_source_q, matrix_.size());
 }
 
 SceneUpdate LiveScene::set_crease_angle(double degrees) {
@@ -93,6 +95,7 @@ void LiveScene::refresh_right_hand_sides() {
     for (int c = 0; c < 3; ++c) {
         b_[c].resize(n);
         diffusion_right_hand_side(matrix_, q_, c, b_[c]);
+        add_corner_light(matrix_, corners_, c, b_[c]);
     }
     solver_->right_hand_sides_changed();
     mark_unconverged();
@@ -200,13 +203,19 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
             refresh_right_hand_sides();  // the source operator (A, F_dr) follows the materials
         } else if (!update.updated_rows.empty()) {
             // q is unchanged and only the rewritten rows of the source operator can differ: b changes
-            // in those rows only (b = source * q, Eq. 12). Cheaper than a full product per channel.
+            // in those rows only (b = source * q, Eq. 12, plus the corners' share, whose coefficients
+            // changed only in those rows too). Cheaper than a full product per channel.
             for (const int32_t i : update.updated_rows) {
                 std::array<double, 3> sum{};
                 if (matrix_.vertex_face_offsets[i] != matrix_.vertex_face_offsets[i + 1])
                     for (int32_t k = matrix_.offsets[i]; k < matrix_.offsets[i + 1]; ++k)
                         for (int c = 0; c < 3; ++c) sum[c] += matrix_.source[k] * q_[matrix_.columns[k]][c];
                 for (int c = 0; c < 3; ++c) b_[c][i] = sum[c];
+            }
+            if (!corners_.empty()) {
+                std::vector<uint8_t> rows(matrix_.size(), 0);
+                for (const int32_t i : update.updated_rows) rows[i] = 1;
+                for (int c = 0; c < 3; ++c) add_corner_light(matrix_, corners_, c, b_[c], rows);
             }
             solver_->right_hand_sides_changed();
         }

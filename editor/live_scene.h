@@ -199,7 +199,8 @@ private:
     std::vector<float> surface_visibility_;     // per surface vertex and light (incident_light)
     ShadingSurface shading_;                    // the surface split at creases (options_.crease_angle_degrees)
     ShadingLight shading_light_;                // q and visibility per shading vertex
-    std::vector<Rgb> q_;                        // per volume vertex
+    std::vector<Rgb> q_;                        // per volume vertex: source_light
+    std::vector<CornerLight> corners_;          // the rest of the light at creases: corner_light
     std::array<std::vector<double>, 3> b_;      // right-hand side per channel
     std::array<std::vector<double>, 3> phi_;    // current fluence per channel
     std::unique_ptr<LiveSolver> solver_;

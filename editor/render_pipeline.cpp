@@ -148,11 +148,13 @@ SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity
     const std::vector<Rgb> surface_q = incident_light(scene.surface, bvh, lighting, &visibility);
     scene.shading = split_at_creases(scene.surface, crease_angle_degrees);
     scene.shading_light = shading_light(scene.surface, scene.shading, bvh, lighting, surface_q, visibility);
-    scene.q = to_volume_vertices(scene.surface, source_light(scene.surface, scene.shading, scene.shading_light.q),
-                                 mesh.vertex_count());
+    const std::vector<Rgb> surface_source_q = source_light(scene.surface, scene.shading, scene.shading_light.q);
+    const std::vector<CornerLight> corners =
+        corner_light(scene.surface, scene.shading, scene.shading_light.q, surface_source_q);
+    scene.q = to_volume_vertices(scene.surface, surface_source_q, mesh.vertex_count());
     scene.lighting_ms = milliseconds_since(lighting_start);
 
-    scene.diffusion = solve_diffusion(mesh, connectivity, materials, scene.q, options);
+    scene.diffusion = solve_diffusion(mesh, connectivity, materials, scene.q, options, corners);
     for (size_t v = 0; v < scene.diffusion.phi.size(); ++v) {
         for (int c = 0; c < 3; ++c) {
             if (!std::isfinite(scene.diffusion.phi[v][c]))

@@ -381,6 +381,39 @@ void diffusion_right_hand_side(const DiffusionMatrix& m, const std::vector<std::
     });
 }
 
+void add_corner_light(const DiffusionMatrix& m, std::span<const CornerLight> corners, int channel,
+                      std::span<double> b, std::span<const uint8_t> rows) {
+    if (channel < 0 || channel > 2) throw InvalidArgumentError("corner light: channel must be 0, 1 or 2");
+    if (b.size() != m.size() || (!rows.empty() && rows.size() != m.size()))
+        throw InvalidArgumentError("corner light: b (" + std::to_string(b.size()) + ") and the row mask (" +
+                                   std::to_string(rows.size()) + ") must have the vertex count " +
+                                   std::to_string(m.size()));
+    const bool fem = m.options.discretization == Discretization::Fem;
+    // Serial: corners lie along creases only (a few percent of the surface at most), and neighbouring
+    // corners add to the same rows.
+    for (const CornerLight& corner : corners) {
+        if (corner.face < 0 || static_cast<size_t>(corner.face) >= m.boundary_face_area.size() || corner.tet < 0 ||
+            static_cast<size_t>(corner.tet) >= m.tet_coefficients.size() ||
+            std::any_of(corner.vertices.begin(), corner.vertices.end(),
+                        [&](int32_t v) { return v < 0 || static_cast<size_t>(v) >= m.size(); }))
+            throw InvalidArgumentError("corner light: face " + std::to_string(corner.face) + " of tet " +
+                                       std::to_string(corner.tet) + " is not in the matrix");
+        // The face's source weight, as assemble_row_impl adds it (Eq. 12 and its consistent variant).
+        const double weight = 8.0 * m.tet_coefficients[corner.tet].inv_a_one_minus_fdr *
+                              m.boundary_face_area[corner.face] * corner.delta[channel];
+        const auto add = [&](int32_t row, double value) {
+            if (rows.empty() || rows[row]) b[row] += value;
+        };
+        if (fem) {
+            add(corner.vertices[0], weight / 6.0);
+            add(corner.vertices[1], weight / 12.0);
+            add(corner.vertices[2], weight / 12.0);
+        } else {
+            add(corner.vertices[0], weight / 3.0);
+        }
+    }
+}
+
 std::vector<double> lumped_vertex_volumes(const DiffusionMatrix& m, const TetConnectivity& conn) {
     std::vector<double> volumes(m.size(), 0.0);
     for (size_t i = 0; i < m.size(); ++i)

@@ -153,6 +153,26 @@ std::vector<int32_t> update_diffusion_matrix(DiffusionMatrix& matrix, const TetM
 void diffusion_right_hand_side(const DiffusionMatrix& matrix, const std::vector<std::array<double, 3>>& q,
                                int channel, std::span<double> b);
 
+// Light that one corner of a boundary face receives apart from its vertex's q. Where the boundary folds
+// (a crease, shading_surface.h) each face should integrate the light of its own side, while
+// b = source * q above has one q per vertex; the corners where the two differ carry the difference.
+struct CornerLight {
+    int32_t face;                       // into TetConnectivity::boundary_faces (boundary_face_area)
+    int32_t tet;                        // the tet the face belongs to (its 1 / (A (1 - F_dr)))
+    std::array<int32_t, 3> vertices;    // the face's vertices, this corner first
+    std::array<double, 3> delta;        // rgb: the corner's light minus q of its vertex
+};
+
+// b += the corners' share of Eq. 12 for one channel: the face's own source entries times delta, so that
+// b = source * q plus this is sum_f sum_{j in f} s^f_ij q_j^f with q_j^f the light of j's corner in f.
+// TransCut lumps s^f (8 S_f / (3 A (1 - F_dr)) on the corner's own row); FEM's consistent face mass
+// also gives each of the face's other two rows half the corner's weight. The coefficients are read
+// from the matrix when this runs, so corners stay valid across painting. `rows`, when not empty, is a
+// per-vertex mask: only rows with a non-zero entry are added to (a partial refresh of b). Throws
+// InvalidArgumentError for a corner outside the matrix or a bad channel or size.
+void add_corner_light(const DiffusionMatrix& matrix, std::span<const CornerLight> corners, int channel,
+                      std::span<double> b, std::span<const uint8_t> rows = {});
+
 // Lumped volume per vertex (sum over its tets of V_t / 4, mm^3): the weights of vertex-based L2 norms.
 std::vector<double> lumped_vertex_volumes(const DiffusionMatrix& matrix, const TetConnectivity& connectivity);
 

@@ -256,7 +256,8 @@ std::array<ConjugateGradientResult, 3> solve_rgb(const DiffusionMatrix& m, const
 }  // namespace
 
 void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std::array<double, 3>>& q,
-                            const DiffusionOptions& options, DiffusionSolution& solution) {
+                            const DiffusionOptions& options, DiffusionSolution& solution,
+                            std::span<const CornerLight> corners) {
     const auto start = std::chrono::steady_clock::now();
     const size_t n = matrix.size();
     if (solution.phi.size() != n) solution.phi.assign(n, {0.0, 0.0, 0.0});
@@ -267,6 +268,7 @@ void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std
     for (int c = 0; c < 3; ++c) {
         b[c].resize(n);
         diffusion_right_hand_side(matrix, q, c, b[c]);
+        add_corner_light(matrix, corners, c, b[c]);
     }
     // Float: the three channels in one loop (solve_rgb); the interleaved float values and the pattern
     // (~16 bytes per nonzero) stay in the last-level cache across iterations at 500K tets. Double:
@@ -344,7 +346,8 @@ void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std
 
 DiffusionSolution solve_diffusion(const TetMesh& mesh, const TetConnectivity& connectivity,
                                   const std::vector<TetMaterial>& materials,
-                                  const std::vector<std::array<double, 3>>& q, const DiffusionOptions& options) {
+                                  const std::vector<std::array<double, 3>>& q, const DiffusionOptions& options,
+                                  std::span<const CornerLight> corners) {
     if (q.size() != mesh.vertex_count())
         throw InvalidArgumentError("solve_diffusion: " + std::to_string(q.size()) + " light values for " +
                                    std::to_string(mesh.vertex_count()) + " vertices");
@@ -356,7 +359,7 @@ DiffusionSolution solve_diffusion(const TetMesh& mesh, const TetConnectivity& co
     assembly.mm_per_unit = options.mm_per_unit;
     const DiffusionMatrix matrix = assemble_diffusion_matrix(mesh, connectivity, materials, assembly);
     solution.assembly_ms = ms_since(start);
-    solve_diffusion_system(matrix, q, options, solution);
+    solve_diffusion_system(matrix, q, options, solution, corners);
     return solution;
 }
 

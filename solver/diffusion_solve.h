@@ -9,6 +9,7 @@
 #include "tetops/tet_mesh.h"
 
 #include <array>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -58,16 +59,20 @@ struct DiffusionSolution {
 };
 
 // q: per vertex (volume vertex order), per channel, the diffuse incoming light (only boundary vertices
-// are read). materials: one per tet. Throws InvalidArgumentError for invalid coefficients or sizes and
-// AlgorithmError if the solver breaks down or fails to converge to the tolerance.
+// are read); `corners`: where faces at a crease receive other light than their vertex's q
+// (shading_surface.h: corner_light), added to b = source * q. materials: one per tet. Throws
+// InvalidArgumentError for invalid coefficients or sizes and AlgorithmError if the solver breaks down or
+// fails to converge to the tolerance.
 DiffusionSolution solve_diffusion(const TetMesh& mesh, const TetConnectivity& connectivity,
                                   const std::vector<TetMaterial>& materials,
-                                  const std::vector<std::array<double, 3>>& q, const DiffusionOptions& options);
+                                  const std::vector<std::array<double, 3>>& q, const DiffusionOptions& options,
+                                  std::span<const CornerLight> corners = {});
 
 // Solves an assembled system (all three channels) with Jacobi CG; phi is the warm start and result
 // (resized and zeroed if its size is wrong). Fills iterations, errors, solve_ms, backend and
 // gpu_fallback_reason of `solution`.
 void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std::array<double, 3>>& q,
-                            const DiffusionOptions& options, DiffusionSolution& solution);
+                            const DiffusionOptions& options, DiffusionSolution& solution,
+                            std::span<const CornerLight> corners = {});
 
 }  // namespace waxwork

@@ -65,7 +65,8 @@ struct BoundarySurface {
     std::vector<int32_t> vertices;                 // volume vertex of each surface vertex (ascending)
     std::vector<Eigen::Vector3d> positions;        // world space (piece transform applied)
     std::vector<Eigen::Vector3d> normals;          // unit, area-weighted, outward
-    std::vector<std::array<int32_t, 3>> triangles; // into the surface arrays, counter-clockwise outside
+    // Into the surface arrays, counter-clockwise outside; triangle t is TetConnectivity::boundary_faces[t].
+    std::vector<std::array<int32_t, 3>> triangles;
     std::vector<int32_t> triangle_tets;            // the tet each triangle is a face of
     std::vector<double> eta;                       // relative index of refraction per surface vertex
 };

@@ -207,4 +207,37 @@ std::vector<Rgb> source_light(const BoundarySurface& surface, const ShadingSurfa
     return q;
 }
 
+std::vector<CornerLight> corner_light(const BoundarySurface& surface, const ShadingSurface& shading,
+                                      const std::vector<Rgb>& shading_q, const std::vector<Rgb>& q) {
+    const size_t n = surface.positions.size();
+    if (shading_q.size() != shading.size() || q.size() != n || shading.triangles.size() != surface.triangles.size() ||
+        surface.triangle_tets.size() != surface.triangles.size())
+        throw InvalidArgumentError("corner_light: " + std::to_string(shading_q.size()) + " shading and " +
+                                   std::to_string(q.size()) + " vertex light values, " +
+                                   std::to_string(shading.size()) + " shading vertices and " +
+                                   std::to_string(shading.triangles.size()) + " shading triangles for a surface of " +
+                                   std::to_string(n) + " vertices and " + std::to_string(surface.triangles.size()) +
+                                   " triangles");
+    std::vector<CornerLight> corners;
+    if (shading.split_copies.empty()) return corners;
+    std::vector<uint8_t> split(shading.size(), 0);
+    for (const int32_t copy : shading.split_copies) split[static_cast<size_t>(copy)] = 1;
+    for (size_t t = 0; t < shading.triangles.size(); ++t) {
+        for (int k = 0; k < 3; ++k) {
+            const auto copy = static_cast<size_t>(shading.triangles[t][k]);
+            if (!split[copy]) continue;
+            const auto& tri = surface.triangles[t];
+            const auto s = static_cast<size_t>(tri[k]);
+            CornerLight corner;
+            for (int c = 0; c < 3; ++c) corner.delta[c] = shading_q[copy][c] - q[s][c];
+            if (corner.delta == Rgb{0, 0, 0}) continue;
+            corner.face = static_cast<int32_t>(t);
+            corner.tet = surface.triangle_tets[t];
+            for (int j = 0; j < 3; ++j) corner.vertices[j] = surface.vertices[tri[(k + j) % 3]];
+            corners.push_back(corner);
+        }
+    }
+    return corners;
+}
+
 }  // namespace waxwork

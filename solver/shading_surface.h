@@ -18,6 +18,7 @@
 // its whole area instead of q at 0 degrees on the lit side and nothing on the grazed one).
 #pragma once
 
+#include "solver/diffusion_matrix.h"
 #include "solver/lighting.h"
 
 #include <Eigen/Core>
@@ -90,5 +91,15 @@ ShadingLight shading_light(const BoundarySurface& surface, const ShadingSurface&
 // (ShadingLight::q); throws InvalidArgumentError on mismatched sizes.
 std::vector<Rgb> source_light(const BoundarySurface& surface, const ShadingSurface& shading,
                               const std::vector<Rgb>& shading_q);
+
+// The rest of the light at creases: the face corners whose shading copy's q differs from the vertex's
+// `q` (per surface vertex: source_light's), each with that difference (diffusion_matrix.h:
+// add_corner_light). With them b integrates each face's own light exactly, for either discretisation
+// and whatever the faces' refractive indices: source_light's mean is only exact for the lumped source
+// of faces that share one eta. Only corners at split vertices are listed, ascending by face; faces are
+// the surface's triangles, which are TetConnectivity::boundary_faces in order. Throws
+// InvalidArgumentError on mismatched sizes.
+std::vector<CornerLight> corner_light(const BoundarySurface& surface, const ShadingSurface& shading,
+                                      const std::vector<Rgb>& shading_q, const std::vector<Rgb>& q);
 
 }  // namespace waxwork

@@ -1,5 +1,6 @@
 #include "solver/shading_surface.h"
 
+#include "solver/diffusion_matrix.h"
 #include "solver/material.h"
 #include "solver/radiance.h"
 #include "solver/solver_test_meshes.h"
@@ -356,6 +357,86 @@ TEST(SourceLight, IntegratesEachSideOfACreaseWithItsOwnLight) {
     short_q.pop_back();
     EXPECT_THROW(source_light(cube.surface, shading, short_q), InvalidArgumentError);
     EXPECT_THROW(source_light(cube.surface, shading, q), InvalidArgumentError);  // per surface vertex, not copy
+}
+
+// The right-hand side with the corners' light (corner_light + add_corner_light) against Eq. 12 written
+// out face by face: every boundary face f adds its source weight 8 S_f / (A_f (1 - F_dr,f)) times its
+// face mass (lumped S_f / 3 on the diagonal; FEM S_f / 6 and S_f / 12) times the light of ITS corners,
+// the q of the shading copy each corner belongs to. The cube's tets get four different etas, so the
+// faces on either side of an edge weigh their light differently: the case where source_light's
+// area-weighted mean alone is not exact even for the lumped source.
+TEST(CornerLight, MakesTheRightHandSideIntegrateEachFacesOwnLight) {
+    const TetMesh mesh = test::make_cube_mesh(3);
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    std::vector<TetMaterial> materials(mesh.tet_count(), material_preset("marble"));
+    for (size_t t = 0; t < materials.size(); ++t) materials[t].eta = 1.0 + 0.15 * static_cast<double>(t % 4);
+    const BoundarySurface surface = extract_boundary_surface(mesh, connectivity, materials);
+    Lighting lighting;  // oblique: every face gets its own light, three in shade
+    lighting.lights.push_back({LightType::Directional, Eigen::Vector3d(0.5, -1, -0.3), {1, 1, 1}});
+    lighting.ambient = {0.01, 0.01, 0.01};
+    const LitShading lit(surface, lighting);
+    const std::vector<Rgb> source = source_light(surface, lit.shading, lit.light.q);
+    const std::vector<CornerLight> corners = corner_light(surface, lit.shading, lit.light.q, source);
+    ASSERT_FALSE(corners.empty());
+    for (const CornerLight& corner : corners) {  // only corners at split vertices, whose light differs
+        const auto& face = connectivity.boundary_faces[corner.face];
+        EXPECT_EQ(corner.tet, face.tet);
+        EXPECT_TRUE(std::is_permutation(corner.vertices.begin(), corner.vertices.end(), face.vertices.begin()));
+        EXPECT_NE(corner.delta, (Rgb{0, 0, 0}));
+    }
+    const std::vector<Rgb> q = to_volume_vertices(surface, source, mesh.vertex_count());
+
+    for (const Discretization discretization : {Discretization::TransCut, Discretization::Fem}) {
+        AssemblyOptions options;
+        options.discretization = discretization;
+        const DiffusionMatrix matrix = assemble_diffusion_matrix(mesh, connectivity, materials, options);
+        for (int c = 0; c < 3; ++c) {
+            std::vector<double> expected(matrix.size(), 0.0);
+            for (size_t t = 0; t < surface.triangles.size(); ++t) {
+                const auto& tri = surface.triangles[t];
+                const double area =
+                    0.5 * (surface.positions[tri[1]] - surface.positions[tri[0]])
+                              .cross(surface.positions[tri[2]] - surface.positions[tri[0]])
+                              .norm();
+                const double eta = materials[surface.triangle_tets[t]].eta;
+                const double fdr = diffuse_fresnel_reflectance(eta);
+                const double weight = 8.0 * area / (boundary_reflection_parameter(eta) * (1 - fdr));
+                for (int j = 0; j < 3; ++j) {
+                    const double light = lit.light.q[lit.shading.triangles[t][j]][c];
+                    for (int i = 0; i < 3; ++i) {
+                        const double mass = discretization == Discretization::TransCut ? (i == j ? 1.0 / 3 : 0.0)
+                                                                                       : (i == j ? 1.0 / 6 : 1.0 / 12);
+                        expected[surface.vertices[tri[i]]] += weight * mass * light;
+                    }
+                }
+            }
+            std::vector<double> b(matrix.size()), without(matrix.size());
+            diffusion_right_hand_side(matrix, q, c, without);
+            b = without;
+            add_corner_light(matrix, corners, c, b);
+            double worst = 0, worst_without = 0, scale = 0;
+            for (size_t i = 0; i < b.size(); ++i) {
+                worst = std::max(worst, std::abs(b[i] - expected[i]));
+                worst_without = std::max(worst_without, std::abs(without[i] - expected[i]));
+                scale = std::max(scale, std::abs(expected[i]));
+            }
+            EXPECT_LT(worst, 1e-12 * scale) << (discretization == Discretization::Fem ? "FEM" : "TransCut");
+            EXPECT_GT(worst_without, 1e-3 * scale) << "the mean alone must miss: else this test tests nothing";
+        }
+    }
+
+    // Nothing split, no corners; sizes are checked.
+    const ShadingSurface unsplit = split_at_creases(surface, 180.0);
+    const ShadingLight unsplit_light = shading_light(surface, unsplit, lit.bvh, lighting, lit.q, lit.visibility);
+    EXPECT_TRUE(corner_light(surface, unsplit, unsplit_light.q, source_light(surface, unsplit, unsplit_light.q)).empty());
+    EXPECT_THROW(corner_light(surface, lit.shading, lit.q, source), InvalidArgumentError);
+    const DiffusionMatrix matrix = assemble_diffusion_matrix(mesh, connectivity, materials);
+    std::vector<double> b(matrix.size() - 1);
+    EXPECT_THROW(add_corner_light(matrix, corners, 0, b), InvalidArgumentError);
+    std::vector<CornerLight> outside = {corners.front()};
+    outside.front().face = static_cast<int32_t>(connectivity.boundary_faces.size());
+    b.resize(matrix.size());
+    EXPECT_THROW(add_corner_light(matrix, outside, 0, b), InvalidArgumentError);
 }
 
 TEST(ShadingRadiance, EqualsTheVertexRadianceWhereNotSplitAndUsesTheCopysLightWhereSplit) {
