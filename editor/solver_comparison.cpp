@@ -3,6 +3,7 @@
 #include "editor/repeated_timing.h"
 #include "editor/svg_chart.h"
 #include "io/atomic_file.h"
+#include "multires/cascadic_solver.h"
 #include "multires/gpu_multigrid_frame_solver.h"
 #include "multires/gpu_multires_solver.h"
 #include "multires/multigrid_cg.h"
@@ -216,6 +217,16 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
     result.solvers.push_back(measurer.curve("multigrid_cg", [&](int cap, Fields& x) {
         for (int c = 0; c < 3; ++c)
             solve_multigrid_cg(multigrid, c, b_copy[static_cast<size_t>(c)], x[static_cast<size_t>(c)], exact_iteration_count(cap));
+    }));
+
+    // The paper's coarse-to-fine pass on the multigrid's Galerkin operators (cascadic_solver.h), with
+    // its default schedule; cap = level-0 CG iterations. No setup of its own: it borrows `multigrid`'s.
+    CascadicSolver cascadic(multigrid);
+    result.solvers.push_back(measurer.curve("cascadic_cg", [&](int cap, Fields& x) {
+        CascadicOptions solve;
+        solve.relative_tolerance = 1e-15;
+        solve.max_iterations = cap;
+        for (int c = 0; c < 3; ++c) cascadic.solve(b_copy[static_cast<size_t>(c)], c, x[static_cast<size_t>(c)], solve);
     }));
 
     // The live editor's frame solver (multigrid_frame_solver.h): the same multigrid CG with the three

@@ -18,7 +18,8 @@
 //
 // What is timed. Per-mesh setup that a frame does not repeat is excluded and reported separately, as
 // its first run and as a rebuild (SolverComparison): the multires hierarchy (hierarchy_ms), the
-// multigrid Galerkin operators and coarsest factorisation (multigrid_setup_ms), the frame solver's own
+// multigrid Galerkin operators and coarsest factorisation (multigrid_setup_ms; cascadic_cg borrows
+// them), the frame solver's own
 // hierarchy, Galerkin operators and interleaved matrix (multigrid_rgb_setup_ms), the float copies of the matrices and the Eigen sparse matrices. Eigen's
 // incomplete Cholesky factorisation is part of every eigen_ic_cg run (its API factorises per solve),
 // and the direct solver's time is factorisation plus solve.
@@ -66,7 +67,7 @@ struct SolverComparison {
     double multigrid_setup_ms = 0, multigrid_setup_rebuild_ms = 0;
     // MultigridFrameSolver's constructor (its own hierarchy included).
     double multigrid_rgb_setup_ms = 0, multigrid_rgb_setup_rebuild_ms = 0;
-    std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, multigrid_cg_rgb,
+    std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, cascadic_cg, multigrid_cg_rgb,
                                        // eigen_ic_cg, [gpu_cg, gpu_multires, gpu_multigrid_cg,] direct
     std::string gpu_fallback_reason;   // options.gl given but the GPU could not run (curves left out)
 };

@@ -184,6 +184,17 @@ void MultigridPreconditioner::solve_coarsest_rgb(std::span<const float> b, std::
     }
 }
 
+void MultigridPreconditioner::solve_coarsest(int channel, std::span<const double> b, std::span<double> x) {
+    Level& level = *levels_.back();
+    if (channel < 0 || channel > 2) throw InvalidArgumentError("multigrid solve_coarsest: channel must be 0, 1 or 2");
+    if (b.size() != level.n || x.size() != level.n)
+        throw InvalidArgumentError("multigrid solve_coarsest: vectors of size " + std::to_string(b.size()) + " and " +
+                                   std::to_string(x.size()) + " for " + std::to_string(level.n) + " entries");
+    const auto n = static_cast<Eigen::Index>(level.n);
+    level.coarse_solution = level.coarsest[static_cast<size_t>(channel)].solve(Eigen::Map<const Eigen::VectorXd>(b.data(), n));
+    std::copy(level.coarse_solution.begin(), level.coarse_solution.end(), x.begin());
+}
+
 // A level pair (l, l + 1) of the previous preconditioner, for the rebuild constructor, and the maps
 // between its vertices and the new ones (-1: none).
 struct MultigridPreconditioner::CarriedLevel {

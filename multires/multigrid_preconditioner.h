@@ -133,6 +133,10 @@ public:
     // factorisation the V-cycle uses: b is widened to double, x rounded to float, as apply_rgb does.
     // Throws InvalidArgumentError on a size mismatch. Not thread-safe.
     void solve_coarsest_rgb(std::span<const float> b, std::span<float> x);
+    // x = A_L^-1 b on the coarsest level for one channel, in double (the cascadic solver's coarsest
+    // solve, cascadic_solver.h). Throws InvalidArgumentError on a size mismatch or a bad channel. Not
+    // thread-safe.
+    void solve_coarsest(int channel, std::span<const double> b, std::span<double> x);
 
     // z = B r for one channel: one V-cycle from a zero start. Not thread-safe (shared work vectors).
     void apply(int channel, std::span<const double> r, std::span<double> z);

@@ -88,7 +88,8 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
     EXPECT_GE(json["hierarchy_ms"].get<double>(), 0.0);
     const auto& solvers = json["solvers"];
     for (const std::string name :
-         {"jacobi_cg", "jacobi_cg_double", "multires", "multigrid_cg", "multigrid_cg_rgb", "eigen_ic_cg", "direct"})
+         {"jacobi_cg", "jacobi_cg_double", "multires", "multigrid_cg", "cascadic_cg", "multigrid_cg_rgb", "eigen_ic_cg",
+          "direct"})
         expect_valid_curve(solvers, name);
     EXPECT_FALSE(solvers.contains("gpu_cg"));
     const std::string svg = testing::read_text(out / "solvers.svg");

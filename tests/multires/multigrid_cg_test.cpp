@@ -27,6 +27,7 @@ using testing::small_levels;
 
 using testing::reference_solution;
 using testing::relative_error;
+using testing::dense;
 
 std::vector<double> random_vector(size_t n, unsigned seed) {
     std::mt19937 rng(seed);
@@ -40,22 +41,6 @@ double dot(const std::vector<double>& a, const std::vector<double>& b) {
     double s = 0;
     for (size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
     return s;
-}
-
-Eigen::MatrixXd dense(const CsrMatrixView<double>& m) {
-    const auto n = static_cast<Eigen::Index>(m.rows);
-    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(n, n);
-    for (Eigen::Index i = 0; i < n; ++i)
-        for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) d(i, m.columns[k]) += m.values[k];
-    return d;
-}
-
-Eigen::MatrixXd dense(const InterpolationOperator& p, Eigen::Index coarse_rows) {
-    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(p.rows()), coarse_rows);
-    for (size_t v = 0; v < p.rows(); ++v)
-        for (int32_t q = p.offsets[v]; q < p.offsets[v + 1]; ++q)
-            d(static_cast<Eigen::Index>(v), p.columns[static_cast<size_t>(q)]) += p.weights[static_cast<size_t>(q)];
-    return d;
 }
 
 TEST(MultigridPreconditioner, CoarseOperatorsAreGalerkinProducts) {
@@ -125,18 +110,13 @@ TEST(MultigridPreconditioner, DefaultIsSymmetricToFloatRoundingInSingle) {
     expect_symmetric_positive(true, 1e-5, defaults.drop_tolerance, defaults.lumping);
 }
 
-// A box of 10^3 cells whose interior vertices are pushed into caps of relative height 1e-5 (0.0009
-// degree dihedrals, as in the stability study): the row-sum lumped coarse operators lose definiteness,
-// so the setup is redone with absolute lumping, and MG-CG still converges to the direct solution.
+// Slivers (testing::make_sliver_system): the row-sum lumped coarse operators lose definiteness, so the
+// setup is redone with absolute lumping, and MG-CG still converges to the direct solution.
 TEST(MultigridPreconditioner, SliversFallBackToAbsoluteLumpingAndStillConverge) {
-    TetMesh mesh = make_box_mesh({10, 10, 10}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(10));
-    const TetConnectivity connectivity = build_connectivity(mesh);
-    flatten_into_slivers(mesh, connectivity, 6, 1e-5);
-    const std::vector<TetMaterial> materials(mesh.tet_count(), material_preset("marble"));
-    const DiffusionMatrix matrix = assemble_diffusion_matrix(mesh, connectivity, materials);
-    std::vector<double> b(matrix.size(), 0.0);
-    for (const int32_t v : connectivity.boundary_vertices) b[static_cast<size_t>(v)] = 1.0 + 0.1 * mesh.positions[v].x();
-    const MultiresHierarchy h = build_multires_hierarchy(matrix, mesh.positions);
+    const testing::SliverSystem s = testing::make_sliver_system();
+    const DiffusionMatrix& matrix = s.matrix;
+    const std::vector<double>& b = s.b;
+    const MultiresHierarchy& h = s.hierarchy;
     ASSERT_GE(h.level_count(), 2u);
 
     MultigridOptions strict;

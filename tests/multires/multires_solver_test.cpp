@@ -13,16 +13,11 @@ namespace waxwork {
 namespace {
 
 using testing::relative_error;
+using testing::all_finite;
 
 // This suite's references stop at 1e-11.
 std::vector<double> reference_solution(const DiffusionMatrix& m, std::span<const double> b, int channel) {
     return testing::reference_solution(m, b, channel, 1e-11);
-}
-
-bool all_finite(std::span<const double> x) {
-    for (double v : x)
-        if (!std::isfinite(v)) return false;
-    return true;
 }
 
 // A small non-symmetric CSR system with its diagonal slots.

@@ -6,11 +6,15 @@
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/lighting.h"
+#include "solver/material.h"
+#include "tetops/box_mesh.h"
+#include "tetops/sliver_maker.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
 #include "tetops/relaxation.h"
 #include "tetops/test_meshes.h"
 
+#include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
@@ -140,6 +144,55 @@ inline std::vector<double> reference_solution(const DiffusionMatrix& m, std::spa
                                      m.values[static_cast<size_t>(channel)].data()};
     EXPECT_TRUE(solve_jacobi_cg<double>(view, b, x, options).converged);
     return x;
+}
+
+// A box of 10^3 cells (10 mm, marble) whose interior vertices are pushed into caps of relative height
+// 1e-5 (0.0009 degree dihedrals, as in the stability study), with a right-hand side on its boundary
+// and the hierarchy of its system: where row-sum lumped Galerkin operators lose definiteness.
+struct SliverSystem {
+    TetMesh mesh;
+    TetConnectivity connectivity;
+    DiffusionMatrix matrix;
+    std::vector<double> b;
+    MultiresHierarchy hierarchy;
+};
+
+inline SliverSystem make_sliver_system() {
+    SliverSystem s;
+    s.mesh = waxwork::make_box_mesh(std::array<int, 3>{10, 10, 10}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(10));
+    s.connectivity = build_connectivity(s.mesh);
+    flatten_into_slivers(s.mesh, s.connectivity, 6, 1e-5);
+    const std::vector<TetMaterial> materials(s.mesh.tet_count(), material_preset("marble"));
+    s.matrix = assemble_diffusion_matrix(s.mesh, s.connectivity, materials);
+    s.b.assign(s.matrix.size(), 0.0);
+    for (const int32_t v : s.connectivity.boundary_vertices)
+        s.b[static_cast<size_t>(v)] = 1.0 + 0.1 * s.mesh.positions[static_cast<size_t>(v)].x();
+    s.hierarchy = build_multires_hierarchy(s.matrix, s.mesh.positions);
+    return s;
+}
+
+// Dense copies of a compressed-row matrix and of an interpolation operator (coarse_rows columns), for
+// checks against dense linear algebra on small systems.
+inline Eigen::MatrixXd dense(const CsrMatrixView<double>& m) {
+    const auto n = static_cast<Eigen::Index>(m.rows);
+    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(n, n);
+    for (Eigen::Index i = 0; i < n; ++i)
+        for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) d(i, m.columns[k]) += m.values[k];
+    return d;
+}
+
+inline Eigen::MatrixXd dense(const InterpolationOperator& p, Eigen::Index coarse_rows) {
+    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(p.rows()), coarse_rows);
+    for (size_t v = 0; v < p.rows(); ++v)
+        for (int32_t q = p.offsets[v]; q < p.offsets[v + 1]; ++q)
+            d(static_cast<Eigen::Index>(v), p.columns[static_cast<size_t>(q)]) += p.weights[static_cast<size_t>(q)];
+    return d;
+}
+
+inline bool all_finite(std::span<const double> x) {
+    for (double v : x)
+        if (!std::isfinite(v)) return false;
+    return true;
 }
 
 }  // namespace waxwork::testing
