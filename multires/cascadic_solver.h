@@ -37,9 +37,8 @@ namespace waxwork {
 struct CascadicOptions {
     // Jacobi CG iterations on level 1. 0 by default: on spot at 486,745 tets (multires_bench,
     // BM_CascadicTo1Percent) 4 or 16 iterations on level 1 (growth 2) bring the start from 24% to 9%
-    // and 7% but save at most one level-0 iteration (17 -> 16) and add 4 and 8 ms to the 20 ms solve:
-    // the Galerkin coarse operators carry about as many entries per row as level 0, so a coarse
-    // iteration costs about a fine one.
+    // and 7% but save at most one level-0 iteration (17 -> 16, about 1 ms) and add 4 and 8 ms to the
+    // 20 ms solve.
     int level_iterations = 0;
     double growth = 2.0;                // each coarser level gets this many times its finer neighbour's
     int max_level_iterations = 200;     // cap per level
