@@ -60,7 +60,7 @@ struct CascadicReport {
     double fine_ms = 0;
 };
 
-// Checks a CascadicOptions: positive iteration counts, growth >= 1 and finite, tolerance in (0, 1).
+// Checks a CascadicOptions: iteration counts >= 0, growth >= 1 and finite, tolerance in (0, 1).
 // Throws InvalidArgumentError naming the field.
 void validate(const CascadicOptions& options);
 
