@@ -54,6 +54,13 @@ void check_materials(const TetMesh& mesh, const std::vector<TetMaterial>& materi
                                    std::to_string(mesh.tet_count()) + " tets");
 }
 
+// A boundary face's source weight before the face mass splits it among the corners (Eq. 12):
+// 4 (1 / (2A)) from the Robin term times the 4 / (1 - F_dr) of Eq. 2, per unit of area. The lumped
+// mass gives each corner a third of it, the consistent one S/6 on the diagonal and S/12 off it.
+double face_source_weight(const DiffusionMatrix::TetCoefficients& co, double area) {
+    return 8.0 * co.inv_a_one_minus_fdr * area;
+}
+
 }  // namespace
 
 void validate_tet_materials(const std::vector<TetMaterial>& materials, std::span<const int32_t> which) {
@@ -138,8 +145,8 @@ void assemble_row_impl(DiffusionMatrix& m, const TetConnectivity& conn, int32_t 
         const auto& co = m.tet_coefficients[conn.boundary_faces[f].tet];
         if constexpr (Fem) {
             const double r_diag = area * co.inv_a / 3.0, r_off = area * co.inv_a / 6.0;
-            const double s_diag = 8.0 * co.inv_a_one_minus_fdr * area / 6.0;
-            const double s_off = 8.0 * co.inv_a_one_minus_fdr * area / 12.0;
+            const double s_diag = face_source_weight(co, area) / 6.0;
+            const double s_off = face_source_weight(co, area) / 12.0;
             for (int c = 0; c < 3; ++c) diag[c] += r_diag;
             source_diag += s_diag;
             for (int32_t slot : m.vertex_face_slots[k]) {
@@ -148,7 +155,7 @@ void assemble_row_impl(DiffusionMatrix& m, const TetConnectivity& conn, int32_t 
             }
         } else {
             for (int c = 0; c < 3; ++c) diag[c] += 2.0 * area * co.inv_a / 3.0;  // Eq. 13: 2 S_i / (3A)
-            source_diag += 8.0 * area * co.inv_a_one_minus_fdr / 3.0;             // Eq. 12
+            source_diag += face_source_weight(co, area) / 3.0;                    // Eq. 12
         }
     }
     for (int c = 0; c < 3; ++c) val[c][d] += diag[c];
@@ -398,9 +405,9 @@ void add_corner_light(const DiffusionMatrix& m, std::span<const CornerLight> cor
                         [&](int32_t v) { return v < 0 || static_cast<size_t>(v) >= m.size(); }))
             throw InvalidArgumentError("corner light: face " + std::to_string(corner.face) + " of tet " +
                                        std::to_string(corner.tet) + " is not in the matrix");
-        // The face's source weight, as assemble_row_impl adds it (Eq. 12 and its consistent variant).
-        const double weight = 8.0 * m.tet_coefficients[corner.tet].inv_a_one_minus_fdr *
-                              m.boundary_face_area[corner.face] * corner.delta[channel];
+        // The face's source entries, as assemble_row_impl adds them, times this corner's own light.
+        const double weight =
+            face_source_weight(m.tet_coefficients[corner.tet], m.boundary_face_area[corner.face]) * corner.delta[channel];
         const auto add = [&](int32_t row, double value) {
             if (rows.empty() || rows[row]) b[row] += value;
         };
