@@ -81,6 +81,13 @@ InterpolationWeights weights_argument(int64_t argument) {
     return argument != 0 ? InterpolationWeights::LinearExact : InterpolationWeights::InverseEdgeLength;
 }
 
+// The scene's hierarchy with the weights a benchmark argument names.
+MultiresHierarchy scene_hierarchy(const Scene& s, int64_t weights) {
+    HierarchyOptions options;
+    options.weights = weights_argument(weights);
+    return build_multires_hierarchy(s.matrix, s.mesh->positions, options);
+}
+
 std::unique_ptr<MultiresSolver> make_solver(const Scene& s, int64_t weights = 0) {
     HierarchyOptions options;
     options.weights = weights_argument(weights);
@@ -318,9 +325,7 @@ double operator_complexity(const MultigridPreconditioner& mg) {
 // default, 0 the exact products). Counter start_err: the error of the pass's start alone.
 void BM_CascadicTo1Percent(benchmark::State& state) {
     const Scene& s = scene(static_cast<size_t>(state.range(0)));
-    HierarchyOptions hierarchy_options;
-    hierarchy_options.weights = weights_argument(state.range(3));
-    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh->positions, hierarchy_options);
+    const MultiresHierarchy h = scene_hierarchy(s, state.range(3));
     MultigridOptions mg_options;
     mg_options.drop_tolerance = static_cast<double>(state.range(4)) / 1000.0;
     MultigridPreconditioner mg(h, mg_options);
@@ -383,9 +388,7 @@ void BM_MultigridCgTo1Percent(benchmark::State& state) {
 // linear-exact).
 void BM_MultigridSetup(benchmark::State& state) {
     const Scene& s = scene(static_cast<size_t>(state.range(0)));
-    HierarchyOptions hierarchy_options;
-    hierarchy_options.weights = weights_argument(state.range(2));
-    const MultiresHierarchy h = build_multires_hierarchy(s.matrix, s.mesh->positions, hierarchy_options);
+    const MultiresHierarchy h = scene_hierarchy(s, state.range(2));
     MultigridOptions options;
     options.drop_tolerance = static_cast<double>(state.range(1)) / 1000.0;
     for (auto _ : state) {
