@@ -3,6 +3,8 @@
 #include "solver/material.h"
 #include "tetops/error.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -254,6 +256,38 @@ void check_framebuffer(const GlApi& gl, const char* which, int width, int height
 }
 
 Eigen::Matrix4f to_float(const Eigen::Matrix4d& m) { return m.cast<float>(); }
+
+// A point light farther than this from the surface's centre is drawn as the parallel light it
+// approximates: the shader's float d.d overflows beyond about 1.8e19, and at this distance the
+// directions to it differ across any surface float can place by less than float's own precision.
+constexpr double kFarPointLight = 1e15;
+
+// One light as the shader takes it, computed in double so that every light validate() accepts draws:
+// a direction is normalised here (its components may be 1e-30 or 1e50, beyond float's range or
+// precision once squared), and a point light beyond kFarPointLight becomes a direction with the
+// irradiance it gives at the centre.
+struct ShaderLight {
+    std::array<float, 4> vector;     // w = 0: unit direction of travel; w = 1: position
+    std::array<float, 3> intensity;  // irradiance (w = 0) or radiant intensity (w = 1)
+};
+
+ShaderLight shader_light(const Light& light, const Eigen::Vector3d& centre) {
+    Eigen::Vector3d vector = light.vector;
+    double scale = 1.0;
+    float w = 1.0f;
+    if (light.type == LightType::Directional) {
+        vector.normalize();
+        w = 0.0f;
+    } else if (const Eigen::Vector3d travel = centre - light.vector; travel.norm() > kFarPointLight) {
+        scale = 1.0 / travel.squaredNorm();
+        vector = travel.normalized();
+        w = 0.0f;
+    }
+    ShaderLight out;
+    out.vector = {static_cast<float>(vector.x()), static_cast<float>(vector.y()), static_cast<float>(vector.z()), w};
+    for (int c = 0; c < 3; ++c) out.intensity[c] = static_cast<float>(light.intensity[c] * scale);
+    return out;
+}
 
 void validate_input(const SurfaceRenderInput& input) {
     const size_t n = input.positions.size();
@@ -602,15 +636,14 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.Uniform4fv(location("clip_plane"), 1, plane.data());
         const auto light_count = static_cast<int>(input.lighting.lights.size());
         gl.Uniform1i(location("light_count"), light_count);
+        Eigen::AlignedBox3d bounds;
+        for (const Eigen::Vector3f& p : input.positions) bounds.extend(p.cast<double>());
+        const Eigen::Vector3d centre = bounds.isEmpty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(bounds.center());
         for (int i = 0; i < light_count; ++i) {
-            const Light& light = input.lighting.lights[i];
-            const float vector[4] = {static_cast<float>(light.vector.x()), static_cast<float>(light.vector.y()),
-                                     static_cast<float>(light.vector.z()), light.type == LightType::Point ? 1.0f : 0.0f};
-            const float intensity[3] = {static_cast<float>(light.intensity[0]), static_cast<float>(light.intensity[1]),
-                                        static_cast<float>(light.intensity[2])};
+            const ShaderLight light = shader_light(input.lighting.lights[i], centre);
             const std::string index = "[" + std::to_string(i) + "]";
-            gl.Uniform4fv(location(("light_vector" + index).c_str()), 1, vector);
-            gl.Uniform3fv(location(("light_intensity" + index).c_str()), 1, intensity);
+            gl.Uniform4fv(location(("light_vector" + index).c_str()), 1, light.vector.data());
+            gl.Uniform3fv(location(("light_intensity" + index).c_str()), 1, light.intensity.data());
         }
         gl.ActiveTexture(GL_TEXTURE0);
         gl.BindTexture(GL_TEXTURE_2D, transmittance_lut_);

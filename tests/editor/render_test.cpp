@@ -116,6 +116,35 @@ TEST(SurfaceRenderer, TopRowOfTheImageIsTheTopOfTheScene) {
     EXPECT_GT(luminance(image, 48, 26), luminance(image, 48, 46) + 50);
 }
 
+// The highlight of every light validate() accepts: directions with components far below or above
+// float's range, and point lights too far for float's d.d, draw what the same light at a unit scale
+// draws (they used to come out black: a direction of 1e-30 normalised in float is 0/0).
+TEST(SurfaceRenderer, LightsOfAnyValidScaleDrawTheSameHighlight) {
+    SurfaceRenderInput input = make_sphere({0, 0, 0});  // highlight only
+    const Eigen::Vector3d travel(-1, -1, -1);
+    input.lighting.lights = {{LightType::Directional, travel, {2, 2, 2}}};
+    const Image reference = render_surface(input);
+    int lit = 0;
+    for (int y = 0; y < reference.height; ++y)
+        for (int x = 0; x < reference.width; ++x) lit += luminance(reference, x, y) > 60;
+    ASSERT_GT(lit, 5) << "the reference shows no highlight";
+    const auto max_difference = [&](const Image& image) {
+        int worst = 0;
+        for (size_t k = 0; k < image.rgba.size(); ++k) worst = std::max(worst, std::abs(image.rgba[k] - reference.rgba[k]));
+        return worst;
+    };
+    for (const double scale : {1e-30, 1e-60, 1e50, 1e100 / std::sqrt(3.0)}) {
+        input.lighting.lights = {{LightType::Directional, scale * travel, {2, 2, 2}}};
+        EXPECT_LE(max_difference(render_surface(input)), 1) << "direction scaled by " << scale;
+    }
+    // A point light at distance d with intensity 2 d^2 gives the irradiance 2 of the parallel light.
+    for (const double distance : {1e20, 1e40, 1e45}) {
+        const double intensity = 2 * distance * distance;
+        input.lighting.lights = {{LightType::Point, -distance * travel.normalized(), {intensity, intensity, intensity}}};
+        EXPECT_LE(max_difference(render_surface(input)), 1) << "point light at " << distance;
+    }
+}
+
 TEST(SurfaceRenderer, RendererIsReusableAndInputIsValidated) {
     HeadlessGlContext context;
     SurfaceRenderer renderer(context.gl());
