@@ -100,8 +100,11 @@ void run_exact_cut(const CutCommandOptions& o, const PlaneCut& plane) {
     const size_t tets_before = mesh.tet_count();
     const size_t vertices_before = mesh.vertex_count();
     const auto start = Clock::now();
-    const ExactCutResult cut = cut_exact(mesh, plane);
-    require_tets_left_by_cut(mesh, tets_before);
+    const ExactCutResult cut = naming_context(o.input, [&] {  // what the volume does not allow
+        ExactCutResult result = cut_exact(mesh, plane);
+        require_tets_left_by_cut(mesh, tets_before);
+        return result;
+    });
     const TetConnectivity connectivity = build_connectivity(mesh);
     nlohmann::ordered_json summary = {
         {"output", o.output},
@@ -136,8 +139,11 @@ void run_cut_command(const CutCommandOptions& o) {
     const size_t vertices_before = mesh.vertex_count();
 
     const auto start = Clock::now();
-    const CutResult cut = remove_cut_away_tets(mesh, plane);
-    require_tets_left_by_cut(mesh, tets_before);
+    const CutResult cut = naming_context(o.input, [&] {
+        CutResult result = remove_cut_away_tets(mesh, plane);
+        require_tets_left_by_cut(mesh, tets_before);
+        return result;
+    });
     const TetConnectivity connectivity = build_connectivity(mesh);
     RelaxationOptions relax;
     relax.max_iterations = o.relax_iterations;

@@ -4,6 +4,7 @@
 #include "editor/render_pipeline.h"
 #include "editor/view_modes.h"
 #include "io/volume_file.h"
+#include "solver/conjugate_gradient.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
 #include "tetops/connectivity.h"
@@ -68,8 +69,8 @@ void check_options(const RenderCommandOptions& o) {
              std::to_string(o.width) + "x" + std::to_string(o.height) + ")");
     }
     validate_mm_per_unit(o.scale, "--scale");
-    // Below about 1e-15 a relative error is under double's rounding: no solver can report it reached.
-    if (!(o.tolerance >= 1e-15 && o.tolerance < 1)) fail("--tol must be a relative tolerance in [1e-15, 1)");
+    if (!(o.tolerance >= kMinRelativeTolerance && o.tolerance < 1))
+        fail("--tol must be a relative tolerance in [1e-15, 1)");
     if (!(o.ambient >= 0 && o.ambient <= kMaxLightValue)) fail("--ambient must be non-negative and at most 1e100");
     if (!is_crease_angle(o.crease_angle)) fail("--crease-angle must be between 0 and 180 degrees");
     if (o.exposure && (!std::isfinite(*o.exposure) || *o.exposure <= 0))

@@ -10,6 +10,7 @@
 #include "io/image_io.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
+#include "solver/conjugate_gradient.h"
 #include "solver/gl_context.h"
 #include "solver/material.h"
 #include "solver/mesh_resolution.h"
@@ -259,7 +260,8 @@ Session parse_session(const Json& json, const fs::path& base_directory, const st
         image.finish();
     }
     session.tolerance = in.number("tolerance", session.tolerance);
-    if (!(session.tolerance > 0 && session.tolerance < 1)) fail_json(in.field("tolerance"), "must be in (0, 1)");
+    if (!(session.tolerance >= kMinRelativeTolerance && session.tolerance < 1))
+        fail_json(in.field("tolerance"), "must be a relative tolerance in [1e-15, 1)");
     if (in.has("frame_iterations")) session.frame_iterations = count_from(in, "frame_iterations");
     if (in.has("frame_ms")) {
         session.frame_ms = in.number("frame_ms");

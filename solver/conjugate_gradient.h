@@ -40,6 +40,11 @@ struct CsrMatrixView {
     const Scalar* values = nullptr;
 };
 
+// The smallest relative tolerance a user may ask a solve for: below about 1e-15 a relative error is
+// under double's rounding, and no solver can report it reached (the render command, sessions and the
+// live scene refuse less; benchmarks that run a fixed iteration count pass 1e-15 to never stop early).
+inline constexpr double kMinRelativeTolerance = 1e-15;
+
 struct ConjugateGradientOptions {
     double relative_tolerance = 1e-3;  // on the estimated ||phi - x||_D / ||x||_D
     int max_iterations = 10000;
@@ -59,7 +64,7 @@ struct ConjugateGradientOptions {
 // measuring the error reached against the work spent.
 inline ConjugateGradientOptions exact_iteration_count(int iterations) {
     ConjugateGradientOptions options;
-    options.relative_tolerance = 1e-15;
+    options.relative_tolerance = kMinRelativeTolerance;
     options.max_iterations = iterations;
     return options;
 }

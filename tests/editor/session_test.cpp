@@ -94,6 +94,13 @@ TEST(Session, ErrorsNameTheFileAndTheStep) {
     EXPECT_NE(e.find("bad.json: field 'scale': must be a length in mm per model unit"), std::string::npos) << e;
     e = session_error(R"({"input": {"volume": "v.vtu"}, "steps": [})");
     EXPECT_NE(e.find("bad.json: not valid JSON"), std::string::npos) << e;
+    // Under double's rounding no solve can reach a tolerance: refused as render --tol refuses it, not
+    // left to the solver's breakdown message, which blamed the mesh.
+    for (const std::string tolerance : {"1e-300", "1e-16", "0", "1"}) {
+        e = session_error(R"({"input": {"volume": "v.vtu"}, "tolerance": )" + tolerance + R"(, "steps": []})");
+        EXPECT_NE(e.find("bad.json: field 'tolerance': must be a relative tolerance in [1e-15, 1)"), std::string::npos)
+            << e;
+    }
     for (const std::string name : {"../escape.png", "/tmp/escape.png", "a/../../b.vtu"}) {  // outside -o
         e = session_error(R"({"input": {"volume": "v.vtu"}, "steps": [{"render": ")" + name + R"("}]})");
         EXPECT_NE(e.find("must stay inside the output directory"), std::string::npos) << e;
