@@ -38,8 +38,8 @@ LiveScene::LiveScene(const TetMesh& mesh, const Lighting& lighting, const LiveSc
     : mesh_(&mesh), options_(options), lighting_(lighting) {
     if (!(options.mm_per_unit > 0) || !std::isfinite(options.mm_per_unit))
         throw InvalidArgumentError("live scene: mm_per_unit must be positive");
-    if (!(options.relative_tolerance >= kMinRelativeTolerance && options.relative_tolerance < 1))
-        throw InvalidArgumentError("live scene: the relative tolerance must be in [1e-15, 1)");
+    if (!(options.relative_tolerance > 0) || !(options.relative_tolerance < 1))
+        throw InvalidArgumentError("live scene: the relative tolerance must be in (0, 1)");
     validate(lighting_);  // the crease angle is checked by the first split_at_creases
     check_materials(mesh);
     solver_ = std::make_unique<LiveSolver>(

@@ -41,8 +41,9 @@ struct CsrMatrixView {
 };
 
 // The smallest relative tolerance a user may ask a solve for: below about 1e-15 a relative error is
-// under double's rounding, and no solver can report it reached (the render command, sessions and the
-// live scene refuse less; benchmarks that run a fixed iteration count pass 1e-15 to never stop early).
+// under double's rounding, and no solver can report it reached (the render command and sessions
+// refuse less; benchmarks that run a fixed iteration count pass it to never stop early; the live scene
+// takes any tolerance in (0, 1) and says so when a solve stops at its precision floor).
 inline constexpr double kMinRelativeTolerance = 1e-15;
 
 struct ConjugateGradientOptions {
