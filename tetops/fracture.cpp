@@ -14,10 +14,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <random>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 
 namespace waxwork {
@@ -460,30 +462,70 @@ WeldResult weld_touching_pieces(TetMesh& mesh, double tolerance) {
     for (size_t t = 0; t < mesh.tet_count(); ++t)
         for (int32_t v : mesh.tets[t]) vertex_piece[v] = mesh.piece_ids[t];
 
-    // Coincident boundary vertices of different pieces: a kd-tree over the boundary vertices.
+    // Two vertices can be one point only when they are closer than half of either one's shortest
+    // edge: farther apart, merging them folds an edge, and a tolerance above the edge length would
+    // pair neighbours across a crack that have partners of their own.
+    std::vector<double> shortest_edge_sq(mesh.vertex_count(), std::numeric_limits<double>::infinity());
+    for (const Tet& tet : mesh.tets)
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b) {
+                const double length_sq = (world[tet[a]] - world[tet[b]]).squaredNorm();
+                shortest_edge_sq[tet[a]] = std::min(shortest_edge_sq[tet[a]], length_sq);
+                shortest_edge_sq[tet[b]] = std::min(shortest_edge_sq[tet[b]], length_sq);
+            }
+
+    // Candidate pairs: boundary vertices of different pieces within the tolerance (a kd-tree over the
+    // boundary vertices; nanoflann keeps distances strictly under the radius, so one ulp more keeps
+    // those equal to the tolerance, and exact copies at tolerance 0).
     const std::vector<int32_t>& boundary = connectivity.boundary_vertices;
     std::vector<Eigen::Vector3d> boundary_points(boundary.size());
     for (size_t i = 0; i < boundary.size(); ++i) boundary_points[i] = world[boundary[i]];
     PointCloud cloud{boundary_points};
     const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    DisjointSets clusters(mesh.vertex_count());
-    const double radius_sq = tolerance * tolerance;
+    const double radius_sq = std::nextafter(tolerance * tolerance, std::numeric_limits<double>::infinity());
+    struct Candidate {
+        double distance_sq;
+        int32_t a, b;  // vertices, a < b
+    };
+    std::vector<Candidate> candidates;
     std::vector<std::pair<uint32_t, double>> matches;
     for (size_t i = 0; i < boundary.size(); ++i) {
         matches.clear();
         tree.radiusSearch(boundary_points[i].data(), radius_sq, matches, nanoflann::SearchParams(32, 0, false));
-        for (const auto& [j, d] : matches)
-            if (vertex_piece[boundary[j]] != vertex_piece[boundary[i]]) clusters.unite(boundary[i], boundary[j]);
+        const int32_t a = boundary[i];
+        for (const auto& [j, d] : matches) {
+            const int32_t b = boundary[j];
+            if (b > a && vertex_piece[a] != vertex_piece[b] && d <= 0.25 * std::min(shortest_edge_sq[a], shortest_edge_sq[b]))
+                candidates.push_back({d, a, b});
+        }
     }
-    // A cluster holding two vertices of one piece would collapse an edge of that piece: leave it alone.
-    std::map<std::pair<int32_t, int32_t>, int32_t> seen;  // (cluster, piece) -> count
-    std::vector<uint8_t> bad_cluster(mesh.vertex_count(), 0);
-    for (int32_t v : boundary)
-        if (++seen[{clusters.find(v), vertex_piece[v]}] > 1) bad_cluster[clusters.find(v)] = 1;
-    auto merged_vertex = [&](int32_t v) {
-        const int32_t root = clusters.find(v);
-        return bad_cluster[root] ? v : root;
+    // Nearest pairs first; a pair joins two clusters unless one piece has a vertex in each (the merge
+    // would collapse an edge of that piece). Uniting every pair within the tolerance instead chained
+    // across cracks (a copy, a neighbour on the other side, that neighbour's copy...) into clusters
+    // that could not merge, so a larger tolerance welded less; and near crack junctions two exact
+    // copies a hair apart (exact fracture's split points) joined one cluster and spoilt both.
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
+        return std::tie(x.distance_sq, x.a, x.b) < std::tie(y.distance_sq, y.a, y.b);
+    });
+    DisjointSets clusters(mesh.vertex_count());
+    std::vector<int32_t> next_member(mesh.vertex_count());  // each cluster as a circular list
+    std::iota(next_member.begin(), next_member.end(), 0);
+    const auto share_a_piece = [&](int32_t root_a, int32_t root_b) {
+        for (int32_t x = root_a;; x = next_member[x]) {
+            for (int32_t y = root_b;; y = next_member[y]) {
+                if (vertex_piece[x] == vertex_piece[y]) return true;
+                if (next_member[y] == root_b) break;
+            }
+            if (next_member[x] == root_a) return false;
+        }
     };
+    for (const Candidate& c : candidates) {
+        const int32_t root_a = clusters.find(c.a), root_b = clusters.find(c.b);
+        if (root_a == root_b || share_a_piece(root_a, root_b)) continue;
+        clusters.unite(root_a, root_b);
+        std::swap(next_member[root_a], next_member[root_b]);  // splices the two lists into one
+    }
+    auto merged_vertex = [&](int32_t v) { return clusters.find(v); };
 
     // Pieces touch when a boundary face of one maps onto a boundary face of another.
     std::map<std::array<int32_t, 3>, int32_t> face_piece;

@@ -107,9 +107,11 @@ struct WeldResult {
     std::vector<int32_t> old_to_new_vertex;
 };
 
-// Merges pieces whose boundary faces coincide in world space (within `tolerance`, world units):
+// Merges pieces whose boundary faces coincide in world space (within `tolerance`, world units, >= 0):
 // coincident vertices become one, the pieces become one piece (the lowest index's transform; the
-// others' rest positions are re-expressed in it). Pieces that do not touch stay apart.
+// others' rest positions are re-expressed in it). Pieces that do not touch stay apart. Vertices of
+// different pieces are coincident when they lie within the tolerance and within half of either one's
+// shortest edge; they merge nearest pairs first, and never two vertices of one piece into one.
 // Implementation notes (fracture.cpp): pieces join only when a whole boundary face matches (touching at
 // a point or an edge joins nothing); absorbed pieces are removed and the rest renumbered in order;
 // throws AlgorithmError (mesh unchanged) if merging would flatten a tet (tolerance too large).
