@@ -5,6 +5,7 @@
 
 #include <tetgen.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <new>
@@ -55,10 +56,20 @@ void fill_plc(const TriangleSurface& surface, tetgenio& in) {
     }
 }
 
+// A switch value in plain decimals with nine significant digits: TetGen's switch parser reads
+// "1e-05" or "4.2949673e+09" as the number before the 'e' and then unknown switches '-', '+', '0'...
+// (a radius-edge bound of 1e9 became 1, which refines for ever).
 std::string format_number(double value) {
-    char buffer[64];
-    std::snprintf(buffer, sizeof buffer, "%.9g", value);
-    return buffer;
+    const int magnitude = value != 0 ? static_cast<int>(std::floor(std::log10(std::abs(value)))) : 0;
+    const int decimals = std::max(0, 8 - magnitude);
+    char buffer[512];
+    std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+    std::string text = buffer;
+    if (text.find('.') != std::string::npos) {
+        text.erase(text.find_last_not_of('0') + 1);
+        if (text.back() == '.') text.pop_back();
+    }
+    return text;
 }
 
 // -p: the input is a PLC; -z: zero-based indices; -q: quality; -a: volume bound; -m: sizes from the

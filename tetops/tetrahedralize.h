@@ -35,10 +35,13 @@ struct MeshSizing {
     double max_edge = 0;
 };
 
+// The smallest radius-edge bound TetGen's refinement ends with (validate_options says why).
+inline constexpr double kMinRadiusEdgeRatio = 1.2;
+
 struct MeshingOptions {
     Mesher mesher = Mesher::TetGen;
     MeshSizing sizing;
-    double max_radius_edge_ratio = 2.0;  // TetGen -q bound
+    double max_radius_edge_ratio = 2.0;  // TetGen -q bound, >= kMinRadiusEdgeRatio
     double min_dihedral_deg = 10.0;      // TetGen -q/ bound (and CGAL exuder goal)
     bool quiet = true;
 };

@@ -418,6 +418,23 @@ TEST(TetrahedralizeTest, RejectsAbsurdOptions) {
     options.min_dihedral_deg = 10;
     options.max_radius_edge_ratio = 0.9;
     expect_rejected(options, "max_radius_edge_ratio");
+    options.max_radius_edge_ratio = 1.1;  // TetGen refines for ever
+    expect_rejected(options, "max_radius_edge_ratio");
+}
+
+// Bounds whose shortest text has an exponent reach TetGen as plain decimals: "1e-05" and
+// "4.2949673e+09" were read as 1 and unknown switches (a radius-edge bound of 1 never ends).
+TEST(TetrahedralizeTest, BoundsOfAnyMagnitudeReachTetGenAsGiven) {
+    const TriangleSurface cube = asset_surface("cube.obj");
+    MeshingOptions options;
+    options.sizing.target_tets = 2000;
+    options.max_radius_edge_ratio = 4294967296.0;
+    options.min_dihedral_deg = 1e-5;
+    ::testing::internal::CaptureStdout();
+    const MeshingResult result = tetrahedralize(cube, options);
+    const std::string printed = ::testing::internal::GetCapturedStdout();
+    EXPECT_EQ(printed.find("Unknown switch"), std::string::npos) << printed;
+    expect_fills_surface(result, cube, 1e-9);
 }
 
 TEST(TetrahedralizeTest, RejectsOpenAndBrokenSurfaces) {
