@@ -326,6 +326,39 @@ void check_off_body(const std::filesystem::path& path, std::uintmax_t size) {
     }
 }
 
+bool is_ply_scalar_type(const std::string& type) {
+    static const std::array<const char*, 16> types = {"char",  "uchar",  "short", "ushort",  "int",    "uint",
+                                                      "float", "double", "int8",  "uint8",   "int16",  "uint16",
+                                                      "int32", "uint32", "float32", "float64"};
+    return std::find(types.begin(), types.end(), type) != types.end();
+}
+
+// What OpenMesh's PLY reader does not survive, refused with the line (line 1 is "ply"): a format
+// other than ascii / binary_little_endian / binary_big_endian 1.0 (a version that is not a number
+// made it loop for ever), a property before any element (it crashed), types PLY does not define,
+// and vertex coordinates that are not float or double (it printed a line per value and read zeros).
+void check_ply_header_line(const std::filesystem::path& path, int line_number, const std::string& keyword,
+                           const std::string& first, const std::string& second, const std::string& third,
+                           bool after_an_element) {
+    const auto fail = [&](const std::string& why) {
+        throw FileError(path.string(), "PLY header line " + std::to_string(line_number) + ": " + why);
+    };
+    if (line_number == 1) {
+        if (keyword != "ply") fail("the file does not start with 'ply'");
+        return;
+    }
+    if (keyword == "format") {
+        if (first != "ascii" && first != "binary_little_endian" && first != "binary_big_endian")
+            fail("unknown format '" + first + "' (ascii, binary_little_endian or binary_big_endian)");
+        if (second != "1.0") fail("unsupported version '" + second + "' (1.0)");
+    } else if (keyword == "property") {
+        if (!after_an_element) fail("a property before any element");
+        const bool list = first == "list";
+        if (list ? !is_ply_scalar_type(second) || !is_ply_scalar_type(third) : !is_ply_scalar_type(first))
+            fail("unknown property type in '" + keyword + " " + first + " " + second + (list ? " " + third : "") + "'");
+    }
+}
+
 void check_ply_body(const std::filesystem::path& path, std::uintmax_t size) {
     std::ifstream in(path, std::ios::binary);
     std::string line;
@@ -334,7 +367,7 @@ void check_ply_body(const std::filesystem::path& path, std::uintmax_t size) {
     // Where the vertices' x, y and z are in an ascii body: the lines of the elements before "vertex"
     // come first, then one line per vertex with its properties in header order.
     unsigned long long lines_before_vertices = 0, vertex_count = 0;
-    bool in_vertex = false, seen_vertex = false, vertex_has_list = false;
+    bool in_vertex = false, seen_vertex = false, vertex_has_list = false, seen_element = false;
     std::array<int, 3> xyz = {-1, -1, -1};
     int vertex_properties = 0;
     size_t header_lines = 0;
@@ -348,8 +381,10 @@ void check_ply_body(const std::filesystem::path& path, std::uintmax_t size) {
         std::string keyword, first, second, third;
         words >> keyword >> first >> second >> third;
         if (keyword == "end_header") break;
+        check_ply_header_line(path, lines + 1, keyword, first, second, third, seen_element);
         if (keyword == "format") ascii = first == "ascii";
         if (keyword == "element") {
+            seen_element = true;
             const auto count = parse_count(path, second);
             check_count_fits(path, first + " elements", count, size);
             elements += count;
@@ -365,7 +400,13 @@ void check_ply_body(const std::filesystem::path& path, std::uintmax_t size) {
             vertex_has_list = vertex_has_list || first == "list";
             const std::string& property = first == "list" ? third : second;
             for (int axis = 0; axis < 3; ++axis)
-                if (property == std::string(1, char('x' + axis))) xyz[axis] = vertex_properties;
+                if (property == std::string(1, char('x' + axis))) {
+                    xyz[axis] = vertex_properties;
+                    if (first != "float" && first != "double" && first != "float32" && first != "float64")
+                        throw FileError(path.string(), "PLY header line " + std::to_string(lines + 1) +
+                                                           ": vertex coordinate " + property + " is " + first +
+                                                           "; Waxwork reads float or double coordinates");
+                }
             ++vertex_properties;
         }
     }

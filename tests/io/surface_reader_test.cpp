@@ -304,6 +304,30 @@ TEST_F(SurfaceReaderFiles, AbsurdHeaderCountsGiveFileErrors) {
                       "header declares");
 }
 
+// Headers OpenMesh's PLY reader does not survive (it crashed on a property before any element,
+// looped for ever on a version that is not a number, printed a line per value for integer
+// coordinates) are refused with their line.
+TEST_F(SurfaceReaderFiles, MalformedPlyHeadersNameTheirLine) {
+    const std::string vertex = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+    const std::string face = "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    expect_file_error(write_text("before.ply", "ply\nformat ascii 1.0\nproperty float x\n" + vertex + face + body),
+                      "PLY header line 3: a property before any element");
+    expect_file_error(write_text("version.ply", "ply\nformat ascii abc\n" + vertex + face + body),
+                      "PLY header line 2: unsupported version 'abc'");
+    expect_file_error(write_text("version_nan.ply", "ply\nformat binary_little_endian nan\n" + vertex + face),
+                      "PLY header line 2: unsupported version 'nan'");
+    expect_file_error(write_text("format.ply", "ply\nformat text 1.0\n" + vertex + face + body),
+                      "PLY header line 2: unknown format 'text'");
+    expect_file_error(write_text("type.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty foo x\n" + face + body),
+                      "PLY header line 4: unknown property type");
+    expect_file_error(write_text("uchar.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty uchar x\n"
+                                              "property float y\nproperty float z\n" + face + body),
+                      "PLY header line 4: vertex coordinate x is uchar");
+    expect_file_error(write_text("magic.ply", "plx\nformat ascii 1.0\n" + vertex + face + body),
+                      "PLY header line 1");
+}
+
 TEST_F(SurfaceReaderFiles, FaceWithMissingVertexGivesFileError) {
     expect_file_error(write_text("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "");
 }
