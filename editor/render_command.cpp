@@ -71,7 +71,7 @@ void check_options(const RenderCommandOptions& o) {
     validate_mm_per_unit(o.scale, "--scale");
     if (!(o.tolerance >= kMinRelativeTolerance && o.tolerance < 1))
         fail("--tol must be a relative tolerance in [1e-15, 1)");
-    if (!(o.ambient >= 0 && o.ambient <= kMaxLightValue)) fail("--ambient must be non-negative and at most 1e100");
+    if (!(o.ambient >= 0 && o.ambient <= kMaxLightIntensity)) fail("--ambient must be non-negative and at most 1e15");
     if (!is_crease_angle(o.crease_angle)) fail("--crease-angle must be between 0 and 180 degrees");
     if (o.exposure && (!std::isfinite(*o.exposure) || *o.exposure <= 0))
         fail("--exposure must be finite and positive");

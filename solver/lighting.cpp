@@ -18,10 +18,10 @@ std::string light_name(size_t index, const Light& light) {
            (light.type == LightType::Directional ? "directional" : "point") + ")";
 }
 
-// Non-negative and at most kMaxLightValue (so finite).
+// Non-negative and at most kMaxLightIntensity (so finite).
 bool valid_light_value(const Rgb& c) {
     for (double x : c) {
-        if (!(x >= 0 && x <= kMaxLightValue)) return false;
+        if (!(x >= 0 && x <= kMaxLightIntensity)) return false;
     }
     return true;
 }
@@ -48,11 +48,11 @@ void validate(const Lighting& lighting) {
             throw InvalidArgumentError(light_name(i, light) + ": direction is the zero vector");
         }
         if (!valid_light_value(light.intensity)) {
-            throw InvalidArgumentError(light_name(i, light) + ": intensity must be non-negative and at most 1e100");
+            throw InvalidArgumentError(light_name(i, light) + ": intensity must be non-negative and at most 1e15");
         }
     }
     if (!valid_light_value(lighting.ambient)) {
-        throw InvalidArgumentError("ambient light must be non-negative and at most 1e100");
+        throw InvalidArgumentError("ambient light must be non-negative and at most 1e15");
     }
 }
 

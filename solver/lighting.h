@@ -50,13 +50,18 @@ struct Lighting {
     bool shadows = true;
 };
 
-// The largest light intensity, ambient or light-vector component: beyond it the solver's sums of
-// squares overflow (1e100 squared, summed over a million vertices, is still finite; 1e308 is not),
-// and so does the normalisation of directions.
+// The largest light-vector component: beyond it the solver's sums of squares overflow (1e100 squared,
+// summed over a million vertices, is still finite; 1e308 is not), and so does the normalisation of
+// directions.
 constexpr double kMaxLightValue = 1e100;
+// The largest light intensity or ambient: the GPU solves in float, whose sums of squares of the
+// right-hand side overflow beyond about 1e18 (spot, 7,588 tets: 1e18 solves, 1e19 does not), and the
+// radiance the renderer draws is float too (a session lit at 1e39 drew a black object). Light is
+// relative (the exposure follows it), so no scene needs more.
+constexpr double kMaxLightIntensity = 1e15;
 
 // Throws InvalidArgumentError naming the light for non-finite components or ones beyond
-// kMaxLightValue, a zero direction, or negative intensities / ambient.
+// kMaxLightValue, a zero direction, or intensities / ambient negative or beyond kMaxLightIntensity.
 void validate(const Lighting& lighting);
 
 // The boundary of a volume in world space, as the lighting and the renderer see it. Surface vertex s

@@ -330,8 +330,9 @@ TEST_F(Render, BadInputIsAOneLineError) {
     // Values whose squares overflow are refused by what they are, not by a solver failing on them.
     for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
              {" --tol 1e-300", "--tol must be a relative tolerance in [1e-15, 1)"},
-             {" --ambient 1e308", "--ambient must be non-negative and at most 1e100"},
-             {" --light dir:1,0,0:1e308,1,1", "intensity must be non-negative and at most 1e100"},
+             {" --ambient 1e308", "--ambient must be non-negative and at most 1e15"},
+             {" --light dir:1,0,0:1e308,1,1", "intensity must be non-negative and at most 1e15"},
+             {" --light dir:1,0,0:1e16,1,1", "intensity must be non-negative and at most 1e15"},
              {" --light point:1e308,0,0", "position has a non-finite component or one beyond 1e100"},
              {" --crease-angle 181", "--crease-angle must be between 0 and 180 degrees"},
              {" --crease-angle nan", "--crease-angle must be between 0 and 180 degrees"}}) {

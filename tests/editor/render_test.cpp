@@ -137,10 +137,12 @@ TEST(SurfaceRenderer, LightsOfAnyValidScaleDrawTheSameHighlight) {
         input.lighting.lights = {{LightType::Directional, scale * travel, {2, 2, 2}}};
         EXPECT_LE(max_difference(render_surface(input)), 1) << "direction scaled by " << scale;
     }
-    // A point light at distance d with intensity 2 d^2 gives the irradiance 2 of the parallel light.
-    for (const double distance : {1e20, 1e40, 1e45}) {
-        const double intensity = 2 * distance * distance;
+    // A point light at distance d gives the irradiance I / d^2 of a parallel light; exposed by 2 d^2 / I
+    // it draws the reference's highlight.
+    const double intensity = kMaxLightIntensity;
+    for (const double distance : {1e16, 1e18, 1e20}) {
         input.lighting.lights = {{LightType::Point, -distance * travel.normalized(), {intensity, intensity, intensity}}};
+        input.exposure = static_cast<float>(2 * distance * distance / intensity);
         EXPECT_LE(max_difference(render_surface(input)), 1) << "point light at " << distance;
     }
 }
