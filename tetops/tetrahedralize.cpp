@@ -81,6 +81,40 @@ void validate_options(const MeshingOptions& options) {
     }
 }
 
+// The widest span a surface may have, in median edge lengths. Real models span hundreds to a few
+// thousand (TetrahedralizeTest.FillsEveryCleanSharedMesh meshes every shared one); a stray vertex far from the rest makes TetGen
+// crash (1e9), hang (1e7 with a tet target) or drop most of the surface without a word (1e8).
+constexpr double kMaxSpanPerMedianEdge = 1e5;
+
+void check_surface_span(const TriangleSurface& surface) {
+    std::vector<double> edges;
+    edges.reserve(3 * surface.triangles.size());
+    for (const auto& tri : surface.triangles)
+        for (int k = 0; k < 3; ++k) edges.push_back((surface.points[tri[k]] - surface.points[tri[(k + 1) % 3]]).norm());
+    const auto middle = edges.begin() + static_cast<std::ptrdiff_t>(edges.size() / 2);
+    std::nth_element(edges.begin(), middle, edges.end());
+    const double median_edge = *middle;
+    // The centre of the bulk: the per-axis median of the points, which one far point cannot move.
+    Eigen::Vector3d centre;
+    std::vector<double> axis(surface.points.size());
+    for (int k = 0; k < 3; ++k) {
+        for (size_t i = 0; i < surface.points.size(); ++i) axis[i] = surface.points[i][k];
+        const auto mid = axis.begin() + static_cast<std::ptrdiff_t>(axis.size() / 2);
+        std::nth_element(axis.begin(), mid, axis.end());
+        centre[k] = *mid;
+    }
+    size_t farthest = 0;
+    double reach = 0;
+    for (size_t i = 0; i < surface.points.size(); ++i)
+        if (const double d = (surface.points[i] - centre).norm(); d > reach) reach = d, farthest = i;
+    if (!(reach <= kMaxSpanPerMedianEdge * median_edge))
+        throw InvalidMeshError("surface to mesh: point " + std::to_string(farthest) + " lies " + number_text(reach) +
+                               " from the middle of the surface, " + number_text(reach / median_edge) +
+                               " times its median edge length (" + number_text(median_edge) +
+                               "); the meshers cannot span more than " + number_text(kMaxSpanPerMedianEdge) +
+                               " (a stray vertex?)");
+}
+
 // The mesher asserts (and may crash) on malformed input, so the surface is checked first: indices in
 // range, finite points, closed and consistently oriented (every directed edge has its reverse exactly
 // once), positive enclosed volume.
@@ -126,6 +160,7 @@ void validate_surface(const TriangleSurface& surface) {
     if (!(enclosed_volume(surface) > 0)) {
         throw InvalidMeshError("surface to mesh: enclosed volume is not positive (inward-facing triangles?)");
     }
+    check_surface_span(surface);
 }
 
 // Predicted tet count of a size field: V / regular_volume(edge) for a uniform size; for a graded one

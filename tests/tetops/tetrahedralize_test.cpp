@@ -422,6 +422,29 @@ TEST(TetrahedralizeTest, RejectsAbsurdOptions) {
     expect_rejected(options, "max_radius_edge_ratio");
 }
 
+// A stray vertex far from the rest is refused by name before TetGen sees it (at 1e9 median edges it
+// crashed TetGen, at 1e8 TetGen dropped most of the surface silently); a long spike is still meshed.
+TEST(TetrahedralizeTest, AStrayVertexFarFromTheSurfaceIsRefusedByName) {
+    TriangleSurface cube = asset_surface("cube.obj");
+    MeshingOptions options;
+    options.sizing.target_tets = 2000;
+    const size_t far_point = 3;
+    for (const double reach : {1e8, 1e9, 1e30}) {
+        TriangleSurface spiked = cube;
+        spiked.points[far_point] = spiked.points[far_point].normalized() * reach;
+        try {
+            tetrahedralize(spiked, options);
+            ADD_FAILURE() << reach << " accepted";
+        } catch (const InvalidMeshError& e) {
+            EXPECT_NE(std::string(e.what()).find("point 3 lies"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("a stray vertex"), std::string::npos) << e.what();
+        }
+    }
+    cube.points[far_point] *= 20.0;
+    const MeshingResult spike = tetrahedralize(cube, options);
+    expect_fills_surface(spike, cube, 1e-9);
+}
+
 // Bounds whose shortest text has an exponent reach TetGen as plain decimals: "1e-05" and
 // "4.2949673e+09" were read as 1 and unknown switches (a radius-edge bound of 1 never ends).
 TEST(TetrahedralizeTest, BoundsOfAnyMagnitudeReachTetGenAsGiven) {
