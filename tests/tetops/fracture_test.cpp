@@ -494,14 +494,19 @@ TEST(PieceTransform, OnlyRigidFiniteMotions) {
     EXPECT_EQ(mesh.piece_transforms[0], x);
 }
 
+// The welding tests' fracture: five Voronoi cells from seed 3, exact walls or along tet faces.
+FractureResult fracture_into_five(TetMesh& mesh, bool exact) {
+    FractureOptions options;
+    options.exact = exact;
+    return fracture_voronoi(mesh, scatter_fracture_seeds(mesh, 5, 3), options);
+}
+
 TEST(Weld, FractureThenWeldInPlaceRestoresOnePiece) {
     const TetMesh before = make_cube_mesh(5);
     const double area_before = boundary_area(before, build_connectivity(before));
     for (bool exact : {true, false}) {
         TetMesh mesh = before;
-        FractureOptions options;
-        options.exact = exact;
-        const FractureResult f = fracture_voronoi(mesh, scatter_fracture_seeds(mesh, 5, 3), options);
+        const FractureResult f = fracture_into_five(mesh, exact);
         ASSERT_GT(f.pieces_after, 1);
         const TetMesh fractured = mesh;
         const WeldResult w = weld_touching_pieces(mesh, 1e-9);
@@ -541,9 +546,7 @@ TEST(Weld, EveryToleranceWeldsTheCracksOfAFractureInPlace) {
     const double area_before = boundary_area(before, build_connectivity(before));
     for (bool exact : {true, false}) {
         TetMesh fractured = before;
-        FractureOptions options;
-        options.exact = exact;
-        const FractureResult f = fracture_voronoi(fractured, scatter_fracture_seeds(fractured, 5, 3), options);
+        const FractureResult f = fracture_into_five(fractured, exact);
         ASSERT_GT(f.pieces_after, 1);
         for (const double tolerance : {0.0, 1e-9, 1e-4, 0.05, 0.1, 0.15, 0.3, 1.0, 10.0}) {
             TetMesh mesh = fractured;
