@@ -3,6 +3,7 @@
 #include "editor/material_options.h"
 #include "editor/render_pipeline.h"
 #include "editor/view_modes.h"
+#include "io/file_extension.h"
 #include "io/volume_file.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/lighting.h"
@@ -73,8 +74,9 @@ void check_options(const RenderCommandOptions& o) {
         fail("--tol must be a relative tolerance in [1e-15, 1)");
     if (!(o.ambient >= 0 && o.ambient <= kMaxLightIntensity)) fail("--ambient must be non-negative and at most 1e15");
     if (!is_crease_angle(o.crease_angle)) fail("--crease-angle must be between 0 and 180 degrees");
-    if (o.exposure && (!std::isfinite(*o.exposure) || *o.exposure <= 0))
-        fail("--exposure must be finite and positive");
+    if (lower_extension(o.output) != ".png") fail("-o " + o.output + ": the image must be a .png");
+    // The renderer exposes in float: beyond 1e30 the product with the radiance leaves its range.
+    if (o.exposure && !(*o.exposure > 0 && *o.exposure <= 1e30)) fail("--exposure must be positive and at most 1e30");
     if (!o.view.empty()) {
         const Eigen::Vector3d v(o.view[0], o.view[1], o.view[2]);
         if (!v.allFinite() || v.norm() == 0) fail("--view must be a finite, non-zero direction");

@@ -335,11 +335,18 @@ TEST_F(Render, BadInputIsAOneLineError) {
              {" --light dir:1,0,0:1e16,1,1", "intensity must be non-negative and at most 1e15"},
              {" --light point:1e308,0,0", "position has a non-finite component or one beyond 1e100"},
              {" --crease-angle 181", "--crease-angle must be between 0 and 180 degrees"},
-             {" --crease-angle nan", "--crease-angle must be between 0 and 180 degrees"}}) {
+             {" --crease-angle nan", "--crease-angle must be between 0 and 180 degrees"},
+             {" --exposure 1e308", "--exposure must be positive and at most 1e30"}}) {
         const auto r = run_waxwork(base + args);
         EXPECT_NE(r.exit_code, 0) << args;
         EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
     }
+    // The image is a PNG whatever its name says, so the name must say so (x.jpg held PNG data).
+    const fs::path jpg = image.parent_path() / "x.jpg";
+    const auto named_jpg = run_waxwork("render " + volume_.string() + " -o " + jpg.string() + " --width 32 --height 24");
+    EXPECT_NE(named_jpg.exit_code, 0);
+    EXPECT_NE(named_jpg.err.find(jpg.string() + ": the image must be a .png"), std::string::npos) << named_jpg.err;
+    EXPECT_FALSE(fs::exists(jpg));
     // A huge view direction is still a direction.
     EXPECT_EQ(run_waxwork(base + " --view 1e308,1e308,1e308").exit_code, 0);
     fs::remove(image);
