@@ -17,8 +17,9 @@ struct RelaxationOptions {
     int max_iterations = 10;
     double step = 0.1;  // rho in the paper
     // A move is rejected when it leaves a tet of the vertex's star under this minimum dihedral angle
-    // (degrees); a tet already under it may not get worse. 0 disables the guard (paper Fig. 9(a));
-    // inverted or flat tets are always rejected.
+    // (degrees); a tet already under it may not get worse. 0 disables the guard (paper Fig. 9(a)):
+    // only moves that invert a tet or leave it exactly zero volume are then rejected, so tets can be
+    // squeezed to angles of 0.0 degrees (a cube's corner tet at volume 4.5e-20 after 100 sweeps).
     double min_dihedral_guard_deg = 0.5;
 };
 
