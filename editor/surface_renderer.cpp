@@ -636,8 +636,11 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.Uniform4fv(location("clip_plane"), 1, plane.data());
         const auto light_count = static_cast<int>(input.lighting.lights.size());
         gl.Uniform1i(location("light_count"), light_count);
+        // The centre only matters to point lights (shader_light): no pass over the vertices without one.
         Eigen::AlignedBox3d bounds;
-        for (const Eigen::Vector3f& p : input.positions) bounds.extend(p.cast<double>());
+        if (std::any_of(input.lighting.lights.begin(), input.lighting.lights.end(),
+                        [](const Light& light) { return light.type == LightType::Point; }))
+            for (const Eigen::Vector3f& p : input.positions) bounds.extend(p.cast<double>());
         const Eigen::Vector3d centre = bounds.isEmpty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(bounds.center());
         for (int i = 0; i < light_count; ++i) {
             const ShaderLight light = shader_light(input.lighting.lights[i], centre);

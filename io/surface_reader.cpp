@@ -326,6 +326,10 @@ void check_off_body(const std::filesystem::path& path, std::uintmax_t size) {
     }
 }
 
+[[noreturn]] void fail_ply_header(const std::filesystem::path& path, int line_number, const std::string& why) {
+    throw FileError(path.string(), "PLY header line " + std::to_string(line_number) + ": " + why);
+}
+
 bool is_ply_scalar_type(const std::string& type) {
     static const std::array<const char*, 16> types = {"char",  "uchar",  "short", "ushort",  "int",    "uint",
                                                       "float", "double", "int8",  "uint8",   "int16",  "uint16",
@@ -340,9 +344,7 @@ bool is_ply_scalar_type(const std::string& type) {
 void check_ply_header_line(const std::filesystem::path& path, int line_number, const std::string& keyword,
                            const std::string& first, const std::string& second, const std::string& third,
                            bool after_an_element) {
-    const auto fail = [&](const std::string& why) {
-        throw FileError(path.string(), "PLY header line " + std::to_string(line_number) + ": " + why);
-    };
+    const auto fail = [&](const std::string& why) { fail_ply_header(path, line_number, why); };
     if (line_number == 1) {
         if (keyword != "ply") fail("the file does not start with 'ply'");
         return;
@@ -403,9 +405,8 @@ void check_ply_body(const std::filesystem::path& path, std::uintmax_t size) {
                 if (property == std::string(1, char('x' + axis))) {
                     xyz[axis] = vertex_properties;
                     if (first != "float" && first != "double" && first != "float32" && first != "float64")
-                        throw FileError(path.string(), "PLY header line " + std::to_string(lines + 1) +
-                                                           ": vertex coordinate " + property + " is " + first +
-                                                           "; Waxwork reads float or double coordinates");
+                        fail_ply_header(path, lines + 1, "vertex coordinate " + property + " is " + first +
+                                                             "; Waxwork reads float or double coordinates");
                 }
             ++vertex_properties;
         }

@@ -525,7 +525,6 @@ WeldResult weld_touching_pieces(TetMesh& mesh, double tolerance) {
         clusters.unite(root_a, root_b);
         std::swap(next_member[root_a], next_member[root_b]);  // splices the two lists into one
     }
-    auto merged_vertex = [&](int32_t v) { return clusters.find(v); };
 
     // Pieces touch when a boundary face of one maps onto a boundary face of another.
     std::map<std::array<int32_t, 3>, int32_t> face_piece;
@@ -533,7 +532,7 @@ WeldResult weld_touching_pieces(TetMesh& mesh, double tolerance) {
     DisjointSets groups(piece_count);
     for (const BoundaryFace& face : connectivity.boundary_faces) {
         std::array<int32_t, 3> key;
-        for (int k = 0; k < 3; ++k) key[k] = merged_vertex(face.vertices[k]);
+        for (int k = 0; k < 3; ++k) key[k] = clusters.find(face.vertices[k]);  // the merged vertex
         std::sort(key.begin(), key.end());
         const int32_t piece = mesh.piece_ids[face.tet];
         auto [it, inserted] = face_piece.try_emplace(key, piece);
@@ -545,7 +544,7 @@ WeldResult weld_touching_pieces(TetMesh& mesh, double tolerance) {
     TetMesh welded = mesh;
     std::vector<int32_t> target(mesh.vertex_count());
     for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-        const int32_t m = merged_vertex(static_cast<int32_t>(v));
+        const int32_t m = clusters.find(static_cast<int32_t>(v));
         target[v] = vertex_piece[v] >= 0 && vertex_piece[m] >= 0 &&
                             groups.find(vertex_piece[v]) == groups.find(vertex_piece[m])
                         ? m
