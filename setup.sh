@@ -43,5 +43,5 @@ if [ "$mode" = test ]; then
   cd "$build"
   ctest --output-on-failure -j "$jobs"
 else
-  "$build/editor/waxwork" demo -o "$here/out/demo"
+  "$build/app/waxwork" demo -o "$here/out/demo"
 fi

@@ -1,9 +1,9 @@
 // The benchmarks' main(): Google Benchmark's, after the allocator policy of the waxwork process
-// (editor/memory_reuse.h), so that a benchmark measures what the application does. With
+// (base/memory_reuse.h), so that a benchmark measures what the application does. With
 // WAXWORK_BENCH_DEFAULT_MALLOC=1 in the environment the policy is left out, to measure what it changes.
 #pragma once
 
-#include "editor/memory_reuse.h"
+#include "base/memory_reuse.h"
 
 #include <benchmark/benchmark.h>
 

@@ -1,9 +1,9 @@
 // Rebuild time of all derived connectivity (edges, one-rings, boundary, components) for spot.
-// Target (issue "Foundation"): under 150 ms at 500K tets on this 2-core machine.
-#include "bench_main.h"
-#include "bench_meshes.h"
+// Target: under 150 ms at 500K tets on this 2-core machine.
 #include "tetops/connectivity.h"
 #include "tetops/quality.h"
+#include "bench_main.h"
+#include "bench_meshes.h"
 
 #include <benchmark/benchmark.h>
 

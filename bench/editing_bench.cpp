@@ -1,14 +1,13 @@
 // Editing at the paper's scale (TransCut Sec. 5, Table 1: 500K-1M tets): a plane cut through spot with
-// relaxation and the connectivity rebuild the solver needs afterwards, the exact cut (issue 6), fracture
+// relaxation and the connectivity rebuild the solver needs afterwards, the exact cut, fracture
 // into 8 pieces, and a 100-point paint stroke.
 // Goals: cut + connectivity + 10 relaxation sweeps <= 500 ms; fracture into 8 pieces <= 1 s; paint
 // stroke <= 20 ms. BM_CrossSectionAccuracy charts how far the cross-section is from the plane and the
 // worst dihedral angle for both cut modes (counters; --benchmark_format=json for the chart):
 //   ./build/bench/editing_bench
 //   ./build/bench/editing_bench --benchmark_filter=CrossSection --benchmark_format=json
-#include "bench_main.h"
-#include "bench_meshes.h"
-#include "editor/cut_study.h"
+#include "bench/studies/cut_study.h"
+#include "solver/material.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
 #include "tetops/exact_cut.h"
@@ -16,7 +15,8 @@
 #include "tetops/paint.h"
 #include "tetops/quality.h"
 #include "tetops/relaxation.h"
-#include "solver/material.h"
+#include "bench_main.h"
+#include "bench_meshes.h"
 
 #include <benchmark/benchmark.h>
 
@@ -101,7 +101,7 @@ void BM_ExactCutConnectivity(benchmark::State& state) {
 }
 BENCHMARK(BM_ExactCutConnectivity)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// Cross-section accuracy of both cut modes on spot (editor/cut_study.h; `waxwork bench --only cut_modes`
+// Cross-section accuracy of both cut modes on spot (bench/studies/cut_study.h; `waxwork bench --only cut_modes`
 // charts the distributions). Arg 0: 0 = remove + 10 relaxation sweeps with the 0.5 degree guard
 // (TransCut Sec. 5), 1 = exact.
 void BM_CrossSectionAccuracy(benchmark::State& state) {

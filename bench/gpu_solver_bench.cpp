@@ -3,15 +3,14 @@
 // cold and warm, as bench/solver_bench.cpp measures the CPU path (same scene: spot 100 mm across,
 // marble, a directional light along -z without shadows).
 //
-// Which device runs it: the context of solver/gl_context.h, i.e. Mesa's llvmpipe through OSMesa by
+// Which device runs it: the context of gl/gl_context.h, i.e. Mesa's llvmpipe through OSMesa by
 // default -- a software rasteriser running the compute shaders on this machine's CPU cores, so these
 // numbers say nothing about GPU speed. On a machine with a GPU the same binary runs on it with
 // WAXWORK_GL_DEVICE=egl (EGL without a display; see gl_context.h). The first lines of the output name
 // the renderer that ran.
 //
 // Run: build/bench/gpu_solver_bench [--benchmark_filter=...]
-#include "bench_main.h"
-#include "bench_meshes.h"
+#include "gl/gl_context.h"
 #include "multires/gpu_independent_set.h"
 #include "multires/gpu_multigrid_frame_solver.h"
 #include "multires/gpu_multires_solver.h"
@@ -19,12 +18,13 @@
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
-#include "solver/gpu_assembly.h"
-#include "solver/gl_context.h"
-#include "solver/gpu_conjugate_gradient.h"
+#include "solver/gpu/gpu_assembly.h"
+#include "solver/gpu/gpu_conjugate_gradient.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
 #include "tetops/connectivity.h"
+#include "bench_main.h"
+#include "bench_meshes.h"
 
 #include <benchmark/benchmark.h>
 

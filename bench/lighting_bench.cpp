@@ -4,13 +4,13 @@
 //
 //   build/bench/lighting_bench --benchmark_filter=Spot
 //   build/bench/lighting_bench --benchmark_filter='SplitAtCreases|ShadingLight|SourceLight' 
-#include "bench_main.h"
 #include "io/surface_reader.h"
 #include "solver/lighting.h"
 #include "solver/ray_caster.h"
 #include "solver/shading_surface.h"
 #include "tetops/connectivity.h"
 #include "tetops/tetrahedralize.h"
+#include "bench_main.h"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>

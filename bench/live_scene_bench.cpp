@@ -1,4 +1,4 @@
-// The live editor's frame loop on spot (issue 7): the per-frame CPU solve while the light rotates and
+// The live editor's frame loop on spot: the per-frame CPU solve while the light rotates and
 // while a brush paints, and the edits at the paper's scale with everything the solver needs rebuilt.
 // Goals: >= 30 fps at ~100K tets while relighting and painting; a cut including connectivity,
 // matrices and lighting <= 500 ms and a 100-point paint stroke including the row updates <= 20 ms at
@@ -7,12 +7,13 @@
 // Frame counters: median / p90 / max wall milliseconds over the frames of one sequence, and the median
 // and p90 process CPU milliseconds (all threads; on an idle two-core machine a frame's wall time lies
 // between half of it and all of it). The edit benchmarks' CPU column is the whole process too.
+#include "base/timing.h"
+#include "scene/document.h"
+#include "scene/live_scene.h"
+#include "solver/material.h"
 #include "bench_main.h"
 #include "bench_meshes.h"
 #include "live_scene_setup.h"
-#include "editor/document.h"
-#include "editor/live_scene.h"
-#include "solver/material.h"
 
 #include <benchmark/benchmark.h>
 
@@ -32,10 +33,6 @@ constexpr size_t kEditTets = 500'000;
 constexpr int kFrames = 90;
 // CG iterations per channel and frame: what fits a 30 fps frame at 100K tets with the lighting update.
 constexpr int kFrameIterations = 8;
-
-double ms_since(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // CPU time of the whole process (all TBB threads), in ms: on a shared machine wall time includes
 // waiting for a core; this does not.
@@ -76,7 +73,7 @@ void BM_RelightFrames(benchmark::State& state) {
             const double cpu_start = process_cpu_ms();
             scene.set_lighting(turning_light(3.0 * f));  // a few degrees per frame
             frame(scene, iterations);
-            ms.push_back(ms_since(start));
+            ms.push_back(milliseconds_since(start));
             cpu.push_back(process_cpu_ms() - cpu_start);
         }
     }
@@ -103,7 +100,7 @@ void BM_PaintFrames(benchmark::State& state) {
             const double cpu_start = process_cpu_ms();
             rows += scene.apply_change(doc.mesh(), doc.apply(op)).updated_rows.size();
             frame(scene, iterations);
-            ms.push_back(ms_since(start));
+            ms.push_back(milliseconds_since(start));
             cpu.push_back(process_cpu_ms() - cpu_start);
         }
     }

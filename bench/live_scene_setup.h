@@ -1,12 +1,12 @@
 // The scene both live-editor benchmarks run (live_scene_bench.cpp, live_solver_bench.cpp): spot
-// scaled to 100 mm (as in the README's performance table), tolerance 1e-3, and a key light that
+// scaled to 100 mm (as in docs/performance.md), tolerance 1e-3, and a key light that
 // turns around the vertical axis.
 #pragma once
 
-#include "editor/edit_operation.h"
-#include "editor/live_scene.h"
-#include "solver/material.h"
+#include "scene/edit_operation.h"
+#include "scene/live_scene.h"
 #include "solver/lighting.h"
+#include "solver/material.h"
 #include "tetops/tet_mesh.h"
 
 #include <Eigen/Geometry>

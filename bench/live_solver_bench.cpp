@@ -1,4 +1,4 @@
-// The live editor's frames per solver method and backend (editor/live_solver.h, issue 5): the per-frame
+// The live editor's frames per solver method and backend (scene/live_solver.h): the per-frame
 // solve while the light rotates and while a brush paints, on spot at ~100K tets, as
 // bench/live_scene_bench.cpp measures the default (CPU Jacobi CG), for
 //   0: CPU Jacobi CG (double), 1: CPU multigrid CG, three channels per V-cycle (the budget of 8 is 2
@@ -16,13 +16,14 @@
 // max |phi - phi*| / max |phi*| after the last frame, phi* the same scene converged to 1e-8 with CPU
 // Jacobi CG, and true_error_l2: the largest per-channel sqrt(sum (phi - phi*)^2 / sum phi*^2) (final_error is
 // the solver's own estimate, which for multigrid CG lags one update: it describes phi before it).
+#include "base/timing.h"
+#include "scene/document.h"
+#include "scene/live_scene.h"
+#include "solver/frame_budget.h"
+#include "solver/material.h"
 #include "bench_main.h"
 #include "bench_meshes.h"
 #include "live_scene_setup.h"
-#include "editor/document.h"
-#include "editor/live_scene.h"
-#include "solver/frame_budget.h"
-#include "solver/material.h"
 
 #include <benchmark/benchmark.h>
 
@@ -39,10 +40,6 @@ using Clock = std::chrono::steady_clock;
 constexpr size_t kFrameTets = 100'000;
 constexpr int kFrames = 30;
 constexpr int kFrameIterations = 8;  // as live_scene_bench: CG iterations per channel and frame
-
-double ms_since(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 struct Variant {
     LiveMethod method;
@@ -131,7 +128,7 @@ void BM_RelightFrames(benchmark::State& state) {
             scene.set_lighting(turning_light(3.0 * f));
             iterations += scene.step(kFrameIterations).total_iterations();
             benchmark::DoNotOptimize(scene.radiance_factors().data());
-            ms.push_back(ms_since(start));
+            ms.push_back(milliseconds_since(start));
         }
     }
     report(state, ms, scene, iterations, doc.mesh());
@@ -153,7 +150,7 @@ void BM_PaintFrames(benchmark::State& state) {
             scene.apply_change(doc.mesh(), doc.apply(op));
             iterations += scene.step(kFrameIterations).total_iterations();
             benchmark::DoNotOptimize(scene.radiance_factors().data());
-            ms.push_back(ms_since(start));
+            ms.push_back(milliseconds_since(start));
         }
     }
     report(state, ms, scene, iterations, doc.mesh());
@@ -178,7 +175,7 @@ void BM_FirstFrameAfterCut(benchmark::State& state) {
         const auto start = Clock::now();
         iterations = scene.step(kFrameIterations).total_iterations();
         benchmark::DoNotOptimize(scene.radiance_factors().data());
-        frame_ms = ms_since(start);
+        frame_ms = milliseconds_since(start);
     }
     state.counters["scene_ms"] = scene_ms;
     state.counters["frame_ms"] = frame_ms;
@@ -221,7 +218,7 @@ void BM_CutToSettledImage(benchmark::State& state) {
         for (int f = 1; f <= kMaxFrames && (frames_to_settle < 0 || frames_to_converge < 0); ++f) {
             const bool converged = scene.step(kFrameIterations).converged;
             benchmark::DoNotOptimize(scene.radiance_factors().data());
-            const double now_ms = ms_since(start) - paused_ms;
+            const double now_ms = milliseconds_since(start) - paused_ms;
             if (converged && frames_to_converge < 0) {
                 frames_to_converge = f;
                 converged_ms = now_ms;
@@ -231,7 +228,7 @@ void BM_CutToSettledImage(benchmark::State& state) {
                 frames_to_settle = f;
                 settle_ms = now_ms;
             }
-            paused_ms += ms_since(pause);
+            paused_ms += milliseconds_since(pause);
         }
     }
     state.counters["scene_ms"] = scene_ms;
@@ -278,9 +275,9 @@ void BM_RelightFramesWithinBudget(benchmark::State& state) {
             scene.set_lighting(turning_light(3.0 * f));
             const auto step_start = Clock::now();
             iterations += scene.step(budget).total_iterations();
-            step_ms.push_back(ms_since(step_start));
+            step_ms.push_back(milliseconds_since(step_start));
             benchmark::DoNotOptimize(scene.radiance_factors().data());
-            frame_ms.push_back(ms_since(start));
+            frame_ms.push_back(milliseconds_since(start));
             over_ms.push_back(step_ms.back() - kFrameBudgetMs);
         }
     }

@@ -1,8 +1,8 @@
 // Meshing spot (assets/meshes/spot.obj) to a tet count with TetGen and CGAL. Reports the tets produced
 // and the wall time of one tetrahedralize() call (which includes the target_tets search passes).
-#include "bench_main.h"
 #include "io/surface_reader.h"
 #include "tetops/tetrahedralize.h"
+#include "bench_main.h"
 
 #include <benchmark/benchmark.h>
 

@@ -14,8 +14,6 @@
 // updates after painting (BM_PaintUpdate); see each benchmark.
 //
 // Run: build-bench/bench/multires_bench (configure with -DWAXWORK_BUILD_BENCH=ON).
-#include "bench_main.h"
-#include "bench_meshes.h"
 #include "multires/cascadic_solver.h"
 #include "multires/multigrid_cg.h"
 #include "multires/multigrid_frame_solver.h"
@@ -24,10 +22,12 @@
 #include "solver/diffusion_matrix.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
-#include "solver/reference_solvers.h"
+#include "solver/reference/reference_solvers.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
 #include "tetops/fracture.h"
+#include "bench_main.h"
+#include "bench_meshes.h"
 
 #include <benchmark/benchmark.h>
 

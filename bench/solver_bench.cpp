@@ -10,15 +10,15 @@
 //
 // Run: build-solver-bench/bench/solver_bench (configure with -DWAXWORK_BUILD_BENCH=ON). Three-channel
 // solves: Float runs the channels in one loop, Double one after the other (diffusion_solve.cpp says why).
-#include "bench_main.h"
-#include "bench_meshes.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
-#include "solver/reference_solvers.h"
+#include "solver/reference/reference_solvers.h"
 #include "tetops/connectivity.h"
+#include "bench_main.h"
+#include "bench_meshes.h"
 
 #include <benchmark/benchmark.h>
 

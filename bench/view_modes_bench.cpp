@@ -1,4 +1,4 @@
-// Building the geometry of each optional view (editor/view_modes.h) for spot: what the editor's worker
+// Building the geometry of each optional view (render/view_modes.h) for spot: what the editor's worker
 // pays when the view or the geometry changes (the slice also when phi moves; the levels view includes
 // assembling the matrix and building the hierarchy). Drawing is not timed here.
 //
@@ -6,9 +6,9 @@
 //
 // The views' cost does not depend on the values of phi, so the scene's phi is a smooth stand-in
 // (exp(-x) per channel) instead of a 500K-tet solve.
+#include "render/view_modes.h"
 #include "bench_main.h"
 #include "bench_meshes.h"
-#include "editor/view_modes.h"
 
 #include <benchmark/benchmark.h>
 

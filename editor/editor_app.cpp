@@ -1,13 +1,14 @@
 #include "editor/editor_app.h"
 
+#include "base/error.h"
+#include "base/timing.h"
+#include "editor/stroke_tools.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
 #include "solver/material.h"
 #include "solver/mesh_resolution.h"
 #include "tetops/connectivity.h"
-#include "tetops/error.h"
 #include "tetops/tetrahedralize.h"
-#include "editor/stroke_tools.h"
 
 #include <GLFW/glfw3.h>
 #include <imgui.h>
@@ -34,10 +35,6 @@ std::string glfw_error_text;
 
 void on_glfw_error(int code, const char* description) {
     glfw_error_text = description ? description : ("GLFW error " + std::to_string(code));
-}
-
-double ms_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 EditorApp* app_of(GLFWwindow* window) { return static_cast<EditorApp*>(glfwGetWindowUserPointer(window)); }
@@ -464,7 +461,7 @@ void EditorApp::start_tick() {
         r->solver_description = core->live->solver_description();
         r->gpu_fallback_reason = core->live->gpu_fallback_reason();
         r->method_fallback_reason = core->live->method_fallback_reason();
-        r->ms = ms_since(start);
+        r->ms = milliseconds_since(start);
         return BackgroundTask::Apply([this, target, r] {
             if (scene_.get() != target) return;  // another file was opened meanwhile
             Scene& s = *scene_;
@@ -602,7 +599,7 @@ void EditorApp::draw_viewport(int fb_h) {
             set_error(std::string("drawing: ") + e.what());
             return;
         }
-        last_render_ms_ = ms_since(start);
+        last_render_ms_ = milliseconds_since(start);
     }
     view_cache_->blit(0, view_x_, y);
 }
@@ -724,7 +721,7 @@ EditorRunStats run_editor(const EditorOptions& options) {
                     std::this_thread::sleep_for(std::chrono::milliseconds(20));
                 } else {
                     app.gl().Finish();  // count the GPU's work in the frame time
-                    frame_ms_sum += ms_since(start);
+                    frame_ms_sum += milliseconds_since(start);
                     view_ms_sum += app.view_ms();
                     if (++stats.frames >= std::max(options.frames, 1)) {
                         write_png(app.read_window(), options.screenshot);

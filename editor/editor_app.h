@@ -12,17 +12,18 @@
 #pragma once
 
 #include "editor/background_task.h"
-#include "editor/document.h"
 #include "editor/file_dialog.h"
 #include "editor/input_script.h"
-#include "editor/live_scene.h"
 #include "editor/orbit_camera.h"
-#include "editor/render_pipeline.h"
-#include "editor/session.h"
-#include "editor/surface_renderer.h"
 #include "editor/view_cache.h"
-#include "editor/view_modes.h"
 #include "editor/viewport_tools.h"
+#include "render/render_input.h"
+#include "render/surface_renderer.h"
+#include "render/view_modes.h"
+#include "scene/document.h"
+#include "scene/live_scene.h"
+#include "scene/session.h"
+#include "solver/light_spec.h"
 #include "solver/ray_caster.h"
 
 #include <deque>

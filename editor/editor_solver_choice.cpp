@@ -1,4 +1,4 @@
-// The solver panel's method and backend choice (issue 5): switching rebuilds the live scene with the
+// The solver panel's method and backend choice: switching rebuilds the live scene with the
 // new LiveSolver (live_solver.h); the GPU backend runs in a hidden window's context shared with this
 // window's (window_gl_context.h). A context or shader that fails shows its reason here and the scene
 // keeps solving on the CPU.

@@ -1,4 +1,4 @@
-// The solver panel's frame budget (issue 4, item 4): each tick's solver step is limited either to a
+// The solver panel's frame budget: each tick's solver step is limited either to a
 // number of iterations or to a time in milliseconds (solver/frame_budget.h). A time budget keeps the
 // frame rate steady whatever the mesh size, method and backend; an iteration budget keeps frames
 // reproducible. The budget covers the solver step only: a tick's edits and radiance come on top.

@@ -1,9 +1,9 @@
 #include "editor/input_script.h"
 
-#include "editor/json_fields.h"
+#include "base/error.h"
+#include "scene/json_fields.h"
 #include "solver/material.h"
 #include "solver/shading_surface.h"
-#include "tetops/error.h"
 
 #include <GLFW/glfw3.h>
 #include <nlohmann/json.hpp>

@@ -1,6 +1,6 @@
 #include "editor/orbit_camera.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,10 +1,10 @@
 // The editor's camera: it orbits a target point, pans in the view plane and zooms along the view
 // direction. Plain math (no window), so it is unit tested; its matrices come from look_at_frame
-// (editor/surface_renderer.h), the function `waxwork render` frames its camera with, so the editor's
+// (render/surface_renderer.h), the function `waxwork render` frames its camera with, so the editor's
 // first frame shows exactly what `waxwork render` renders.
 #pragma once
 
-#include "editor/surface_renderer.h"
+#include "render/camera.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>

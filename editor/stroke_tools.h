@@ -3,8 +3,8 @@
 // the surface points under a paint stroke (found by casting view rays at the boundary surface).
 #pragma once
 
-#include "editor/edit_operation.h"
 #include "editor/orbit_camera.h"
+#include "scene/edit_operation.h"
 #include "solver/ray_caster.h"
 
 #include <Eigen/Core>

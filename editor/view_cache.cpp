@@ -1,6 +1,6 @@
 #include "editor/view_cache.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 namespace waxwork {
 

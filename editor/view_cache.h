@@ -4,7 +4,7 @@
 // 130 ms on a 1000 x 700 view with 4x MSAA at 100K tets); a copy costs well under a millisecond.
 #pragma once
 
-#include "solver/gl_context.h"
+#include "gl/gl_context.h"
 
 #include <Eigen/Core>
 

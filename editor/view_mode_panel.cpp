@@ -1,9 +1,9 @@
-// The View panel's choice of optional view (editor/view_modes.h) and its legend. A change only marks
+// The View panel's choice of optional view (render/view_modes.h) and its legend. A change only marks
 // the view dirty: the worker builds the view's geometry (ViewGeometryCache) with the next tick, so
 // the UI never waits for a hierarchy build or the slice of a large volume.
 #include "editor/editor_app.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <imgui.h>
 

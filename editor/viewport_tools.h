@@ -10,9 +10,9 @@
 //   Home                 resets the view (the editor rebuilds the camera)
 #pragma once
 
-#include "editor/edit_operation.h"
 #include "editor/orbit_camera.h"
 #include "editor/stroke_tools.h"
+#include "scene/edit_operation.h"
 #include "solver/lighting.h"
 
 #include <Eigen/Core>

@@ -1,6 +1,6 @@
 #include "editor/window_gl_context.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <GLFW/glfw3.h>
 

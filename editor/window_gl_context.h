@@ -4,7 +4,7 @@
 // releases it at the end (LiveSolver does both around every GPU call).
 #pragma once
 
-#include "editor/live_solver.h"
+#include "gl/shared_context.h"
 
 #include <memory>
 #include <string>

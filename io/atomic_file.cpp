@@ -1,6 +1,6 @@
 #include "io/atomic_file.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>

@@ -1,6 +1,6 @@
 #include "io/file_contents.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <cerrno>
 #include <cstring>

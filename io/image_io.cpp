@@ -1,7 +1,7 @@
 #include "io/image_io.h"
 
+#include "base/error.h"
 #include "io/atomic_file.h"
-#include "tetops/error.h"
 
 #include <fstream>
 #include <iterator>

@@ -2,7 +2,7 @@
 
 #include "io/file_extension.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <CGAL/IO/OFF.h>
 #include <CGAL/Simple_cartesian.h>

@@ -1,11 +1,11 @@
 #include "io/tetgen_format.h"
 
+#include "base/error.h"
 #include "io/ascii_numbers.h"
 #include "io/atomic_file.h"
 #include "io/file_contents.h"
 #include "io/text_scanner.h"
 #include "io/volume_checks.h"
-#include "tetops/error.h"
 
 namespace waxwork {
 namespace {

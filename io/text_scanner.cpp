@@ -1,6 +1,6 @@
 #include "io/text_scanner.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <charconv>
 #include <cmath>

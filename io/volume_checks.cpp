@@ -1,6 +1,6 @@
 #include "io/volume_checks.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <cstdint>
 

@@ -1,11 +1,11 @@
 #include "io/volume_file.h"
 
+#include "base/error.h"
 #include "io/file_extension.h"
 #include "io/gmsh_format.h"
 #include "io/medit_format.h"
 #include "io/tetgen_format.h"
 #include "io/vtu_format.h"
-#include "tetops/error.h"
 
 #include <optional>
 #include <string>

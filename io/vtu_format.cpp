@@ -1,10 +1,10 @@
 #include "io/vtu_format.h"
 
+#include "base/error.h"
 #include "io/atomic_file.h"
 #include "io/base64.h"
 #include "io/file_contents.h"
 #include "io/volume_checks.h"
-#include "tetops/error.h"
 
 #include <pugixml.hpp>
 

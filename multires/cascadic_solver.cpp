@@ -1,6 +1,7 @@
 #include "multires/cascadic_solver.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
+#include "base/timing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -8,10 +9,6 @@
 
 namespace waxwork {
 namespace {
-
-double elapsed_ms(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Bornemann and Deuflhard's schedule: level l >= 1 runs level_iterations growth^(l - 1), capped.
 int iterations_on_level(const CascadicOptions& options, size_t level) {
@@ -81,7 +78,7 @@ CascadicReport CascadicSolver::coarse_pass(std::span<const double> b, int channe
     const size_t levels = operators_.level_count();
     if (levels == 1) {  // level 0 is the coarsest: solved exactly
         operators_.solve_coarsest(channel, b, x);
-        report.coarse_ms = elapsed_ms(start);
+        report.coarse_ms = milliseconds_since(start);
         return report;
     }
     // The Galerkin right-hand sides: b^{l+1} = (P^l)^T b^l.
@@ -98,7 +95,7 @@ CascadicReport CascadicSolver::coarse_pass(std::span<const double> b, int channe
         report.coarse_levels.push_back(std::move(entry));
     }
     interpolate(operators_.interpolation(0), x_[1], x);
-    report.coarse_ms = elapsed_ms(start);
+    report.coarse_ms = milliseconds_since(start);
     return report;
 }
 
@@ -110,7 +107,7 @@ CascadicReport CascadicSolver::solve(std::span<const double> b, int channel, std
     cg.relative_tolerance = options.relative_tolerance;
     cg.max_iterations = options.max_iterations;
     report.fine = solve_jacobi_cg<double>(operators_.view(0, channel), b, x, cg);
-    report.fine_ms = elapsed_ms(start);
+    report.fine_ms = milliseconds_since(start);
     return report;
 }
 

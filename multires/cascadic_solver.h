@@ -5,7 +5,7 @@
 // systems instead of Eq. 17's.
 //
 // Why. The paper's pass cannot halve Jacobi CG's time on our systems even with exact coarse solves
-// that cost nothing (multires/coarse_start_bound.h; README "Solvers against each other"): the exact
+// that cost nothing (bench/studies/coarse_start_bound.h; docs/benchmarks.md): the exact
 // solution of level 1's Eq. 17 system, interpolated, leaves a 12% error on spot at 486,745 tets. Eq. 17
 // collocates the fine equations at the retained vertices (S M^l P^l y = S b), so its solution is not the
 // best element of range(P) in any norm. The Galerkin system P^T M P y = P^T b gives exactly that best

@@ -1,4 +1,4 @@
-// Jacobi-preconditioned BiCGSTAB on the GPU (float, solver/gpu_kernels.h) for the three rgb systems of
+// Jacobi-preconditioned BiCGSTAB on the GPU (float, solver/gpu/gpu_kernels.h) for the three rgb systems of
 // a coarse multires level at once: the algorithm of multires/bicgstab.h with its breakdown, stagnation,
 // divergence and revert rules applied per channel (a channel that stops is frozen while the others go
 // on). Float reaches relative residuals of ~1e-6 at best; the coarse levels only provide start vectors
@@ -6,8 +6,8 @@
 #pragma once
 
 #include "multires/bicgstab.h"
-#include "solver/gpu_kernels.h"
-#include "solver/gpu_matrix.h"
+#include "solver/gpu/gpu_kernels.h"
+#include "solver/gpu/gpu_matrix.h"
 
 #include <array>
 

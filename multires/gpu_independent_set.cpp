@@ -1,6 +1,6 @@
 #include "multires/gpu_independent_set.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <algorithm>
 #include <bit>

@@ -9,8 +9,8 @@
 // the device stamps selections with the round number instead, so no clearing pass is needed.
 #pragma once
 
+#include "gl/gpu_compute.h"
 #include "multires/independent_set.h"
-#include "solver/gpu_compute.h"
 
 #include <cstdint>
 #include <vector>

@@ -34,7 +34,7 @@
 #include "multires/multigrid_preconditioner.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/frame_budget.h"
-#include "solver/gpu_kernels.h"
+#include "solver/gpu/gpu_kernels.h"
 
 #include <Eigen/Core>
 

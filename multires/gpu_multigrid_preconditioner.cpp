@@ -1,6 +1,6 @@
 #include "multires/gpu_multigrid_preconditioner.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <string>
 #include <utility>

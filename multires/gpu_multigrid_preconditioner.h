@@ -33,8 +33,8 @@
 #pragma once
 
 #include "multires/multigrid_preconditioner.h"
-#include "solver/gpu_kernels.h"
-#include "solver/gpu_matrix.h"
+#include "solver/gpu/gpu_kernels.h"
+#include "solver/gpu/gpu_matrix.h"
 
 #include <memory>
 #include <span>

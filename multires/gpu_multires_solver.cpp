@@ -1,6 +1,6 @@
 #include "multires/gpu_multires_solver.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 namespace waxwork {
 

@@ -2,7 +2,7 @@
 // hierarchy is built on the CPU (independent sets, Eq. 16 weights, Eq. 17 coarse matrices in double)
 // and uploaded once in float; each solve restricts b by injection, runs BiCGSTAB on the coarsest
 // level to convergence and a few iterations on each finer level (gpu_bicgstab.h), interpolates down
-// (Eq. 16) and finishes with the level-0 Jacobi CG of solver/gpu_conjugate_gradient.h, all three
+// (Eq. 16) and finishes with the level-0 Jacobi CG of solver/gpu/gpu_conjugate_gradient.h, all three
 // channels at once and without leaving the device except for reduction scalars.
 //
 // Per-frame mode (solve_frame): only the level-0 CG, warm-started from the previous frame, as the CPU
@@ -12,7 +12,7 @@
 #include "multires/gpu_bicgstab.h"
 #include "multires/hierarchy.h"
 #include "multires/multires_solver.h"
-#include "solver/gpu_conjugate_gradient.h"
+#include "solver/gpu/gpu_conjugate_gradient.h"
 
 #include <array>
 #include <memory>

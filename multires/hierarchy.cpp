@@ -1,8 +1,8 @@
 #include "multires/hierarchy.h"
 
+#include "base/error.h"
 #include "multires/independent_set.h"
 #include "tetops/cut.h"
-#include "tetops/error.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -507,7 +507,7 @@ std::vector<int32_t> level0_changes(const DiffusionMatrix& matrix, std::span<con
 // coarser level). The update would select most vertices again anyway, and little would be left to copy
 // for the cost of working out what may be: spot broken into 5 cells at 59,332 tets changes 37% of
 // level 0, 65% of level 1 and 93% of level 2, and rebuilt every level 1.09x as long as from scratch
-// (README, "Rebuilding the hierarchy after a cut or a fracture"). A fresh level is also the
+// (docs/solvers.md). A fresh level is also the
 // selection a build from scratch would make on its graph.
 constexpr double kMaxCarriedChangeShare = 0.5;
 

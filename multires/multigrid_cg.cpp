@@ -1,6 +1,6 @@
 #include "multires/multigrid_cg.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

@@ -6,8 +6,8 @@
 // solver/cg_channel_state.h does for the Jacobi CG loops).
 #pragma once
 
+#include "base/error.h"
 #include "solver/conjugate_gradient.h"
-#include "tetops/error.h"
 
 #include <array>
 #include <cmath>

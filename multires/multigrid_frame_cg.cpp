@@ -1,6 +1,6 @@
 #include "multires/multigrid_frame_cg.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,8 +2,8 @@
 
 #include "multires/parallel_rows.h"
 
+#include "base/error.h"
 #include "solver/conjugate_gradient.h"
-#include "tetops/error.h"
 
 
 #include <algorithm>

@@ -3,10 +3,10 @@
 #include "multires/carried_rows.h"
 #include "multires/link_union.h"
 #include "multires/parallel_rows.h"
-#include "solver/reference_solvers.h"
+#include "solver/reference/reference_solvers.h"
 
+#include "base/error.h"
 #include "tetops/cut.h"
-#include "tetops/error.h"
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>

@@ -1,6 +1,7 @@
 #include "multires/multires_solver.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
+#include "base/timing.h"
 
 #include <algorithm>
 #include <chrono>
@@ -18,10 +19,6 @@ std::string MultiresSolveReport::fallback_reasons() const {
 }
 
 namespace {
-
-double elapsed_ms(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
 
 void check_channel(int channel) {
     if (channel < 0 || channel > 2)
@@ -131,7 +128,7 @@ void MultiresSolver::solve_fine(std::span<const double> b, int channel, std::spa
     }
     if (report.fine.smallest_eigenvalue_estimate > 0)
         eigenvalue_hint_[static_cast<size_t>(channel)] = report.fine.smallest_eigenvalue_estimate;
-    report.fine_ms = elapsed_ms(start);
+    report.fine_ms = milliseconds_since(start);
 }
 
 MultiresSolveReport MultiresSolver::solve(std::span<const double> b, int channel, std::span<double> x,
@@ -194,7 +191,7 @@ void MultiresSolver::coarse_pass(std::span<const double> b, int channel, std::sp
     } else {
         std::fill(x.begin(), x.end(), 0.0);
     }
-    report.coarse_ms = elapsed_ms(start);
+    report.coarse_ms = milliseconds_since(start);
 }
 
 void MultiresSolver::correct_start(std::span<const double> b, int channel, std::span<double> x,

@@ -1,7 +1,7 @@
 #include "solver/conjugate_gradient.h"
 
+#include "base/error.h"
 #include "solver/cg_channel_state.h"
-#include "tetops/error.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

@@ -1,7 +1,7 @@
 #include "solver/diffusion_matrix.h"
 
+#include "base/error.h"
 #include "solver/material.h"
-#include "tetops/error.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

@@ -1,9 +1,10 @@
 #include "solver/diffusion_solve.h"
 
+#include "base/error.h"
+#include "base/timing.h"
 #include "solver/cg_channel_state.h"
 #include "solver/conjugate_gradient.h"
-#include "solver/gpu_conjugate_gradient.h"
-#include "tetops/error.h"
+#include "solver/gpu/gpu_conjugate_gradient.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -20,10 +21,6 @@
 
 namespace waxwork {
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
 
 // --- Three channels in one CG loop --------------------------------------------------------------
 // The three rgb systems share one pattern, so one pass over the pattern serves all three: the column
@@ -341,7 +338,7 @@ void solve_diffusion_system(const DiffusionMatrix& matrix, const std::vector<std
             throw AlgorithmError(msg.str());
         }
     }
-    solution.solve_ms = ms_since(start);
+    solution.solve_ms = milliseconds_since(start);
 }
 
 DiffusionSolution solve_diffusion(const TetMesh& mesh, const TetConnectivity& connectivity,
@@ -358,7 +355,7 @@ DiffusionSolution solve_diffusion(const TetMesh& mesh, const TetConnectivity& co
     assembly.stiffness_form = options.stiffness_form;
     assembly.mm_per_unit = options.mm_per_unit;
     const DiffusionMatrix matrix = assemble_diffusion_matrix(mesh, connectivity, materials, assembly);
-    solution.assembly_ms = ms_since(start);
+    solution.assembly_ms = milliseconds_since(start);
     solve_diffusion_system(matrix, q, options, solution, corners);
     return solution;
 }

@@ -3,8 +3,8 @@
 // choosing solvers) is in diffusion_matrix.h and conjugate_gradient.h.
 #pragma once
 
+#include "gl/gl_context.h"
 #include "solver/diffusion_matrix.h"
-#include "solver/gl_context.h"
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
@@ -26,7 +26,7 @@ enum class SolverPrecision {
 
 enum class SolverBackend {
     Cpu,
-    // Jacobi CG in float on OpenGL 4.3 compute shaders (solver/gpu_conjugate_gradient.h), on the
+    // Jacobi CG in float on OpenGL 4.3 compute shaders (solver/gpu/gpu_conjugate_gradient.h), on the
     // context of DiffusionOptions::gl. Falls back to the CPU when the GPU path cannot run, and
     // finishes in double on the CPU, from the GPU's phi, when float CG stops short of the tolerance
     // (see DiffusionSolution::gpu_fallback_reason); `precision` does not apply (always float).

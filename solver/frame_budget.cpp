@@ -1,6 +1,6 @@
 #include "solver/frame_budget.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <chrono>
 #include <cmath>
@@ -57,6 +57,15 @@ FrameDeadline FrameDeadline::share(int parts) const {
     // One part, or no time left (an expired deadline stays expired): the share is the whole deadline.
     if (left > 0 && parts > 1) part.end_ = now + left / parts;
     return part;
+}
+
+std::string frame_ms_problem(double milliseconds) {
+    if (!std::isfinite(milliseconds) || milliseconds <= 0 || milliseconds > kMaxFrameMilliseconds) {
+        std::ostringstream msg;
+        msg << "must be a time in milliseconds in (0, " << kMaxFrameMilliseconds << "]";
+        return msg.str();
+    }
+    return "";
 }
 
 }  // namespace waxwork

@@ -1,6 +1,5 @@
-// How much work one live frame may do (issue 4, item 4: "a budget per frame, iterations or
-// milliseconds"): at most so many iterations, at most so many milliseconds, or both (whichever
-// runs out first).
+// How much work one live frame may do: at most so many iterations, at most so many milliseconds, or
+// both (whichever runs out first).
 //
 // Why milliseconds as well as iterations. An iteration budget costs a different time on every mesh
 // size, method and machine; what the user wants to fix is the frame rate. The CPU solvers check a
@@ -17,6 +16,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 
 namespace waxwork {
 
@@ -68,5 +68,11 @@ private:
     double end_ = 0;
     bool bounded_ = false;
 };
+
+// The largest frame time accepted (a frame of 10 s is no longer live; a larger value is more likely a typo).
+constexpr double kMaxFrameMilliseconds = 10000;
+// Checks a frame time in ms: finite and in (0, kMaxFrameMilliseconds]. Returns "" when valid, else
+// what is wrong (for the option's and the session file's one-line errors).
+std::string frame_ms_problem(double milliseconds);
 
 }  // namespace waxwork

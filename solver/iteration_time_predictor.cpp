@@ -1,6 +1,6 @@
 #include "solver/iteration_time_predictor.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <algorithm>
 #include <cmath>

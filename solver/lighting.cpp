@@ -1,8 +1,8 @@
 #include "solver/lighting.h"
 
+#include "base/error.h"
 #include "solver/material.h"
 #include "solver/radiance.h"
-#include "tetops/error.h"
 
 #include <tbb/parallel_for.h>
 

@@ -1,6 +1,6 @@
 #include "solver/material.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <algorithm>
 #include <array>
@@ -131,6 +131,29 @@ std::string material_label(const TetMaterial& material) {
     for (const Preset& p : kJensen2001)
         if (TetMaterial{p.mua, p.musp, p.eta} == material) return std::string(p.name);
     return "custom";
+}
+
+std::string resolved_materials_name(const TetMesh& mesh, const std::optional<TetMaterial>& override) {
+    if (override) return material_label(*override);
+    return mesh.has_materials() ? "stored" : "marble";
+}
+
+std::vector<TetMaterial> resolve_materials(const TetMesh& mesh, const std::optional<TetMaterial>& override) {
+    if (override) {
+        validate_material(*override);
+        return std::vector<TetMaterial>(mesh.tet_count(), *override);
+    }
+    if (!mesh.has_materials()) return std::vector<TetMaterial>(mesh.tet_count(), material_preset("marble"));
+    if (mesh.materials.size() != mesh.tet_count()) {
+        throw InvalidArgumentError("the volume stores " + std::to_string(mesh.materials.size()) + " materials for " +
+                                   std::to_string(mesh.tet_count()) + " tets");
+    }
+    // Painted volumes hold few distinct materials in long runs: validate each run once.
+    for (size_t t = 0; t < mesh.materials.size(); ++t) {
+        if (t == 0 || !(mesh.materials[t] == mesh.materials[t - 1]))
+            validate_material(mesh.materials[t], "stored material of tet " + std::to_string(t));
+    }
+    return mesh.materials;
 }
 
 }  // namespace waxwork

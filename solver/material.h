@@ -12,6 +12,7 @@
 
 #include "tetops/tet_mesh.h"
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -60,5 +61,13 @@ std::vector<std::string> material_preset_names();
 TetMaterial material_preset(std::string_view name);
 // A preset's name when `material` equals one, else "custom".
 std::string material_label(const TetMaterial& material);
+
+// One material per tet: `override` everywhere when given, else the volume's stored materials, else
+// the marble preset. Every material is validated (validate_material); a stored one that fails names
+// its tet.
+std::vector<TetMaterial> resolve_materials(const TetMesh& mesh, const std::optional<TetMaterial>& override);
+// What resolve_materials(mesh, override) fills the tets with, by name: the override's preset name
+// ("custom" for other coefficients; material_label), "stored" for the volume's own, else "marble".
+std::string resolved_materials_name(const TetMesh& mesh, const std::optional<TetMaterial>& override);
 
 }  // namespace waxwork

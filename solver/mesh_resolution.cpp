@@ -1,7 +1,7 @@
 #include "solver/mesh_resolution.h"
 
+#include "base/error.h"
 #include "solver/material.h"
-#include "tetops/error.h"
 
 #include <algorithm>
 #include <cmath>

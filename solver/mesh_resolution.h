@@ -28,7 +28,7 @@ struct MeshResolutionRule {
     double interior_fraction_of_diagonal = 1.0 / 8.0;
     double grading = 0.5;
     // Multiplies the rule's edge lengths (surface and largest): the mesh-size studies' knob
-    // (editor/resolution_study.h, accuracy_study.h). 1 is the rule above.
+    // (bench/studies/resolution_study.h, accuracy_study.h). 1 is the rule above.
     double size_factor = 1.0;
 };
 

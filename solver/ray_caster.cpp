@@ -1,6 +1,6 @@
 #include "solver/ray_caster.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>

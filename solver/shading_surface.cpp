@@ -1,8 +1,8 @@
 #include "solver/shading_surface.h"
 
+#include "base/error.h"
 #include "tetops/connectivity.h"
 #include "tetops/disjoint_sets.h"
-#include "tetops/error.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

@@ -1,6 +1,6 @@
 #include "solver/warm_start.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <string>
 

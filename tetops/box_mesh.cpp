@@ -1,6 +1,6 @@
 #include "tetops/box_mesh.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <cmath>
 

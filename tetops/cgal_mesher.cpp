@@ -1,6 +1,6 @@
 #include "tetops/cgal_mesher.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 #include "tetops/mesher_scale.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>

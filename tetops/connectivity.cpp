@@ -1,7 +1,7 @@
 #include "tetops/connectivity.h"
 
+#include "base/error.h"
 #include "tetops/disjoint_sets.h"
-#include "tetops/error.h"
 
 #include <tbb/parallel_for.h>
 

@@ -1,6 +1,6 @@
 #include "tetops/cut.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <tbb/parallel_for.h>
 

@@ -1,7 +1,7 @@
 #include "tetops/exact_cut.h"
 
+#include "base/error.h"
 #include "tetops/connectivity.h"
-#include "tetops/error.h"
 #include "tetops/quality.h"
 #include "tetops/split_quality.h"
 
@@ -144,7 +144,7 @@ bool may_slide(const TetMesh& mesh, const std::vector<KeptFace>& faces, int32_t 
 // enough to catch the near-degenerate crossings that rounding, relaxation and earlier cuts leave next
 // to a corner or a wall. Random edit sequences found 4e-9 of an edge (a 3e-6 degree sliver), 3e-6 next
 // to a cube's corner (0.004 degrees) and 1e-3 next to a relaxed cross-section (0.014 degrees);
-// LiveSolver.RandomEditSequences* in tests/editor/live_solver_test.cpp.
+// LiveSolver.RandomEditSequences* in tests/scene/live_solver_test.cpp.
 constexpr double kHairline = 1e-3;
 
 // Moves vertices whose crossing is within snap_fraction of them onto the surface when the guard on

@@ -1,4 +1,4 @@
-// Exact cutting (issue 6): tets crossed by the cutting surface are split along it, so the
+// Exact cutting: tets crossed by the cutting surface are split along it, so the
 // cross-section follows the surface instead of the staircase of whole tets that TransCut Sec. 5's
 // remove-and-relax leaves behind.
 //

@@ -1,9 +1,9 @@
 #include "tetops/fracture.h"
 
+#include "base/error.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
 #include "tetops/disjoint_sets.h"
-#include "tetops/error.h"
 #include "tetops/exact_cut.h"
 #include "tetops/quality.h"
 #include "tetops/split_coarsening.h"

@@ -1,4 +1,4 @@
-// Breaking a volume into pieces (issue 6, part 3) and putting pieces back together.
+// Breaking a volume into pieces and putting pieces back together.
 //
 // A piece is a set of tets with its own rigid transform (TetMesh::piece_ids, piece_transforms). Pieces
 // share no vertices: fracturing duplicates every vertex on a crack so each piece can move on its own;

@@ -1,6 +1,6 @@
 #include "tetops/fragments.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <algorithm>
 #include <cmath>

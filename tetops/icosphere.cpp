@@ -1,6 +1,6 @@
 #include "tetops/icosphere.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <cmath>
 #include <map>

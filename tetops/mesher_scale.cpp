@@ -1,6 +1,6 @@
 #include "tetops/mesher_scale.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <Eigen/Geometry>
 

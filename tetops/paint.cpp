@@ -1,6 +1,6 @@
 #include "tetops/paint.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <nanoflann.hpp>
 #include <tbb/parallel_for.h>

@@ -1,6 +1,6 @@
 #include "tetops/relaxation.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 #include "tetops/quality.h"
 
 #include <tbb/parallel_for.h>

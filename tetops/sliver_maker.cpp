@@ -1,6 +1,6 @@
 #include "tetops/sliver_maker.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 namespace waxwork {
 

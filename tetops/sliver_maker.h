@@ -1,4 +1,4 @@
-// Deliberately degenerate tets for stability tests and studies (issue 8: "slivers, min dihedral 0.01
+// Deliberately degenerate tets for stability tests and studies ("slivers, min dihedral 0.01
 // to 1 degree"): interior vertices are pushed towards the opposite face of one tet of their star, which
 // flattens that tet into a cap of relative height `flatness` while every tet stays positively oriented
 // (the star of an interior vertex of a convex-celled mesh is star-shaped from the face's centroid).

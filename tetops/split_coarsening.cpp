@@ -1,6 +1,6 @@
 #include "tetops/split_coarsening.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 #include "tetops/quality.h"
 #include "tetops/split_quality.h"
 

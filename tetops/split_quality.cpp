@@ -1,7 +1,7 @@
 #include "tetops/split_quality.h"
 
+#include "base/error.h"
 #include "tetops/connectivity.h"
-#include "tetops/error.h"
 #include "tetops/exact_cut.h"
 #include "tetops/quality.h"
 

@@ -1,4 +1,4 @@
-// The quality guarantee of exact splitting (issue 6, exact_cut.h and fracture.h): no tet that a split
+// The quality guarantee of exact splitting (exact_cut.h and fracture.h): no tet that a split
 // creates or moves may end with a minimum dihedral angle under min(guard, that of the tet it came
 // from before the operation). Snapping checks the guard before moving a vertex (exact_cut.cpp); the
 // case split of a crossed tet cannot choose its shapes, so afterwards a guarded optimisation moves

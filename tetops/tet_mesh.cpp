@@ -1,6 +1,6 @@
 #include "tetops/tet_mesh.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>

@@ -1,6 +1,6 @@
 #include "tetops/tetgen_mesher.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 #include "tetops/mesher_scale.h"
 
 #include <tetgen.h>

@@ -1,7 +1,7 @@
 #include "tetops/tetrahedralize.h"
 
+#include "base/error.h"
 #include "tetops/cgal_mesher.h"
-#include "tetops/error.h"
 #include "tetops/size_field.h"
 #include "tetops/spatial_order.h"
 #include "tetops/tetgen_mesher.h"
@@ -353,6 +353,11 @@ MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOption
     result.milliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return result;
+}
+
+MeshingResult tetrahedralize_surface_file(const std::filesystem::path& path, const TriangleSurface& surface,
+                                          const MeshingOptions& options) {
+    return naming_context(path.string(), [&] { return tetrahedralize(surface, options); });
 }
 
 }  // namespace waxwork

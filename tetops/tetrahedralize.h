@@ -5,6 +5,7 @@
 #include "tetops/tet_mesh.h"
 #include "tetops/triangle_surface.h"
 
+#include <filesystem>
 #include <optional>
 
 namespace waxwork {
@@ -55,5 +56,10 @@ struct MeshingResult {
 // Fills a closed, outward-oriented, self-intersection-free surface with tets. Throws
 // InvalidArgumentError on absurd options and AlgorithmError when the mesher fails.
 MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOptions& options);
+
+// tetrahedralize(surface, options) for the surface read from `path`: its errors name the file
+// ("PATH: PROBLEM", the same error type), since the meshers' own messages know no file.
+MeshingResult tetrahedralize_surface_file(const std::filesystem::path& path, const TriangleSurface& surface,
+                                          const MeshingOptions& options);
 
 }  // namespace waxwork

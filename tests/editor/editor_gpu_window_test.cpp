@@ -1,8 +1,8 @@
 // `waxwork edit --backend gpu` under a virtual X server: the live solve runs on the GPU path in a hidden
 // window's context shared with the editor's window (editor/window_gl_context.h), and the view equals the
 // CPU backend's; a failing GPU falls back to the CPU and says so.
-#include "editor/cli_run.h"
 #include "io/image_io.h"
+#include "support/cli_run.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

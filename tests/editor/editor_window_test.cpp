@@ -2,10 +2,10 @@
 // OpenGL 4.5 core context (Mesa llvmpipe through GLX), loads and solves a scene on its worker threads,
 // draws, saves a screenshot and exits cleanly; and its 3D view shows exactly what `waxwork render`
 // (OSMesa) writes for the same scene.
-#include "editor/cli_run.h"
 #include "io/image_io.h"
 #include "io/volume_file.h"
 #include "solver/material.h"
+#include "support/cli_run.h"
 #include "tetops/test_meshes.h"
 
 #include <Eigen/Geometry>

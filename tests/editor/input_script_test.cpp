@@ -1,6 +1,6 @@
 #include "editor/input_script.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <GLFW/glfw3.h>
 #include <gtest/gtest.h>

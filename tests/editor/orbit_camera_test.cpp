@@ -1,5 +1,5 @@
+#include "base/error.h"
 #include "editor/orbit_camera.h"
-#include "tetops/error.h"
 
 #include <gtest/gtest.h>
 

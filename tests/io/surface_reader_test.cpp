@@ -1,6 +1,6 @@
 #include "io/surface_reader.h"
 
-#include "tetops/error.h"
+#include "base/error.h"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>

@@ -1,11 +1,11 @@
 // Volume files: exact round trips in every format, rejection of broken files, atomic saves.
+#include "base/error.h"
 #include "io/atomic_file.h"
 #include "io/gmsh_format.h"
 #include "io/medit_format.h"
 #include "io/tetgen_format.h"
 #include "io/volume_file.h"
 #include "io/vtu_format.h"
-#include "tetops/error.h"
 #include "tetops/tet_mesh.h"
 
 #include <gtest/gtest.h>

@@ -1,8 +1,8 @@
+#include "base/error.h"
 #include "multires/cascadic_solver.h"
 #include "multires/multires_solver.h"
+#include "solver/reference/reference_solvers.h"
 #include "multires_test_systems.h"
-#include "solver/reference_solvers.h"
-#include "tetops/error.h"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>

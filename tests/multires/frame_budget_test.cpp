@@ -1,10 +1,10 @@
 // Millisecond frame budgets (solver/frame_budget.h) in the multires per-frame solvers, on a fake clock:
 // MultiresSolver::solve_frame and MultigridFrameSolver::step stop where the deadline says, equal to the
 // iteration-budget run of that length bit for bit, and successive timed frames converge.
+#include "base/error.h"
 #include "multires/multigrid_frame_solver.h"
 #include "multires/multires_solver.h"
 #include "multires_test_systems.h"
-#include "tetops/error.h"
 
 #include <gtest/gtest.h>
 

@@ -4,8 +4,8 @@
 // irregular random graphs, for several seeds.
 #include "multires/gpu_independent_set.h"
 #include "multires/independent_set.h"
-#include "multires_test_systems.h"
 #include "solver/gpu_test_context.h"
+#include "multires_test_systems.h"
 
 #include <gtest/gtest.h>
 

@@ -1,14 +1,14 @@
 // The device multigrid CG (multires/gpu_multigrid_frame_solver.h) against the CPU frame solver and the
 // double-precision solution, on llvmpipe in CI.
+#include "base/error.h"
 #include "multires/gpu_multigrid_frame_solver.h"
 #include "multires/multigrid_frame_solver.h"
-#include "multires_test_systems.h"
-#include "solver/gpu_conjugate_gradient.h"
+#include "solver/gpu/gpu_conjugate_gradient.h"
 #include "solver/gpu_test_context.h"
 #include "solver/material.h"
 #include "tetops/box_mesh.h"
 #include "tetops/sliver_maker.h"
-#include "tetops/error.h"
+#include "multires_test_systems.h"
 
 #include <gtest/gtest.h>
 

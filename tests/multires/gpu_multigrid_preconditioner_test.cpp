@@ -1,12 +1,12 @@
 // The device V-cycle (multires/gpu_multigrid_preconditioner.h) against the CPU float apply_rgb, on
 // llvmpipe in CI: the same operator to float rounding, and a row update after painting equal to a
 // rebuild.
+#include "base/error.h"
 #include "multires/gpu_multigrid_preconditioner.h"
 #include "multires/hierarchy.h"
 #include "multires/multigrid_preconditioner.h"
-#include "multires_test_systems.h"
 #include "solver/gpu_test_context.h"
-#include "tetops/error.h"
+#include "multires_test_systems.h"
 
 #include <gtest/gtest.h>
 

@@ -6,8 +6,8 @@
 #include "multires/gpu_multires_solver.h"
 #include "multires/hierarchy.h"
 #include "multires/multires_solver.h"
-#include "multires_test_systems.h"
 #include "solver/gpu_test_context.h"
+#include "multires_test_systems.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
+#include "base/error.h"
 #include "multires/hierarchy.h"
 #include "multires/independent_set.h"
 #include "multires/multires_solver.h"
 #include "multires_test_systems.h"
-#include "tetops/error.h"
 
 #include <tbb/global_control.h>
 

@@ -1,14 +1,14 @@
+#include "base/error.h"
 #include "multires/multigrid_cg.h"
 #include "multires/multigrid_preconditioner.h"
-#include "multires_test_systems.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
-#include "solver/reference_solvers.h"
+#include "solver/reference/reference_solvers.h"
 #include "tetops/box_mesh.h"
 #include "tetops/cut.h"
 #include "tetops/relaxation.h"
 #include "tetops/sliver_maker.h"
-#include "tetops/error.h"
+#include "multires_test_systems.h"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>

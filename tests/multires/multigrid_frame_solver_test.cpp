@@ -1,9 +1,9 @@
+#include "base/error.h"
 #include "multires/multigrid_cg.h"
 #include "multires/multigrid_frame_solver.h"
 #include "multires/multigrid_preconditioner.h"
-#include "multires_test_systems.h"
 #include "solver/lighting.h"
-#include "tetops/error.h"
+#include "multires_test_systems.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>

@@ -1,7 +1,7 @@
+#include "base/error.h"
 #include "multires/bicgstab.h"
 #include "multires/multires_solver.h"
 #include "multires_test_systems.h"
-#include "tetops/error.h"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>

@@ -8,10 +8,10 @@
 #include "solver/lighting.h"
 #include "solver/material.h"
 #include "tetops/box_mesh.h"
-#include "tetops/sliver_maker.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
 #include "tetops/relaxation.h"
+#include "tetops/sliver_maker.h"
 #include "tetops/test_meshes.h"
 
 #include <Eigen/Dense>

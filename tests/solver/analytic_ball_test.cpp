@@ -1,10 +1,10 @@
 // The accuracy test: the exact fluence in a homogeneous ball (seeds README) against solve_diffusion.
-#include "solver/analytic_ball.h"
+#include "base/error.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
 #include "solver/material.h"
+#include "solver/reference/analytic_ball.h"
 #include "solver_test_meshes.h"
-#include "tetops/error.h"
 
 #include <gtest/gtest.h>
 

@@ -1,12 +1,12 @@
+#include "base/error.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
 #include "solver/material.h"
-#include "solver/reference_solvers.h"
+#include "solver/reference/reference_solvers.h"
+#include "tetops/sliver_maker.h"
 #include "lit_block_system.h"
 #include "solver_test_meshes.h"
-#include "tetops/error.h"
-#include "tetops/sliver_maker.h"
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>

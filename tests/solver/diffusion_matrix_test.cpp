@@ -1,7 +1,7 @@
+#include "base/error.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/material.h"
 #include "solver_test_meshes.h"
-#include "tetops/error.h"
 
 #include <gtest/gtest.h>
 

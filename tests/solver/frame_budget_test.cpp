@@ -1,6 +1,7 @@
 // Frame budgets (solver/frame_budget.h): validation, deadlines on an injected clock, Jacobi CG stopping
 // at a deadline exactly where an iteration budget would, and the GPU's iteration-time predictor
 // (solver/iteration_time_predictor.h) on synthetic timings. No real clock is timed here.
+#include "base/error.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/frame_budget.h"
@@ -8,7 +9,6 @@
 #include "solver/material.h"
 #include "lit_block_system.h"
 #include "solver_test_meshes.h"
-#include "tetops/error.h"
 
 #include <gtest/gtest.h>
 

@@ -1,18 +1,18 @@
-// The device assembly of the diffusion matrix (solver/gpu_assembly.h) against the CPU assembly, on
+// The device assembly of the diffusion matrix (solver/gpu/gpu_assembly.h) against the CPU assembly, on
 // Mesa's llvmpipe through OSMesa in CI: every stored value of both discretisations, painted materials,
 // the row update after painting, moved vertices, bad input, and a GPU solve on device-assembled values.
-#include "solver/gpu_assembly.h"
+#include "solver/gpu/gpu_assembly.h"
 
+#include "base/error.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
-#include "solver/gpu_conjugate_gradient.h"
-#include "solver/gpu_matrix.h"
+#include "solver/gpu/gpu_conjugate_gradient.h"
+#include "solver/gpu/gpu_matrix.h"
 #include "solver/gpu_test_context.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
 #include "solver/solver_test_meshes.h"
 #include "tetops/connectivity.h"
-#include "tetops/error.h"
 
 #include <gtest/gtest.h>
 

@@ -1,19 +1,19 @@
 // The GPU solver (OpenGL 4.3 compute shaders) against the CPU path, on Mesa's llvmpipe through OSMesa
 // in CI: kernels, CG on spot and on a cut spot, the per-frame warm start, row updates after painting,
 // and the fallback to the CPU when a shader fails.
+#include "gl/gl_context.h"
 #include "io/surface_reader.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
-#include "solver/gl_context.h"
+#include "solver/gpu/gpu_conjugate_gradient.h"
+#include "solver/gpu/gpu_kernels.h"
+#include "solver/gpu/gpu_matrix.h"
+#include "solver/gpu/gpu_radiance.h"
 #include "solver/gpu_test_context.h"
-#include "solver/gpu_conjugate_gradient.h"
-#include "solver/gpu_kernels.h"
-#include "solver/gpu_matrix.h"
-#include "solver/gpu_radiance.h"
-#include "solver/radiance.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
+#include "solver/radiance.h"
 #include "solver/solver_test_meshes.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
@@ -197,7 +197,7 @@ TEST(GpuKernels, ProductDotAndAxpbyMatchTheCpu) {
     }
 }
 
-// The correctness bar: float GPU CG at a tight tolerance against double CPU CG, 1e-4 relative.
+// The correctness bar: float GPU CG at a tight tolerance against double CPU CG, 1e-4 relative.
 void expect_gpu_matches_cpu(const System& s, GpuMatrixFormat format, const char* label) {
     WAXWORK_REQUIRE_GL(context);
     const auto reference = cpu_double_solution(s, 1e-9);

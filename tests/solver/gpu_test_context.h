@@ -2,8 +2,8 @@
 // machine cannot give OpenGL 4.3 (Mesa's llvmpipe through OSMesa gives 4.5 in CI).
 #pragma once
 
-#include "solver/gl_context.h"
-#include "solver/gpu_compute.h"
+#include "gl/gl_context.h"
+#include "gl/gpu_compute.h"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
+#include "base/error.h"
 #include "solver/lighting.h"
 #include "solver/ray_caster.h"
 #include "tetops/connectivity.h"
-#include "tetops/error.h"
-#include "tetops/tet_mesh.h"
 #include "tetops/test_meshes.h"
+#include "tetops/tet_mesh.h"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/material.h"
-#include "solver/reference_solvers.h"
+#include "solver/reference/reference_solvers.h"
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 

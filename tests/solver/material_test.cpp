@@ -1,5 +1,5 @@
+#include "base/error.h"
 #include "solver/material.h"
-#include "tetops/error.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

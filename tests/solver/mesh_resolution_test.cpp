@@ -1,7 +1,7 @@
 // The default mesh size rule (solver/mesh_resolution.h).
+#include "base/error.h"
 #include "solver/material.h"
 #include "solver/mesh_resolution.h"
-#include "tetops/error.h"
 #include "tetops/icosphere.h"
 
 #include <gtest/gtest.h>

@@ -1,12 +1,12 @@
 #include "solver/shading_surface.h"
 
+#include "base/error.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/material.h"
 #include "solver/radiance.h"
 #include "solver/solver_test_meshes.h"
-#include "tetops/test_meshes.h"
 #include "tetops/connectivity.h"
-#include "tetops/error.h"
+#include "tetops/test_meshes.h"
 
 #include "io/surface_reader.h"
 #include "tetops/tetrahedralize.h"

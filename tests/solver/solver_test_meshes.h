@@ -5,8 +5,8 @@
 #include "tetops/connectivity.h"
 #include "tetops/icosphere.h"
 #include "tetops/quality.h"
-#include "tetops/tet_mesh.h"
 #include "tetops/test_meshes.h"
+#include "tetops/tet_mesh.h"
 #include "tetops/tetrahedralize.h"
 #include "tetops/triangle_surface.h"
 

@@ -1,9 +1,9 @@
 // Extending a warm start over vertices without a value (solver/warm_start.h).
+#include "base/error.h"
 #include "solver/warm_start.h"
-#include "solver_test_meshes.h"
-#include "tetops/error.h"
 #include "tetops/exact_cut.h"
 #include "tetops/fracture.h"
+#include "solver_test_meshes.h"
 
 #include <gtest/gtest.h>
 

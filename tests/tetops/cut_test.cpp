@@ -1,12 +1,12 @@
 // Cutting and relaxation (TransCut Sec. 5): which tets go, what survives, and that relaxation keeps
 // vertices on their side and tets above the 0.5 degree guard.
+#include "base/error.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
-#include "tetops/error.h"
 #include "tetops/quality.h"
 #include "tetops/relaxation.h"
-#include "tetops/tet_mesh.h"
 #include "tetops/test_meshes.h"
+#include "tetops/tet_mesh.h"
 
 #include <gtest/gtest.h>
 

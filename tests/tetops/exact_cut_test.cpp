@@ -1,15 +1,15 @@
 // Exact cutting: crossed tets are split along the surface, so the cross-section lies on it.
+#include "base/error.h"
 #include "io/surface_reader.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
-#include "tetops/error.h"
 #include "tetops/exact_cut.h"
 #include "tetops/fracture.h"
+#include "tetops/mesh_checks.h"
 #include "tetops/quality.h"
+#include "tetops/test_meshes.h"
 #include "tetops/tet_mesh.h"
 #include "tetops/tetrahedralize.h"
-#include "tetops/mesh_checks.h"
-#include "tetops/test_meshes.h"
 
 #include <gtest/gtest.h>
 

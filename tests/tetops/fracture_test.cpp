@@ -1,11 +1,11 @@
 // Fracture into pieces (Voronoi cells and planes), piece transforms and welding.
+#include "base/error.h"
 #include "tetops/connectivity.h"
-#include "tetops/error.h"
 #include "tetops/fracture.h"
-#include "tetops/quality.h"
-#include "tetops/tet_mesh.h"
 #include "tetops/mesh_checks.h"
+#include "tetops/quality.h"
 #include "tetops/test_meshes.h"
+#include "tetops/tet_mesh.h"
 
 #include <gtest/gtest.h>
 

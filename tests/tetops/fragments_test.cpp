@@ -1,11 +1,11 @@
 // Dropping small detached parts (tetops/fragments.h): which parts go, that the largest always stays,
 // and that per-tet data follow the tets that remain.
+#include "base/error.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
-#include "tetops/error.h"
 #include "tetops/fragments.h"
-#include "tetops/tet_mesh.h"
 #include "tetops/test_meshes.h"
+#include "tetops/tet_mesh.h"
 
 #include <gtest/gtest.h>
 

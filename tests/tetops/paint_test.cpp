@@ -1,10 +1,10 @@
 // Volumetric painting (TransCut Sec. 5): Gaussian weights from the nearest stroke point, compared with
 // a brute-force evaluation over every tet and every stroke point.
+#include "base/error.h"
 #include "tetops/cut.h"
-#include "tetops/error.h"
 #include "tetops/paint.h"
-#include "tetops/tet_mesh.h"
 #include "tetops/test_meshes.h"
+#include "tetops/tet_mesh.h"
 
 #include <gtest/gtest.h>
 

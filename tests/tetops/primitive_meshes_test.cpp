@@ -1,6 +1,6 @@
 // The generated reference geometry: Kuhn boxes and icospheres.
+#include "base/error.h"
 #include "tetops/box_mesh.h"
-#include "tetops/error.h"
 #include "tetops/icosphere.h"
 #include "tetops/quality.h"
 

@@ -1,9 +1,9 @@
 // Collapsing the vertices of splits nothing needs any more (tetops/split_coarsening.h): a cube split
 // by two planes, the second of which swallows the first on its positive side, as a later Voronoi cell
 // swallows an earlier wall.
+#include "base/error.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
-#include "tetops/error.h"
 #include "tetops/exact_cut.h"
 #include "tetops/mesh_checks.h"
 #include "tetops/quality.h"

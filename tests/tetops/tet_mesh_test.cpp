@@ -1,9 +1,9 @@
+#include "base/error.h"
 #include "tetops/connectivity.h"
-#include "tetops/error.h"
 #include "tetops/quality.h"
 #include "tetops/spatial_order.h"
-#include "tetops/tet_mesh.h"
 #include "tetops/test_meshes.h"
+#include "tetops/tet_mesh.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>

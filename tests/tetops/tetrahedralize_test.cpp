@@ -1,5 +1,5 @@
+#include "base/error.h"
 #include "io/surface_reader.h"
-#include "tetops/error.h"
 #include "tetops/quality.h"
 #include "tetops/size_field.h"
 #include "tetops/tetgen_mesher.h"

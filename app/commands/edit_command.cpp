@@ -1,0 +1,146 @@
+// `waxwork edit [FILE]`: opens the interactive editor (editor/editor_app.h). With --screenshot it draws
+// --frames frames once loading and solving have finished, saves the window (UI included unless
+// --hide-ui) as a PNG and exits: for the docs and the tests, under xvfb-run on a server.
+#include "app/commands.h"
+#include "app/options/live_solver_options.h"
+#include "app/options/material_options.h"
+#include "app/options/surface_meshing_options.h"
+#include "base/error.h"
+#include "editor/editor_app.h"
+#include "solver/material.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <iostream>
+#include <memory>
+
+namespace waxwork {
+namespace {
+
+struct EditCommandOptions {
+    std::string file;
+    std::string session;
+    std::string screenshot;
+    std::string input;
+    int frames = 10;
+    bool hide_ui = false;
+    int width = 1280;
+    int height = 800;
+    std::optional<size_t> max_tets;
+    MaterialOptions material;
+    std::vector<std::string> lights;
+    double scale = 1.0;
+    double crease_angle = kDefaultCreaseAngleDegrees;
+    std::vector<double> view;
+    std::string show = "radiance";
+    std::string slice_normal;
+    double slice_offset = 0;
+    bool quality_interior = false;
+    LiveSolverChoice solver;
+};
+
+void run_edit_command(const EditCommandOptions& o) {
+    if (o.width < 64 || o.height < 64 || o.width > kMaxImageSide || o.height > kMaxImageSide)
+        throw InvalidArgumentError("--width/--height must be between 64 and " + std::to_string(kMaxImageSide));
+    if (o.frames < 1 || o.frames > 100000) throw InvalidArgumentError("--frames must be between 1 and 100000");
+    validate_mm_per_unit(o.scale, "--scale");
+    if (!is_crease_angle(o.crease_angle))
+        throw InvalidArgumentError("--crease-angle must be between 0 and 180 degrees");
+    EditorOptions options;
+    options.view.mode = parse_view_mode(o.show);
+    if (!o.slice_normal.empty()) options.view.slice_normal = parse_slice_normal(o.slice_normal);
+    options.view.slice_offset = o.slice_offset;
+    options.view.quality_interior = o.quality_interior;
+    validate(options.view);
+    options.file = o.file;
+    options.session = o.session;
+    options.screenshot = o.screenshot;
+    options.frames = o.frames;
+    options.hide_ui = o.hide_ui;
+    options.width = o.width;
+    options.height = o.height;
+    options.max_tets = o.max_tets;
+    options.material = chosen_material(o.material);
+    options.scale = o.scale;
+    options.crease_angle_degrees = o.crease_angle;
+    options.solver_backend = parse_live_backend(o.solver.backend);
+    options.solver_method = parse_live_method(o.solver.method);
+    options.frame_ms = o.solver.frame_ms;
+    for (const std::string& spec : o.lights) options.lights.push_back(parse_light_spec(spec));
+    // Read before the window opens: a bad script is a one-line error, with or without a display.
+    if (!o.input.empty()) options.input = read_input_script(o.input);
+    if (!o.view.empty()) {
+        const Eigen::Vector3d v(o.view[0], o.view[1], o.view[2]);
+        if (!v.allFinite() || v.norm() == 0) throw InvalidArgumentError("--view must be a finite, non-zero direction");
+        options.camera.eye_direction = v;
+        if (v.normalized().cross(options.camera.up).norm() < 1e-3) options.camera.up = Eigen::Vector3d(0, 0, -1);
+    }
+    const EditorRunStats stats = run_editor(options);
+    if (!o.screenshot.empty()) {
+        const nlohmann::ordered_json summary = {
+            {"screenshot", o.screenshot},  {"frames", stats.frames},
+            {"frame_ms", stats.mean_frame_ms}, {"view_ms", stats.mean_view_ms},
+            {"solver_ticks", stats.ticks}, {"tick_ms", stats.tick_ms}, {"tets", stats.tets},
+            {"vertices", stats.vertices},  {"gl_version", stats.gl_version},
+            {"gl_renderer", stats.gl_renderer}, {"solver_backend", stats.solver_backend},
+            {"gpu_fallback_reason", stats.gpu_fallback_reason},
+            {"method_fallback_reason", stats.method_fallback_reason},
+            {"view_reads_device_radiance", stats.view_reads_device_radiance},
+        };
+        std::cout << summary.dump() << "\n";
+    }
+}
+
+}  // namespace
+
+void add_edit_command(CLI::App& app) {
+    auto options = std::make_shared<EditCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("edit", "Open the interactive editor (needs a display)");
+    cmd->add_option("file", options->file, "Surface (OBJ, OFF, PLY, STL) or volume (VTU, MSH, MESH, NODE) to open")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--session", options->session,
+                    "Open a session file (as `waxwork run` takes): its input, material, lights and camera, with "
+                    "its edits replayed (undoable); File > Save session records yours")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--screenshot", options->screenshot,
+                    "Draw --frames frames after loading and solving, save the window to this PNG and exit");
+    cmd->add_option("--input", options->input,
+                    "Replay this JSON list of timed mouse and key events into the window (editor/input_script.h)")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--frames", options->frames, "Frames drawn before the screenshot")->capture_default_str();
+    cmd->add_flag("--hide-ui", options->hide_ui, "Show the 3D view alone (Tab toggles it)");
+    cmd->add_option("--width", options->width, "Window width")->capture_default_str();
+    cmd->add_option("--height", options->height, "Window height")->capture_default_str();
+    add_max_tets_option(*cmd, options->max_tets, "Meshing a surface: about this many tets");
+    add_material_options(*cmd, options->material);
+    cmd->add_option("--light", options->lights, "dir:X,Y,Z[:R,G,B] or point:X,Y,Z[:R,G,B], as for render")
+        ->expected(1)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    cmd->add_option("--scale", options->scale, "Millimetres per model unit")->capture_default_str();
+    cmd->add_option("--crease-angle", options->crease_angle,
+                    "Shade and light the surface as folded where neighbouring triangles turn by more than "
+                    "this many degrees, as for render (a session's own value wins)")
+        ->capture_default_str();
+    cmd->add_option("--view", options->view, "Direction from the object towards the camera, X,Y,Z")
+        ->delimiter(',')
+        ->expected(3);
+    cmd->add_option("--show", options->show,
+                    "What the view shows, as for render: radiance, materials, quality, wireframe, slice, levels")
+        ->capture_default_str();
+    cmd->add_option("--slice-normal", options->slice_normal, "--show slice: X,Y,Z, pointing at the half cut away");
+    cmd->add_option("--slice-offset", options->slice_offset, "--show slice: offset in [-1, 1] half extents")
+        ->capture_default_str();
+    cmd->add_flag("--quality-interior", options->quality_interior,
+                  "--show quality: also cut at the slice plane and colour the cross-section's tets");
+    add_live_solver_options(*cmd, options->solver, "in a context shared with the window");
+    cmd->footer(
+        "Mouse: left drag uses the current tool; right drag (or Alt+left) orbits, middle drag (or Shift+right)\n"
+        "pans, the wheel zooms, Home resets the view, Esc cancels a stroke or drag.\n"
+        "With --hide-ui the first frame shows exactly what `waxwork render` writes for the same volume,\n"
+        "materials, lights, --view and window size.");
+    cmd->callback([options] { run_edit_command(*options); });
+}
+
+}  // namespace waxwork

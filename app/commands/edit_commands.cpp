@@ -1,0 +1,353 @@
+// `waxwork cut`, `waxwork fracture` and `waxwork paint`: the editing operations of TransCut Sec. 5 (and
+// the exact cut and fracture) from the command line.
+//   waxwork cut VOLUME -o OUT --plane=NX,NY,NZ,D [--relax ITERS] [--no-guard] [--exact]
+//               [--remove-fragments FRACTION]
+//   waxwork fracture VOLUME -o OUT --pieces N [--seed K] [--exact|--no-exact] [--min-piece-tets M]
+//                    [--collapse|--no-collapse]
+//   waxwork paint VOLUME -o OUT --at "X,Y,Z;X,Y,Z" (--material NAME | --mua R,G,B --musp R,G,B --eta N)
+//                 --sigma S [--base NAME]
+// Each prints a one-line JSON summary on stdout.
+#include "app/options/material_options.h"
+#include "base/error.h"
+#include "base/timing.h"
+#include "io/volume_file.h"
+#include "solver/material.h"
+#include "tetops/connectivity.h"
+#include "tetops/cut.h"
+#include "tetops/exact_cut.h"
+#include "tetops/fracture.h"
+#include "tetops/fragments.h"
+#include "tetops/paint.h"
+#include "tetops/quality.h"
+#include "tetops/relaxation.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace waxwork {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Comma-separated finite numbers, exactly `count` of them; `what` names the option in errors.
+std::vector<double> parse_numbers(const std::string& text, size_t count, const std::string& what) {
+    std::vector<double> values;
+    size_t begin = 0;
+    while (true) {
+        const size_t end = text.find(',', begin);
+        const std::string field = text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+        char* stop = nullptr;
+        errno = 0;
+        const double value = std::strtod(field.c_str(), &stop);
+        const char* field_end = field.c_str() + field.size();
+        const bool blank_rest = stop && std::all_of(static_cast<const char*>(stop), field_end, [](char c) {
+            return std::isspace(static_cast<unsigned char>(c)) != 0;
+        });
+        if (field.empty() || stop == field.c_str() || !blank_rest || errno == ERANGE || !std::isfinite(value))
+            throw InvalidArgumentError(what + ": \"" + text + "\" is not " +
+                                       (count == 1 ? std::string("a finite number")
+                                                   : std::to_string(count) + " comma-separated finite numbers"));
+        values.push_back(value);
+        if (end == std::string::npos) break;
+        begin = end + 1;
+    }
+    if (values.size() != count)
+        throw InvalidArgumentError(what + ": expected " + std::to_string(count) + " comma-separated numbers, got " +
+                                   std::to_string(values.size()) + " in \"" + text + "\"");
+    return values;
+}
+
+struct CutCommandOptions {
+    std::string input;
+    std::string output;
+    std::string plane;
+    int relax_iterations = 10;
+    bool no_guard = false;
+    bool exact = false;
+    std::optional<double> remove_fragments;  // volume fraction (tetops/fragments.h)
+};
+
+// After the cut: drops the parts under the fraction, if asked, and reports them in the summary
+// (whose "components" then counts the parts kept).
+void remove_fragments_after_cut(const CutCommandOptions& o, TetMesh& mesh, nlohmann::ordered_json& summary) {
+    if (!o.remove_fragments) return;
+    const FragmentRemoval removal = remove_small_fragments(mesh, *o.remove_fragments);
+    summary["fragments_removed"] = removal.fragments_removed;
+    summary["fragment_tets_removed"] = removal.removed.tets_removed;
+    summary["components"] = removal.parts_kept;
+    summary["tets_after"] = mesh.tet_count();
+    summary["vertices_after"] = mesh.vertex_count();
+}
+
+// Exact mode: tets crossed by the plane are split along it, so no relaxation is needed.
+void run_exact_cut(const CutCommandOptions& o, const PlaneCut& plane) {
+    TetMesh mesh = read_volume(o.input);
+    const size_t tets_before = mesh.tet_count();
+    const size_t vertices_before = mesh.vertex_count();
+    const auto start = Clock::now();
+    const ExactCutResult cut = naming_context(o.input, [&] {  // what the volume does not allow
+        ExactCutResult result = cut_exact(mesh, plane);
+        require_tets_left_by_cut(mesh, tets_before);
+        return result;
+    });
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    nlohmann::ordered_json summary = {
+        {"output", o.output},
+        {"mode", "exact"},
+        {"tets_before", tets_before},
+        {"vertices_before", vertices_before},
+        {"tets_after", mesh.tet_count()},
+        {"vertices_after", mesh.vertex_count()},
+        {"tets_removed", cut.tets_removed},
+        {"tets_split", cut.tets_split},
+        {"vertices_snapped", cut.vertices_snapped},
+        {"vertices_added", cut.vertices_added},
+        {"components", connectivity.component_count},
+        {"vertices_smoothed", cut.vertices_smoothed},
+        {"min_dihedral_deg", cut.min_dihedral_deg},
+        {"tets_under_guard", cut.tets_under_guard},
+    };
+    remove_fragments_after_cut(o, mesh, summary);
+    summary["milliseconds"] = milliseconds_since(start);
+    write_volume(mesh, o.output);
+    std::cout << summary.dump() << "\n";
+}
+
+void run_cut_command(const CutCommandOptions& o) {
+    const std::vector<double> p = parse_numbers(o.plane, 4, "cut --plane");
+    const PlaneCut plane(Eigen::Vector3d(p[0], p[1], p[2]), p[3]);
+    if (o.exact) return run_exact_cut(o, plane);
+    if (o.relax_iterations < 0) throw InvalidArgumentError("cut --relax: the iteration count must be >= 0");
+
+    TetMesh mesh = read_volume(o.input);
+    const size_t tets_before = mesh.tet_count();
+    const size_t vertices_before = mesh.vertex_count();
+
+    const auto start = Clock::now();
+    const CutResult cut = naming_context(o.input, [&] {
+        CutResult result = remove_cut_away_tets(mesh, plane);
+        require_tets_left_by_cut(mesh, tets_before);
+        return result;
+    });
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    RelaxationOptions relax;
+    relax.max_iterations = o.relax_iterations;
+    relax.min_dihedral_guard_deg = o.no_guard ? 0.0 : relax.min_dihedral_guard_deg;
+    const RelaxationReport report = relax_cut_vertices(mesh, connectivity, plane, relax);
+    nlohmann::ordered_json summary = {
+        {"output", o.output},
+        {"mode", "relax"},
+        {"tets_before", tets_before},
+        {"vertices_before", vertices_before},
+        {"tets_after", mesh.tet_count()},
+        {"vertices_after", mesh.vertex_count()},
+        {"tets_removed", cut.tets_removed},
+        {"components", connectivity.component_count},
+        {"relax_iterations", report.iterations},
+        {"vertices_moved", report.vertices_moved},
+        {"moves_rejected", report.moves_rejected},
+        {"guard_deg", relax.min_dihedral_guard_deg},
+        {"min_dihedral_deg", report.min_dihedral_deg},
+    };
+    remove_fragments_after_cut(o, mesh, summary);
+    summary["milliseconds"] = milliseconds_since(start);
+    write_volume(mesh, o.output);
+    std::cout << summary.dump() << "\n";
+}
+
+struct FractureCommandOptions {
+    std::string input;
+    std::string output;
+    int pieces = 0;
+    uint32_t seed = 1;
+    bool exact = true;
+    int min_piece_tets = FractureOptions{}.min_piece_tets;
+    bool collapse = FractureOptions{}.collapse_swallowed_walls;
+};
+
+void run_fracture_command(const FractureCommandOptions& o) {
+    if (o.pieces < 1 || o.pieces > kMaxFracturePieces)
+        throw InvalidArgumentError("fracture --pieces: must be between 1 and " + std::to_string(kMaxFracturePieces) +
+                                   ", got " + std::to_string(o.pieces));
+    if (o.min_piece_tets < 0) throw InvalidArgumentError("fracture --min-piece-tets: must be >= 0");
+    TetMesh mesh = read_volume(o.input);
+    const size_t tets_before = mesh.tet_count();
+    const size_t vertices_before = mesh.vertex_count();
+    const auto start = Clock::now();
+    FractureOptions options;
+    options.exact = o.exact;
+    options.min_piece_tets = o.min_piece_tets;
+    options.collapse_swallowed_walls = o.collapse;
+    const FractureResult result = naming_context(o.input, [&] {  // what the volume does not allow
+        return fracture_voronoi(mesh, scatter_fracture_seeds(mesh, o.pieces, o.seed), options);
+    });
+    const double elapsed = milliseconds_since(start);
+    write_volume(mesh, o.output);
+    nlohmann::ordered_json summary = {
+        {"output", o.output},
+        {"mode", o.exact ? "exact" : "tet_faces"},
+        {"seed", o.seed},
+        {"tets_before", tets_before},
+        {"vertices_before", vertices_before},
+        {"tets_after", mesh.tet_count()},
+        {"vertices_after", mesh.vertex_count()},
+        {"pieces_before", result.pieces_before},
+        {"pieces", result.pieces_after},
+        {"tets_split", result.tets_split},
+        {"vertices_collapsed", result.vertices_collapsed},
+        {"vertices_duplicated", result.vertices_duplicated},
+        {"min_dihedral_deg", result.min_dihedral_deg},
+        {"tets_under_guard", result.tets_under_guard},
+        {"milliseconds", elapsed},
+    };
+    std::cout << summary.dump() << "\n";
+}
+
+struct PaintCommandOptions {
+    std::string input;
+    std::string output;
+    std::string at;
+    double sigma = 0;
+    std::string base = "marble";
+    MaterialOptions material;
+};
+
+std::vector<Eigen::Vector3d> parse_points(const std::string& text) {
+    std::vector<Eigen::Vector3d> points;
+    size_t begin = 0;
+    while (begin <= text.size()) {
+        const size_t end = text.find(';', begin);
+        const std::string item = text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+        const bool blank = std::all_of(item.begin(), item.end(),
+                                       [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; });
+        if (!blank) {
+            const std::vector<double> v = parse_numbers(item, 3, "paint --at");
+            points.emplace_back(v[0], v[1], v[2]);
+        }
+        if (end == std::string::npos) break;
+        begin = end + 1;
+    }
+    if (points.empty()) throw InvalidArgumentError("paint --at: no stroke points given (expected X,Y,Z[;X,Y,Z...])");
+    return points;
+}
+
+void run_paint_command(const PaintCommandOptions& o) {
+    const std::vector<Eigen::Vector3d> stroke = parse_points(o.at);
+    if (!(o.sigma > 0) || !std::isfinite(o.sigma))
+        throw InvalidArgumentError("paint --sigma: must be a positive number (world units)");
+    const std::optional<TetMaterial> brush_material = chosen_material(o.material);
+    if (!brush_material)
+        throw InvalidArgumentError("paint: choose the brush with --material NAME or --mua R,G,B --musp R,G,B --eta N");
+    PaintBrush brush;
+    brush.material = *brush_material;
+    brush.sigma = o.sigma;
+    const TetMaterial base = material_preset(o.base);
+
+    TetMesh mesh = read_volume(o.input);
+    const auto start = Clock::now();
+    const PaintIndex index(mesh);
+    const PaintResult result = paint_stroke(mesh, index, stroke, brush, base);
+    const double elapsed = milliseconds_since(start);
+
+    write_volume(mesh, o.output);
+    nlohmann::ordered_json summary = {
+        {"output", o.output},
+        {"tets_before", mesh.tet_count()},
+        {"vertices_before", mesh.vertex_count()},
+        {"tets_after", mesh.tet_count()},
+        {"vertices_after", mesh.vertex_count()},
+        {"stroke_points", stroke.size()},
+        {"tets_changed", result.changed_tets.size()},
+        {"min_dihedral_deg", mesh_min_dihedral_deg(mesh)},
+        {"milliseconds", elapsed},
+    };
+    std::cout << summary.dump() << "\n";
+}
+
+}  // namespace
+
+void add_cut_command(CLI::App& app) {
+    auto options = std::make_shared<CutCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("cut", "Cut a volume with a plane and relax the cross-section");
+    cmd->add_option("input", options->input, "Volume file (.vtu, .msh, .mesh, .node)")->required()->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", options->output, "Volume file to write")->required();
+    cmd->add_option("--plane", options->plane, "NX,NY,NZ,D: removes the side n.x > D (write --plane=-1,0,0,0 when "
+                                               "the first number is negative)")
+        ->required();
+    cmd->add_option("--relax", options->relax_iterations, "Relaxation sweeps moving cut vertices onto the plane")
+        ->capture_default_str();
+    cmd->add_flag("--no-guard", options->no_guard,
+                  "Let relaxation create tets under 0.5 degrees (paper Fig. 9(a); for comparison only)");
+    cmd->add_flag("--exact", options->exact,
+                  "Split the tets crossed by the plane along it instead of relaxing (--relax and --no-guard are "
+                  "then unused)");
+    // Checked on the text (parse_numbers): CLI11 would take an empty value for no option at all.
+    const CLI::Validator fraction_check(
+        [](std::string& text) {
+            try {
+                const double fraction = parse_numbers(text, 1, "the volume fraction")[0];
+                return fraction >= 0 && fraction < 1 ? std::string() : "'" + text + "' is not in [0, 1)";
+            } catch (const InvalidArgumentError& error) {
+                return std::string(error.what());
+            }
+        },
+        "FRACTION", "volume fraction");
+    cmd->add_option("--remove-fragments", options->remove_fragments,
+                    "Then drop the detached parts smaller than this fraction of the volume (0.001: 0.1%), such as "
+                    "the caps a plane grazing a concave shape leaves floating; the largest part always stays")
+        ->check(fraction_check);
+    cmd->footer("Tets with all four vertices on the side n.x > D are removed (TransCut Sec. 5); vertices left there\n"
+                "then move toward their one-ring average, never across the plane and never below the guard.\n"
+                "--exact: vertices within 20% of an edge from the plane snap onto it (when no tet of their star\n"
+                "drops under 0.5 degrees), every other crossed edge is split, crossed tets are split into tets on\n"
+                "either side and the side n.x > D is removed: the cross-section lies on the plane.");
+    cmd->callback([options] { run_cut_command(*options); });
+}
+
+void add_fracture_command(CLI::App& app) {
+    auto options = std::make_shared<FractureCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("fracture", "Break a volume into pieces along Voronoi cells");
+    cmd->add_option("input", options->input, "Volume file (.vtu, .msh, .mesh, .node)")->required()->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", options->output, "Volume file to write (.vtu keeps the pieces)")->required();
+    cmd->add_option("--pieces", options->pieces, "Number of Voronoi seeds (pieces)")->required();
+    cmd->add_option("--seed", options->seed, "Random seed for the seed points")->capture_default_str();
+    cmd->add_flag("--exact,!--no-exact", options->exact,
+                  "Split tets along the cell walls (flat cracks; default) or keep whole tets (cracks on tet faces)");
+    cmd->add_option("--min-piece-tets", options->min_piece_tets, "Smaller pieces join their largest neighbour")
+        ->capture_default_str();
+    cmd->add_flag("--collapse,!--no-collapse", options->collapse,
+                  "Exact mode: collapse the vertices that walls of earlier cells left inside later ones (default), "
+                  "or keep every split (to compare)");
+    cmd->footer("Seeds are scattered uniformly in the volume; each cell's part of each piece becomes a piece (a cell\n"
+                "cut in two by a concave volume gives two), with the crack vertices duplicated so pieces move apart.");
+    cmd->callback([options] { run_fracture_command(*options); });
+}
+
+void add_paint_command(CLI::App& app) {
+    auto options = std::make_shared<PaintCommandOptions>();
+    CLI::App* cmd = app.add_subcommand("paint", "Blend a material into the tets around stroke points");
+    cmd->add_option("input", options->input, "Volume file (.vtu, .msh, .mesh, .node)")->required()->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", options->output, "Volume file to write (.vtu keeps the materials)")->required();
+    cmd->add_option("--at", options->at, "Stroke points in world space: \"X,Y,Z;X,Y,Z;...\"")->required();
+    cmd->add_option("--sigma", options->sigma, "Gaussian width of the brush in world units")->required();
+    cmd->add_option("--base", options->base, "Material of every tet when the volume stores none")
+        ->capture_default_str();
+    add_material_options(*cmd, options->material);
+    cmd->footer("Weight w = exp(-d^2 / (2 sigma^2)), d from a tet's centroid to the nearest stroke point; tets with\n"
+                "w < 0.001 are untouched; material <- (1 - w) material + w brush (TransCut Sec. 5).");
+    cmd->callback([options] { run_paint_command(*options); });
+}
+
+}  // namespace waxwork

@@ -1,0 +1,50 @@
+#include "app/options/surface_meshing_options.h"
+
+#include "base/error.h"
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+namespace waxwork {
+
+CLI::Option* add_max_tets_option(CLI::App& command, std::optional<size_t>& max_tets, const std::string& description) {
+    const CLI::Validator positive_count(
+        [](std::string& text) -> std::string {
+            const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+            return digits && text.find_first_not_of('0') != std::string::npos ? "" : "must be a positive whole number of tets";
+        },
+        "COUNT");
+    return command.add_option("--max-tets", max_tets, description)->check(positive_count);
+}
+
+void add_surface_meshing_options(CLI::App& command, SurfaceMeshingOptions& options) {
+    command.add_option("--mesher", options.mesher, "tetgen (keeps the surface's triangles) or cgal (remeshes it)")
+        ->check(CLI::IsMember({"tetgen", "cgal"}))
+        ->capture_default_str();
+    command.add_option("--min-dihedral", options.min_dihedral, "Minimum dihedral angle in degrees: TetGen's bound (away from the input's triangles), "
+                       "the target of CGAL's sliver perturber and exuder")
+        ->capture_default_str();
+    command.add_option("--radius-edge", options.radius_edge, "Radius-edge ratio bound")->capture_default_str();
+    command.add_flag("--fill-holes", options.fill_holes, "Opt-in repair: close holes in an open surface");
+    command.add_flag("--autorefine", options.autorefine, "Opt-in repair: remove self-intersections");
+}
+
+LoadedSurface load_surface_to_mesh(const std::string& path, const SurfaceMeshingOptions& options) {
+    SurfaceRepairOptions repair;
+    repair.fill_holes = options.fill_holes;
+    repair.autorefine = options.autorefine;
+    LoadedSurface loaded = load_closed_surface(path, repair);
+    for (const std::string& line : loaded.repairs) std::cerr << "waxwork: " << path << ": repaired: " << line << "\n";
+    return loaded;
+}
+
+MeshingOptions meshing_options(const SurfaceMeshingOptions& options) {
+    MeshingOptions meshing;
+    meshing.mesher = options.mesher == "cgal" ? Mesher::Cgal : Mesher::TetGen;
+    meshing.min_dihedral_deg = options.min_dihedral;
+    meshing.max_radius_edge_ratio = options.radius_edge;
+    return meshing;
+}
+
+}  // namespace waxwork

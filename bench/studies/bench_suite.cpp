@@ -1,0 +1,396 @@
+#include "bench/studies/bench_suite.h"
+
+#include "base/error.h"
+#include "bench/studies/accuracy_study.h"
+#include "bench/studies/coarse_start_bound.h"
+#include "bench/studies/cut_study.h"
+#include "bench/studies/resolution_study.h"
+#include "bench/studies/solver_comparison.h"
+#include "bench/studies/stability_study.h"
+#include "bench/studies/svg_chart.h"
+#include "bench/studies/timing_table.h"
+#include "io/atomic_file.h"
+#include "io/file_contents.h"
+#include "io/surface_reader.h"
+#include "multires/multigrid_preconditioner.h"
+#include "multires/multires_solver.h"
+#include "solver/light_spec.h"
+#include "solver/material.h"
+#include "solver/reference/reference_solvers.h"
+#include "tetops/connectivity.h"
+#include "tetops/cut.h"
+#include "tetops/quality.h"
+#include "tetops/tetrahedralize.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <exception>
+#include <iostream>
+#include <map>
+#include <thread>
+
+namespace waxwork {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+void write_json(const std::filesystem::path& path, const Json& json) {
+    write_file_atomically(path, [&](std::ostream& out) { out << json.dump(2) << "\n"; });
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+    write_file_atomically(path, [&](std::ostream& out) { out << text; });
+}
+
+// The shipped spot meshed by TetGen to about target_tets.
+TetMesh spot_volume(const BenchSuiteOptions& o, size_t target_tets) {
+    MeshingOptions meshing;
+    meshing.sizing.target_tets = target_tets;
+    return tetrahedralize(load_closed_surface(o.asset_dir / "meshes/spot.obj").surface, meshing).mesh;
+}
+
+// The solver parts' scene: spot in marble, 30 mm per unit, under the key light.
+constexpr double solver_scene_mm_per_unit = 30;
+
+struct SolverScene {
+    TetMesh mesh;
+    TetConnectivity connectivity;
+    std::vector<TetMaterial> materials;
+    Lighting lighting;
+};
+
+SolverScene solver_scene(const BenchSuiteOptions& o, size_t target_tets) {
+    SolverScene scene;
+    scene.mesh = spot_volume(o, target_tets);
+    scene.connectivity = build_connectivity(scene.mesh);
+    scene.materials.assign(scene.mesh.tet_count(), material_preset("marble"));
+    scene.lighting.lights.push_back(default_key_light());
+    return scene;
+}
+
+void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index) {
+    const SolverScene scene = solver_scene(o, target_tets);
+    SolverComparisonOptions options;
+    options.mm_per_unit = solver_scene_mm_per_unit;
+    options.max_seconds = o.quick ? 8.0 : 60.0;
+    // Every path, the GPU one included (llvmpipe here: a CPU, so its times are not GPU times).
+    const std::unique_ptr<HeadlessGlContext> context = open_gpu_for_comparison(options);
+    const SolverComparison comparison = compare_solvers(scene.mesh, scene.connectivity, scene.materials, scene.lighting, options);
+    if (!comparison.gpu_fallback_reason.empty())
+        std::cerr << "warning: no GPU curves: " << comparison.gpu_fallback_reason << "\n";
+    const std::string stem = "solvers_spot_" + std::to_string((target_tets + 500) / 1000) + "k";
+    write_solver_comparison(o.output_dir, stem, {"assets/meshes/spot.obj", "marble", solver_scene_mm_per_unit},
+                            comparison);
+    Json& listed = index["solvers"];
+    if (!listed.is_array()) listed = Json::array();
+    if (std::find(listed.begin(), listed.end(), Json(stem + ".json")) == listed.end()) listed.push_back(stem + ".json");
+}
+
+// One row of the coarse_start part: on one lit system, for each choice of Eq. 16's weights
+// (hierarchy.h InterpolationWeights), the best start level 1 can give the paper's scheme
+// (bench/studies/coarse_start_bound.h), the start its own coarse pass gives, and the V-cycle-preconditioned
+// CG's iterations on the same hierarchy.
+Json coarse_start_row(const SolverScene& scene, const std::vector<TetMaterial>& materials, double mm_per_unit) {
+    constexpr double target_error = 1e-2;  // "to 1%", as in the solver comparison
+    AssemblyOptions assembly;
+    assembly.mm_per_unit = mm_per_unit;
+    const DiffusionMatrix matrix = assemble_diffusion_matrix(scene.mesh, scene.connectivity, materials, assembly);
+    const std::vector<Rgb> q = incident_light(scene.mesh, scene.connectivity, materials, scene.lighting);
+    ChannelVectors b, reference;
+    for (int c = 0; c < 3; ++c) {
+        const auto sc = static_cast<size_t>(c);
+        b[sc].resize(matrix.size());
+        diffusion_right_hand_side(matrix, q, c, b[sc]);
+        const Eigen::VectorXd x = refined_direct_solution(
+            to_eigen_sparse(matrix, c), Eigen::Map<const Eigen::VectorXd>(b[sc].data(), static_cast<Eigen::Index>(b[sc].size())));
+        reference[sc].assign(x.data(), x.data() + x.size());
+    }
+    Json row = {{"tets", scene.mesh.tet_count()}, {"vertices", matrix.size()}, {"mm_per_unit", mm_per_unit}};
+    for (const auto& [key, weights] : {std::pair{"paper_weights", InterpolationWeights::InverseEdgeLength},
+                                       std::pair{"linear_exact_weights", InterpolationWeights::LinearExact}}) {
+        HierarchyOptions hierarchy_options;
+        hierarchy_options.weights = weights;
+        // The scheme's own start: its coarse-to-fine pass as MultiresSolver runs it, no level-0 iteration.
+        MultiresSolver scheme(matrix, scene.mesh.positions, hierarchy_options);
+        ChannelVectors scheme_start;
+        MultiresSolveOptions coarse_pass_only;
+        coarse_pass_only.max_iterations = 0;
+        for (int c = 0; c < 3; ++c) {
+            scheme_start[static_cast<size_t>(c)].resize(matrix.size());
+            scheme.solve(b[static_cast<size_t>(c)], c, scheme_start[static_cast<size_t>(c)], coarse_pass_only);
+        }
+        const MultiresHierarchy& hierarchy = scheme.hierarchy();
+        const CoarseStartBound bound = measure_coarse_start_bound(hierarchy, b, reference, target_error);
+        const int from_scheme = jacobi_cg_iterations_to(hierarchy, b, scheme_start, reference, target_error, 10000);
+        MultigridPreconditioner multigrid(hierarchy);
+        const auto ratio = [&](int iterations) {
+            return bound.iterations_from_zero > 0 && iterations >= 0
+                       ? Json(static_cast<double>(iterations) / bound.iterations_from_zero)
+                       : Json(nullptr);
+        };
+        const InterpolationOperator& p = hierarchy.levels[0].interpolation;
+        row[key] = {{"level1_vertices", bound.coarse_vertices},
+                    {"linear_exact_rows", p.linear_exact_rows},
+                    {"paper_weight_rows", p.paper_weight_rows},
+                    {"interpolation_error", bound.interpolation_error},
+                    {"eq17_start_error", bound.eq17_start_error},
+                    {"galerkin_start_error", bound.galerkin_start_error},
+                    {"scheme_start_error", combined_relative_error(scheme_start, reference)},
+                    {"iterations_to_1pct", {{"zero_start", bound.iterations_from_zero},
+                                            {"scheme_coarse_pass", from_scheme},
+                                            {"eq17_exact_level1", bound.iterations_from_eq17},
+                                            {"galerkin_exact_level1", bound.iterations_from_galerkin}}},
+                    {"iteration_ratio_eq17", ratio(bound.iterations_from_eq17)},
+                    {"iteration_ratio_galerkin", ratio(bound.iterations_from_galerkin)},
+                    {"multigrid_cg_iterations", {{"to_1pct", multigrid_cg_iterations_to(multigrid, b, reference, 1e-2, 1000)},
+                                                 {"to_1e-6", multigrid_cg_iterations_to(multigrid, b, reference, 1e-6, 1000)}}}};
+    }
+    return row;
+}
+
+// The best start the paper's coarse level can give the level-0 CG, on the solver parts' systems and, at
+// 50K tets, across the measured materials and scales (the diffusion length against the mesh size), with
+// the paper's weights and linear-exact ones: why its coarse-to-fine scheme saves so few iterations.
+void run_coarse_start_part(const BenchSuiteOptions& o, Json& index) {
+    Json sizes = Json::array();
+    const std::vector<size_t> targets = o.quick ? std::vector<size_t>{50'000} : std::vector<size_t>{50'000, 500'000};
+    for (const size_t target : targets) {
+        const SolverScene scene = solver_scene(o, target);
+        sizes.push_back(coarse_start_row(scene, scene.materials, solver_scene_mm_per_unit));
+    }
+    // The sweep: every preset at the solver scene's scale, and marble from 3 mm to 300 mm per unit.
+    const SolverScene scene = solver_scene(o, 50'000);
+    std::vector<std::pair<std::string, double>> cases;
+    if (o.quick) {
+        cases = {{"marble", 3}, {"marble", 300}, {"spectralon", solver_scene_mm_per_unit}};
+    } else {
+        for (const std::string& name : material_preset_names()) cases.emplace_back(name, solver_scene_mm_per_unit);
+        for (const double scale : {3.0, 10.0, 100.0, 300.0}) cases.emplace_back("marble", scale);
+    }
+    const double mean_edge = measure_quality(scene.mesh).mean_edge_length;  // model units
+    Json sweep = Json::array();
+    for (const auto& [name, scale] : cases) {
+        const TetMaterial material = material_preset(name);
+        Json row = coarse_start_row(scene, std::vector<TetMaterial>(scene.mesh.tet_count(), material), scale);
+        Json lengths = Json::array();
+        for (int c = 0; c < 3; ++c) lengths.push_back(diffusion_length(material.mua[static_cast<size_t>(c)], material.musp[static_cast<size_t>(c)]));
+        row["material"] = name;
+        row["diffusion_length_mm"] = lengths;  // null (infinite) where mu_a = 0
+        row["mean_edge_mm"] = mean_edge * scale;
+        sweep.push_back(std::move(row));
+    }
+    write_json(o.output_dir / "coarse_start.json", {{"mesh", "assets/meshes/spot.obj"},
+                                                    {"material", "marble"},
+                                                    {"mm_per_unit", solver_scene_mm_per_unit},
+                                                    {"sizes", sizes},
+                                                    {"materials", sweep}});
+    index["coarse_start"] = "coarse_start.json";
+}
+
+// Cross-section distance and dihedral distributions of both cut modes.
+void run_cut_modes_part(const BenchSuiteOptions& o, Json& index) {
+    const TetMesh mesh = spot_volume(o, o.quick ? 50'000 : 500'000);
+    const auto box = bounding_box(mesh);
+    const Eigen::Vector3d normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
+    const std::vector<CutModeResult> results =
+        compare_cut_modes(mesh, PlaneCut(normal, normal.dot(0.5 * (box[0] + box[1]))));
+    Json json = {{"tets_before", mesh.tet_count()}, {"modes", to_json(results)}};
+    write_json(o.output_dir / "cut_modes.json", json);
+
+    // At most ~200 points per line: every k-th sample of a sorted distribution, the last one always.
+    auto thin = [](size_t n, auto&& point) {
+        std::vector<std::pair<double, double>> points;
+        const size_t step = std::max<size_t>(1, n / 200);
+        for (size_t i = 0; i < n; i += step) points.push_back(point(i));
+        if (n > 0 && (n - 1) % step != 0) points.push_back(point(n - 1));
+        return points;
+    };
+    std::vector<ChartSeries> distance_lines, quality_lines;
+    for (const CutModeResult& r : results) {
+        const size_t n = r.distances_per_edge.size();
+        // Exact cuts put vertices on the plane to rounding (often exactly 0): drawn at 1e-17.
+        distance_lines.push_back({r.mode, thin(n, [&](size_t i) {
+                                      return std::pair{static_cast<double>(i + 1) / static_cast<double>(n),
+                                                       std::max(r.distances_per_edge[i], 1e-17)};
+                                  }), false});
+        const size_t below_10 = r.tets_below(10.0);
+        char name[96];
+        std::snprintf(name, sizeof name, "%s (worst %.2f deg)", r.mode.c_str(), r.worst_dihedral_deg());
+        quality_lines.push_back({name, thin(below_10, [&](size_t i) {
+                                     return std::pair{r.min_dihedral_deg[i], static_cast<double>(i + 1)};
+                                 }), false});
+    }
+    ChartOptions distance_chart;
+    distance_chart.title = "Cross-section vertices' distance to the cutting plane (spot, " +
+                           std::to_string(mesh.tet_count()) + " tets)";
+    distance_chart.x = {"fraction of cross-section vertices (sorted)", AxisScale::Linear, 0, 1};
+    distance_chart.y = {"distance / mean edge length", AxisScale::Log};
+    write_svg_chart(o.output_dir / "cut_modes.svg", distance_lines, distance_chart);
+    ChartOptions quality_chart;
+    quality_chart.title = "Tets under a minimum dihedral angle after the cut";
+    quality_chart.x = {"minimum dihedral angle (degrees)", AxisScale::Log, 0.1, 10};
+    quality_chart.y = {"tets below", AxisScale::Log};
+    write_svg_chart(o.output_dir / "cut_quality.svg", quality_lines, quality_chart);
+    index["cut_modes"] = "cut_modes.json";
+}
+
+void run_accuracy_part(const BenchSuiteOptions& o, Json& index) {
+    const StudySize size{.quick = o.quick};
+    const std::vector<ConvergenceSeries> ball = study_ball_convergence(size);
+    SurfaceConvergenceOptions spot_options;
+    spot_options.surface = o.asset_dir / "meshes/spot.obj";
+    if (o.quick) {
+        spot_options.mm_per_unit = 3;  // the coarse (D/25) default mesh: seconds, not minutes
+        spot_options.size_factors = {2.0, 1.5, 1.0};
+        spot_options.reference_size_factor = 0.6;
+    }
+    const ConvergenceSeries spot = study_surface_convergence(spot_options);
+    write_json(o.output_dir / "accuracy.json", Json{{"ball", to_json(ball)}, {"surface", to_json({spot})}});
+
+    auto chart = [&](const std::vector<ConvergenceSeries>& series, const std::string& title,
+                     const std::filesystem::path& path) {
+        std::vector<ChartSeries> lines;
+        for (const ConvergenceSeries& s : series) {
+            ChartSeries line;
+            char name[160];
+            std::snprintf(name, sizeof name, "%s (order %.2f)", s.name.c_str(), s.observed_order());
+            line.name = name;
+            for (const ConvergencePoint& p : s.points) line.points.emplace_back(p.tet_size_mm, p.relative_error);
+            lines.push_back(std::move(line));
+        }
+        ChartOptions options;
+        options.title = title;
+        options.x = {"mean tet size (mm)", AxisScale::Log};
+        options.y = {"relative L2 error of phi", AxisScale::Log};
+        write_svg_chart(path, lines, options);
+    };
+    chart(ball, "Ball (R = 10 mm) against the analytic solution", o.output_dir / "accuracy_ball.svg");
+    chart({spot}, "Spot against a mesh of half the default size", o.output_dir / "accuracy_spot.svg");
+    index["accuracy"] = "accuracy.json";
+}
+
+void run_table1_part(const BenchSuiteOptions& o, Json& index) {
+    std::vector<TimingRow> rows;
+    TimingOptions options;
+    options.target_tets = o.quick ? 100'000 : 500'000;
+    const std::vector<std::string> models =
+        o.quick ? std::vector<std::string>{"spot"} : std::vector<std::string>{"spot", "torus", "skull"};
+    for (const std::string& model : models)
+        rows.push_back(measure_timing_row(o.asset_dir / "meshes" / (model + ".obj"), options));
+    write_json(o.output_dir / "table1.json", to_json(rows));
+    write_text(o.output_dir / "table1.md", timing_table_markdown(rows));
+    index["table1"] = "table1.md";
+}
+
+void run_stability_part(const BenchSuiteOptions& o, Json& index) {
+    const std::vector<StudyTable> tables = run_stability_studies({.quick = o.quick});
+    Json json = Json::array();
+    std::string markdown;
+    for (const StudyTable& t : tables) {
+        json.push_back(t.to_json());
+        markdown += t.to_markdown() + "\n";
+    }
+    write_json(o.output_dir / "stability.json", json);
+    write_text(o.output_dir / "stability.md", markdown);
+    index["stability"] = "stability.md";
+}
+
+void run_resolution_part(const BenchSuiteOptions& o, Json& index) {
+    ResolutionStudyOptions options;
+    options.surface = o.asset_dir / "meshes/spot.obj";
+    if (o.quick) {
+        options.mm_per_unit = 3;
+        options.size_factors = {2.0, 1.0};
+        options.tolerances = {0.1, 0.01, 1e-3};
+        options.reference_size_factor = 0.7;
+    }
+    const ResolutionStudy study = run_resolution_study(options);
+    Json json = study.to_json();
+    json["material"] = options.material;
+    json["mm_per_unit"] = options.mm_per_unit;
+    json["error_bound"] = options.error_bound;
+    write_json(o.output_dir / "resolution.json", json);
+
+    std::map<double, ChartSeries> by_factor;
+    for (const ResolutionSample& s : study.samples) {
+        ChartSeries& line = by_factor[s.size_factor];
+        char name[96];
+        std::snprintf(name, sizeof name, "%.2g x default size (%zu tets)", s.size_factor, s.tets);
+        line.name = name;
+        line.points.emplace_back(s.solve_ms, s.image_error);
+    }
+    std::vector<ChartSeries> lines;
+    for (auto& [factor, line] : by_factor) lines.push_back(std::move(line));
+    ChartOptions chart;
+    chart.title = "Rendered image error against solve time (tolerances along each line)";
+    chart.x = {"assembly + solve (ms)", AxisScale::Log};
+    chart.y = {"relative image error", AxisScale::Log};
+    write_svg_chart(o.output_dir / "resolution.svg", lines, chart);
+    index["resolution"] = "resolution.json";
+}
+
+}  // namespace
+
+void run_bench_suite(const BenchSuiteOptions& o) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.output_dir, ec);
+    if (ec) throw FileError(o.output_dir.string(), "cannot create the output directory: " + ec.message());
+
+    // With --only, the parts not run keep their entries from an earlier run of the suite in DIR.
+    Json index = Json::object();
+    if (!o.only.empty() && std::filesystem::exists(o.output_dir / "bench.json")) {
+        try {
+            index = Json::parse(read_file_contents(o.output_dir / "bench.json"));
+        } catch (const std::exception&) {
+            index = Json::object();  // unreadable: start afresh
+        }
+    }
+    index["quick"] = o.quick;
+    index["hardware_threads"] = std::thread::hardware_concurrency();
+    const std::time_t now = std::time(nullptr);
+    char date[32];
+    std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+    index["date"] = date;
+    if (!index.contains("parts") || !index["parts"].is_object()) index["parts"] = Json::object();
+
+    using Part = std::function<void(Json&)>;
+    std::vector<std::pair<std::string, Part>> parts = {
+        {"solvers_50k", [&](Json& i) { run_solver_part(o, 50'000, i); }},
+    };
+    if (!o.quick) parts.emplace_back("solvers_500k", [&](Json& i) { run_solver_part(o, 500'000, i); });
+    parts.emplace_back("coarse_start", [&](Json& i) { run_coarse_start_part(o, i); });
+    parts.emplace_back("accuracy", [&](Json& i) { run_accuracy_part(o, i); });
+    parts.emplace_back("cut_modes", [&](Json& i) { run_cut_modes_part(o, i); });
+    parts.emplace_back("table1", [&](Json& i) { run_table1_part(o, i); });
+    parts.emplace_back("stability", [&](Json& i) { run_stability_part(o, i); });
+    parts.emplace_back("resolution", [&](Json& i) { run_resolution_part(o, i); });
+
+    for (const std::string& wanted : o.only)
+        if (std::none_of(parts.begin(), parts.end(), [&](const auto& part) { return part.first == wanted; }))
+            throw InvalidArgumentError("bench --only: unknown part '" + wanted + "'" +
+                                       (o.quick && wanted == "solvers_500k" ? " (not part of --quick)" : ""));
+
+    std::exception_ptr first_failure;
+    for (const auto& [name, part] : parts) {
+        if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), name) == o.only.end()) continue;
+        if (o.progress) o.progress(name);
+        const auto start = std::chrono::steady_clock::now();
+        Json entry;
+        try {
+            part(index);
+            entry["status"] = "ok";
+        } catch (const std::exception& e) {
+            entry["status"] = std::string("failed: ") + e.what();
+            if (!first_failure) first_failure = std::current_exception();
+        }
+        entry["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        index["parts"][name] = entry;
+        write_json(o.output_dir / "bench.json", index);  // after every part: a crash keeps what ran
+    }
+    if (first_failure) std::rethrow_exception(first_failure);
+}
+
+}  // namespace waxwork

@@ -1,0 +1,38 @@
+// `waxwork bench [--quick] -o DIR`: the reproducible speed-against-accuracy suite. Writes
+// into DIR, each part as JSON plus a chart (SVG) or a markdown table:
+//   solvers_*.json/.svg   error of phi against time for every solver path (paper Fig. 7), per mesh size
+//   coarse_start.json     the best level-0 start a coarse level can give the paper's multires scheme
+//   accuracy.json, accuracy_ball.svg, accuracy_spot.svg
+//                         error against tet size: the analytic ball, spot against a fine reference
+//   cut_modes.json, cut_modes.svg, cut_quality.svg
+//                         cross-section distance and dihedral angles of remove+relax and exact cuts
+//   table1.json/.md       T_b, T_m, T_s, cut and paint per shipped model beside the paper's Table 1
+//   stability.json/.md    where the methods fail and what Waxwork does (bench/studies/stability_study.h)
+//   resolution.json/.svg  image error against per-frame cost over mesh size x tolerance
+//   bench.json            what ran, with what settings, how long each part took, on which machine
+// --quick (under 2 minutes here) uses smaller meshes and fewer samples; the full suite takes under 20.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace waxwork {
+
+struct BenchSuiteOptions {
+    std::filesystem::path output_dir;
+    bool quick = false;
+    std::filesystem::path asset_dir;                    // holds meshes/spot.obj, torus.obj, skull.obj
+    std::function<void(const std::string&)> progress;   // one line per part started; may be empty
+    // Run only these parts (names as in bench.json: solvers_50k, solvers_500k, coarse_start, accuracy, cut_modes, table1,
+    // stability, resolution); empty: all. An unknown name is an InvalidArgumentError.
+    std::vector<std::string> only;
+};
+
+// Runs every part; a part that throws is recorded in bench.json with its error and the suite goes
+// on, then the first such error is rethrown at the end (so the command fails loudly but still leaves
+// everything that worked). Throws FileError when DIR cannot be created or written.
+void run_bench_suite(const BenchSuiteOptions& options);
+
+}  // namespace waxwork

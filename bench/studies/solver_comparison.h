@@ -1,0 +1,106 @@
+// The solver comparison behind `waxwork bench solvers`: one lit diffusion system, every solver of the
+// project on it, and for each the relative error of phi against a direct reference as a function of
+// solve time.
+//
+// Error. Relative L2 over all three channels together, sqrt(sum_c |x_c - ref_c|^2 / sum_c |ref_c|^2):
+// one number per run, dominated by the brightest channel, the same for every solver. The reference is
+// CHOLMOD's (or Eigen's) direct solution in double with one step of iterative refinement; the
+// `direct` entry is that method timed again, so its error only shows rounding.
+//
+// Curves. Each iterative solver is run from a cold start (zero; multires: its coarse-to-fine pass) for
+// an increasing schedule of iteration caps (0, 1, 2, ... growing by a quarter), all three channels per
+// run; a point is (time of that run, its error). Measuring the error is outside the timed region.
+// Runs shorter than 100 ms are repeated three times and the fastest kept, after one untimed warm-up
+// run. A point is kept only if it ran faster than every later point (noise that made a small cap
+// slower than a larger one drops the small cap), so every curve is strictly monotone in time. A curve ends below floor_error, when the error stops falling (float's
+// precision floor), or after max_seconds of measuring. time_to_1pct_ms: the smallest cap with error
+// <= target_error is found by bisection between the curve's bracketing caps and timed again.
+//
+// What is timed. Per-mesh setup that a frame does not repeat is excluded and reported separately, as
+// its first run and as a rebuild (SolverComparison): the multires hierarchy (hierarchy_ms), the
+// multigrid Galerkin operators and coarsest factorisation (multigrid_setup_ms; cascadic_cg borrows
+// them), the frame solver's own
+// hierarchy, Galerkin operators and interleaved matrix (multigrid_rgb_setup_ms), the float copies of the matrices and the Eigen sparse matrices. Eigen's
+// incomplete Cholesky factorisation is part of every eigen_ic_cg run (its API factorises per solve),
+// and the direct solver's time is factorisation plus solve.
+#pragma once
+
+#include "gl/gl_context.h"
+#include "solver/lighting.h"
+#include "tetops/connectivity.h"
+#include "tetops/tet_mesh.h"
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace waxwork {
+
+struct SolverComparisonOptions {
+    double mm_per_unit = 1.0;
+    double target_error = 1e-2;   // time_to_1pct_ms
+    double floor_error = 1e-4;    // a curve stops once below this
+    double max_seconds = 60.0;    // per solver, measuring included
+    // When set (a current OpenGL >= 4.3 context): also the GPU curves gpu_cg (solver/gpu/gpu_conjugate_gradient.h),
+    // gpu_multires (multires/gpu_multires_solver.h) and gpu_multigrid_cg (multires/gpu_multigrid_frame_solver.h);
+    // their times include reading phi back.
+    const GlApi* gl = nullptr;
+};
+
+struct SolverCurve {
+    std::string name;
+    std::vector<std::pair<double, double>> curve;  // (ms, relative error), time strictly increasing
+    std::optional<double> time_to_target_ms;       // nullopt when the target was not reached
+    std::optional<int> cap_to_target;              // the smallest cap reaching it (nullopt: not reached,
+                                                   // or no cap, as for direct)
+};
+
+struct SolverComparison {
+    size_t tets = 0, vertices = 0, levels = 0;
+    // Per-mesh setup, each twice: its first run in the process (which also maps every fresh page it
+    // touches), and *_rebuild_ms, the median of three runs after it, which reuse the memory freed by
+    // the run before, as the editor's rebuild after a cut does (base/memory_reuse.h).
+    double hierarchy_ms = 0, hierarchy_rebuild_ms = 0;
+    double multigrid_setup_ms = 0, multigrid_setup_rebuild_ms = 0;
+    // MultigridFrameSolver's constructor (its own hierarchy included).
+    double multigrid_rgb_setup_ms = 0, multigrid_rgb_setup_rebuild_ms = 0;
+    std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, cascadic_cg, multigrid_cg_rgb,
+                                       // eigen_ic_cg, [gpu_cg, gpu_multires, gpu_multigrid_cg,] direct
+    std::string gpu_fallback_reason;   // options.gl given but the GPU could not run (curves left out)
+};
+
+// Assembles the TransCut system (materials per tet), lights it (q from `lighting`) and compares the
+// solvers. Throws InvalidArgumentError for bad materials, lighting or options, AlgorithmError when a
+// solver breaks down.
+SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                 const std::vector<TetMaterial>& materials, const Lighting& lighting,
+                                 const SolverComparisonOptions& options);
+
+// The setup times as (JSON key, ms) in the order written: hierarchy_ms, hierarchy_rebuild_ms,
+// multigrid_setup_ms, multigrid_setup_rebuild_ms, multigrid_rgb_setup_ms, multigrid_rgb_setup_rebuild_ms.
+std::vector<std::pair<std::string, double>> setup_times(const SolverComparison& comparison);
+
+// What a comparison solved, recorded with it: the mesh file as given, the materials (a preset's name,
+// "custom" coefficients, or "stored" for the volume's own) and the millimetres per model unit the
+// coefficients (per mm) were applied at.
+struct ComparedScene {
+    std::string mesh;
+    std::string material;
+    double mm_per_unit = 0;
+};
+
+// Writes DIR/STEM.json, {"mesh", "material", "mm_per_unit", "tets", "vertices", "levels",
+// setup_times..., "solvers": {NAME: {"time_to_1pct_ms", "cap_to_1pct", "curve": [[ms, rel_error],
+// ...]}}}, and DIR/STEM.svg (error against time, one line per solver), atomically.
+void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const ComparedScene& scene,
+                             const SolverComparison& comparison);
+
+// For the GPU curves: a headless OpenGL context (OSMesa's llvmpipe unless WAXWORK_GL_DEVICE=egl finds a
+// GPU) set as options.gl. Returns null, with one warning line on stderr, when none can be created; the
+// CPU curves are measured either way.
+std::unique_ptr<HeadlessGlContext> open_gpu_for_comparison(SolverComparisonOptions& options);
+
+}  // namespace waxwork

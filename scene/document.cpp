@@ -1,0 +1,345 @@
+#include "scene/document.h"
+
+#include "base/error.h"
+#include "base/timing.h"
+#include "tetops/cut.h"
+#include "tetops/exact_cut.h"
+#include "tetops/fracture.h"
+#include "tetops/fragments.h"
+#include "tetops/paint.h"
+#include "tetops/quality.h"
+#include "tetops/relaxation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <numeric>
+#include <sstream>
+
+namespace waxwork {
+namespace {
+
+double min_dihedral_of(const TetMesh& mesh) {
+    const std::vector<double> angles = min_dihedral_angles_deg(mesh);
+    return angles.empty() ? 0.0 : *std::min_element(angles.begin(), angles.end());
+}
+
+template <typename T>
+size_t vector_bytes(const std::vector<T>& v) {
+    return v.capacity() * sizeof(T);
+}
+
+size_t mesh_bytes(const TetMesh& m) {
+    return sizeof(TetMesh) + vector_bytes(m.positions) + vector_bytes(m.tets) + vector_bytes(m.materials) +
+           vector_bytes(m.original_ids) + vector_bytes(m.piece_ids) + vector_bytes(m.piece_transforms);
+}
+
+std::unique_ptr<CuttingSurface> make_surface(const std::variant<PlaneSurface, StrokeSurface>& surface) {
+    if (const auto* p = std::get_if<PlaneSurface>(&surface)) return std::make_unique<PlaneCut>(p->normal, p->offset);
+    const auto& s = std::get<StrokeSurface>(surface);
+    return std::make_unique<StrokeCut>(s.eye, s.view_direction, s.points, s.flip);
+}
+
+RelaxationOptions relaxation_options(const RelaxSettings& r) {
+    RelaxationOptions o;
+    o.max_iterations = r.iterations;
+    o.step = r.step;
+    o.min_dihedral_guard_deg = r.guard_deg;
+    return o;
+}
+
+}  // namespace
+
+Document::Document(TetMesh mesh, const TetMaterial& default_material, size_t undo_budget_bytes)
+    : mesh_(std::move(mesh)), budget_(undo_budget_bytes) {
+    validate(mesh_);
+    if (!mesh_.has_materials()) mesh_.materials.assign(mesh_.tet_count(), default_material);
+    min_dihedral_deg_ = min_dihedral_of(mesh_);
+}
+
+ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
+    const auto start = std::chrono::steady_clock::now();
+    ChangeReport report;
+    report.name = operation_name(op);
+    report.tets_before = mesh_.tet_count();
+    report.vertices_before = mesh_.vertex_count();
+    entry.op = op;
+    entry.old_min_dihedral_deg = min_dihedral_deg_;
+    std::ostringstream details;
+
+    // Cut: remove the tets on the cut-away side, then relax the cut vertices onto the surface
+    // (TransCut Sec. 5), or split the crossed tets exactly along it. Works on a copy that becomes the mesh only when everything succeeded; the
+    // old mesh becomes the undo snapshot, so the copy costs nothing extra.
+    const auto cut = [&](const std::variant<PlaneSurface, StrokeSurface>& spec, const RelaxSettings& relax,
+                         bool exact) {
+        const std::unique_ptr<CuttingSurface> surface = make_surface(spec);
+        auto after = std::make_shared<TetMesh>(mesh_);
+        std::shared_ptr<TetConnectivity> connectivity;
+        if (exact) {
+            // Crossed tets are split along the surface (tetops/exact_cut.h): nothing is left on the
+            // cut-away side, so there is nothing to relax.
+            ExactCutResult result = cut_exact(*after, *surface);
+            require_tets_left_by_cut(*after, mesh_.tet_count());
+            connectivity = std::make_shared<TetConnectivity>(build_connectivity(*after));
+            min_dihedral_deg_ = result.min_dihedral_deg;
+            // Kept vertices (origin: vertex v) give the map both ways; vertices made on edges have none.
+            entry.snapshot_vertex.resize(result.vertex_origins.size());
+            report.old_to_new_vertex.assign(mesh_.vertex_count(), -1);
+            for (size_t v = 0; v < result.vertex_origins.size(); ++v) {
+                const VertexOrigin& origin = result.vertex_origins[v];
+                entry.snapshot_vertex[v] = origin.is_vertex() ? origin.a : -1;
+                if (origin.is_vertex()) report.old_to_new_vertex[static_cast<size_t>(origin.a)] = static_cast<int32_t>(v);
+            }
+            report.vertex_origins = std::move(result.vertex_origins);
+            report.tets_under_guard = result.tets_under_guard;
+            details << result.tets_split << " tets split, " << result.tets_removed << " tets removed, "
+                    << result.vertices_snapped << " vertices snapped onto the surface, " << result.tets_under_guard
+                    << " tets under the angle guard";
+        } else {
+            CutResult removed = remove_cut_away_tets(*after, *surface);
+            require_tets_left_by_cut(*after, mesh_.tet_count());
+            connectivity = std::make_shared<TetConnectivity>(build_connectivity(*after));
+            const RelaxationReport relaxed =
+                relax_cut_vertices(*after, *connectivity, *surface, relaxation_options(relax));
+            min_dihedral_deg_ = relaxed.min_dihedral_deg;
+            entry.snapshot_vertex = inverse_vertex_map(removed.old_to_new_vertex, after->vertex_count());
+            report.old_to_new_vertex = std::move(removed.old_to_new_vertex);
+            details << removed.tets_removed << " tets removed, " << relaxed.vertices_moved
+                    << " vertices relaxed (" << relaxed.iterations << " sweeps, " << relaxed.moves_rejected
+                    << " moves rejected by the guard)";
+        }
+        // A cut of a concave shape can leave specks floating: say so, and what drops them.
+        const FragmentSurvey fragments = survey_fragments(*after, *connectivity, kDefaultFragmentFraction);
+        if (fragments.small_parts > 0)
+            details << "; left " << fragments.small_parts << " detached "
+                    << (fragments.small_parts == 1 ? "part" : "parts") << " under " << 100 * kDefaultFragmentFraction
+                    << "% of the volume (" << fragments.small_part_tets << " tets; Edit > Remove fragments drops them)";
+        entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
+        mesh_ = std::move(*after);
+        report.topology = true;
+        report.connectivity = std::move(connectivity);
+    };
+
+    if (const auto* o = std::get_if<PlaneCutOp>(&op)) {
+        cut(o->plane, o->relax, o->exact);
+    } else if (const auto* o = std::get_if<StrokeCutOp>(&op)) {
+        cut(o->stroke, o->relax, o->exact);
+    } else if (const auto* o = std::get_if<RelaxOp>(&op)) {
+        const std::unique_ptr<CuttingSurface> surface = make_surface(o->surface);
+        const std::vector<Eigen::Vector3d> before = mesh_.positions;
+        const TetConnectivity connectivity = build_connectivity(mesh_);
+        // relax_cut_vertices validates its options before moving anything, and a move is applied only
+        // after its whole star passed: an exception leaves `before` to restore.
+        RelaxationReport relaxed;
+        try {
+            relaxed = relax_cut_vertices(mesh_, connectivity, *surface, relaxation_options(o->relax));
+        } catch (...) {
+            mesh_.positions = before;
+            throw;
+        }
+        for (size_t v = 0; v < before.size(); ++v) {
+            if (before[v] != mesh_.positions[v]) {
+                entry.moved_vertices.push_back(static_cast<int32_t>(v));
+                entry.old_positions.push_back(before[v]);
+            }
+        }
+        min_dihedral_deg_ = relaxed.min_dihedral_deg;
+        report.positions = !entry.moved_vertices.empty();
+        report.connectivity = std::make_shared<const TetConnectivity>(connectivity);
+        details << entry.moved_vertices.size() << " vertices moved in " << relaxed.iterations << " sweeps";
+    } else if (const auto* o = std::get_if<PaintOp>(&op)) {
+        PaintBrush brush;
+        brush.material = o->material;
+        brush.sigma = o->sigma;
+        brush.cutoff_weight = o->cutoff_weight;
+        if (!(brush.sigma > 0)) throw InvalidArgumentError("paint: sigma must be a positive number");
+        if (!paint_index_) paint_index_ = std::make_shared<PaintIndex>(mesh_);
+        // Every tet the brush can reach, saved before painting: the changed tets are among them.
+        const auto candidates = paint_index_->nearest_within(o->points, paint_radius(brush));
+        std::vector<TetMaterial> old(candidates.size());
+        for (size_t i = 0; i < candidates.size(); ++i) old[i] = mesh_.materials[candidates[i].first];
+        PaintResult painted = paint_stroke(mesh_, *paint_index_, o->points, brush);
+        // Both lists ascend: merge to keep the old materials of the changed tets only.
+        size_t i = 0;
+        for (const int32_t t : painted.changed_tets) {
+            while (i < candidates.size() && static_cast<int32_t>(candidates[i].first) < t) ++i;
+            if (i == candidates.size() || static_cast<int32_t>(candidates[i].first) != t)
+                throw AlgorithmError("paint changed tet " + std::to_string(t) + " outside the brush radius");
+            entry.material_tets.push_back(t);
+            entry.old_materials.push_back(old[i]);
+        }
+        report.changed_material_tets = std::move(painted.changed_tets);
+        details << report.changed_material_tets.size() << " tets painted";
+    } else if (const auto* o = std::get_if<SetMaterialOp>(&op)) {
+        if (o->piece && (*o->piece < 0 || static_cast<size_t>(*o->piece) >= mesh_.piece_transforms.size()))
+            throw InvalidArgumentError("set_material: piece " + std::to_string(*o->piece) + " does not exist (" +
+                                       std::to_string(mesh_.piece_transforms.size()) + " pieces)");
+        for (size_t t = 0; t < mesh_.tet_count(); ++t) {
+            if (o->piece && mesh_.piece_ids[t] != *o->piece) continue;
+            if (mesh_.materials[t] == o->material) continue;
+            entry.material_tets.push_back(static_cast<int32_t>(t));
+            entry.old_materials.push_back(mesh_.materials[t]);
+            mesh_.materials[t] = o->material;
+        }
+        report.changed_material_tets = entry.material_tets;
+        details << report.changed_material_tets.size() << " tets changed";
+    } else if (const auto* o = std::get_if<RemoveFragmentsOp>(&op)) {
+        auto after = std::make_shared<TetMesh>(mesh_);
+        FragmentRemoval removal = remove_small_fragments(*after, o->max_volume_fraction);
+        if (removal.fragments_removed > 0) {
+            entry.snapshot_vertex = inverse_vertex_map(removal.removed.old_to_new_vertex, after->vertex_count());
+            report.old_to_new_vertex = std::move(removal.removed.old_to_new_vertex);
+            entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
+            mesh_ = std::move(*after);
+            min_dihedral_deg_ = min_dihedral_of(mesh_);
+            report.topology = true;
+        }
+        details << removal.fragments_removed << " fragments removed (" << removal.removed.tets_removed << " tets), "
+                << removal.parts_kept << (removal.parts_kept == 1 ? " part" : " parts") << " kept";
+    } else {
+        run_piece_operation(op, entry, report, details);
+    }
+
+    if (report.topology || report.positions || report.piece_transforms) paint_index_.reset();
+    report.tets_after = mesh_.tet_count();
+    report.vertices_after = mesh_.vertex_count();
+    report.min_dihedral_deg = min_dihedral_deg_;
+    report.details = details.str();
+    entry.bytes = sizeof(UndoEntry) + vector_bytes(entry.material_tets) + vector_bytes(entry.old_materials) +
+                  vector_bytes(entry.moved_vertices) + vector_bytes(entry.old_positions) +
+                  vector_bytes(entry.snapshot_vertex) +
+                  (entry.snapshot ? mesh_bytes(*entry.snapshot) : 0);
+    report.milliseconds = milliseconds_since(start);
+    return report;
+}
+
+void Document::push_undo(UndoEntry entry, ChangeReport& report) {
+    if (entry.bytes > budget_) {
+        // Keeping it would mean dropping every other entry and still exceeding the budget.
+        report.undo_entries_evicted = undo_.size();
+        evicted_ += undo_.size();
+        undo_.clear();
+        undo_bytes_ = 0;
+        report.undoable = false;
+        return;
+    }
+    while (!undo_.empty() && undo_bytes_ + entry.bytes > budget_) {
+        undo_bytes_ -= undo_.front().bytes;
+        undo_.pop_front();
+        ++evicted_;
+        ++report.undo_entries_evicted;
+    }
+    undo_bytes_ += entry.bytes;
+    undo_.push_back(std::move(entry));
+}
+
+ChangeReport Document::apply(const EditOperation& op) {
+    UndoEntry entry;
+    ChangeReport report = run(op, entry);
+    redo_.clear();
+    history_.push_back(op);
+    push_undo(std::move(entry), report);
+    return report;
+}
+
+std::optional<ChangeReport> Document::undo() {
+    if (undo_.empty()) return std::nullopt;
+    const auto start = std::chrono::steady_clock::now();
+    UndoEntry entry = std::move(undo_.back());
+    undo_.pop_back();
+    undo_bytes_ -= entry.bytes;
+    ChangeReport report;
+    report.name = "undo " + operation_name(entry.op);
+    report.tets_before = mesh_.tet_count();
+    report.vertices_before = mesh_.vertex_count();
+    if (entry.snapshot) {
+        if (entry.snapshot_vertex.size() == mesh_.vertex_count()) report.old_to_new_vertex = std::move(entry.snapshot_vertex);
+        mesh_ = *entry.snapshot;
+        report.topology = true;
+    } else if (entry.piece >= 0) {
+        mesh_.piece_transforms[entry.piece] = entry.old_transform;
+        report.piece_transforms = true;
+    } else if (!entry.moved_vertices.empty()) {
+        for (size_t i = 0; i < entry.moved_vertices.size(); ++i)
+            mesh_.positions[entry.moved_vertices[i]] = entry.old_positions[i];
+        report.positions = true;
+    } else {
+        for (size_t i = 0; i < entry.material_tets.size(); ++i)
+            mesh_.materials[entry.material_tets[i]] = entry.old_materials[i];
+        report.changed_material_tets = entry.material_tets;
+    }
+    if (report.topology || report.positions || report.piece_transforms) paint_index_.reset();
+    min_dihedral_deg_ = entry.old_min_dihedral_deg;
+    report.min_dihedral_deg = min_dihedral_deg_;
+    report.tets_after = mesh_.tet_count();
+    report.vertices_after = mesh_.vertex_count();
+    redo_.push_back(std::move(entry.op));
+    history_.pop_back();
+    report.milliseconds = milliseconds_since(start);
+    return report;
+}
+
+std::optional<ChangeReport> Document::redo() {
+    if (redo_.empty()) return std::nullopt;
+    UndoEntry entry;
+    ChangeReport report = run(redo_.back(), entry);
+    report.name = "redo " + report.name;
+    history_.push_back(redo_.back());
+    redo_.pop_back();
+    push_undo(std::move(entry), report);
+    return report;
+}
+
+// Fracture, piece moves and welds (tetops/fracture.h).
+void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, ChangeReport& report,
+                                   std::ostringstream& details) {
+    if (const auto* o = std::get_if<FractureOp>(&op)) {
+        const std::vector<Eigen::Vector3d> seeds =
+            o->seeds.empty() ? scatter_fracture_seeds(mesh_, o->pieces, o->seed) : o->seeds;
+        FractureOptions options;
+        options.exact = o->exact;
+        options.min_piece_tets = o->min_piece_tets;
+        auto after = std::make_shared<TetMesh>(mesh_);
+        FractureResult result = fracture_voronoi(*after, seeds, options);
+        // Vertices before keep their index; the fracture only appends.
+        report.old_to_new_vertex.resize(mesh_.vertex_count());
+        std::iota(report.old_to_new_vertex.begin(), report.old_to_new_vertex.end(), 0);
+        entry.snapshot_vertex = inverse_vertex_map(report.old_to_new_vertex, after->vertex_count());
+        report.vertex_origins = std::move(result.vertex_origins);
+        entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
+        mesh_ = std::move(*after);
+        min_dihedral_deg_ = result.min_dihedral_deg;
+        report.topology = true;
+        report.tets_under_guard = result.tets_under_guard;
+        details << result.pieces_before << " -> " << result.pieces_after << " pieces, " << result.tets_split
+                << " tets split, " << result.vertices_collapsed << " vertices of swallowed walls collapsed, "
+                << result.vertices_duplicated << " crack vertices duplicated, "
+                << result.tets_under_guard << " tets under the angle guard";
+    } else if (const auto* o = std::get_if<MovePieceOp>(&op)) {
+        if (o->piece < 0 || static_cast<size_t>(o->piece) >= mesh_.piece_transforms.size())
+            throw InvalidArgumentError("move_piece: piece " + std::to_string(o->piece) + " does not exist (" +
+                                       std::to_string(mesh_.piece_transforms.size()) + " pieces)");
+        entry.piece = o->piece;
+        entry.old_transform = mesh_.piece_transforms[o->piece];
+        set_piece_transform(mesh_, o->piece, o->transform);
+        report.piece_transforms = true;
+        details << "piece " << o->piece << " moved";
+    } else if (const auto* o = std::get_if<WeldOp>(&op)) {
+        auto after = std::make_shared<TetMesh>(mesh_);
+        WeldResult result = weld_touching_pieces(*after, o->tolerance);
+        if (result.vertices_merged > 0 || result.pieces_after != result.pieces_before || !(*after == mesh_)) {
+            if (result.old_to_new_vertex.size() == mesh_.vertex_count()) {
+                entry.snapshot_vertex = inverse_vertex_map(result.old_to_new_vertex, after->vertex_count());
+                report.old_to_new_vertex = std::move(result.old_to_new_vertex);
+            }
+            entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
+            mesh_ = std::move(*after);
+            min_dihedral_deg_ = min_dihedral_of(mesh_);
+            report.topology = true;
+        }
+        details << result.pieces_before << " -> " << result.pieces_after << " pieces, " << result.vertices_merged
+                << " vertices merged";
+    }
+}
+
+}  // namespace waxwork

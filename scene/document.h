@@ -1,0 +1,149 @@
+// One edited volume with bounded undo/redo: the document applies edit operations
+// (edit_operation.h) through the tetops algorithms, reports what each changed so the live scene
+// (live_scene.h) can update only what it must, and keeps the data to undo it.
+//
+// Undo data, per kind, the smallest that restores the mesh bit for bit (TetMesh::operator==):
+//   paint, set_material   the changed tets and their old materials
+//   move_piece            the piece's old transform
+//   relax                 the moved vertices and their old positions
+//   cut, fracture, weld   a snapshot of the mesh before (every array changes: tets are removed or
+//                         split, vertices renumbered or duplicated)
+// Redo re-runs the operation: every operation is deterministic, so the result is identical, and the
+// redo stack costs only the operations themselves.
+//
+// Memory: the undo entries' bytes are bounded by a budget (default 512 MiB); when a new entry would
+// exceed it the oldest entries are dropped (counted in evicted_undo_count()). An entry larger than the
+// whole budget is not kept at all (the edit then cannot be undone; the report says so).
+//
+// Not synchronised: one thread (or one lock) applies, undoes and redoes (see live_scene.h for the
+// window's threading).
+//
+// The document always stores materials: a volume loaded without them gets the default material on
+// every tet, so paint, undo and the solver all see one material per tet.
+#pragma once
+
+#include "scene/edit_operation.h"
+#include "tetops/connectivity.h"
+#include "tetops/cut.h"
+#include "tetops/tet_mesh.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace waxwork {
+
+class PaintIndex;
+
+// What an applied (or undone, or redone) operation changed. The live scene reacts to the flags.
+struct ChangeReport {
+    std::string name;           // operation name ("paint", ...), "undo paint", "redo paint"
+    double milliseconds = 0;    // running the tetops algorithm(s) and recording undo data
+    size_t tets_before = 0, tets_after = 0;
+    size_t vertices_before = 0, vertices_after = 0;
+    double min_dihedral_deg = 0;  // of the whole mesh afterwards (0 when empty)
+    // Exact cut and exact fracture: tets left under min(0.5 degrees, their parent's angle) (split_quality.h).
+    size_t tets_under_guard = 0;
+
+    bool topology = false;         // tets/vertices added, removed or renumbered
+    bool positions = false;        // rest positions moved (topology unchanged)
+    bool piece_transforms = false; // one or more piece transforms changed
+    bool all_materials = false;    // potentially every tet's material changed
+    std::vector<int32_t> changed_material_tets;  // else: exactly these tets' materials changed (ascending)
+
+    // Set by operations that build the new mesh's connectivity anyway (cut with relaxation): the
+    // live scene reuses it instead of rebuilding. Null otherwise.
+    std::shared_ptr<const TetConnectivity> connectivity;
+    // Cut (exact or not), fracture, weld, and undoing any of them: per vertex before, its index after
+    // or -1 (lets the solver keep its warm start and rebuild its hierarchy around the change).
+    std::vector<int32_t> old_to_new_vertex;
+    // Exact cut and fracture: per vertex after, where it comes from (vertex v, or the point of edge ab
+    // it was made on). An index below vertices_before names a vertex before the change; a fracture's appended
+    // vertices (crack copies, vertices on walls that cross earlier walls) may also name vertices after
+    // with a lower index than their own (FractureResult::vertex_origins), so read in index order.
+    std::vector<VertexOrigin> vertex_origins;
+
+    bool undoable = true;       // false when the entry exceeded the whole undo budget
+    size_t undo_entries_evicted = 0;  // oldest entries dropped to make room for this one
+    std::string details;        // one line, operation specific (tets removed, vertices moved, ...)
+
+    bool anything_changed() const {
+        return topology || positions || piece_transforms || all_materials || !changed_material_tets.empty();
+    }
+};
+
+inline constexpr size_t kDefaultUndoBudgetBytes = size_t{512} << 20;
+
+class Document {
+public:
+    // `default_material` is given to every tet when `mesh` stores no materials. Validates the mesh.
+    explicit Document(TetMesh mesh, const TetMaterial& default_material,
+                      size_t undo_budget_bytes = kDefaultUndoBudgetBytes);
+
+    const TetMesh& mesh() const { return mesh_; }
+    double min_dihedral_deg() const { return min_dihedral_deg_; }
+
+    // Runs the operation. On an exception (bad parameters, an algorithm failure) the mesh is left as
+    // it was and nothing is recorded. Clears the redo stack.
+    ChangeReport apply(const EditOperation& op);
+
+    bool can_undo() const { return !undo_.empty(); }
+    bool can_redo() const { return !redo_.empty(); }
+    // nullopt when there is nothing to undo / redo.
+    std::optional<ChangeReport> undo();
+    std::optional<ChangeReport> redo();
+
+    size_t undo_count() const { return undo_.size(); }
+    size_t redo_count() const { return redo_.size(); }
+    size_t undo_bytes() const { return undo_bytes_; }
+    size_t undo_budget_bytes() const { return budget_; }
+    size_t evicted_undo_count() const { return evicted_; }
+
+    // The operations that made the current mesh from the loaded one, oldest first (applied and not
+    // undone; evicted undo entries still count): the session record (session.h write_session).
+    const std::vector<EditOperation>& history() const { return history_; }
+
+private:
+    // Exactly one kind of undo data is filled (see the top of this header).
+    struct UndoEntry {
+        EditOperation op;
+        std::vector<int32_t> material_tets;           // paint, set_material
+        std::vector<TetMaterial> old_materials;
+        std::vector<int32_t> moved_vertices;          // relax
+        std::vector<Eigen::Vector3d> old_positions;
+        int piece = -1;                               // move_piece
+        RigidTransform old_transform;
+        std::shared_ptr<const TetMesh> snapshot;      // cut, fracture, weld
+        // Cut, fracture and weld: per vertex after the edit, its vertex in the snapshot, or -1 (made
+        // by the edit); undoing reports it as the change's vertex map, so the live scene keeps its warm start
+        // and rebuilds its hierarchy around the change.
+        std::vector<int32_t> snapshot_vertex;
+        double old_min_dihedral_deg = 0;
+        size_t bytes = 0;
+    };
+    ChangeReport run(const EditOperation& op, UndoEntry& entry);
+    // fracture, move_piece, weld (tetops/fracture.h).
+    void run_piece_operation(const EditOperation& op, UndoEntry& entry, ChangeReport& report,
+                             std::ostringstream& details);
+    void push_undo(UndoEntry entry, ChangeReport& report);
+
+    TetMesh mesh_;
+    // Tet centroids for painting, built on the first stroke and kept until the geometry changes
+    // (a kd-tree build costs more than a stroke at 500K tets). shared_ptr: PaintIndex stays opaque here.
+    std::shared_ptr<PaintIndex> paint_index_;
+    double min_dihedral_deg_ = 0;
+    size_t budget_;
+    size_t undo_bytes_ = 0;
+    size_t evicted_ = 0;
+    std::deque<UndoEntry> undo_;
+    std::vector<EditOperation> redo_;  // most recently undone last
+    std::vector<EditOperation> history_;
+};
+
+}  // namespace waxwork

@@ -1,0 +1,504 @@
+#include "scene/session.h"
+
+#include "base/error.h"
+#include "base/timing.h"
+#include "gl/gl_context.h"
+#include "io/atomic_file.h"
+#include "io/file_extension.h"
+#include "io/image_io.h"
+#include "io/surface_reader.h"
+#include "io/volume_file.h"
+#include "render/render_input.h"
+#include "scene/json_fields.h"
+#include "scene/live_scene.h"
+#include "solver/conjugate_gradient.h"
+#include "solver/frame_budget.h"
+#include "solver/material.h"
+#include "solver/mesh_resolution.h"
+#include "solver/solved_scene.h"
+#include "tetops/tetrahedralize.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+namespace waxwork {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+Json rgb_to_json(const Rgb& c) { return Json::array({c[0], c[1], c[2]}); }
+
+Rgb rgb_from(FieldReader& in, const std::string& key) {
+    const Eigen::Vector3d v = in.vector(key);
+    if ((v.array() < 0).any()) fail_json(in.field(key), "must be non-negative");
+    return {v.x(), v.y(), v.z()};
+}
+
+Light light_from_json(const Json& json, const std::string& context) {
+    FieldReader in(json, context);
+    Light light;
+    if (in.has("direction") == in.has("position"))
+        fail_json(context, "give exactly one of 'direction' (a directional light) and 'position' (a point light)");
+    if (in.has("direction")) {
+        light.type = LightType::Directional;
+        light.vector = in.vector("direction");
+        if (light.vector.norm() == 0) fail_json(in.field("direction"), "must not be zero");
+    } else {
+        light.type = LightType::Point;
+        light.vector = in.vector("position");
+    }
+    if (in.has("intensity")) light.intensity = rgb_from(in, "intensity");
+    in.finish();
+    return light;
+}
+
+Json light_to_json(const Light& light) {
+    Json j;
+    j[light.type == LightType::Directional ? "direction" : "position"] = vector_to_json(light.vector);
+    j["intensity"] = rgb_to_json(light.intensity);
+    return j;
+}
+
+// "lights", "ambient", "shadows" of `in` into `lighting` (only the fields present).
+void read_lighting_fields(FieldReader& in, Lighting& lighting) {
+    if (in.has("lights")) {
+        const Json& lights = in.at("lights");
+        if (!lights.is_array()) fail_json(in.field("lights"), "expected an array of lights");
+        lighting.lights.clear();
+        for (size_t i = 0; i < lights.size(); ++i)
+            lighting.lights.push_back(light_from_json(lights[i], in.field("lights") + " light " + std::to_string(i)));
+    }
+    if (in.has("ambient")) lighting.ambient = rgb_from(in, "ambient");
+    lighting.shadows = in.boolean("shadows", lighting.shadows);
+}
+
+void write_lighting_fields(const Lighting& lighting, Json& j) {
+    Json lights = Json::array();
+    for (const Light& l : lighting.lights) lights.push_back(light_to_json(l));
+    j["lights"] = lights;
+    j["ambient"] = rgb_to_json(lighting.ambient);
+    j["shadows"] = lighting.shadows;
+}
+
+CameraSettings camera_from_json(const Json& json, const std::string& context, CameraSettings camera) {
+    FieldReader in(json, context);
+    if (in.has("eye_direction")) camera.eye_direction = in.vector("eye_direction");
+    if (camera.eye_direction.norm() == 0) fail_json(in.field("eye_direction"), "must not be zero");
+    if (in.has("up")) camera.up = in.vector("up");
+    camera.fov_y_degrees = in.number("fov_y_deg", camera.fov_y_degrees);
+    if (!(camera.fov_y_degrees > 1 && camera.fov_y_degrees < 170)) fail_json(in.field("fov_y_deg"), "must be in (1, 170)");
+    camera.margin = in.number("margin", camera.margin);
+    if (!(camera.margin > 0)) fail_json(in.field("margin"), "must be positive");
+    if (in.has("target_offset")) camera.target_offset = in.vector("target_offset");
+    in.finish();
+    return camera;
+}
+
+Json camera_to_json(const CameraSettings& c) {
+    Json j{{"eye_direction", vector_to_json(c.eye_direction)},
+           {"up", vector_to_json(c.up)},
+           {"fov_y_deg", c.fov_y_degrees},
+           {"margin", c.margin}};
+    if (c.target_offset != Eigen::Vector3d::Zero()) j["target_offset"] = vector_to_json(c.target_offset);
+    return j;
+}
+
+std::string output_name(FieldReader& in, const std::string& key) {
+    const Json& v = in.at(key);
+    if (!v.is_string() || v.get<std::string>().empty()) fail_json(in.field(key), "expected a file name");
+    // Outputs go to the run's output directory: a session from elsewhere writes nothing outside it.
+    const fs::path name(v.get<std::string>());
+    const bool climbs = std::any_of(name.begin(), name.end(), [](const fs::path& part) { return part == ".."; });
+    if (name.is_absolute() || climbs)
+        fail_json(in.field(key), "'" + name.string() + "' must stay inside the output directory (a relative path without '..')");
+    return name.string();
+}
+
+int count_from(FieldReader& in, const std::string& key) {
+    const int64_t n = in.integer(key);
+    if (n < 1 || n > 1000000) fail_json(in.field(key), "must be a count >= 1");
+    return static_cast<int>(n);
+}
+
+SessionStep step_from_json(const Json& json, const std::string& context, const Session& session) {
+    if (!json.is_object()) fail_json(context, "a step must be a JSON object");
+    if (json.contains("op")) return edit_operation_from_json(json, context);
+    FieldReader in(json, context);
+    SessionStep step;
+    if (in.has("render")) {
+        RenderStep r;
+        r.file = output_name(in, "render");
+        if (lower_extension(r.file) != ".png") fail_json(in.field("render"), "'" + r.file + "' must be a .png");
+        if (in.has("frames")) r.frames = count_from(in, "frames");
+        step = r;
+    } else if (in.has("save")) {
+        step = SaveStep{output_name(in, "save")};
+        if (!is_volume_path(std::get<SaveStep>(step).file))
+            fail_json(in.field("save"), "'" + std::get<SaveStep>(step).file +
+                                            "' must name a volume format (.vtu keeps pieces and materials; .msh, .mesh, .node)");
+    } else if (in.has("light")) {
+        LightStep l{session.lighting};
+        FieldReader light(in.at("light"), in.field("light"));
+        read_lighting_fields(light, l.lighting);
+        light.finish();
+        try {
+            validate(l.lighting);
+        } catch (const Error& e) {
+            fail_json(in.field("light"), e.what());
+        }
+        step = l;
+    } else if (in.has("camera")) {
+        step = CameraStep{camera_from_json(in.at("camera"), in.field("camera"), session.camera)};
+    } else if (in.has("undo")) {
+        step = UndoStep{count_from(in, "undo")};
+    } else if (in.has("redo")) {
+        step = RedoStep{count_from(in, "redo")};
+    } else {
+        fail_json(context, "expected an edit operation (\"op\") or one of render, save, light, camera, undo, redo");
+    }
+    in.finish();
+    return step;
+}
+
+std::string step_kind(const SessionStep& step) {
+    if (const auto* op = std::get_if<EditOperation>(&step)) return operation_name(*op);
+    static const char* const kinds[] = {"", "render", "save", "light", "camera", "undo", "redo"};
+    return kinds[step.index()];
+}
+
+Json step_to_json(const SessionStep& step, const Session& session) {
+    if (const auto* op = std::get_if<EditOperation>(&step)) return to_json(*op);
+    if (const auto* r = std::get_if<RenderStep>(&step)) {
+        Json j{{"render", r->file}};
+        if (r->frames) j["frames"] = *r->frames;
+        return j;
+    }
+    if (const auto* s = std::get_if<SaveStep>(&step)) return Json{{"save", s->file}};
+    if (const auto* l = std::get_if<LightStep>(&step)) {
+        Json light = Json::object();
+        write_lighting_fields(l->lighting, light);
+        return Json{{"light", light}};
+    }
+    if (const auto* c = std::get_if<CameraStep>(&step)) return Json{{"camera", camera_to_json(c->camera)}};
+    if (const auto* u = std::get_if<UndoStep>(&step)) return Json{{"undo", u->count}};
+    (void)session;
+    return Json{{"redo", std::get<RedoStep>(step).count}};
+}
+
+fs::path relative_if_possible(const fs::path& path, const fs::path& base) {
+    std::error_code ec;
+    const fs::path relative = fs::relative(path, base, ec);
+    return ec || relative.empty() ? path : relative;
+}
+
+}  // namespace
+
+Session parse_session(const Json& json, const fs::path& base_directory, const std::string& name) {
+    Session session;
+    session.name = name;
+    FieldReader in(json, name);
+    {
+        FieldReader input(in.at("input"), in.field("input"));
+        if (input.has("surface") == input.has("volume"))
+            fail_json(in.field("input"), "give exactly one of 'surface' (a mesh to fill) and 'volume'");
+        const std::string key = input.has("surface") ? "surface" : "volume";
+        const Json& file = input.at(key);
+        if (!file.is_string() || file.get<std::string>().empty()) fail_json(input.field(key), "expected a file path");
+        (key == "surface" ? session.input.surface : session.input.volume) =
+            base_directory / fs::path(file.get<std::string>());
+        if (input.has("max_tets")) {
+            const int64_t n = input.integer("max_tets");
+            if (n < 1) fail_json(input.field("max_tets"), "must be positive");
+            session.input.max_tets = static_cast<size_t>(n);
+        }
+        if (input.has("edge")) {
+            session.input.edge = input.number("edge");
+            if (!(*session.input.edge > 0)) fail_json(input.field("edge"), "must be positive");
+        }
+        if (input.has("mesher")) {
+            const Json& m = input.at("mesher");
+            if (m == "tetgen") {
+                session.input.mesher = Mesher::TetGen;
+            } else if (m == "cgal") {
+                session.input.mesher = Mesher::Cgal;
+            } else {
+                fail_json(input.field("mesher"), "expected \"tetgen\" or \"cgal\"");
+            }
+        }
+        if (key == "volume" && (session.input.max_tets || session.input.edge || input.has("mesher")))
+            fail_json(in.field("input"), "meshing options apply to a 'surface' input only");
+        input.finish();
+    }
+    session.material = in.has("material") ? in.material("material") : material_from_json(Json("marble"), name);
+    session.scale = in.number("scale", session.scale);
+    if (!(session.scale >= kMinMmPerUnit && session.scale <= kMaxMmPerUnit))
+        fail_json(in.field("scale"), "must be a length in mm per model unit between 1e-6 and 1e6");
+    read_lighting_fields(in, session.lighting);
+    try {
+        validate(session.lighting);
+    } catch (const Error& e) {
+        fail_json(name, e.what());
+    }
+    if (in.has("camera")) session.camera = camera_from_json(in.at("camera"), in.field("camera"), session.camera);
+    if (in.has("image")) {
+        FieldReader image(in.at("image"), in.field("image"));
+        const int64_t w = image.integer("width", session.width), h = image.integer("height", session.height);
+        if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide)
+            fail_json(in.field("image"), "width and height must be between 1 and " + std::to_string(kMaxImageSide));
+        session.width = static_cast<int>(w);
+        session.height = static_cast<int>(h);
+        image.finish();
+    }
+    session.tolerance = in.number("tolerance", session.tolerance);
+    if (!(session.tolerance >= kMinRelativeTolerance && session.tolerance < 1))
+        fail_json(in.field("tolerance"), "must be a relative tolerance in [1e-15, 1)");
+    if (in.has("frame_iterations")) session.frame_iterations = count_from(in, "frame_iterations");
+    if (in.has("frame_ms")) {
+        session.frame_ms = in.number("frame_ms");
+        const std::string problem = frame_ms_problem(*session.frame_ms);
+        if (!problem.empty()) fail_json(in.field("frame_ms"), problem);
+    }
+    session.crease_angle_degrees = in.number("crease_angle", session.crease_angle_degrees);
+    if (!is_crease_angle(session.crease_angle_degrees))
+        fail_json(in.field("crease_angle"), "must be between 0 and 180 degrees");
+    const Json& steps = in.at("steps");
+    if (!steps.is_array()) fail_json(in.field("steps"), "expected an array of steps");
+    for (size_t i = 0; i < steps.size(); ++i)
+        session.steps.push_back(step_from_json(steps[i], name + ": step " + std::to_string(i), session));
+    in.finish();
+    return session;
+}
+
+Session read_session(const fs::path& path) {
+    return parse_session(read_json_file(path), path.parent_path(), path.string());
+}
+
+Json session_to_json(const Session& session) {
+    Json j;
+    Json input = Json::object();
+    if (!session.input.surface.empty()) {
+        input["surface"] = session.input.surface.generic_string();
+        if (session.input.max_tets) input["max_tets"] = *session.input.max_tets;
+        if (session.input.edge) input["edge"] = *session.input.edge;
+        input["mesher"] = session.input.mesher == Mesher::TetGen ? "tetgen" : "cgal";
+    } else {
+        input["volume"] = session.input.volume.generic_string();
+    }
+    j["input"] = input;
+    j["material"] = material_to_json(session.material);
+    j["scale"] = session.scale;
+    write_lighting_fields(session.lighting, j);
+    j["camera"] = camera_to_json(session.camera);
+    j["image"] = Json{{"width", session.width}, {"height", session.height}};
+    j["tolerance"] = session.tolerance;
+    j["frame_iterations"] = session.frame_iterations;
+    if (session.frame_ms) j["frame_ms"] = *session.frame_ms;
+    j["crease_angle"] = session.crease_angle_degrees;
+    Json steps = Json::array();
+    for (const SessionStep& step : session.steps) steps.push_back(step_to_json(step, session));
+    j["steps"] = steps;
+    return j;
+}
+
+void write_session(const fs::path& path, const Session& session) {
+    Session relative = session;
+    const fs::path base = fs::absolute(path).parent_path();
+    if (!relative.input.surface.empty())
+        relative.input.surface = relative_if_possible(fs::absolute(relative.input.surface), base);
+    if (!relative.input.volume.empty())
+        relative.input.volume = relative_if_possible(fs::absolute(relative.input.volume), base);
+    const std::string text = session_to_json(relative).dump(2) + "\n";
+    write_file_atomically(path, [&](std::ostream& out) { out << text; });
+}
+
+Session record_session(const Session& setup, const Document& document, const std::vector<SessionStep>& extra_steps) {
+    Session session = setup;
+    session.steps.clear();
+    for (const EditOperation& op : document.history()) session.steps.emplace_back(op);
+    session.steps.insert(session.steps.end(), extra_steps.begin(), extra_steps.end());
+    return session;
+}
+
+TetMesh read_session_input(const Session& session) {
+    if (!session.input.volume.empty()) return read_volume(session.input.volume);
+    const LoadedSurface loaded = load_closed_surface(session.input.surface);
+    MeshingOptions meshing;
+    meshing.mesher = session.input.mesher;
+    if (session.input.edge) {
+        meshing.sizing.edge_length = session.input.edge;
+    } else if (session.input.max_tets) {
+        meshing.sizing.target_tets = session.input.max_tets;
+    } else {
+        meshing.sizing = default_mesh_sizing(loaded.surface, session.material, session.scale);
+    }
+    return tetrahedralize_surface_file(session.input.surface, loaded.surface, meshing).mesh;
+}
+
+TetMesh load_session_input(const Session& session) {
+    const std::string context = session.name + ": input";
+    try {
+        return naming_context(context, [&] { return read_session_input(session); });
+    } catch (const FileError& e) {  // still "PATH: PROBLEM" with path() the input; the session follows
+        throw FileError(e.path(), e.problem() + " (" + context + ")");
+    }
+}
+
+FrameBudget session_frame_budget(const Session& session, const SessionRunOptions& run_options) {
+    const std::optional<double> ms = run_options.frame_ms ? run_options.frame_ms : session.frame_ms;
+    return ms ? FrameBudget::milliseconds(*ms) : FrameBudget::iterations(session.frame_iterations);
+}
+
+namespace {
+
+// An output named "frames/f1.png" gets its folder inside the output directory (output_name keeps it
+// there); FileError naming the folder when it cannot be made (a file of that name, say).
+void create_parent_directory(const fs::path& path) {
+    std::error_code ec;
+    fs::create_directories(path.parent_path(), ec);
+    if (ec) throw FileError(path.parent_path().string(), "cannot create the directory: " + ec.message());
+}
+
+}  // namespace
+
+SessionResult run_session(const Session& session, const fs::path& output_directory, const SessionRunOptions& run_options) {
+    std::error_code ec;
+    fs::create_directories(output_directory, ec);
+    if (ec) throw FileError(output_directory.string(), "cannot create the directory: " + ec.message());
+
+    SessionResult result;
+    const auto load_start = std::chrono::steady_clock::now();
+    Document document(load_session_input(session), session.material);
+    result.load_ms = milliseconds_since(load_start);
+    result.input_tets = document.mesh().tet_count();
+    LiveSceneOptions scene_options;
+    scene_options.mm_per_unit = session.scale;
+    scene_options.relative_tolerance = session.tolerance;
+    scene_options.crease_angle_degrees = session.crease_angle_degrees;
+    scene_options.method = run_options.method;
+    scene_options.backend = run_options.backend;
+    // One GL context for the whole session, created at the first render (or now, for the GPU solver,
+    // which then shares it with the renderer). A context that fails here makes the solver fall back
+    // with the reason (live_solver.h).
+    std::unique_ptr<HeadlessGlContext> context;
+    if (run_options.backend == LiveBackend::Gpu) {
+        try {
+            context = std::make_unique<HeadlessGlContext>();
+            scene_options.gl_context = borrow_headless_solver_context(*context);
+        } catch (const Error&) {
+            context.reset();
+        }
+    }
+    std::unique_ptr<SurfaceRenderer> renderer;
+    LiveScene scene(document.mesh(), session.lighting, scene_options);
+    ImageSettings image;
+    image.width = session.width;
+    image.height = session.height;
+    image.camera = session.camera;
+
+    Json metrics = Json::array();
+    for (size_t i = 0; i < session.steps.size(); ++i) {
+        const SessionStep& step = session.steps[i];
+        const std::string context_name = session.name + ": step " + std::to_string(i) + " (" + step_kind(step) + ")";
+        const auto start = std::chrono::steady_clock::now();
+        StepMetrics m;
+        m.name = step_kind(step);
+        try {
+            if (const auto* op = std::get_if<EditOperation>(&step)) {
+                scene.apply_change(document.mesh(), document.apply(*op));
+            } else if (const auto* r = std::get_if<RenderStep>(&step)) {
+                FrameReport frame;
+                if (r->frames) {
+                    for (int f = 0; f < *r->frames; ++f) {
+                        frame = scene.step(session_frame_budget(session, run_options));
+                        m.solver_iterations += frame.total_iterations();
+                    }
+                } else {
+                    frame = scene.converge();
+                    m.solver_iterations = frame.total_iterations();
+                }
+                if (!context) context = std::make_unique<HeadlessGlContext>();
+                context->make_current();  // the solver may have used its own context meanwhile
+                if (!renderer) renderer = std::make_unique<SurfaceRenderer>(context->gl());
+                const SolvedScene solved = scene.solved_scene();
+                const Image picture =
+                    render_scene(*renderer, make_render_input(document.mesh(), solved, scene.lighting(), image));
+                const fs::path path = output_directory / r->file;
+                create_parent_directory(path);
+                write_png(picture, path);
+                result.written.push_back(path);
+            } else if (const auto* s = std::get_if<SaveStep>(&step)) {
+                const fs::path path = output_directory / s->file;
+                create_parent_directory(path);
+                write_volume(document.mesh(), path);
+                result.written.push_back(path);
+            } else if (const auto* l = std::get_if<LightStep>(&step)) {
+                scene.set_lighting(l->lighting);
+            } else if (const auto* c = std::get_if<CameraStep>(&step)) {
+                image.camera = c->camera;
+            } else if (const auto* u = std::get_if<UndoStep>(&step)) {
+                for (int k = 0; k < u->count; ++k) {
+                    const auto report = document.undo();
+                    if (!report) fail_json(context_name, "nothing left to undo");
+                    scene.apply_change(document.mesh(), *report);
+                }
+            } else {
+                for (int k = 0; k < std::get<RedoStep>(step).count; ++k) {
+                    const auto report = document.redo();
+                    if (!report) fail_json(context_name, "nothing left to redo");
+                    scene.apply_change(document.mesh(), *report);
+                }
+            }
+        } catch (const FileError& e) {
+            throw FileError(e.path(), context_name + ": " + e.problem());
+        } catch (const InvalidArgumentError& e) {
+            const std::string what = e.what();
+            throw InvalidArgumentError(what.rfind(context_name, 0) == 0 ? what : context_name + ": " + what);
+        } catch (const InvalidMeshError& e) {
+            throw InvalidMeshError(context_name + ": " + e.what());
+        } catch (const Error& e) {
+            throw AlgorithmError(context_name + ": " + e.what());
+        }
+        m.milliseconds = milliseconds_since(start);
+        m.tets = document.mesh().tet_count();
+        m.vertices = document.mesh().vertex_count();
+        const std::optional<double> error = scene.estimated_error();
+        m.estimated_error = error.value_or(-1);
+        metrics.push_back(Json{{"step", i},
+                               {"name", m.name},
+                               {"milliseconds", m.milliseconds},
+                               {"tets", m.tets},
+                               {"vertices", m.vertices},
+                               {"solver_iterations", m.solver_iterations},
+                               {"estimated_error", error ? Json(*error) : Json(nullptr)}});
+        result.steps.push_back(m);
+    }
+    const FrameBudget budget = session_frame_budget(session, run_options);
+    const Json summary{{"session", session.name},
+                       {"load_milliseconds", result.load_ms},
+                       {"input_tets", result.input_tets},
+                       {"undo_bytes", document.undo_bytes()},
+                       {"undo_entries_evicted", document.evicted_undo_count()},
+                       {"solver_backend", live_backend_name(scene.backend())},
+                       {"solver_method", live_method_name(run_options.method)},
+                       // The time budget of the frames of render steps with "frames"; null: frame_iterations.
+                       {"frame_ms", budget.limits_time() ? Json(budget.max_milliseconds) : Json(nullptr)},
+                       {"gpu_fallback_reason", scene.gpu_fallback_reason()},
+                       {"method_fallback_reason", scene.method_fallback_reason()},
+                       {"steps", metrics}};
+    write_file_atomically(output_directory / "metrics.json", [&](std::ostream& out) { out << summary.dump(2) << "\n"; });
+    result.mesh = document.mesh();
+    result.solver_backend = scene.backend();
+    result.gpu_fallback_reason = scene.gpu_fallback_reason();
+    result.method_fallback_reason = scene.method_fallback_reason();
+    return result;
+}
+
+}  // namespace waxwork

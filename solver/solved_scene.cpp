@@ -1,0 +1,52 @@
+#include "solver/solved_scene.h"
+
+#include "base/error.h"
+#include "base/timing.h"
+#include "solver/radiance.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+namespace waxwork {
+
+SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity,
+                        const std::vector<TetMaterial>& materials, const Lighting& lighting,
+                        const DiffusionOptions& options, double crease_angle_degrees) {
+    SolvedScene scene;
+    const auto lighting_start = std::chrono::steady_clock::now();
+    // The surface and its shadow BVH are built once and shared by the lighting of the solve, the
+    // shading's copies and the renderer.
+    scene.surface = extract_boundary_surface(mesh, connectivity, materials);
+    const TriangleBvh bvh = lighting.shadows ? build_shadow_bvh(scene.surface) : TriangleBvh();
+    std::vector<float> visibility;
+    const std::vector<Rgb> surface_q = incident_light(scene.surface, bvh, lighting, &visibility);
+    scene.shading = split_at_creases(scene.surface, crease_angle_degrees);
+    scene.shading_light = shading_light(scene.surface, scene.shading, bvh, lighting, surface_q, visibility);
+    const std::vector<Rgb> surface_source_q = source_light(scene.surface, scene.shading, scene.shading_light.q);
+    const std::vector<CornerLight> corners =
+        corner_light(scene.surface, scene.shading, scene.shading_light.q, surface_source_q);
+    scene.q = to_volume_vertices(scene.surface, surface_source_q, mesh.vertex_count());
+    scene.lighting_ms = milliseconds_since(lighting_start);
+
+    scene.diffusion = solve_diffusion(mesh, connectivity, materials, scene.q, options, corners);
+    for (size_t v = 0; v < scene.diffusion.phi.size(); ++v) {
+        for (int c = 0; c < 3; ++c) {
+            if (!std::isfinite(scene.diffusion.phi[v][c]))
+                throw AlgorithmError("the diffusion solve gave a non-finite fluence at vertex " + std::to_string(v));
+        }
+    }
+    scene.radiance_factor =
+        shading_radiance_factors(scene.surface, scene.shading, scene.diffusion.phi, scene.shading_light.q);
+    for (size_t d = 0; d < scene.radiance_factor.size(); ++d) {
+        for (int c = 0; c < 3; ++c) {
+            if (!std::isfinite(scene.radiance_factor[d][c]))
+                throw AlgorithmError("non-finite exitant radiance at vertex " +
+                                     std::to_string(scene.surface.vertices[scene.shading.surface_vertex[d]]) +
+                                     " (float overflow: are the light intensities absurd?)");
+        }
+    }
+    return scene;
+}
+
+}  // namespace waxwork

@@ -1,0 +1,206 @@
+// The command-line contract: subcommands, --help, errors, and the mesh/info pipeline end to end.
+#include "io/volume_file.h"
+#include "support/cli_run.h"
+#include "tetops/test_meshes.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <filesystem>
+
+namespace waxwork {
+namespace {
+
+using testing::run_waxwork;
+using testing::scratch_dir;
+namespace fs = std::filesystem;
+
+const std::string kAssets = WAXWORK_ASSET_DIR;
+const std::string kShared = WAXWORK_SHARED_DIR;
+
+using testing::line_count;
+
+TEST(Cli, HelpOnEveryCommand) {
+    for (const std::string command : {"", "mesh", "info"}) {
+        const auto r = run_waxwork(command + " --help");
+        EXPECT_EQ(r.exit_code, 0) << command;
+        EXPECT_NE(r.out.find("Usage"), std::string::npos) << command;
+    }
+}
+
+TEST(Cli, UnknownCommandAndOptionAreOneLineErrors) {
+    for (const std::string args : {"carve", "info --bogus x.vtu", "mesh", "mesh in.obj"}) {
+        const auto r = run_waxwork(args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_EQ(line_count(r.err), 1u) << args << ": " << r.err;
+        EXPECT_EQ(r.err.rfind("waxwork: ", 0), 0u) << r.err;
+    }
+}
+
+// CLI11 alone reads an empty value as the option's default: a script whose variable came out empty
+// would run silently with defaults. Every option that takes a value refuses it, naming the option.
+TEST(Cli, EmptyOptionValuesAreRefusedNamingTheOption) {
+    const auto dir = scratch_dir("cli_empty");
+    const fs::path volume = dir / "cube.vtu";
+    write_volume(testing::make_cube_mesh(3), volume);
+    const std::string in = volume.string(), out = (dir / "out.vtu").string();
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"cut " + in + " -o " + out + " --plane=1,0,0,0 --relax ''", "--relax"},
+        {"cut " + in + " -o " + out + " --plane ''", "--plane"},
+        {"fracture " + in + " -o " + out + " --pieces ''", "--pieces"},
+        {"render " + in + " -o " + (dir / "a.png").string() + " --width ''", "--width"},
+        {"render " + in + " -o ''", "--output"},
+        {"info ''", "volume"},
+    };
+    for (const auto& [args, option] : cases) {
+        const auto r = run_waxwork(args);
+        EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
+        EXPECT_EQ(line_count(r.err), 1u) << args << ": " << r.err;
+        EXPECT_NE(r.err.find(option), std::string::npos) << args << ": " << r.err;
+        EXPECT_NE(r.err.find("empty value"), std::string::npos) << args << ": " << r.err;
+    }
+    EXPECT_FALSE(fs::exists(out));
+    // The same options with values still run.
+    EXPECT_EQ(run_waxwork("cut " + in + " -o " + out + " --plane=1,0,0,0 --relax 2").exit_code, 0);
+}
+
+TEST(Cli, MissingAndCorruptFilesNameTheFile) {
+    const auto dir = scratch_dir("cli_corrupt");
+    const auto r = run_waxwork("info " + (dir / "absent.vtu").string());
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.err.find("absent.vtu"), std::string::npos) << r.err;
+
+    const fs::path garbage = dir / "garbage.vtu";
+    { std::ofstream(garbage) << "<VTKFile type=\"UnstructuredGrid\"><Piece NumberOfPoints=\"3\">"; }
+    const auto g = run_waxwork("info " + garbage.string());
+    EXPECT_NE(g.exit_code, 0);
+    EXPECT_EQ(line_count(g.err), 1u) << g.err;
+    EXPECT_NE(g.err.find("garbage.vtu"), std::string::npos) << g.err;
+
+    // Raw bytes a message quotes from a binary file are shown as \xNN: the error stays one line of text.
+    const fs::path binary = dir / "binary.off";
+    { std::ofstream(binary, std::ios::binary) << "OFF\n9M\xff\x1b[2J\x07 1 2\n"; }
+    const auto b = run_waxwork("mesh " + binary.string() + " -o " + (dir / "b.vtu").string());
+    EXPECT_NE(b.exit_code, 0);
+    EXPECT_EQ(line_count(b.err), 1u) << b.err;
+    EXPECT_NE(b.err.find("binary.off"), std::string::npos) << b.err;
+    EXPECT_TRUE(std::all_of(b.err.begin(), b.err.end(), [](char c) { return c == '\n' || (c >= 0x20 && c < 0x7f); }))
+        << b.err;
+
+    // A stored material the file format allows but no solve can use (no scattering), and fracture
+    // pieces the volume cannot hold: the errors name the file.
+    TetMesh cube = testing::make_cube_mesh(3);
+    cube.materials.assign(cube.tet_count(), TetMaterial{{0.1, 0.1, 0.1}, {0, 1, 1}, 1.3});
+    const fs::path clear = dir / "clear.vtu";
+    write_volume(cube, clear);
+    const auto m = run_waxwork("render " + clear.string() + " -o " + (dir / "clear.png").string());
+    EXPECT_NE(m.exit_code, 0);
+    EXPECT_NE(m.err.find("clear.vtu: stored material of tet 0: mu_s'"), std::string::npos) << m.err;
+    const auto f = run_waxwork("fracture " + clear.string() + " -o " + (dir / "f.vtu").string() + " --pieces 100");
+    EXPECT_NE(f.exit_code, 0);
+    EXPECT_NE(f.err.find("clear.vtu: fracture: 100 pieces of a volume of 162 tets"), std::string::npos) << f.err;
+}
+
+TEST(Cli, MeshThenInfoOnTheEmbeddedCube) {
+    const auto dir = scratch_dir("cli_mesh");
+    const auto volume = dir / "cube.vtu";
+    const auto m = run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + volume.string() + " --max-tets 3000");
+    ASSERT_EQ(m.exit_code, 0) << m.err;
+    const auto summary = nlohmann::json::parse(m.out);
+    const double tets = summary["tets"];
+    EXPECT_GT(tets, 2400);
+    EXPECT_LT(tets, 3600);
+
+    const auto cells = dir / "cells.csv";
+    const auto i = run_waxwork("info " + volume.string() + " --cells " + cells.string());
+    ASSERT_EQ(i.exit_code, 0) << i.err;
+    const auto info = nlohmann::json::parse(i.out);
+    for (const char* key : {"vertices", "tets", "boundary_faces", "components", "min_dihedral_deg",
+                            "max_dihedral_deg", "volume", "bbox"})
+        EXPECT_TRUE(info.contains(key)) << key;
+    EXPECT_EQ(info["tets"], summary["tets"]);
+    EXPECT_EQ(info["components"], 1);
+    // cube.obj spans [-1, 1]^3 or similar: the volume equals the bbox volume for a box.
+    const auto lo = info["bbox"]["min"], hi = info["bbox"]["max"];
+    const double box = (double(hi[0]) - double(lo[0])) * (double(hi[1]) - double(lo[1])) * (double(hi[2]) - double(lo[2]));
+    EXPECT_NEAR(double(info["volume"]), box, 1e-6 * box);
+    EXPECT_GT(double(info["min_dihedral_deg"]), 0.0);
+
+    const std::string csv = testing::read_text(cells);
+    EXPECT_EQ(csv.substr(0, csv.find('\n')),
+              "cx,cy,cz,mua_r,mua_g,mua_b,musp_r,musp_g,musp_b,eta,original_id,piece,min_dihedral_deg");
+    EXPECT_EQ(line_count(csv), static_cast<size_t>(tets) + 1);
+}
+
+TEST(Cli, EveryVolumeFormatIsReadableByInfo) {
+    const auto dir = scratch_dir("cli_formats");
+    nlohmann::json reference;
+    for (const std::string ext : {"vtu", "msh", "mesh", "node"}) {
+        const auto volume = dir / ("torus." + ext);
+        const auto m = run_waxwork("mesh " + kAssets + "/meshes/torus.obj -o " + volume.string() + " --edge 0.2");
+        ASSERT_EQ(m.exit_code, 0) << ext << ": " << m.err;
+        const auto i = run_waxwork("info " + volume.string());
+        ASSERT_EQ(i.exit_code, 0) << ext << ": " << i.err;
+        auto info = nlohmann::json::parse(i.out);
+        EXPECT_EQ(info["components"], 1) << ext;
+        info.erase("file");
+        if (reference.is_null()) reference = info;
+        EXPECT_EQ(info["tets"], reference["tets"]) << ext;
+        EXPECT_EQ(info["vertices"], reference["vertices"]) << ext;
+        EXPECT_NEAR(double(info["volume"]), double(reference["volume"]), 1e-9) << ext;
+    }
+}
+
+TEST(Cli, BrokenSharedMeshesGiveClearErrors) {
+    if (!fs::exists(kShared + "/data/meshes")) GTEST_SKIP() << "../shared is not present";
+    const auto dir = scratch_dir("cli_bad");
+    struct Case {
+        std::string file, expected;
+    };
+    for (const Case& c : {Case{"bad_cow.obj", "81 self-intersecting triangle pairs"},
+                          Case{"bad_stanford-bunny.obj", "223 boundary edges"},
+                          Case{"horse.ply", "4 self-intersecting triangle pairs"}}) {
+        const auto r = run_waxwork("mesh " + kShared + "/data/meshes/" + c.file + " -o " + (dir / "x.vtu").string());
+        EXPECT_EQ(r.exit_code, 1) << c.file;
+        EXPECT_EQ(line_count(r.err), 1u) << r.err;
+        EXPECT_NE(r.err.find(c.file + ": "), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(dir / "x.vtu"));
+    }
+}
+
+TEST(Cli, AbsurdParametersAreRejected) {
+    const auto dir = scratch_dir("cli_absurd");
+    const std::string in = kAssets + "/meshes/cube.obj -o " + (dir / "x.vtu").string();
+    for (const std::string args : {" --edge -1", " --edge nan", " --max-tets 0", " --min-dihedral 80",
+                                   " --scale 0", " --scale 1e300", " --mua 0.1,0.1 --musp 1,1,1 --eta 1.3",
+                                   " --mua -1,0,0 --musp 1,1,1 --eta 1.3", " --material unobtainium"}) {
+        const auto r = run_waxwork("mesh " + in + args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_EQ(line_count(r.err), 1u) << args << ": " << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir / "x.vtu"));
+    // A negative count is refused as such, not read into an unsigned option as 2^64 - 1.
+    for (const std::string& command : {"mesh " + in, "bench solvers --mesh " + kAssets + "/meshes/cube.obj -o " + dir.string()}) {
+        const auto r = run_waxwork(command + " --max-tets=-1");
+        EXPECT_NE(r.exit_code, 0) << command;
+        EXPECT_NE(r.err.find("--max-tets: must be a positive whole number"), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("18446744073709551615"), std::string::npos) << r.err;
+    }
+}
+
+// A size the mesher refuses for this surface is reported with the surface file's name: spot's
+// triangles, which TetGen keeps, need more than 3,000 tets.
+TEST(Cli, AMeshingRefusalNamesTheSurfaceFile) {
+    const auto dir = scratch_dir("cli_refusal");
+    const std::string surface = kAssets + "/meshes/spot.obj";
+    const auto r = run_waxwork("mesh " + surface + " -o " + (dir / "x.vtu").string() + " --max-tets 3000");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(surface + ": meshing option sizing.target_tets = 3000"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "x.vtu"));
+}
+
+}  // namespace
+}  // namespace waxwork

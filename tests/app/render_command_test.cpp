@@ -1,0 +1,380 @@
+// `waxwork render` and `waxwork demo` end to end: the binary meshes, solves, renders and writes files.
+#include "io/image_io.h"
+#include "solver/shading_surface.h"
+#include "support/cli_run.h"
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace waxwork {
+namespace {
+
+using testing::run_waxwork;
+using testing::scratch_dir;
+namespace fs = std::filesystem;
+
+const std::string kAssets = WAXWORK_ASSET_DIR;
+constexpr const char* kHeader = "x,y,z,boundary,q_r,q_g,q_b,phi_r,phi_g,phi_b,lo_r,lo_g,lo_b";
+
+using testing::line_count;
+
+struct FieldRow {
+    double x, y, z;
+    bool boundary;
+    std::array<double, 3> q, phi, lo;
+};
+
+struct Fields {
+    std::string header;
+    std::vector<FieldRow> rows;
+    bool all_finite = true;
+};
+
+Fields read_fields(const fs::path& path) {
+    std::ifstream in(path);
+    Fields fields;
+    std::getline(in, fields.header);
+    std::string line;
+    while (std::getline(in, line)) {
+        std::vector<double> v;
+        std::stringstream s(line);
+        std::string item;
+        while (std::getline(s, item, ',')) {
+            // strtod accepts "nan" and "inf", which is what the test must catch.
+            v.push_back(std::strtod(item.c_str(), nullptr));
+            if (!std::isfinite(v.back())) fields.all_finite = false;
+        }
+        if (v.size() != 13) {
+            ADD_FAILURE() << "row with " << v.size() << " columns: " << line;
+            continue;
+        }
+        fields.rows.push_back({v[0], v[1], v[2], v[3] != 0, {v[4], v[5], v[6]}, {v[7], v[8], v[9]}, {v[10], v[11], v[12]}});
+    }
+    return fields;
+}
+
+// Mean lo per channel over boundary vertices whose coordinate `axis` is within 5% of the box of `bound`.
+std::array<double, 3> mean_lo_near(const Fields& f, int axis, bool at_max) {
+    double lo = 1e300, hi = -1e300;
+    for (const auto& r : f.rows) {
+        const double c = axis == 0 ? r.x : axis == 1 ? r.y : r.z;
+        lo = std::min(lo, c);
+        hi = std::max(hi, c);
+    }
+    const double cut = 0.05 * (hi - lo);
+    std::array<double, 3> sum{};
+    int count = 0;
+    for (const auto& r : f.rows) {
+        const double c = axis == 0 ? r.x : axis == 1 ? r.y : r.z;
+        if (!r.boundary || (at_max ? c < hi - cut : c > lo + cut)) continue;
+        for (int k = 0; k < 3; ++k) sum[k] += r.lo[k];
+        ++count;
+    }
+    EXPECT_GT(count, 0);
+    for (double& s : sum) s /= std::max(count, 1);
+    return sum;
+}
+
+std::array<double, 3> mean_lo(const Fields& f) {
+    std::array<double, 3> sum{};
+    int count = 0;
+    for (const auto& r : f.rows) {
+        if (!r.boundary) continue;
+        for (int k = 0; k < 3; ++k) sum[k] += r.lo[k];
+        ++count;
+    }
+    for (double& s : sum) s /= std::max(count, 1);
+    return sum;
+}
+
+// One cube volume for the whole suite (meshing is the slow part).
+class Render : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        dir_ = scratch_dir("render_command");
+        volume_ = dir_ / "cube.vtu";
+        const auto m = run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + volume_.string() + " --max-tets 5000");
+        ASSERT_EQ(m.exit_code, 0) << m.err;
+        const auto i = run_waxwork("info " + volume_.string());
+        ASSERT_EQ(i.exit_code, 0) << i.err;
+        vertices_ = nlohmann::json::parse(i.out)["vertices"];
+    }
+    static fs::path dir_, volume_;
+    static size_t vertices_;
+};
+fs::path Render::dir_, Render::volume_;
+size_t Render::vertices_ = 0;
+
+TEST_F(Render, MarbleLitFromPlusXIsBrighterOnThePlusXSide) {
+    const fs::path image = dir_ / "marble.png", fields = dir_ / "marble.csv";
+    // The cube spans 2 model units: at 10 mm per unit it is 2 cm of marble, several diffusion lengths.
+    const auto r = run_waxwork("render " + volume_.string() + " -o " + image.string() +
+                               " --material marble --light dir:-1,0,0 --scale 10 --width 160 --height 120 --fields " +
+                               fields.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto summary = nlohmann::json::parse(r.out);
+    EXPECT_EQ(summary["vertices"], vertices_);
+    for (const char* key : {"tets", "iterations", "estimated_error", "assembly_ms", "solve_ms", "lighting_ms",
+                            "render_ms", "output", "exposure"})
+        EXPECT_TRUE(summary.contains(key)) << key;
+
+    const Image png = read_png(image);
+    ASSERT_EQ(png.width, 160);
+    ASSERT_EQ(png.height, 120);
+    int bright = 0;
+    for (int y = 0; y < png.height; ++y)
+        for (int x = 0; x < png.width; ++x) bright += png.pixel(x, y)[0] > 80;
+    EXPECT_GT(bright, png.width * png.height / 20) << "the image is (nearly) black";
+
+    const Fields f = read_fields(fields);
+    EXPECT_EQ(f.header, kHeader);
+    EXPECT_EQ(f.rows.size(), vertices_);
+    EXPECT_TRUE(f.all_finite);
+    const auto lit = mean_lo_near(f, 0, true), dark = mean_lo_near(f, 0, false);
+    for (int c = 0; c < 3; ++c) EXPECT_GT(lit[c], 3 * dark[c]) << "channel " << c;
+    // Interior vertices carry no q or lo; every q and lo is non-negative.
+    for (const auto& row : f.rows) {
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_GE(row.lo[c], 0);
+            EXPECT_GE(row.q[c], 0);
+            if (!row.boundary) {
+                EXPECT_EQ(row.q[c], 0);
+                EXPECT_EQ(row.lo[c], 0);
+            }
+        }
+    }
+}
+
+TEST_F(Render, FemAgreesWithTransCut) {
+    // Marble at 10 mm per unit: the diffusion length (3.9-8.5 mm) spans several edges (about 1.2 mm),
+    // where the two discretisations must agree; on an under-resolved mesh they legitimately differ.
+    const std::string common = volume_.string() + " --material marble --light dir:-1,-0.5,-0.2 --scale 10 "
+                                                  "--width 64 --height 48 --tol 1e-6";
+    const auto a = run_waxwork("render " + common + " -o " + (dir_ / "t.png").string() + " --fields " +
+                               (dir_ / "t.csv").string());
+    const auto b = run_waxwork("render " + common + " --method fem -o " + (dir_ / "f.png").string() + " --fields " +
+                               (dir_ / "f.csv").string());
+    ASSERT_EQ(a.exit_code, 0) << a.err;
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    const Fields t = read_fields(dir_ / "t.csv"), f = read_fields(dir_ / "f.csv");
+    ASSERT_EQ(t.rows.size(), f.rows.size());
+    // Lumped and consistent mass differ by O(h^2): compare phi in the energy-like mean over vertices.
+    for (int c = 0; c < 3; ++c) {
+        double diff = 0, norm = 0;
+        for (size_t v = 0; v < t.rows.size(); ++v) {
+            diff += std::abs(t.rows[v].phi[c] - f.rows[v].phi[c]);
+            norm += std::abs(t.rows[v].phi[c]);
+        }
+        ASSERT_GT(norm, 0);
+        EXPECT_LT(diff / norm, 0.05) << "channel " << c;
+    }
+}
+
+TEST_F(Render, GpuBackendAgreesWithTheCpuAndFallsBackWithAWarning) {
+    const std::string common = volume_.string() + " --material marble --light dir:-1,-0.5,-0.2 --scale 10 "
+                                                  "--width 64 --height 48";
+    const auto cpu = run_waxwork("render " + common + " --tol 1e-8 -o " + (dir_ / "c.png").string() + " --fields " +
+                                 (dir_ / "c.csv").string());
+    const auto gpu = run_waxwork("render " + common + " --tol 1e-5 --backend gpu -o " + (dir_ / "g.png").string() +
+                                 " --fields " + (dir_ / "g.csv").string());
+    ASSERT_EQ(cpu.exit_code, 0) << cpu.err;
+    ASSERT_EQ(gpu.exit_code, 0) << gpu.err;
+    EXPECT_EQ(nlohmann::json::parse(cpu.out)["backend"], "cpu");
+    EXPECT_EQ(nlohmann::json::parse(gpu.out)["backend"], "gpu") << gpu.err;
+    EXPECT_TRUE(gpu.err.empty()) << gpu.err;
+    const Fields c = read_fields(dir_ / "c.csv"), g = read_fields(dir_ / "g.csv");
+    ASSERT_EQ(c.rows.size(), g.rows.size());
+    for (int ch = 0; ch < 3; ++ch) {
+        double diff = 0, peak = 0;
+        for (size_t v = 0; v < c.rows.size(); ++v) {
+            diff = std::max(diff, std::abs(c.rows[v].phi[ch] - g.rows[v].phi[ch]));
+            peak = std::max(peak, std::abs(c.rows[v].phi[ch]));
+        }
+        ASSERT_GT(peak, 0);
+        EXPECT_LT(diff / peak, 1e-4) << "channel " << ch;
+    }
+
+    // A driver that rejects a shader: one warning line naming it, and the CPU result.
+    setenv("WAXWORK_GPU_FORCE_FAIL", "1", 1);
+    const auto fallback = run_waxwork("render " + common + " --backend gpu -o " + (dir_ / "f.png").string());
+    unsetenv("WAXWORK_GPU_FORCE_FAIL");
+    ASSERT_EQ(fallback.exit_code, 0) << fallback.err;
+    EXPECT_EQ(nlohmann::json::parse(fallback.out)["backend"], "cpu");
+    EXPECT_EQ(line_count(fallback.err), 1u) << fallback.err;
+    EXPECT_NE(fallback.err.find("warning: solving on the CPU instead"), std::string::npos) << fallback.err;
+    EXPECT_NE(fallback.err.find("failed to compile"), std::string::npos) << fallback.err;
+
+    // A tolerance float CG cannot reach: the CPU finishes in double from the GPU's phi, with one
+    // warning line, and reaches the CPU's answer.
+    const auto tight = run_waxwork("render " + common + " --tol 1e-12 --backend gpu -o " + (dir_ / "t.png").string() +
+                                   " --fields " + (dir_ / "t.csv").string());
+    ASSERT_EQ(tight.exit_code, 0) << tight.err;
+    EXPECT_EQ(nlohmann::json::parse(tight.out)["backend"], "cpu");
+    EXPECT_EQ(line_count(tight.err), 1u) << tight.err;
+    EXPECT_NE(tight.err.find("float CG on the GPU stopped at an estimated error of"), std::string::npos) << tight.err;
+    const Fields t = read_fields(dir_ / "t.csv");
+    for (int ch = 0; ch < 3; ++ch) {
+        double diff = 0, peak = 0;
+        for (size_t v = 0; v < c.rows.size(); ++v) {
+            diff = std::max(diff, std::abs(c.rows[v].phi[ch] - t.rows[v].phi[ch]));
+            peak = std::max(peak, std::abs(c.rows[v].phi[ch]));
+        }
+        EXPECT_LT(diff / peak, 1e-6) << "channel " << ch;
+    }
+}
+
+TEST_F(Render, StoredMaterialsAreUsedWithoutAMaterialOption) {
+    const fs::path ketchup = dir_ / "ketchup.vtu";
+    const auto m = run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + ketchup.string() +
+                               " --max-tets 3000 --material ketchup");
+    ASSERT_EQ(m.exit_code, 0) << m.err;
+    const std::string args = " --light dir:0,0,-1 --scale 10 --width 64 --height 48";
+    const auto k = run_waxwork("render " + ketchup.string() + " -o " + (dir_ / "k.png").string() + " --fields " +
+                               (dir_ / "k.csv").string() + args);
+    const auto w = run_waxwork("render " + ketchup.string() + " --material marble -o " + (dir_ / "w.png").string() +
+                               " --fields " + (dir_ / "w.csv").string() + args);
+    ASSERT_EQ(k.exit_code, 0) << k.err;
+    ASSERT_EQ(w.exit_code, 0) << w.err;
+    EXPECT_EQ(nlohmann::json::parse(k.out)["materials"], "stored");
+    const auto red = mean_lo(read_fields(dir_ / "k.csv")), white = mean_lo(read_fields(dir_ / "w.csv"));
+    ASSERT_GT(red[2], 0);
+    ASSERT_GT(white[2], 0);
+    EXPECT_GT(red[0] / red[2], 3 * white[0] / white[2]);
+}
+
+TEST_F(Render, BackLitThinSlabGlowsMoreThanAThickOne) {
+    // The same cube at two scales: 1 mm per unit (2 mm of skin) passes light through; 40 (8 cm) does not.
+    std::array<double, 2> back{};
+    for (int i = 0; i < 2; ++i) {
+        const fs::path fields = dir_ / ("slab" + std::to_string(i) + ".csv");
+        const auto r = run_waxwork("render " + volume_.string() + " --material skin1 --light dir:1,0,0 --scale " +
+                                   (i == 0 ? "1" : "40") + " --ambient 0 --width 32 --height 24 -o " +
+                                   (dir_ / "slab.png").string() + " --fields " + fields.string());
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const Fields f = read_fields(fields);
+        const auto far = mean_lo_near(f, 0, true), near = mean_lo_near(f, 0, false);
+        back[i] = far[0] / near[0];  // red: transmitted over reflected
+    }
+    EXPECT_GT(back[0], 10 * back[1]);
+}
+
+TEST_F(Render, PointLightInsideTheObjectLightsNothing) {
+    const fs::path fields = dir_ / "inside.csv";
+    const auto r = run_waxwork("render " + volume_.string() + " --light point:0,0,0 --ambient 0 --width 32 --height 24 -o " +
+                               (dir_ / "inside.png").string() + " --fields " + fields.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["lights_inside"], 1);
+    const Fields f = read_fields(fields);
+    EXPECT_TRUE(f.all_finite);
+    for (const auto& row : f.rows)
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(row.lo[c], 0);
+}
+
+// The cube's edges are creases: the summary counts the copies the image shades them with, and 180
+// degrees (one normal per vertex) makes none. The solve's light differs exactly along the edges, where
+// the split integrates each face's own light (source_light).
+TEST_F(Render, CreaseAngleSplitsTheCubesEdgesForTheImageAndTheSource) {
+    const std::string base = "render " + volume_.string() + " --width 64 --height 48 -o " + (dir_ / "crease.png").string();
+    const fs::path split_fields = dir_ / "split.csv", unsplit_fields = dir_ / "unsplit.csv";
+    const auto split = run_waxwork(base + " --fields " + split_fields.string());
+    const auto unsplit = run_waxwork(base + " --crease-angle 180 --fields " + unsplit_fields.string());
+    ASSERT_EQ(split.exit_code, 0) << split.err;
+    ASSERT_EQ(unsplit.exit_code, 0) << unsplit.err;
+    const auto a = nlohmann::json::parse(split.out), b = nlohmann::json::parse(unsplit.out);
+    EXPECT_EQ(a["crease_angle_deg"], kDefaultCreaseAngleDegrees);
+    EXPECT_GT(a["shading_copies"].get<int>(), 0);
+    EXPECT_EQ(b["shading_copies"], 0);
+
+    const Fields fa = read_fields(split_fields), fb = read_fields(unsplit_fields);
+    ASSERT_EQ(fa.rows.size(), fb.rows.size());
+    Eigen::AlignedBox3d box;
+    for (const auto& r : fa.rows) box.extend(Eigen::Vector3d(r.x, r.y, r.z));
+    size_t moved = 0;
+    for (size_t v = 0; v < fa.rows.size(); ++v) {
+        const FieldRow &ra = fa.rows[v], &rb = fb.rows[v];
+        const Eigen::Vector3d p(ra.x, ra.y, ra.z);
+        int faces = 0;  // the cube's faces the vertex lies on
+        for (int k = 0; k < 3; ++k)
+            faces += std::abs(p[k] - box.min()[k]) < 1e-6 * box.diagonal().norm() ||
+                     std::abs(p[k] - box.max()[k]) < 1e-6 * box.diagonal().norm();
+        if (ra.q != rb.q) {
+            ++moved;
+            EXPECT_GE(faces, 2) << "light moved off the edges at " << p.transpose();
+        }
+    }
+    EXPECT_GT(moved, 0u);
+}
+
+TEST_F(Render, BadInputIsAOneLineError) {
+    const fs::path image = dir_ / "bad.png";
+    const std::string base = "render " + volume_.string() + " -o " + image.string() + " --width 32 --height 24";
+    for (const std::string args :
+         {" --light dir:1,0", " --light spot:0,0,1", " --light dir:1,0,0:1,1", " --light dir:0,0,0",
+          " --light dir:1,0,0:-1,1,1", " --light dir:1,x,0", " --light point:1,2,3extra", " --material unobtainium",
+          " --mua 0.1,0.1,0.1 --musp 0,1,1 --eta 1.3", " --mua nan,0.1,0.1 --musp 1,1,1 --eta 1.3", " --tol nan",
+          " --width 0", " --height -5", " --width 20000", " --scale 0", " --scale -3", " --scale inf", " --scale 1e300",
+          " --method magic", " --view 0,0,0", " --exposure -1"}) {
+        const auto r = run_waxwork(base + args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_EQ(line_count(r.err), 1u) << args << ": " << r.err;
+        EXPECT_EQ(r.err.rfind("waxwork: ", 0), 0u) << r.err;
+    }
+    // Values whose squares overflow are refused by what they are, not by a solver failing on them.
+    for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+             {" --tol 1e-300", "--tol must be a relative tolerance in [1e-15, 1)"},
+             {" --ambient 1e308", "--ambient must be non-negative and at most 1e15"},
+             {" --light dir:1,0,0:1e308,1,1", "intensity must be non-negative and at most 1e15"},
+             {" --light dir:1,0,0:1e16,1,1", "intensity must be non-negative and at most 1e15"},
+             {" --light point:1e308,0,0", "position has a non-finite component or one beyond 1e100"},
+             {" --crease-angle 181", "--crease-angle must be between 0 and 180 degrees"},
+             {" --crease-angle nan", "--crease-angle must be between 0 and 180 degrees"},
+             {" --exposure 1e308", "--exposure must be positive and at most 1e30"}}) {
+        const auto r = run_waxwork(base + args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+    }
+    // The image is a PNG whatever its name says, so the name must say so (x.jpg held PNG data).
+    const fs::path jpg = image.parent_path() / "x.jpg";
+    const auto named_jpg = run_waxwork("render " + volume_.string() + " -o " + jpg.string() + " --width 32 --height 24");
+    EXPECT_NE(named_jpg.exit_code, 0);
+    EXPECT_NE(named_jpg.err.find(jpg.string() + ": the image must be a .png"), std::string::npos) << named_jpg.err;
+    EXPECT_FALSE(fs::exists(jpg));
+    // A huge view direction is still a direction.
+    EXPECT_EQ(run_waxwork(base + " --view 1e308,1e308,1e308").exit_code, 0);
+    fs::remove(image);
+    const auto light = run_waxwork(base + " --light dir:1,0");
+    EXPECT_NE(light.err.find("dir:1,0"), std::string::npos) << light.err;
+    EXPECT_FALSE(fs::exists(image));
+    const auto missing = run_waxwork("render " + (dir_ / "absent.vtu").string() + " -o " + image.string());
+    EXPECT_NE(missing.exit_code, 0);
+    EXPECT_NE(missing.err.find("absent.vtu"), std::string::npos) << missing.err;
+}
+
+TEST(Demo, WritesTheVolumeAndImages) {
+    const fs::path dir = scratch_dir("demo");
+    // Small images keep it quick; the mesh is the default marble-driven one the demo uses.
+    const auto r = run_waxwork("demo -o " + dir.string() + " --width 96 --height 72 --no-editor");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir / "spot.vtu"));
+    size_t images = 0;
+    for (const auto& entry : fs::directory_iterator(dir)) {
+        if (entry.path().extension() != ".png") continue;
+        ++images;
+        const Image png = read_png(entry.path());
+        EXPECT_EQ(png.width, 96);
+        EXPECT_EQ(png.height, 72);
+        EXPECT_NE(r.out.find(entry.path().string()), std::string::npos) << "not reported: " << entry.path();
+    }
+    EXPECT_GE(images, 4u);
+}
+
+}  // namespace
+}  // namespace waxwork
