@@ -6,10 +6,10 @@
 // built anew, hundreds of MB at 500K tets. glibc's malloc serves each block above its mmap threshold
 // (adaptive, at most 32 MiB) with a fresh mmap, unmaps it on free, and trims the heap top beyond 128
 // KiB, so the next edit first pays a page fault and the zeroing of every 4 KiB page it touches. On
-// the virtual machine measured here that is most of the setup's time: spot at 486,745 tets, plane
-// cut with the live scene's rebuild 599 -> 286 ms, multigrid setup 808 -> 192 ms, hierarchy build after
-// other work 248 -> 82 ms (docs/performance.md). With the policy, blocks up
-// to 1 GiB come from the heap and freed memory stays there for the next edit instead of going back to
+// the virtual machine measured here that is most of the setup's time (spot at 486,745 tets: the
+// plane cut with the live scene's rebuild, the multigrid setup and a hierarchy build after other work
+// take 2 to 4 times as long without the policy; docs/performance.md). With the policy, blocks up to
+// 1 GiB come from the heap and freed memory stays there for the next edit instead of going back to
 // the system.
 //
 // Cost: the process keeps up to 1 GiB of freed memory mapped (its resident size stays near its peak

@@ -122,8 +122,8 @@ struct LostConnections {
 // Per thread, tag[u] == i when u is adjacent to a "joiner" of i: a neighbour k of i that can join i to
 // its neighbours (retained; in the later passes, newly retained). A dropped pair (i, j) shares one
 // exactly when tag[j] == i. Tagging the rows of i's few joiners reads contiguous rows; intersecting
-// per-vertex lists of retained neighbours for every pair instead (the first version) reads two
-// scattered lists per pair and took 1.7x as long at 97K vertices.
+// per-vertex lists of retained neighbours for every pair instead reads two scattered lists per pair
+// and takes 1.7x as long at 97K vertices.
 // One selection keeps its tags through all its tests: a tag left by an earlier test names a joiner
 // that is still retained (the retained set only grows), so it can only say "joined", which stays true.
 class JoinedTags {

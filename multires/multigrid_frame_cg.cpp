@@ -20,7 +20,7 @@ constexpr int kMinUpdatesToHalve = 10;
 // convergence without another V-cycle. The drift is measured in the D^-1 norm, which weighs the
 // rounding noise of a float residual more than the estimate's B norm does, so it is no bound, only a
 // filter, set from measurements on the GPU: a frame's 1e-2 claim on a well-shaped cube moved r by
-// about 6e-4 (kept: the claim held), a 1e-4 claim on 1e-5 slivers that was 2x off by 1.6e-2.
+// about 6e-4 (and the claim held), a 1e-4 claim on 1e-5 slivers that was 2x off by 1.6e-2.
 constexpr double kTrustedResidualDrift = 1e-3;
 
 }  // namespace

@@ -23,7 +23,7 @@ GLuint groups_for(size_t count) {
 // Why no shared-memory tree: llvmpipe runs each barrier() as a switch through all 256 invocations of
 // a workgroup (coroutines). On spot at 50K tets (13K vertices) a three-channel dot took 4.4 ms with a
 // binary tree (8 barriers), 2.3 ms with a 16 x 16 fold (2 barriers) and 0.5 ms with no barrier at all,
-// as here (bench/gpu_solver_bench.cpp, BM_GpuDot; the product went from 13 to 3 ms). On a GPU the
+// as here (bench/gpu_solver_bench.cpp, BM_GpuDot; the matrix product likewise). On a GPU the
 // price is a few MB of writes at most (512 x 256 x 6 floats) and one more small dispatch.
 const char* kPrelude = R"(#version 430
 layout(local_size_x = 256) in;
