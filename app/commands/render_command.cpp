@@ -6,19 +6,17 @@
 #include "io/volume_file.h"
 #include "render/render_input.h"
 #include "render/view_modes.h"
+#include "render/volume_render.h"
 #include "scene/fields_csv.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/light_spec.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
 #include "solver/solved_scene.h"
-#include "tetops/connectivity.h"
-#include "tetops/point_location.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -107,45 +105,28 @@ void run_render_command(const RenderCommandOptions& o) {
     lighting.ambient = {o.ambient, o.ambient, o.ambient};
     const std::optional<TetMaterial> chosen = chosen_material(o.material);
 
-    const TetMesh mesh = read_volume(o.volume);
-    if (mesh.tet_count() == 0) throw InvalidArgumentError(o.volume + ": the volume has no tets to render");
-    const TetConnectivity connectivity = build_connectivity(mesh);
-    // A stored material no solve can use is the file's problem.
-    const std::vector<TetMaterial> materials = naming_context(o.volume, [&] { return resolve_materials(mesh, chosen); });
+    VolumeRenderSettings settings;
+    settings.material = chosen;
+    settings.lighting = lighting;
+    settings.diffusion.discretization = o.method == "fem" ? Discretization::Fem : Discretization::TransCut;
+    settings.diffusion.mm_per_unit = o.scale;
+    settings.diffusion.relative_tolerance = o.tolerance;
+    if (o.backend == "gpu") settings.diffusion.backend = SolverBackend::Gpu;
+    settings.crease_angle_degrees = o.crease_angle;
+    settings.image.width = o.width;
+    settings.image.height = o.height;
+    settings.image.camera = camera_for_view(o.view);
+    if (o.exposure) settings.image.exposure = static_cast<float>(*o.exposure);
+    settings.view = view;
 
-    // One OpenGL context for the GPU solve and the renderer (the same device).
-    HeadlessGlContext context;
-    DiffusionOptions diffusion;
-    diffusion.discretization = o.method == "fem" ? Discretization::Fem : Discretization::TransCut;
-    diffusion.mm_per_unit = o.scale;
-    diffusion.relative_tolerance = o.tolerance;
-    if (o.backend == "gpu") {
-        diffusion.backend = SolverBackend::Gpu;
-        diffusion.gl = &context.gl();
-    }
-    const SolvedScene scene = solve_scene(mesh, connectivity, materials, lighting, diffusion, o.crease_angle);
+    const TetMesh mesh = read_volume(o.volume);
+    const VolumeRender render = render_volume(mesh, o.volume, settings);
+    const SolvedScene& scene = render.scene;
     if (!scene.diffusion.gpu_fallback_reason.empty())
         std::cerr << "warning: solving on the CPU instead: " << scene.diffusion.gpu_fallback_reason << "\n";
+    write_png(render.image, o.output);
+    if (!o.fields.empty()) write_fields_csv(o.fields, mesh, render.connectivity, scene);
 
-    const auto render_start = std::chrono::steady_clock::now();
-    ImageSettings settings;
-    settings.width = o.width;
-    settings.height = o.height;
-    settings.camera = camera_for_view(o.view);
-    if (o.exposure) settings.exposure = static_cast<float>(*o.exposure);
-    SurfaceRenderInput input = make_render_input(mesh, scene, lighting, settings);
-    const ViewGeometry view_geometry = build_view_geometry(mesh, connectivity, materials, scene, view);
-    apply_view(view_geometry, input);
-    SurfaceRenderer renderer(context.gl());
-    const Image image = render_scene(renderer, input);
-    const double render_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - render_start).count();
-    write_png(image, o.output);
-    if (!o.fields.empty()) write_fields_csv(o.fields, mesh, connectivity, scene);
-
-    size_t lights_inside = 0;
-    for (const Light& light : lighting.lights)
-        lights_inside += light.type == LightType::Point && point_inside_volume(mesh, light.vector);
     const DiffusionSolution& s = scene.diffusion;
     nlohmann::ordered_json summary = {
         {"output", o.output},
@@ -156,19 +137,19 @@ void run_render_command(const RenderCommandOptions& o) {
         {"backend", s.backend == SolverBackend::Gpu ? "gpu" : "cpu"},
         {"mm_per_unit", o.scale},
         {"lights", lighting.lights.size()},
-        {"lights_inside", lights_inside},
+        {"lights_inside", render.lights_inside},
         {"iterations", s.iterations},
         {"estimated_error", s.estimated_relative_error},
-        {"exposure", input.exposure},
+        {"exposure", render.exposure},
         {"crease_angle_deg", o.crease_angle},
         {"shading_copies", scene.shading.size() - scene.surface.vertices.size()},
         {"lighting_ms", scene.lighting_ms},
         {"assembly_ms", s.assembly_ms},
         {"solve_ms", s.solve_ms},
-        {"render_ms", render_ms},
+        {"render_ms", render.render_ms},
         {"view", view_mode_name(view.mode)},
     };
-    if (view.mode != ViewMode::Radiance) summary["legend"] = view_geometry.legend.title;
+    if (view.mode != ViewMode::Radiance) summary["legend"] = render.view.legend.title;
     if (!o.fields.empty()) summary["fields"] = o.fields;
     std::cout << summary.dump() << "\n";
 }

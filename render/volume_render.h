@@ -1,0 +1,47 @@
+// One picture of a volume: its materials resolved, the light solved (on the CPU, or on the GPU in the
+// picture's own OpenGL context, one device for both), the view applied and the image drawn. What
+// `waxwork render` does between reading its options and writing its files.
+#pragma once
+
+#include "io/image_io.h"
+#include "render/render_input.h"
+#include "render/view_modes.h"
+#include "solver/diffusion_solve.h"
+#include "solver/lighting.h"
+#include "solver/shading_surface.h"
+#include "solver/solved_scene.h"
+#include "tetops/connectivity.h"
+#include "tetops/tet_mesh.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace waxwork {
+
+struct VolumeRenderSettings {
+    std::optional<TetMaterial> material;  // every tet's, when given (resolve_materials)
+    Lighting lighting;
+    // backend Gpu: solved in the picture's context; `gl` is then set here and must be left null.
+    DiffusionOptions diffusion;
+    double crease_angle_degrees = kDefaultCreaseAngleDegrees;
+    ImageSettings image;
+    ViewOptions view;
+};
+
+struct VolumeRender {
+    TetConnectivity connectivity;
+    std::vector<TetMaterial> materials;
+    SolvedScene scene;
+    ViewGeometry view;  // the view's colours, overlays and legend (empty for the radiance view)
+    Image image;
+    float exposure = 1;    // the one the image was drawn with
+    double render_ms = 0;  // the renderer's input, the view and the drawing
+    size_t lights_inside = 0;  // point lights inside the volume (they light nothing)
+};
+
+// Throws InvalidArgumentError for an empty volume or bad settings; errors about the volume's own
+// data (stored materials no solve can use) name `volume_name`.
+VolumeRender render_volume(const TetMesh& mesh, const std::string& volume_name, const VolumeRenderSettings& settings);
+
+}  // namespace waxwork
