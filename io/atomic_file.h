@@ -24,9 +24,15 @@ using FileWriter = std::pair<std::filesystem::path, std::function<void(std::ostr
 
 // Several files that belong together (TetGen's .node and .ele): every temporary is written and
 // synced before the first rename, so a failure while producing any of them leaves all targets intact,
-// and so does a target that is a directory (refused before the first rename). Each file is replaced
-// atomically; the set as a whole is not (a crash or an I/O error between two renames can leave one
-// new and one old file), which no POSIX file system can offer.
+// and so does a target that is a directory (refused before the first rename). The old content of each
+// existing target is kept aside (a hard link, else a copy) until all are replaced: when a later rename
+// fails (an immutable file, a full directory), the files already replaced are put back and the error
+// names the file that failed. Each file is replaced atomically; the set as a whole survives any
+// failure the process sees, but not a crash between two renames (no POSIX file system offers that),
+// which can leave one new and one old file beside a hidden .NAME.bak-* copy of the old one.
+//
+// Both functions first remove the hidden temporaries and backups of the same targets left by
+// processes that no longer run (killed during a save).
 void write_files_atomically(const std::vector<FileWriter>& files);
 
 }  // namespace waxwork

@@ -10,7 +10,12 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <linux/fs.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstring>
@@ -524,6 +529,61 @@ TEST_F(VolumeFileTest, AtomicWriteOfSeveralFilesChecksEveryTargetBeforeReplacing
     EXPECT_NE(message.find("directory"), std::string::npos) << message;
     EXPECT_EQ(read_text(path("v.node")), node_before);
     EXPECT_EQ(file_count(), 2u) << "a temporary file was left";
+}
+
+// Sets or clears the immutable flag (chattr +i): a file even root cannot replace. False where the
+// file system or the process's privileges do not allow it.
+bool set_immutable(const fs::path& file, bool immutable) {
+    const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return false;
+    int flags = 0;
+    bool ok = ::ioctl(fd, FS_IOC_GETFLAGS, &flags) == 0;
+    if (ok) {
+        flags = immutable ? (flags | FS_IMMUTABLE_FL) : (flags & ~FS_IMMUTABLE_FL);
+        ok = ::ioctl(fd, FS_IOC_SETFLAGS, &flags) == 0;
+    }
+    ::close(fd);
+    return ok;
+}
+
+// The .ele of a pair cannot be replaced after the .node was: the .node is put back, so the pair on
+// disk is still the old, consistent one, and the error names the .ele.
+TEST_F(VolumeFileTest, APairWhoseSecondFileCannotBeReplacedKeepsTheOldPair) {
+    const TetMesh old_mesh = make_test_mesh();
+    write_volume(old_mesh, path("v.node"));
+    const std::string node_before = read_text(path("v.node"));
+    if (!set_immutable(path("v.ele"), true)) GTEST_SKIP() << "cannot make a file immutable here (needs root on ext4)";
+    TetMesh new_mesh = old_mesh;
+    for (Eigen::Vector3d& p : new_mesh.positions) p *= 2;
+    const std::string message = error_of([&] { write_volume(new_mesh, path("v.node")); });
+    ASSERT_TRUE(set_immutable(path("v.ele"), false));
+    EXPECT_NE(message.find("v.ele"), std::string::npos) << message;
+    EXPECT_EQ(read_text(path("v.node")), node_before);
+    EXPECT_EQ(read_volume(path("v.node")).positions, old_mesh.positions);
+    EXPECT_EQ(file_count(), 2u) << "a temporary or a backup was left";
+    write_volume(new_mesh, path("v.node"));  // and once the .ele can be replaced, both are
+    EXPECT_EQ(read_volume(path("v.node")).positions, new_mesh.positions);
+    EXPECT_EQ(file_count(), 2u);
+}
+
+// Hidden temporaries and backups of a target left by a process that was killed during a save are
+// removed by the next save to that target; a live process's are not, nor other files' ones.
+TEST_F(VolumeFileTest, ASaveRemovesTheTemporariesOfKilledSaves) {
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) ::_exit(0);
+    ASSERT_EQ(::waitpid(child, nullptr, 0), child);
+    const std::string dead = std::to_string(child), live = std::to_string(::getppid());
+    write_text(path(".v.vtu.tmp-" + dead + "-0-1"), "half a volume");
+    write_text(path(".v.vtu.bak-" + dead + "-2-3"), "an old volume");
+    write_text(path(".v.vtu.tmp-" + live + "-0-1"), "another process's save in progress");
+    write_text(path(".w.vtu.tmp-" + dead + "-0-1"), "another file's leftover");
+    write_volume(make_test_mesh(), path("v.vtu"));
+    EXPECT_FALSE(fs::exists(path(".v.vtu.tmp-" + dead + "-0-1")));
+    EXPECT_FALSE(fs::exists(path(".v.vtu.bak-" + dead + "-2-3")));
+    EXPECT_TRUE(fs::exists(path(".v.vtu.tmp-" + live + "-0-1")));
+    EXPECT_TRUE(fs::exists(path(".w.vtu.tmp-" + dead + "-0-1")));
+    EXPECT_EQ(file_count(), 3u);
 }
 
 // A pipe (or a device) is refused by name instead of blocking the reader.
