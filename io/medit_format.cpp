@@ -83,8 +83,16 @@ TetMesh parse_medit(std::string_view contents, const std::string& file) {
                 scanner.next_integer("tetrahedron ref");
                 tets.push_back(tet);
             }
+        } else if (same_keyword(keyword, "Hexahedra") || same_keyword(keyword, "Prisms") ||
+                   same_keyword(keyword, "Pyramids")) {
+            // Other volume elements: skipping them would drop part of the volume silently.
+            const int64_t count = scanner.next_integer("number of elements");
+            if (count != 0)
+                scanner.fail("contains " + std::to_string(count) + " " + std::string(keyword) +
+                             "; Waxwork reads volumes of tetrahedra only (split them into tetrahedra first)");
         } else {
-            // Unknown section: its entries are numbers, so skip up to the next keyword.
+            // Surface and other sections (Triangles, Edges, Corners, ...): their entries are numbers,
+            // so skip up to the next keyword.
             while (!scanner.at_end() && !is_keyword(scanner.peek_token())) scanner.next_token("number");
         }
     }

@@ -275,10 +275,30 @@ private:
     throw FileError(file, problem);
 }
 
-pugi::xml_node find_array(const pugi::xml_node& parent, std::string_view name) {
-    for (const pugi::xml_node& array : parent.children("DataArray"))
-        if (name == array.attribute("Name").value()) return array;
-    return {};
+// The DataArray of `parent` called `name`, or a null node. Two arrays of one name are refused: which
+// one a program reads is arbitrary, so the file is ambiguous.
+pugi::xml_node find_array(const pugi::xml_node& parent, std::string_view name, const std::string& file) {
+    pugi::xml_node found;
+    for (const pugi::xml_node& array : parent.children("DataArray")) {
+        if (name != array.attribute("Name").value()) continue;
+        if (found) fail_file(file, std::string(parent.name()) + " has two DataArrays named '" + std::string(name) + "'");
+        found = array;
+    }
+    return found;
+}
+
+// VTK cell types that fill a volume (linear and higher-order hexahedra, wedges, pyramids, polyhedra,
+// quadratic tetrahedra): a file holding one describes a volume Waxwork would read only in part.
+bool is_volume_cell_type(uint8_t type) {
+    switch (type) {
+        case 11: case 12: case 13: case 14: case 15: case 16:  // voxel .. hexagonal prism
+        case 24: case 25: case 26: case 27: case 29: case 32: case 33:  // quadratic 3D cells
+        case 42:  // polyhedron
+        case 71: case 72: case 73: case 74:  // Lagrange 3D cells
+            return true;
+        default:
+            return false;
+    }
 }
 
 }  // namespace
@@ -381,6 +401,8 @@ TetMesh parse_vtu(std::string contents, const std::string& file) {
     const uint64_t n_cells = reader.parse_count(piece.attribute("NumberOfCells").value(), "NumberOfCells");
 
     std::vector<double> coordinates;
+    const auto point_arrays = piece.child("Points").children("DataArray");
+    if (std::distance(point_arrays.begin(), point_arrays.end()) > 1) fail_file(file, "Points has more than one DataArray");
     if (const pugi::xml_node points = piece.child("Points").child("DataArray")) {
         coordinates = reader.read<double>(points, 3, n_points);
     } else if (n_points > 0) {
@@ -394,9 +416,9 @@ TetMesh parse_vtu(std::string contents, const std::string& file) {
     coordinates = {};
 
     const pugi::xml_node cells = piece.child("Cells");
-    const pugi::xml_node offsets_node = find_array(cells, "offsets");
-    const pugi::xml_node connectivity_node = find_array(cells, "connectivity");
-    const pugi::xml_node types_node = find_array(cells, "types");
+    const pugi::xml_node offsets_node = find_array(cells, "offsets", file);
+    const pugi::xml_node connectivity_node = find_array(cells, "connectivity", file);
+    const pugi::xml_node types_node = find_array(cells, "types", file);
     if (n_cells > 0 && (!offsets_node || !connectivity_node || !types_node)) {
         fail_file(file, "Cells needs DataArrays 'connectivity', 'offsets' and 'types'");
     }
@@ -421,17 +443,36 @@ TetMesh parse_vtu(std::string contents, const std::string& file) {
             }
         }
     }
-    auto cell_is_tet = [&](size_t c) {
-        const int64_t begin = c == 0 ? 0 : offsets[c - 1];
-        return types[c] == kVtkTetra && offsets[c] - begin == 4;
+    auto cell_points = [&](size_t c) { return offsets[c] - (c == 0 ? 0 : offsets[c - 1]); };
+    auto cell_is_tet = [&](size_t c) { return types[c] == kVtkTetra && cell_points(c) == 4; };
+    // Why a cell is not a tetrahedron (read only where it must be one).
+    auto not_a_tet = [&](size_t c) {
+        const std::string cell = "cell " + std::to_string(c);
+        if (types[c] == kVtkTetra)
+            return cell + " is a tetrahedron (VTK type 10) with " + std::to_string(cell_points(c)) +
+                   " points in 'offsets'; a tetrahedron has 4";
+        return cell + " is not a tetrahedron (VTK type " + std::to_string(types[c]) + ")";
     };
 
     const pugi::xml_node field_data = grid.child("FieldData");
-    const pugi::xml_node version_node = find_array(field_data, "waxwork_format_version");
+    const pugi::xml_node version_node = find_array(field_data, "waxwork_format_version", file);
     if (!version_node) {
-        // A .vtu from another program: geometry of its tetrahedra only.
+        // A file with Waxwork's own arrays but no version is a damaged Waxwork file, not another
+        // program's: reading its geometry alone would drop its materials and pieces silently.
+        for (const char* name : {"piece", "original_id", "mua"})
+            if (find_array(piece.child("CellData"), name, file))
+                fail_file(file, std::string("has Waxwork's CellData '") + name +
+                                    "' but no FieldData 'waxwork_format_version' (a damaged Waxwork volume?)");
+        if (find_array(field_data, "piece_transforms", file))
+            fail_file(file, "has Waxwork's FieldData 'piece_transforms' but no 'waxwork_format_version' "
+                            "(a damaged Waxwork volume?)");
+        // A .vtu from another program: geometry of its tetrahedra only. Surface and line cells are
+        // dropped (they bound or annotate the volume); other volume cells are refused, since dropping
+        // them would drop part of the volume.
         std::vector<Tet> tets;
         for (size_t c = 0; c < n_cells; ++c) {
+            if (is_volume_cell_type(types[c]) || (types[c] == kVtkTetra && !cell_is_tet(c)))
+                fail_file(file, not_a_tet(c) + "; Waxwork reads volumes of linear tetrahedra only");
             if (!cell_is_tet(c)) continue;
             const size_t begin = static_cast<size_t>(offsets[c] - 4);
             tets.push_back({static_cast<int32_t>(connectivity[begin]), static_cast<int32_t>(connectivity[begin + 1]),
@@ -451,14 +492,13 @@ TetMesh parse_vtu(std::string contents, const std::string& file) {
     mesh.positions = std::move(positions);
     mesh.tets.resize(n_cells);
     for (size_t c = 0; c < n_cells; ++c) {
-        if (!cell_is_tet(c)) fail_file(file, "cell " + std::to_string(c) + " is not a tetrahedron (VTK type " +
-                                  std::to_string(types[c]) + ")");
+        if (!cell_is_tet(c)) fail_file(file, not_a_tet(c));
         const size_t begin = static_cast<size_t>(offsets[c] - 4);
         for (int k = 0; k < 4; ++k) mesh.tets[c][k] = static_cast<int32_t>(connectivity[begin + k]);
     }
     connectivity = {};
 
-    const pugi::xml_node transforms_node = find_array(field_data, "piece_transforms");
+    const pugi::xml_node transforms_node = find_array(field_data, "piece_transforms", file);
     if (!transforms_node) fail_file(file, "missing FieldData array 'piece_transforms'");
     const std::vector<double> transforms = reader.read<double>(transforms_node, 12, std::nullopt);
     mesh.piece_transforms.resize(transforms.size() / 12);
@@ -470,9 +510,9 @@ TetMesh parse_vtu(std::string contents, const std::string& file) {
     }
 
     const pugi::xml_node cell_data = piece.child("CellData");
-    const pugi::xml_node mua_node = find_array(cell_data, "mua");
-    const pugi::xml_node musp_node = find_array(cell_data, "musp");
-    const pugi::xml_node eta_node = find_array(cell_data, "eta");
+    const pugi::xml_node mua_node = find_array(cell_data, "mua", file);
+    const pugi::xml_node musp_node = find_array(cell_data, "musp", file);
+    const pugi::xml_node eta_node = find_array(cell_data, "eta", file);
     const int material_arrays = (mua_node ? 1 : 0) + (musp_node ? 1 : 0) + (eta_node ? 1 : 0);
     if (material_arrays != 0 && material_arrays != 3) {
         fail_file(file, "CellData has only some of the material arrays 'mua', 'musp', 'eta'");
@@ -491,8 +531,8 @@ TetMesh parse_vtu(std::string contents, const std::string& file) {
             material.eta = eta[t];
         }
     }
-    const pugi::xml_node original_node = find_array(cell_data, "original_id");
-    const pugi::xml_node piece_node = find_array(cell_data, "piece");
+    const pugi::xml_node original_node = find_array(cell_data, "original_id", file);
+    const pugi::xml_node piece_node = find_array(cell_data, "piece", file);
     if (!original_node || !piece_node) fail_file(file, "CellData needs arrays 'original_id' and 'piece'");
     mesh.original_ids = reader.read<int32_t>(original_node, 1, n_cells);
     mesh.piece_ids = reader.read<int32_t>(piece_node, 1, n_cells);

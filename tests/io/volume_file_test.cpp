@@ -348,6 +348,81 @@ TEST_F(VolumeFileTest, ErrorsNameTheFileAndTheProblem) {
     EXPECT_NE(error_of([&] { read_volume(path("missing.vtu")); }).find("missing.vtu"), std::string::npos);
 }
 
+// The same third-party file with other cells: volume cells that are not linear tetrahedra, and a
+// tetrahedron whose offsets give it the wrong number of points, are refused by name instead of
+// dropping part of the volume.
+TEST_F(VolumeFileTest, VtuVolumeCellsThatAreNotTetrahedraAreRefused) {
+    const auto with_cells = [](const std::string& connectivity, const std::string& offsets, const std::string& types) {
+        return std::string(R"(<?xml version="1.0"?>
+<VTKFile type="UnstructuredGrid" version="0.1" byte_order="LittleEndian">
+  <UnstructuredGrid>
+    <Piece NumberOfPoints="8" NumberOfCells="2">
+      <Points><DataArray type="Float32" NumberOfComponents="3" format="ascii">
+        0 0 0  1 0 0  1 1 0  0 1 0  0 0 1  1 0 1  1 1 1  0 1 1
+      </DataArray></Points>
+      <Cells>
+        <DataArray type="Int32" Name="connectivity" format="ascii">)") + connectivity + R"(</DataArray>
+        <DataArray type="Int32" Name="offsets" format="ascii">)" + offsets + R"(</DataArray>
+        <DataArray type="UInt8" Name="types" format="ascii">)" + types + R"(</DataArray>
+      </Cells>
+    </Piece>
+  </UnstructuredGrid>
+</VTKFile>
+)";
+    };
+    EXPECT_EQ(parse_vtu(with_cells("0 1 3 4  0 1 2", "4 7", "10 5"), "tet.vtu").tet_count(), 1u);
+    const std::string hexahedron =
+        error_of([&] { parse_vtu(with_cells("0 1 3 4  0 1 2 3 4 5 6 7", "4 12", "10 12"), "hex.vtu"); });
+    EXPECT_NE(hexahedron.find("hex.vtu: cell 1 is not a tetrahedron (VTK type 12)"), std::string::npos) << hexahedron;
+    EXPECT_NE(hexahedron.find("tetrahedra only"), std::string::npos) << hexahedron;
+    const std::string five_points =
+        error_of([&] { parse_vtu(with_cells("0 1 3 4 5  0 1 2", "5 8", "10 5"), "offsets.vtu"); });
+    EXPECT_NE(five_points.find("cell 0 is a tetrahedron (VTK type 10) with 5 points"), std::string::npos)
+        << five_points;
+}
+
+// A Waxwork file with a DataArray given twice is ambiguous; one whose version array was lost is a
+// damaged Waxwork file, not another program's geometry (which would silently drop its materials).
+TEST_F(VolumeFileTest, VtuDuplicateArraysAndALostVersionAreRefused) {
+    TetMesh mesh = make_test_mesh();
+    mesh.materials.assign(mesh.tet_count(), TetMaterial{{0.1, 0.1, 0.1}, {1, 1, 1}, 1.3});
+    std::ostringstream out;
+    format_vtu(mesh, out);
+    const std::string text = out.str();
+    ASSERT_EQ(parse_vtu(text, "ok.vtu").materials, mesh.materials);
+
+    std::string twice = text;
+    const size_t begin = twice.find("<DataArray type=\"Float64\" Name=\"eta\"");
+    ASSERT_NE(begin, std::string::npos);
+    const size_t end = twice.find("</DataArray>", begin) + std::string("</DataArray>").size();
+    twice.insert(end, twice.substr(begin, end - begin));
+    const std::string duplicate = error_of([&] { parse_vtu(twice, "twice.vtu"); });
+    EXPECT_NE(duplicate.find("twice.vtu: CellData has two DataArrays named 'eta'"), std::string::npos) << duplicate;
+
+    std::string unversioned = text;
+    const size_t name = unversioned.find("Name=\"waxwork_format_version\"");
+    ASSERT_NE(name, std::string::npos);
+    unversioned.replace(name, std::string("Name=\"waxwork_format_version\"").size(), "Name=\"something_else\"");
+    const std::string lost = error_of([&] { parse_vtu(unversioned, "lost.vtu"); });
+    EXPECT_NE(lost.find("lost.vtu: has Waxwork's CellData"), std::string::npos) << lost;
+    EXPECT_NE(lost.find("waxwork_format_version"), std::string::npos) << lost;
+}
+
+// MEDIT files with hexahedra, prisms or pyramids are refused (their part of the volume would be lost);
+// an empty section of them is harmless.
+TEST_F(VolumeFileTest, MeditVolumeElementsOtherThanTetrahedraAreRefused) {
+    const std::string head = "MeshVersionFormatted 1\nDimension 3\nVertices\n5\n0 0 0 1\n1 0 0 1\n0 1 0 1\n"
+                             "0 0 1 1\n1 1 1 1\nTetrahedra\n1\n1 2 3 4 0\n";
+    EXPECT_EQ(parse_medit(head + "Hexahedra\n0\nEnd\n", "empty.mesh").tet_count(), 1u);
+    for (const std::string section : {"Hexahedra\n1\n1 2 3 4 5 1 2 3 0\n", "Prisms\n1\n1 2 3 4 5 1 0\n",
+                                      "Pyramids\n1\n1 2 3 4 5 0\n"}) {
+        const std::string message = error_of([&] { parse_medit(head + section + "End\n", "mixed.mesh"); });
+        EXPECT_NE(message.find("mixed.mesh"), std::string::npos) << message;
+        EXPECT_NE(message.find("contains 1 " + section.substr(0, section.find('\n'))), std::string::npos) << message;
+        EXPECT_NE(message.find("tetrahedra only"), std::string::npos) << message;
+    }
+}
+
 TEST_F(VolumeFileTest, VtuTruncatedBase64IsReported) {
     std::ostringstream out;
     format_vtu(make_test_mesh(), out);
