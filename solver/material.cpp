@@ -37,10 +37,6 @@ constexpr std::array<Preset, 12> kJensen2001 = {{
     {"wholemilk", {2.55, 3.21, 3.77}, {0.0011, 0.0024, 0.014}, 1.3},
 }};
 
-constexpr double kMaxCoefficientPerMm = 1e4;
-constexpr double kMinEta = 1.0;
-constexpr double kMaxEta = 3.0;
-constexpr std::array<char, 3> kChannelNames = {'r', 'g', 'b'};
 
 }  // namespace
 
@@ -93,24 +89,7 @@ void validate_mm_per_unit(double mm_per_unit, std::string_view what) {
 
 void validate_material(const TetMaterial& m, std::string_view context) {
     if (material_is_valid(m)) return;
-    auto fail = [&](const std::string& problem) {
-        throw InvalidArgumentError(std::string(context) + ": " + problem);
-    };
-    for (int c = 0; c < 3; ++c) {
-        const std::string channel = std::string(" (channel ") + kChannelNames[c] + ")";
-        const double mua = m.mua[c], musp = m.musp[c];
-        if (!std::isfinite(mua)) fail("mu_a is not finite" + channel);
-        if (!std::isfinite(musp)) fail("mu_s' is not finite" + channel);
-        if (mua < 0) fail("mu_a = " + number_text(mua) + " is negative" + channel);
-        if (musp <= 0)
-            fail("mu_s' = " + number_text(musp) +
-                 " must be positive (the diffusion approximation needs scattering)" + channel);
-        if (mua > kMaxCoefficientPerMm || musp > kMaxCoefficientPerMm)
-            fail("coefficient above 1e4 per mm" + channel + "; coefficients are per millimetre");
-    }
-    if (!std::isfinite(m.eta)) fail("eta is not finite");
-    if (m.eta < kMinEta || m.eta > kMaxEta)
-        fail("eta = " + number_text(m.eta) + " is outside [1, 3] (relative index of refraction)");
+    throw InvalidArgumentError(std::string(context) + ": " + material_problem(m));
 }
 
 std::vector<std::string> material_preset_names() {

@@ -95,21 +95,27 @@ private:
 // 1e300, near double's largest).
 constexpr double kMaxCoordinate = 1e100;
 
-// What is wrong with a stored material's numbers ("" when nothing): a non-finite or negative
-// coefficient, or an eta that is not a positive number.
-std::string material_number_problem(const TetMaterial& m) {
-    constexpr const char* kChannel[3] = {"red", "green", "blue"};
+}  // namespace
+
+std::string material_problem(const TetMaterial& m) {
+    constexpr std::array<char, 3> kChannelNames = {'r', 'g', 'b'};
     for (int c = 0; c < 3; ++c) {
-        if (!std::isfinite(m.mua[c]) || m.mua[c] < 0)
-            return std::string("mu_a (") + kChannel[c] + ") = " + number_text(m.mua[c]) + " is not a non-negative number";
-        if (!std::isfinite(m.musp[c]) || m.musp[c] < 0)
-            return std::string("mu_s' (") + kChannel[c] + ") = " + number_text(m.musp[c]) + " is not a non-negative number";
+        const std::string channel = std::string(" (channel ") + kChannelNames[c] + ")";
+        const double mua = m.mua[c], musp = m.musp[c];
+        if (!std::isfinite(mua)) return "mu_a is not finite" + channel;
+        if (!std::isfinite(musp)) return "mu_s' is not finite" + channel;
+        if (mua < 0) return "mu_a = " + number_text(mua) + " is negative" + channel;
+        if (musp <= 0)
+            return "mu_s' = " + number_text(musp) + " must be positive (the diffusion approximation needs scattering)" +
+                   channel;
+        if (mua > kMaxCoefficientPerMm || musp > kMaxCoefficientPerMm)
+            return "coefficient above 1e4 per mm" + channel + "; coefficients are per millimetre";
     }
-    if (!std::isfinite(m.eta) || !(m.eta > 0)) return "eta = " + number_text(m.eta) + " is not a positive number";
+    if (!std::isfinite(m.eta)) return "eta is not finite";
+    if (m.eta < kMinEta || m.eta > kMaxEta)
+        return "eta = " + number_text(m.eta) + " is outside [1, 3] (relative index of refraction)";
     return "";
 }
-
-}  // namespace
 
 std::vector<std::string> find_invariant_violations(const TetMesh& mesh) {
     ViolationLog log;
@@ -164,8 +170,9 @@ std::vector<std::string> find_invariant_violations(const TetMesh& mesh) {
             (mesh.piece_ids[t] < 0 || static_cast<size_t>(mesh.piece_ids[t]) >= mesh.piece_transforms.size()))
             log.add("piece", "tet " + std::to_string(t) + " has piece id " + std::to_string(mesh.piece_ids[t]) +
                                  " without a transform");
-        if (t < mesh.materials.size())
-            if (const std::string problem = material_number_problem(mesh.materials[t]); !problem.empty())
+        // Painted volumes hold few distinct materials in long runs: each run is checked once.
+        if (t < mesh.materials.size() && (t == 0 || !(mesh.materials[t] == mesh.materials[t - 1])))
+            if (const std::string problem = material_problem(mesh.materials[t]); !problem.empty())
                 log.add("material", "tet " + std::to_string(t) + "'s material: " + problem);
     }
     for (size_t v = 0; v < referenced.size(); ++v)

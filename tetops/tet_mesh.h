@@ -18,7 +18,8 @@ namespace waxwork {
 using Tet = std::array<int32_t, 4>;
 
 // Scattering coefficients of one tet, per rgb channel, in 1/mm (see solver/material.h for meaning).
-// Stored with the geometry so that painted volumes save and reload; tetops never interprets them.
+// Stored with the geometry so that painted volumes save and reload; tetops interprets them no further
+// than material_problem's range check.
 struct TetMaterial {
     std::array<double, 3> mua{};   // absorption coefficient mu_a
     std::array<double, 3> musp{};  // reduced scattering coefficient mu_s'
@@ -26,6 +27,19 @@ struct TetMaterial {
 
     friend bool operator==(const TetMaterial&, const TetMaterial&) = default;
 };
+
+// The materials the diffusion model can solve: finite coefficients per millimetre with mu_a >= 0 and
+// 0 < mu_s' (the diffusion approximation needs scattering), both at most kMaxCoefficientPerMm (larger
+// values are a unit error: per metre instead of per millimetre), and eta in [kMinEta, kMaxEta], where
+// the fit of the diffuse Fresnel reflectance (solver/material.h) holds. Stored materials must be in
+// this range (a TetMesh invariant), so whatever a reader accepts or a save writes can be rendered.
+inline constexpr double kMaxCoefficientPerMm = 1e4;
+inline constexpr double kMinEta = 1.0;
+inline constexpr double kMaxEta = 3.0;
+
+// What is wrong with `material` ("" when it is in the range above), e.g.
+// "mu_s' = 0 must be positive (the diffusion approximation needs scattering) (channel r)".
+std::string material_problem(const TetMaterial& material);
 
 // Rigid motion of one piece: x_world = rotation * x_rest + translation.
 struct RigidTransform {
@@ -77,8 +91,8 @@ std::array<Eigen::Vector3d, 2> bounding_box(const TetMesh& mesh);
 
 // Every broken invariant, described in one line each; empty when the mesh is valid. Checks array
 // sizes, index ranges, finite coordinates, positive orientation, distinct vertices per tet, piece ids,
-// unreferenced vertices, finite and non-negative materials, and that no face is shared by more than
-// two tets.
+// unreferenced vertices, materials in the model's range (material_problem), and that no face is
+// shared by more than two tets.
 std::vector<std::string> find_invariant_violations(const TetMesh& mesh);
 
 // Throws InvalidMeshError listing the first violations when find_invariant_violations is non-empty.

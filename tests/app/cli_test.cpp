@@ -1,9 +1,12 @@
 // The command-line contract: subcommands, --help, errors, and the mesh/info pipeline end to end.
 #include "io/volume_file.h"
+#include "io/vtu_format.h"
 #include "support/cli_run.h"
 #include "tetops/test_meshes.h"
 
 #include <gtest/gtest.h>
+
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -88,15 +91,29 @@ TEST(Cli, MissingAndCorruptFilesNameTheFile) {
     EXPECT_TRUE(std::all_of(b.err.begin(), b.err.end(), [](char c) { return c == '\n' || (c >= 0x20 && c < 0x7f); }))
         << b.err;
 
-    // A stored material the file format allows but no solve can use (no scattering), and fracture
-    // pieces the volume cannot hold: the errors name the file.
+    // A stored material the file format can hold but no solve can use (no scattering): no save writes
+    // it, and every command that reads a file holding it refuses the file by name, so nothing `info`
+    // or `cut` accepts fails only at `render`.
     TetMesh cube = testing::make_cube_mesh(3);
     cube.materials.assign(cube.tet_count(), TetMaterial{{0.1, 0.1, 0.1}, {0, 1, 1}, 1.3});
     const fs::path clear = dir / "clear.vtu";
+    EXPECT_THROW(write_volume(cube, clear), InvalidMeshError);
+    {
+        std::ofstream out(clear, std::ios::binary);
+        format_vtu(cube, out);
+    }
+    for (const std::string command : {"info " + clear.string(), "render " + clear.string() + " -o " + (dir / "clear.png").string(),
+                                      "cut " + clear.string() + " -o " + (dir / "c.vtu").string() + " --plane=1,0,0,0.5"}) {
+        const auto m = run_waxwork(command);
+        EXPECT_NE(m.exit_code, 0) << command;
+        EXPECT_NE(m.err.find("clear.vtu"), std::string::npos) << m.err;
+        EXPECT_NE(m.err.find("tet 0's material: mu_s' = 0 must be positive"), std::string::npos) << m.err;
+    }
+    EXPECT_FALSE(fs::exists(dir / "c.vtu"));
+
+    // Fracture pieces the volume cannot hold: the error names the file.
+    cube.materials.clear();
     write_volume(cube, clear);
-    const auto m = run_waxwork("render " + clear.string() + " -o " + (dir / "clear.png").string());
-    EXPECT_NE(m.exit_code, 0);
-    EXPECT_NE(m.err.find("clear.vtu: stored material of tet 0: mu_s'"), std::string::npos) << m.err;
     const auto f = run_waxwork("fracture " + clear.string() + " -o " + (dir / "f.vtu").string() + " --pieces 100");
     EXPECT_NE(f.exit_code, 0);
     EXPECT_NE(f.err.find("clear.vtu: fracture: 100 pieces of a volume of 162 tets"), std::string::npos) << f.err;
