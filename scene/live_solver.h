@@ -1,65 +1,46 @@
-// The per-frame diffusion solver behind LiveScene: one interface for the methods and
-// backends a live editor can use, each warm-started from the previous frame's phi and told what an
-// edit changed, so it redoes only that.
+// The per-frame diffusion solver behind LiveScene: one interface for the methods and backends a live
+// editor can use, each warm-started from the previous frame's phi and told what an edit changed, so it
+// redoes only that. Each method and backend is a FrameSolver of its own (frame_solver.h):
 //
-//   CPU Jacobi CG        conjugate_gradient.h in double, per channel (the default: on spot it is as
-//                        fast to 1% as the multires solver, live_scene.h).
-//   CPU multigrid CG     multires/multigrid_frame_solver.h: CG preconditioned by the V-cycle on the
-//                        hierarchy of Li et al. 2013 (Sec. 4.1, Eq. 16), the three rgb channels in one
-//                        pass (one sweep over the pattern per level serves all three). Its state (phi,
-//                        residual, search directions) persists across frames: a light change only
-//                        moves the residual by the change of b (set_right_hand_side), painting updates
-//                        the changed level-0 rows and the coarse Galerkin rows depending on them
-//                        (update_values; a whole-object material every row), a new matrix (cut,
-//                        relaxation) rebuilds it. solver.phi(c) is copied into the host phi after
-//                        each frame (phi(), the radiance, saves, a cut's warm start). Its budget is
-//                        counted in V-cycles: an iteration budget of k maps to max(1, k / 4) V-cycles
-//                        (kIterationsPerVcycle: one costs about 4 Jacobi CG iterations of the three
-//                        channels; 0 runs none), and FrameReport counts V-cycles as each
-//                        channel's iterations. Its error estimate lags one CG update when the budget runs
-//                        out (an upper estimate, multigrid_frame_solver.h).
-//   multires             multires/multires_solver.h (CPU) or multires/gpu_multires_solver.h (GPU): the
-//                        paper's own per-frame scheme (Sec. 4). The first frame after a (re)build (or a
-//                        replaced phi) solves coarse to fine (BiCGSTAB on the coarse levels of the Eq. 17
-//                        hierarchy, Eq. 16 interpolation, CG on level 0 within the frame's budget): from
-//                        zero in a new scene, and as a correction of the host phi when there is one (a
-//                        cut's carried phi, a relaxation's; MultiresSolver::set_warm_start, computed on
-//                        the host for the GPU backend too, so both start from the same vector); later
-//                        frames run only the level-0 Jacobi CG, warm from the previous frame's phi (a light
-//                        change: new right-hand sides, same warm start). Painting updates the changed
-//                        level-0 rows and the coarse rows depending on them (MultiresSolver::update_values
-//                        with rows), and the GPU re-uploads only those rows of every level (update_rows).
-//                        The hierarchy lives on the host for both backends (the device copy is built from
-//                        it, and a fallback to the CPU keeps solving with it).
-//   GPU CG               solver/gpu/gpu_conjugate_gradient.h (float, OpenGL 4.3 compute shaders): matrix,
-//                        right-hand sides and phi stay on the device between frames; painting uploads
-//                        only the rewritten rows (GpuDiffusionSolver::update_rows). phi is read back
-//                        after each frame so the host copy (phi(), saves, the CPU radiance) stays valid.
-//   GPU multigrid CG     multires/gpu_multigrid_frame_solver.h: the CPU multigrid CG's algorithm with phi,
-//                        r, p, q and the V-cycle's levels on the device (float); the hierarchy and the
-//                        Galerkin operators are built on the host at the first GPU frame after a
-//                        (re)build (from the rest positions kept by matrix_rebuilt), painting uploads the
-//                        recomputed rows of every level. Budgets as for the CPU multigrid (V-cycles;
-//                        a time limit is checked between V-cycles, each CG step reads back its sums
-//                        anyway, so no prediction is needed). After a GPU failure the CPU multigrid CG
-//                        takes over; when the V-cycle cannot be built (AlgorithmError) GPU Jacobi CG does.
+//   CPU Jacobi CG        jacobi_frame_solver.h: conjugate_gradient.h in double, per channel (the
+//                        default: on spot it is as fast to 1% as the multires solver, live_scene.h).
+//   CPU multigrid CG     multigrid_frame_adapter.h: CG preconditioned by the V-cycle on the hierarchy of
+//                        Li et al. 2013 (Sec. 4.1, Eq. 16), the three rgb channels in one pass, its
+//                        state persisting across frames (multigrid_frame.h). Its budget is counted in
+//                        V-cycles: an iteration budget of k maps to max(1, k / 4) V-cycles (one costs
+//                        about 4 Jacobi CG iterations of the three channels; 0 runs none), and
+//                        FrameReport counts V-cycles as each channel's iterations.
+//   multires             multires_frame_adapter.h (CPU) or gpu_multires_frame_adapter.h (GPU): the
+//                        paper's own per-frame scheme (Sec. 4): coarse to fine after a (re)build or a
+//                        replaced phi, then the level-0 Jacobi CG warm from the previous frame's phi. The
+//                        hierarchy lives on the host for both backends.
+//   GPU CG               gpu_jacobi_frame_solver.h: solver/gpu/gpu_conjugate_gradient.h (float, OpenGL
+//                        4.3 compute shaders), matrix, right-hand sides and phi resident on the device.
+//   GPU multigrid CG     gpu_multigrid_frame_adapter.h: the CPU multigrid CG's algorithm on the device
+//                        (float), its budgets as for the CPU multigrid.
+// Every implementation copies its phi into the host phi after each frame (phi(), the CPU radiance,
+// saves, a cut's warm start).
 //
-// The GPU backend runs on a SolverGlContext: the editor's hidden window sharing the main window's
-// objects, or an OSMesa context (tests, `waxwork run`). The context is made current around every GPU
-// call, because the editor runs each frame on a new worker thread. When the context or a shader fails
-// (no OpenGL 4.3, a driver bug, WAXWORK_GPU_FORCE_FAIL), the solver switches to the CPU method for
-// good and says why (gpu_fallback_reason()): a driver problem never stops the editor.
+// This class chooses the implementation (make_frame_solver) and performs the fallbacks between them.
+// The GPU backend runs on a SolverGlContext (gpu_frame_context.h): the editor's hidden window sharing
+// the main window's objects, or an OSMesa context (tests, `waxwork run`). When the context or a shader
+// fails (no OpenGL 4.3, a driver bug, WAXWORK_GPU_FORCE_FAIL), the solver switches to the CPU
+// implementation of the same method for good, continuing from the host phi, and says why
+// (gpu_fallback_reason()): a driver problem never stops the editor.
 //
 // Likewise when the multigrid V-cycle cannot be built or applied (AlgorithmError: a coarse Galerkin
 // operator that is not positive definite, as on volumes of extreme slivers; the stability study's
-// "slivers, multigrid" table), the frame and the following ones run Jacobi CG from the last phi and
-// method_fallback_reason() says why; the next matrix rebuild (a cut) tries the multigrid again.
+// "slivers, multigrid" table), the frame and the following ones run Jacobi CG (on the same backend)
+// from the last phi and method_fallback_reason() says why; the next matrix rebuild (a cut) tries the
+// multigrid again.
 #pragma once
 
 #include "gl/gl_context.h"
 #include "gl/gpu_compute.h"
 #include "gl/shared_context.h"
 #include "multires/multigrid_preconditioner.h"
+#include "scene/frame_solver.h"
+#include "scene/gpu_frame_context.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/frame_budget.h"
@@ -78,9 +59,6 @@
 
 namespace waxwork {
 
-class MultigridFrameCg;
-class MultigridFrameSolver;
-class MultiresSolver;
 struct MultiresHierarchy;
 
 enum class LiveMethod { JacobiCg, MultigridCg, Multires };
@@ -102,12 +80,6 @@ struct LiveSolverOptions {
     MillisecondClock clock;
     // The multigrid method's V-cycle (smoother, dropping, lumping and its fallback).
     MultigridOptions multigrid;
-};
-
-struct LiveSolverChannel {
-    int iterations = 0;
-    double estimated_relative_error = 1;
-    bool converged = false;
 };
 
 // Not thread-safe: LiveScene calls it under its mutex.
@@ -200,116 +172,33 @@ public:
     std::string description() const;
 
 private:
-    struct Gpu;
-    std::array<LiveSolverChannel, 3> iterate_cpu(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
-                                                 std::array<std::vector<double>, 3>& phi, int iteration_budget,
-                                                 double relative_tolerance, const std::array<bool, 3>& skip);
-    std::array<LiveSolverChannel, 3> iterate_multigrid(const DiffusionMatrix& matrix,
-                                                       const std::array<std::vector<double>, 3>& b,
-                                                       std::array<std::vector<double>, 3>& phi, int iteration_budget,
-                                                       double relative_tolerance, const std::array<bool, 3>& skip);
-    // The multigrid and multires estimates a frame of no iterations reports go back to 1 (unknown).
-    void forget_estimates();
-    // Multires (both backends): applies pending value changes to the host hierarchy and queues the
-    // changed rows of every level for the device.
-    void update_multires_values(const DiffusionMatrix& matrix);
-    std::array<LiveSolverChannel, 3> iterate_multires(const std::array<std::vector<double>, 3>& b,
-                                                      std::array<std::vector<double>, 3>& phi, int iteration_budget,
-                                                      double relative_tolerance, const std::array<bool, 3>& skip);
-    std::array<LiveSolverChannel, 3> iterate_gpu_multires(const DiffusionMatrix& matrix,
-                                                          const std::array<std::vector<double>, 3>& b,
-                                                          std::array<std::vector<double>, 3>& phi, int iteration_budget,
-                                                          double relative_tolerance);
-    std::array<LiveSolverChannel, 3> iterate_gpu_multigrid(const DiffusionMatrix& matrix,
-                                                           const std::array<std::vector<double>, 3>& b,
-                                                           std::array<std::vector<double>, 3>& phi, int iteration_budget,
-                                                           double relative_tolerance, const std::array<bool, 3>& skip);
-    // The multigrid runs on the device (or will at the next GPU frame).
-    bool gpu_multigrid() const { return backend_ == LiveBackend::Gpu && !multigrid_positions_.empty(); }
-    // The CPU multigrid frame solver for `matrix` (sets method_fallback_reason_ when it cannot be built).
-    // `hierarchy`: one already built for `matrix` (rebuilt around an edit); else it is built here.
-    // `previous`: the solver before that edit (new_of_old_vertex its vertex map), whose unchanged
-    // Galerkin rows the new preconditioner copies.
-    void build_cpu_multigrid(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix,
-                             std::optional<MultiresHierarchy> hierarchy = std::nullopt,
-                             const MultigridFrameSolver* previous = nullptr, std::span<const int32_t> new_of_old_vertex = {});
-    std::array<LiveSolverChannel, 3> iterate_gpu(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
-                                                 std::array<std::vector<double>, 3>& phi, int iteration_budget,
-                                                 double relative_tolerance, const std::array<bool, 3>& skip);
+    // The implementation for `method` on the current backend (the one place that chooses).
+    std::unique_ptr<FrameSolver> make_frame_solver(LiveMethod method);
+    // A frame of the current implementation; a multigrid one whose V-cycle cannot be built or applied
+    // is replaced by Jacobi CG, which solves the frame instead.
+    FrameResult run_frame(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
+                          std::array<std::vector<double>, 3>& phi, int iteration_budget, double relative_tolerance,
+                            const std::array<bool, 3>& skip);
+    // Jacobi CG on the current backend instead of the multigrid, until the next matrix rebuild.
+    void use_jacobi_instead(const std::exception& e);
     void fall_back(const std::string& reason);
-    void release_gpu();
-    struct PendingChanges;
-    // A frame of either multigrid frame solver (CPU or device): sends the pending changes (values, b,
-    // phi), runs the V-cycles the budget allows, `read_phi` copies the solver's phi to the host.
-    std::array<LiveSolverChannel, 3> multigrid_frame(MultigridFrameCg& solver, PendingChanges& pending,
-                                                     const DiffusionMatrix& matrix,
-                                                     const std::array<std::vector<double>, 3>& b,
-                                                     std::array<std::vector<double>, 3>& phi, int iteration_budget,
-                                                     double relative_tolerance, const std::array<bool, 3>& skip,
-                                                     const std::function<void()>& read_phi);
-    // After a multires coarse-to-fine pass: method_fallback_reason() names its skipped levels ("" when
-    // none was skipped).
-    void note_coarse_fallbacks(const std::string& reasons);
 
     LiveMethod method_;
     LiveBackend backend_, requested_backend_;
-    std::shared_ptr<SolverGlContext> context_;
-    std::string gpu_fallback_reason_;
-    std::string method_fallback_reason_;
     MultigridOptions multigrid_options_;
-    std::string renderer_;
-    std::array<double, 3> eigenvalue_hint_{};
-    // What changed since one copy of the system last caught up; each copy (the multigrid frame
-    // solver, the multires hierarchy, the device) applies its own record at its next frame, so a
-    // change reaches every copy exactly once whichever of them runs when.
-    struct PendingChanges {
-        bool all_values = false;    // every matrix value changed (same pattern); rows is then empty
-        std::vector<int32_t> rows;  // else the rows that changed, ascending and unique
-        bool right_hand_sides = true;
-        bool solution = true;  // the host phi was replaced (or never sent): start from it
-
-        void values_changed() {
-            all_values = true;
-            rows.clear();
-        }
-        void rows_changed(std::span<const int32_t> ascending_unique);  // nothing to add after all_values
-        void values_applied() {
-            all_values = false;
-            rows.clear();
-        }
-    };
-
-    std::unique_ptr<MultigridFrameSolver> multigrid_;
-    PendingChanges multigrid_pending_;  // values, b, and phi as a warm start
-    // The multigrid method on the GPU backend: the mesh's rest positions (the hierarchy's Eq. 16
-    // weights), kept from matrix_rebuilt for the device solver built at the next GPU frame and for a
-    // CPU multigrid after a fallback. Empty when the method is not (or no longer) run on the device;
-    // the device solver takes its changes through gpu_pending_.
-    std::vector<Eigen::Vector3d> multigrid_positions_;
-    // With multigrid_positions_ after an edit with a vertex map: the hierarchy and preconditioner
-    // rebuilt around the edit from the device solver's (or from the ones still waiting here), for the
-    // device solver built at the next GPU frame. Empty otherwise, and after painting (stale values).
-    MultigridOperators multigrid_waiting_;
-    // The last frame's estimates, reported by a frame of no V-cycles (1 after a change).
-    std::array<double, 3> multigrid_error_{1, 1, 1};
-    std::unique_ptr<MultiresSolver> multires_;
-    // Values, and `solution`: the next frame solves coarse to fine (after a rebuild or a replaced phi),
-    // correcting the host phi unless it is zero; between those frames the CPU's warm starts are the
-    // solver's own last solutions, the device's its resident phi.
-    PendingChanges multires_pending_;
-    std::array<double, 3> multires_error_{1, 1, 1};  // reported by a frame of no iterations
-    // Rows per level the device copy of the hierarchy has not received yet (ascending, unique); all of
-    // them when gpu_pending_.all_values.
-    std::vector<std::vector<int32_t>> gpu_level_rows_;
-    std::unique_ptr<Gpu> gpu_;
-    // Device work, applied at the next GPU iterate with the context current. Rows are collected only
-    // while the GPU backend runs (a device made later is sent everything).
-    PendingChanges gpu_pending_;
     // Time budgets: the clock, the deadline of the frame being solved (unbounded outside a budgeted
-    // iterate(): the CPU paths read it), and the GPU's cost per iteration.
+    // iterate()), and the GPU's cost per iteration.
     MillisecondClock clock_;
     FrameDeadline deadline_;
     IterationTimePredictor gpu_iteration_time_;
+    std::string gpu_fallback_reason_;
+    std::string method_fallback_reason_;
+    GpuFrameContext gpu_context_;  // outlives solver_, whose device objects live in it
+    std::unique_ptr<FrameSolver> solver_;
+    // Whether solver_ is the method's own implementation. Jacobi CG stands in for the multires and
+    // multigrid methods until the first matrix_rebuilt (their hierarchy needs the mesh), and for the
+    // multigrid after its V-cycle failed, until the next one.
+    bool runs_method_;
 };
 
 }  // namespace waxwork
