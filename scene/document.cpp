@@ -40,6 +40,35 @@ std::unique_ptr<CuttingSurface> make_surface(const std::variant<PlaneSurface, St
     return std::make_unique<StrokeCut>(s.eye, s.view_direction, s.points, s.flip);
 }
 
+// The counts of a tetops result without its arrays (OperationResult).
+CutResult without_arrays(CutResult r) {
+    r.old_to_new_vertex = {};
+    r.new_to_old_tet = {};
+    return r;
+}
+ExactCutResult without_arrays(ExactCutResult r) {
+    r.new_to_old_tet = {};
+    r.vertex_origins = {};
+    return r;
+}
+FractureResult without_arrays(FractureResult r) {
+    r.vertex_origins = {};
+    return r;
+}
+WeldResult without_arrays(WeldResult r) {
+    r.old_to_new_vertex = {};
+    return r;
+}
+FragmentRemoval without_arrays(FragmentRemoval r) {
+    r.removed = without_arrays(std::move(r.removed));
+    return r;
+}
+PaintResult without_arrays(PaintResult r) {
+    r.changed_tets = {};
+    r.weights = {};
+    return r;
+}
+
 RelaxationOptions relaxation_options(const RelaxSettings& r) {
     RelaxationOptions o;
     o.max_iterations = r.iterations;
@@ -95,6 +124,7 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
             details << result.tets_split << " tets split, " << result.tets_removed << " tets removed, "
                     << result.vertices_snapped << " vertices snapped onto the surface, " << result.tets_under_guard
                     << " tets under the angle guard";
+            report.result = without_arrays(std::move(result));
         } else {
             CutResult removed = remove_cut_away_tets(*after, *surface);
             require_tets_left_by_cut(*after, mesh_.tet_count());
@@ -107,6 +137,7 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
             details << removed.tets_removed << " tets removed, " << relaxed.vertices_moved
                     << " vertices relaxed (" << relaxed.iterations << " sweeps, " << relaxed.moves_rejected
                     << " moves rejected by the guard)";
+            report.result = RelaxedCutResult{without_arrays(std::move(removed)), relaxed};
         }
         // A cut of a concave shape can leave specks floating: say so, and what drops them.
         const FragmentSurvey fragments = survey_fragments(*after, *connectivity, kDefaultFragmentFraction);
@@ -147,6 +178,7 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
         report.positions = !entry.moved_vertices.empty();
         report.connectivity = std::make_shared<const TetConnectivity>(connectivity);
         details << entry.moved_vertices.size() << " vertices moved in " << relaxed.iterations << " sweeps";
+        report.result = relaxed;
     } else if (const auto* o = std::get_if<PaintOp>(&op)) {
         PaintBrush brush;
         brush.material = o->material;
@@ -170,6 +202,7 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
         }
         report.changed_material_tets = std::move(painted.changed_tets);
         details << report.changed_material_tets.size() << " tets painted";
+        report.result = without_arrays(std::move(painted));
     } else if (const auto* o = std::get_if<SetMaterialOp>(&op)) {
         if (o->piece && (*o->piece < 0 || static_cast<size_t>(*o->piece) >= mesh_.piece_transforms.size()))
             throw InvalidArgumentError("set_material: piece " + std::to_string(*o->piece) + " does not exist (" +
@@ -196,6 +229,7 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
         }
         details << removal.fragments_removed << " fragments removed (" << removal.removed.tets_removed << " tets), "
                 << removal.parts_kept << (removal.parts_kept == 1 ? " part" : " parts") << " kept";
+        report.result = without_arrays(std::move(removal));
     } else {
         run_piece_operation(op, entry, report, details);
     }
@@ -299,6 +333,7 @@ void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, Ch
         FractureOptions options;
         options.exact = o->exact;
         options.min_piece_tets = o->min_piece_tets;
+        options.collapse_swallowed_walls = o->collapse;
         auto after = std::make_shared<TetMesh>(mesh_);
         FractureResult result = fracture_voronoi(*after, seeds, options);
         // Vertices before keep their index; the fracture only appends.
@@ -315,6 +350,7 @@ void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, Ch
                 << " tets split, " << result.vertices_collapsed << " vertices of swallowed walls collapsed, "
                 << result.vertices_duplicated << " crack vertices duplicated, "
                 << result.tets_under_guard << " tets under the angle guard";
+        report.result = without_arrays(std::move(result));
     } else if (const auto* o = std::get_if<MovePieceOp>(&op)) {
         if (o->piece < 0 || static_cast<size_t>(o->piece) >= mesh_.piece_transforms.size())
             throw InvalidArgumentError("move_piece: piece " + std::to_string(o->piece) + " does not exist (" +
@@ -339,6 +375,7 @@ void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, Ch
         }
         details << result.pieces_before << " -> " << result.pieces_after << " pieces, " << result.vertices_merged
                 << " vertices merged";
+        report.result = without_arrays(std::move(result));
     }
 }
 

@@ -25,6 +25,11 @@
 #include "scene/edit_operation.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
+#include "tetops/exact_cut.h"
+#include "tetops/fracture.h"
+#include "tetops/fragments.h"
+#include "tetops/paint.h"
+#include "tetops/relaxation.h"
 #include "tetops/tet_mesh.h"
 
 #include <array>
@@ -35,11 +40,25 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace waxwork {
 
-class PaintIndex;
+// A cut with relaxation: the tets it removed, then the relaxation of the cut vertices.
+struct RelaxedCutResult {
+    CutResult removal;
+    RelaxationReport relaxation;
+};
+
+// What an operation's tetops algorithm reported, for callers that summarise it (the command line's
+// JSON): RelaxedCutResult (plane and stroke cuts), ExactCutResult (exact cuts), RelaxationReport
+// (relax), FractureResult, WeldResult, FragmentRemoval (remove_fragments), PaintResult; monostate for
+// move_piece, set_material and undo. Only the counts: the per-vertex and per-tet arrays are left empty
+// (the ones the scene needs are ChangeReport's own old_to_new_vertex, vertex_origins and
+// changed_material_tets), so a report stays small.
+using OperationResult = std::variant<std::monostate, RelaxedCutResult, ExactCutResult, RelaxationReport,
+                                     FractureResult, WeldResult, FragmentRemoval, PaintResult>;
 
 // What an applied (or undone, or redone) operation changed. The live scene reacts to the flags.
 struct ChangeReport {
@@ -72,6 +91,7 @@ struct ChangeReport {
     bool undoable = true;       // false when the entry exceeded the whole undo budget
     size_t undo_entries_evicted = 0;  // oldest entries dropped to make room for this one
     std::string details;        // one line, operation specific (tets removed, vertices moved, ...)
+    OperationResult result;     // the same counts, typed (applied and redone operations)
 
     bool anything_changed() const {
         return topology || positions || piece_transforms || all_materials || !changed_material_tets.empty();

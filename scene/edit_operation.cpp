@@ -126,6 +126,8 @@ struct ToJson {
         }
         j["exact"] = op.exact;
         j["min_piece_tets"] = op.min_piece_tets;
+        // Written only when off: a session that keeps the default records no field for it.
+        if (!op.collapse) j["collapse"] = false;
         return j;
     }
     Json operator()(const MovePieceOp& op) const {
@@ -262,6 +264,7 @@ EditOperation edit_operation_from_json(const Json& json, const std::string& cont
         const int64_t min_tets = in.integer("min_piece_tets", op.min_piece_tets);
         if (min_tets < 0 || min_tets > 1000000000) fail_json(in.field("min_piece_tets"), "must be non-negative");
         op.min_piece_tets = static_cast<int>(min_tets);
+        op.collapse = in.boolean("collapse", true);
         result = op;
     } else if (name == "move_piece") {
         MovePieceOp op;

@@ -12,7 +12,7 @@
 //    "relax": {...}, "exact": false}
 //   {"op": "relax", "plane": {"normal": [...], "offset": d} | "stroke": {"eye": ..., ...}, "relax": {...}}
 //   {"op": "fracture", "pieces": 5, "seed": 1} or {"op": "fracture", "seeds": [[...], ...]}, "exact": true,
-//    "min_piece_tets": 8
+//    "min_piece_tets": 8, "collapse": true       ("collapse" is written only when false)
 //   {"op": "move_piece", "piece": 1, "rotation": [[3x3 rows]], "translation": [...]}
 //   {"op": "weld", "tolerance": 1e-6}
 //   {"op": "remove_fragments", "max_volume_fraction": 0.001}
@@ -88,6 +88,8 @@ struct FractureOp {
     std::vector<Eigen::Vector3d> seeds;  // world space; when non-empty, pieces/seed are ignored
     bool exact = true;
     int min_piece_tets = 8;
+    // FractureOptions::collapse_swallowed_walls; false only to compare (`waxwork fracture --no-collapse`).
+    bool collapse = true;
     friend bool operator==(const FractureOp&, const FractureOp&) = default;
 };
 

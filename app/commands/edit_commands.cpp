@@ -6,20 +6,19 @@
 //                    [--collapse|--no-collapse]
 //   waxwork paint VOLUME -o OUT --at "X,Y,Z;X,Y,Z" (--material NAME | --mua R,G,B --musp R,G,B --eta N)
 //                 --sigma S [--base NAME]
-// Each prints a one-line JSON summary on stdout.
+// Each builds the edit operation its options stand for (scene/edit_operation.h) and applies it
+// through a Document, as the editor and sessions do, then writes the volume and prints a one-line JSON
+// summary on stdout.
 #include "app/options/material_options.h"
 #include "base/error.h"
 #include "base/timing.h"
 #include "io/volume_file.h"
+#include "scene/document.h"
+#include "scene/edit_operation.h"
 #include "solver/material.h"
-#include "tetops/connectivity.h"
 #include "tetops/cut.h"
-#include "tetops/exact_cut.h"
 #include "tetops/fracture.h"
-#include "tetops/fragments.h"
-#include "tetops/paint.h"
 #include "tetops/quality.h"
-#include "tetops/relaxation.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -34,6 +33,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace waxwork {
@@ -69,6 +69,41 @@ std::vector<double> parse_numbers(const std::string& text, size_t count, const s
     return values;
 }
 
+// The volume a command edits, in the Document the editor and sessions edit through (scene/document.h),
+// so the three cannot apply an operation differently. Nothing is undone on the command line: with no
+// undo budget the document keeps no snapshot of the volume before an edit.
+class EditedVolume {
+public:
+    // Reads `input`. The document gives every tet `base` when the file stores no materials; they are
+    // written out only with `write_base`: a painted volume needs them, a cut or a fracture adds no
+    // materials the input did not have.
+    EditedVolume(const std::string& input, const TetMaterial& base, bool write_base)
+        : EditedVolume(input, read_volume(input), base, write_base) {}
+
+    const TetMesh& mesh() const { return document_.mesh(); }
+
+    // Errors name the volume (what it does not allow: a cut that leaves nothing, more pieces than tets).
+    ChangeReport apply(const EditOperation& op) {
+        return naming_context(input_, [&] { return document_.apply(op); });
+    }
+
+    void write(const std::string& output) const {
+        if (keep_materials_) return write_volume(document_.mesh(), output);
+        TetMesh mesh = document_.mesh();
+        mesh.materials.clear();
+        write_volume(mesh, output);
+    }
+
+private:
+    EditedVolume(const std::string& input, TetMesh mesh, const TetMaterial& base, bool write_base)
+        : input_(input), keep_materials_(write_base || mesh.has_materials()),
+          document_(std::move(mesh), base, /*undo_budget_bytes=*/0) {}
+
+    std::string input_;
+    bool keep_materials_;
+    Document document_;
+};
+
 struct CutCommandOptions {
     std::string input;
     std::string output;
@@ -79,91 +114,79 @@ struct CutCommandOptions {
     std::optional<double> remove_fragments;  // volume fraction (tetops/fragments.h)
 };
 
-// After the cut: drops the parts under the fraction, if asked, and reports them in the summary
-// (whose "components" then counts the parts kept).
-void remove_fragments_after_cut(const CutCommandOptions& o, TetMesh& mesh, nlohmann::ordered_json& summary) {
-    if (!o.remove_fragments) return;
-    const FragmentRemoval removal = remove_small_fragments(mesh, *o.remove_fragments);
-    summary["fragments_removed"] = removal.fragments_removed;
-    summary["fragment_tets_removed"] = removal.removed.tets_removed;
-    summary["components"] = removal.parts_kept;
-    summary["tets_after"] = mesh.tet_count();
-    summary["vertices_after"] = mesh.vertex_count();
-}
-
-// Exact mode: tets crossed by the plane are split along it, so no relaxation is needed.
-void run_exact_cut(const CutCommandOptions& o, const PlaneCut& plane) {
-    TetMesh mesh = read_volume(o.input);
-    const size_t tets_before = mesh.tet_count();
-    const size_t vertices_before = mesh.vertex_count();
-    const auto start = Clock::now();
-    const ExactCutResult cut = naming_context(o.input, [&] {  // what the volume does not allow
-        ExactCutResult result = cut_exact(mesh, plane);
-        require_tets_left_by_cut(mesh, tets_before);
-        return result;
-    });
-    const TetConnectivity connectivity = build_connectivity(mesh);
-    nlohmann::ordered_json summary = {
+// Exact mode: tets crossed by the plane are split along it, so nothing is relaxed.
+nlohmann::ordered_json exact_cut_summary(const CutCommandOptions& o, const ChangeReport& report) {
+    const auto& cut = std::get<ExactCutResult>(report.result);
+    return {
         {"output", o.output},
         {"mode", "exact"},
-        {"tets_before", tets_before},
-        {"vertices_before", vertices_before},
-        {"tets_after", mesh.tet_count()},
-        {"vertices_after", mesh.vertex_count()},
+        {"tets_before", report.tets_before},
+        {"vertices_before", report.vertices_before},
+        {"tets_after", report.tets_after},
+        {"vertices_after", report.vertices_after},
         {"tets_removed", cut.tets_removed},
         {"tets_split", cut.tets_split},
         {"vertices_snapped", cut.vertices_snapped},
         {"vertices_added", cut.vertices_added},
-        {"components", connectivity.component_count},
+        {"components", report.connectivity->component_count},
         {"vertices_smoothed", cut.vertices_smoothed},
         {"min_dihedral_deg", cut.min_dihedral_deg},
         {"tets_under_guard", cut.tets_under_guard},
     };
-    remove_fragments_after_cut(o, mesh, summary);
-    summary["milliseconds"] = milliseconds_since(start);
-    write_volume(mesh, o.output);
-    std::cout << summary.dump() << "\n";
+}
+
+nlohmann::ordered_json relaxed_cut_summary(const CutCommandOptions& o, const PlaneCutOp& op,
+                                           const ChangeReport& report) {
+    const auto& cut = std::get<RelaxedCutResult>(report.result);
+    return {
+        {"output", o.output},
+        {"mode", "relax"},
+        {"tets_before", report.tets_before},
+        {"vertices_before", report.vertices_before},
+        {"tets_after", report.tets_after},
+        {"vertices_after", report.vertices_after},
+        {"tets_removed", cut.removal.tets_removed},
+        {"components", report.connectivity->component_count},
+        {"relax_iterations", cut.relaxation.iterations},
+        {"vertices_moved", cut.relaxation.vertices_moved},
+        {"moves_rejected", cut.relaxation.moves_rejected},
+        {"guard_deg", op.relax.guard_deg},
+        {"min_dihedral_deg", cut.relaxation.min_dihedral_deg},
+    };
+}
+
+// After the cut: drops the parts under the fraction, if asked, and reports them in the summary
+// (whose "components" then counts the parts kept).
+void remove_fragments_after_cut(const CutCommandOptions& o, EditedVolume& volume, nlohmann::ordered_json& summary) {
+    if (!o.remove_fragments) return;
+    const ChangeReport report = volume.apply(RemoveFragmentsOp{*o.remove_fragments});
+    const auto& removal = std::get<FragmentRemoval>(report.result);
+    summary["fragments_removed"] = removal.fragments_removed;
+    summary["fragment_tets_removed"] = removal.removed.tets_removed;
+    summary["components"] = removal.parts_kept;
+    summary["tets_after"] = report.tets_after;
+    summary["vertices_after"] = report.vertices_after;
 }
 
 void run_cut_command(const CutCommandOptions& o) {
     const std::vector<double> p = parse_numbers(o.plane, 4, "cut --plane");
-    const PlaneCut plane(Eigen::Vector3d(p[0], p[1], p[2]), p[3]);
-    if (o.exact) return run_exact_cut(o, plane);
-    if (o.relax_iterations < 0) throw InvalidArgumentError("cut --relax: the iteration count must be >= 0");
+    PlaneCutOp op;
+    op.plane = {Eigen::Vector3d(p[0], p[1], p[2]), p[3]};
+    PlaneCut(op.plane.normal, op.plane.offset);  // a zero or non-finite plane fails before the volume is read
+    op.exact = o.exact;
+    if (!o.exact) {  // --relax and --no-guard are unused by an exact cut
+        if (o.relax_iterations < 0) throw InvalidArgumentError("cut --relax: the iteration count must be >= 0");
+        op.relax.iterations = o.relax_iterations;
+        if (o.no_guard) op.relax.guard_deg = 0;
+    }
 
-    TetMesh mesh = read_volume(o.input);
-    const size_t tets_before = mesh.tet_count();
-    const size_t vertices_before = mesh.vertex_count();
-
+    EditedVolume volume(o.input, TetMaterial{}, /*write_base=*/false);
     const auto start = Clock::now();
-    const CutResult cut = naming_context(o.input, [&] {
-        CutResult result = remove_cut_away_tets(mesh, plane);
-        require_tets_left_by_cut(mesh, tets_before);
-        return result;
-    });
-    const TetConnectivity connectivity = build_connectivity(mesh);
-    RelaxationOptions relax;
-    relax.max_iterations = o.relax_iterations;
-    relax.min_dihedral_guard_deg = o.no_guard ? 0.0 : relax.min_dihedral_guard_deg;
-    const RelaxationReport report = relax_cut_vertices(mesh, connectivity, plane, relax);
-    nlohmann::ordered_json summary = {
-        {"output", o.output},
-        {"mode", "relax"},
-        {"tets_before", tets_before},
-        {"vertices_before", vertices_before},
-        {"tets_after", mesh.tet_count()},
-        {"vertices_after", mesh.vertex_count()},
-        {"tets_removed", cut.tets_removed},
-        {"components", connectivity.component_count},
-        {"relax_iterations", report.iterations},
-        {"vertices_moved", report.vertices_moved},
-        {"moves_rejected", report.moves_rejected},
-        {"guard_deg", relax.min_dihedral_guard_deg},
-        {"min_dihedral_deg", report.min_dihedral_deg},
-    };
-    remove_fragments_after_cut(o, mesh, summary);
+    const ChangeReport report = volume.apply(op);
+    nlohmann::ordered_json summary = o.exact ? exact_cut_summary(o, report) : relaxed_cut_summary(o, op, report);
+    remove_fragments_after_cut(o, volume, summary);
     summary["milliseconds"] = milliseconds_since(start);
-    write_volume(mesh, o.output);
+    volume.write(o.output);
     std::cout << summary.dump() << "\n";
 }
 
@@ -182,27 +205,27 @@ void run_fracture_command(const FractureCommandOptions& o) {
         throw InvalidArgumentError("fracture --pieces: must be between 1 and " + std::to_string(kMaxFracturePieces) +
                                    ", got " + std::to_string(o.pieces));
     if (o.min_piece_tets < 0) throw InvalidArgumentError("fracture --min-piece-tets: must be >= 0");
-    TetMesh mesh = read_volume(o.input);
-    const size_t tets_before = mesh.tet_count();
-    const size_t vertices_before = mesh.vertex_count();
+    FractureOp op;
+    op.pieces = o.pieces;
+    op.seed = o.seed;
+    op.exact = o.exact;
+    op.min_piece_tets = o.min_piece_tets;
+    op.collapse = o.collapse;
+
+    EditedVolume volume(o.input, TetMaterial{}, /*write_base=*/false);
     const auto start = Clock::now();
-    FractureOptions options;
-    options.exact = o.exact;
-    options.min_piece_tets = o.min_piece_tets;
-    options.collapse_swallowed_walls = o.collapse;
-    const FractureResult result = naming_context(o.input, [&] {  // what the volume does not allow
-        return fracture_voronoi(mesh, scatter_fracture_seeds(mesh, o.pieces, o.seed), options);
-    });
+    const ChangeReport report = volume.apply(op);
     const double elapsed = milliseconds_since(start);
-    write_volume(mesh, o.output);
+    volume.write(o.output);
+    const auto& result = std::get<FractureResult>(report.result);
     nlohmann::ordered_json summary = {
         {"output", o.output},
         {"mode", o.exact ? "exact" : "tet_faces"},
         {"seed", o.seed},
-        {"tets_before", tets_before},
-        {"vertices_before", vertices_before},
-        {"tets_after", mesh.tet_count()},
-        {"vertices_after", mesh.vertex_count()},
+        {"tets_before", report.tets_before},
+        {"vertices_before", report.vertices_before},
+        {"tets_after", report.tets_after},
+        {"vertices_after", report.vertices_after},
         {"pieces_before", result.pieces_before},
         {"pieces", result.pieces_after},
         {"tets_split", result.tets_split},
@@ -244,33 +267,32 @@ std::vector<Eigen::Vector3d> parse_points(const std::string& text) {
 }
 
 void run_paint_command(const PaintCommandOptions& o) {
-    const std::vector<Eigen::Vector3d> stroke = parse_points(o.at);
+    PaintOp op;
+    op.points = parse_points(o.at);
     if (!(o.sigma > 0) || !std::isfinite(o.sigma))
         throw InvalidArgumentError("paint --sigma: must be a positive number (world units)");
+    op.sigma = o.sigma;
     const std::optional<TetMaterial> brush_material = chosen_material(o.material);
     if (!brush_material)
         throw InvalidArgumentError("paint: choose the brush with --material NAME or --mua R,G,B --musp R,G,B --eta N");
-    PaintBrush brush;
-    brush.material = *brush_material;
-    brush.sigma = o.sigma;
+    op.material = *brush_material;
     const TetMaterial base = material_preset(o.base);
 
-    TetMesh mesh = read_volume(o.input);
+    EditedVolume volume(o.input, base, /*write_base=*/true);
     const auto start = Clock::now();
-    const PaintIndex index(mesh);
-    const PaintResult result = paint_stroke(mesh, index, stroke, brush, base);
+    const ChangeReport report = volume.apply(op);
     const double elapsed = milliseconds_since(start);
 
-    write_volume(mesh, o.output);
+    volume.write(o.output);
     nlohmann::ordered_json summary = {
         {"output", o.output},
-        {"tets_before", mesh.tet_count()},
-        {"vertices_before", mesh.vertex_count()},
-        {"tets_after", mesh.tet_count()},
-        {"vertices_after", mesh.vertex_count()},
-        {"stroke_points", stroke.size()},
-        {"tets_changed", result.changed_tets.size()},
-        {"min_dihedral_deg", mesh_min_dihedral_deg(mesh)},
+        {"tets_before", report.tets_before},
+        {"vertices_before", report.vertices_before},
+        {"tets_after", report.tets_after},
+        {"vertices_after", report.vertices_after},
+        {"stroke_points", op.points.size()},
+        {"tets_changed", report.changed_material_tets.size()},
+        {"min_dihedral_deg", mesh_min_dihedral_deg(volume.mesh())},
         {"milliseconds", elapsed},
     };
     std::cout << summary.dump() << "\n";

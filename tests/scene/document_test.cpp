@@ -237,6 +237,81 @@ TEST(Document, CutsFracturesAndWeldsMapTheirVerticesBothWays) {
     }
 }
 
+// Each operation's own counts come typed in ChangeReport::result (the command line's summaries read
+// them), agreeing with the mesh and the details line; its arrays stay in the report's own fields.
+TEST(Document, ReportsTheOperationsOwnCounts) {
+    Document doc(test_cube(), material_preset("marble"));
+    const ChangeReport cut = doc.apply(plane_cut(0.55));
+    const auto& relaxed = std::get<RelaxedCutResult>(cut.result);
+    EXPECT_EQ(relaxed.removal.tets_removed, cut.tets_before - cut.tets_after);
+    EXPECT_GT(relaxed.relaxation.vertices_moved, 0u);
+    EXPECT_EQ(relaxed.relaxation.min_dihedral_deg, cut.min_dihedral_deg);
+    EXPECT_NE(cut.details.find(std::to_string(relaxed.removal.tets_removed) + " tets removed, " +
+                               std::to_string(relaxed.relaxation.vertices_moved) + " vertices relaxed"),
+              std::string::npos)
+        << cut.details;
+    EXPECT_TRUE(relaxed.removal.old_to_new_vertex.empty());
+    EXPECT_EQ(cut.old_to_new_vertex.size(), cut.vertices_before);
+
+    PlaneCutOp exact = plane_cut(0.3);
+    exact.exact = true;
+    const ChangeReport split = doc.apply(exact);
+    const auto& exact_result = std::get<ExactCutResult>(split.result);
+    EXPECT_GT(exact_result.tets_split, 0u);
+    EXPECT_EQ(exact_result.tets_under_guard, split.tets_under_guard);
+    EXPECT_EQ(exact_result.min_dihedral_deg, split.min_dihedral_deg);
+    EXPECT_TRUE(exact_result.vertex_origins.empty());
+    EXPECT_TRUE(exact_result.new_to_old_tet.empty());
+    EXPECT_EQ(split.vertex_origins.size(), split.vertices_after);
+
+    const ChangeReport relax = doc.apply(RelaxOp{PlaneSurface{Eigen::Vector3d(1, 0.2, 0.1), 0.2}, RelaxSettings{3, 0.3, 0.5}});
+    EXPECT_LE(std::get<RelaxationReport>(relax.result).iterations, 3);
+
+    const ChangeReport paint = doc.apply(paint_at({0.1, 0.5, 0.5}));
+    const auto& painted = std::get<PaintResult>(paint.result);
+    EXPECT_TRUE(painted.changed_tets.empty());
+    EXPECT_TRUE(painted.weights.empty());
+    EXPECT_FALSE(paint.changed_material_tets.empty());
+
+    const ChangeReport set = doc.apply(SetMaterialOp{material_preset("skin1"), std::nullopt});
+    EXPECT_TRUE(std::holds_alternative<std::monostate>(set.result));
+
+    FractureOp fracture;
+    fracture.pieces = 3;
+    fracture.seed = 2;
+    const ChangeReport broken = doc.apply(fracture);
+    const FractureResult pieces = std::get<FractureResult>(broken.result);
+    EXPECT_EQ(static_cast<size_t>(pieces.pieces_after), doc.mesh().piece_transforms.size());
+    EXPECT_EQ(pieces.pieces_before, 1);
+    EXPECT_TRUE(pieces.vertex_origins.empty());
+    EXPECT_EQ(broken.vertex_origins.size(), broken.vertices_after);
+    EXPECT_TRUE(std::holds_alternative<std::monostate>(doc.undo()->result));
+    const FractureResult again = std::get<FractureResult>(doc.redo()->result);  // redo re-runs it
+    EXPECT_EQ(again.pieces_after, pieces.pieces_after);
+    EXPECT_EQ(again.vertices_duplicated, pieces.vertices_duplicated);
+
+    const ChangeReport weld = doc.apply(WeldOp{1e-9});
+    EXPECT_EQ(std::get<WeldResult>(weld.result).pieces_before, pieces.pieces_after);
+    EXPECT_EQ(static_cast<size_t>(std::get<WeldResult>(weld.result).pieces_after), doc.mesh().piece_transforms.size());
+    EXPECT_TRUE(std::get<WeldResult>(weld.result).old_to_new_vertex.empty());
+}
+
+// FractureOp::collapse is FractureOptions::collapse_swallowed_walls: off, every split the walls made stays.
+TEST(Document, FractureWithoutCollapseKeepsEverySplit) {
+    FractureOp collapsed;
+    collapsed.pieces = 12;
+    collapsed.seed = 3;
+    FractureOp kept = collapsed;
+    kept.collapse = false;
+    Document a(testing::make_cube_mesh(8), material_preset("marble"));
+    Document b(testing::make_cube_mesh(8), material_preset("marble"));
+    const ChangeReport with = a.apply(collapsed), without = b.apply(kept);
+    EXPECT_GT(std::get<FractureResult>(with.result).vertices_collapsed, 0u);
+    EXPECT_EQ(std::get<FractureResult>(without.result).vertices_collapsed, 0u);
+    EXPECT_LT(a.mesh().tet_count(), b.mesh().tet_count());
+    EXPECT_EQ(a.mesh().piece_transforms.size(), b.mesh().piece_transforms.size());
+}
+
 // A U of 7 x 6 x 2 cells with a long arm (i = 0) and a short one (i = 6, two cells up): cutting its
 // bridge away (y < 1.5) leaves the short arm as a fragment of 1/6 of the volume.
 TetMesh u_with_a_short_arm() {

@@ -28,6 +28,7 @@ std::vector<EditOperation> one_of_each() {
     seeded.seeds = {Eigen::Vector3d(0.1, 0.2, 0.3), Eigen::Vector3d(0.7, 0.8, 0.9)};
     seeded.exact = false;
     seeded.min_piece_tets = 0;
+    seeded.collapse = false;
     MovePieceOp move;
     move.piece = 2;
     move.transform.rotation = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
@@ -50,6 +51,20 @@ TEST(EditOperation, EveryKindRoundTripsThroughJsonText) {
         EXPECT_TRUE(back == op) << text;
         EXPECT_EQ(to_json(back).dump(), text);
     }
+}
+
+// Fields added to an operation are written only when not at their default, so the JSON of every
+// operation that keeps the default, and so every recorded session, is the same text as without them.
+TEST(EditOperation, FractureWritesCollapseOnlyWhenOff) {
+    FractureOp op;
+    op.pieces = 3;
+    op.seed = 2;
+    EXPECT_EQ(to_json(op).dump(), R"({"op":"fracture","pieces":3,"seed":2,"exact":true,"min_piece_tets":8})");
+    EXPECT_TRUE(std::get<FractureOp>(edit_operation_from_json(to_json(op))).collapse);
+    op.collapse = false;
+    EXPECT_EQ(to_json(op).dump(),
+              R"({"op":"fracture","pieces":3,"seed":2,"exact":true,"min_piece_tets":8,"collapse":false})");
+    EXPECT_FALSE(std::get<FractureOp>(edit_operation_from_json(to_json(op))).collapse);
 }
 
 TEST(EditOperation, DefaultsFillOmittedFields) {
@@ -95,6 +110,8 @@ TEST(EditOperation, ErrorsNameTheContextAndTheField) {
               std::string::npos)
         << error_of(R"({"op":"fracture","pieces":1001})");
     EXPECT_NE(error_of(R"({"op":"relax","relax":{}})").find("exactly one of"), std::string::npos);
+    EXPECT_NE(error_of(R"({"op":"fracture","pieces":3,"collapse":0})").find("field 'collapse': expected true or false"),
+              std::string::npos);
 }
 
 }  // namespace
