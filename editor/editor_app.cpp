@@ -126,24 +126,6 @@ void EditorApp::set_error(const std::string& message) {
     show_error_popup_ = true;
 }
 
-namespace {
-
-// Installs a freshly loaded volume: a document (stored materials kept, else `material` on every
-// tet) and its live scene. Runs on the load worker.
-std::shared_ptr<SceneCore> make_core(TetMesh mesh, Session setup, LiveSceneOptions live) {
-    if (mesh.tet_count() == 0) throw InvalidArgumentError(setup.name + ": the volume has no tets");
-    auto core = std::make_shared<SceneCore>();
-    core->document = std::make_shared<Document>(std::move(mesh), setup.material);
-    live.mm_per_unit = setup.scale;
-    live.relative_tolerance = setup.tolerance;
-    live.crease_angle_degrees = setup.crease_angle_degrees;
-    core->live = std::make_shared<LiveScene>(core->document->mesh(), setup.lighting, live);
-    core->setup = std::move(setup);
-    return core;
-}
-
-}  // namespace
-
 void EditorApp::open_file(const fs::path& path) {
     if (load_task_.busy()) {
         set_error("still loading " + load_task_.label() + "; try again when it finishes");
@@ -171,7 +153,7 @@ void EditorApp::open_file(const fs::path& path) {
         progress.set_stage(setup.input.volume.empty() ? "meshing the surface" : "reading the volume");
         TetMesh mesh = read_session_input(setup);
         progress.set_stage("building the document and the live scene");
-        auto core = make_core(std::move(mesh), setup, solver);
+        auto core = std::make_shared<SceneCore>(std::move(mesh), setup, solver);
         return BackgroundTask::Apply([this, path, core, material_name] { install_core(core, path, material_name, {}); });
     });
 }
@@ -193,10 +175,10 @@ void EditorApp::open_session(const fs::path& path) {
         Session setup = session;
         setup.steps.clear();
         progress.set_stage("building the document and the live scene");
-        auto core = make_core(std::move(mesh), setup, solver);
+        auto core = std::make_shared<SceneCore>(std::move(mesh), setup, solver);
         return BackgroundTask::Apply([this, path, core, edits] {
             install_core(core, path, "session", edits);
-            adopt_frame_budget(core->setup);
+            adopt_frame_budget(core->setup());
         });
     });
 }
@@ -206,14 +188,14 @@ void EditorApp::install_core(std::shared_ptr<SceneCore> core, const fs::path& pa
     pending_jobs_.clear();
     scene_ = std::make_unique<Scene>();
     scene_->core = core;
-    scene_->tets = core->document->mesh().tet_count();
-    scene_->vertices = core->document->mesh().vertex_count();
+    scene_->tets = core->document().mesh().tet_count();
+    scene_->vertices = core->document().mesh().vertex_count();
     scene_->material_name = material_name;
-    lighting_ = core->setup.lighting;
-    live_options_.mm_per_unit = core->setup.scale;
-    live_options_.relative_tolerance = core->setup.tolerance;
-    live_options_.crease_angle_degrees = core->setup.crease_angle_degrees;
-    options_.camera = core->setup.camera;
+    lighting_ = core->setup().lighting;
+    live_options_.mm_per_unit = core->setup().scale;
+    live_options_.relative_tolerance = core->setup().tolerance;
+    live_options_.crease_angle_degrees = core->setup().crease_angle_degrees;
+    options_.camera = core->setup().camera;
     camera_.reset();
     current_file_ = path;
     for (const EditOperation& op : replay) queue_edit(op);
@@ -234,8 +216,7 @@ void EditorApp::queue_job(std::string label, SceneJob job) {
 
 void EditorApp::queue_edit(const EditOperation& op) {
     queue_job(operation_name(op), [op](SceneCore& core) {
-        const ChangeReport report = core.document->apply(op);
-        core.live->apply_change(core.document->mesh(), report);
+        const ChangeReport report = core.apply(op);
         std::ostringstream line;
         line << report.name << ": " << report.details << " (" << std::lround(report.milliseconds) << " ms)";
         if (!report.undoable) line << "; too large to undo";
@@ -245,7 +226,7 @@ void EditorApp::queue_edit(const EditOperation& op) {
 
 void EditorApp::save_volume(const fs::path& path) {
     queue_job("save", [path](SceneCore& core) {
-        write_volume(core.document->mesh(), path);
+        core.save_volume(path);
         return "Saved " + path.string();
     });
     current_file_ = path;
@@ -262,7 +243,7 @@ void EditorApp::save_session(const fs::path& path) {
     if (frame_budget_in_ms_) current.frame_ms = frame_ms_;
     current.crease_angle_degrees = live_options_.crease_angle_degrees;
     queue_job("save session", [path, current](SceneCore& core) {
-        Session setup = core.setup;
+        Session setup = core.setup();
         setup.frame_iterations = current.frame_iterations;
         setup.frame_ms = current.frame_ms;
         setup.crease_angle_degrees = current.crease_angle_degrees;
@@ -270,19 +251,15 @@ void EditorApp::save_session(const fs::path& path) {
         setup.camera = current.camera;
         setup.width = current.width;
         setup.height = current.height;
-        write_session(path, record_session(setup, *core.document));
-        return "Saved the session (" + std::to_string(core.document->history().size()) + " edits) to " + path.string();
+        core.save_session(path, setup);
+        return "Saved the session (" + std::to_string(core.document().history().size()) + " edits) to " + path.string();
     });
 }
 
 void EditorApp::rebuild_live_scene() {
     const LiveSceneOptions options = live_options_;
     queue_job("solver settings", [options](SceneCore& core) {
-        const Lighting lighting = core.live->lighting();
-        core.live.reset();  // it borrows the document's mesh: release before building the next one
-        core.live = std::make_shared<LiveScene>(core.document->mesh(), lighting, options);
-        core.setup.scale = options.mm_per_unit;
-        core.setup.tolerance = options.relative_tolerance;
+        core.set_solver_options(options);
         return std::string("Solver settings changed: solving again");
     });
     if (scene_->core) scene_->exposure_locked = false;
@@ -346,18 +323,17 @@ bool EditorApp::idle() const {
 void EditorApp::start_tick() {
     // What this tick does, handed over whole: the UI thread queues the next batch meanwhile.
     std::shared_ptr<SceneCore> core = scene_->core;
-    auto jobs = std::make_shared<std::vector<std::pair<std::string, SceneJob>>>(pending_jobs_.begin(), pending_jobs_.end());
+    auto request = std::make_shared<SceneTickRequest>();
+    request->jobs.assign(std::make_move_iterator(pending_jobs_.begin()), std::make_move_iterator(pending_jobs_.end()));
     pending_jobs_.clear();
-    std::optional<Lighting> lighting;
-    if (lighting_dirty_) lighting = lighting_;
+    if (lighting_dirty_) request->lighting = lighting_;
     lighting_dirty_ = false;
-    std::optional<double> crease_angle;
-    if (crease_angle_dirty_) crease_angle = live_options_.crease_angle_degrees;
+    if (crease_angle_dirty_) request->crease_angle = live_options_.crease_angle_degrees;  // checked by set_crease_angle
     crease_angle_dirty_ = false;
-    const FrameBudget budget = frame_budget();
-    const bool first = !scene_->render_input;
-    const bool need_bvh = !scene_->surface_bvh;
-    ImageSettings settings;
+    request->budget = frame_budget();
+    request->first = !scene_->render_input;
+    request->need_bvh = !scene_->surface_bvh;
+    ImageSettings& settings = request->image;
     settings.width = std::max(view_w_, 1);
     settings.height = std::max(view_h_, 1);
     if (camera_) {
@@ -366,102 +342,15 @@ void EditorApp::start_tick() {
     } else {
         settings.camera = options_.camera;
     }
-    const std::string label = jobs->empty() ? "solve" : jobs->front().first;
-    Scene* target = scene_.get();
-    const ViewOptions view = view_options_;
-    const bool view_changed = view_dirty_;
+    request->view = view_options_;
+    request->view_changed = view_dirty_;
     view_dirty_ = false;
-    std::shared_ptr<ViewWorkerState> view_worker = view_worker_;
+    const std::string label = request->jobs.empty() ? "solve" : request->jobs.front().first;
+    Scene* target = scene_.get();
 
-    struct Result {
-        std::vector<std::string> messages, errors;
-        bool geometry_changed = false;
-        std::optional<SurfaceRenderInput> input;
-        std::shared_ptr<const TriangleBvh> bvh;
-        std::vector<int32_t> surface_piece;
-        std::vector<RigidTransform> piece_transforms;
-        FrameReport frame;
-        bool converged = false;
-        std::optional<double> error;
-        bool can_undo = false, can_redo = false;
-        size_t history = 0, tets = 0, vertices = 0;
-        double min_dihedral = 0;
-        double ms = 0;
-        std::shared_ptr<const ViewGeometry> view;
-        LiveBackend backend = LiveBackend::Cpu;
-        std::string solver_description, gpu_fallback_reason, method_fallback_reason;
-    };
-    tick_task_.start(label, [this, target, core, jobs, lighting, crease_angle, budget, first, need_bvh, settings, view,
-                             view_changed, view_worker](TaskProgress& progress) {
-        const auto start = std::chrono::steady_clock::now();
-        auto r = std::make_shared<Result>();
-        for (auto& [name, job] : *jobs) {
-            progress.set_stage(name);
-            try {
-                r->messages.push_back(job(*core));
-                r->geometry_changed = true;
-            } catch (const std::exception& e) {
-                r->errors.push_back(name + ": " + e.what());
-            }
-        }
-        if (crease_angle) {
-            progress.set_stage("crease angle");
-            core->live->set_crease_angle(*crease_angle);  // checked by set_crease_angle above
-            r->messages.push_back("Surface split where it folds by more than " + number_text(*crease_angle) + " degrees");
-            r->geometry_changed = true;  // the shading's vertices
-        }
-        if (lighting) core->live->set_lighting(*lighting);
-        progress.set_stage("solving");
-        r->frame = core->live->step(budget);
-        r->converged = core->live->converged();
-        r->error = core->live->estimated_error();
-        const TetMesh& mesh = core->document->mesh();
-        if (first || r->geometry_changed) ++view_worker->geometry_version;
-        if (lighting || r->frame.total_iterations() > 0) ++view_worker->solution_version;
-        if (first || r->geometry_changed || lighting || r->frame.total_iterations() > 0 || view_changed) {
-            progress.set_stage("radiance");
-            // GPU backend in the hidden window's context (shared with this window's): the view draws E
-            // from the solver's device buffer, and the exposure is taken from a read-back of it, so E
-            // is not also computed from phi on the CPU (at 100K tets that cost more than a device
-            // frame). Not with an OSMesa context of the solver's own (when no shared context could be
-            // made): its buffers are not this window's.
-            std::vector<std::array<float, 3>> device_e;
-            std::shared_ptr<const GpuBuffer> device_buffer;
-            if (core->live->options().gl_context) device_buffer = core->live->device_radiance(&device_e);
-            const SolvedScene solved = core->live->solved_scene(/*with_radiance=*/!device_buffer);
-            r->input = make_render_input(mesh, solved, core->live->lighting(), settings,
-                                         device_buffer ? &device_e : nullptr);
-            if (view.mode != ViewMode::Radiance) {
-                progress.set_stage("view");
-                r->view = view_worker->cache.get(mesh, core->live->connectivity(), mesh.materials, solved, view,
-                                                 view_worker->geometry_version, view_worker->solution_version);
-                apply_view(*r->view, *r->input);
-            }
-            r->input->device_radiance = device_buffer;
-            if (need_bvh || r->geometry_changed) {
-                r->bvh = std::make_shared<const TriangleBvh>(r->input->positions, r->input->triangles);
-                // Each drawn (shading) vertex's piece, for picking pieces to move.
-                std::vector<int32_t> vertex_piece(mesh.vertex_count(), 0);
-                for (size_t t = 0; t < mesh.tet_count(); ++t)
-                    for (int32_t v : mesh.tets[t]) vertex_piece[v] = mesh.piece_ids[t];
-                const ShadingSurface& shading = solved.shading;
-                r->surface_piece.resize(shading.size());
-                for (size_t d = 0; d < shading.size(); ++d)
-                    r->surface_piece[d] = vertex_piece[solved.surface.vertices[shading.surface_vertex[d]]];
-            }
-        }
-        r->piece_transforms = mesh.piece_transforms;
-        r->can_undo = core->document->can_undo();
-        r->can_redo = core->document->can_redo();
-        r->history = core->document->history().size();
-        r->tets = mesh.tet_count();
-        r->vertices = mesh.vertex_count();
-        r->min_dihedral = core->document->min_dihedral_deg();
-        r->backend = core->live->backend();
-        r->solver_description = core->live->solver_description();
-        r->gpu_fallback_reason = core->live->gpu_fallback_reason();
-        r->method_fallback_reason = core->live->method_fallback_reason();
-        r->ms = milliseconds_since(start);
+    tick_task_.start(label, [this, target, core, request](TaskProgress& progress) {
+        auto r = std::make_shared<SceneTickResult>(
+            core->tick(*request, [&progress](const std::string& stage) { progress.set_stage(stage); }));
         return BackgroundTask::Apply([this, target, r] {
             if (scene_.get() != target) return;  // another file was opened meanwhile
             Scene& s = *scene_;
@@ -480,7 +369,7 @@ void EditorApp::start_tick() {
             s.piece_transforms = std::move(r->piece_transforms);
             s.last_frame = r->frame;
             s.converged = r->converged;
-            s.estimated_error = r->error;
+            s.estimated_error = r->estimated_error;
             if (s.converged && s.render_input) s.exposure_locked = true;
             s.can_undo = r->can_undo;
             s.can_redo = r->can_redo;
@@ -492,9 +381,9 @@ void EditorApp::start_tick() {
             s.solver_description = r->solver_description;
             s.gpu_fallback_reason = r->gpu_fallback_reason;
             s.method_fallback_reason = r->method_fallback_reason;
-            s.tick_ms = r->ms;
+            s.tick_ms = r->milliseconds;
             if (!s.converged || r->frame.total_iterations() > 0) {
-                s.tick_ms_sum += r->ms;
+                s.tick_ms_sum += r->milliseconds;
                 ++s.ticks;
             }
         });
@@ -616,9 +505,8 @@ void EditorApp::remove_fragments() {
 
 void EditorApp::queue_history_step(bool redo) {
     queue_job(redo ? "redo" : "undo", [redo](SceneCore& core) {
-        const auto report = redo ? core.document->redo() : core.document->undo();
+        const auto report = redo ? core.redo() : core.undo();
         if (!report) return std::string(redo ? "Nothing to redo" : "Nothing to undo");
-        core.live->apply_change(core.document->mesh(), *report);
         return report->name;
     });
 }

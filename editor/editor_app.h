@@ -3,12 +3,12 @@
 // image), an orbit camera, and background tasks for everything slow.
 //
 // Threading: the UI thread owns every piece of editor state and never waits. Loading (reading,
-// meshing, building the Document and LiveScene) runs as one BackgroundTask; after that a second task
-// runs "ticks" one after another on a worker: each applies the queued edits (Document::apply, undo,
-// redo, saves) and lighting changes to the document and live scene, advances the solve by the
-// per-frame iteration budget (LiveScene::step) and prepares the next image input. Only the worker
-// touches the Document and LiveScene while a tick runs; the UI thread sees copies (EditorScene) that
-// it installs when it polls the finished tick, and queues new work for the next one.
+// meshing, building the SceneCore: document and live scene, scene/scene_core.h) runs as one
+// BackgroundTask; after that a second task runs SceneCore::tick one after another on a worker: each
+// applies the queued edits (apply, undo, redo, saves) and lighting changes to the document and live
+// scene, advances the solve by the per-frame budget and prepares the next image input. Only the worker
+// touches the SceneCore while a tick runs; the UI thread sees copies (EditorScene) that it installs
+// when it polls the finished tick, and queues new work for the next one.
 #pragma once
 
 #include "editor/background_task.h"
@@ -22,6 +22,7 @@
 #include "render/view_modes.h"
 #include "scene/document.h"
 #include "scene/live_scene.h"
+#include "scene/scene_core.h"
 #include "scene/session.h"
 #include "solver/light_spec.h"
 #include "solver/ray_caster.h"
@@ -92,21 +93,9 @@ class EditorApp;
 // Drives `app` in `window` through GLFW's installed callbacks (viewport_input.cpp), for --input.
 std::unique_ptr<ScriptTarget> make_window_script_target(GLFWwindow* window, EditorApp& app);
 
-// The document and its live scene, used by one worker tick at a time (never by the UI thread while a
-// tick runs). LiveScene borrows the document's mesh: `live` is declared last so it is destroyed first.
-struct SceneCore {
-    std::shared_ptr<Document> document;
-    std::shared_ptr<LiveScene> live;
-    Session setup;  // input, material, scale, lights, camera: the recorded session's head
-};
-
-// One queued piece of work for the next tick; returns a status line. Throws to report a failure
-// (the document is then unchanged, Document::apply's guarantee).
-using SceneJob = std::function<std::string(SceneCore&)>;
-
 // What the UI thread knows about the scene: copies refreshed after every tick.
 struct EditorScene {
-    std::shared_ptr<SceneCore> core;
+    std::shared_ptr<SceneCore> core;  // used by one worker tick at a time, never while a tick runs
     size_t tets = 0, vertices = 0;
     bool can_undo = false, can_redo = false;
     size_t history_size = 0;
@@ -294,14 +283,9 @@ private:
     bool show_error_popup_ = false;
     double last_render_ms_ = 0;
 
-    // The optional views (view_modes.h): the UI's choice, and the worker's cache of the geometry.
-    struct ViewWorkerState {
-        ViewGeometryCache cache;
-        long long geometry_version = 0, solution_version = 0;
-    };
+    // The optional views (view_modes.h): the UI's choice (SceneCore caches their geometry).
     ViewOptions view_options_ = options_.view;
     bool view_dirty_ = false;  // the choice changed: the next tick rebuilds the image input
-    std::shared_ptr<ViewWorkerState> view_worker_ = std::make_shared<ViewWorkerState>();
     std::shared_ptr<const ViewGeometry> view_geometry_;  // of the installed image input (the legend)
 };
 

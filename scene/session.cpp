@@ -11,6 +11,7 @@
 #include "render/render_input.h"
 #include "scene/json_fields.h"
 #include "scene/live_scene.h"
+#include "scene/scene_core.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/frame_budget.h"
 #include "solver/material.h"
@@ -378,10 +379,7 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
     Document document(load_session_input(session), session.material);
     result.load_ms = milliseconds_since(load_start);
     result.input_tets = document.mesh().tet_count();
-    LiveSceneOptions scene_options;
-    scene_options.mm_per_unit = session.scale;
-    scene_options.relative_tolerance = session.tolerance;
-    scene_options.crease_angle_degrees = session.crease_angle_degrees;
+    LiveSceneOptions scene_options;  // the scale, tolerance and crease angle come from the session
     scene_options.method = run_options.method;
     scene_options.backend = run_options.backend;
     // One GL context for the whole session, created at the first render (or now, for the GPU solver,
@@ -397,7 +395,8 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
         }
     }
     std::unique_ptr<SurfaceRenderer> renderer;
-    LiveScene scene(document.mesh(), session.lighting, scene_options);
+    // Declared after the context and the renderer: the live scene, which may use the context, goes first.
+    SceneCore core(std::move(document), session, scene_options);
     ImageSettings image;
     image.width = session.width;
     image.height = session.height;
@@ -412,24 +411,24 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
         m.name = step_kind(step);
         try {
             if (const auto* op = std::get_if<EditOperation>(&step)) {
-                scene.apply_change(document.mesh(), document.apply(*op));
+                core.apply(*op);
             } else if (const auto* r = std::get_if<RenderStep>(&step)) {
                 FrameReport frame;
                 if (r->frames) {
                     for (int f = 0; f < *r->frames; ++f) {
-                        frame = scene.step(session_frame_budget(session, run_options));
+                        frame = core.step(session_frame_budget(session, run_options));
                         m.solver_iterations += frame.total_iterations();
                     }
                 } else {
-                    frame = scene.converge();
+                    frame = core.converge();
                     m.solver_iterations = frame.total_iterations();
                 }
                 if (!context) context = std::make_unique<HeadlessGlContext>();
                 context->make_current();  // the solver may have used its own context meanwhile
                 if (!renderer) renderer = std::make_unique<SurfaceRenderer>(context->gl());
-                const SolvedScene solved = scene.solved_scene();
-                const Image picture =
-                    render_scene(*renderer, make_render_input(document.mesh(), solved, scene.lighting(), image));
+                const SolvedScene solved = core.live().solved_scene();
+                const Image picture = render_scene(
+                    *renderer, make_render_input(core.document().mesh(), solved, core.live().lighting(), image));
                 const fs::path path = output_directory / r->file;
                 create_parent_directory(path);
                 write_png(picture, path);
@@ -437,23 +436,19 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
             } else if (const auto* s = std::get_if<SaveStep>(&step)) {
                 const fs::path path = output_directory / s->file;
                 create_parent_directory(path);
-                write_volume(document.mesh(), path);
+                core.save_volume(path);
                 result.written.push_back(path);
             } else if (const auto* l = std::get_if<LightStep>(&step)) {
-                scene.set_lighting(l->lighting);
+                core.set_lighting(l->lighting);
             } else if (const auto* c = std::get_if<CameraStep>(&step)) {
                 image.camera = c->camera;
             } else if (const auto* u = std::get_if<UndoStep>(&step)) {
                 for (int k = 0; k < u->count; ++k) {
-                    const auto report = document.undo();
-                    if (!report) fail_json(context_name, "nothing left to undo");
-                    scene.apply_change(document.mesh(), *report);
+                    if (!core.undo()) fail_json(context_name, "nothing left to undo");
                 }
             } else {
                 for (int k = 0; k < std::get<RedoStep>(step).count; ++k) {
-                    const auto report = document.redo();
-                    if (!report) fail_json(context_name, "nothing left to redo");
-                    scene.apply_change(document.mesh(), *report);
+                    if (!core.redo()) fail_json(context_name, "nothing left to redo");
                 }
             }
         } catch (const FileError& e) {
@@ -467,9 +462,9 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
             throw AlgorithmError(context_name + ": " + e.what());
         }
         m.milliseconds = milliseconds_since(start);
-        m.tets = document.mesh().tet_count();
-        m.vertices = document.mesh().vertex_count();
-        const std::optional<double> error = scene.estimated_error();
+        m.tets = core.document().mesh().tet_count();
+        m.vertices = core.document().mesh().vertex_count();
+        const std::optional<double> error = core.live().estimated_error();
         m.estimated_error = error.value_or(-1);
         metrics.push_back(Json{{"step", i},
                                {"name", m.name},
@@ -484,20 +479,20 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
     const Json summary{{"session", session.name},
                        {"load_milliseconds", result.load_ms},
                        {"input_tets", result.input_tets},
-                       {"undo_bytes", document.undo_bytes()},
-                       {"undo_entries_evicted", document.evicted_undo_count()},
-                       {"solver_backend", live_backend_name(scene.backend())},
+                       {"undo_bytes", core.document().undo_bytes()},
+                       {"undo_entries_evicted", core.document().evicted_undo_count()},
+                       {"solver_backend", live_backend_name(core.live().backend())},
                        {"solver_method", live_method_name(run_options.method)},
                        // The time budget of the frames of render steps with "frames"; null: frame_iterations.
                        {"frame_ms", budget.limits_time() ? Json(budget.max_milliseconds) : Json(nullptr)},
-                       {"gpu_fallback_reason", scene.gpu_fallback_reason()},
-                       {"method_fallback_reason", scene.method_fallback_reason()},
+                       {"gpu_fallback_reason", core.live().gpu_fallback_reason()},
+                       {"method_fallback_reason", core.live().method_fallback_reason()},
                        {"steps", metrics}};
     write_file_atomically(output_directory / "metrics.json", [&](std::ostream& out) { out << summary.dump(2) << "\n"; });
-    result.mesh = document.mesh();
-    result.solver_backend = scene.backend();
-    result.gpu_fallback_reason = scene.gpu_fallback_reason();
-    result.method_fallback_reason = scene.method_fallback_reason();
+    result.mesh = core.document().mesh();
+    result.solver_backend = core.live().backend();
+    result.gpu_fallback_reason = core.live().gpu_fallback_reason();
+    result.method_fallback_reason = core.live().method_fallback_reason();
     return result;
 }
 

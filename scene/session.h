@@ -1,6 +1,7 @@
 // Scripted editing sessions: a JSON file that names an input, a material, lights, a camera
 // and a list of steps, replayed headless by `waxwork run SESSION.json -o OUTDIR` through the same
-// Document and LiveScene the editor uses, rendering frames with the OSMesa renderer.
+// SceneCore (scene_core.h: Document and LiveScene) the editor uses, rendering frames with the OSMesa
+// renderer.
 //
 //   {
 //     "input": {"surface": "spot.obj", "max_tets": 20000, "mesher": "tetgen"}   (or "edge": L; neither:
