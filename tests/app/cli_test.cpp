@@ -1,4 +1,5 @@
 // The command-line contract: subcommands, --help, errors, and the mesh/info pipeline end to end.
+#include "base/error.h"
 #include "io/volume_file.h"
 #include "io/vtu_format.h"
 #include "support/cli_run.h"
@@ -102,7 +103,7 @@ TEST(Cli, MissingAndCorruptFilesNameTheFile) {
         std::ofstream out(clear, std::ios::binary);
         format_vtu(cube, out);
     }
-    for (const std::string command : {"info " + clear.string(), "render " + clear.string() + " -o " + (dir / "clear.png").string(),
+    for (const std::string& command : {"info " + clear.string(), "render " + clear.string() + " -o " + (dir / "clear.png").string(),
                                       "cut " + clear.string() + " -o " + (dir / "c.vtu").string() + " --plane=1,0,0,0.5"}) {
         const auto m = run_waxwork(command);
         EXPECT_NE(m.exit_code, 0) << command;

@@ -81,7 +81,7 @@ TEST(CutPlane, RemovesExactlyTheTetsWithAllVerticesCutAway) {
 TEST(CutPlane, KeepsMaterialsAndTestsPiecesInWorldSpace) {
     TetMesh mesh = make_cube_mesh(4);
     mesh.materials.resize(mesh.tet_count());
-    for (size_t t = 0; t < mesh.tet_count(); ++t) mesh.materials[t].mua = {double(t), 0, 0};
+    for (size_t t = 0; t < mesh.tet_count(); ++t) mesh.materials[t] = TetMaterial{{double(t), 0, 0}, {1, 1, 1}, 1.3};
     // The piece sits at x in [10, 11] in world space; a cut at x > 10.5 must act on rest x > 0.5.
     mesh.piece_transforms[0].translation = Eigen::Vector3d(10, 0, 0);
     const TetMesh before = mesh;

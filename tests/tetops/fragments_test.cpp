@@ -23,7 +23,7 @@ using testing::make_cube_mesh;
 TetMesh body_and_speck() {
     TetMesh mesh = concatenate(make_cube_mesh(4), make_cube_mesh(1, Eigen::Vector3d(3, 0, 0), 0.1));
     mesh.materials.resize(mesh.tet_count());
-    for (size_t t = 0; t < mesh.tet_count(); ++t) mesh.materials[t].eta = 1.0 + 0.001 * static_cast<double>(t);
+    for (size_t t = 0; t < mesh.tet_count(); ++t) mesh.materials[t] = TetMaterial{{0.1, 0.1, 0.1}, {1, 1, 1}, 1.0 + 0.001 * static_cast<double>(t)};
     return mesh;
 }
 

@@ -317,7 +317,7 @@ TEST(SpatialOrder, KeepsTheMeshAndImprovesLocality) {
     for (int32_t t : perm) shuffled.push_back(mesh.tets[t]);
     TetMesh scrambled = make_tet_mesh(mesh.positions, shuffled);
     scrambled.materials.resize(scrambled.tet_count());
-    for (size_t t = 0; t < scrambled.tet_count(); ++t) scrambled.materials[t].eta = 1.0 + double(t) / 1e6;
+    for (size_t t = 0; t < scrambled.tet_count(); ++t) scrambled.materials[t] = TetMaterial{{0.1, 0.1, 0.1}, {1, 1, 1}, 1.0 + double(t) / 1e6};
     const double volume = total_volume(scrambled);
 
     // The mean index distance between face neighbours measures memory locality.
