@@ -2,7 +2,7 @@
 
 #include "base/error.h"
 #include "multires/independent_set.h"
-#include "tetops/cut.h"
+#include "tetops/vertex_map.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>

@@ -6,7 +6,7 @@
 #include "solver/reference/reference_solvers.h"
 
 #include "base/error.h"
-#include "tetops/cut.h"
+#include "tetops/vertex_map.h"
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>

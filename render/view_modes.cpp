@@ -1,6 +1,7 @@
 #include "render/view_modes.h"
 
 #include "base/error.h"
+#include "base/number_list.h"
 #include "multires/hierarchy.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/material.h"
@@ -10,7 +11,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 
 namespace waxwork {
@@ -91,19 +91,9 @@ Eigen::Vector3d parse_slice_normal(std::string_view text) {
     const auto fail = [&](const std::string& why) {
         throw InvalidArgumentError("bad slice normal '" + std::string(text) + "': " + why);
     };
-    Eigen::Vector3d normal;
-    std::string_view rest = text;
-    for (int k = 0; k < 3; ++k) {
-        const size_t comma = rest.find(',');
-        if ((k < 2) != (comma != std::string_view::npos)) fail("expected three numbers X,Y,Z");
-        std::string_view item = rest.substr(0, comma);
-        if (!item.empty() && item.front() == '+') item.remove_prefix(1);  // from_chars refuses a '+'
-        double value = 0;
-        const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
-        if (item.empty() || ec != std::errc() || ptr != item.data() + item.size()) fail("expected three numbers X,Y,Z");
-        normal[k] = value;
-        if (comma != std::string_view::npos) rest.remove_prefix(comma + 1);
-    }
+    std::vector<double> v;
+    if (!parse_number_list(text, v) || v.size() != 3) fail("expected three numbers X,Y,Z");
+    const Eigen::Vector3d normal(v[0], v[1], v[2]);
     if (!normal.allFinite() || normal.norm() == 0) fail("the normal must be finite and non-zero");
     return normal;
 }
@@ -117,16 +107,9 @@ std::array<float, 3> quality_colour(double angle) {
 std::array<float, 3> fluence_colour(double t) { return sample_stops(fluence_stops(), t); }
 
 std::array<float, 3> material_colour(const TetMaterial& material) {
-    // The colour a thick slab of the material shows under white light: the total diffuse
-    // reflectance of the dipole model (Jensen et al. 2001, Eq. 8 with the reduced albedo) per
-    // channel, which separates materials whose albedos all lie close to 1 far better than the albedo.
-    const double a = boundary_reflection_parameter(material.eta);
-    std::array<double, 3> reflectance{};
-    for (int c = 0; c < 3; ++c) {
-        const double albedo = material.musp[c] / std::max(material.musp[c] + material.mua[c], 1e-300);
-        const double s = std::sqrt(3.0 * (1.0 - albedo));
-        reflectance[c] = 0.5 * albedo * (1.0 + std::exp(-4.0 / 3.0 * a * s)) * std::exp(-s);
-    }
+    // The colour a thick slab of the material shows under white light, per channel: it separates
+    // materials whose albedos all lie close to 1 far better than the albedo does.
+    const std::array<double, 3> reflectance = diffuse_reflectance(material);
     const double peak = std::max({reflectance[0], reflectance[1], reflectance[2]});
     Colour colour{};
     for (int c = 0; c < 3; ++c) colour[c] = peak > 0 ? static_cast<float>(0.9 * reflectance[c] / peak) : 0.5f;

@@ -87,7 +87,8 @@ struct ViewGeometry {
 inline constexpr double kQualityRedDeg = 5, kQualityYellowDeg = 20, kQualityGreenDeg = 40;
 std::array<float, 3> quality_colour(double min_dihedral_deg);
 std::array<float, 3> fluence_colour(double t);
-// A material's display colour: its albedo per channel scaled so the largest channel is 0.9.
+// A material's display colour: its diffuse reflectance per channel (solver/material.h) scaled so the
+// largest channel is 0.9.
 std::array<float, 3> material_colour(const TetMaterial& material);
 
 // The individual views. `surface` is the scene's boundary (SolvedScene::surface): vertex colours are

@@ -15,8 +15,6 @@
 namespace waxwork {
 namespace {
 
-// Edge index (kTetEdges order) of the local vertex pair (a, b).
-constexpr std::array<std::array<int, 4>, 4> kEdgeOfPair = {{{-1, 0, 1, 2}, {0, -1, 3, 4}, {1, 3, -1, 5}, {2, 4, 5, -1}}};
 // For local vertex a, the other three in ascending order (the order of TetIncidence::slots).
 constexpr std::array<std::array<int, 3>, 4> kOthers = {{{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}}};
 
@@ -117,7 +115,7 @@ void assemble_row_impl(DiffusionMatrix& m, const TetConnectivity& conn, int32_t 
         const auto& co = coefficients[t];
         const double k0 = co.kappa[0], k1 = co.kappa[1], k2 = co.kappa[2];
         for (int s = 0; s < 3; ++s) {
-            const double g = 4.0 * geo.edge_stiffness[kEdgeOfPair[inc.local][kOthers[inc.local][s]]];
+            const double g = 4.0 * geo.edge_stiffness[tet_edge_index(inc.local, kOthers[inc.local][s])];
             const int32_t slot = inc.slots[s];
             const double w0 = k0 * g, w1 = k1 * g, w2 = k2 * g;  // M_ij = 4 w_ij (Eq. 14)
             val[0][slot] += w0;

@@ -56,6 +56,19 @@ double boundary_reflection_parameter(double eta) {
     return (1.0 + fdr) / (1.0 - fdr);
 }
 
+std::array<double, 3> diffuse_reflectance(const TetMaterial& material) {
+    const double a = boundary_reflection_parameter(material.eta);
+    std::array<double, 3> rd{};
+    for (int c = 0; c < 3; ++c) {
+        const double extinction = material.mua[c] + material.musp[c];
+        const double albedo = extinction > 0 ? material.musp[c] / extinction : 0.0;
+        // sigma_tr z_r of the real source; the virtual one lies (1 + 4A/3) times deeper.
+        const double root = std::sqrt(3 * (1 - albedo));
+        rd[c] = 0.5 * albedo * (1 + std::exp(-4.0 / 3.0 * a * root)) * std::exp(-root);
+    }
+    return rd;
+}
+
 double fresnel_transmittance(double cos_incident, double eta) {
     const double cos_i = std::clamp(cos_incident, 0.0, 1.0);
     const double sin_i2 = std::max(0.0, 1.0 - cos_i * cos_i);

@@ -12,6 +12,7 @@
 
 #include "tetops/tet_mesh.h"
 
+#include <array>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -35,6 +36,13 @@ double diffuse_fresnel_reflectance(double eta);
 
 // A = (1 + F_dr) / (1 - F_dr), the internal-reflection parameter of the Robin boundary (Eq. 2).
 double boundary_reflection_parameter(double eta);
+
+// Total diffuse reflectance R_d of a semi-infinite slab per rgb channel, in [0, 1): the dipole
+// profile R_d(r) of Jensen et al. 2001 integrated over the surface plane, which has the closed form
+// R_d = (alpha'/2) (1 + exp(-(4/3) A sqrt(3 (1 - alpha')))) exp(-sqrt(3 (1 - alpha'))) with the reduced
+// albedo alpha' = mu_s' / (mu_a + mu_s') and A = boundary_reflection_parameter(eta). Independent of
+// scale: the colour a thick slab of the material shows under white light, 1 without absorption.
+std::array<double, 3> diffuse_reflectance(const TetMaterial& material);
 
 // Unpolarised Fresnel transmittance 1 - (R_s + R_p)/2 for light arriving at angle acos(cos_incident)
 // from the side of index 1 onto a side of relative index eta. eta < 1 means leaving a denser medium:

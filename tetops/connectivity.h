@@ -39,6 +39,18 @@ struct BoundaryFace {
 inline constexpr std::array<std::array<int, 3>, 4> kTetFaces = {{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
 // The six edges of a tet as pairs of local vertex indices.
 inline constexpr std::array<std::array<int, 2>, 6> kTetEdges = {{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+// The index in kTetEdges of the edge between local vertices a and b, in either order (a != b, both in
+// [0, 4)): lo + hi - 1 in the order above, plus one past the three edges of vertex 0.
+constexpr int tet_edge_index(int a, int b) {
+    const int lo = a < b ? a : b, hi = a < b ? b : a;
+    return lo + hi - 1 + (lo > 0 ? 1 : 0);
+}
+static_assert([] {
+    for (int e = 0; e < 6; ++e)
+        if (tet_edge_index(kTetEdges[e][0], kTetEdges[e][1]) != e || tet_edge_index(kTetEdges[e][1], kTetEdges[e][0]) != e)
+            return false;
+    return true;
+}());
 
 struct TetConnectivity {
     // Unique undirected edges (a < b), sorted lexicographically.

@@ -1,6 +1,7 @@
 #include "tetops/cut.h"
 
 #include "base/error.h"
+#include "tetops/vertex_map.h"
 
 #include <tbb/parallel_for.h>
 
@@ -114,19 +115,7 @@ double StrokeCut::side(const Eigen::Vector3d& x) const {
 std::vector<Eigen::Vector3d> world_positions(const TetMesh& mesh) {
     std::vector<Eigen::Vector3d> world = mesh.positions;
     if (mesh.piece_ids.empty() || mesh.piece_transforms.empty()) return world;
-    // The piece of each vertex; -1 until a tet claims it.
-    std::vector<int32_t> vertex_piece(mesh.vertex_count(), -1);
-    for (size_t t = 0; t < mesh.tet_count(); ++t) {
-        const int32_t piece = mesh.piece_ids[t];
-        for (int32_t v : mesh.tets[t]) {
-            if (vertex_piece[v] == -1) {
-                vertex_piece[v] = piece;
-            } else if (vertex_piece[v] != piece) {
-                throw InvalidMeshError("vertex " + std::to_string(v) + " is shared by pieces " +
-                                       std::to_string(vertex_piece[v]) + " and " + std::to_string(piece));
-            }
-        }
-    }
+    const std::vector<int32_t> vertex_piece = vertex_pieces(mesh);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, world.size(), 4096), [&](const auto& range) {
         for (size_t v = range.begin(); v != range.end(); ++v) {
             const int32_t piece = vertex_piece[v];
@@ -160,13 +149,6 @@ CutResult remove_cut_away_tets(TetMesh& mesh, const CuttingSurface& surface) {
         }
     });
     return remove_tets(mesh, remove);
-}
-
-std::vector<int32_t> inverse_vertex_map(std::span<const int32_t> old_to_new, size_t vertices_after) {
-    std::vector<int32_t> new_to_old(vertices_after, -1);
-    for (size_t v = 0; v < old_to_new.size(); ++v)
-        if (old_to_new[v] >= 0) new_to_old[static_cast<size_t>(old_to_new[v])] = static_cast<int32_t>(v);
-    return new_to_old;
 }
 
 CutResult remove_tets(TetMesh& mesh, const std::vector<uint8_t>& remove) {

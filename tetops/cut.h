@@ -9,6 +9,7 @@
 #pragma once
 
 #include "tetops/tet_mesh.h"
+#include "tetops/vertex_map.h"  // inverse_vertex_map, for the maps of CutResult
 
 #include <cstdint>
 #include <span>
@@ -95,7 +96,8 @@ struct VertexOrigin {
 struct CutResult {
     size_t tets_removed = 0;
     size_t vertices_removed = 0;
-    // Per vertex of the mesh before the cut: its index after, or -1 when it was removed.
+    // Per vertex of the mesh before the cut: its index after, or -1 when it was removed
+    // (inverse_vertex_map reads it the other way).
     std::vector<int32_t> old_to_new_vertex;
     // Per tet after the cut: its index before (so per-tet arrays held elsewhere can follow).
     std::vector<int32_t> new_to_old_tet;
@@ -116,11 +118,6 @@ CutResult remove_cut_away_tets(TetMesh& mesh, const CuttingSurface& surface);
 // caller keeps its mesh unchanged. An empty volume can be neither lit nor rendered, and cutting on
 // the wrong side is an easy slip of a plane's sign or a stroke's direction.
 void require_tets_left_by_cut(const TetMesh& after, size_t tets_before);
-
-// A vertex map the other way: per vertex after an edit, its vertex before (-1: none maps there), from
-// old_to_new (per vertex before, its index after or -1; CutResult::old_to_new_vertex and the maps of
-// other edits). Entries of old_to_new must be below vertices_after.
-std::vector<int32_t> inverse_vertex_map(std::span<const int32_t> old_to_new, size_t vertices_after);
 
 // Removes the tets flagged in `remove` (one flag per tet) and the vertices left without a tet, with
 // the same compaction and bookkeeping as remove_cut_away_tets (which is this with a side test).

@@ -4,6 +4,7 @@
 #include "tetops/connectivity.h"
 #include "tetops/quality.h"
 #include "tetops/split_quality.h"
+#include "tetops/vertex_map.h"
 
 #include <tbb/parallel_for.h>
 
@@ -18,9 +19,6 @@
 namespace waxwork {
 namespace {
 
-// Local edge index of the tet edge (i, j), i != j, in the order of kTetEdges.
-constexpr int kEdgeIndex[4][4] = {{-1, 0, 1, 2}, {0, -1, 3, 4}, {1, 3, -1, 5}, {2, 4, 5, -1}};
-
 uint64_t edge_key(int32_t a, int32_t b) {
     const auto lo = static_cast<uint32_t>(std::min(a, b));
     const auto hi = static_cast<uint32_t>(std::max(a, b));
@@ -30,15 +28,6 @@ uint64_t edge_key(int32_t a, int32_t b) {
 int sign_of(double v) { return v > 0 ? 1 : (v < 0 ? -1 : 0); }
 
 bool crosses(int si, int sj) { return si * sj < 0; }
-
-// Per vertex: the transform of its piece (vertices belong to one piece; world_positions checks it).
-std::vector<int32_t> vertex_pieces(const TetMesh& mesh) {
-    std::vector<int32_t> piece(mesh.vertex_count(), -1);
-    if (mesh.piece_ids.size() != mesh.tet_count()) return piece;
-    for (size_t t = 0; t < mesh.tet_count(); ++t)
-        for (int32_t v : mesh.tets[t]) piece[v] = mesh.piece_ids[t];
-    return piece;
-}
 
 Eigen::Vector3d to_rest(const TetMesh& mesh, int32_t piece, const Eigen::Vector3d& world) {
     if (piece < 0 || static_cast<size_t>(piece) >= mesh.piece_transforms.size()) return world;
@@ -70,7 +59,7 @@ void split_tet(const Tet& g, const std::array<int, 4>& s, const std::array<int32
         if (s[i] < 0) neg[n_neg < 2 ? n_neg : 1] = i, ++n_neg;
     }
     if (n_pos == 2 && n_neg == 2) {
-        const auto c = [&](int p, int n) { return cut_vertex[kEdgeIndex[pos[p]][neg[n]]]; };
+        const auto c = [&](int p, int n) { return cut_vertex[tet_edge_index(pos[p], neg[n])]; };
         cap = {c(0, 0), c(0, 1), c(1, 1), c(1, 0)};
     } else {
         for (int e = 0; e < 6; ++e)
@@ -87,7 +76,7 @@ void split_tet(const Tet& g, const std::array<int, 4>& s, const std::array<int32
                 const int i = f[k], j = f[(k + 1) % 3];
                 if (side * s[i] >= 0) polygon.push_back(g[i]);
                 if (side * s[i] > 0) has_strict = true;
-                if (crosses(s[i], s[j])) polygon.push_back(cut_vertex[kEdgeIndex[i][j]]);
+                if (crosses(s[i], s[j])) polygon.push_back(cut_vertex[tet_edge_index(i, j)]);
             }
             if (polygon.size() >= 3 && has_strict) faces.push_back(std::move(polygon));
         }

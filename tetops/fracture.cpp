@@ -8,6 +8,7 @@
 #include "tetops/quality.h"
 #include "tetops/split_coarsening.h"
 #include "tetops/split_quality.h"
+#include "tetops/vertex_map.h"
 
 #include <nanoflann.hpp>
 #include <tbb/parallel_for.h>
@@ -458,9 +459,7 @@ WeldResult weld_touching_pieces(TetMesh& mesh, double tolerance) {
 
     const std::vector<Eigen::Vector3d> world = world_positions(mesh);
     const TetConnectivity connectivity = build_connectivity(mesh);
-    std::vector<int32_t> vertex_piece(mesh.vertex_count(), -1);
-    for (size_t t = 0; t < mesh.tet_count(); ++t)
-        for (int32_t v : mesh.tets[t]) vertex_piece[v] = mesh.piece_ids[t];
+    const std::vector<int32_t> vertex_piece = vertex_pieces(mesh);
 
     // Two vertices can be one point only when they are closer than half of either one's shortest
     // edge: farther apart, merging them folds an edge, and a tolerance above the edge length would

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <numbers>
 
 namespace waxwork {
 namespace {
@@ -24,6 +25,52 @@ TEST(Material, DerivedQuantities) {
     EXPECT_LT(fdr, 0.5);
     EXPECT_NEAR(boundary_reflection_parameter(1.3), (1 + fdr) / (1 - fdr), 1e-15);
     EXPECT_NEAR(diffuse_fresnel_reflectance(1.0), 0.0016, 1e-12);  // nearly no reflection at a matched index
+}
+
+TEST(Material, DiffuseReflectanceRanksMaterialsByHowMuchLightComesBack) {
+    // Strong absorption (ketchup's green and blue) reflects less than weak absorption (its red).
+    const auto ketchup = diffuse_reflectance(material_preset("ketchup"));
+    EXPECT_GT(ketchup[0], ketchup[1]);
+    EXPECT_GT(ketchup[0], ketchup[2]);
+    // No absorption reflects everything (a semi-infinite slab keeps no energy), more than any
+    // absorbing material.
+    TetMaterial white = material_preset("marble");
+    white.mua = {0, 0, 0};
+    const auto rd = diffuse_reflectance(white);
+    const auto marble = diffuse_reflectance(material_preset("marble"));
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_GT(rd[c], marble[c]);
+        EXPECT_NEAR(rd[c], 1.0, 1e-12);
+        EXPECT_GT(marble[c], 0.0);
+    }
+}
+
+TEST(Material, DiffuseReflectanceIsTheDipoleProfileIntegratedOverThePlane) {
+    // R_d(r) of the dipole (Jensen et al. 2001): a real source at z_r = 1 / sigma_t' and a negative
+    // virtual one at z_v = z_r (1 + 4A/3), integrated as 2 pi r R_d(r) dr by Simpson's rule.
+    for (const char* name : {"marble", "ketchup", "skimmilk"}) {
+        const TetMaterial m = material_preset(name);
+        const double a = boundary_reflection_parameter(m.eta);
+        const std::array<double, 3> closed = diffuse_reflectance(m);
+        for (int c = 0; c < 3; ++c) {
+            const double sigma_t = m.mua[c] + m.musp[c], albedo = m.musp[c] / sigma_t;
+            const double sigma_tr = std::sqrt(3 * m.mua[c] * sigma_t);
+            const double zr = 1 / sigma_t, zv = zr * (1 + 4 * a / 3);
+            const auto pole = [&](double z, double r) {
+                const double d = std::sqrt(r * r + z * z);
+                return z * (sigma_tr * d + 1) * std::exp(-sigma_tr * d) / (d * d * d);
+            };
+            const auto integrand = [&](double r) {
+                return 2 * std::numbers::pi * r * albedo / (4 * std::numbers::pi) * (pole(zr, r) + pole(zv, r));
+            };
+            const double end = 60 / sigma_tr + 60 * zv;  // the tail beyond is below e^-60
+            const int n = 200000;
+            const double h = end / n;
+            double sum = integrand(0) + integrand(end);
+            for (int i = 1; i < n; ++i) sum += (i % 2 ? 4 : 2) * integrand(i * h);
+            EXPECT_NEAR(sum * h / 3, closed[c], 1e-9 * closed[c]) << name << " channel " << c;
+        }
+    }
 }
 
 TEST(Material, FresnelTransmittance) {

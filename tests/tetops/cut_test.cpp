@@ -7,6 +7,7 @@
 #include "tetops/relaxation.h"
 #include "tetops/test_meshes.h"
 #include "tetops/tet_mesh.h"
+#include "tetops/vertex_map.h"
 
 #include <gtest/gtest.h>
 
