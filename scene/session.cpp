@@ -6,6 +6,7 @@
 #include "io/atomic_file.h"
 #include "io/file_extension.h"
 #include "io/image_io.h"
+#include "io/output_folder.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
 #include "render/render_input.h"
@@ -22,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <climits>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -116,11 +118,10 @@ std::string output_name(FieldReader& in, const std::string& key) {
     const Json& v = in.at(key);
     if (!v.is_string() || v.get<std::string>().empty()) fail_json(in.field(key), "expected a file name");
     // Outputs go to the run's output directory: a session from elsewhere writes nothing outside it.
-    const fs::path name(v.get<std::string>());
-    const bool climbs = std::any_of(name.begin(), name.end(), [](const fs::path& part) { return part == ".."; });
-    if (name.is_absolute() || climbs)
-        fail_json(in.field(key), "'" + name.string() + "' must stay inside the output directory (a relative path without '..')");
-    return name.string();
+    const std::string name = v.get<std::string>();
+    const std::string problem = output_name_problem(name);
+    if (!problem.empty()) fail_json(in.field(key), problem);
+    return name;
 }
 
 int count_from(FieldReader& in, const std::string& key) {
@@ -359,22 +360,28 @@ FrameBudget session_frame_budget(const Session& session, const SessionRunOptions
 
 namespace {
 
-// An output named "frames/f1.png" gets its folder inside the output directory (output_name keeps it
-// there); FileError naming the folder when it cannot be made (a file of that name, say).
-void create_parent_directory(const fs::path& path) {
-    std::error_code ec;
-    fs::create_directories(path.parent_path(), ec);
-    if (ec) throw FileError(path.parent_path().string(), "cannot create the directory: " + ec.message());
+// The file a render or save step writes, or nullptr.
+const std::string* output_file(const SessionStep& step) {
+    if (const auto* r = std::get_if<RenderStep>(&step)) return &r->file;
+    if (const auto* v = std::get_if<SaveStep>(&step)) return &v->file;
+    return nullptr;
 }
 
-}  // namespace
+Json written_to_json(const std::vector<fs::path>& written, const fs::path& output_directory) {
+    Json list = Json::array();
+    for (const fs::path& path : written) list.push_back(path.lexically_relative(output_directory).generic_string());
+    return list;
+}
 
-SessionResult run_session(const Session& session, const fs::path& output_directory, const SessionRunOptions& run_options) {
-    std::error_code ec;
-    fs::create_directories(output_directory, ec);
-    if (ec) throw FileError(output_directory.string(), "cannot create the directory: " + ec.message());
+// What a replay has done so far, for metrics.json when a step fails.
+struct ReplayProgress {
+    std::optional<size_t> step;  // the step running; nullopt while the input loads
+    Json steps = Json::array();  // metrics of the finished steps
+};
 
-    SessionResult result;
+// The replay behind run_session; returns metrics.json's summary without "status" and "written".
+Json replay_session(const Session& session, const fs::path& output_directory, const SessionRunOptions& run_options,
+                    SessionResult& result, ReplayProgress& progress) {
     const auto load_start = std::chrono::steady_clock::now();
     Document document(load_session_input(session), session.material);
     result.load_ms = milliseconds_since(load_start);
@@ -402,8 +409,8 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
     image.height = session.height;
     image.camera = session.camera;
 
-    Json metrics = Json::array();
     for (size_t i = 0; i < session.steps.size(); ++i) {
+        progress.step = i;
         const SessionStep& step = session.steps[i];
         const std::string context_name = session.name + ": step " + std::to_string(i) + " (" + step_kind(step) + ")";
         const auto start = std::chrono::steady_clock::now();
@@ -429,13 +436,11 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
                 const SolvedScene solved = core.live().solved_scene();
                 const Image picture = render_scene(
                     *renderer, make_render_input(core.document().mesh(), solved, core.live().lighting(), image));
-                const fs::path path = output_directory / r->file;
-                create_parent_directory(path);
+                const fs::path path = contained_output_path(output_directory, r->file);
                 write_png(picture, path);
                 result.written.push_back(path);
             } else if (const auto* s = std::get_if<SaveStep>(&step)) {
-                const fs::path path = output_directory / s->file;
-                create_parent_directory(path);
+                const fs::path path = contained_output_path(output_directory, s->file);
                 core.save_volume(path);
                 result.written.push_back(path);
             } else if (const auto* l = std::get_if<LightStep>(&step)) {
@@ -466,7 +471,7 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
         m.vertices = core.document().mesh().vertex_count();
         const std::optional<double> error = core.live().estimated_error();
         m.estimated_error = error.value_or(-1);
-        metrics.push_back(Json{{"step", i},
+        progress.steps.push_back(Json{{"step", i},
                                {"name", m.name},
                                {"milliseconds", m.milliseconds},
                                {"tets", m.tets},
@@ -476,8 +481,7 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
         result.steps.push_back(m);
     }
     const FrameBudget budget = session_frame_budget(session, run_options);
-    const Json summary{{"session", session.name},
-                       {"load_milliseconds", result.load_ms},
+    const Json summary{{"load_milliseconds", result.load_ms},
                        {"input_tets", result.input_tets},
                        {"undo_bytes", core.document().undo_bytes()},
                        {"undo_entries_evicted", core.document().evicted_undo_count()},
@@ -487,12 +491,60 @@ SessionResult run_session(const Session& session, const fs::path& output_directo
                        {"frame_ms", budget.limits_time() ? Json(budget.max_milliseconds) : Json(nullptr)},
                        {"gpu_fallback_reason", core.live().gpu_fallback_reason()},
                        {"method_fallback_reason", core.live().method_fallback_reason()},
-                       {"steps", metrics}};
-    write_file_atomically(output_directory / "metrics.json", [&](std::ostream& out) { out << summary.dump(2) << "\n"; });
+                       {"steps", progress.steps}};
     result.mesh = core.document().mesh();
     result.solver_backend = core.live().backend();
     result.gpu_fallback_reason = core.live().gpu_fallback_reason();
     result.method_fallback_reason = core.live().method_fallback_reason();
+    return summary;
+}
+
+}  // namespace
+
+SessionResult run_session(const Session& session, const fs::path& output_directory, const SessionRunOptions& run_options) {
+    std::error_code ec;
+    fs::create_directories(output_directory, ec);
+    if (ec) throw FileError(output_directory.string(), "cannot create the directory: " + ec.message());
+    // Every output's whole path must fit the system's limit with a save's temporary name: checked
+    // before the input is meshed, not at the step.
+    for (size_t i = 0; i < session.steps.size(); ++i) {
+        const std::string* name = output_file(session.steps[i]);
+        const size_t length = name ? (fs::absolute(output_directory) / *name).native().size() : 0;
+        if (length + (255 - kMaxSavedFileNameBytes) >= PATH_MAX)
+            throw InvalidArgumentError(session.name + ": step " + std::to_string(i) + " (" + step_kind(session.steps[i]) +
+                                       "): the output path is " + std::to_string(length) + " bytes long in " +
+                                       output_directory.string() + "; at most " +
+                                       std::to_string(PATH_MAX - 1 - (255 - kMaxSavedFileNameBytes)) + " fit");
+    }
+    const fs::path metrics_path = output_directory / "metrics.json";
+    const auto write_metrics = [&](const Json& summary) {
+        write_file_atomically(metrics_path, [&](std::ostream& out) { out << summary.dump(2) << "\n"; });
+    };
+
+    SessionResult result;
+    ReplayProgress progress;
+    Json summary;
+    try {
+        summary = replay_session(session, output_directory, run_options, result, progress);
+    } catch (const Error& e) {
+        // The outputs written before the failure stay (each one complete); metrics.json says which
+        // they are and where the replay stopped. The step's error is the one reported: a folder that
+        // cannot take metrics.json either must not hide it.
+        try {
+            write_metrics(Json{{"session", session.name},
+                               {"status", "failed"},
+                               {"failed_step", progress.step ? Json(*progress.step) : Json(nullptr)},
+                               {"error", e.what()},
+                               {"written", written_to_json(result.written, output_directory)},
+                               {"steps", progress.steps}});
+        } catch (const Error&) {
+        }
+        throw;
+    }
+    Json out{{"session", session.name}, {"status", "ok"}};
+    out.update(summary);
+    out["written"] = written_to_json(result.written, output_directory);
+    write_metrics(out);
     return result;
 }
 
