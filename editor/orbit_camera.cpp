@@ -14,7 +14,7 @@ OrbitCamera::OrbitCamera(const Eigen::AlignedBox3d& box, const CameraSettings& s
     centre_ = box.center();
     target_ = centre_ + settings.target_offset;
     radius_ = bounding_radius(box);
-    eye_direction_ = settings.eye_direction.normalized();
+    eye_direction_ = settings.eye_direction.stableNormalized();
     up_ = settings.up.normalized();
     fov_y_degrees_ = settings.fov_y_degrees;
     distance_ = (check.eye - target_).norm();

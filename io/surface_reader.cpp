@@ -1,6 +1,7 @@
 #include "io/surface_reader.h"
 
 #include "io/file_extension.h"
+#include "tetops/tet_mesh.h"
 
 #include "base/error.h"
 
@@ -550,9 +551,13 @@ TriangleSurface read_surface_file(const std::filesystem::path& path) {
     TriangleSurface surface;
     surface.points = soup.points;
     // The formats not checked above (PLY, binary or ascii) can still carry NaN or infinity.
-    for (size_t v = 0; v < surface.points.size(); ++v)
+    for (size_t v = 0; v < surface.points.size(); ++v) {
         if (!surface.points[v].allFinite())
             throw FileError(name, "vertex " + std::to_string(v) + " has a non-finite coordinate");
+        if (surface.points[v].cwiseAbs().maxCoeff() > kMaxCoordinate)
+            throw FileError(name, "vertex " + std::to_string(v) + " has a coordinate beyond " +
+                                      kMaxCoordinateText + " (the renderer's float arithmetic would overflow)");
+    }
     for (size_t f = 0; f < faces.size(); ++f) {
         const auto& face = faces[f];
         if (face.size() < 3)

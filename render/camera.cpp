@@ -8,25 +8,31 @@
 
 namespace waxwork {
 
+bool up_orients_view(const Eigen::Vector3d& eye_direction, const Eigen::Vector3d& up) {
+    if (!eye_direction.allFinite() || !up.allFinite()) return false;
+    if (eye_direction.cwiseAbs().maxCoeff() == 0 || up.cwiseAbs().maxCoeff() == 0) return false;
+    // Only the directions count: stableNormalized scales before squaring, so a vector of 1e308 (or
+    // 1e-300) is a direction like any other instead of overflowing (or underflowing) its norm.
+    return eye_direction.stableNormalized().cross(up.stableNormalized()).norm() >= 1e-9;
+}
+
 CameraFrame look_at_frame(const Eigen::Vector3d& target, const Eigen::Vector3d& eye_direction,
                           const Eigen::Vector3d& up_hint, double distance, double radius, double fov_y_degrees,
                           double aspect) {
     if (!target.allFinite() || !std::isfinite(distance) || !(distance > 0) || !std::isfinite(radius) || !(radius > 0)) {
         throw InvalidArgumentError("camera: target, distance and radius must be finite, distance and radius positive");
     }
-    if (!eye_direction.allFinite() || eye_direction.norm() == 0) {
+    if (!eye_direction.allFinite() || eye_direction.cwiseAbs().maxCoeff() == 0) {
         throw InvalidArgumentError("camera: eye direction must be finite and non-zero");
     }
     if (!(fov_y_degrees > 0 && fov_y_degrees < 180)) {
         throw InvalidArgumentError("camera: vertical field of view must be in (0, 180) degrees");
     }
     if (!(aspect > 0) || !std::isfinite(aspect)) throw InvalidArgumentError("camera: aspect ratio must be positive");
-    const Eigen::Vector3d forward = -eye_direction.normalized();  // eye -> target
-    Eigen::Vector3d right = forward.cross(up_hint);
-    if (!right.allFinite() || right.norm() < 1e-9 * up_hint.norm() || up_hint.norm() == 0) {
+    if (!up_orients_view(eye_direction, up_hint))
         throw InvalidArgumentError("camera: up vector is zero or parallel to the view direction");
-    }
-    right.normalize();
+    const Eigen::Vector3d forward = -eye_direction.stableNormalized();  // eye -> target
+    const Eigen::Vector3d right = forward.cross(up_hint.stableNormalized()).normalized();
     const Eigen::Vector3d up = right.cross(forward);
 
     CameraFrame frame;

@@ -21,6 +21,10 @@ struct CameraSettings {
     Eigen::Vector3d target_offset = Eigen::Vector3d::Zero();
 };
 
+// Whether `up` can orient a view along `eye_direction`: both finite and non-zero (of any magnitude)
+// and not parallel. What look_at_frame requires, for readers to check where the values enter.
+bool up_orients_view(const Eigen::Vector3d& eye_direction, const Eigen::Vector3d& up);
+
 struct CameraFrame {
     Eigen::Vector3d eye;
     Eigen::Matrix4d view;

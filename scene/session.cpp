@@ -9,6 +9,7 @@
 #include "io/output_folder.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
+#include "render/camera.h"
 #include "render/render_input.h"
 #include "scene/json_fields.h"
 #include "scene/live_scene.h"
@@ -94,8 +95,10 @@ void write_lighting_fields(const Lighting& lighting, Json& j) {
 CameraSettings camera_from_json(const Json& json, const std::string& context, CameraSettings camera) {
     FieldReader in(json, context);
     if (in.has("eye_direction")) camera.eye_direction = in.vector("eye_direction");
-    if (camera.eye_direction.norm() == 0) fail_json(in.field("eye_direction"), "must not be zero");
+    if (camera.eye_direction.cwiseAbs().maxCoeff() == 0) fail_json(in.field("eye_direction"), "must not be zero");
     if (in.has("up")) camera.up = in.vector("up");
+    if (!up_orients_view(camera.eye_direction, camera.up))
+        fail_json(in.field(in.has("up") ? "up" : "eye_direction"), "the up vector must not be zero or parallel to the eye direction");
     camera.fov_y_degrees = in.number("fov_y_deg", camera.fov_y_degrees);
     if (!(camera.fov_y_degrees > 1 && camera.fov_y_degrees < 170)) fail_json(in.field("fov_y_deg"), "must be in (1, 170)");
     camera.margin = in.number("margin", camera.margin);

@@ -26,12 +26,17 @@ double CuttingSurface::step_to_surface(const Eigen::Vector3d& from, const Eigen:
     return lo;
 }
 
-PlaneCut::PlaneCut(const Eigen::Vector3d& normal, double offset) {
-    if (!normal.allFinite() || !std::isfinite(offset))
-        throw InvalidArgumentError("cutting plane: normal and offset must be finite numbers");
+std::string plane_problem(const Eigen::Vector3d& normal, double offset) {
+    if (!normal.allFinite() || !std::isfinite(offset)) return "normal and offset must be finite numbers";
     const double length = normal.stableNorm();  // no overflow for huge components (1e300)
-    if (!(length > 0) || !std::isfinite(length))
-        throw InvalidArgumentError("cutting plane: the normal must not be the zero vector");
+    if (!(length > 0) || !std::isfinite(length)) return "the normal must not be the zero vector";
+    return "";
+}
+
+PlaneCut::PlaneCut(const Eigen::Vector3d& normal, double offset) {
+    const std::string problem = plane_problem(normal, offset);
+    if (!problem.empty()) throw InvalidArgumentError("cutting plane: " + problem);
+    const double length = normal.stableNorm();
     normal_ = normal / length;
     offset_ = offset / length;
 }

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace waxwork {
@@ -36,6 +37,9 @@ public:
     // side. The default bisects side(); surfaces with a closed form override it.
     virtual double step_to_surface(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
 };
+
+// What is wrong with the plane n.x = D ("" when nothing is): a non-finite number or a zero normal.
+std::string plane_problem(const Eigen::Vector3d& normal, double offset);
 
 // The plane n.x = D; the side n.x > D is cut away. The normal need not be unit length (it is
 // normalised, so side() is the signed Euclidean distance).

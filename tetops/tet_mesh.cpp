@@ -91,10 +91,6 @@ private:
     std::unordered_map<std::string, int> counts_;
 };
 
-// Coordinates beyond this overflow the products of volumes and quality measures (1e100 cubed is
-// 1e300, near double's largest).
-constexpr double kMaxCoordinate = 1e100;
-
 }  // namespace
 
 std::string material_problem(const TetMaterial& m) {
@@ -134,7 +130,8 @@ std::vector<std::string> find_invariant_violations(const TetMesh& mesh) {
         if (!mesh.positions[v].allFinite())
             log.add("coordinates", "vertex " + std::to_string(v) + " is not finite");
         else if (mesh.positions[v].cwiseAbs().maxCoeff() > kMaxCoordinate)
-            log.add("coordinates", "vertex " + std::to_string(v) + " lies beyond 1e100 (volumes would overflow)");
+            log.add("coordinates", "vertex " + std::to_string(v) + " lies beyond " + kMaxCoordinateText +
+                                       " (the renderer's float arithmetic would overflow)");
     }
     for (size_t i = 0; i < mesh.piece_transforms.size(); ++i) {
         const RigidTransform& x = mesh.piece_transforms[i];
@@ -144,7 +141,7 @@ std::vector<std::string> find_invariant_violations(const TetMesh& mesh) {
         if (!x.rotation.allFinite() || !x.translation.allFinite() || !orthonormal)
             log.add("transform", "piece transform " + std::to_string(i) + " is not a finite rigid motion");
         else if (x.translation.cwiseAbs().maxCoeff() > kMaxCoordinate)
-            log.add("transform", "piece transform " + std::to_string(i) + " moves beyond 1e100");
+            log.add("transform", "piece transform " + std::to_string(i) + " moves beyond " + kMaxCoordinateText);
     }
 
     std::vector<uint8_t> referenced(mesh.positions.size(), 0);

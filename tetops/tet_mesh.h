@@ -37,6 +37,13 @@ inline constexpr double kMaxCoefficientPerMm = 1e4;
 inline constexpr double kMinEta = 1.0;
 inline constexpr double kMaxEta = 3.0;
 
+// The largest coordinate magnitude of a model (surface or volume), in model units. The renderer and
+// the shadow rays work in float: a ray-triangle test multiplies up to three coordinate differences,
+// which stays far inside float's range (3.4e38) below (2e12)^3. At the smallest scale (1e-6 mm per
+// unit) 1e12 units are a kilometre, beyond any object diffusion can light.
+inline constexpr double kMaxCoordinate = 1e12;
+inline constexpr const char* kMaxCoordinateText = "1e12";  // for messages
+
 // What is wrong with `material` ("" when it is in the range above), e.g.
 // "mu_s' = 0 must be positive (the diffusion approximation needs scattering) (channel r)".
 std::string material_problem(const TetMaterial& material);

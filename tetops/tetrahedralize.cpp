@@ -161,6 +161,11 @@ void validate_surface(const TriangleSurface& surface) {
         throw InvalidMeshError("surface to mesh: enclosed volume is not positive (inward-facing triangles?)");
     }
     check_surface_span(surface);
+    for (size_t i = 0; i < surface.points.size(); ++i) {
+        if (surface.points[i].cwiseAbs().maxCoeff() > kMaxCoordinate)
+            throw InvalidMeshError("surface to mesh: point " + std::to_string(i) + " lies beyond " +
+                                   kMaxCoordinateText + " (the renderer's float arithmetic would overflow)");
+    }
 }
 
 // Predicted tet count of a size field: V / regular_volume(edge) for a uniform size; for a graded one

@@ -172,7 +172,9 @@ void run_cut_command(const CutCommandOptions& o) {
     const std::vector<double> p = parse_numbers(o.plane, 4, "cut --plane");
     PlaneCutOp op;
     op.plane = {Eigen::Vector3d(p[0], p[1], p[2]), p[3]};
-    PlaneCut(op.plane.normal, op.plane.offset);  // a zero or non-finite plane fails before the volume is read
+    // A zero or non-finite plane fails before the volume is read, naming the option.
+    if (const std::string problem = plane_problem(op.plane.normal, op.plane.offset); !problem.empty())
+        throw InvalidArgumentError("cut --plane=" + o.plane + ": " + problem);
     op.exact = o.exact;
     if (!o.exact) {  // --relax and --no-guard are unused by an exact cut
         if (o.relax_iterations < 0) throw InvalidArgumentError("cut --relax: the iteration count must be >= 0");

@@ -142,6 +142,8 @@ TEST(CutCommand, ExactCutLeavesTheCrossSectionOnThePlane) {
     const auto bad = run_waxwork("cut " + in.string() + " -o " + (dir / "x.vtu").string() + " --plane=0,0,0,1 --exact");
     EXPECT_NE(bad.exit_code, 0);
     EXPECT_EQ(line_count(bad.err), 1u);
+    EXPECT_NE(bad.err.find("cut --plane=0,0,0,1: the normal must not be the zero vector"), std::string::npos) << bad.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "x.vtu"));
 }
 
 TEST(CutCommand, ACutThatLeavesNothingIsAnErrorAndWritesNothing) {

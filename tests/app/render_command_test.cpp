@@ -320,7 +320,8 @@ TEST_F(Render, BadInputIsAOneLineError) {
          {" --light dir:1,0", " --light spot:0,0,1", " --light dir:1,0,0:1,1", " --light dir:0,0,0",
           " --light dir:1,0,0:-1,1,1", " --light dir:1,x,0", " --light point:1,2,3extra", " --material unobtainium",
           " --mua 0.1,0.1,0.1 --musp 0,1,1 --eta 1.3", " --mua nan,0.1,0.1 --musp 1,1,1 --eta 1.3", " --tol nan",
-          " --width 0", " --height -5", " --width 20000", " --scale 0", " --scale -3", " --scale inf", " --scale 1e300",
+          " --width 0", " --height -5", " --width 20000", " --width 8193", " --scale 0", " --scale -3", " --scale inf",
+          " --scale 1e300",
           " --method magic", " --view 0,0,0", " --exposure -1"}) {
         const auto r = run_waxwork(base + args);
         EXPECT_NE(r.exit_code, 0) << args;

@@ -401,6 +401,20 @@ TEST_F(SurfaceReaderFiles, NonFiniteBinaryCoordinatesAreNamed) {
     expect_file_error(file("nan.ply"), "vertex 3 has a non-finite coordinate");
 }
 
+// Float's largest value is a valid binary coordinate, but beyond what the renderer can multiply: refused
+// by the reader, as the volume readers refuse it, rather than by the renderer after meshing.
+TEST_F(SurfaceReaderFiles, CoordinatesBeyondTheRenderersRangeAreNamed) {
+    auto cube = make_openmesh_cube();
+    cube.set_point(OpenMesh::VertexHandle(5), {std::numeric_limits<float>::max(), 1.0f, 1.0f});
+    ASSERT_TRUE(OpenMesh::IO::write_mesh(cube, file("far.stl").string(), OpenMesh::IO::Options::Binary));
+    expect_file_error(file("far.stl"), "has a coordinate beyond 1e12");
+    ASSERT_TRUE(OpenMesh::IO::write_mesh(cube, file("far.ply").string(), OpenMesh::IO::Options::Binary));
+    expect_file_error(file("far.ply"), "vertex 5 has a coordinate beyond 1e12");
+    cube.set_point(OpenMesh::VertexHandle(5), {1e11f, 1.0f, 1.0f});
+    ASSERT_TRUE(OpenMesh::IO::write_mesh(cube, file("near.ply").string(), OpenMesh::IO::Options::Binary));
+    EXPECT_NO_THROW(read_surface_file(file("near.ply")));
+}
+
 TEST_F(SurfaceReaderFiles, BadOffFacesAreNamedWithTheirLine) {
     const std::string body = cube_off_body([](int k) { return corner(k) + "\n"; });
     std::string bad_index = body;

@@ -317,6 +317,40 @@ std::string error_of(Function&& function) {
     return {};
 }
 
+// A volume every reader accepts is one the renderer can draw: coordinates beyond float's range (or
+// beyond what float can multiply) are refused naming the file, and nothing of the kind is written.
+TEST_F(VolumeFileTest, CoordinatesBeyondTheRenderersRangeAreRefused) {
+    const TetMesh far = make_tet_mesh({{0, 0, 0}, {3.5e38, 0, 0}, {0, 3.5e38, 0}, {0, 0, 3.5e38}}, {{0, 1, 2, 3}});
+    for (const std::string name : {"far.vtu", "far.msh", "far.mesh", "far.node"})
+        EXPECT_THROW(write_volume(far, path(name)), InvalidMeshError) << name;
+    EXPECT_EQ(file_count(), 0u);
+    std::ostringstream node, ele, medit;
+    node.precision(17);
+    medit.precision(17);
+    node << far.vertex_count() << " 3 0 0\n";
+    medit << "MeshVersionFormatted 2\nDimension 3\nVertices\n" << far.vertex_count() << "\n";
+    for (size_t v = 0; v < far.vertex_count(); ++v) {
+        const Eigen::Vector3d& p = far.positions[v];
+        node << v << " " << p.x() << " " << p.y() << " " << p.z() << "\n";
+        medit << p.x() << " " << p.y() << " " << p.z() << " 0\n";
+    }
+    ele << far.tet_count() << " 4 0\n";
+    medit << "Tetrahedra\n" << far.tet_count() << "\n";
+    for (size_t t = 0; t < far.tet_count(); ++t) {
+        const auto& tet = far.tets[t];
+        ele << t << " " << tet[0] << " " << tet[1] << " " << tet[2] << " " << tet[3] << "\n";
+        medit << tet[0] + 1 << " " << tet[1] + 1 << " " << tet[2] + 1 << " " << tet[3] + 1 << " 0\n";
+    }
+    medit << "End\n";
+    write_text(path("far.node"), node.str());
+    write_text(path("far.ele"), ele.str());
+    write_text(path("far.mesh"), medit.str());
+    for (const std::string name : {"far.node", "far.mesh"}) {
+        const std::string e = error_of([&] { read_volume(path(name)); });
+        EXPECT_NE(e.find("lies beyond 1e12"), std::string::npos) << name << ": " << e;
+    }
+}
+
 TEST_F(VolumeFileTest, ErrorsNameTheFileAndTheProblem) {
     const std::string gmsh = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n3\n4\n"
                              "0 0 0\n1 0 0\n0 1 0\n0 0 1\n$EndNodes\n$Elements\n1 1 17 17\n3 1 4 1\n"

@@ -183,6 +183,20 @@ TEST(Camera, FramesTheBoxInsideTheFrustum) {
     EXPECT_THROW(frame_camera(box, bad, 1.0), InvalidArgumentError);
 }
 
+// Only the directions of the eye and up vectors count, at any magnitude a double holds.
+TEST(Camera, EyeAndUpVectorsOfAnyMagnitudeAreDirections) {
+    const Eigen::AlignedBox3d box(Eigen::Vector3d(-1, -2, 0), Eigen::Vector3d(3, 1, 2));
+    const CameraFrame unit = frame_camera(box, CameraSettings{}, 4.0 / 3.0);
+    for (const double magnitude : {1e308, 1e-300}) {
+        CameraSettings scaled;
+        scaled.eye_direction *= magnitude;
+        scaled.up *= magnitude;
+        const CameraFrame frame = frame_camera(box, scaled, 4.0 / 3.0);
+        EXPECT_LT((frame.view - unit.view).norm(), 1e-12 * unit.view.norm()) << magnitude;
+        EXPECT_LT((frame.projection - unit.projection).norm(), 1e-12 * unit.projection.norm()) << magnitude;
+    }
+}
+
 TEST(ImageIo, PngRoundTripIsExact) {
     Image image;
     image.width = 37;

@@ -117,6 +117,27 @@ TEST(Session, ErrorsNameTheFileAndTheStep) {
 
 // An input that fails to load names the session as well as the input, whichever error type it raises: the
 // input is a path relative to the session, and the user ran the session.
+// A camera that cannot be oriented is refused where it is read, not at the first render; a direction
+// of any magnitude is a direction.
+TEST(Session, CamerasAreCheckedWhenRead) {
+    std::string e = session_error(R"({"input": {"volume": "v.vtu"}, "camera": {"eye_direction": [0, 2, 0]}, "steps": []})");
+    EXPECT_NE(e.find("bad.json: field 'camera': field 'eye_direction': the up vector must not be zero or parallel"),
+              std::string::npos)
+        << e;
+    e = session_error(R"({"input": {"volume": "v.vtu"}, "steps": [{"render": "a.png"},
+                          {"camera": {"up": [0, 0, -1e308], "eye_direction": [0, 0, 1]}}]})");
+    EXPECT_NE(e.find("bad.json: step 1: field 'camera': field 'up': the up vector must not be zero or parallel"),
+              std::string::npos)
+        << e;
+    const Session huge = parse_session(Json::parse(R"({"input": {"volume": "v.vtu"},
+        "camera": {"eye_direction": [1e308, 0, 1e308], "up": [0, 1e-300, 0]}, "steps": []})"), "/d", "s.json");
+    const Eigen::AlignedBox3d box(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1));
+    CameraSettings unit = huge.camera;
+    unit.eye_direction = {1, 0, 1};
+    unit.up = {0, 1, 0};
+    EXPECT_LT((frame_camera(box, huge.camera, 1.0).view - frame_camera(box, unit, 1.0).view).norm(), 1e-12);
+}
+
 TEST(Session, InputErrorsNameTheSession) {
     const fs::path dir = scratch("input_errors");
     std::ofstream(dir / "empty.stl") << "solid x\nendsolid x\n";

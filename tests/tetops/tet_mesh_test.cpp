@@ -120,13 +120,22 @@ TEST(TetMesh, ValidateFindsEveryKindOfViolation) {
     folded.tets[1] = {0, 2, 1, 4};
     ASSERT_GT(signed_volume(folded, 1), 0);
     EXPECT_TRUE(find_invariant_violations(folded).empty());
-    // Coordinates and moves whose volumes would overflow.
-    TetMesh far = good;
-    far.positions[0].x() = 1e300;
-    EXPECT_TRUE(has(find_invariant_violations(far), "lies beyond 1e100"));
-    TetMesh far_move = good;
-    far_move.piece_transforms[0].translation.x() = 1e300;
-    EXPECT_TRUE(has(find_invariant_violations(far_move), "moves beyond 1e100"));
+    // Coordinates and moves beyond what the float renderer can multiply: refused whether they overflow
+    // float itself (3.5e38) or only its products (1e13), while a valid mesh just inside is kept.
+    for (const double reach : {1e300, 3.5e38, 1e13}) {
+        TetMesh far = good;
+        for (auto& p : far.positions) p *= reach;
+        EXPECT_TRUE(has(find_invariant_violations(far), "lies beyond 1e12 (the renderer's float arithmetic would overflow)"))
+            << reach;
+        TetMesh far_move = good;
+        far_move.piece_transforms[0].translation.x() = reach;
+        EXPECT_TRUE(has(find_invariant_violations(far_move), "moves beyond 1e12")) << reach;
+    }
+    TetMesh large = good;
+    double largest = 0;
+    for (const auto& p : large.positions) largest = std::max(largest, p.cwiseAbs().maxCoeff());
+    for (auto& p : large.positions) p *= 0.9e12 / largest;
+    EXPECT_TRUE(find_invariant_violations(large).empty());
 }
 
 TEST(TetMesh, ValidateReportIsBoundedForBadlyBrokenMeshes) {
