@@ -26,13 +26,25 @@ struct GmshNodes {
     std::unordered_map<int64_t, int32_t> index_of_tag;
 };
 
+// The first line of a $Nodes or $Elements section: the counts of blocks and of `item`s (then the
+// smallest and largest tag, unused), each checked against what the rest of the file can hold (a block
+// header takes at least 8 bytes, an item `item_bytes`).
+struct SectionCounts {
+    int64_t blocks = 0, items = 0;
+};
+SectionCounts read_section_counts(TextScanner& scanner, const std::string& item, size_t item_bytes) {
+    SectionCounts counts;
+    counts.blocks = scanner.next_integer("number of " + item + " blocks");
+    counts.items = scanner.next_integer("number of " + item + "s");
+    scanner.next_integer("minimum " + item + " tag");
+    scanner.next_integer("maximum " + item + " tag");
+    scanner.check_count(counts.blocks, 8, item + " blocks");
+    scanner.check_count(counts.items, item_bytes, item + "s");
+    return counts;
+}
+
 GmshNodes read_nodes(TextScanner& scanner) {
-    const int64_t block_count = scanner.next_integer("number of node blocks");
-    const int64_t node_count = scanner.next_integer("number of nodes");
-    scanner.next_integer("minimum node tag");
-    scanner.next_integer("maximum node tag");
-    scanner.check_count(block_count, 8, "node blocks");
-    scanner.check_count(node_count, 8, "nodes");
+    const auto [block_count, node_count] = read_section_counts(scanner, "node", 8);
     GmshNodes nodes;
     nodes.positions.reserve(static_cast<size_t>(node_count));
     nodes.index_of_tag.reserve(static_cast<size_t>(node_count));
@@ -74,12 +86,7 @@ GmshNodes read_nodes(TextScanner& scanner) {
 }
 
 std::vector<Tet> read_tets(TextScanner& scanner, const GmshNodes& nodes) {
-    const int64_t block_count = scanner.next_integer("number of element blocks");
-    const int64_t element_count = scanner.next_integer("number of elements");
-    scanner.next_integer("minimum element tag");
-    scanner.next_integer("maximum element tag");
-    scanner.check_count(block_count, 8, "element blocks");
-    scanner.check_count(element_count, 2, "elements");
+    const auto [block_count, element_count] = read_section_counts(scanner, "element", 2);
     std::vector<Tet> tets;
     int64_t seen = 0;
     for (int64_t block = 0; block < block_count; ++block) {

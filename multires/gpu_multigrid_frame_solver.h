@@ -78,9 +78,6 @@ public:
     const GpuBuffer& solution_buffer() const { return phi_; }
     GpuKernels& kernels() { return *kernels_; }
 
-    const MultiresHierarchy& hierarchy() const { return *hierarchy_; }
-    const MultigridPreconditioner& preconditioner() const { return *preconditioner_; }
-
 private:
     void precondition() override;
     MultigridCgState::StepSums step_sums() override;
@@ -93,8 +90,6 @@ private:
     // Uploads three host channels interleaved into `target`.
     void upload(const std::array<std::span<const double>, 3>& v, GpuBuffer& target);
 
-    std::unique_ptr<MultiresHierarchy> hierarchy_;
-    std::unique_ptr<MultigridPreconditioner> preconditioner_;
     std::unique_ptr<GpuKernels> kernels_;
     std::unique_ptr<GpuMultigridPreconditioner> device_;
     GpuBuffer b_, r_, z_, p_, q_, phi_, scratch_;

@@ -20,6 +20,7 @@
 
 #include <array>
 #include <limits>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -87,6 +88,9 @@ public:
     void set_relative_tolerance(double tolerance);
 
     size_t size() const { return n_; }
+    // The operators the V-cycle runs on (set by the subclass's constructor).
+    const MultiresHierarchy& hierarchy() const { return *hierarchy_; }
+    const MultigridPreconditioner& preconditioner() const { return *preconditioner_; }
 
 protected:
     using Rgb = MultigridCgState::Rgb;
@@ -140,6 +144,8 @@ protected:
 
     FrameSolverOptions options_;
     size_t n_ = 0;
+    std::unique_ptr<MultiresHierarchy> hierarchy_;
+    std::unique_ptr<MultigridPreconditioner> preconditioner_;
 
 private:
     FrameStep step_within(int max_vcycles, const FrameDeadline& deadline);

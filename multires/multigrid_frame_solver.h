@@ -67,9 +67,6 @@ public:
     // The current solution of one channel (valid until the next step or reset).
     std::span<const double> phi(int channel) const;
 
-    const MultiresHierarchy& hierarchy() const { return *hierarchy_; }
-    const MultigridPreconditioner& preconditioner() const { return *preconditioner_; }
-
 private:
     void precondition() override;
     MultigridCgState::StepSums step_sums() override;
@@ -83,8 +80,6 @@ private:
     // frame's 1e-2 is not.
     bool confirms_convergence() const override { return options_.relative_tolerance < 1e-6; }
 
-    std::unique_ptr<MultiresHierarchy> hierarchy_;
-    std::unique_ptr<MultigridPreconditioner> preconditioner_;
     std::vector<double> values_;  // level 0, the three channels interleaved (3 per stored entry)
     std::array<std::vector<double>, 3> phi_;
     std::vector<double> b_, r_, z_, p_, q_;  // interleaved: entry 3 i + c is channel c at vertex i

@@ -31,4 +31,18 @@ private:
     std::vector<std::array<double, 3>> q_;
 };
 
+// FrameSolver::radiance_on_device of a GPU frame solver whose device copy `device` (null until made)
+// holds a `solver` (with kernels(), solution_buffer() and size()) and its DeviceRadiance `radiance`:
+// E from the solver's resident phi, or null without a device copy.
+template <class Device>
+std::shared_ptr<const GpuBuffer> device_copy_radiance(GpuFrameContext& context, Device* device,
+                                                      const BoundarySurface& surface, const ShadingSurface& shading,
+                                                      const std::vector<std::array<double, 3>>& shading_q,
+                                                      std::vector<std::array<float, 3>>* host_copy) {
+    if (!device) return nullptr;
+    auto& solver = *device->solver;
+    return device->radiance.compute(context, solver.kernels(), solver.solution_buffer(), solver.size(), surface,
+                                    shading, shading_q, host_copy);
+}
+
 }  // namespace waxwork

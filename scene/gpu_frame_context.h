@@ -6,6 +6,7 @@
 // new worker thread.
 #pragma once
 
+#include "gl/gpu_compute.h"
 #include "gl/shared_context.h"
 #include "scene/frame_solver.h"
 
@@ -28,6 +29,20 @@ public:
     // (llvmpipe ...)".
     std::string with_renderer(std::string text) const;
 
+    // Makes the device copy `device` when there is none, on `gl` (this context, current): checks for
+    // compute shaders (GpuError without them), sets its `solver` to what `make_solver` returns and
+    // notes the renderer. Returns whether it made one (a new copy: the caller's pending changes restart).
+    template <class Device, class MakeSolver>
+    bool make_device(std::unique_ptr<Device>& device, const GlApi& gl, MakeSolver&& make_solver) {
+        if (device) return false;
+        require_compute_support(gl);
+        auto made = std::make_unique<Device>();
+        made->solver = make_solver();
+        device = std::move(made);
+        note_renderer(gl);
+        return true;
+    }
+
     // Frees `device` (an object holding buffers of this context) with the context current. Throws when
     // the context cannot be made current; `device` is then kept.
     template <class Device>
@@ -38,6 +53,16 @@ public:
             device.reset();
         } else {
             device.reset();
+        }
+    }
+    // The same for a new matrix (FrameSolver::matrix_rebuilt: a new pattern, made again at the next
+    // frame); a failure is the device's, reported as GpuError "GPU solver: ...".
+    template <class Device>
+    void free_device_for_new_matrix(std::unique_ptr<Device>& device) {
+        try {
+            free_device(device);
+        } catch (const std::exception& e) {
+            throw GpuError(std::string("GPU solver: ") + e.what());
         }
     }
     // The same where nothing could act on a failure (a destructor, a fallback): a context that cannot

@@ -8,11 +8,7 @@ namespace waxwork {
 
 void GpuJacobiFrameSolver::matrix_rebuilt(const TetMesh&, const DiffusionMatrix&, std::span<const int32_t>) {
     pending_ = PendingChanges{};  // the next device copy takes this matrix; b and phi to send
-    try {
-        context_.free_device(device_);  // a new pattern: made again at the next frame
-    } catch (const std::exception& e) {
-        throw GpuError(std::string("GPU solver: ") + e.what());
-    }
+    context_.free_device_for_new_matrix(device_);
 }
 
 FrameResult GpuJacobiFrameSolver::iterate(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
@@ -27,12 +23,7 @@ FrameResult GpuJacobiFrameSolver::iterate(const DiffusionMatrix& matrix, const s
     SolverGlContext& context = context_.open();
     const CurrentContext current(context);
     const GlApi& gl = context.gl();
-    if (!device_) {
-        require_compute_support(gl);
-        auto device = std::make_unique<Device>();
-        device->solver = std::make_unique<GpuDiffusionSolver>(gl, matrix);
-        device_ = std::move(device);
-        context_.note_renderer(gl);
+    if (context_.make_device(device_, gl, [&] { return std::make_unique<GpuDiffusionSolver>(gl, matrix); })) {
         pending_ = PendingChanges{};  // a new device copy: the current values; b and phi to send
     } else if (pending_.all_values) {
         device_->solver->update_values(matrix);
@@ -63,15 +54,6 @@ FrameResult GpuJacobiFrameSolver::iterate(const DiffusionMatrix& matrix, const s
     for (int c = 0; c < 3; ++c)
         result.channels[c] = {results[c].iterations, results[c].estimated_relative_error, results[c].converged};
     return result;
-}
-
-std::shared_ptr<const GpuBuffer> GpuJacobiFrameSolver::radiance_on_device(
-    const BoundarySurface& surface, const ShadingSurface& shading, const std::vector<std::array<double, 3>>& shading_q,
-    std::vector<std::array<float, 3>>* host_copy) {
-    if (!device_) return nullptr;
-    GpuDiffusionSolver& solver = *device_->solver;
-    return device_->radiance.compute(context_, solver.kernels(), solver.solution_buffer(), solver.size(), surface,
-                                     shading, shading_q, host_copy);
 }
 
 std::unique_ptr<FrameSolver> GpuJacobiFrameSolver::cpu_successor() { return std::make_unique<JacobiFrameSolver>(); }

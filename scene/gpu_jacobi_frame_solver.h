@@ -41,7 +41,9 @@ public:
 
     std::shared_ptr<const GpuBuffer> radiance_on_device(const BoundarySurface& surface, const ShadingSurface& shading,
                                                         const std::vector<std::array<double, 3>>& shading_q,
-                                                        std::vector<std::array<float, 3>>* host_copy) override;
+                                                        std::vector<std::array<float, 3>>* host_copy) override {
+        return device_copy_radiance(context_, device_.get(), surface, shading, shading_q, host_copy);
+    }
     std::unique_ptr<FrameSolver> cpu_successor() override;
     std::string description() const override { return context_.with_renderer("GPU Jacobi CG (float)"); }
 

@@ -65,33 +65,7 @@ void GpuMultigridFrameAdapter::matrix_rebuilt(const TetMesh& mesh, const Diffusi
         waiting_ = rebuilt_multigrid_operators(previous_hierarchy, previous_preconditioner, new_of_old_vertex, matrix,
                                                mesh.positions, options_);
     }
-    try {
-        context_.free_device(device_);  // a new pattern: made again at the next frame
-    } catch (const std::exception& e) {
-        throw GpuError(std::string("GPU solver: ") + e.what());
-    }
-}
-
-void GpuMultigridFrameAdapter::values_changed() {
-    forget_estimates();
-    pending_.values_changed();
-    waiting_ = MultigridOperators{};  // old values at level 0: the device solver builds afresh
-}
-
-void GpuMultigridFrameAdapter::rows_changed(std::span<const int32_t> rows) {
-    forget_estimates();
-    waiting_ = MultigridOperators{};  // old values at level 0: the device solver builds afresh
-    pending_.rows_changed(rows);
-}
-
-void GpuMultigridFrameAdapter::right_hand_sides_changed() {
-    pending_.right_hand_sides = true;
-    forget_estimates();
-}
-
-void GpuMultigridFrameAdapter::solution_changed() {
-    pending_.solution = true;
-    forget_estimates();
+    context_.free_device_for_new_matrix(device_);
 }
 
 FrameResult GpuMultigridFrameAdapter::iterate(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
@@ -105,32 +79,18 @@ FrameResult GpuMultigridFrameAdapter::iterate(const DiffusionMatrix& matrix, con
     SolverGlContext& context = context_.open();
     const CurrentContext current(context);
     const GlApi& gl = context.gl();
-    if (!device_) {
-        require_compute_support(gl);
+    const bool made = context_.make_device(device_, gl, [&] {
         FrameSolverOptions frame_options;
         frame_options.multigrid = options_;
-        auto device = std::make_unique<Device>();
-        device->solver = waiting_.hierarchy
-                             ? std::make_unique<GpuMultigridFrameSolver>(
-                                   gl, matrix, std::exchange(waiting_, MultigridOperators{}), frame_options)
-                             : std::make_unique<GpuMultigridFrameSolver>(gl, matrix, positions_, frame_options);
-        device_ = std::move(device);
-        context_.note_renderer(gl);
-        pending_ = PendingChanges{};  // a new device copy: the current values; b and phi to send
-    }
+        return waiting_.hierarchy ? std::make_unique<GpuMultigridFrameSolver>(
+                                        gl, matrix, std::exchange(waiting_, MultigridOperators{}), frame_options)
+                                  : std::make_unique<GpuMultigridFrameSolver>(gl, matrix, positions_, frame_options);
+    });
+    if (made) pending_ = PendingChanges{};  // a new device copy: the current values; b and phi to send
     GpuMultigridFrameSolver& solver = *device_->solver;
     result.channels = multigrid_frame(solver, pending_, error_, matrix, b, phi, limits, relative_tolerance, skip,
                                       [&] { phi = solver.phi(); });
     return result;
-}
-
-std::shared_ptr<const GpuBuffer> GpuMultigridFrameAdapter::radiance_on_device(
-    const BoundarySurface& surface, const ShadingSurface& shading, const std::vector<std::array<double, 3>>& shading_q,
-    std::vector<std::array<float, 3>>* host_copy) {
-    if (!device_) return nullptr;
-    GpuMultigridFrameSolver& solver = *device_->solver;
-    return device_->radiance.compute(context_, solver.kernels(), solver.solution_buffer(), solver.size(), surface,
-                                     shading, shading_q, host_copy);
 }
 
 std::unique_ptr<FrameSolver> GpuMultigridFrameAdapter::cpu_successor() {

@@ -14,23 +14,18 @@
 #include "multires/gpu_multigrid_frame_solver.h"
 #include "multires/multigrid_preconditioner.h"
 #include "scene/device_radiance.h"
-#include "scene/frame_solver.h"
 #include "scene/gpu_frame_context.h"
-#include "scene/pending_changes.h"
+#include "scene/multigrid_frame_adapter_base.h"
 
-#include <Eigen/Core>
-
-#include <array>
 #include <memory>
-#include <vector>
 
 namespace waxwork {
 
-class GpuMultigridFrameAdapter : public FrameSolver {
+class GpuMultigridFrameAdapter : public MultigridFrameAdapterBase {
 public:
     // `context` outlives this object.
     GpuMultigridFrameAdapter(GpuFrameContext& context, const MultigridOptions& options)
-        : context_(context), options_(options) {}
+        : MultigridFrameAdapterBase(options), context_(context) {}
     ~GpuMultigridFrameAdapter() override { context_.free_device_or_leak(device_); }
     GpuMultigridFrameAdapter(const GpuMultigridFrameAdapter&) = delete;
     GpuMultigridFrameAdapter& operator=(const GpuMultigridFrameAdapter&) = delete;
@@ -39,10 +34,6 @@ public:
     // solver and frees the device copy; throws GpuError when it cannot be freed.
     void matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix,
                         std::span<const int32_t> new_of_old_vertex) override;
-    void values_changed() override;
-    void rows_changed(std::span<const int32_t> rows) override;
-    void right_hand_sides_changed() override;
-    void solution_changed() override;
 
     FrameResult iterate(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
                         std::array<std::vector<double>, 3>& phi, const FrameLimits& limits, double relative_tolerance,
@@ -50,7 +41,9 @@ public:
 
     std::shared_ptr<const GpuBuffer> radiance_on_device(const BoundarySurface& surface, const ShadingSurface& shading,
                                                         const std::vector<std::array<double, 3>>& shading_q,
-                                                        std::vector<std::array<float, 3>>* host_copy) override;
+                                                        std::vector<std::array<float, 3>>* host_copy) override {
+        return device_copy_radiance(context_, device_.get(), surface, shading, shading_q, host_copy);
+    }
     std::unique_ptr<FrameSolver> cpu_successor() override;
 
     // The operators waiting for the next frame's device solver, else the device solver's.
@@ -63,20 +56,13 @@ private:
         std::unique_ptr<GpuMultigridFrameSolver> solver;
         DeviceRadiance radiance;  // freed before the solver whose kernels it uses
     };
-    void forget_estimates() { error_ = {1, 1, 1}; }
+    bool has_solver() const override { return device_ != nullptr; }
 
+    // positions_: kept from matrix_rebuilt for the device solver built at the next frame and for a CPU
+    // multigrid after a fallback (empty on an empty matrix); waiting_: the operators rebuilt around an
+    // edit, for that device solver; pending_: the device's record.
     GpuFrameContext& context_;
-    MultigridOptions options_;
-    // The mesh's rest positions (the hierarchy's Eq. 16 weights), kept from matrix_rebuilt for the
-    // device solver built at the next frame and for a CPU multigrid after a fallback. Empty on an
-    // empty matrix.
-    std::vector<Eigen::Vector3d> positions_;
-    // After an edit with a vertex map: the hierarchy and preconditioner rebuilt around the edit, for
-    // the device solver built at the next frame. Empty otherwise, and after painting (stale values).
-    MultigridOperators waiting_;
     std::unique_ptr<Device> device_;
-    PendingChanges pending_;                // the device's: values, b, and phi as a warm start
-    std::array<double, 3> error_{1, 1, 1};  // the last frame's estimates (1 after a change)
 };
 
 }  // namespace waxwork

@@ -13,11 +13,7 @@ void GpuMultiresFrameAdapter::matrix_rebuilt(const TetMesh& mesh, const Diffusio
     host_.matrix_rebuilt(mesh, matrix, new_of_old_vertex);
     device_pending_ = PendingChanges{};
     level_rows_.clear();
-    try {
-        context_.free_device(device_);  // a new pattern: made again at the next frame
-    } catch (const std::exception& e) {
-        throw GpuError(std::string("GPU solver: ") + e.what());
-    }
+    context_.free_device_for_new_matrix(device_);
 }
 
 void GpuMultiresFrameAdapter::values_changed() {
@@ -61,12 +57,7 @@ FrameResult GpuMultiresFrameAdapter::iterate(const DiffusionMatrix& matrix, cons
     const CurrentContext current(context);
     const GlApi& gl = context.gl();
     const MultiresHierarchy& hierarchy = host.hierarchy();
-    if (!device_) {
-        require_compute_support(gl);
-        auto device = std::make_unique<Device>();
-        device->solver = std::make_unique<GpuMultiresSolver>(gl, matrix, hierarchy);
-        device_ = std::move(device);
-        context_.note_renderer(gl);
+    if (context_.make_device(device_, gl, [&] { return std::make_unique<GpuMultiresSolver>(gl, matrix, hierarchy); })) {
         device_pending_ = PendingChanges{};  // a new device copy: the current values; b to send
         level_rows_.clear();
         host_.pending.solution = true;  // its phi starts at zero: start from the host phi (below)
@@ -140,15 +131,6 @@ FrameResult GpuMultiresFrameAdapter::iterate(const DiffusionMatrix& matrix, cons
         out[c] = {results[c].iterations, results[c].estimated_relative_error, results[c].converged};
     }
     return result;
-}
-
-std::shared_ptr<const GpuBuffer> GpuMultiresFrameAdapter::radiance_on_device(
-    const BoundarySurface& surface, const ShadingSurface& shading, const std::vector<std::array<double, 3>>& shading_q,
-    std::vector<std::array<float, 3>>* host_copy) {
-    if (!device_) return nullptr;
-    GpuMultiresSolver& solver = *device_->solver;
-    return device_->radiance.compute(context_, solver.kernels(), solver.solution_buffer(), solver.size(), surface,
-                                     shading, shading_q, host_copy);
 }
 
 std::unique_ptr<FrameSolver> GpuMultiresFrameAdapter::cpu_successor() {

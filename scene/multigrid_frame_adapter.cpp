@@ -10,7 +10,7 @@ namespace waxwork {
 
 MultigridFrameAdapter::MultigridFrameAdapter(const MultigridOptions& options, std::vector<Eigen::Vector3d> positions,
                                              MultigridOperators waiting, const std::array<double, 3>& error)
-    : options_(options), error_(error), positions_(std::move(positions)), waiting_(std::move(waiting)) {}
+    : MultigridFrameAdapterBase(options, std::move(positions), std::move(waiting), error) {}
 
 void MultigridFrameAdapter::matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix,
                                            std::span<const int32_t> new_of_old_vertex) {
@@ -39,28 +39,6 @@ void MultigridFrameAdapter::build(std::span<const Eigen::Vector3d> positions, co
                                                                  new_of_old_vertex)
                         : std::make_unique<MultigridFrameSolver>(matrix, positions, frame_options);
     pending_ = PendingChanges{};  // a new solver: b and phi to send
-}
-
-void MultigridFrameAdapter::values_changed() {
-    forget_estimates();
-    pending_.values_changed();
-    waiting_ = MultigridOperators{};  // old values at level 0: the solver is built afresh
-}
-
-void MultigridFrameAdapter::rows_changed(std::span<const int32_t> rows) {
-    forget_estimates();
-    waiting_ = MultigridOperators{};  // old values at level 0: the solver is built afresh
-    if (solver_) pending_.rows_changed(rows);  // a solver built later takes the current values
-}
-
-void MultigridFrameAdapter::right_hand_sides_changed() {
-    pending_.right_hand_sides = true;
-    forget_estimates();
-}
-
-void MultigridFrameAdapter::solution_changed() {
-    pending_.solution = true;
-    forget_estimates();
 }
 
 FrameResult MultigridFrameAdapter::iterate(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,

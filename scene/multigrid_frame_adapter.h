@@ -7,22 +7,16 @@
 #pragma once
 
 #include "multires/multigrid_frame_solver.h"
-#include "multires/multigrid_preconditioner.h"
-#include "scene/frame_solver.h"
-#include "scene/pending_changes.h"
+#include "scene/multigrid_frame_adapter_base.h"
 
-#include <Eigen/Core>
-
-#include <array>
 #include <memory>
 #include <optional>
-#include <vector>
 
 namespace waxwork {
 
-class MultigridFrameAdapter : public FrameSolver {
+class MultigridFrameAdapter : public MultigridFrameAdapterBase {
 public:
-    explicit MultigridFrameAdapter(const MultigridOptions& options) : options_(options) {}
+    explicit MultigridFrameAdapter(const MultigridOptions& options) : MultigridFrameAdapterBase(options) {}
     // Going on from the GPU multigrid CG after a device failure: built at the next frame from the rest
     // positions the device solver was built from and, when the operators waiting for the device are
     // this matrix's, their hierarchy; `error`: the device's last estimates.
@@ -31,10 +25,6 @@ public:
 
     void matrix_rebuilt(const TetMesh& mesh, const DiffusionMatrix& matrix,
                         std::span<const int32_t> new_of_old_vertex) override;
-    void values_changed() override;
-    void rows_changed(std::span<const int32_t> rows) override;
-    void right_hand_sides_changed() override;
-    void solution_changed() override;
 
     // The deadline is checked between V-cycles (at least one runs).
     FrameResult iterate(const DiffusionMatrix& matrix, const std::array<std::vector<double>, 3>& b,
@@ -51,17 +41,12 @@ private:
     void build(std::span<const Eigen::Vector3d> positions, const DiffusionMatrix& matrix,
                std::optional<MultiresHierarchy> hierarchy = std::nullopt,
                const MultigridFrameSolver* previous = nullptr, std::span<const int32_t> new_of_old_vertex = {});
-    void forget_estimates() { error_ = {1, 1, 1}; }
+    bool has_solver() const override { return solver_ != nullptr; }
 
-    MultigridOptions options_;
+    // positions_ and waiting_ are set only after a GPU fallback, until the next frame builds the
+    // solver: the mesh's rest positions and the operators that were waiting for the device (their
+    // hierarchy is this matrix's unless painting cleared them since).
     std::unique_ptr<MultigridFrameSolver> solver_;  // null on an empty matrix, or until built
-    PendingChanges pending_;                        // values, b, and phi as a warm start
-    std::array<double, 3> error_{1, 1, 1};          // the last frame's estimates (1 after a change)
-    // After a GPU fallback, until the next frame builds the solver: the mesh's rest positions and the
-    // operators that were waiting for the device (their hierarchy is this matrix's unless painting
-    // cleared them since). Empty otherwise.
-    std::vector<Eigen::Vector3d> positions_;
-    MultigridOperators waiting_;
 };
 
 }  // namespace waxwork

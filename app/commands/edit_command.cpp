@@ -19,52 +19,31 @@
 namespace waxwork {
 namespace {
 
+// The editor's own options are bound to `editor` directly; the rest are text parsed into it.
 struct EditCommandOptions {
-    std::string file;
-    std::string session;
-    std::string screenshot;
+    EditorOptions editor;
     std::string input;
-    int frames = 10;
-    bool hide_ui = false;
-    int width = 1280;
-    int height = 800;
-    std::optional<size_t> max_tets;
     MaterialOptions material;
     std::vector<std::string> lights;
-    double scale = 1.0;
-    double crease_angle = kDefaultCreaseAngleDegrees;
     std::vector<double> view;
     std::string show = "radiance";
     std::string slice_normal;
-    double slice_offset = 0;
-    bool quality_interior = false;
     LiveSolverChoice solver;
 };
 
 void run_edit_command(const EditCommandOptions& o) {
-    if (o.width < 64 || o.height < 64 || o.width > kMaxImageSide || o.height > kMaxImageSide)
+    EditorOptions options = o.editor;
+    if (options.width < 64 || options.height < 64 || options.width > kMaxImageSide || options.height > kMaxImageSide)
         throw InvalidArgumentError("--width/--height must be between 64 and " + std::to_string(kMaxImageSide));
-    if (o.frames < 1 || o.frames > 100000) throw InvalidArgumentError("--frames must be between 1 and 100000");
-    validate_mm_per_unit(o.scale, "--scale");
-    if (!is_crease_angle(o.crease_angle))
+    if (options.frames < 1 || options.frames > 100000)
+        throw InvalidArgumentError("--frames must be between 1 and 100000");
+    validate_mm_per_unit(options.scale, "--scale");
+    if (!is_crease_angle(options.crease_angle_degrees))
         throw InvalidArgumentError("--crease-angle must be between 0 and 180 degrees");
-    EditorOptions options;
     options.view.mode = parse_view_mode(o.show);
     if (!o.slice_normal.empty()) options.view.slice_normal = parse_slice_normal(o.slice_normal);
-    options.view.slice_offset = o.slice_offset;
-    options.view.quality_interior = o.quality_interior;
     validate(options.view);
-    options.file = o.file;
-    options.session = o.session;
-    options.screenshot = o.screenshot;
-    options.frames = o.frames;
-    options.hide_ui = o.hide_ui;
-    options.width = o.width;
-    options.height = o.height;
-    options.max_tets = o.max_tets;
     options.material = chosen_material(o.material);
-    options.scale = o.scale;
-    options.crease_angle_degrees = o.crease_angle;
     options.solver_backend = parse_live_backend(o.solver.backend);
     options.solver_method = parse_live_method(o.solver.method);
     options.frame_ms = o.solver.frame_ms;
@@ -78,9 +57,9 @@ void run_edit_command(const EditCommandOptions& o) {
         if (v.normalized().cross(options.camera.up).norm() < 1e-3) options.camera.up = Eigen::Vector3d(0, 0, -1);
     }
     const EditorRunStats stats = run_editor(options);
-    if (!o.screenshot.empty()) {
+    if (!options.screenshot.empty()) {
         const nlohmann::ordered_json summary = {
-            {"screenshot", o.screenshot},  {"frames", stats.frames},
+            {"screenshot", options.screenshot.string()},  {"frames", stats.frames},
             {"frame_ms", stats.mean_frame_ms}, {"view_ms", stats.mean_view_ms},
             {"solver_ticks", stats.ticks}, {"tick_ms", stats.tick_ms}, {"tets", stats.tets},
             {"vertices", stats.vertices},  {"gl_version", stats.gl_version},
@@ -98,28 +77,28 @@ void run_edit_command(const EditCommandOptions& o) {
 void add_edit_command(CLI::App& app) {
     auto options = std::make_shared<EditCommandOptions>();
     CLI::App* cmd = app.add_subcommand("edit", "Open the interactive editor (needs a display)");
-    cmd->add_option("file", options->file, "Surface (OBJ, OFF, PLY, STL) or volume (VTU, MSH, MESH, NODE) to open")
+    cmd->add_option("file", options->editor.file, "Surface (OBJ, OFF, PLY, STL) or volume (VTU, MSH, MESH, NODE) to open")
         ->check(CLI::ExistingFile);
-    cmd->add_option("--session", options->session,
+    cmd->add_option("--session", options->editor.session,
                     "Open a session file (as `waxwork run` takes): its input, material, lights and camera, with "
                     "its edits replayed (undoable); File > Save session records yours")
         ->check(CLI::ExistingFile);
-    cmd->add_option("--screenshot", options->screenshot,
+    cmd->add_option("--screenshot", options->editor.screenshot,
                     "Draw --frames frames after loading and solving, save the window to this PNG and exit");
     cmd->add_option("--input", options->input,
                     "Replay this JSON list of timed mouse and key events into the window (editor/input_script.h)")
         ->check(CLI::ExistingFile);
-    cmd->add_option("--frames", options->frames, "Frames drawn before the screenshot")->capture_default_str();
-    cmd->add_flag("--hide-ui", options->hide_ui, "Show the 3D view alone (Tab toggles it)");
-    cmd->add_option("--width", options->width, "Window width")->capture_default_str();
-    cmd->add_option("--height", options->height, "Window height")->capture_default_str();
-    add_max_tets_option(*cmd, options->max_tets, "Meshing a surface: about this many tets");
+    cmd->add_option("--frames", options->editor.frames, "Frames drawn before the screenshot")->capture_default_str();
+    cmd->add_flag("--hide-ui", options->editor.hide_ui, "Show the 3D view alone (Tab toggles it)");
+    cmd->add_option("--width", options->editor.width, "Window width")->capture_default_str();
+    cmd->add_option("--height", options->editor.height, "Window height")->capture_default_str();
+    add_max_tets_option(*cmd, options->editor.max_tets, "Meshing a surface: about this many tets");
     add_material_options(*cmd, options->material);
     cmd->add_option("--light", options->lights, "dir:X,Y,Z[:R,G,B] or point:X,Y,Z[:R,G,B], as for render")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-    cmd->add_option("--scale", options->scale, "Millimetres per model unit")->capture_default_str();
-    cmd->add_option("--crease-angle", options->crease_angle,
+    cmd->add_option("--scale", options->editor.scale, "Millimetres per model unit")->capture_default_str();
+    cmd->add_option("--crease-angle", options->editor.crease_angle_degrees,
                     "Shade and light the surface as folded where neighbouring triangles turn by more than "
                     "this many degrees, as for render (a session's own value wins)")
         ->capture_default_str();
@@ -130,9 +109,9 @@ void add_edit_command(CLI::App& app) {
                     "What the view shows, as for render: radiance, materials, quality, wireframe, slice, levels")
         ->capture_default_str();
     cmd->add_option("--slice-normal", options->slice_normal, "--show slice: X,Y,Z, pointing at the half cut away");
-    cmd->add_option("--slice-offset", options->slice_offset, "--show slice: offset in [-1, 1] half extents")
+    cmd->add_option("--slice-offset", options->editor.view.slice_offset, "--show slice: offset in [-1, 1] half extents")
         ->capture_default_str();
-    cmd->add_flag("--quality-interior", options->quality_interior,
+    cmd->add_flag("--quality-interior", options->editor.view.quality_interior,
                   "--show quality: also cut at the slice plane and colour the cross-section's tets");
     add_live_solver_options(*cmd, options->solver, "in a context shared with the window");
     cmd->footer(

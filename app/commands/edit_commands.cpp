@@ -11,6 +11,7 @@
 // summary on stdout.
 #include "app/options/material_options.h"
 #include "base/error.h"
+#include "base/number_list.h"
 #include "base/timing.h"
 #include "io/volume_file.h"
 #include "scene/document.h"
@@ -25,7 +26,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -41,28 +41,19 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Comma-separated finite numbers, exactly `count` of them; `what` names the option in errors.
+// Comma-separated finite numbers, exactly `count` of them, blanks allowed around each; `what` names
+// the option in errors. A value beyond double's normal range (overflow, or underflow to a subnormal)
+// is refused as not a finite number: it is a typing error, not a plane or a position.
 std::vector<double> parse_numbers(const std::string& text, size_t count, const std::string& what) {
     std::vector<double> values;
-    size_t begin = 0;
-    while (true) {
-        const size_t end = text.find(',', begin);
-        const std::string field = text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
-        char* stop = nullptr;
-        errno = 0;
-        const double value = std::strtod(field.c_str(), &stop);
-        const char* field_end = field.c_str() + field.size();
-        const bool blank_rest = stop && std::all_of(static_cast<const char*>(stop), field_end, [](char c) {
-            return std::isspace(static_cast<unsigned char>(c)) != 0;
-        });
-        if (field.empty() || stop == field.c_str() || !blank_rest || errno == ERANGE || !std::isfinite(value))
-            throw InvalidArgumentError(what + ": \"" + text + "\" is not " +
-                                       (count == 1 ? std::string("a finite number")
-                                                   : std::to_string(count) + " comma-separated finite numbers"));
-        values.push_back(value);
-        if (end == std::string::npos) break;
-        begin = end + 1;
-    }
+    const bool numbers = parse_number_list(text, values, NumberSpacing::Blanks) &&
+                         std::all_of(values.begin(), values.end(), [](double v) {
+                             return v == 0 || std::isnormal(v);
+                         });
+    if (!numbers)
+        throw InvalidArgumentError(what + ": \"" + text + "\" is not " +
+                                   (count == 1 ? std::string("a finite number")
+                                               : std::to_string(count) + " comma-separated finite numbers"));
     if (values.size() != count)
         throw InvalidArgumentError(what + ": expected " + std::to_string(count) + " comma-separated numbers, got " +
                                    std::to_string(values.size()) + " in \"" + text + "\"");

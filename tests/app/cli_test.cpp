@@ -16,14 +16,10 @@
 namespace waxwork {
 namespace {
 
-using testing::run_waxwork;
-using testing::scratch_dir;
+using namespace testing;
 namespace fs = std::filesystem;
 
-const std::string kAssets = WAXWORK_ASSET_DIR;
 const std::string kShared = WAXWORK_SHARED_DIR;
-
-using testing::line_count;
 
 TEST(Cli, HelpOnEveryCommand) {
     for (const std::string command : {"", "mesh", "info"}) {
@@ -67,6 +63,27 @@ TEST(Cli, EmptyOptionValuesAreRefusedNamingTheOption) {
     EXPECT_FALSE(fs::exists(out));
     // The same options with values still run.
     EXPECT_EQ(run_waxwork("cut " + in + " -o " + out + " --plane=1,0,0,0 --relax 2").exit_code, 0);
+}
+
+// cut --plane takes four comma-separated finite numbers, blanks allowed around each (a quoted
+// "1, 0, 0, 0"); anything else is one line naming the option and the text.
+TEST(Cli, CutPlaneIsFourFiniteNumbers) {
+    const auto dir = scratch_dir("cli_plane");
+    const fs::path volume = dir / "cube.vtu";
+    write_volume(testing::make_cube_mesh(3), volume);
+    const std::string cut = "cut " + volume.string() + " -o " + (dir / "out.vtu").string();
+    EXPECT_EQ(run_waxwork(cut + " --plane ' 1, 0 ,0, 0.1'").exit_code, 0);
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"1,0,x,0", "cut --plane: \"1,0,x,0\" is not 4 comma-separated finite numbers"},
+        {"1,0,1e999,0", "cut --plane: \"1,0,1e999,0\" is not 4 comma-separated finite numbers"},
+        {"1,0,0", "cut --plane: expected 4 comma-separated numbers, got 3 in \"1,0,0\""},
+    };
+    for (const auto& [plane, message] : cases) {
+        const auto r = run_waxwork(cut + " --plane=" + plane);
+        EXPECT_NE(r.exit_code, 0) << plane;
+        EXPECT_EQ(line_count(r.err), 1u) << plane << ": " << r.err;
+        EXPECT_NE(r.err.find(message), std::string::npos) << plane << ": " << r.err;
+    }
 }
 
 TEST(Cli, MissingAndCorruptFilesNameTheFile) {

@@ -18,12 +18,8 @@
 namespace waxwork {
 namespace {
 
-using testing::line_count;
-using testing::run_waxwork;
-using testing::scratch_dir;
+using namespace testing;
 namespace fs = std::filesystem;
-
-const std::string kAssets = WAXWORK_ASSET_DIR;
 
 // The embedded cube meshed once per test into `dir`.
 fs::path meshed_cube(const fs::path& dir) {

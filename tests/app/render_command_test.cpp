@@ -17,14 +17,10 @@
 namespace waxwork {
 namespace {
 
-using testing::run_waxwork;
-using testing::scratch_dir;
+using namespace testing;
 namespace fs = std::filesystem;
 
-const std::string kAssets = WAXWORK_ASSET_DIR;
 constexpr const char* kHeader = "x,y,z,boundary,q_r,q_g,q_b,phi_r,phi_g,phi_b,lo_r,lo_g,lo_b";
-
-using testing::line_count;
 
 struct FieldRow {
     double x, y, z;

@@ -1,40 +1,20 @@
 // `waxwork edit --backend gpu` under a virtual X server: the live solve runs on the GPU path in a hidden
 // window's context shared with the editor's window (editor/window_gl_context.h), and the view equals the
 // CPU backend's; a failing GPU falls back to the CPU and says so.
-#include "io/image_io.h"
-#include "support/cli_run.h"
+#include "editor_window_fixture.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 
 namespace waxwork {
 namespace {
 
-using testing::have_xvfb;
-using testing::run_under_xvfb;
-using testing::run_waxwork;
-using testing::scratch_dir;
+using namespace testing;
 namespace fs = std::filesystem;
 
-const std::string kAssets = WAXWORK_ASSET_DIR;
-
-// The summary line `edit --screenshot` prints.
-nlohmann::json summary_of(const testing::CommandResult& r) {
-    const size_t start = r.out.find('{');
-    if (start == std::string::npos) return {};
-    return nlohmann::json::parse(r.out.substr(start));
-}
-
-class EditorGpuWindow : public ::testing::Test {
-protected:
-    void SetUp() override {
-        if (!have_xvfb()) GTEST_SKIP() << "xvfb-run is not installed (setup.sh installs xvfb and xauth)";
-    }
-};
+class EditorGpuWindow : public WindowTest {};
 
 TEST_F(EditorGpuWindow, GpuBackendShowsWhatTheCpuBackendShows) {
     const fs::path dir = scratch_dir("editor_gpu");
@@ -57,9 +37,7 @@ TEST_F(EditorGpuWindow, GpuBackendShowsWhatTheCpuBackendShows) {
     // Both converge phi to the editor's tolerance 1e-3 (float on the GPU, double on the CPU) along
     // different iteration paths: under one 8-bit step apart after exposure, as in editor_window_test,
     // plus one for the float solve.
-    int max_difference = 0;
-    for (size_t i = 0; i < a.rgba.size(); ++i) max_difference = std::max(max_difference, std::abs(a.rgba[i] - b.rgba[i]));
-    EXPECT_LE(max_difference, 3);
+    EXPECT_LE(max_channel_difference(a, b), 3);
 }
 
 TEST_F(EditorGpuWindow, AFailingGpuFallsBackAndReportsWhy) {

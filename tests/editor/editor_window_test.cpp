@@ -2,11 +2,10 @@
 // OpenGL 4.5 core context (Mesa llvmpipe through GLX), loads and solves a scene on its worker threads,
 // draws, saves a screenshot and exits cleanly; and its 3D view shows exactly what `waxwork render`
 // (OSMesa) writes for the same scene.
-#include "io/image_io.h"
 #include "io/volume_file.h"
 #include "solver/material.h"
-#include "support/cli_run.h"
 #include "tetops/test_meshes.h"
+#include "editor_window_fixture.h"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -23,36 +22,31 @@
 namespace waxwork {
 namespace {
 
-using testing::have_xvfb;
-using testing::run_under_xvfb;
-using testing::run_waxwork;
-using testing::scratch_dir;
+using namespace testing;
 namespace fs = std::filesystem;
 
-const std::string kAssets = WAXWORK_ASSET_DIR;
+class EditorWindow : public WindowTest {};
 
-
-// Mean of r + g + b over a rectangle.
-double mean_brightness(const Image& image, int x0, int y0, int x1, int y1) {
-    double sum = 0;
-    for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) sum += image.pixel(x, y)[0] + image.pixel(x, y)[1] + image.pixel(x, y)[2];
-    return sum / ((x1 - x0) * static_cast<double>(y1 - y0));
+// Draws SCENE (a volume and render's options) with `waxwork render` and in the editor without panels
+// (--hide-ui), as DIR/NAME_render.png and DIR/NAME_edit.png, and compares them. Both draw the same
+// geometry with Mesa's llvmpipe (OSMesa for render, GLX under Xvfb for the window) through the same
+// SurfaceRenderer and camera, so coverage and shading agree exactly. The radiance does not quite:
+// render solves phi in one CG run, the editor converges it frame by frame (LiveScene), each stopping
+// within the relative tolerance 1e-3, and the automatic exposure follows phi. A relative difference of
+// 2e-3 moves an 8-bit sRGB value by under one step, so every channel may differ by at most 1 after
+// rounding (2 allowed for the two roundings).
+void expect_edit_shows_what_render_writes(const fs::path& dir, const std::string& scene, const std::string& name) {
+    const fs::path rendered = dir / (name + "_render.png"), edited = dir / (name + "_edit.png");
+    const auto render = run_waxwork("render " + scene + " -o " + rendered.string());
+    ASSERT_EQ(render.exit_code, 0) << name << ": " << render.err;
+    const auto edit = run_under_xvfb("edit " + scene + " --hide-ui --frames 2 --screenshot " + edited.string());
+    ASSERT_EQ(edit.exit_code, 0) << name << ": " << edit.err;
+    const Image a = read_png(rendered), b = read_png(edited);
+    ASSERT_EQ(a.width, b.width) << name;
+    ASSERT_EQ(a.height, b.height) << name;
+    EXPECT_LE(max_channel_difference(a, b), 2) << name;
+    EXPECT_GT(mean_brightness(a, 0, 0, a.width, a.height), mean_brightness(a, 0, 0, 20, 20) + 5) << name;  // not empty
 }
-
-// The largest difference of one channel of one pixel between two images of the same size.
-int max_channel_difference(const Image& a, const Image& b) {
-    int largest = 0;
-    for (size_t i = 0; i < a.rgba.size(); ++i) largest = std::max(largest, std::abs(a.rgba[i] - b.rgba[i]));
-    return largest;
-}
-
-class EditorWindow : public ::testing::Test {
-protected:
-    void SetUp() override {
-        if (!have_xvfb()) GTEST_SKIP() << "xvfb-run is not installed (setup.sh installs xvfb and xauth)";
-    }
-};
 
 TEST_F(EditorWindow, OpensRendersSavesAScreenshotAndExits) {
     const fs::path dir = scratch_dir("editor_screenshot");
@@ -76,23 +70,8 @@ TEST_F(EditorWindow, ViewWithoutPanelsEqualsWaxworkRender) {
     const fs::path dir = scratch_dir("editor_equals_render");
     const fs::path volume = dir / "torus.vtu";
     ASSERT_EQ(run_waxwork("mesh " + kAssets + "/meshes/torus.obj -o " + volume.string() + " --max-tets 12000").exit_code, 0);
-    const fs::path rendered = dir / "render.png", edited = dir / "edit.png";
-    const std::string scene = volume.string() + " --width 320 --height 240 --view 0.3,0.8,0.6 --material skin1";
-    const auto render = run_waxwork("render " + scene + " -o " + rendered.string());
-    ASSERT_EQ(render.exit_code, 0) << render.err;
-    const auto edit = run_under_xvfb("edit " + scene + " --hide-ui --frames 2 --screenshot " + edited.string());
-    ASSERT_EQ(edit.exit_code, 0) << edit.err;
-    // Both draw the same geometry with Mesa's llvmpipe (OSMesa for render, GLX under Xvfb for the
-    // window) through the same SurfaceRenderer and camera, so coverage and shading agree exactly. The
-    // radiance does not quite: render solves phi in one CG run, the editor converges it frame by frame
-    // (LiveScene), each stopping within the relative tolerance 1e-3, and the automatic exposure follows
-    // phi. A relative difference of 2e-3 moves an 8-bit sRGB value by under one step, so every
-    // channel may differ by at most 1 after rounding (2 allowed for the two roundings).
-    const Image a = read_png(rendered), b = read_png(edited);
-    ASSERT_EQ(a.width, b.width);
-    ASSERT_EQ(a.height, b.height);
-    EXPECT_LE(max_channel_difference(a, b), 2);
-    EXPECT_GT(mean_brightness(a, 0, 0, a.width, a.height), mean_brightness(a, 0, 0, 20, 20) + 5);  // not empty
+    expect_edit_shows_what_render_writes(
+        dir, volume.string() + " --width 320 --height 240 --view 0.3,0.8,0.6 --material skin1", "radiance");
 }
 
 TEST_F(EditorWindow, EveryOptionalViewEqualsWaxworkRenderShow) {
@@ -106,17 +85,8 @@ TEST_F(EditorWindow, EveryOptionalViewEqualsWaxworkRenderShow) {
                                    "slice --slice-normal 1,0,0.3 --slice-offset 0.2", "levels"}) {
         std::string name = show;
         for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-        const fs::path rendered = dir / (name + "_render.png"), edited = dir / (name + "_edit.png");
-        const std::string scene = volume.string() + " --width 320 --height 240 --view 0.3,0.8,0.6 --show " + show;
-        const auto render = run_waxwork("render " + scene + " -o " + rendered.string());
-        ASSERT_EQ(render.exit_code, 0) << render.err;
-        const auto edit = run_under_xvfb("edit " + scene + " --hide-ui --frames 2 --screenshot " + edited.string());
-        ASSERT_EQ(edit.exit_code, 0) << edit.err;
-        const Image a = read_png(rendered), b = read_png(edited);
-        ASSERT_EQ(a.width, b.width);
-        ASSERT_EQ(a.height, b.height);
-        EXPECT_LE(max_channel_difference(a, b), 2) << name;
-        EXPECT_GT(mean_brightness(a, 0, 0, a.width, a.height), mean_brightness(a, 0, 0, 20, 20) + 5) << name;
+        expect_edit_shows_what_render_writes(
+            dir, volume.string() + " --width 320 --height 240 --view 0.3,0.8,0.6 --show " + show, name);
     }
 }
 

@@ -31,9 +31,7 @@ MillisecondClock fake_clock(double step) {
 // Reads before iteration k + 1 return k * step: a deadline of `ms` lets ceil(ms / step) run.
 int iterations_within(double ms, double step) { return static_cast<int>(std::ceil(ms / step)); }
 
-std::array<std::span<const double>, 3> spans(const std::array<std::vector<double>, 3>& v) {
-    return {v[0], v[1], v[2]};
-}
+using testing::spans;
 
 // sqrt(e . M e) / sqrt(x* . M x*) for e = x - x*: the norm CG lowers at every iteration.
 double energy_error(const DiffusionMatrix& m, int channel, std::span<const double> x, std::span<const double> exact) {

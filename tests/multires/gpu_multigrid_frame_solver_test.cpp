@@ -27,9 +27,7 @@ FrameSolverOptions frame_options(int64_t min_coarse, double tolerance) {
     return options;
 }
 
-std::array<std::span<const double>, 3> spans(const std::array<std::vector<double>, 3>& v) {
-    return {v[0], v[1], v[2]};
-}
+using testing::spans;
 
 // The device frame solver and the CPU one on the same system, with the same options and b.
 struct BothBackends {
@@ -223,18 +221,7 @@ TEST(GpuMultigridFrameSolver, FollowsPaintedValues) {
     WAXWORK_REQUIRE_GL(context);
     auto s = testing::make_test_system(8);
     GpuMultigridFrameSolver solver(context->gl(), s.matrix, s.mesh.positions, frame_options(30, 1e-6));
-    solver.set_right_hand_side(spans(s.b));
-    FrameStep step = testing::step_until_converged(solver, 5, 20);
-    ASSERT_TRUE(step.converged);
-    const std::vector<int32_t> rows = testing::paint_test_system(s, 40, 7);
-    solver.update_values(s.matrix, rows);
-    step = testing::step_until_converged(solver, 5, 20);
-    EXPECT_TRUE(step.converged);
-    const auto phi = solver.phi();
-    for (int c = 0; c < 3; ++c) {
-        const auto reference = reference_solution(s.matrix, s.b[static_cast<size_t>(c)], c);
-        EXPECT_LT(relative_error(phi[static_cast<size_t>(c)], reference), kFloatSolutionBound) << "channel " << c;
-    }
+    testing::expect_follows_painted_values(solver, s, kFloatSolutionBound);
 }
 
 // A time budget stops between V-cycles (a fake clock: no timing in unit tests), and a budget that ran k
@@ -263,26 +250,16 @@ TEST(GpuMultigridFrameSolver, RejectsBadInput) {
     WAXWORK_REQUIRE_GL(context);
     const auto s = testing::make_test_system(5);
     GpuMultigridFrameSolver solver(context->gl(), s.matrix, s.mesh.positions, frame_options(20, 1e-2));
-    EXPECT_THROW(solver.step(1), InvalidArgumentError);  // no right-hand side yet
-    std::vector<double> short_b(s.b[0].size() - 1);
-    EXPECT_THROW(solver.set_right_hand_side({short_b, s.b[1], s.b[2]}), InvalidArgumentError);
+    testing::expect_refuses_steps_without_a_valid_b(solver, s);
     std::vector<double> nan_b = s.b[0];
     nan_b[3] = std::nan("");
-    EXPECT_THROW(solver.set_right_hand_side({nan_b, s.b[1], s.b[2]}), AlgorithmError);
     EXPECT_THROW(solver.set_phi({nan_b, s.b[1], s.b[2]}), AlgorithmError);
     solver.set_right_hand_side(spans(s.b));
     EXPECT_THROW(solver.step(0), InvalidArgumentError);
     EXPECT_THROW(solver.step(FrameBudget{}), InvalidArgumentError);
     EXPECT_THROW(solver.set_relative_tolerance(-1), InvalidArgumentError);
     EXPECT_THROW(solver.update_values(s.matrix, std::vector<int32_t>{-1}), InvalidArgumentError);
-    // A zero right-hand side is solved by phi = 0 at once.
-    const std::vector<double> zero(s.b[0].size(), 0.0);
-    solver.set_right_hand_side({zero, zero, zero});
-    solver.reset();
-    const FrameStep step = solver.step(1);
-    EXPECT_TRUE(step.converged);
-    for (const auto& channel : solver.phi())
-        for (double v : channel) EXPECT_EQ(v, 0.0);
+    testing::expect_zero_b_solved_at_once(solver);
 }
 
 }  // namespace

@@ -27,9 +27,7 @@ FrameSolverOptions frame_options(int64_t min_coarse, double tolerance) {
     return options;
 }
 
-std::array<std::span<const double>, 3> spans(const std::array<std::vector<double>, 3>& v) {
-    return {v[0], v[1], v[2]};
-}
+using testing::spans;
 
 
 TEST(MultigridPreconditioner, ApplyRgbEqualsThreeApplyCalls) {
@@ -187,39 +185,17 @@ TEST(MultigridFrameSolver, IsDeterministicAcrossThreadCounts) {
 TEST(MultigridFrameSolver, FollowsPaintedValues) {
     auto s = testing::make_test_system(8);
     MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(30, 1e-8));
-    solver.set_right_hand_side(spans(s.b));
-    FrameStep step = testing::step_until_converged(solver, 5, 20);
-    ASSERT_TRUE(step.converged);
-    const std::vector<int32_t> rows = testing::paint_test_system(s, 40, 7);
-    solver.update_values(s.matrix, rows);
-    step = testing::step_until_converged(solver, 5, 20);
-    EXPECT_TRUE(step.converged);
-    for (int c = 0; c < 3; ++c) {
-        const auto reference = reference_solution(s.matrix, s.b[static_cast<size_t>(c)], c);
-        EXPECT_LT(relative_error(solver.phi(c), reference), 1e-6) << "channel " << c;
-    }
+    testing::expect_follows_painted_values(solver, s, 1e-6);
 }
 
 TEST(MultigridFrameSolver, RejectsBadInput) {
     const auto s = testing::make_test_system(5);
     MultigridFrameSolver solver(s.matrix, s.mesh.positions, frame_options(20, 1e-2));
-    EXPECT_THROW(solver.step(1), InvalidArgumentError);  // no right-hand side yet
-    std::vector<double> short_b(s.b[0].size() - 1);
-    EXPECT_THROW(solver.set_right_hand_side({short_b, s.b[1], s.b[2]}), InvalidArgumentError);
-    std::vector<double> nan_b = s.b[0];
-    nan_b[3] = std::nan("");
-    EXPECT_THROW(solver.set_right_hand_side({nan_b, s.b[1], s.b[2]}), AlgorithmError);
+    testing::expect_refuses_steps_without_a_valid_b(solver, s);
     solver.set_right_hand_side(spans(s.b));
     EXPECT_THROW(solver.step(0), InvalidArgumentError);
     EXPECT_THROW((void)solver.phi(3), InvalidArgumentError);
-    // A zero right-hand side is solved by phi = 0 at once.
-    const std::vector<double> zero(s.b[0].size(), 0.0);
-    solver.set_right_hand_side({zero, zero, zero});
-    solver.reset();
-    const FrameStep step = solver.step(1);
-    EXPECT_TRUE(step.converged);
-    for (int c = 0; c < 3; ++c)
-        for (double v : solver.phi(c)) EXPECT_EQ(v, 0.0);
+    testing::expect_zero_b_solved_at_once(solver);
 }
 
 }  // namespace

@@ -82,8 +82,7 @@ TEST(Bicgstab, NonFiniteMatrixIsReportedAndXStaysFinite) {
 
 TEST(MultiresSolver, ConvergesToTheFineSolution) {
     const auto s = testing::make_test_system(14);  // 3375 vertices
-    HierarchyOptions h;
-    h.min_coarse_vertices = 100;
+    const HierarchyOptions h = testing::small_levels(100);
     MultiresSolver solver(s.matrix, s.mesh.positions, h);
     ASSERT_GE(solver.hierarchy().level_count(), 3u);
     for (int channel = 0; channel < 3; ++channel) {
@@ -109,8 +108,7 @@ TEST(MultiresSolver, ConvergesToTheFineSolution) {
 
 TEST(MultiresSolver, SingularCoarsestLevelFallsBackAndStaysFinite) {
     const auto s = testing::make_test_system(10);
-    HierarchyOptions h;
-    h.min_coarse_vertices = 100;
+    const HierarchyOptions h = testing::small_levels(100);
     MultiresSolver solver(s.matrix, s.mesh.positions, h);
     ASSERT_GE(solver.hierarchy().level_count(), 3u);
     HierarchyLevel& coarsest = solver.hierarchy().levels.back();
@@ -137,8 +135,7 @@ TEST(MultiresSolver, SingularCoarsestLevelFallsBackAndStaysFinite) {
 
 TEST(MultiresSolver, ZeroRowOnACoarseLevelStaysFinite) {
     const auto s = testing::make_test_system(10);
-    HierarchyOptions h;
-    h.min_coarse_vertices = 100;
+    const HierarchyOptions h = testing::small_levels(100);
     MultiresSolver solver(s.matrix, s.mesh.positions, h);
     ASSERT_GE(solver.hierarchy().level_count(), 3u);
     HierarchyLevel& level = solver.hierarchy().levels[1];
@@ -161,8 +158,7 @@ TEST(MultiresSolver, ZeroRowOnACoarseLevelStaysFinite) {
 
 TEST(MultiresSolver, FrameModeWarmStartsFromTheLastSolution) {
     const auto s = testing::make_test_system(10);
-    HierarchyOptions h;
-    h.min_coarse_vertices = 100;
+    const HierarchyOptions h = testing::small_levels(100);
     MultiresSolver solver(s.matrix, s.mesh.positions, h);
     MultiresSolveOptions options;
     options.relative_tolerance = 1e-6;
@@ -187,8 +183,7 @@ TEST(MultiresSolver, FrameModeWarmStartsFromTheLastSolution) {
 
 TEST(MultiresSolver, SolveIsDeterministic) {
     const auto s = testing::make_test_system(8);
-    HierarchyOptions h;
-    h.min_coarse_vertices = 50;
+    const HierarchyOptions h = testing::small_levels(50);
     MultiresSolver a(s.matrix, s.mesh.positions, h), b(s.matrix, s.mesh.positions, h);
     std::vector<double> xa(s.b[0].size()), xb(s.b[0].size());
     a.solve(s.b[0], 0, xa);
@@ -196,16 +191,10 @@ TEST(MultiresSolver, SolveIsDeterministic) {
     EXPECT_EQ(xa, xb);
 }
 
-}  // namespace
-}  // namespace waxwork
-
-namespace waxwork {
-namespace {
 
 TEST(MultiresSolver, UpdateValuesEqualsARebuild) {
     auto s = testing::make_test_system(6);
-    HierarchyOptions h;
-    h.min_coarse_vertices = 30;
+    const HierarchyOptions h = testing::small_levels(30);
     MultiresSolver updated(s.matrix, s.mesh.positions, h);
     const std::vector<TetMaterial> painted(s.mesh.tet_count(), TetMaterial{{0.3, 0.02, 0.1}, {2, 1, 0.5}, 1.4});
     assemble_diffusion_values(s.matrix, s.connectivity, painted);
@@ -218,11 +207,6 @@ TEST(MultiresSolver, UpdateValuesEqualsARebuild) {
     EXPECT_THROW(updated.update_values(other), InvalidArgumentError);
 }
 
-}  // namespace
-}  // namespace waxwork
-
-namespace waxwork {
-namespace {
 
 TEST(MultiresSolver, SingleLevelMeshSolvesWithCgAlone) {
     const auto s = testing::make_test_system(2);  // 27 vertices: below min_coarse_vertices
@@ -240,16 +224,10 @@ TEST(MultiresSolver, SingleLevelMeshSolvesWithCgAlone) {
     EXPECT_THROW(solver.solve(s.b[0], 3, x), InvalidArgumentError);
 }
 
-}  // namespace
-}  // namespace waxwork
-
-namespace waxwork {
-namespace {
 
 TEST(MultiresSolver, UpdateOfChangedRowsEqualsARebuild) {
     auto s = testing::make_test_system(8);
-    HierarchyOptions h;
-    h.min_coarse_vertices = 30;
+    const HierarchyOptions h = testing::small_levels(30);
     MultiresSolver updated(s.matrix, s.mesh.positions, h);
     ASSERT_GE(updated.hierarchy().level_count(), 3u);
     const std::vector<int32_t> rows = testing::paint_test_system(s, 30, 11);
@@ -268,11 +246,6 @@ TEST(MultiresSolver, UpdateOfChangedRowsEqualsARebuild) {
     EXPECT_THROW(updated.update_values(s.matrix, bad), InvalidArgumentError);
 }
 
-}  // namespace
-}  // namespace waxwork
-
-namespace waxwork {
-namespace {
 
 // sqrt((x - x*)^T M (x - x*)): the error norm that level-0 CG minimises and the corrected start's step
 // is chosen in.
@@ -296,8 +269,7 @@ std::vector<double> frame_start(MultiresSolver& solver, std::span<const double> 
 
 TEST(MultiresSolver, CorrectedWarmStartIsCloserThanTheStartOrTheColdPass) {
     const auto s = testing::make_test_system(14);
-    HierarchyOptions h;
-    h.min_coarse_vertices = 100;
+    const HierarchyOptions h = testing::small_levels(100);
     const auto turned = testing::light_rhs(s, 0);
     const auto lit = testing::light_rhs(s, 25);  // the light turned by 25 degrees since `turned`
     for (int channel = 0; channel < 3; ++channel) {
@@ -327,8 +299,7 @@ TEST(MultiresSolver, CorrectedWarmStartIsCloserThanTheStartOrTheColdPass) {
 
 TEST(MultiresSolver, CorrectedStartIsNeverWorseEvenWithBrokenCoarseLevels) {
     const auto s = testing::make_test_system(10);
-    HierarchyOptions h;
-    h.min_coarse_vertices = 100;
+    const HierarchyOptions h = testing::small_levels(100);
     MultiresSolver solver(s.matrix, s.mesh.positions, h);
     ASSERT_GE(solver.hierarchy().level_count(), 3u);
     // Level 1's matrix negated: its coarse correction points the wrong way (BiCGSTAB still converges
@@ -347,8 +318,7 @@ TEST(MultiresSolver, CorrectedStartIsNeverWorseEvenWithBrokenCoarseLevels) {
 
 TEST(MultiresSolver, ZeroWarmStartIsTheColdPassAndBadStartsAreRejected) {
     const auto s = testing::make_test_system(8);
-    HierarchyOptions h;
-    h.min_coarse_vertices = 50;
+    const HierarchyOptions h = testing::small_levels(50);
     MultiresSolver a(s.matrix, s.mesh.positions, h), b(s.matrix, s.mesh.positions, h);
     const std::vector<double> zero(s.b[0].size(), 0.0);
     b.set_warm_start(0, zero);

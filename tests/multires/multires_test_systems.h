@@ -1,8 +1,11 @@
 // Small assembled diffusion systems for the multires tests.
 #pragma once
 
+#include "base/error.h"
+#include "multires/gpu_multigrid_frame_solver.h"
 #include "multires/hierarchy.h"
 #include "multires/multigrid_frame_cg.h"
+#include "multires/multigrid_frame_solver.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/lighting.h"
@@ -117,7 +120,6 @@ inline CutSystem cut_system(const TetMesh& mesh, const Eigen::Vector3d& normal, 
     return c;
 }
 
-// sqrt(sum (x - reference)^2 / sum reference^2).
 // Frames of `budget` V-cycles until a frame converges, at most `max_frames`; the last frame's step.
 inline FrameStep step_until_converged(MultigridFrameCg& solver, int budget, int max_frames) {
     FrameStep step;
@@ -125,6 +127,23 @@ inline FrameStep step_until_converged(MultigridFrameCg& solver, int budget, int 
     return step;
 }
 
+// The three channels as the frame solvers take them.
+inline std::array<std::span<const double>, 3> spans(const std::array<std::vector<double>, 3>& v) {
+    return {v[0], v[1], v[2]};
+}
+
+// A frame solver's phi, per channel, on the host.
+inline std::array<std::vector<double>, 3> phi_of(const MultigridFrameSolver& solver) {
+    std::array<std::vector<double>, 3> phi;
+    for (int c = 0; c < 3; ++c) {
+        const std::span<const double> channel = solver.phi(c);
+        phi[static_cast<size_t>(c)].assign(channel.begin(), channel.end());
+    }
+    return phi;
+}
+inline std::array<std::vector<double>, 3> phi_of(const GpuMultigridFrameSolver& solver) { return solver.phi(); }
+
+// sqrt(sum (x - reference)^2 / sum reference^2).
 inline double relative_error(std::span<const double> x, std::span<const double> reference) {
     double e = 0, r = 0;
     for (size_t i = 0; i < x.size(); ++i) {
@@ -149,6 +168,47 @@ inline std::vector<double> reference_solution(const DiffusionMatrix& m, std::spa
 // A box of 10^3 cells (10 mm, marble) whose interior vertices are pushed into caps of relative height
 // 1e-5 (0.0009 degree dihedrals, as in the stability study), with a right-hand side on its boundary
 // and the hierarchy of its system: where row-sum lumped Galerkin operators lose definiteness.
+// Either frame solver on `s`: converges, follows 40 painted vertices (update_values) and converges
+// again, each channel then within `bound` of the painted system's double solution.
+template <class Solver>
+void expect_follows_painted_values(Solver& solver, TestSystem& s, double bound) {
+    solver.set_right_hand_side(spans(s.b));
+    FrameStep step = step_until_converged(solver, 5, 20);
+    ASSERT_TRUE(step.converged);
+    const std::vector<int32_t> rows = paint_test_system(s, 40, 7);
+    solver.update_values(s.matrix, rows);
+    step = step_until_converged(solver, 5, 20);
+    EXPECT_TRUE(step.converged);
+    const auto phi = phi_of(solver);
+    for (int c = 0; c < 3; ++c) {
+        const auto reference = reference_solution(s.matrix, s.b[static_cast<size_t>(c)], c);
+        EXPECT_LT(relative_error(phi[static_cast<size_t>(c)], reference), bound) << "channel " << c;
+    }
+}
+
+// Either frame solver on `s`, before any right-hand side: a step, and a b of the wrong size or with a
+// NaN, are refused.
+inline void expect_refuses_steps_without_a_valid_b(MultigridFrameCg& solver, const TestSystem& s) {
+    EXPECT_THROW(solver.step(1), InvalidArgumentError);  // no right-hand side yet
+    std::vector<double> short_b(s.b[0].size() - 1);
+    EXPECT_THROW(solver.set_right_hand_side({short_b, s.b[1], s.b[2]}), InvalidArgumentError);
+    std::vector<double> nan_b = s.b[0];
+    nan_b[3] = std::nan("");
+    EXPECT_THROW(solver.set_right_hand_side({nan_b, s.b[1], s.b[2]}), AlgorithmError);
+}
+
+// Either frame solver: a zero right-hand side is solved by phi = 0 at once.
+template <class Solver>
+void expect_zero_b_solved_at_once(Solver& solver) {
+    const std::vector<double> zero(solver.size(), 0.0);
+    solver.set_right_hand_side({zero, zero, zero});
+    solver.reset();
+    const FrameStep step = solver.step(1);
+    EXPECT_TRUE(step.converged);
+    for (const auto& channel : phi_of(solver))
+        for (double v : channel) EXPECT_EQ(v, 0.0);
+}
+
 struct SliverSystem {
     TetMesh mesh;
     TetConnectivity connectivity;

@@ -12,6 +12,9 @@
 
 namespace waxwork::testing {
 
+// The assets (meshes, sessions) the commands under test read.
+inline const std::string kAssets = WAXWORK_ASSET_DIR;
+
 struct CommandResult {
     int exit_code = -1;
     std::string out;
