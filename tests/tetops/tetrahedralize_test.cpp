@@ -280,8 +280,10 @@ TEST(TetrahedralizeTest, TinyAndHugeSurfacesAreMeshedAsAtUnitSize) {
     // Beyond kMaxCoordinate the volume could be meshed but not rendered: refused by name.
     TriangleSurface huge = spot;
     for (auto& p : huge.points) p *= 0x1p66;
+    MeshingOptions huge_options;
+    huge_options.sizing.edge_length = 0.1 * 0x1p66;
     try {
-        tetrahedralize(huge, MeshingOptions{});
+        tetrahedralize(huge, huge_options);
         ADD_FAILURE() << "meshed";
     } catch (const InvalidMeshError& e) {
         EXPECT_NE(std::string(e.what()).find("lies beyond 1e12"), std::string::npos) << e.what();
