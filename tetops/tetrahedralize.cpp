@@ -399,6 +399,12 @@ MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOption
     validate_options(options);
     report_stage(options.progress, "checking the surface for meshing");
     validate_surface(surface);
+    if (options.mesher == Mesher::TetGen && surface.triangles.size() > kMaxTetGenTriangles)
+        throw InvalidArgumentError(
+            "TetGen keeps every one of the surface's " + std::to_string(surface.triangles.size()) +
+            " triangles, and its quality meshes of more than " + std::to_string(kMaxTetGenTriangles) +
+            " take over a minute (horse.ply, 96966 triangles: 93 s); use the CGAL mesher (--mesher cgal), "
+            "which remeshes the surface, or simplify the surface");
     const double volume = enclosed_volume(surface);
     const double area = surface_area(surface);
 

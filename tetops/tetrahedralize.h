@@ -41,13 +41,20 @@ struct MeshSizing {
 // The largest mesh made: about a minute's work on a two-core machine at the measured TetGen rate
 // (kMeasuredTetsPerSecond, uniform size, from the surface to the finished, ordered mesh). A larger
 // one is refused up front with the predicted time.
-inline constexpr size_t kMaxMeshTets = 10'000'000;
-inline constexpr double kMeasuredTetsPerSecond = 200'000;
+inline constexpr size_t kMaxMeshTets = 2'000'000;
+inline constexpr double kMeasuredTetsPerSecond = 40'000;
 // The most surface triangles the meshers take. TetGen keeps every triangle (its mesh of a surface
 // has at least 1.4 tets per triangle, and its quality bound adds many more), and CGAL answers a
 // distance query on them for every size it asks; both ran past 180 s on a 2M-triangle sphere. More
 // are refused up front (InvalidMeshError), before any check or mesher runs.
 inline constexpr size_t kMaxSurfaceTriangles = 500'000;
+
+// The most surface triangles TetGen takes (CGAL remeshes the surface and takes up to
+// kMaxSurfaceTriangles). TetGen keeps every triangle, and the work of its quality refinement grows
+// with them, whatever the size asks for: bad_stanford-bunny.obj (70K triangles, holes filled) at the
+// default size takes 48 s, horse.ply (97K) 93 s, the skull's coarsest quality mesh (100K) 66 s, where
+// CGAL takes 5 to 10 s. More are refused up front (InvalidArgumentError) with the way out.
+inline constexpr size_t kMaxTetGenTriangles = 75'000;
 
 // The smallest radius-edge bound TetGen's refinement ends with (validate_options says why).
 inline constexpr double kMinRadiusEdgeRatio = 1.2;

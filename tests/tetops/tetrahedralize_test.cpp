@@ -572,7 +572,7 @@ TEST(TetrahedralizeTest, RefusesUpFrontWhatWouldRunForMinutes) {
         EXPECT_NE(std::string(e.what()).find("tets per second"), std::string::npos) << e.what();
     }
     options.sizing.target_tets.reset();
-    options.sizing.edge_length = 0.005;  // about 1e8 tets in the 2x2x2 cube
+    options.sizing.edge_length = 0.02;  // about 1.2e7 tets in the 2x2x2 cube
     EXPECT_THROW(tetrahedralize(cube, options), InvalidArgumentError);
 
     const TriangleSurface sphere = make_icosphere(8, 1.0);  // 1,310,720 triangles
