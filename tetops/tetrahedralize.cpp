@@ -208,10 +208,9 @@ TetGenSettings tetgen_settings(const MeshingOptions& options, const SizeField& s
 }
 
 // Mesh_3's vertex bound: this many times the vertices the size predicts, and never under the floor
-// (small meshes vary most against the prediction). A stretched cube (one corner moved 500 edges out)
-// reached the floor in PROTECTION_SECONDS while protecting its needle's edges, where the prediction was
-// about PREDICTED vertices; the shared meshes stay under a fifth of the bound (measured with
-// TetrahedralizeTest.CgalStaysFarUnderItsVertexBound).
+// (small meshes vary most against the prediction). A cube with one corner moved to x = 1000 (a needle)
+// never finished protecting its sharp edges; the bound stops it. Ordinary meshes stay far under it
+// (TetrahedralizeTest.CgalStaysFarUnderItsVertexBound).
 constexpr double kCgalVertexBoundPerPredicted = 10;
 // TetGen's bound on added points for a bounded size, the same way (TetGen adds about 17,000 points a
 // second here: skull, 150,000 in 8.7 s, so the floor is a few seconds' work).
