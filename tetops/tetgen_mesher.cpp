@@ -134,29 +134,17 @@ TetMesh to_tet_mesh(const tetgenio& out) {
     return make_tet_mesh(std::move(positions), std::move(tets));
 }
 
-// The background mesh of a graded run: the points of a quality mesh at the coarsest size, each
-// carrying kMetricPerEdge edge(depth), tetrahedralized again without the surface so that the mesh is
-// convex (their Delaunay tetrahedralization). TetGen 1.5.0 finds each point of the meshed surface, and
-// each point it adds, in the background mesh by walking from a nearby tet (scoutpoint); a walk that
-// leaves a non-convex mesh through a concavity falls back to testing every tet of it. On the quality
-// mesh itself that made the sizing of a 70K-triangle surface a search of every background tet for
-// most points, minutes where the rest of the run takes seconds; in the convex hull every walk ends in
-// the tet it seeks. Tets outside the surface only join surface vertices, whose size is the surface's.
+// The background mesh of a graded run: a quality mesh at the coarsest size, each of its vertices
+// carrying kMetricPerEdge edge(depth); TetGen interpolates it linearly inside its tets. Its run is
+// bounded by the same limit on added points as the graded run; cut short, it still carries sizes.
 void make_background_mesh(const TriangleSurface& surface, const TetGenSettings& graded, tetgenio& background) {
     const SizeField& size = graded.size;
-    tetgenio quality;
     {
         tetgenio in;
         fill_plc(surface, in);
-        run_tetgen(make_switches(graded, std::isfinite(size.max_edge), false), in, quality, nullptr);
+        run_tetgen(make_switches(graded, std::isfinite(size.max_edge), false), in, background, nullptr);
     }
     report_stage(graded.progress, "meshing (TetGen, sizing field)");
-    tetgenio points;
-    points.firstnumber = 0;
-    points.numberofpoints = quality.numberofpoints;
-    points.pointlist = new REAL[3 * quality.numberofpoints];
-    std::copy(quality.pointlist, quality.pointlist + 3 * quality.numberofpoints, points.pointlist);
-    run_tetgen(graded.quiet ? "zQ" : "z", points, background, nullptr);
     const SurfaceDistance distance(surface);
     background.numberofpointmtrs = 1;
     background.pointmtrlist = new REAL[background.numberofpoints];

@@ -30,9 +30,8 @@ struct TetGenSettings {
 TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettings& settings,
                               bool* stopped_at_point_limit = nullptr);
 
-// The background mesh a graded run sizes itself from (tetgen_tetrahedralize with a graded size): the
-// Delaunay tetrahedralization of the points of a quality mesh at settings.size.max_edge, which is
-// convex (tetgen_mesher.cpp says why it must be). For tests.
+// The background mesh a graded run sizes itself from (tetgen_tetrahedralize with a graded size): a
+// quality mesh at settings.size.max_edge. For tests.
 TetMesh tetgen_background_mesh(const TriangleSurface& surface, const TetGenSettings& settings);
 
 // The TetGen volume bound (-a) that gives tets of mean edge length `edge`: a regular tet of edge L has

@@ -590,32 +590,5 @@ TEST(TetrahedralizeTest, RefusesUpFrontWhatWouldRunForMinutes) {
     }
 }
 
-// TetGen 1.5.0 finds each point of a graded run in the background mesh by walking to it, and a walk
-// that leaves the mesh through a concavity ends in a search of every background tet: on the quality
-// mesh of bad_stanford-bunny.obj (holes filled) or horse.ply that made the sizing run for minutes.
-// The background mesh is convex, so every walk ends where it should.
-TEST(TetrahedralizeTest, TetGensBackgroundMeshIsConvex) {
-    const TriangleSurface spot = asset_surface("spot.obj");  // concave: ears, horns, legs
-    TetGenSettings settings;
-    settings.size = {0.05, 0.5, 0.3};
-    const TetMesh background = tetgen_background_mesh(spot, settings);
-    ASSERT_GT(background.tet_count(), 100u);
-    const std::vector<std::array<int32_t, 3>> faces = boundary_faces(background);
-    ASSERT_FALSE(faces.empty());
-    Eigen::AlignedBox3d box;
-    for (const auto& p : background.positions) box.extend(p);
-    const double tolerance = 1e-9 * box.diagonal().squaredNorm();
-    size_t concave_faces = 0;
-    for (const auto& f : faces) {
-        const Eigen::Vector3d& a = background.positions[f[0]];
-        const Eigen::Vector3d normal =
-            (background.positions[f[1]] - a).cross(background.positions[f[2]] - a);  // outward
-        bool beyond = false;
-        for (const auto& p : background.positions) beyond = beyond || normal.dot(p - a) > tolerance;
-        concave_faces += beyond;
-    }
-    EXPECT_EQ(concave_faces, 0u) << "of " << faces.size() << " boundary faces";
-}
-
 }  // namespace
 }  // namespace waxwork
