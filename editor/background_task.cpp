@@ -4,16 +4,6 @@
 
 namespace waxwork {
 
-void TaskProgress::set_stage(std::string stage) {
-    std::lock_guard lock(mutex_);
-    stage_ = std::move(stage);
-}
-
-std::string TaskProgress::stage() const {
-    std::lock_guard lock(mutex_);
-    return stage_;
-}
-
 BackgroundTask::~BackgroundTask() {
     cancel();
     if (thread_.joinable()) thread_.join();

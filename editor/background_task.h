@@ -4,6 +4,8 @@
 // to install the result (the only moment shared editor state changes), or the error it threw.
 #pragma once
 
+#include "base/progress.h"
+
 #include <atomic>
 #include <chrono>
 #include <exception>
@@ -15,24 +17,9 @@
 
 namespace waxwork {
 
-// What the work may report while it runs (read by the UI thread: atomics and a locked string).
-class TaskProgress {
-public:
-    // fraction in [0, 1]; negative: unknown (the bar animates instead).
-    void set_fraction(float fraction) { fraction_.store(fraction); }
-    float fraction() const { return fraction_.load(); }
-    void set_stage(std::string stage);
-    std::string stage() const;
-    // Cooperative cancellation: long loops check it and return early.
-    bool cancel_requested() const { return cancel_.load(); }
-    void request_cancel() { cancel_.store(true); }
-
-private:
-    std::atomic<float> fraction_{-1.0f};
-    std::atomic<bool> cancel_{false};
-    mutable std::mutex mutex_;
-    std::string stage_;
-};
+// What the work may report while it runs (read by the UI thread): the shared progress type, so that
+// the library calls the work makes (meshing, repairs) report their own stages into it.
+class TaskProgress : public Progress {};
 
 class BackgroundTask {
 public:

@@ -4,6 +4,7 @@
 #include "tetops/tet_mesh.h"
 
 #include "base/error.h"
+#include "base/progress.h"
 
 #include <CGAL/IO/OFF.h>
 #include <CGAL/Simple_cartesian.h>
@@ -20,6 +21,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <iostream>
 #include <mutex>
 #include <sstream>
@@ -525,6 +527,51 @@ PolygonSoup read_off(const std::filesystem::path& path) {
     return soup;
 }
 
+// For each point and triangle of `repaired`, its index in `file`: a point at exactly the position of
+// a file vertex (the smallest index there), a triangle on three such points that a file face joins
+// too; -1 for what a repair made.
+SurfaceIndexMap file_indices(const TriangleSurface& file, const TriangleSurface& repaired) {
+    using Position = std::array<double, 3>;
+    std::map<Position, int32_t> by_position;
+    for (size_t i = 0; i < file.points.size(); ++i)
+        by_position.emplace(Position{file.points[i].x(), file.points[i].y(), file.points[i].z()},
+                            static_cast<int32_t>(i));
+    const auto file_point = [&](const Eigen::Vector3d& p) {
+        const auto it = by_position.find(Position{p.x(), p.y(), p.z()});
+        return it == by_position.end() ? int32_t{-1} : it->second;
+    };
+    const auto key = [](std::array<int32_t, 3> t) {
+        std::sort(t.begin(), t.end());
+        return t;
+    };
+    std::map<std::array<int32_t, 3>, int32_t> by_corners;
+    for (size_t t = 0; t < file.triangles.size(); ++t) {
+        std::array<int32_t, 3> corners{};
+        bool valid = true;
+        for (int k = 0; k < 3; ++k) {
+            const int32_t v = file.triangles[t][k];
+            valid = valid && v >= 0 && static_cast<size_t>(v) < file.points.size();
+            if (valid) corners[k] = file_point(file.points[v]);
+        }
+        if (valid) by_corners.emplace(key(corners), static_cast<int32_t>(t));
+    }
+    SurfaceIndexMap map;
+    map.points.reserve(repaired.points.size());
+    for (const auto& p : repaired.points) map.points.push_back(file_point(p));
+    map.triangles.reserve(repaired.triangles.size());
+    for (const auto& t : repaired.triangles) {
+        std::array<int32_t, 3> corners{};
+        bool known = true;
+        for (int k = 0; k < 3; ++k) {
+            known = known && t[k] >= 0 && static_cast<size_t>(t[k]) < map.points.size() && map.points[t[k]] >= 0;
+            if (known) corners[k] = map.points[t[k]];
+        }
+        const auto it = known ? by_corners.find(key(corners)) : by_corners.end();
+        map.triangles.push_back(it == by_corners.end() ? -1 : it->second);
+    }
+    return map;
+}
+
 }  // namespace
 
 TriangleSurface read_surface_file(const std::filesystem::path& path) {
@@ -572,9 +619,18 @@ TriangleSurface read_surface_file(const std::filesystem::path& path) {
     return surface;
 }
 
-LoadedSurface load_closed_surface(const std::filesystem::path& path, const SurfaceRepairOptions& options) {
+LoadedSurface load_closed_surface(const std::filesystem::path& path, const SurfaceRepairOptions& options,
+                                  Progress* progress) {
     LoadedSurface loaded;
+    report_stage(progress, "reading");
     loaded.surface = read_surface_file(path);
+    if (options.max_triangles > 0) {
+        if (const std::string problem = triangle_count_problem(loaded.surface.triangles.size(), options.max_triangles);
+            !problem.empty())
+            throw InvalidMeshError(path.string() + ": " + problem);
+    }
+    const TriangleSurface file = options.fill_holes || options.autorefine ? loaded.surface : TriangleSurface{};
+    report_stage(progress, "checking the surface");
     const std::string name = path.string();
     auto reject = [&](const std::vector<std::string>& defects) {
         std::string message = name + ": ";
@@ -593,9 +649,18 @@ LoadedSurface load_closed_surface(const std::filesystem::path& path, const Surfa
         reject(problems);
     }
 
-    for (auto& line : repair_hard_defects(loaded.surface, options)) loaded.repairs.push_back(std::move(line));
-    // After a shape-changing repair, indices no longer match the file; the messages use the new ones.
-    problems = find_surface_defects(loaded.surface).describe();
+    check_cancelled(progress);
+    for (auto& line : repair_hard_defects(loaded.surface, options, progress)) loaded.repairs.push_back(std::move(line));
+    report_stage(progress, "checking the repaired surface");
+    // After a shape-changing repair the messages still name the file's vertices and faces: those the
+    // repairs kept are found again by position; those they made are marked as new.
+    const SurfaceIndexMap in_file = file_indices(file, loaded.surface);
+    problems = find_surface_defects(loaded.surface).describe(&in_file);
+    if (!problems.empty() && std::any_of(problems.begin(), problems.end(), [](const std::string& line) {
+            return line.find("[new ") != std::string::npos;
+        }))
+        problems.push_back("[new I]: a vertex or face the repairs made, I its number in the repaired surface; "
+                           "other numbers are the file's");
     if (!problems.empty()) {
         problems.push_back("repairs tried: " + [&] {
             std::string all;

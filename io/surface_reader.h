@@ -14,6 +14,8 @@
 
 namespace waxwork {
 
+class Progress;
+
 // The file's vertices and faces in file order (indices count from 0), with polygons split into fans
 // of triangles. Faces that repeat a vertex are kept (validation reports or drops them); vertices that
 // no face uses are kept. Throws FileError("PATH: PROBLEM") for an unknown extension, a missing, empty,
@@ -29,7 +31,8 @@ struct LoadedSurface {
 // validates the result. Throws FileError for unreadable files and InvalidMeshError for surfaces that
 // stay defective; what() is "FILE: DEFECT; DEFECT; ...", FILE as the caller spelled it, e.g.
 // "bad_cow.obj: 81 self-intersecting triangle pairs (first: faces 10 and 2411)".
+// `progress`, when given, is told each stage (reading, checking, each repair).
 LoadedSurface load_closed_surface(const std::filesystem::path& path,
-                                  const SurfaceRepairOptions& options = {});
+                                  const SurfaceRepairOptions& options = {}, Progress* progress = nullptr);
 
 }  // namespace waxwork

@@ -1,6 +1,7 @@
 #include "tetops/cgal_mesher.h"
 
 #include "base/error.h"
+#include "base/progress.h"
 #include "tetops/mesher_scale.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -11,7 +12,10 @@
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polyhedral_mesh_domain_with_features_3.h>
 #include <CGAL/Random.h>
+#include <CGAL/Mesh_error_code.h>
+#include <CGAL/exude_mesh_3.h>
 #include <CGAL/make_mesh_3.h>
+#include <CGAL/perturb_mesh_3.h>
 
 #include <unordered_map>
 
@@ -106,6 +110,7 @@ TetMesh cgal_tetrahedralize(const TriangleSurface& surface, const CgalSettings& 
         size = SizeField::uniform(box.diagonal().norm() / 20);
     }
     try {
+        report_stage(settings.progress, "meshing (CGAL, surface domain)");
         // Seeded generators: the domain's initial points and the exuder draw from them.
         CGAL::get_default_random() = CGAL::Random(0);
         CGAL::Random domain_random(0);
@@ -121,11 +126,32 @@ TetMesh cgal_tetrahedralize(const TriangleSurface& surface, const CgalSettings& 
             params::facet_distance = kFacetDistancePerEdge * size.surface_edge,
             params::cell_radius_edge_ratio = std::max(settings.max_radius_edge_ratio, 2.0),
             params::cell_size = GradedSize{&size, &distance, kCellSizePerEdge});
-        // Perturb, then exude, both towards the sliver bound and without a time limit, so that the
-        // mesh does not depend on the machine's speed.
-        const Complex complex = CGAL::make_mesh_3<Complex>(
-            domain, criteria, params::perturb(params::sliver_bound = settings.min_dihedral_deg),
-            params::exude(params::sliver_bound = settings.min_dihedral_deg));
+        // Refinement first, with Mesh_3's bound on its vertices and the cancel flag (both also stop
+        // the sharp-edge protection), then the sliver perturber and exuder, both towards the sliver
+        // bound and without a time limit, so that the mesh does not depend on the machine's speed.
+        report_stage(settings.progress, "meshing (CGAL)");
+        CGAL::Mesh_error_code error = CGAL::CGAL_MESH_3_NO_ERROR;
+        Complex complex = CGAL::make_mesh_3<Complex>(
+            domain, criteria, params::no_perturb(), params::no_exude(),
+            params::mesh_3_options(params::maximal_number_of_vertices = settings.max_vertices,
+                                   params::pointer_to_error_code = &error,
+                                   params::pointer_to_stop_atomic_boolean =
+                                       settings.progress ? settings.progress->cancel_flag() : nullptr));
+        if (error == CGAL::CGAL_MESH_3_STOPPED) settings.progress->throw_if_cancelled();
+        if (error == CGAL::CGAL_MESH_3_MAXIMAL_NUMBER_OF_VERTICES_REACHED)
+            throw AlgorithmError("CGAL Mesh_3 stopped at its limit of " + std::to_string(settings.max_vertices) +
+                                 " vertices, where this size needs about " +
+                                 std::to_string(settings.predicted_vertices) +
+                                 ": sharp features meeting at a small angle (a needle-like or very thin "
+                                 "part) make its refinement go on without end; use the TetGen mesher "
+                                 "(--mesher tetgen), which keeps the surface's triangles");
+        check_cancelled(settings.progress);
+        report_stage(settings.progress, "perturbing slivers (CGAL)");
+        CGAL::perturb_mesh_3(complex, domain, params::time_limit = 0,
+                             params::sliver_bound = settings.min_dihedral_deg);
+        check_cancelled(settings.progress);
+        report_stage(settings.progress, "exuding slivers (CGAL)");
+        CGAL::exude_mesh_3(complex, params::time_limit = 0, params::sliver_bound = settings.min_dihedral_deg);
         return to_tet_mesh(complex);
     } catch (const Error&) {
         throw;

@@ -8,6 +8,8 @@
 
 namespace waxwork {
 
+class Progress;
+
 struct CgalSettings {
     SizeField size;                      // unbounded: a size from the bounding box is used
     double max_radius_edge_ratio = 2.0;  // cell_radius_edge_ratio (raised to 2, where termination holds)
@@ -16,11 +18,19 @@ struct CgalSettings {
     // armadillo (29K) at 3.5; with the perturber first, 8.8 and 5.0 (spot at 50K: 6.6 -> 10.0) for
     // about 1 s more (TetrahedralizeTest.CgalPerturbsSliversTowardsTheBound).
     double min_dihedral_deg = 10.0;
+    // Mesh_3's own bound on its work: refinement (sharp-edge protection included) stops at this many
+    // vertices and the run fails with AlgorithmError. 0: no limit. tetrahedralize() sets it to many
+    // times the vertices the size predicts: sharp features meeting at a tiny angle (a needle-like
+    // part) make the protecting balls shrink without end, and the refinement never finishes.
+    size_t max_vertices = 0;
+    size_t predicted_vertices = 0;  // for the message when max_vertices is reached
+    Progress* progress = nullptr;   // stages, and its cancel flag stops the refinement
 };
 
 // Sharp edges (dihedral angle under 120 degrees, CGAL's 60-degree feature angle) are protected so
 // that cubes and CAD parts keep their corners. Deterministic: every random generator is seeded.
-// Throws AlgorithmError when CGAL fails or produces no tets.
+// Throws AlgorithmError when CGAL fails, reaches settings.max_vertices or produces no tets, and
+// CancelledError when settings.progress asks it to stop.
 TetMesh cgal_tetrahedralize(const TriangleSurface& surface, const CgalSettings& settings);
 
 }  // namespace waxwork

@@ -1,5 +1,7 @@
 #include "tetops/surface_check.h"
 
+#include "base/progress.h"
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_self_intersections.h>
@@ -231,6 +233,13 @@ std::string plural(size_t n, const std::string& singular, const std::string& plu
 
 }  // namespace
 
+std::string triangle_count_problem(size_t triangles, size_t limit) {
+    if (triangles <= limit) return {};
+    return std::to_string(triangles) + " triangles, more than the meshers take (" + std::to_string(limit) +
+           ": they keep or query every one, and a 2M-triangle surface ran for minutes); simplify the surface "
+           "to at most " + std::to_string(limit) + " triangles first";
+}
+
 bool SurfaceDefects::has_safe_repairs() const {
     return duplicate_points || unreferenced_points || repeated_index_triangles || zero_area_triangles ||
            inconsistent_edges || signed_volume < 0.0;
@@ -325,16 +334,13 @@ SurfaceDefects analyze(const TriangleSurface& surface, bool with_intersections) 
 SurfaceDefects find_surface_defects(const TriangleSurface& surface) { return analyze(surface, true); }
 
 std::vector<std::string> SurfaceDefects::describe(const SurfaceIndexMap* origin) const {
-    auto point_id = [&](int32_t i) {
-        return std::to_string(origin && i >= 0 && static_cast<size_t>(i) < origin->points.size()
-                                  ? origin->points[i]
-                                  : i);
+    // Through origin when given; an element origin marks as new (-1) is "[new I]", I its own index.
+    auto translated = [&](int32_t i, const std::vector<int32_t>* map) {
+        if (!map || i < 0 || static_cast<size_t>(i) >= map->size()) return std::to_string(i);
+        return (*map)[i] >= 0 ? std::to_string((*map)[i]) : "[new " + std::to_string(i) + "]";
     };
-    auto triangle_id = [&](int32_t i) {
-        return std::to_string(origin && i >= 0 && static_cast<size_t>(i) < origin->triangles.size()
-                                  ? origin->triangles[i]
-                                  : i);
-    };
+    auto point_id = [&](int32_t i) { return translated(i, origin ? &origin->points : nullptr); };
+    auto triangle_id = [&](int32_t i) { return translated(i, origin ? &origin->triangles : nullptr); };
     auto edge = [&](const std::array<int32_t, 2>& e) { return "vertices " + point_id(e[0]) + " and " + point_id(e[1]); };
 
     std::vector<std::string> lines;
@@ -539,7 +545,8 @@ std::vector<std::string> repair_safe_defects(TriangleSurface& surface, SurfaceIn
     return repairs;
 }
 
-std::vector<std::string> repair_hard_defects(TriangleSurface& surface, const SurfaceRepairOptions& options) {
+std::vector<std::string> repair_hard_defects(TriangleSurface& surface, const SurfaceRepairOptions& options,
+                                             Progress* progress) {
     std::vector<std::string> repairs;
     if (!options.fill_holes && !options.autorefine) return repairs;
     repair_safe_defects(surface);  // the halfedge mesh below needs merged points and no degenerate faces
@@ -578,7 +585,9 @@ std::vector<std::string> repair_hard_defects(TriangleSurface& surface, const Sur
             for (auto g : CGAL::halfedges_around_face(h, mesh)) seen.insert(g);
         }
         size_t new_faces = 0, new_vertices = 0, unfaired = 0;
+        report_stage(progress, "repairing (filling holes)");
         for (auto h : holes) {
+            check_cancelled(progress);
             std::vector<Mesh::Face_index> faces;
             std::vector<Mesh::Vertex_index> vertices;
             const bool faired = std::get<0>(PMP::triangulate_refine_and_fair_hole(
@@ -597,6 +606,7 @@ std::vector<std::string> repair_hard_defects(TriangleSurface& surface, const Sur
     if (options.autorefine && before.self_intersecting_pairs > 0) {
         // CGAL 5.5 has no autorefine(); its experimental local remeshing is the available tool. It may
         // fail on some intersections, so the caller re-validates and rejects what remains.
+        report_stage(progress, "repairing (removing self-intersections)");
         const bool complete = PMP::experimental::remove_self_intersections(mesh);
         repairs.push_back(std::string("remeshed around ") +
                           plural(before.self_intersecting_pairs, "self-intersecting triangle pair",

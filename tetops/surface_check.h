@@ -17,14 +17,23 @@
 
 namespace waxwork {
 
+class Progress;
+
 // Opt-in repairs that change the shape of the surface.
 struct SurfaceRepairOptions {
     bool fill_holes = false;  // close every boundary loop with a refined, faired patch
     bool autorefine = false;  // remove self-intersections (CGAL's experimental local remeshing)
+    // More triangles than this are refused before any check or repair (0: no limit): the meshers'
+    // limit (kMaxSurfaceTriangles), so that a surface too large to mesh is refused at once.
+    size_t max_triangles = 0;
 };
 
+// The problem of a surface with `triangles` triangles where at most `limit` are taken ("" if none):
+// "N triangles, more than the meshers take (M); simplify the surface to at most M triangles first".
+std::string triangle_count_problem(size_t triangles, size_t limit);
+
 // Where each element of a repaired surface came from: its index before the repairs (for messages
-// that name elements by their index in the user's file).
+// that name elements by their index in the user's file), or -1 for one a repair made.
 struct SurfaceIndexMap {
     std::vector<int32_t> points;
     std::vector<int32_t> triangles;
@@ -71,7 +80,8 @@ struct SurfaceDefects {
 
     // One line per defect that repair_safe_defects() cannot fix, most important first, e.g.
     // "223 boundary edges (the surface is open; first: vertices 10 and 11)"; empty when the surface
-    // is acceptable after the safe repairs. Element indices are translated through origin if given.
+    // is acceptable after the safe repairs. Element indices are translated through origin if given;
+    // one it maps to -1 is written "[new I]" with I its index in this surface.
     std::vector<std::string> describe(const SurfaceIndexMap* origin = nullptr) const;
 };
 
@@ -90,7 +100,8 @@ std::vector<std::string> repair_safe_defects(TriangleSurface& surface,
 // Applies the shape-changing repairs selected in options (hole filling, self-intersection removal),
 // then the safe repairs again. Returns one line per repair made, or a line saying why a requested
 // repair could not run (it needs an edge- and vertex-manifold surface). The caller re-validates.
+// `progress`, when given, is told each repair as it starts.
 std::vector<std::string> repair_hard_defects(TriangleSurface& surface,
-                                             const SurfaceRepairOptions& options);
+                                             const SurfaceRepairOptions& options, Progress* progress = nullptr);
 
 }  // namespace waxwork

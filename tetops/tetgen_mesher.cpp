@@ -1,6 +1,7 @@
 #include "tetops/tetgen_mesher.h"
 
 #include "base/error.h"
+#include "base/progress.h"
 #include "tetops/mesher_scale.h"
 
 #include <tetgen.h>
@@ -133,10 +134,38 @@ TetMesh to_tet_mesh(const tetgenio& out) {
     return make_tet_mesh(std::move(positions), std::move(tets));
 }
 
+// The background mesh of a graded run: a quality mesh at the coarsest size, each of its vertices
+// carrying kMetricPerEdge edge(depth); TetGen interpolates it linearly inside its tets. Its run is
+// bounded by the same limit on added points as the graded run; cut short, it still carries sizes.
+void make_background_mesh(const TriangleSurface& surface, const TetGenSettings& graded, tetgenio& background) {
+    const SizeField& size = graded.size;
+    {
+        tetgenio in;
+        fill_plc(surface, in);
+        run_tetgen(make_switches(graded, std::isfinite(size.max_edge), false), in, background, nullptr);
+    }
+    report_stage(graded.progress, "meshing (TetGen, sizing field)");
+    const SurfaceDistance distance(surface);
+    background.numberofpointmtrs = 1;
+    background.pointmtrlist = new REAL[background.numberofpoints];
+    for (int i = 0; i < background.numberofpoints; ++i) {
+        const REAL* p = &background.pointlist[3 * i];
+        background.pointmtrlist[i] = kMetricPerEdge * size.edge_at_depth(distance({p[0], p[1], p[2]}));
+    }
+}
+
 }  // namespace
 
 double tetgen_volume_bound_for_edge(double edge) {
     return kVolumeBoundPerRegularVolume * edge * edge * edge / (6 * std::sqrt(2.0));
+}
+
+TetMesh tetgen_background_mesh(const TriangleSurface& surface, const TetGenSettings& settings) {
+    TetGenSettings graded = settings;
+    graded.max_added_points = -1;
+    tetgenio background;
+    make_background_mesh(surface, graded, background);
+    return to_tet_mesh(background);
 }
 
 TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettings& settings,
@@ -162,32 +191,22 @@ TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettin
         return to_tet_mesh(out);
     }
 
-    // A point limit would cut the background mesh short too: the graded runs have none.
-    TetGenSettings graded = settings;
-    graded.max_added_points = -1;
-    // Graded: the background mesh is a quality mesh at the coarsest size; each of its vertices gets
-    // the wanted circumradius bound at its depth, and TetGen interpolates it linearly inside its tets,
-    // which reproduces edge(d) exactly where it is linear.
+    // The point limit bounds both runs; the background mesh only carries sizes, so when it is cut
+    // short the run goes on with it, and only the graded run's stop is reported.
+    const TetGenSettings& graded = settings;
+    report_stage(settings.progress, "meshing (TetGen, background mesh)");
     tetgenio background;
-    {
-        tetgenio in;
-        fill_plc(surface, in);
-        run_tetgen(make_switches(graded, std::isfinite(size.max_edge), false), in, background, nullptr);
-    }
-    const SurfaceDistance distance(surface);
-    background.numberofpointmtrs = 1;
-    background.pointmtrlist = new REAL[background.numberofpoints];
-    for (int i = 0; i < background.numberofpoints; ++i) {
-        const REAL* p = &background.pointlist[3 * i];
-        background.pointmtrlist[i] = kMetricPerEdge * size.edge_at_depth(distance({p[0], p[1], p[2]}));
-    }
+    make_background_mesh(surface, graded, background);
     tetgenio in;
     tetgenio out;
     fill_plc(surface, in);
     in.numberofpointmtrs = 1;
     in.pointmtrlist = new REAL[in.numberofpoints];
     for (int i = 0; i < in.numberofpoints; ++i) in.pointmtrlist[i] = kMetricPerEdge * size.surface_edge;
+    report_stage(settings.progress, "meshing (TetGen, graded)");
     run_tetgen(make_switches(graded, false, true), in, out, &background);
+    if (stopped_at_point_limit && settings.max_added_points >= 0)
+        *stopped_at_point_limit = out.numberofpoints - in.numberofpoints >= settings.max_added_points;
     return to_tet_mesh(out);
 }
 

@@ -1,10 +1,14 @@
 #include "tetops/tetrahedralize.h"
 
 #include "base/error.h"
+#include "base/progress.h"
 #include "tetops/cgal_mesher.h"
 #include "tetops/size_field.h"
 #include "tetops/spatial_order.h"
+#include "tetops/surface_check.h"
 #include "tetops/tetgen_mesher.h"
+
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <chrono>
@@ -18,10 +22,6 @@ namespace waxwork {
 
 namespace {
 
-constexpr size_t kMaxTargetTets = 50'000'000;
-// Refuse sizes whose predicted output is larger than this: it would not fit in memory on the
-// machines Waxwork targets and the solver could not run on it anyway.
-constexpr double kMaxPredictedTets = 20e6;
 // Mean tet volume over the volume of the regular tet with the mean edge: 0.88 measured on TetGen's
 // output (spot, 230K tets), so count ~ 1.14 V / regular_volume(edge); rounded up for the estimate.
 constexpr double kTetsPerRegularVolume = 1.2;
@@ -37,6 +37,13 @@ constexpr double kBareCheckTetsPerTriangle = 4.0;
 // quality meshes have 3.2 (skull, cut short) to 6 tets per vertex, so with fewer tets per point than
 // any of them the run stopped there has more tets than allowed.
 constexpr double kTetsPerAddedPointForFloorCheck = 3.0;
+
+// " (about T s at the measured N tets per second; the limit takes about M s)" for a mesh of `tets`.
+std::string predicted_time(double tets) {
+    return " (about " + number_text(std::round(tets / kMeasuredTetsPerSecond)) + " s at the measured " +
+           number_text(kMeasuredTetsPerSecond) + " tets per second; the limit takes about " +
+           number_text(std::round(double(kMaxMeshTets) / kMeasuredTetsPerSecond)) + " s)";
+}
 
 void validate_options(const MeshingOptions& options) {
     if (options.mesher != Mesher::TetGen && options.mesher != Mesher::Cgal) {
@@ -59,10 +66,10 @@ void validate_options(const MeshingOptions& options) {
                                        ": must be a positive length");
         }
     } else if (sizing.target_tets) {
-        if (*sizing.target_tets == 0 || *sizing.target_tets > kMaxTargetTets) {
+        if (*sizing.target_tets == 0 || *sizing.target_tets > kMaxMeshTets) {
             throw InvalidArgumentError("meshing option sizing.target_tets = " +
                                        std::to_string(*sizing.target_tets) + ": must be in 1.." +
-                                       std::to_string(kMaxTargetTets));
+                                       std::to_string(kMaxMeshTets) + predicted_time(*sizing.target_tets));
         }
     } else {
         if (!(sizing.surface_edge > 0) || !std::isfinite(sizing.surface_edge)) {
@@ -119,6 +126,9 @@ void check_surface_span(const TriangleSurface& surface) {
 // range, finite points, closed and consistently oriented (every directed edge has its reverse exactly
 // once), positive enclosed volume.
 void validate_surface(const TriangleSurface& surface) {
+    if (const std::string problem = triangle_count_problem(surface.triangles.size(), kMaxSurfaceTriangles);
+        !problem.empty())
+        throw InvalidMeshError("surface to mesh: " + problem);
     if (surface.triangles.size() < 4) {
         throw InvalidMeshError("surface to mesh: " + std::to_string(surface.triangles.size()) +
                                " triangles cannot enclose a volume");
@@ -184,16 +194,17 @@ double predicted_tets(const SizeField& size, double volume, double area) {
 
 void check_predicted_size(const SizeField& size, double volume, double area, const std::string& option) {
     const double predicted = predicted_tets(size, volume, area);
-    if (predicted > kMaxPredictedTets) {
+    if (predicted > double(kMaxMeshTets)) {
         throw InvalidArgumentError("meshing option " + option + ": about " + number_text(predicted) +
                                    " tets predicted for a volume of " + number_text(volume) +
-                                   ", above the limit of " + number_text(kMaxPredictedTets) +
-                                   "; use a larger edge length");
+                                   ", above the limit of " + number_text(double(kMaxMeshTets)) +
+                                   predicted_time(predicted) + "; use a larger edge length");
     }
 }
 
 TetGenSettings tetgen_settings(const MeshingOptions& options, const SizeField& size) {
     TetGenSettings settings;
+    settings.progress = options.progress;
     settings.size = size;
     settings.max_radius_edge_ratio = options.max_radius_edge_ratio;
     settings.min_dihedral_deg = options.min_dihedral_deg;
@@ -201,11 +212,63 @@ TetGenSettings tetgen_settings(const MeshingOptions& options, const SizeField& s
     return settings;
 }
 
+// Mesh_3's vertex bound: this many times the vertices the size predicts, and never under the floor
+// (small meshes vary most against the prediction). A cube with one corner moved to x = 1000 (a needle)
+// never finished protecting its sharp edges; the bound stops it. Ordinary meshes stay far under it
+// (TetrahedralizeTest.CgalStaysFarUnderItsVertexBound).
+constexpr double kCgalVertexBoundPerPredicted = 10;
+// TetGen's bound on added points for a bounded size, the same way (TetGen adds about 17,000 points a
+// second here: skull, 150,000 in 8.7 s, so the floor is a few seconds' work).
+constexpr double kTetGenAddedPointsPerPredicted = 10;
+constexpr double kTetGenAddedPointFloor = 50'000;
+constexpr double kCgalVertexBoundFloor = 50'000;
+
+// Vertices of a mesh of this size: about one per 5 tets inside, plus the surface's at the surface
+// edge (an equilateral triangle of edge h has area 0.433 h^2 and a closed surface half as many
+// vertices as triangles).
+double predicted_vertices(const SizeField& size, double volume, double area) {
+    const double h = size.surface_edge;
+    return predicted_tets(size, volume, area) / 5 + area / (2 * 0.433 * h * h);
+}
+
 TetMesh run_mesher(const TriangleSurface& surface, const MeshingOptions& options, const SizeField& size) {
+    check_cancelled(options.progress);
     if (options.mesher == Mesher::Cgal) {
-        return cgal_tetrahedralize(surface, {size, options.max_radius_edge_ratio, options.min_dihedral_deg});
+        CgalSettings settings{size, options.max_radius_edge_ratio, options.min_dihedral_deg};
+        settings.progress = options.progress;
+        // An unbounded size is meshed at a twentieth of the box diagonal (cgal_mesher.cpp).
+        SizeField predicted_size = size;
+        if (!size.is_bounded()) {
+            Eigen::AlignedBox3d box;
+            for (const auto& p : surface.points) box.extend(p);
+            predicted_size = SizeField::uniform(box.diagonal().norm() / 20);
+        }
+        const double predicted = predicted_vertices(predicted_size, enclosed_volume(surface), surface_area(surface));
+        settings.predicted_vertices = static_cast<size_t>(std::ceil(predicted));
+        settings.max_vertices =
+            static_cast<size_t>(std::max(kCgalVertexBoundFloor, std::ceil(kCgalVertexBoundPerPredicted * predicted)));
+        return cgal_tetrahedralize(surface, settings);
     }
-    return tetgen_tetrahedralize(surface, tetgen_settings(options, size));
+    report_stage(options.progress, "meshing (TetGen)");
+    TetGenSettings settings = tetgen_settings(options, size);
+    if (!size.is_bounded()) return tetgen_tetrahedralize(surface, settings);
+    // TetGen keeps every input triangle, and a detailed surface can need far more refinement than the
+    // size asks for (bad_stanford-bunny.obj, 70K triangles, at the default size: CGAL makes 15K tets
+    // in 5 s, TetGen's two quality runs had not finished after 110 s). TetGen's own limit on added
+    // points bounds that work, at many times what the size predicts.
+    const double predicted = predicted_vertices(size, enclosed_volume(surface), surface_area(surface));
+    settings.max_added_points =
+        static_cast<long>(std::max(kTetGenAddedPointFloor, std::ceil(kTetGenAddedPointsPerPredicted * predicted)));
+    bool stopped = false;
+    TetMesh mesh = tetgen_tetrahedralize(surface, settings, &stopped);
+    if (stopped)
+        throw InvalidArgumentError(
+            "TetGen stopped at its limit of " + std::to_string(settings.max_added_points) +
+            " added points, where this size needs about " + std::to_string(static_cast<long>(std::ceil(predicted))) +
+            " vertices: it keeps the surface's " + std::to_string(surface.triangles.size()) +
+            " triangles, and they need far more refinement than the size asks for; use the CGAL mesher "
+            "(--mesher cgal), which remeshes the surface");
+    return mesh;
 }
 
 // The error for a target below TetGen's floor on this surface (`floor`: what it needs).
@@ -222,6 +285,7 @@ TetMesh run_mesher(const TriangleSurface& surface, const MeshingOptions& options
 // add vertices to it (1.4-6x the tets on the shared meshes): when it alone is over the promise, the
 // target is refused at once.
 void check_tetgen_bare_floor(const TriangleSurface& surface, const MeshingOptions& options, size_t target) {
+    report_stage(options.progress, "meshing (TetGen, bare floor check)");
     TetGenSettings bare;
     bare.size = SizeField::unbounded();
     bare.quality = false;
@@ -261,6 +325,8 @@ TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& opt
     const auto run_capped = [&](const SizeField& size, bool& stopped) {
         TetGenSettings settings = tetgen_settings(options, size);
         settings.max_added_points = static_cast<long>(std::ceil(most / kTetsPerAddedPointForFloorCheck));
+        check_cancelled(options.progress);
+        report_stage(options.progress, "meshing (TetGen, capped run)");
         return tetgen_tetrahedralize(surface, settings, &stopped);
     };
     bool floor_checked = false;
@@ -335,7 +401,14 @@ TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& opt
 MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     validate_options(options);
+    report_stage(options.progress, "checking the surface for meshing");
     validate_surface(surface);
+    if (options.mesher == Mesher::TetGen && surface.triangles.size() > kMaxTetGenTriangles)
+        throw InvalidArgumentError(
+            "TetGen keeps every one of the surface's " + std::to_string(surface.triangles.size()) +
+            " triangles, and its quality meshes of more than " + std::to_string(kMaxTetGenTriangles) +
+            " take over a minute (horse.ply, 96966 triangles: 93 s); use the CGAL mesher (--mesher cgal), "
+            "which remeshes the surface, or simplify the surface");
     const double volume = enclosed_volume(surface);
     const double area = surface_area(surface);
 
@@ -353,7 +426,10 @@ MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOption
         check_predicted_size(size, volume, area, "sizing.surface_edge = " + number_text(sizing.surface_edge));
         result.mesh = run_mesher(surface, options, size);
     }
+    check_cancelled(options.progress);
+    report_stage(options.progress, "ordering the mesh");
     sort_spatially(result.mesh);
+    report_stage(options.progress, "measuring quality");
     result.quality = measure_quality(result.mesh);
     result.milliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -10,6 +10,8 @@
 
 namespace waxwork {
 
+class Progress;
+
 enum class Mesher { TetGen, Cgal };
 
 // How fine the volume is. Exactly one of the three ways is used, in this order of precedence:
@@ -24,8 +26,8 @@ enum class Mesher { TetGen, Cgal };
 // - graded: edge(d) = min(surface_edge + grading * d, max_edge) at depth d; max_edge == 0: no cap.
 //   TetGen: a quality mesh at max_edge is the background mesh (-m) carrying 0.9 edge(d) per vertex;
 //   CGAL: the same rule as a sizing field, d from an AABB tree.
-// Sizes whose predicted count (1.2 V / regular-tet volume, or the graded shell integral) exceeds 20M
-// tets are refused with InvalidArgumentError.
+// Targets above kMaxMeshTets, and sizes whose predicted count (1.2 V / regular-tet volume, or the
+// graded shell integral) exceeds it, are refused with InvalidArgumentError before any meshing.
 struct MeshSizing {
     std::optional<double> edge_length;   // target edge length in model units, uniform
     std::optional<size_t> target_tets;   // about this many tets (within 20%)
@@ -36,6 +38,24 @@ struct MeshSizing {
     double max_edge = 0;
 };
 
+// The largest mesh made: about a minute's work on a two-core machine at the measured TetGen rate
+// (kMeasuredTetsPerSecond, uniform size, from the surface to the finished, ordered mesh). A larger
+// one is refused up front with the predicted time.
+inline constexpr size_t kMaxMeshTets = 2'000'000;
+inline constexpr double kMeasuredTetsPerSecond = 40'000;
+// The most surface triangles the meshers take. TetGen keeps every triangle (its mesh of a surface
+// has at least 1.4 tets per triangle, and its quality bound adds many more), and CGAL answers a
+// distance query on them for every size it asks; both ran past 180 s on a 2M-triangle sphere. More
+// are refused up front (InvalidMeshError), before any check or mesher runs.
+inline constexpr size_t kMaxSurfaceTriangles = 500'000;
+
+// The most surface triangles TetGen takes (CGAL remeshes the surface and takes up to
+// kMaxSurfaceTriangles). TetGen keeps every triangle, and the work of its quality refinement grows
+// with them, whatever the size asks for: bad_stanford-bunny.obj (70K triangles, holes filled) at the
+// default size takes 48 s, horse.ply (97K) 93 s, the skull's coarsest quality mesh (100K) 66 s, where
+// CGAL takes 5 to 10 s. More are refused up front (InvalidArgumentError) with the way out.
+inline constexpr size_t kMaxTetGenTriangles = 75'000;
+
 // The smallest radius-edge bound TetGen's refinement ends with (validate_options says why).
 inline constexpr double kMinRadiusEdgeRatio = 1.2;
 
@@ -45,6 +65,9 @@ struct MeshingOptions {
     double max_radius_edge_ratio = 2.0;  // TetGen -q bound, >= kMinRadiusEdgeRatio
     double min_dihedral_deg = 10.0;      // TetGen -q/ bound (and CGAL exuder goal)
     bool quiet = true;
+    // Told each stage (checks, each mesher run, ordering, quality) and asked between them whether to
+    // stop (CancelledError); CGAL's refinement also stops on its cancel flag. Not owned; may be null.
+    Progress* progress = nullptr;
 };
 
 struct MeshingResult {

@@ -1,5 +1,6 @@
 // `waxwork mesh INPUT -o OUTPUT`: surface file -> validated surface -> tetrahedral volume file.
 #include "app/commands.h"
+#include "app/stderr_progress.h"
 #include "app/options/material_options.h"
 #include "app/options/surface_meshing_options.h"
 #include "base/error.h"
@@ -31,8 +32,10 @@ struct MeshCommandOptions {
 
 void run_mesh_command(const MeshCommandOptions& o) {
     validate_mm_per_unit(o.scale, "--scale");  // before the (possibly long) surface checks
-    const LoadedSurface loaded = load_surface_to_mesh(o.input, o.meshing);
+    StderrProgress progress("waxwork: " + o.input + ": ");
+    const LoadedSurface loaded = load_surface_to_mesh(o.input, o.meshing, &progress);
     MeshingOptions options = meshing_options(o.meshing);
+    options.progress = &progress;
     // tetrahedralize() validates the explicit sizes (positive, finite, not absurdly many tets).
     if (o.edge) {
         options.sizing.edge_length = o.edge;
@@ -45,7 +48,9 @@ void run_mesh_command(const MeshCommandOptions& o) {
     MeshingResult result = tetrahedralize_surface_file(o.input, loaded.surface, options);
     if (const auto material = chosen_material(o.material))
         result.mesh.materials.assign(result.mesh.tet_count(), *material);
+    progress.set_stage("writing " + o.output);
     write_volume(result.mesh, o.output);
+    progress.finish();
 
     const QualityReport& q = result.quality;
     nlohmann::ordered_json summary = {
@@ -71,7 +76,8 @@ void add_mesh_command(CLI::App& app) {
     cmd->add_option("input", options->input, "Surface file")->required()->check(CLI::ExistingFile);
     cmd->add_option("-o,--output", options->output, "Volume file (.vtu, .msh, .mesh, .node)")->required();
     auto* edge = cmd->add_option("--edge", options->edge, "Target edge length in model units");
-    auto* tets = add_max_tets_option(*cmd, options->max_tets, "About this many tets (within 20%)");
+    auto* tets = add_max_tets_option(*cmd, options->max_tets,
+                                     "About this many tets (within 20%), at most " + std::to_string(kMaxMeshTets));
     edge->excludes(tets);
     add_surface_meshing_options(*cmd, options->meshing);
     cmd->add_option("--scale", options->scale, "Millimetres per model unit (sizes the default mesh)")

@@ -1,5 +1,6 @@
 #include "app/options/surface_meshing_options.h"
 
+#include "app/stderr_progress.h"
 #include "base/error.h"
 
 #include <CLI/CLI.hpp>
@@ -30,11 +31,14 @@ void add_surface_meshing_options(CLI::App& command, SurfaceMeshingOptions& optio
     command.add_flag("--autorefine", options.autorefine, "Opt-in repair: remove self-intersections");
 }
 
-LoadedSurface load_surface_to_mesh(const std::string& path, const SurfaceMeshingOptions& options) {
+LoadedSurface load_surface_to_mesh(const std::string& path, const SurfaceMeshingOptions& options,
+                                   StderrProgress* progress) {
     SurfaceRepairOptions repair;
     repair.fill_holes = options.fill_holes;
     repair.autorefine = options.autorefine;
-    LoadedSurface loaded = load_closed_surface(path, repair);
+    repair.max_triangles = kMaxSurfaceTriangles;  // refused before the checks, which take long too
+    LoadedSurface loaded = load_closed_surface(path, repair, progress);
+    if (progress) progress->finish();
     for (const std::string& line : loaded.repairs) std::cerr << "waxwork: " << path << ": repaired: " << line << "\n";
     return loaded;
 }

@@ -19,6 +19,8 @@ class Option;
 
 namespace waxwork {
 
+class StderrProgress;
+
 struct SurfaceMeshingOptions {
     std::string mesher = "tetgen";
     double min_dihedral = 10.0;
@@ -36,7 +38,9 @@ CLI::Option* add_max_tets_option(CLI::App& command, std::optional<size_t>& max_t
 
 // Reads and validates the surface with the repairs the options allow (load_closed_surface); each
 // repair made is reported on stderr as "waxwork: PATH: repaired: WHAT".
-LoadedSurface load_surface_to_mesh(const std::string& path, const SurfaceMeshingOptions& options);
+// `progress`, when given, shows each stage; its status line is blanked before the repairs are listed.
+LoadedSurface load_surface_to_mesh(const std::string& path, const SurfaceMeshingOptions& options,
+                                   StderrProgress* progress = nullptr);
 
 // The mesher and quality bounds of the options; the caller sets the sizing. tetrahedralize() validates
 // them.

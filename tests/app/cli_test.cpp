@@ -237,5 +237,20 @@ TEST(Cli, AMeshingRefusalNamesTheSurfaceFile) {
     EXPECT_FALSE(fs::exists(dir / "x.vtu"));
 }
 
+// The documented maximum of --max-tets (50M) ran for minutes: a target beyond what is made here in
+// about a minute is refused at once, naming the file, the limit and the predicted time.
+TEST(Cli, ATargetBeyondTheMeasuredLimitIsRefusedUpFront) {
+    const auto dir = scratch_dir("cli_limit");
+    const std::string surface = kAssets + "/meshes/spot.obj";
+    const auto r = run_waxwork("mesh " + surface + " -o " + (dir / "x.vtu").string() + " --max-tets 50000000");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(surface + ": meshing option sizing.target_tets = 50000000: must be in 1.."),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("tets per second"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "x.vtu"));
+}
+
 }  // namespace
 }  // namespace waxwork

@@ -95,9 +95,9 @@ void expect_file_error(const fs::path& path, const std::string& fragment) {
     }
 }
 
-std::string load_error(const fs::path& path) {
+std::string load_error(const fs::path& path, const SurfaceRepairOptions& options = {}) {
     try {
-        load_closed_surface(path);
+        load_closed_surface(path, options);
     } catch (const InvalidMeshError& e) {
         return e.what();
     }
@@ -465,6 +465,85 @@ TEST_F(SurfaceReaderFiles, TruncatedTextFilesNeverPassSilently) {
             }
         }
     }
+}
+
+}  // namespace
+}  // namespace waxwork
+
+namespace waxwork {
+namespace {
+
+// Three vertices no face uses (the safe repairs drop them, renumbering the rest) and a face repeating
+// a vertex (dropped too), then `body`, whose vertex numbers start at 4.
+std::string renumbered_by_repairs(const std::string& body) {
+    return "v 9 9 9\nv 8 8 8\nv 7 7 7\nf 1 1 2\n" + body;
+}
+
+// The error messages name the file's vertices and faces whether or not a shape-changing repair ran
+// first: the repairs renumber the surface, and its numbers pointed at the wrong elements.
+TEST_F(SurfaceReaderFiles, DefectsAfterHardRepairsAreNamedByTheFilesNumbers) {
+    // Two tets sharing only the corner at file vertex 3 (pinched: the hard repairs cannot run).
+    const fs::path pinched = write_text("pinched.obj", renumbered_by_repairs(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv -1 0 0\nv 0 -1 0\nv 0 0 -1\n"
+        "f 4 6 5\nf 4 5 7\nf 4 7 6\nf 5 6 7\nf 4 8 9\nf 4 10 8\nf 4 9 10\nf 8 10 9\n"));
+    const std::string plain = load_error(pinched);
+    EXPECT_NE(plain.find("pinched; vertex 3)"), std::string::npos) << plain;
+    for (const SurfaceRepairOptions options : {SurfaceRepairOptions{.fill_holes = true, .autorefine = false},
+                                               SurfaceRepairOptions{.fill_holes = false, .autorefine = true}}) {
+        const std::string repaired = load_error(pinched, options);
+        EXPECT_NE(repaired.find("pinched; vertex 3)"), std::string::npos) << repaired;
+    }
+
+    // An open tet (its hole is filled) beside two closed tets crossing each other (they stay crossed):
+    // the crossing faces keep the file's numbers, faces 5 on (0-based, after the repeated-index face).
+    const fs::path crossed = write_text("crossed.obj", renumbered_by_repairs(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+        "v 5 0 0\nv 6 0 0\nv 5 1 0\nv 5 0 1\n"
+        "v 5.2 0.2 0.2\nv 6.2 0.2 0.2\nv 5.2 1.2 0.2\nv 5.2 0.2 1.2\n"
+        "f 4 6 5\nf 4 5 7\nf 4 7 6\n"
+        "f 8 10 9\nf 8 9 11\nf 8 11 10\nf 9 10 11\n"
+        "f 12 14 13\nf 12 13 15\nf 12 15 14\nf 13 14 15\n"));
+    const std::string before = load_error(crossed);
+    const auto first_pair = [](const std::string& message) {
+        const size_t at = message.find("self-intersecting triangle pairs (first: ");
+        return at == std::string::npos ? std::string() : message.substr(at, message.find(')', at) - at);
+    };
+    ASSERT_NE(first_pair(before), "") << before;
+    const std::string after = load_error(crossed, {.fill_holes = true, .autorefine = false});
+    EXPECT_EQ(after.find("(the surface is open"), std::string::npos) << after;  // the hole was filled
+    EXPECT_EQ(first_pair(after), first_pair(before)) << before << "\n" << after;
+}
+
+// A surface with more triangles than the meshers take is refused right after reading, before the
+// checks and repairs (which took a minute on a 2M-triangle surface), naming the file.
+TEST_F(SurfaceReaderFiles, MoreTrianglesThanTheLimitAreRefusedBeforeTheChecks) {
+    const fs::path path = write_text("cube.obj", cube_obj());
+    EXPECT_NO_THROW(load_closed_surface(path, {.fill_holes = false, .autorefine = false, .max_triangles = 12}));
+    try {
+        load_closed_surface(path, {.fill_holes = false, .autorefine = false, .max_triangles = 11});
+        ADD_FAILURE() << "loaded";
+    } catch (const InvalidMeshError& e) {
+        EXPECT_EQ(std::string(e.what()).rfind(path.string() + ": 12 triangles, more than the meshers take (11", 0), 0u)
+            << e.what();
+    }
+}
+
+// Vertices and faces a repair made have no number in the file: they are marked as new, and the
+// message says which numbering the others use.
+TEST(SurfaceIndexNames, ElementsARepairMadeAreMarkedAsNew) {
+    SurfaceDefects defects;
+    defects.triangle_count = 2;
+    defects.non_manifold_vertices = 1;
+    defects.first_non_manifold_vertex = 1;
+    defects.boundary_edges = 1;
+    defects.first_boundary_edge = {0, 1};
+    SurfaceIndexMap origin;
+    origin.points = {17, -1};
+    origin.triangles = {0, 1};
+    const std::vector<std::string> lines = defects.describe(&origin);
+    ASSERT_EQ(lines.size(), 2u);
+    EXPECT_NE(lines[0].find("vertices 17 and [new 1]"), std::string::npos) << lines[0];
+    EXPECT_NE(lines[1].find("vertex [new 1]"), std::string::npos) << lines[1];
 }
 
 }  // namespace
