@@ -22,13 +22,6 @@ namespace fs = std::filesystem;
 constexpr uint64_t kSeed = 20261128;
 constexpr int kCasesPerFormat = 300;
 
-std::string read_bytes(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
 void write_bytes(const fs::path& path, const std::string& bytes) {
     std::ofstream(path, std::ios::binary) << bytes;
 }
@@ -97,7 +90,7 @@ TEST(VolumeFuzz, MutatedFilesOfEveryFormatAreReadValidOrRefusedByName) {
                                          {dir / "valid.node", dir / "valid.node"}, {dir / "valid.node", dir / "valid.ele"}};
     testing::ByteMutator mutator(kSeed);
     for (const Source& source : sources) {
-        const std::string original = read_bytes(source.bytes);
+        const std::string original = testing::read_text(source.bytes);
         ASSERT_NO_THROW(read_volume(source.path)) << source.path;  // the unmutated file reads
         const fs::path case_dir = dir / ("cases_" + source.bytes.filename().string());
         fs::create_directories(case_dir);
