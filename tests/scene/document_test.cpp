@@ -4,6 +4,8 @@
 #include "solver/material.h"
 #include "tetops/test_meshes.h"
 
+#include "support/scratch_dir.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -90,7 +92,7 @@ TEST(Document, UndoRestoresTheMeshBitForBitForEveryKind) {
 }
 
 TEST(Document, SaveAndReloadAfterEveryKindOfOperationIsIdentical) {
-    const auto path = std::filesystem::temp_directory_path() / "waxwork_document_reload.vtu";
+    const auto path = testing::scratch_dir("document_reload") / "reload.vtu";
     std::vector<EditOperation> ops = material_and_geometry_ops();
     ops.push_back(WeldOp{1e-9});
     // One document through every kind in turn (fracture, move and weld included), saved and reloaded

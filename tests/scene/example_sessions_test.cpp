@@ -5,6 +5,8 @@
 #include "render/render_input.h"
 #include "scene/session.h"
 
+#include "support/scratch_dir.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -22,8 +24,7 @@ constexpr int kHeight = 180;
 // Spot meshed once for all tests, the way the sessions mesh it (marble at their scale).
 const fs::path& spot_volume() {
     static const fs::path path = [] {
-        const fs::path dir = fs::temp_directory_path() / "waxwork_example_sessions_test";
-        fs::create_directories(dir);
+        const fs::path dir = testing::scratch_dir("example_sessions_spot");
         const fs::path volume = dir / "spot.vtu";
         write_volume(load_session_input(read_session(kSessions / "backlit.json")), volume);
         return volume;
@@ -44,8 +45,7 @@ Replay replay(const std::string& name) {
     r.session.input.volume = spot_volume();
     r.session.width = kWidth;
     r.session.height = kHeight;
-    r.out = fs::temp_directory_path() / ("waxwork_example_sessions_test_" + name);
-    fs::remove_all(r.out);
+    r.out = testing::scratch_dir("example_sessions_" + name);
     r.result = run_session(r.session, r.out);
     return r;
 }

@@ -177,13 +177,6 @@ TEST(LiveFrameBudget, InvalidBudgetsAreRejected) {
     }
 }
 
-fs::path scratch(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("waxwork_frame_budget_test_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
 std::string session_error(const fs::path& dir, const std::string& frame_ms) {
     const fs::path path = dir / "bad.json";
     std::ofstream(path) << R"({"input": {"volume": "v.vtu"}, "frame_ms": )" << frame_ms << R"(, "steps": []})";
@@ -196,7 +189,7 @@ std::string session_error(const fs::path& dir, const std::string& frame_ms) {
 }
 
 TEST(SessionFrameBudget, FrameMsRoundTripsAndIsOptional) {
-    const fs::path dir = scratch("round_trip");
+    const fs::path dir = testing::scratch_dir("round_trip");
     std::ofstream(dir / "s.json") << R"({"input": {"volume": "v.vtu"}, "frame_iterations": 6, "frame_ms": 7.5,
                                          "steps": [{"render": "a.png", "frames": 2}]})";
     const Session session = read_session(dir / "s.json");
@@ -226,7 +219,7 @@ TEST(SessionFrameBudget, FrameMsRoundTripsAndIsOptional) {
 }
 
 TEST(SessionFrameBudget, BadFrameMsNamesTheFileAndField) {
-    const fs::path dir = scratch("errors");
+    const fs::path dir = testing::scratch_dir("errors");
     for (const std::string bad : {"-1", "0", "\"fast\"", "1e9", "null"}) {
         const std::string e = session_error(dir, bad);
         EXPECT_NE(e.find("bad.json: field 'frame_ms'"), std::string::npos) << bad << ": " << e;
@@ -234,7 +227,7 @@ TEST(SessionFrameBudget, BadFrameMsNamesTheFileAndField) {
 }
 
 TEST(SessionFrameBudget, RunReplaysWithATimeBudget) {
-    const fs::path dir = scratch("run");
+    const fs::path dir = testing::scratch_dir("run");
     write_volume(testing::make_cube_mesh(4), dir / "cube.vtu");
     std::ofstream(dir / "s.json") << R"({"input": {"volume": "cube.vtu"}, "frame_ms": 5, "scale": 10,
         "lights": [{"direction": [1, -0.8, -0.5]}], "steps": [{"render": "a.png", "frames": 2}, {"render": "b.png"}]})";
@@ -251,7 +244,7 @@ TEST(SessionFrameBudget, RunReplaysWithATimeBudget) {
 TEST(CliFrameBudget, BadFrameMsIsAOneLineError) {
     using waxwork::testing::line_count;
     using waxwork::testing::run_waxwork;
-    const fs::path dir = scratch("cli");
+    const fs::path dir = testing::scratch_dir("cli");
     write_volume(testing::make_cube_mesh(3), dir / "cube.vtu");
     std::ofstream(dir / "s.json")
         << R"({"input": {"volume": "cube.vtu"}, "steps": [{"render": "a.png", "frames": 1}]})";
@@ -284,7 +277,7 @@ TEST(CliFrameBudget, BadFrameMsIsAOneLineError) {
 // budget shows (both converge to the same tolerance: the pictures agree to rounding).
 TEST(CliFrameBudget, EditorWithATimeBudgetConvergesToTheSamePicture) {
     if (!waxwork::testing::have_xvfb()) GTEST_SKIP() << "xvfb-run is not installed";
-    const fs::path dir = scratch("editor");
+    const fs::path dir = testing::scratch_dir("editor");
     write_volume(testing::make_cube_mesh(6), dir / "cube.vtu");
     const std::string common = "edit " + (dir / "cube.vtu").string() + " --hide-ui --width 320 --height 240 --frames 1";
     const auto iterations =

@@ -20,13 +20,6 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 using testing::run_waxwork;
 
-fs::path scratch(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("waxwork_session_backend_test_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
 // A paint, a cut and a partly converged frame: every kind of device update the live GPU solver does.
 void write_session_file(const fs::path& dir) {
     write_volume(testing::make_cube_mesh(6), dir / "cube.vtu");
@@ -54,7 +47,7 @@ int max_channel_difference(const Image& a, const Image& b) {
 }
 
 TEST(SessionBackend, GpuRunGivesTheCpuRunsVolumeAndImages) {
-    const fs::path dir = scratch("gpu");
+    const fs::path dir = testing::scratch_dir("gpu");
     write_session_file(dir);
     const Session session = read_session(dir / "s.json");
     const SessionResult cpu = run_session(session, dir / "cpu");
@@ -74,7 +67,7 @@ TEST(SessionBackend, GpuRunGivesTheCpuRunsVolumeAndImages) {
 }
 
 TEST(SessionBackend, AFailingGpuRunFallsBackAndSaysWhy) {
-    const fs::path dir = scratch("fallback");
+    const fs::path dir = testing::scratch_dir("fallback");
     write_session_file(dir);
     SessionRunOptions gpu_options;
     gpu_options.backend = LiveBackend::Gpu;
@@ -93,7 +86,7 @@ TEST(SessionBackend, AFailingGpuRunFallsBackAndSaysWhy) {
 // multires solver, on the CPU and on the GPU, and gives the images of the default method; an unknown
 // method is refused.
 TEST(SessionBackend, RunAcceptsTheMultiresMethod) {
-    const fs::path dir = scratch("multires");
+    const fs::path dir = testing::scratch_dir("multires");
     write_session_file(dir);
     const auto jacobi = run_waxwork("run " + (dir / "s.json").string() + " -o " + (dir / "jacobi").string());
     ASSERT_EQ(jacobi.exit_code, 0) << jacobi.err;
@@ -115,7 +108,7 @@ TEST(SessionBackend, RunAcceptsTheMultiresMethod) {
 
 // The run's first line and metrics.json give the volume as loaded, not as the first step left it.
 TEST(SessionBackend, RunReportsTheInputAsLoaded) {
-    const fs::path dir = scratch("input_tets");
+    const fs::path dir = testing::scratch_dir("input_tets");
     write_volume(testing::make_cube_mesh(6), dir / "cube.vtu");  // 1296 tets
     std::ofstream(dir / "s.json") << R"({"input": {"volume": "cube.vtu"}, "image": {"width": 32, "height": 24},
         "steps": [{"op": "plane_cut", "normal": [1, 0, 0], "offset": 0.5}, {"save": "cut.vtu"}]})";

@@ -5,6 +5,8 @@
 #include "solver/material.h"
 #include "tetops/test_meshes.h"
 
+#include "support/scratch_dir.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -16,13 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
-
-fs::path scratch(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("waxwork_session_test_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
 
 const fs::path kSessions = fs::path(WAXWORK_ASSET_DIR) / "sessions";
 
@@ -41,7 +36,7 @@ TEST(Session, ExampleSessionsParseAndRoundTripThroughJson) {
 }
 
 std::string session_error(const std::string& text) {
-    const fs::path dir = scratch("errors");
+    const fs::path dir = testing::scratch_dir("errors");
     const fs::path path = dir / "bad.json";
     std::ofstream(path) << text;
     try {
@@ -139,7 +134,7 @@ TEST(Session, CamerasAreCheckedWhenRead) {
 }
 
 TEST(Session, InputErrorsNameTheSession) {
-    const fs::path dir = scratch("input_errors");
+    const fs::path dir = testing::scratch_dir("input_errors");
     std::ofstream(dir / "empty.stl") << "solid x\nendsolid x\n";
     std::ofstream(dir / "open.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";  // one triangle: not closed
     const auto run_error = [&](const std::string& input) -> std::string {
@@ -165,7 +160,7 @@ TEST(Session, InputErrorsNameTheSession) {
 // The crease angle is the session's: it round-trips, a bad one names the field, and it reaches the
 // rendered frames (a cube's edges shade as folded at 40 degrees and as one normal per vertex at 180).
 TEST(Session, CreaseAngleRoundTripsAndReachesTheFrames) {
-    const fs::path dir = scratch("crease");
+    const fs::path dir = testing::scratch_dir("crease");
     write_volume(testing::make_cube_mesh(4), dir / "cube.vtu");
     const auto session_with = [&](const std::string& angle) {
         return parse_session(Json::parse(R"({"input": {"volume": "cube.vtu"}, "crease_angle": )" + angle +
@@ -193,7 +188,7 @@ TEST(Session, CreaseAngleRoundTripsAndReachesTheFrames) {
 // shadows) rather than rendered black; an explicit empty list is no light, and an "ambient" alone
 // keeps the key light.
 TEST(Session, WithoutLightsItIsLitAsRenderLightsIt) {
-    const fs::path dir = scratch("default_lights");
+    const fs::path dir = testing::scratch_dir("default_lights");
     write_volume(testing::make_cube_mesh(4), dir / "cube.vtu");
     const auto parse = [&](const std::string& fields) {
         return parse_session(Json::parse(R"({"input": {"volume": "cube.vtu"}, )" + fields +
@@ -223,7 +218,7 @@ TEST(Session, WithoutLightsItIsLitAsRenderLightsIt) {
 
 // Outputs in sub-folders of the output directory get their folders.
 TEST(Session, OutputsInSubfoldersCreateThem) {
-    const fs::path dir = scratch("subfolders");
+    const fs::path dir = testing::scratch_dir("subfolders");
     write_volume(testing::make_cube_mesh(3), dir / "cube.vtu");
     const Session session = parse_session(
         Json::parse(R"({"input": {"volume": "cube.vtu"}, "image": {"width": 32, "height": 24},
@@ -235,7 +230,7 @@ TEST(Session, OutputsInSubfoldersCreateThem) {
 }
 
 TEST(Session, RunErrorsNameTheStep) {
-    const fs::path dir = scratch("run_errors");
+    const fs::path dir = testing::scratch_dir("run_errors");
     write_volume(testing::make_cube_mesh(3), dir / "cube.vtu");
     std::ofstream(dir / "s.json") << R"({"input": {"volume": "cube.vtu"}, "steps": [{"save": "a.vtu"}, {"undo": 1}]})";
     try {
@@ -248,7 +243,7 @@ TEST(Session, RunErrorsNameTheStep) {
 }
 
 TEST(Session, RecordedHistoryReplaysToTheSameVolumeBitForBit) {
-    const fs::path dir = scratch("record");
+    const fs::path dir = testing::scratch_dir("record");
     write_volume(testing::make_cube_mesh(6), dir / "cube.vtu");
     Session setup;
     setup.name = "setup";
@@ -293,7 +288,7 @@ TEST(Session, RecordedHistoryReplaysToTheSameVolumeBitForBit) {
 }
 
 TEST(Session, UndoAndRedoStepsReplay) {
-    const fs::path dir = scratch("undo");
+    const fs::path dir = testing::scratch_dir("undo");
     const TetMesh cube = testing::make_cube_mesh(4);
     write_volume(cube, dir / "cube.vtu");
     std::ofstream(dir / "s.json") << R"({"input": {"volume": "cube.vtu"}, "scale": 10, "steps": [

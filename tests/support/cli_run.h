@@ -1,6 +1,8 @@
 // Runs the waxwork executable from tests and captures what it prints.
 #pragma once
 
+#include "support/scratch_dir.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -49,14 +51,6 @@ inline CommandResult run_waxwork(const std::string& arguments, const std::string
 
 // Number of lines in captured output (a one-line error message has exactly one).
 inline size_t line_count(const std::string& s) { return static_cast<size_t>(std::count(s.begin(), s.end(), '\n')); }
-
-// A fresh, empty scratch directory for one test.
-inline std::filesystem::path scratch_dir(const std::string& name) {
-    const auto dir = std::filesystem::temp_directory_path() / ("waxwork_test_" + std::to_string(::getpid())) / name;
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    return dir;
-}
 
 // Whether xvfb-run is installed (the window tests skip without it).
 inline bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
