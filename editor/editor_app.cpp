@@ -8,6 +8,7 @@
 #include "solver/material.h"
 #include "solver/mesh_resolution.h"
 #include "tetops/connectivity.h"
+#include "tetops/model_scale.h"
 #include "tetops/tetrahedralize.h"
 
 #include <GLFW/glfw3.h>
@@ -66,7 +67,7 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
 
     lighting_ = default_lighting();
     if (!options.lights.empty()) lighting_.lights = options.lights;
-    live_options_.mm_per_unit = options.scale;
+    live_options_.mm_per_unit = options.scale.value_or(1.0);  // until a model loads with its own
     live_options_.crease_angle_degrees = options.crease_angle_degrees;
     choose_solver(options.solver_method, options.solver_backend);
     if (options.frame_ms) {
@@ -126,7 +127,7 @@ void EditorApp::set_error(const std::string& message) {
     show_error_popup_ = true;
 }
 
-void EditorApp::open_file(const fs::path& path) {
+void EditorApp::open_file(const fs::path& path, std::optional<double> scale) {
     if (load_task_.busy()) {
         set_error("still loading " + load_task_.label() + "; try again when it finishes");
         return;
@@ -140,7 +141,7 @@ void EditorApp::open_file(const fs::path& path) {
     (is_volume_path(path) ? setup.input.volume : setup.input.surface) = fs::absolute(path);
     setup.input.max_tets = options_.max_tets;
     setup.material = options_.material.value_or(material_preset("marble"));
-    setup.scale = live_options_.mm_per_unit;
+    setup.scale = scale ? scale : options_.scale;
     setup.tolerance = live_options_.relative_tolerance;
     setup.crease_angle_degrees = live_options_.crease_angle_degrees;
     setup.lighting = lighting_;
@@ -151,10 +152,14 @@ void EditorApp::open_file(const fs::path& path) {
     status_ = "Loading " + path.string();
     load_task_.start(path.filename().string(), [this, path, setup, material_name, solver = live_options_](TaskProgress& progress) {
         progress.set_stage(setup.input.volume.empty() ? "meshing the surface" : "reading the volume");
-        TetMesh mesh = read_session_input(setup);
+        SessionVolume input = read_session_input(setup);
+        const LoadedModel model = measure_loaded_model(input);
+        Session resolved = setup;
+        resolved.scale = input.scale.mm_per_unit;
         progress.set_stage("building the document and the live scene");
-        auto core = std::make_shared<SceneCore>(std::move(mesh), setup, solver);
-        return BackgroundTask::Apply([this, path, core, material_name] { install_core(core, path, material_name, {}); });
+        auto core = std::make_shared<SceneCore>(std::move(input.mesh), resolved, solver);
+        return BackgroundTask::Apply(
+            [this, path, core, material_name, model] { install_core(core, path, material_name, {}, model); });
     });
 }
 
@@ -164,7 +169,8 @@ void EditorApp::open_session(const fs::path& path) {
         progress.set_stage("reading the session");
         Session session = read_session(path);
         progress.set_stage(session.input.volume.empty() ? "meshing the surface" : "reading the volume");
-        TetMesh mesh = load_session_input(session);
+        SessionVolume input = load_session_input(session);
+        const LoadedModel model = measure_loaded_model(input);
         // Edits are replayed (and become undoable); the last light and camera steps set the scene's.
         std::vector<EditOperation> edits;
         for (const SessionStep& step : session.steps) {
@@ -174,17 +180,23 @@ void EditorApp::open_session(const fs::path& path) {
         }
         Session setup = session;
         setup.steps.clear();
+        setup.scale = input.scale.mm_per_unit;
         progress.set_stage("building the document and the live scene");
-        auto core = std::make_shared<SceneCore>(std::move(mesh), setup, solver);
-        return BackgroundTask::Apply([this, path, core, edits] {
-            install_core(core, path, "session", edits);
+        auto core = std::make_shared<SceneCore>(std::move(input.mesh), setup, solver);
+        return BackgroundTask::Apply([this, path, core, edits, model] {
+            install_core(core, path, "session", edits, model);
             adopt_frame_budget(core->setup());
         });
     });
 }
 
+EditorApp::LoadedModel EditorApp::measure_loaded_model(const SessionVolume& input) {
+    return {describe_model_scale(input.scale, bounding_extent(input.mesh.positions)),
+            mean_surface_edge_length(input.mesh)};
+}
+
 void EditorApp::install_core(std::shared_ptr<SceneCore> core, const fs::path& path, const std::string& material_name,
-                             const std::vector<EditOperation>& replay) {
+                             const std::vector<EditOperation>& replay, const LoadedModel& model) {
     pending_jobs_.clear();
     scene_ = std::make_unique<Scene>();
     scene_->core = core;
@@ -192,7 +204,11 @@ void EditorApp::install_core(std::shared_ptr<SceneCore> core, const fs::path& pa
     scene_->vertices = core->document().mesh().vertex_count();
     scene_->material_name = material_name;
     lighting_ = core->setup().lighting;
-    live_options_.mm_per_unit = core->setup().scale;
+    live_options_.mm_per_unit = *core->setup().scale;
+    scene_->extent = bounding_extent(core->document().mesh().positions);
+    scene_->surface_edge = model.surface_edge;
+    scene_->setup_material = core->setup().material;
+    scene_->source_surface = core->setup().input.surface;
     live_options_.relative_tolerance = core->setup().tolerance;
     live_options_.crease_angle_degrees = core->setup().crease_angle_degrees;
     options_.camera = core->setup().camera;
@@ -200,7 +216,7 @@ void EditorApp::install_core(std::shared_ptr<SceneCore> core, const fs::path& pa
     current_file_ = path;
     for (const EditOperation& op : replay) queue_edit(op);
     status_ = "Loaded " + path.filename().string() + ": " + std::to_string(scene_->tets) + " tets, " +
-              std::to_string(scene_->vertices) + " vertices";
+              std::to_string(scene_->vertices) + " vertices; " + model.scale_note;
     glfwSetWindowTitle(window_, ("Waxwork - " + path.filename().string()).c_str());
     lighting_dirty_ = false;
     crease_angle_dirty_ = false;
@@ -624,6 +640,7 @@ EditorRunStats run_editor(const EditorOptions& options) {
         const EditorScene& scene = app.scene();
         stats.tets = scene.tets;
         stats.vertices = scene.vertices;
+        stats.mm_per_unit = app.mm_per_unit();
         stats.ticks = scene.ticks;
         stats.tick_ms = scene.ticks ? scene.tick_ms_sum / scene.ticks : 0;
         stats.solver_backend = live_backend_name(scene.solver_backend);

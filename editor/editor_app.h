@@ -52,7 +52,8 @@ struct EditorOptions {
     int width = 1280;                    // window size in screen coordinates
     int height = 800;
     std::vector<Light> lights;           // empty: default_key_light
-    double scale = 1.0;                  // millimetres per model unit
+    std::optional<double> scale;         // millimetres per model unit; nullopt: the volume's stored scale,
+                                         // else one chosen from the model's size (tetops/model_scale.h)
     double crease_angle_degrees = kDefaultCreaseAngleDegrees;  // where the surface folds (--crease-angle)
     CameraSettings camera;               // the first view (as `waxwork render --view`)
     ViewOptions view;                    // what the 3D view shows (as `waxwork render --show`)
@@ -73,6 +74,7 @@ struct EditorRunStats {
     double tick_ms = 0;          // mean worker tick (edits, solver step, image input) while converging
     int ticks = 0;
     size_t tets = 0, vertices = 0;
+    double mm_per_unit = 0;      // the scale the model was shown at
     std::string gl_version, gl_renderer;
     std::string solver_backend;       // "cpu" or "gpu": what solved the last frame
     std::string gpu_fallback_reason;  // why the GPU backend was given up, if it was
@@ -114,6 +116,11 @@ struct EditorScene {
     double tick_ms_sum = 0;
     int ticks = 0;
     double min_dihedral_deg = 0;
+    // Of the loaded volume, for the size in mm beside the scale and the mesh's fit to the rule at it.
+    Eigen::Vector3d extent = Eigen::Vector3d::Zero();  // bounding box, model units
+    double surface_edge = 0;                           // mean_surface_edge_length, model units
+    TetMaterial setup_material;                        // the material the rule sizes for
+    std::filesystem::path source_surface;              // the surface it was meshed from (empty: a volume)
     LiveBackend solver_backend = LiveBackend::Cpu;  // after the latest tick (Cpu after a fallback)
     std::string solver_description;
     std::string gpu_fallback_reason;
@@ -146,9 +153,11 @@ public:
     const GlApi& gl() const { return gl_; }
     const EditorScene& scene() const { return *scene_; }
     double view_ms() const { return last_render_ms_; }
+    double mm_per_unit() const { return live_options_.mm_per_unit; }
 
-    // Loads a surface (meshed with the current options) or a volume file, in the background.
-    void open_file(const std::filesystem::path& path);
+    // Loads a surface (meshed with the current options) or a volume file, in the background, at
+    // `scale` mm per unit when given (else --scale, else the volume's stored scale, else the model's).
+    void open_file(const std::filesystem::path& path, std::optional<double> scale = std::nullopt);
     void save_volume(const std::filesystem::path& path);
     void on_drop(const std::vector<std::filesystem::path>& paths);
     void on_key(int key, int mods);
@@ -191,8 +200,16 @@ private:
 
     void open_dialog(FileDialog::Mode mode, bool session = false);
     void relax_last_cut();
+    // What loading found out about the model, measured off the UI thread.
+    struct LoadedModel {
+        std::string scale_note;  // describe_model_scale: ends the status line
+        double surface_edge = 0; // mean_surface_edge_length
+    };
+    static LoadedModel measure_loaded_model(const SessionVolume& input);
     void install_core(std::shared_ptr<SceneCore> core, const std::filesystem::path& path,
-                      const std::string& material_name, const std::vector<EditOperation>& replay);
+                      const std::string& material_name, const std::vector<EditOperation>& replay,
+                      const LoadedModel& model);
+    void draw_scale_fit();  // editor_panels.cpp: the size in mm and the mesh's fit to the scale
     std::optional<PieceHit> piece_under(const Eigen::Vector2d& pixel) const;
     void file_dialog_result();
     void undo();

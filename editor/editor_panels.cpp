@@ -5,6 +5,8 @@
 
 #include "editor/material_swatch.h"
 #include "solver/material.h"
+#include "solver/mesh_resolution.h"
+#include "tetops/model_scale.h"
 
 #include <GLFW/glfw3.h>
 #include <imgui.h>
@@ -241,6 +243,7 @@ void EditorApp::draw_solver_panel() {
     if (ImGui::DragFloat("mm per unit", &scale, 0.1f, 0.01f, 10000.0f, "%.2f", ImGuiSliderFlags_Logarithmic))
         live_options_.mm_per_unit = std::clamp(static_cast<double>(scale), 1e-3, 1e6);
     if (ImGui::IsItemDeactivatedAfterEdit()) rebuild_live_scene();
+    draw_scale_fit();
     ImGui::SliderFloat("exposure", &exposure_stops_, -4.0f, 4.0f, "%+.1f stops");
     ImGui::SameLine();
     if (ImGui::SmallButton("auto")) {
@@ -266,6 +269,31 @@ void EditorApp::draw_solver_panel() {
     const ImGuiIO& io = ImGui::GetIO();
     ImGui::Text("frame %.1f ms (%.0f fps), 3D view %.1f ms", 1000.0f / std::max(io.Framerate, 1e-3f), io.Framerate,
                 last_render_ms_);
+}
+
+// The object's size at the scale, and what the scale asks of the mesh: the rule's surface edge
+// (solver/mesh_resolution.h) against the mesh's. A scale changed after meshing can leave the mesh too
+// coarse for the diffusion length (blotchy light) or far finer than it needs (slow); a mesh made from a
+// surface can be made again at the new scale.
+void EditorApp::draw_scale_fit() {
+    const Scene& s = *scene_;
+    if (!s.core || !(s.extent.norm() > 0) || !(s.surface_edge > 0)) return;
+    const double mm = live_options_.mm_per_unit;
+    ImGui::TextDisabled("object %s", size_in_mm(s.extent, mm).c_str());
+    const double wanted = default_surface_edge(s.extent.norm(), s.setup_material, mm);
+    const double ratio = s.surface_edge / wanted;
+    // Within a factor 1.5 either way the rule's error estimate (about h^2) changes by at most 2.25x.
+    if (ratio >= 1.0 / 1.5 && ratio <= 1.5) return;
+    if (ratio > 1.5)
+        ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "mesh %.1fx coarser than the light needs at this scale",
+                           ratio);
+    else
+        ImGui::TextDisabled("mesh %.1fx finer than the light needs at this scale (slower)", 1.0 / ratio);
+    if (s.source_surface.empty()) return;
+    if (ImGui::SmallButton("Remesh at this scale")) open_file(s.source_surface, mm);
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("Meshes %s again for %.3g mm per unit (edits are not kept)",
+                          s.source_surface.filename().string().c_str(), mm);
 }
 
 void EditorApp::draw_view_panel() {

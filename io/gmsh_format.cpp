@@ -132,7 +132,7 @@ std::vector<Tet> read_tets(TextScanner& scanner, const GmshNodes& nodes) {
 
 }  // namespace
 
-TetMesh parse_gmsh(std::string_view contents, const std::string& file) {
+TetMesh parse_gmsh(std::string_view contents, const std::string& file, VolumeMetadata* metadata) {
     TextScanner scanner(contents, file);
     if (scanner.peek_token() != "$MeshFormat") scanner.fail("not a Gmsh file (it does not start with $MeshFormat)");
     GmshNodes nodes;
@@ -173,15 +173,19 @@ TetMesh parse_gmsh(std::string_view contents, const std::string& file) {
     }
     if (!have_nodes || !have_elements) throw FileError(file, "missing $Nodes or $Elements section");
     if (tets.empty()) throw FileError(file, "contains no tetrahedra (element type 4)");
+    if (metadata) *metadata = find_metadata_comments(contents, "", file);
     return mesh_from_foreign_geometry(std::move(nodes.positions), std::move(tets), file);
 }
 
-void format_gmsh(const TetMesh& mesh, std::ostream& out) {
+void format_gmsh(const TetMesh& mesh, std::ostream& out, const VolumeMetadata& metadata) {
     const auto n_vertices = static_cast<int64_t>(mesh.vertex_count());
     const auto n_tets = static_cast<int64_t>(mesh.tet_count());
     std::string text;
     text.reserve(static_cast<size_t>(n_vertices) * 72 + static_cast<size_t>(n_tets) * 40 + 512);
-    text += "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1";
+    text += "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
+    if (const std::string lines = metadata_comment_lines(metadata, ""); !lines.empty())
+        text += "$Comments\n" + lines + "$EndComments\n";
+    text += "$Entities\n0 0 0 1\n1";
     const auto box = bounding_box(mesh);
     for (const auto& corner : box)
         for (int k = 0; k < 3; ++k) {
@@ -228,12 +232,12 @@ void format_gmsh(const TetMesh& mesh, std::ostream& out) {
     out.write(text.data(), static_cast<std::streamsize>(text.size()));
 }
 
-void write_gmsh(const TetMesh& mesh, const std::filesystem::path& path) {
-    write_file_atomically(path, [&](std::ostream& out) { format_gmsh(mesh, out); });
+void write_gmsh(const TetMesh& mesh, const std::filesystem::path& path, const VolumeMetadata& metadata) {
+    write_file_atomically(path, [&](std::ostream& out) { format_gmsh(mesh, out, metadata); });
 }
 
-TetMesh read_gmsh(const std::filesystem::path& path) {
-    return parse_gmsh(read_file_contents(path), path.string());
+TetMesh read_gmsh(const std::filesystem::path& path, VolumeMetadata* metadata) {
+    return parse_gmsh(read_file_contents(path), path.string(), metadata);
 }
 
 }  // namespace waxwork

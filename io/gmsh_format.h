@@ -10,9 +10,11 @@
 //
 // Writing: a minimal valid file with one volume entity (tag 1, no physical groups) holding every
 // node (tags 1..N, TetMesh order) and every tet (tags 1..M, TetMesh order); rest-frame positions,
-// exact shortest-round-trip decimals. Materials, original ids and pieces are not stored.
+// exact shortest-round-trip decimals. Materials, original ids and pieces are not stored; the scale
+// is (volume_metadata.h).
 #pragma once
 
+#include "io/volume_metadata.h"
 #include "tetops/tet_mesh.h"
 
 #include <filesystem>
@@ -22,10 +24,11 @@
 
 namespace waxwork {
 
-void format_gmsh(const TetMesh& mesh, std::ostream& out);
-TetMesh parse_gmsh(std::string_view contents, const std::string& file_name);
+// `metadata` is written as volume_metadata.h says; parsing fills `metadata` when given.
+void format_gmsh(const TetMesh& mesh, std::ostream& out, const VolumeMetadata& metadata = {});
+TetMesh parse_gmsh(std::string_view contents, const std::string& file_name, VolumeMetadata* metadata = nullptr);
 
-void write_gmsh(const TetMesh& mesh, const std::filesystem::path& path);
-TetMesh read_gmsh(const std::filesystem::path& path);
+void write_gmsh(const TetMesh& mesh, const std::filesystem::path& path, const VolumeMetadata& metadata = {});
+TetMesh read_gmsh(const std::filesystem::path& path, VolumeMetadata* metadata = nullptr);
 
 }  // namespace waxwork

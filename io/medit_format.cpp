@@ -25,7 +25,7 @@ bool is_keyword(std::string_view token) {
 
 }  // namespace
 
-TetMesh parse_medit(std::string_view contents, const std::string& file) {
+TetMesh parse_medit(std::string_view contents, const std::string& file, VolumeMetadata* metadata) {
     TextScanner scanner(contents, file, '#');
     if (!same_keyword(scanner.peek_token(), "MeshVersionFormatted")) {
         scanner.fail("not a MEDIT file (it does not start with MeshVersionFormatted)");
@@ -98,13 +98,16 @@ TetMesh parse_medit(std::string_view contents, const std::string& file) {
     }
     if (!have_end) scanner.fail("missing End keyword (truncated file?)");
     if (tets.empty()) throw FileError(file, "contains no tetrahedra");
+    if (metadata) *metadata = find_metadata_comments(contents, "# ", file);
     return mesh_from_foreign_geometry(std::move(positions), std::move(tets), file);
 }
 
-void format_medit(const TetMesh& mesh, std::ostream& out) {
+void format_medit(const TetMesh& mesh, std::ostream& out, const VolumeMetadata& metadata) {
     std::string text;
     text.reserve(mesh.vertex_count() * 72 + mesh.tet_count() * 40 + 256);
-    text += "MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n";
+    text += "MeshVersionFormatted 2\n";
+    text += metadata_comment_lines(metadata, "# ");
+    text += "\nDimension 3\n\nVertices\n";
     append_number(text, static_cast<int64_t>(mesh.vertex_count()));
     text += '\n';
     for (const Eigen::Vector3d& p : mesh.positions) {
@@ -129,12 +132,12 @@ void format_medit(const TetMesh& mesh, std::ostream& out) {
     out.write(text.data(), static_cast<std::streamsize>(text.size()));
 }
 
-void write_medit(const TetMesh& mesh, const std::filesystem::path& path) {
-    write_file_atomically(path, [&](std::ostream& out) { format_medit(mesh, out); });
+void write_medit(const TetMesh& mesh, const std::filesystem::path& path, const VolumeMetadata& metadata) {
+    write_file_atomically(path, [&](std::ostream& out) { format_medit(mesh, out, metadata); });
 }
 
-TetMesh read_medit(const std::filesystem::path& path) {
-    return parse_medit(read_file_contents(path), path.string());
+TetMesh read_medit(const std::filesystem::path& path, VolumeMetadata* metadata) {
+    return parse_medit(read_file_contents(path), path.string(), metadata);
 }
 
 }  // namespace waxwork

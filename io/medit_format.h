@@ -11,9 +11,10 @@
 //
 // Writing: MeshVersionFormatted 2 (double precision), vertex ref 0, and each tet's ref set to its
 // piece id so a fractured volume keeps its pieces distinguishable in other tools. Rest-frame
-// positions, exact shortest-round-trip decimals.
+// positions, exact shortest-round-trip decimals; the scale in a comment (volume_metadata.h).
 #pragma once
 
+#include "io/volume_metadata.h"
 #include "tetops/tet_mesh.h"
 
 #include <filesystem>
@@ -23,10 +24,11 @@
 
 namespace waxwork {
 
-void format_medit(const TetMesh& mesh, std::ostream& out);
-TetMesh parse_medit(std::string_view contents, const std::string& file_name);
+// `metadata` is written as volume_metadata.h says; parsing fills `metadata` when given.
+void format_medit(const TetMesh& mesh, std::ostream& out, const VolumeMetadata& metadata = {});
+TetMesh parse_medit(std::string_view contents, const std::string& file_name, VolumeMetadata* metadata = nullptr);
 
-void write_medit(const TetMesh& mesh, const std::filesystem::path& path);
-TetMesh read_medit(const std::filesystem::path& path);
+void write_medit(const TetMesh& mesh, const std::filesystem::path& path, const VolumeMetadata& metadata = {});
+TetMesh read_medit(const std::filesystem::path& path, VolumeMetadata* metadata = nullptr);
 
 }  // namespace waxwork

@@ -82,15 +82,16 @@ std::filesystem::path with_extension(std::filesystem::path path, const char* ext
 }  // namespace
 
 TetMesh parse_tetgen(std::string_view node_contents, const std::string& node_file, std::string_view ele_contents,
-                     const std::string& ele_file) {
+                     const std::string& ele_file, VolumeMetadata* metadata) {
     TetGenNodes nodes = parse_nodes(node_contents, node_file);
     std::vector<Tet> tets = parse_elements(ele_contents, ele_file, nodes);
     if (tets.empty()) throw FileError(ele_file, "contains no tetrahedra");
+    if (metadata) *metadata = find_metadata_comments(node_contents, "# ", node_file);
     return mesh_from_foreign_geometry(std::move(nodes.positions), std::move(tets), ele_file);
 }
 
-void format_tetgen_node(const TetMesh& mesh, std::ostream& out) {
-    std::string text;
+void format_tetgen_node(const TetMesh& mesh, std::ostream& out, const VolumeMetadata& metadata) {
+    std::string text = metadata_comment_lines(metadata, "# ");
     text.reserve(mesh.vertex_count() * 72 + 64);
     append_number(text, static_cast<int64_t>(mesh.vertex_count()));
     // A boundary marker column (0: unmarked) ends every line with a one-character token, so a file
@@ -125,19 +126,19 @@ void format_tetgen_ele(const TetMesh& mesh, std::ostream& out) {
     out.write(text.data(), static_cast<std::streamsize>(text.size()));
 }
 
-void write_tetgen(const TetMesh& mesh, const std::filesystem::path& path) {
+void write_tetgen(const TetMesh& mesh, const std::filesystem::path& path, const VolumeMetadata& metadata) {
     write_files_atomically({
-        FileWriter{with_extension(path, ".node"), [&](std::ostream& out) { format_tetgen_node(mesh, out); }},
+        FileWriter{with_extension(path, ".node"), [&](std::ostream& out) { format_tetgen_node(mesh, out, metadata); }},
         FileWriter{with_extension(path, ".ele"), [&](std::ostream& out) { format_tetgen_ele(mesh, out); }},
     });
 }
 
-TetMesh read_tetgen(const std::filesystem::path& path) {
+TetMesh read_tetgen(const std::filesystem::path& path, VolumeMetadata* metadata) {
     const std::filesystem::path node_path = with_extension(path, ".node");
     const std::filesystem::path ele_path = with_extension(path, ".ele");
     const std::string node_contents = read_file_contents(node_path);
     const std::string ele_contents = read_file_contents(ele_path);
-    return parse_tetgen(node_contents, node_path.string(), ele_contents, ele_path.string());
+    return parse_tetgen(node_contents, node_path.string(), ele_contents, ele_path.string(), metadata);
 }
 
 }  // namespace waxwork

@@ -15,9 +15,11 @@
 //
 // Writing: 0-based numbering, no point attributes, boundary markers all 0 (unmarked; the column makes
 // truncation detectable), and the region attribute set to the piece id. Both files are replaced
-// atomically (write_files_atomically). Rest-frame positions, exact shortest-round-trip decimals.
+// atomically (write_files_atomically). Rest-frame positions, exact shortest-round-trip decimals; the
+// scale in a comment of the .node file (volume_metadata.h).
 #pragma once
 
+#include "io/volume_metadata.h"
 #include "tetops/tet_mesh.h"
 
 #include <filesystem>
@@ -27,13 +29,15 @@
 
 namespace waxwork {
 
-void format_tetgen_node(const TetMesh& mesh, std::ostream& out);
+// `metadata` is written to the .node file as volume_metadata.h says; parsing fills `metadata` when given.
+void format_tetgen_node(const TetMesh& mesh, std::ostream& out, const VolumeMetadata& metadata = {});
 void format_tetgen_ele(const TetMesh& mesh, std::ostream& out);
 TetMesh parse_tetgen(std::string_view node_contents, const std::string& node_file_name,
-                     std::string_view ele_contents, const std::string& ele_file_name);
+                     std::string_view ele_contents, const std::string& ele_file_name,
+                     VolumeMetadata* metadata = nullptr);
 
 // `path` may end in .node or .ele (or anything else: .node and .ele are substituted).
-void write_tetgen(const TetMesh& mesh, const std::filesystem::path& path);
-TetMesh read_tetgen(const std::filesystem::path& path);
+void write_tetgen(const TetMesh& mesh, const std::filesystem::path& path, const VolumeMetadata& metadata = {});
+TetMesh read_tetgen(const std::filesystem::path& path, VolumeMetadata* metadata = nullptr);
 
 }  // namespace waxwork

@@ -34,28 +34,32 @@ VolumeFormat format_of(const std::filesystem::path& path) {
 
 bool is_volume_path(const std::filesystem::path& path) { return format_named_by(path).has_value(); }
 
-TetMesh read_volume(const std::filesystem::path& path) {
+TetMesh read_volume(const std::filesystem::path& path) { return read_volume_file(path).mesh; }
+
+VolumeFile read_volume_file(const std::filesystem::path& path) {
+    VolumeFile file;
     switch (format_of(path)) {
-        case VolumeFormat::Vtu: return read_vtu(path);
-        case VolumeFormat::Gmsh: return read_gmsh(path);
-        case VolumeFormat::Medit: return read_medit(path);
-        case VolumeFormat::TetGen: return read_tetgen(path);
+        case VolumeFormat::Vtu: file.mesh = read_vtu(path, &file.metadata); return file;
+        case VolumeFormat::Gmsh: file.mesh = read_gmsh(path, &file.metadata); return file;
+        case VolumeFormat::Medit: file.mesh = read_medit(path, &file.metadata); return file;
+        case VolumeFormat::TetGen: file.mesh = read_tetgen(path, &file.metadata); return file;
     }
     throw FileError(path.string(), "unknown volume format");
 }
 
-void write_volume(const TetMesh& mesh, const std::filesystem::path& path) {
+void write_volume(const TetMesh& mesh, const std::filesystem::path& path, const VolumeMetadata& metadata) {
     const VolumeFormat format = format_of(path);
     try {
         validate(mesh);
     } catch (const InvalidMeshError& error) {
         throw InvalidMeshError(path.string() + ": not saved: " + error.what());
     }
+    check_metadata(metadata, path.string());
     switch (format) {
-        case VolumeFormat::Vtu: write_vtu(mesh, path); return;
-        case VolumeFormat::Gmsh: write_gmsh(mesh, path); return;
-        case VolumeFormat::Medit: write_medit(mesh, path); return;
-        case VolumeFormat::TetGen: write_tetgen(mesh, path); return;
+        case VolumeFormat::Vtu: write_vtu(mesh, path, metadata); return;
+        case VolumeFormat::Gmsh: write_gmsh(mesh, path, metadata); return;
+        case VolumeFormat::Medit: write_medit(mesh, path, metadata); return;
+        case VolumeFormat::TetGen: write_tetgen(mesh, path, metadata); return;
     }
 }
 

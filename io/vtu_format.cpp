@@ -303,7 +303,7 @@ bool is_volume_cell_type(uint8_t type) {
 
 }  // namespace
 
-void format_vtu(const TetMesh& mesh, std::ostream& out) {
+void format_vtu(const TetMesh& mesh, std::ostream& out, const VolumeMetadata& metadata) {
     const size_t n_tets = mesh.tet_count();
     out << "<?xml version=\"1.0\"?>\n"
            "<!-- Waxwork volume: see io/vtu_format.h for the layout. -->\n"
@@ -321,6 +321,7 @@ void format_vtu(const TetMesh& mesh, std::ostream& out) {
         for (int i = 0; i < 3; ++i) transforms.push_back(transform.translation[i]);
     }
     write_data_array(out, "      ", "piece_transforms", 12, transforms.data(), transforms.size());
+    if (metadata.mm_per_unit) write_data_array(out, "      ", "mm_per_unit", 1, &*metadata.mm_per_unit, 1);
     out << "    </FieldData>\n"
         << "    <Piece NumberOfPoints=\"" << mesh.vertex_count() << "\" NumberOfCells=\"" << n_tets << "\">\n"
         << "      <Points>\n";
@@ -361,7 +362,8 @@ void format_vtu(const TetMesh& mesh, std::ostream& out) {
            "</VTKFile>\n";
 }
 
-TetMesh parse_vtu(std::string contents, const std::string& file) {
+TetMesh parse_vtu(std::string contents, const std::string& file, VolumeMetadata* metadata) {
+    if (metadata) *metadata = {};
     pugi::xml_document document;
     const pugi::xml_parse_result parsed =
         document.load_buffer_inplace(contents.data(), contents.size(), pugi::parse_default, pugi::encoding_utf8);
@@ -509,6 +511,12 @@ TetMesh parse_vtu(std::string contents, const std::string& file) {
         mesh.piece_transforms[p].translation = Eigen::Vector3d(x[9], x[10], x[11]);
     }
 
+    VolumeMetadata stored;
+    if (const pugi::xml_node scale_node = find_array(field_data, "mm_per_unit", file))
+        stored.mm_per_unit = reader.read<double>(scale_node, 1, 1)[0];
+    check_metadata(stored, file);
+    if (metadata) *metadata = stored;
+
     const pugi::xml_node cell_data = piece.child("CellData");
     const pugi::xml_node mua_node = find_array(cell_data, "mua", file);
     const pugi::xml_node musp_node = find_array(cell_data, "musp", file);
@@ -541,10 +549,12 @@ TetMesh parse_vtu(std::string contents, const std::string& file) {
     return mesh;
 }
 
-void write_vtu(const TetMesh& mesh, const std::filesystem::path& path) {
-    write_file_atomically(path, [&](std::ostream& out) { format_vtu(mesh, out); });
+void write_vtu(const TetMesh& mesh, const std::filesystem::path& path, const VolumeMetadata& metadata) {
+    write_file_atomically(path, [&](std::ostream& out) { format_vtu(mesh, out, metadata); });
 }
 
-TetMesh read_vtu(const std::filesystem::path& path) { return parse_vtu(read_file_contents(path), path.string()); }
+TetMesh read_vtu(const std::filesystem::path& path, VolumeMetadata* metadata) {
+    return parse_vtu(read_file_contents(path), path.string(), metadata);
+}
 
 }  // namespace waxwork

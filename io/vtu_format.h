@@ -5,6 +5,7 @@
 //   FieldData  waxwork_format_version  Int32, 1 value
 //              piece_transforms        Float64, 12 components per piece: the rotation row-major
 //                                      (r00 r01 r02 r10 ... r22), then the translation (tx ty tz)
+//              mm_per_unit             Float64, 1 value, when the scale is stored (volume_metadata.h)
 //   Points     Float64 x 3             rest-frame positions
 //   Cells      connectivity Int32, offsets Int64, types UInt8 (all VTK_TETRA = 10; VTK's tetra
 //              ordering has the same positive orientation as TetMesh, so tets are stored as is)
@@ -24,6 +25,7 @@
 // no materials or pieces. Compressed, appended and big-endian data are rejected with a FileError.
 #pragma once
 
+#include "io/volume_metadata.h"
 #include "tetops/tet_mesh.h"
 
 #include <filesystem>
@@ -35,14 +37,15 @@ namespace waxwork {
 inline constexpr int kVtuFormatVersion = 1;
 
 // Writes `mesh` as .vtu to `out` (binary mode). The mesh should satisfy validate().
-void format_vtu(const TetMesh& mesh, std::ostream& out);
+void format_vtu(const TetMesh& mesh, std::ostream& out, const VolumeMetadata& metadata = {});
 
 // Parses .vtu text; `file_name` is used in error messages. Throws FileError on malformed,
 // inconsistent or invalid content. Takes the text by value because the XML is parsed in place.
-TetMesh parse_vtu(std::string contents, const std::string& file_name);
+// Fills `metadata` when given (nothing is stored in a .vtu from another program).
+TetMesh parse_vtu(std::string contents, const std::string& file_name, VolumeMetadata* metadata = nullptr);
 
 // File versions: the write is atomic (see atomic_file.h).
-void write_vtu(const TetMesh& mesh, const std::filesystem::path& path);
-TetMesh read_vtu(const std::filesystem::path& path);
+void write_vtu(const TetMesh& mesh, const std::filesystem::path& path, const VolumeMetadata& metadata = {});
+TetMesh read_vtu(const std::filesystem::path& path, VolumeMetadata* metadata = nullptr);
 
 }  // namespace waxwork

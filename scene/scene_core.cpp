@@ -4,6 +4,7 @@
 #include "base/timing.h"
 #include "io/volume_file.h"
 #include "solver/solved_scene.h"
+#include "tetops/model_scale.h"
 
 #include <array>
 #include <chrono>
@@ -25,7 +26,9 @@ SceneCore::SceneCore(TetMesh mesh, const Session& setup, LiveSceneOptions solver
 SceneCore::SceneCore(Document document, const Session& setup, LiveSceneOptions solver)
     : setup_(setup), document_(std::move(document)) {
     setup_.steps.clear();
-    solver.mm_per_unit = setup_.scale;
+    // A setup that names no scale (the editor's, a test's) gets the model's default, as an input would.
+    if (!setup_.scale) setup_.scale = default_mm_per_unit(bounding_extent(document_.mesh().positions).norm());
+    solver.mm_per_unit = *setup_.scale;
     solver.relative_tolerance = setup_.tolerance;
     solver.crease_angle_degrees = setup_.crease_angle_degrees;
     live_ = std::make_unique<LiveScene>(document_.mesh(), setup_.lighting, solver);
@@ -72,7 +75,9 @@ FrameReport SceneCore::step(const FrameBudget& budget) { return live_->step(budg
 
 FrameReport SceneCore::converge() { return live_->converge(); }
 
-void SceneCore::save_volume(const std::filesystem::path& path) const { write_volume(document_.mesh(), path); }
+void SceneCore::save_volume(const std::filesystem::path& path) const {
+    write_volume(document_.mesh(), path, VolumeMetadata{setup_.scale});
+}
 
 void SceneCore::save_session(const std::filesystem::path& path, const Session& head) const {
     write_session(path, record_session(head, document_));

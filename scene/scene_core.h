@@ -80,7 +80,7 @@ public:
     // A freshly loaded volume: InvalidArgumentError "NAME: the volume has no tets" for an empty one,
     // else the document (materials stored in `mesh` kept, setup.material on every tet otherwise) and its
     // live scene. `solver` gives the method, backend and context; setup's scale, tolerance and crease
-    // angle replace its own.
+    // angle replace its own (a setup without a scale gets default_mm_per_unit of the volume's size).
     SceneCore(TetMesh mesh, const Session& setup, LiveSceneOptions solver);
     // As above for a document already built (no emptiness check: the Document constructor's).
     SceneCore(Document document, const Session& setup, LiveSceneOptions solver);
@@ -89,7 +89,8 @@ public:
 
     const Document& document() const { return document_; }
     const LiveScene& live() const { return *live_; }
-    // The session head: input, material, scale, tolerance, lighting, camera, frame budget (no steps).
+    // The session head: input, material, scale (always set), tolerance, lighting, camera, frame budget
+    // (no steps).
     const Session& setup() const { return setup_; }
 
     // Document::apply / undo / redo, each followed by the live scene's update from the report.

@@ -243,9 +243,11 @@ Session parse_session(const Json& json, const fs::path& base_directory, const st
         input.finish();
     }
     session.material = in.has("material") ? in.material("material") : material_from_json(Json("marble"), name);
-    session.scale = in.number("scale", session.scale);
-    if (!(session.scale >= kMinMmPerUnit && session.scale <= kMaxMmPerUnit))
-        fail_json(in.field("scale"), "must be a length in mm per model unit between 1e-6 and 1e6");
+    if (in.has("scale")) {
+        session.scale = in.number("scale");
+        if (!(*session.scale >= kMinMmPerUnit && *session.scale <= kMaxMmPerUnit))
+            fail_json(in.field("scale"), "must be a length in mm per model unit between 1e-6 and 1e6");
+    }
     read_lighting_fields(in, session.lighting);
     try {
         validate(session.lighting);
@@ -299,7 +301,7 @@ Json session_to_json(const Session& session) {
     }
     j["input"] = input;
     j["material"] = material_to_json(session.material);
-    j["scale"] = session.scale;
+    if (session.scale) j["scale"] = *session.scale;
     write_lighting_fields(session.lighting, j);
     j["camera"] = camera_to_json(session.camera);
     j["image"] = Json{{"width", session.width}, {"height", session.height}};
@@ -332,9 +334,15 @@ Session record_session(const Session& setup, const Document& document, const std
     return session;
 }
 
-TetMesh read_session_input(const Session& session) {
-    if (!session.input.volume.empty()) return read_volume(session.input.volume);
+SessionVolume read_session_input(const Session& session) {
+    if (!session.input.volume.empty()) {
+        VolumeFile file = read_volume_file(session.input.volume);
+        const ModelScale scale =
+            choose_model_scale(session.scale, file.metadata.mm_per_unit, bounding_extent(file.mesh.positions));
+        return {std::move(file.mesh), scale};
+    }
     const LoadedSurface loaded = load_closed_surface(session.input.surface);
+    const ModelScale scale = choose_model_scale(session.scale, std::nullopt, bounding_extent(loaded.surface.points));
     MeshingOptions meshing;
     meshing.mesher = session.input.mesher;
     if (session.input.edge) {
@@ -342,12 +350,12 @@ TetMesh read_session_input(const Session& session) {
     } else if (session.input.max_tets) {
         meshing.sizing.target_tets = session.input.max_tets;
     } else {
-        meshing.sizing = default_mesh_sizing(loaded.surface, session.material, session.scale);
+        meshing.sizing = default_mesh_sizing(loaded.surface, session.material, scale.mm_per_unit);
     }
-    return tetrahedralize_surface_file(session.input.surface, loaded.surface, meshing).mesh;
+    return {tetrahedralize_surface_file(session.input.surface, loaded.surface, meshing).mesh, scale};
 }
 
-TetMesh load_session_input(const Session& session) {
+SessionVolume load_session_input(const Session& session) {
     const std::string context = session.name + ": input";
     try {
         return naming_context(context, [&] { return read_session_input(session); });
@@ -386,7 +394,11 @@ struct ReplayProgress {
 Json replay_session(const Session& session, const fs::path& output_directory, const SessionRunOptions& run_options,
                     SessionResult& result, ReplayProgress& progress) {
     const auto load_start = std::chrono::steady_clock::now();
-    Document document(load_session_input(session), session.material);
+    SessionVolume input = load_session_input(session);
+    Session setup = session;  // the scale resolved: the session's, else the input volume's, else the model's
+    setup.scale = input.scale.mm_per_unit;
+    result.scale = input.scale;
+    Document document(std::move(input.mesh), session.material);
     result.load_ms = milliseconds_since(load_start);
     result.input_tets = document.mesh().tet_count();
     LiveSceneOptions scene_options;  // the scale, tolerance and crease angle come from the session
@@ -406,7 +418,7 @@ Json replay_session(const Session& session, const fs::path& output_directory, co
     }
     std::unique_ptr<SurfaceRenderer> renderer;
     // Declared after the context and the renderer: the live scene, which may use the context, goes first.
-    SceneCore core(std::move(document), session, scene_options);
+    SceneCore core(std::move(document), setup, scene_options);
     ImageSettings image;
     image.width = session.width;
     image.height = session.height;
@@ -486,6 +498,8 @@ Json replay_session(const Session& session, const fs::path& output_directory, co
     const FrameBudget budget = session_frame_budget(session, run_options);
     const Json summary{{"load_milliseconds", result.load_ms},
                        {"input_tets", result.input_tets},
+                       {"mm_per_unit", result.scale.mm_per_unit},
+                       {"scale_source", scale_source_name(result.scale.source)},
                        {"undo_bytes", core.document().undo_bytes()},
                        {"undo_entries_evicted", core.document().evicted_undo_count()},
                        {"solver_backend", live_backend_name(core.live().backend())},

@@ -7,7 +7,8 @@
 //     "input": {"surface": "spot.obj", "max_tets": 20000, "mesher": "tetgen"}   (or "edge": L; neither:
 //              sized for the material and scale, solver/mesh_resolution.h) | {"volume": "spot.vtu"},
 //     "material": "marble" | {"mua": [..], "musp": [..], "eta": 1.3},   (tets without a stored material)
-//     "scale": 30,                         millimetres per model unit
+//     "scale": 30,                         millimetres per model unit (optional: the input volume's
+//                                          stored scale, else chosen from the model's size)
 //     "lights": [{"direction": [1,-1,-1], "intensity": [1,1,1]}, {"position": [0,2,0]}],
 //     "ambient": [0.02, 0.02, 0.02], "shadows": true,   optional: without "lights" (or "ambient"),
 //                                          render's key light (and ambient); "lights": [] is no light
@@ -42,6 +43,7 @@
 #include "solver/light_spec.h"
 #include "solver/lighting.h"
 #include "solver/shading_surface.h"
+#include "tetops/model_scale.h"
 #include "tetops/tet_mesh.h"
 #include "tetops/tetrahedralize.h"
 
@@ -89,7 +91,9 @@ struct Session {
     std::string name;  // the file it came from, for errors ("session" when built in memory)
     SessionInput input;
     TetMaterial material;
-    double scale = 30;
+    // Millimetres per model unit; nullopt: the input volume's stored scale, else one chosen from the
+    // model's size (tetops/model_scale.h).
+    std::optional<double> scale;
     // Without "lights" / "ambient": `waxwork render`'s key light and ambient (an empty "lights" list
     // is no light).
     Lighting lighting = default_lighting();
@@ -120,13 +124,20 @@ void write_session(const std::filesystem::path& path, const Session& session);
 Session record_session(const Session& setup, const Document& document,
                        const std::vector<SessionStep>& extra_steps = {});
 
-// The volume a session starts from (meshing the surface, or reading the volume); errors name the input
-// file only. For a session that is not a file: the editor opening a mesh.
-TetMesh read_session_input(const Session& session);
+// The volume a session starts from and its scale (the session's, else the one the volume stores, else
+// the model's default).
+struct SessionVolume {
+    TetMesh mesh;
+    ModelScale scale;
+};
+
+// The volume a session starts from (meshing the surface at the scale, or reading the volume); errors
+// name the input file only. For a session that is not a file: the editor opening a mesh.
+SessionVolume read_session_input(const Session& session);
 
 // As read_session_input, with the session before every error ("s.json: input: bad.stl: no faces"): a
 // session's input is often a path relative to it, and the user runs the session, not the mesh.
-TetMesh load_session_input(const Session& session);
+SessionVolume load_session_input(const Session& session);
 
 struct StepMetrics {
     std::string name;
@@ -141,6 +152,7 @@ struct SessionResult {
     std::vector<StepMetrics> steps;
     double load_ms = 0;  // meshing or reading the input
     size_t input_tets = 0;  // as loaded, before the first step
+    ModelScale scale;       // the scale the session ran at, and where it came from
     std::vector<std::filesystem::path> written;  // images and volumes, in order
     LiveBackend solver_backend = LiveBackend::Cpu;  // that solved the last step (Cpu after a fallback)
     std::string gpu_fallback_reason;                // why the GPU was given up ("" if it was not)

@@ -93,11 +93,8 @@ bool material_is_valid(const TetMaterial& m) {
 }  // namespace
 
 void validate_mm_per_unit(double mm_per_unit, std::string_view what) {
-    if (std::isfinite(mm_per_unit) && mm_per_unit >= kMinMmPerUnit && mm_per_unit <= kMaxMmPerUnit) return;
-    std::ostringstream got;
-    got << mm_per_unit;
-    throw InvalidArgumentError(std::string(what) + " must be a length in mm per model unit between 1e-6 and 1e6 (got " +
-                               got.str() + ")");
+    const std::string problem = mm_per_unit_problem(mm_per_unit);
+    if (!problem.empty()) throw InvalidArgumentError(std::string(what) + " " + problem);
 }
 
 void validate_material(const TetMaterial& m, std::string_view context) {

@@ -10,6 +10,7 @@
 // of a finite volume does).
 #pragma once
 
+#include "tetops/model_scale.h"
 #include "tetops/tet_mesh.h"
 
 #include <array>
@@ -54,12 +55,8 @@ double fresnel_transmittance(double cos_incident, double eta);
 // 1e4 per mm (a mean free path under 0.1 micrometre: a unit error, not a material).
 void validate_material(const TetMaterial& material, std::string_view context = "material");
 
-// The coefficients are per millimetre, so every scene has a scale in millimetres per model unit.
-// Between 1e-6 (a model in nanometres) and 1e6 (in kilometres): outside, lengths in mm over- or
-// underflow the tet volumes of the diffusion matrix (a 1e308 scale made every tet "degenerate").
-inline constexpr double kMinMmPerUnit = 1e-6;
-inline constexpr double kMaxMmPerUnit = 1e6;
-// Throws InvalidArgumentError "WHAT must be a length in mm per model unit between 1e-6 and 1e6 (got X)"
+// The coefficients are per millimetre, so every scene has a scale in millimetres per model unit
+// (tetops/model_scale.h). Throws InvalidArgumentError "WHAT must be a length in mm per model unit between 1e-6 and 1e6 (got X)"
 // for a scale outside that range or not finite.
 void validate_mm_per_unit(double mm_per_unit, std::string_view what = "scale");
 

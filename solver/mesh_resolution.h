@@ -35,6 +35,16 @@ struct MeshResolutionRule {
 // The smallest diffusion length over the rgb channels, in mm (infinite when every mu_a is 0).
 double smallest_diffusion_length_mm(const TetMaterial& material);
 
+// The rule's surface edge h_s, in model units, for a model whose bounding-box diagonal is `diagonal`
+// model units (before the rule's size_factor).
+double default_surface_edge(double diagonal, const TetMaterial& material, double mm_per_unit,
+                            const MeshResolutionRule& rule = {});
+
+// The mean length of the edges of the mesh's boundary faces (each face's three edges; edges shared by
+// two faces count twice, which weights them alike): what default_surface_edge asks of a mesh, to say
+// how far an existing mesh is from the rule at another scale. Zero for a mesh without tets.
+double mean_surface_edge_length(const TetMesh& mesh);
+
 // Graded sizing for `surface` filled with `material` at mm_per_unit millimetres per model unit.
 MeshSizing default_mesh_sizing(const TriangleSurface& surface, const TetMaterial& material, double mm_per_unit,
                                const MeshResolutionRule& rule = {});

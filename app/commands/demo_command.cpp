@@ -154,7 +154,7 @@ void run_demo_command(const DemoCommandOptions& o) {
     }
     const TetMesh mesh = tetrahedralize(loaded.surface, meshing).mesh;
     const fs::path volume_path = dir / "spot.vtu";
-    write_volume(mesh, volume_path);
+    write_volume(mesh, volume_path, VolumeMetadata{o.scale});
     std::cout << "wrote " << volume_path.string() << " (" << mesh.tet_count() << " tets, " << mesh.vertex_count()
               << " vertices, marble-driven sizing at " << o.scale << " mm per unit, " << seconds_since(mesh_start)
               << " s)\n";

@@ -37,7 +37,7 @@ void run_edit_command(const EditCommandOptions& o) {
         throw InvalidArgumentError("--width/--height must be between 64 and " + std::to_string(kMaxImageSide));
     if (options.frames < 1 || options.frames > 100000)
         throw InvalidArgumentError("--frames must be between 1 and 100000");
-    validate_mm_per_unit(options.scale, "--scale");
+    if (options.scale) validate_mm_per_unit(*options.scale, "--scale");
     if (!is_crease_angle(options.crease_angle_degrees))
         throw InvalidArgumentError("--crease-angle must be between 0 and 180 degrees");
     options.view.mode = parse_view_mode(o.show);
@@ -62,7 +62,8 @@ void run_edit_command(const EditCommandOptions& o) {
             {"screenshot", options.screenshot.string()},  {"frames", stats.frames},
             {"frame_ms", stats.mean_frame_ms}, {"view_ms", stats.mean_view_ms},
             {"solver_ticks", stats.ticks}, {"tick_ms", stats.tick_ms}, {"tets", stats.tets},
-            {"vertices", stats.vertices},  {"gl_version", stats.gl_version},
+            {"vertices", stats.vertices},  {"mm_per_unit", stats.mm_per_unit},
+            {"gl_version", stats.gl_version},
             {"gl_renderer", stats.gl_renderer}, {"solver_backend", stats.solver_backend},
             {"gpu_fallback_reason", stats.gpu_fallback_reason},
             {"method_fallback_reason", stats.method_fallback_reason},
@@ -97,7 +98,9 @@ void add_edit_command(CLI::App& app) {
     cmd->add_option("--light", options->lights, "dir:X,Y,Z[:R,G,B] or point:X,Y,Z[:R,G,B], as for render")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-    cmd->add_option("--scale", options->editor.scale, "Millimetres per model unit")->capture_default_str();
+    cmd->add_option("--scale", options->editor.scale,
+                    "Millimetres per model unit (default: the volume's stored scale, else the bounding-box "
+                    "diagonal about 75 mm)");
     cmd->add_option("--crease-angle", options->editor.crease_angle_degrees,
                     "Shade and light the surface as folded where neighbouring triangles turn by more than "
                     "this many degrees, as for render (a session's own value wins)")

@@ -69,7 +69,7 @@ public:
     // written out only with `write_base`: a painted volume needs them, a cut or a fracture adds no
     // materials the input did not have.
     EditedVolume(const std::string& input, const TetMaterial& base, bool write_base)
-        : EditedVolume(input, read_volume(input), base, write_base) {}
+        : EditedVolume(input, read_volume_file(input), base, write_base) {}
 
     const TetMesh& mesh() const { return document_.mesh(); }
 
@@ -78,20 +78,22 @@ public:
         return naming_context(input_, [&] { return document_.apply(op); });
     }
 
+    // Keeps what the input stored beside the mesh (its scale).
     void write(const std::string& output) const {
-        if (keep_materials_) return write_volume(document_.mesh(), output);
+        if (keep_materials_) return write_volume(document_.mesh(), output, metadata_);
         TetMesh mesh = document_.mesh();
         mesh.materials.clear();
-        write_volume(mesh, output);
+        write_volume(mesh, output, metadata_);
     }
 
 private:
-    EditedVolume(const std::string& input, TetMesh mesh, const TetMaterial& base, bool write_base)
-        : input_(input), keep_materials_(write_base || mesh.has_materials()),
-          document_(std::move(mesh), base, /*undo_budget_bytes=*/0) {}
+    EditedVolume(const std::string& input, VolumeFile file, const TetMaterial& base, bool write_base)
+        : input_(input), keep_materials_(write_base || file.mesh.has_materials()), metadata_(file.metadata),
+          document_(std::move(file.mesh), base, /*undo_budget_bytes=*/0) {}
 
     std::string input_;
     bool keep_materials_;
+    VolumeMetadata metadata_;
     Document document_;
 };
 

@@ -4,6 +4,7 @@
 #include "io/volume_file.h"
 #include "solver/material.h"
 #include "tetops/connectivity.h"
+#include "tetops/model_scale.h"
 #include "tetops/quality.h"
 
 #include <CLI/CLI.hpp>
@@ -43,7 +44,8 @@ void write_cells_csv(const TetMesh& mesh, const std::string& path) {
 }
 
 void run_info_command(const InfoCommandOptions& o) {
-    const TetMesh mesh = read_volume(o.volume);
+    const VolumeFile file = read_volume_file(o.volume);
+    const TetMesh& mesh = file.mesh;
     const TetConnectivity connectivity = build_connectivity(mesh);
     const QualityReport q = measure_quality(mesh);
     const auto [lo, hi] = bounding_box(mesh);
@@ -69,6 +71,9 @@ void run_info_command(const InfoCommandOptions& o) {
         {"volume", total_volume(mesh)},
         {"bbox", {{"min", {lo.x(), lo.y(), lo.z()}}, {"max", {hi.x(), hi.y(), hi.z()}}}},
     };
+    // The scale the file stores, and the size it gives (null: none stored; render picks one).
+    info["mm_per_unit"] = file.metadata.mm_per_unit ? nlohmann::ordered_json(*file.metadata.mm_per_unit) : nullptr;
+    if (file.metadata.mm_per_unit) info["size_mm"] = size_in_mm(hi - lo, *file.metadata.mm_per_unit);
     if (!o.cells.empty()) write_cells_csv(mesh, o.cells);
     std::cout << info.dump(2) << "\n";
 }

@@ -8,6 +8,7 @@
 #include "io/volume_file.h"
 #include "solver/material.h"
 #include "solver/mesh_resolution.h"
+#include "tetops/model_scale.h"
 #include "tetops/tetrahedralize.h"
 
 #include <CLI/CLI.hpp>
@@ -25,15 +26,19 @@ struct MeshCommandOptions {
     std::string output;
     std::optional<double> edge;
     std::optional<size_t> max_tets;
-    double scale = 1.0;
+    std::optional<double> scale;  // nullopt: chosen from the model's size
     SurfaceMeshingOptions meshing;
     MaterialOptions material;
 };
 
 void run_mesh_command(const MeshCommandOptions& o) {
-    validate_mm_per_unit(o.scale, "--scale");  // before the (possibly long) surface checks
+    if (o.scale) validate_mm_per_unit(*o.scale, "--scale");  // before the (possibly long) surface checks
     StderrProgress progress("waxwork: " + o.input + ": ");
     const LoadedSurface loaded = load_surface_to_mesh(o.input, o.meshing, &progress);
+    const Eigen::Vector3d extent = bounding_extent(loaded.surface.points);
+    const ModelScale scale = choose_model_scale(o.scale, std::nullopt, extent);
+    if (scale.source != ScaleSource::Given)
+        std::cerr << "waxwork: " << o.input << ": scale: " << describe_model_scale(scale, extent) << "\n";
     MeshingOptions options = meshing_options(o.meshing);
     options.progress = &progress;
     // tetrahedralize() validates the explicit sizes (positive, finite, not absurdly many tets).
@@ -43,13 +48,13 @@ void run_mesh_command(const MeshCommandOptions& o) {
         options.sizing.target_tets = o.max_tets;
     } else {
         const TetMaterial material = chosen_material(o.material).value_or(material_preset("marble"));
-        options.sizing = default_mesh_sizing(loaded.surface, material, o.scale);
+        options.sizing = default_mesh_sizing(loaded.surface, material, scale.mm_per_unit);
     }
     MeshingResult result = tetrahedralize_surface_file(o.input, loaded.surface, options);
     if (const auto material = chosen_material(o.material))
         result.mesh.materials.assign(result.mesh.tet_count(), *material);
     progress.set_stage("writing " + o.output);
-    write_volume(result.mesh, o.output);
+    write_volume(result.mesh, o.output, VolumeMetadata{scale.mm_per_unit});
     progress.finish();
 
     const QualityReport& q = result.quality;
@@ -57,6 +62,8 @@ void run_mesh_command(const MeshCommandOptions& o) {
         {"output", o.output},
         {"vertices", result.mesh.vertex_count()},
         {"tets", result.mesh.tet_count()},
+        {"mm_per_unit", scale.mm_per_unit},
+        {"scale_source", scale_source_name(scale.source)},
         {"min_dihedral_deg", q.min_dihedral_deg},
         {"max_dihedral_deg", q.max_dihedral_deg},
         {"max_radius_edge_ratio", q.max_radius_edge_ratio},
@@ -80,8 +87,9 @@ void add_mesh_command(CLI::App& app) {
                                      "About this many tets (within 20%), at most " + std::to_string(kMaxMeshTets));
     edge->excludes(tets);
     add_surface_meshing_options(*cmd, options->meshing);
-    cmd->add_option("--scale", options->scale, "Millimetres per model unit (sizes the default mesh)")
-        ->capture_default_str();
+    cmd->add_option("--scale", options->scale,
+                    "Millimetres per model unit, stored in the volume (sizes the default mesh; default: "
+                    "the bounding-box diagonal about 75 mm)");
     add_material_options(*cmd, options->material);
     cmd->footer(
         "Without --edge or --max-tets the size follows the material (default marble): tets near the surface\n"

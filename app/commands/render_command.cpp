@@ -13,6 +13,7 @@
 #include "solver/lighting.h"
 #include "solver/material.h"
 #include "solver/solved_scene.h"
+#include "tetops/model_scale.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -39,7 +40,7 @@ struct RenderCommandOptions {
     // off (1-4%); the estimate bounds the true error from above, so the fluence itself is typically
     // closer than 1e-2.
     double tolerance = 1e-2;
-    double scale = 1.0;
+    std::optional<double> scale;  // nullopt: the volume's stored scale, else chosen from its size
     double ambient = kDefaultAmbient;
     double crease_angle = kDefaultCreaseAngleDegrees;
     std::vector<double> view;
@@ -71,7 +72,7 @@ void check_options(const RenderCommandOptions& o) {
         fail("--width/--height must be between 1 and " + std::to_string(kMaxImageSide) + " (got " +
              std::to_string(o.width) + "x" + std::to_string(o.height) + ")");
     }
-    validate_mm_per_unit(o.scale, "--scale");
+    if (o.scale) validate_mm_per_unit(*o.scale, "--scale");
     if (!(o.tolerance >= kMinRelativeTolerance && o.tolerance < 1))
         fail("--tol must be a relative tolerance in [1e-15, 1)");
     if (!(o.ambient >= 0 && o.ambient <= kMaxLightIntensity)) fail("--ambient must be non-negative and at most 1e15");
@@ -109,7 +110,6 @@ void run_render_command(const RenderCommandOptions& o) {
     settings.material = chosen;
     settings.lighting = lighting;
     settings.diffusion.discretization = o.method == "fem" ? Discretization::Fem : Discretization::TransCut;
-    settings.diffusion.mm_per_unit = o.scale;
     settings.diffusion.relative_tolerance = o.tolerance;
     if (o.backend == "gpu") settings.diffusion.backend = SolverBackend::Gpu;
     settings.crease_angle_degrees = o.crease_angle;
@@ -119,7 +119,13 @@ void run_render_command(const RenderCommandOptions& o) {
     if (o.exposure) settings.image.exposure = static_cast<float>(*o.exposure);
     settings.view = view;
 
-    const TetMesh mesh = read_volume(o.volume);
+    const VolumeFile file = read_volume_file(o.volume);
+    const TetMesh& mesh = file.mesh;
+    const Eigen::Vector3d extent = bounding_extent(mesh.positions);
+    const ModelScale scale = choose_model_scale(o.scale, file.metadata.mm_per_unit, extent);
+    if (scale.source == ScaleSource::ModelSize)
+        std::cerr << "waxwork: " << o.volume << ": scale: " << describe_model_scale(scale, extent) << "\n";
+    settings.diffusion.mm_per_unit = scale.mm_per_unit;
     const VolumeRender render = render_volume(mesh, o.volume, settings);
     const SolvedScene& scene = render.scene;
     if (!scene.diffusion.gpu_fallback_reason.empty())
@@ -135,7 +141,8 @@ void run_render_command(const RenderCommandOptions& o) {
         {"materials", chosen ? "option" : mesh.has_materials() ? "stored" : "marble default"},
         {"method", o.method},
         {"backend", s.backend == SolverBackend::Gpu ? "gpu" : "cpu"},
-        {"mm_per_unit", o.scale},
+        {"mm_per_unit", scale.mm_per_unit},
+        {"scale_source", scale_source_name(scale.source)},
         {"lights", lighting.lights.size()},
         {"lights_inside", render.lights_inside},
         {"iterations", s.iterations},
@@ -180,8 +187,9 @@ void add_render_command(CLI::App& app) {
                     "the CPU when float cannot reach --tol)")
         ->check(CLI::IsMember({"cpu", "gpu"}))
         ->capture_default_str();
-    cmd->add_option("--scale", options->scale, "Millimetres per model unit (coefficients are per mm)")
-        ->capture_default_str();
+    cmd->add_option("--scale", options->scale,
+                    "Millimetres per model unit (coefficients are per mm; default: the scale stored in the volume, "
+                    "else the bounding-box diagonal about 75 mm)");
     cmd->add_option("--ambient", options->ambient, "Ambient irradiance added to every boundary vertex")
         ->capture_default_str();
     cmd->add_option("--crease-angle", options->crease_angle,

@@ -74,6 +74,26 @@ TEST_F(EditorWindow, ViewWithoutPanelsEqualsWaxworkRender) {
         dir, volume.string() + " --width 320 --height 240 --view 0.3,0.8,0.6 --material skin1", "radiance");
 }
 
+// A volume opens at the scale it stores, a surface at the model's default, and --scale wins over both.
+TEST_F(EditorWindow, OpensAtTheStoredScaleElseTheModelsElseTheGivenOne) {
+    const fs::path dir = scratch_dir("editor_scale");
+    const fs::path volume = dir / "torus.vtu";
+    ASSERT_EQ(run_waxwork("mesh " + kAssets + "/meshes/torus.obj -o " + volume.string() + " --max-tets 3000 --scale 7")
+                  .exit_code,
+              0);
+    const std::string window = " --hide-ui --width 160 --height 120 --frames 1 --screenshot " + (dir / "s.png").string();
+    const auto stored = run_under_xvfb("edit " + volume.string() + window);
+    ASSERT_EQ(stored.exit_code, 0) << stored.err;
+    EXPECT_EQ(summary_of(stored)["mm_per_unit"], 7.0);
+    const auto given = run_under_xvfb("edit " + volume.string() + " --scale 12" + window);
+    ASSERT_EQ(given.exit_code, 0) << given.err;
+    EXPECT_EQ(summary_of(given)["mm_per_unit"], 12.0);
+    // torus.obj is 2.5 x 0.5 x 2.5 units: a 3.57-unit diagonal, 20 mm per unit.
+    const auto surface = run_under_xvfb("edit " + kAssets + "/meshes/torus.obj --max-tets 3000" + window);
+    ASSERT_EQ(surface.exit_code, 0) << surface.err;
+    EXPECT_EQ(summary_of(surface)["mm_per_unit"], 20.0);
+}
+
 TEST_F(EditorWindow, EveryOptionalViewEqualsWaxworkRenderShow) {
     // The optional views (view_modes.h) are built by the same functions in both commands; the editor
     // builds them on its worker from the live scene. Same tolerance argument as above (the slice's

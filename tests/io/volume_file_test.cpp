@@ -6,6 +6,7 @@
 #include "io/tetgen_format.h"
 #include "io/volume_file.h"
 #include "io/vtu_format.h"
+#include "tetops/model_scale.h"
 #include "tetops/tet_mesh.h"
 
 #include <gtest/gtest.h>
@@ -493,6 +494,54 @@ TEST_F(VolumeFileTest, VtuInconsistentFilesAreRejected) {
     EXPECT_THROW(parse_vtu(wrong_count, "count.vtu"), FileError);
 }
 
+// The scale is stored in every format, read back bit for bit, and other tools' files (no scale) and
+// files saved without one read as having none.
+TEST_F(VolumeFileTest, EveryFormatStoresTheScale) {
+    const TetMesh mesh = make_test_mesh();
+    for (const double scale : {30.0, 0.1 + 0.2, kMinMmPerUnit, kMaxMmPerUnit}) {
+        for (const char* name : {"s.vtu", "s.msh", "s.mesh", "s.node"}) {
+            write_volume(mesh, path(name), VolumeMetadata{scale});
+            const VolumeFile file = read_volume_file(path(name));
+            ASSERT_TRUE(file.metadata.mm_per_unit) << name;
+            EXPECT_EQ(std::memcmp(&*file.metadata.mm_per_unit, &scale, sizeof scale), 0) << name << " " << scale;
+            EXPECT_EQ(file.mesh.positions, mesh.positions) << name;
+            write_volume(mesh, path(name));
+            EXPECT_FALSE(read_volume_file(path(name)).metadata.mm_per_unit) << name;
+        }
+    }
+    // The foreign readers still read the files: the scale is a comment or a section they skip.
+    write_volume(mesh, path("t.msh"), VolumeMetadata{30});
+    EXPECT_NE(read_text(path("t.msh")).find("$Comments\nwaxwork mm_per_unit 30\n$EndComments"), std::string::npos);
+    write_volume(mesh, path("t.mesh"), VolumeMetadata{30});
+    EXPECT_EQ(read_text(path("t.mesh")).rfind("MeshVersionFormatted 2\n# waxwork mm_per_unit 30\n", 0), 0u);
+}
+
+TEST_F(VolumeFileTest, AStoredScaleOutOfRangeIsRefusedNamingTheFile) {
+    const TetMesh mesh = make_test_mesh();
+    EXPECT_THROW(write_volume(mesh, path("bad.vtu"), VolumeMetadata{0.0}), FileError);
+    EXPECT_FALSE(fs::exists(path("bad.vtu")));
+    std::ostringstream vtu;
+    format_vtu(mesh, vtu, VolumeMetadata{-1.0});
+    write_text(path("neg.vtu"), vtu.str());
+    std::ostringstream medit;
+    format_medit(mesh, medit, VolumeMetadata{1e300});
+    write_text(path("huge.mesh"), medit.str());
+    std::string nan_text = medit.str();
+    nan_text.replace(nan_text.find("1e+300"), 6, "nan");
+    write_text(path("nan.mesh"), nan_text);
+    std::string word = medit.str();
+    word.replace(word.find("1e+300"), 6, "thirty");
+    write_text(path("word.mesh"), word);
+    for (const auto& [name, problem] : std::vector<std::pair<std::string, std::string>>{
+             {"neg.vtu", "stored mm_per_unit must be a length in mm per model unit between 1e-6 and 1e6 (got -1)"},
+             {"huge.mesh", "stored mm_per_unit must be a length in mm per model unit"},
+             {"nan.mesh", "stored mm_per_unit must be a length"},
+             {"word.mesh", "stored mm_per_unit 'thirty' is not a number"}}) {
+        const std::string e = error_of([&] { read_volume(path(name)); });
+        EXPECT_NE(e.find(path(name).string() + ": " + problem), std::string::npos) << e;
+    }
+}
+
 TEST_F(VolumeFileTest, UnknownExtensionIsAFileError) {
     const std::string message = error_of([&] { read_volume(path("volume.obj")); });
     EXPECT_NE(message.find("volume.obj"), std::string::npos);
@@ -525,10 +574,10 @@ std::vector<Format> all_formats() {
     const std::string valid_node = node.str();
     const std::string valid_ele = ele.str();
     return {
-        {"vtu", text_of(format_vtu), [](const std::string& s) { return parse_vtu(s, "fuzz.vtu"); }},
-        {"gmsh", text_of(format_gmsh), [](const std::string& s) { return parse_gmsh(s, "fuzz.msh"); }},
-        {"medit", text_of(format_medit), [](const std::string& s) { return parse_medit(s, "fuzz.mesh"); }},
-        {"tetgen_node", text_of(format_tetgen_node),
+        {"vtu", text_of([](const TetMesh& m, std::ostream& out) { format_vtu(m, out); }), [](const std::string& s) { return parse_vtu(s, "fuzz.vtu"); }},
+        {"gmsh", text_of([](const TetMesh& m, std::ostream& out) { format_gmsh(m, out); }), [](const std::string& s) { return parse_gmsh(s, "fuzz.msh"); }},
+        {"medit", text_of([](const TetMesh& m, std::ostream& out) { format_medit(m, out); }), [](const std::string& s) { return parse_medit(s, "fuzz.mesh"); }},
+        {"tetgen_node", text_of([](const TetMesh& m, std::ostream& out) { format_tetgen_node(m, out); }),
          [valid_ele](const std::string& s) { return parse_tetgen(s, "fuzz.node", valid_ele, "fuzz.ele"); }},
         {"tetgen_ele", text_of(format_tetgen_ele),
          [valid_node](const std::string& s) { return parse_tetgen(valid_node, "fuzz.node", s, "fuzz.ele"); }},

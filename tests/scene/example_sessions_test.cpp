@@ -26,7 +26,8 @@ const fs::path& spot_volume() {
     static const fs::path path = [] {
         const fs::path dir = testing::scratch_dir("example_sessions_spot");
         const fs::path volume = dir / "spot.vtu";
-        write_volume(load_session_input(read_session(kSessions / "backlit.json")), volume);
+        const SessionVolume input = load_session_input(read_session(kSessions / "backlit.json"));
+        write_volume(input.mesh, volume, VolumeMetadata{input.scale.mm_per_unit});
         return volume;
     }();
     return path;

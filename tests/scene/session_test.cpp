@@ -5,7 +5,7 @@
 #include "solver/material.h"
 #include "tetops/test_meshes.h"
 
-#include "support/scratch_dir.h"
+#include "support/cli_run.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -214,6 +214,39 @@ TEST(Session, WithoutLightsItIsLitAsRenderLightsIt) {
     for (int y = 0; y < image.height; ++y)
         for (int x = 0; x < image.width; ++x) brightest = std::max(brightest, brightness(x, y));
     EXPECT_GT(brightest, brightness(0, 0) + 100);
+}
+
+// The scale is the session's, else the one its input volume stores, else the model's default; a save
+// step stores the scale the session ran at, so the volume reopens at it.
+TEST(Session, ScaleComesFromTheSessionElseTheVolumeElseTheModel) {
+    const fs::path dir = testing::scratch_dir("scale");
+    const TetMesh cube = testing::make_cube_mesh(3);
+    write_volume(cube, dir / "stored.vtu", VolumeMetadata{12.0});
+    write_volume(cube, dir / "plain.vtu");
+    const auto run = [&](const std::string& input, const std::string& scale, const std::string& out) {
+        const Session session = parse_session(Json::parse(R"({"input": {"volume": ")" + input + R"("}, )" + scale +
+                                                          R"("image": {"width": 32, "height": 24},
+                                                              "steps": [{"save": "saved.vtu"}]})"),
+                                              dir, "s.json");
+        EXPECT_EQ(session_to_json(session).contains("scale"), !scale.empty());
+        return run_session(session, dir / out).scale;
+    };
+    const ModelScale stored = run("stored.vtu", "", "stored");
+    EXPECT_EQ(stored.mm_per_unit, 12.0);
+    EXPECT_EQ(stored.source, ScaleSource::Stored);
+    const ModelScale given = run("stored.vtu", R"("scale": 7, )", "given");
+    EXPECT_EQ(given.mm_per_unit, 7.0);
+    EXPECT_EQ(given.source, ScaleSource::Given);
+    const ModelScale model = run("plain.vtu", "", "model");
+    EXPECT_EQ(model.mm_per_unit, default_mm_per_unit(bounding_extent(cube.positions).norm()));
+    EXPECT_EQ(model.source, ScaleSource::ModelSize);
+    for (const auto& [out, expected] : std::vector<std::pair<std::string, double>>{
+             {"stored", 12.0}, {"given", 7.0}, {"model", model.mm_per_unit}}) {
+        EXPECT_EQ(read_volume_file(dir / out / "saved.vtu").metadata.mm_per_unit, expected) << out;
+        const Json metrics = Json::parse(testing::read_text(dir / out / "metrics.json"));
+        EXPECT_EQ(metrics["mm_per_unit"], expected) << out;
+    }
+    EXPECT_EQ(Json::parse(testing::read_text(dir / "stored" / "metrics.json"))["scale_source"], "stored");
 }
 
 // Outputs in sub-folders of the output directory get their folders.
