@@ -37,8 +37,6 @@ void run_mesh_command(const MeshCommandOptions& o) {
     const LoadedSurface loaded = load_surface_to_mesh(o.input, o.meshing, &progress);
     const Eigen::Vector3d extent = bounding_extent(loaded.surface.points);
     const ModelScale scale = choose_model_scale(o.scale, std::nullopt, extent);
-    if (scale.source != ScaleSource::Given)
-        std::cerr << "waxwork: " << o.input << ": scale: " << describe_model_scale(scale, extent) << "\n";
     MeshingOptions options = meshing_options(o.meshing);
     options.progress = &progress;
     // tetrahedralize() validates the explicit sizes (positive, finite, not absurdly many tets).
@@ -56,6 +54,9 @@ void run_mesh_command(const MeshCommandOptions& o) {
     progress.set_stage("writing " + o.output);
     write_volume(result.mesh, o.output, VolumeMetadata{scale.mm_per_unit});
     progress.finish();
+    // Said once the volume is written: an error stays the one line it is.
+    if (scale.source != ScaleSource::Given)
+        std::cerr << "waxwork: " << o.input << ": scale: " << describe_model_scale(scale, extent) << "\n";
 
     const QualityReport& q = result.quality;
     nlohmann::ordered_json summary = {

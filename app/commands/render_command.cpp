@@ -123,14 +123,15 @@ void run_render_command(const RenderCommandOptions& o) {
     const TetMesh& mesh = file.mesh;
     const Eigen::Vector3d extent = bounding_extent(mesh.positions);
     const ModelScale scale = choose_model_scale(o.scale, file.metadata.mm_per_unit, extent);
-    if (scale.source == ScaleSource::ModelSize)
-        std::cerr << "waxwork: " << o.volume << ": scale: " << describe_model_scale(scale, extent) << "\n";
     settings.diffusion.mm_per_unit = scale.mm_per_unit;
     const VolumeRender render = render_volume(mesh, o.volume, settings);
     const SolvedScene& scene = render.scene;
     if (!scene.diffusion.gpu_fallback_reason.empty())
         std::cerr << "warning: solving on the CPU instead: " << scene.diffusion.gpu_fallback_reason << "\n";
     write_png(render.image, o.output);
+    // Said once the image is written: an error stays the one line it is.
+    if (scale.source == ScaleSource::ModelSize)
+        std::cerr << "waxwork: " << o.volume << ": scale: " << describe_model_scale(scale, extent) << "\n";
     if (!o.fields.empty()) write_fields_csv(o.fields, mesh, render.connectivity, scene);
 
     const DiffusionSolution& s = scene.diffusion;
