@@ -32,9 +32,12 @@ protected:
         ASSERT_EQ(r.exit_code, 0) << r.err;
         r = run_waxwork("fracture " + cube.string() + " -o " + pieces().string() + " --pieces 4 --seed 3");
         ASSERT_EQ(r.exit_code, 0) << r.err;
+        r = run_waxwork("cut " + pieces().string() + " -o " + cut_pieces().string() + " --plane=1,1,0.3,0.2 --exact");
+        ASSERT_EQ(r.exit_code, 0) << r.err;
     }
     static void TearDownTestSuite() { delete dir_; }
     static fs::path pieces() { return *dir_ / "pieces.vtu"; }
+    static fs::path cut_pieces() { return *dir_ / "cut_pieces.vtu"; }
     static fs::path* dir_;
 };
 fs::path* Export::dir_ = nullptr;
@@ -66,46 +69,48 @@ ReadSurface subset(const ReadSurface& s, const std::vector<size_t>& triangles) {
 }
 
 TEST_F(Export, WritesEachPieceAsAClosedOutwardShellEnclosingItsVolume) {
-    const TetMesh mesh = read_volume(pieces());
-    const TetConnectivity connectivity = build_connectivity(mesh);
-    ASSERT_GE(connectivity.component_count, 2);
-    const double volume = total_volume(mesh);
-    for (const std::string mode : {"merged", "separate"})
-        for (const std::string format : {"ply", "obj", "stl"}) {
-            const fs::path out = *dir_ / (mode + "." + format);
-            const auto r = run_waxwork("export " + pieces().string() + " -o " + out.string() + " --pieces " + mode);
-            ASSERT_EQ(r.exit_code, 0) << r.err;
-            ASSERT_EQ(line_count(r.out), 1u) << r.out;
-            const auto summary = nlohmann::json::parse(r.out);
-            EXPECT_EQ(summary["triangles"], connectivity.boundary_faces.size());
-            EXPECT_EQ(summary["shells"], mode == "merged" ? 1 : connectivity.component_count);
-            EXPECT_EQ(summary["radiance"], false);
+    for (const fs::path& input : {pieces(), cut_pieces()}) {
+        const TetMesh mesh = read_volume(input);
+        const TetConnectivity connectivity = build_connectivity(mesh);
+        ASSERT_GE(connectivity.component_count, 2);
+        const double volume = total_volume(mesh);
+        for (const std::string mode : {"merged", "separate"})
+            for (const std::string format : {"ply", "obj", "stl"}) {
+                const fs::path out = *dir_ / (mode + "." + format);
+                const auto r = run_waxwork("export " + input.string() + " -o " + out.string() + " --pieces " + mode);
+                ASSERT_EQ(r.exit_code, 0) << r.err;
+                ASSERT_EQ(line_count(r.out), 1u) << r.out;
+                const auto summary = nlohmann::json::parse(r.out);
+                EXPECT_EQ(summary["triangles"], connectivity.boundary_faces.size());
+                EXPECT_EQ(summary["shells"], mode == "merged" ? 1 : connectivity.component_count);
+                EXPECT_EQ(summary["radiance"], false);
 
-            const ReadSurface s = read_exported(out);
-            const std::string what = mode + " " + format;
-            EXPECT_EQ(s.triangles.size(), connectivity.boundary_faces.size()) << what;
-            EXPECT_NEAR(enclosed_volume(s), volume, (format == "stl" ? 1e-6 : 1e-9) * volume) << what;
-            EXPECT_TRUE(closed_and_oriented(s)) << what;
-            if (format == "stl") continue;  // STL welds nothing: pieces that touch cannot be told apart
-            if (mode == "merged") {
-                EXPECT_EQ(s.positions.size(), connectivity.boundary_vertices.size()) << what;
-                continue;
+                const ReadSurface s = read_exported(out);
+                const std::string what = input.filename().string() + " " + mode + " " + format;
+                EXPECT_EQ(s.triangles.size(), connectivity.boundary_faces.size()) << what;
+                EXPECT_NEAR(enclosed_volume(s), volume, (format == "stl" ? 1e-6 : 1e-9) * volume) << what;
+                EXPECT_TRUE(closed_and_oriented(s)) << what;
+                if (format == "stl") continue;  // STL welds nothing: pieces that touch cannot be told apart
+                if (mode == "merged") {
+                    EXPECT_EQ(s.positions.size(), connectivity.boundary_vertices.size()) << what;
+                    continue;
+                }
+                // Separate: the pieces share no vertex, and each is one closed shell of positive volume.
+                const auto groups = vertex_connected_groups(s);
+                EXPECT_EQ(groups.size(), size_t(connectivity.component_count)) << what;
+                double sum = 0;
+                for (const auto& group : groups) {
+                    const ReadSurface part = subset(s, group);
+                    EXPECT_TRUE(closed_and_oriented(part)) << what;
+                    EXPECT_GT(enclosed_volume(part), 0) << what;
+                    sum += enclosed_volume(part);
+                }
+                EXPECT_NEAR(sum, volume, 1e-9 * volume) << what;
+                if (format == "obj") {
+                    EXPECT_EQ(s.groups.size(), size_t(connectivity.component_count)) << what;
+                }
             }
-            // Separate: the pieces share no vertex, and each is one closed shell of positive volume.
-            const auto groups = vertex_connected_groups(s);
-            EXPECT_EQ(groups.size(), size_t(connectivity.component_count)) << what;
-            double sum = 0;
-            for (const auto& group : groups) {
-                const ReadSurface part = subset(s, group);
-                EXPECT_TRUE(closed_and_oriented(part)) << what;
-                EXPECT_GT(enclosed_volume(part), 0) << what;
-                sum += enclosed_volume(part);
-            }
-            EXPECT_NEAR(sum, volume, 1e-9 * volume) << what;
-            if (format == "obj") {
-                EXPECT_EQ(s.groups.size(), size_t(connectivity.component_count)) << what;
-            }
-        }
+    }
 }
 
 TEST_F(Export, BakedColoursAreRenderFieldsRadianceInSrgb) {
