@@ -248,6 +248,14 @@ void EditorApp::save_volume(const fs::path& path) {
     current_file_ = path;
 }
 
+void EditorApp::export_surface(const fs::path& path) {
+    queue_job("export", [path](SceneCore& core) {
+        // Pieces apart: what Blender's and a slicer's users expect of a fractured model.
+        const bool coloured = core.export_surface(path, ShellGrouping::Separate);
+        return "Exported the surface" + std::string(coloured ? " with its light" : "") + " to " + path.string();
+    });
+}
+
 void EditorApp::save_session(const fs::path& path) {
     // The view and lights as they are now, not as the session started.
     Session current;

@@ -173,6 +173,9 @@ public:
     // InvalidArgumentError outside [0, 180].
     void set_crease_angle(double degrees);
     void save_session(const std::filesystem::path& path);
+    // File > Export: the boundary surface (.ply, .obj, .stl), with the current light's radiance baked
+    // into vertex colours where the format stores them (SceneCore::export_surface), in the background.
+    void export_surface(const std::filesystem::path& path);
 
 private:
     using Scene = EditorScene;
@@ -198,7 +201,9 @@ private:
     void draw_overlays();
     void apply_theme(float scale);
 
-    void open_dialog(FileDialog::Mode mode, bool session = false);
+    // What a Save dialog writes when confirmed.
+    enum class SaveKind { Volume, Session, Surface };
+    void open_dialog(FileDialog::Mode mode, SaveKind kind = SaveKind::Volume);
     void relax_last_cut();
     // What loading found out about the model, measured off the UI thread.
     struct LoadedModel {
@@ -293,7 +298,7 @@ private:
     double framebuffer_scale_ = 1.0;
 
     FileDialog file_dialog_;
-    bool saving_session_ = false;
+    SaveKind saving_ = SaveKind::Volume;
     std::string status_;
     std::string last_error_;
     std::string error_message_;

@@ -67,16 +67,20 @@ void EditorApp::apply_theme(float scale) {
     else io.FontGlobalScale = scale;
 }
 
-void EditorApp::open_dialog(FileDialog::Mode mode, bool session) {
+void EditorApp::open_dialog(FileDialog::Mode mode, SaveKind kind) {
     const fs::path directory = current_file_.empty() ? fs::current_path() : current_file_.parent_path();
-    saving_session_ = session;
+    saving_ = kind;
+    const std::string stem = current_file_.empty() ? "" : current_file_.stem().string();
     if (mode == FileDialog::Mode::Open) {
         file_dialog_.open(mode, "Open", directory, openable_extensions());
-    } else if (session) {
+    } else if (kind == SaveKind::Session) {
         file_dialog_.open(mode, "Save session", directory, {".json"}, "session.json");
+    } else if (kind == SaveKind::Surface) {
+        file_dialog_.open(mode, "Export surface", directory, {".ply", ".obj", ".stl"},
+                          (stem.empty() ? "surface" : stem) + ".ply");
     } else {
-        const std::string name = current_file_.empty() ? "volume.vtu" : current_file_.stem().string() + ".vtu";
-        file_dialog_.open(mode, "Save volume", directory, {".vtu", ".msh", ".mesh", ".node"}, name);
+        file_dialog_.open(mode, "Save volume", directory, {".vtu", ".msh", ".mesh", ".node"},
+                          (stem.empty() ? "volume" : stem) + ".vtu");
     }
 }
 
@@ -84,7 +88,8 @@ void EditorApp::file_dialog_result() {
     if (options_.hide_ui) return;
     if (const auto chosen = file_dialog_.draw(ui_scale_)) {
         if (file_dialog_.mode() == FileDialog::Mode::Open) open_file(*chosen);
-        else if (saving_session_) save_session(*chosen);
+        else if (saving_ == SaveKind::Session) save_session(*chosen);
+        else if (saving_ == SaveKind::Surface) export_surface(*chosen);
         else save_volume(*chosen);
     }
 }
@@ -112,7 +117,9 @@ void EditorApp::draw_menu_bar() {
     if (ImGui::BeginMenu("File")) {
         if (ImGui::MenuItem("Open...", "Ctrl+O")) open_dialog(FileDialog::Mode::Open);
         if (ImGui::MenuItem("Save volume...", "Ctrl+S", false, scene_->core != nullptr)) open_dialog(FileDialog::Mode::Save);
-        if (ImGui::MenuItem("Save session...", nullptr, false, scene_->core != nullptr)) open_dialog(FileDialog::Mode::Save, true);
+        if (ImGui::MenuItem("Save session...", nullptr, false, scene_->core != nullptr)) open_dialog(FileDialog::Mode::Save, SaveKind::Session);
+        if (ImGui::MenuItem("Export surface...", nullptr, false, scene_->core != nullptr))
+            open_dialog(FileDialog::Mode::Save, SaveKind::Surface);
         ImGui::Separator();
         if (ImGui::MenuItem("Quit", "Ctrl+Q")) glfwSetWindowShouldClose(window_, GLFW_TRUE);
         ImGui::EndMenu();

@@ -177,8 +177,10 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
     } else if (kind == "idle") {
         e.action = ScriptAction::WaitIdle;
         events.push_back(e);
-    } else if (kind == "save_session" || kind == "save_volume") {
-        e.action = kind == "save_session" ? ScriptAction::SaveSession : ScriptAction::SaveVolume;
+    } else if (kind == "save_session" || kind == "save_volume" || kind == "export_surface") {
+        e.action = kind == "save_session"  ? ScriptAction::SaveSession
+                   : kind == "save_volume" ? ScriptAction::SaveVolume
+                                           : ScriptAction::ExportSurface;
         const Json& f = in.at("file");
         if (!f.is_string() || f.get<std::string>().empty()) fail_json(in.field("file"), "expected a file path");
         e.file = fs::absolute(base / fs::path(f.get<std::string>()));
@@ -186,7 +188,7 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
     } else {
         fail_json(entry, "unknown event \"" + kind +
                              "\" (expected press, move, release, drag, scroll, key, tool, material, crease_angle, "
-                             "idle, save_session, save_volume)");
+                             "idle, save_session, save_volume, export_surface)");
     }
     in.finish();
 }
@@ -231,6 +233,7 @@ void InputScriptPlayer::advance(ScriptTarget& target) {
         case ScriptAction::WaitIdle: break;
         case ScriptAction::SaveSession: target.save_session(e.file); break;
         case ScriptAction::SaveVolume: target.save_volume(e.file); break;
+        case ScriptAction::ExportSurface: target.export_surface(e.file); break;
         }
         last_fired_ = frame_;
         ++next_;

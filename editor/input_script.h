@@ -16,7 +16,8 @@
 //     {"event": "key", "key": "Home", "mods": ["ctrl"]},      press and release a key
 //     {"event": "idle"},                                      wait until edits are applied and solved
 //     {"event": "save_session", "file": "s.json"},            as File > Save session / Save volume
-//     {"event": "save_volume", "file": "v.vtu"}
+//     {"event": "save_volume", "file": "v.vtu"},
+//     {"event": "export_surface", "file": "v.ply"}            as File > Export surface
 //   ]
 //
 // Positions are window coordinates (GLFW's: screen units, origin top-left; with --hide-ui the view
@@ -38,7 +39,8 @@
 namespace waxwork {
 
 enum class ScriptAction {
-    Move, Press, Release, Scroll, Key, SelectTool, SelectMaterial, SetCreaseAngle, WaitIdle, SaveSession, SaveVolume
+    Move, Press, Release, Scroll, Key, SelectTool, SelectMaterial, SetCreaseAngle, WaitIdle, SaveSession, SaveVolume,
+    ExportSurface
 };
 
 struct ScriptEvent {
@@ -52,7 +54,7 @@ struct ScriptEvent {
     Tool tool = Tool::Orbit;
     std::string material;        // SelectMaterial: a preset name (material_preset_names())
     double degrees = 0;          // SetCreaseAngle: in [0, 180]
-    std::filesystem::path file;  // SaveSession, SaveVolume (absolute after parsing)
+    std::filesystem::path file;  // SaveSession, SaveVolume, ExportSurface (absolute after parsing)
     std::string context;         // "SCRIPT: entry N (kind)" for messages
 };
 
@@ -87,6 +89,7 @@ public:
     virtual void set_crease_angle(double degrees) = 0;            // as the View panel's slider
     virtual void save_session(const std::filesystem::path& file) = 0;
     virtual void save_volume(const std::filesystem::path& file) = 0;
+    virtual void export_surface(const std::filesystem::path& file) = 0;
 };
 
 // Replays a script, a frame at a time.

@@ -4,6 +4,7 @@
 #include "editor/editor_app.h"
 
 #include "base/error.h"
+#include "render/srgb.h"
 
 #include <imgui.h>
 
@@ -17,10 +18,7 @@ namespace {
 
 // Linear rgb to what ImGui draws (sRGB), so the legend matches the picture.
 ImU32 legend_colour(const std::array<float, 3>& c) {
-    auto encode = [](float x) {
-        x = std::clamp(x, 0.0f, 1.0f);
-        return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
-    };
+    auto encode = [](float x) { return static_cast<float>(srgb_encode(std::clamp(x, 0.0f, 1.0f))); };
     return ImGui::ColorConvertFloat4ToU32(ImVec4(encode(c[0]), encode(c[1]), encode(c[2]), 1.0f));
 }
 

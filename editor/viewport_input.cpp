@@ -231,6 +231,7 @@ public:
     void set_crease_angle(double degrees) override { app_.set_crease_angle(degrees); }
     void save_session(const std::filesystem::path& file) override { app_.save_session(file); }
     void save_volume(const std::filesystem::path& file) override { app_.save_volume(file); }
+    void export_surface(const std::filesystem::path& file) override { app_.export_surface(file); }
 
 private:
     GLFWwindow* window_;

@@ -8,22 +8,51 @@
 #include "tetops/point_location.h"
 
 #include <chrono>
+#include <optional>
+#include <utility>
 
 namespace waxwork {
 
-VolumeRender render_volume(const TetMesh& mesh, const std::string& volume_name, const VolumeRenderSettings& settings) {
-    if (mesh.tet_count() == 0) throw InvalidArgumentError(volume_name + ": the volume has no tets to render");
-    VolumeRender result;
-    result.connectivity = build_connectivity(mesh);
-    // A stored material no solve can use is the file's problem.
-    result.materials = naming_context(volume_name, [&] { return resolve_materials(mesh, settings.material); });
+namespace {
 
+// Checked before any OpenGL context is made.
+void check_not_empty(const TetMesh& mesh, const std::string& volume_name) {
+    if (mesh.tet_count() == 0) throw InvalidArgumentError(volume_name + ": the volume has no tets to render");
+}
+
+// What both entry points share; `gl` serves a GPU solve.
+VolumeLight solve_light(const TetMesh& mesh, const std::string& volume_name, const VolumeRenderSettings& settings,
+                        const GlApi* gl) {
+    VolumeLight light;
+    light.connectivity = build_connectivity(mesh);
+    // A stored material no solve can use is the file's problem.
+    light.materials = naming_context(volume_name, [&] { return resolve_materials(mesh, settings.material); });
+    DiffusionOptions diffusion = settings.diffusion;
+    if (diffusion.backend == SolverBackend::Gpu) diffusion.gl = gl;
+    light.scene = solve_scene(mesh, light.connectivity, light.materials, settings.lighting, diffusion,
+                              settings.crease_angle_degrees);
+    return light;
+}
+
+}  // namespace
+
+VolumeLight solve_volume_light(const TetMesh& mesh, const std::string& volume_name, const VolumeRenderSettings& settings) {
+    check_not_empty(mesh, volume_name);
+    // A context only for a GPU solve: the CPU's needs none.
+    std::optional<HeadlessGlContext> context;
+    if (settings.diffusion.backend == SolverBackend::Gpu) context.emplace();
+    return solve_light(mesh, volume_name, settings, context ? &context->gl() : nullptr);
+}
+
+VolumeRender render_volume(const TetMesh& mesh, const std::string& volume_name, const VolumeRenderSettings& settings) {
+    check_not_empty(mesh, volume_name);
     // One OpenGL context for the GPU solve and the renderer (the same device).
     HeadlessGlContext context;
-    DiffusionOptions diffusion = settings.diffusion;
-    if (diffusion.backend == SolverBackend::Gpu) diffusion.gl = &context.gl();
-    result.scene = solve_scene(mesh, result.connectivity, result.materials, settings.lighting, diffusion,
-                               settings.crease_angle_degrees);
+    VolumeLight solved = solve_light(mesh, volume_name, settings, &context.gl());
+    VolumeRender result;
+    result.connectivity = std::move(solved.connectivity);
+    result.materials = std::move(solved.materials);
+    result.scene = std::move(solved.scene);
 
     const auto render_start = std::chrono::steady_clock::now();
     SurfaceRenderInput input = make_render_input(mesh, result.scene, settings.lighting, settings.image);

@@ -40,6 +40,16 @@ struct VolumeRender {
     size_t lights_inside = 0;  // point lights inside the volume (they light nothing)
 };
 
+// The light of a volume exactly as render_volume solves it, without drawing: the connectivity, the
+// resolved materials and the solved scene (`waxwork export --radiance` bakes it). With backend Gpu the
+// solve runs in a headless context of its own. Throws as render_volume.
+struct VolumeLight {
+    TetConnectivity connectivity;
+    std::vector<TetMaterial> materials;
+    SolvedScene scene;
+};
+VolumeLight solve_volume_light(const TetMesh& mesh, const std::string& volume_name, const VolumeRenderSettings& settings);
+
 // Throws InvalidArgumentError for an empty volume or bad settings; errors about the volume's own
 // data (stored materials no solve can use) name `volume_name`.
 VolumeRender render_volume(const TetMesh& mesh, const std::string& volume_name, const VolumeRenderSettings& settings);

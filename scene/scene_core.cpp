@@ -2,7 +2,9 @@
 
 #include "base/error.h"
 #include "base/timing.h"
+#include "io/surface_writer.h"
 #include "io/volume_file.h"
+#include "scene/surface_export.h"
 #include "solver/solved_scene.h"
 #include "tetops/model_scale.h"
 
@@ -77,6 +79,19 @@ FrameReport SceneCore::converge() { return live_->converge(); }
 
 void SceneCore::save_volume(const std::filesystem::path& path) const {
     write_volume(document_.mesh(), path, VolumeMetadata{setup_.scale});
+}
+
+bool SceneCore::export_surface(const std::filesystem::path& path, ShellGrouping grouping) {
+    const bool colours = stores_vertex_colours(surface_format(path));
+    std::optional<SolvedScene> solved;
+    if (colours) {
+        converge();
+        solved = live_->solved_scene(false);
+    }
+    const SurfaceExport surface =
+        surface_export(document_.mesh(), live_->connectivity(), grouping, solved ? &*solved : nullptr);
+    write_surface(path, surface.shells, surface.colours);
+    return colours;
 }
 
 void SceneCore::save_session(const std::filesystem::path& path, const Session& head) const {

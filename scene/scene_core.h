@@ -21,6 +21,7 @@
 #include "solver/frame_budget.h"
 #include "solver/lighting.h"
 #include "solver/ray_caster.h"
+#include "tetops/boundary_shells.h"
 #include "tetops/tet_mesh.h"
 
 #include <cstddef>
@@ -116,6 +117,10 @@ public:
 
     // The volume (format from the extension, io/volume_file.h).
     void save_volume(const std::filesystem::path& path) const;
+    // The boundary surface (io/surface_writer.h, format from the extension): converges the light first
+    // and, where the format stores colours, bakes its exitant radiance (scene/surface_export.h, as
+    // `waxwork export --radiance` bakes it). Returns whether colours were written.
+    bool export_surface(const std::filesystem::path& path, ShellGrouping grouping);
     // The session that replays this document: `head` (usually setup() with what the front end changed
     // since: its view, lights, frame budget) and the document's history as steps.
     void save_session(const std::filesystem::path& path, const Session& head) const;

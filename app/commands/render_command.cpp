@@ -1,6 +1,6 @@
 // `waxwork render VOLUME -o IMAGE.png`: a volume, its materials and lights -> diffusion -> a PNG.
 #include "app/commands.h"
-#include "app/options/material_options.h"
+#include "app/options/scene_light_options.h"
 #include "base/error.h"
 #include "io/file_extension.h"
 #include "io/volume_file.h"
@@ -8,12 +8,9 @@
 #include "render/view_modes.h"
 #include "render/volume_render.h"
 #include "scene/fields_csv.h"
-#include "solver/conjugate_gradient.h"
-#include "solver/light_spec.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
 #include "solver/solved_scene.h"
-#include "tetops/model_scale.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -29,23 +26,12 @@ namespace {
 struct RenderCommandOptions {
     std::string volume;
     std::string output;
-    MaterialOptions material;
-    std::vector<std::string> lights;
+    SceneLightOptions light;
     int width = 800;
     int height = 600;
     std::string fields;
-    std::string method = "transcut";
-    // 1e-2: the resolution study (`waxwork bench --only resolution`; docs/accuracy.md) finds the image
-    // at 1e-2 within 0.05% of the image at 1e-3 on spot at 3 and 30 mm per unit, while 1e-1 is visibly
-    // off (1-4%); the estimate bounds the true error from above, so the fluence itself is typically
-    // closer than 1e-2.
-    double tolerance = 1e-2;
-    std::optional<double> scale;  // nullopt: the volume's stored scale, else chosen from its size
-    double ambient = kDefaultAmbient;
-    double crease_angle = kDefaultCreaseAngleDegrees;
     std::vector<double> view;
     std::optional<double> exposure;
-    std::string backend = "cpu";
     std::string show = "radiance";
     std::string slice_normal;
     double slice_offset = 0;
@@ -63,20 +49,13 @@ ViewOptions view_options(const RenderCommandOptions& o) {
     return view;
 }
 
-// Physically meaningless values are refused before any work: a scale beyond these bounds is a unit
-// error (a nanometre or a kilometre per model unit), not a scene.
-
 void check_options(const RenderCommandOptions& o) {
     auto fail = [](const std::string& what) { throw InvalidArgumentError(what); };
     if (o.width <= 0 || o.height <= 0 || o.width > kMaxImageSide || o.height > kMaxImageSide) {
         fail("--width/--height must be between 1 and " + std::to_string(kMaxImageSide) + " (got " +
              std::to_string(o.width) + "x" + std::to_string(o.height) + ")");
     }
-    if (o.scale) validate_mm_per_unit(*o.scale, "--scale");
-    if (!(o.tolerance >= kMinRelativeTolerance && o.tolerance < 1))
-        fail("--tol must be a relative tolerance in [1e-15, 1)");
-    if (!(o.ambient >= 0 && o.ambient <= kMaxLightIntensity)) fail("--ambient must be non-negative and at most 1e15");
-    if (!is_crease_angle(o.crease_angle)) fail("--crease-angle must be between 0 and 180 degrees");
+    check_scene_light_options(o.light);
     if (lower_extension(o.output) != ".png") fail("-o " + o.output + ": the image must be a .png");
     // The renderer exposes in float: beyond 1e30 the product with the radiance leaves its range.
     if (o.exposure && !(*o.exposure > 0 && *o.exposure <= 1e30)) fail("--exposure must be positive and at most 1e30");
@@ -100,38 +79,24 @@ CameraSettings camera_for_view(const std::vector<double>& view) {
 void run_render_command(const RenderCommandOptions& o) {
     check_options(o);
     const ViewOptions view = view_options(o);
-    Lighting lighting;
-    for (const std::string& spec : o.lights) lighting.lights.push_back(parse_light_spec(spec));
-    if (lighting.lights.empty()) lighting.lights.push_back(default_key_light());
-    lighting.ambient = {o.ambient, o.ambient, o.ambient};
-    const std::optional<TetMaterial> chosen = chosen_material(o.material);
-
-    VolumeRenderSettings settings;
-    settings.material = chosen;
-    settings.lighting = lighting;
-    settings.diffusion.discretization = o.method == "fem" ? Discretization::Fem : Discretization::TransCut;
-    settings.diffusion.relative_tolerance = o.tolerance;
-    if (o.backend == "gpu") settings.diffusion.backend = SolverBackend::Gpu;
-    settings.crease_angle_degrees = o.crease_angle;
+    const VolumeFile file = read_volume_file(o.volume);
+    const TetMesh& mesh = file.mesh;
+    const ModelScale scale = chosen_scale(o.light, file);
+    VolumeRenderSettings settings = scene_light_settings(o.light, scale);
+    const Lighting& lighting = settings.lighting;
+    const std::optional<TetMaterial>& chosen = settings.material;
     settings.image.width = o.width;
     settings.image.height = o.height;
     settings.image.camera = camera_for_view(o.view);
     if (o.exposure) settings.image.exposure = static_cast<float>(*o.exposure);
     settings.view = view;
 
-    const VolumeFile file = read_volume_file(o.volume);
-    const TetMesh& mesh = file.mesh;
-    const Eigen::Vector3d extent = bounding_extent(mesh.positions);
-    const ModelScale scale = choose_model_scale(o.scale, file.metadata.mm_per_unit, extent);
-    settings.diffusion.mm_per_unit = scale.mm_per_unit;
     const VolumeRender render = render_volume(mesh, o.volume, settings);
     const SolvedScene& scene = render.scene;
     if (!scene.diffusion.gpu_fallback_reason.empty())
         std::cerr << "warning: solving on the CPU instead: " << scene.diffusion.gpu_fallback_reason << "\n";
     write_png(render.image, o.output);
-    // Said once the image is written: an error stays the one line it is.
-    if (scale.source == ScaleSource::ModelSize)
-        std::cerr << "waxwork: " << o.volume << ": scale: " << describe_model_scale(scale, extent) << "\n";
+    report_chosen_scale(o.volume, scale, mesh);
     if (!o.fields.empty()) write_fields_csv(o.fields, mesh, render.connectivity, scene);
 
     const DiffusionSolution& s = scene.diffusion;
@@ -140,7 +105,7 @@ void run_render_command(const RenderCommandOptions& o) {
         {"vertices", mesh.vertex_count()},
         {"tets", mesh.tet_count()},
         {"materials", chosen ? "option" : mesh.has_materials() ? "stored" : "marble default"},
-        {"method", o.method},
+        {"method", o.light.method},
         {"backend", s.backend == SolverBackend::Gpu ? "gpu" : "cpu"},
         {"mm_per_unit", scale.mm_per_unit},
         {"scale_source", scale_source_name(scale.source)},
@@ -149,7 +114,7 @@ void run_render_command(const RenderCommandOptions& o) {
         {"iterations", s.iterations},
         {"estimated_error", s.estimated_relative_error},
         {"exposure", render.exposure},
-        {"crease_angle_deg", o.crease_angle},
+        {"crease_angle_deg", o.light.crease_angle},
         {"shading_copies", scene.shading.size() - scene.surface.vertices.size()},
         {"lighting_ms", scene.lighting_ms},
         {"assembly_ms", s.assembly_ms},
@@ -169,34 +134,10 @@ void add_render_command(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("render", "Solve the light diffusion in a volume and render a PNG");
     cmd->add_option("volume", options->volume, "Volume file (.vtu, .msh, .mesh, .node/.ele)")->required();
     cmd->add_option("-o,--output", options->output, "PNG image to write")->required();
-    add_material_options(*cmd, options->material);
-    cmd->add_option("--light", options->lights,
-                    "dir:X,Y,Z[:R,G,B] (direction of travel) or point:X,Y,Z[:R,G,B] (position, model units); "
-                    "repeatable; intensity 1,1,1 by default")
-        ->expected(1)
-        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    add_scene_light_options(*cmd, options->light);
     cmd->add_option("--width", options->width, "Image width in pixels")->capture_default_str();
     cmd->add_option("--height", options->height, "Image height in pixels")->capture_default_str();
     cmd->add_option("--fields", options->fields, "Also write q, phi and exitant radiance per vertex to this CSV");
-    cmd->add_option("--method", options->method, "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass)")
-        ->check(CLI::IsMember({"transcut", "fem"}))
-        ->capture_default_str();
-    cmd->add_option("--tol", options->tolerance, "Relative tolerance of the diffusion solve")->capture_default_str();
-    cmd->add_option("--backend", options->backend,
-                    "Diffusion solver: cpu, or gpu (float CG on OpenGL 4.3 compute shaders in the render context; "
-                    "falls back to the CPU with a warning when the driver cannot run it, and finishes in double on "
-                    "the CPU when float cannot reach --tol)")
-        ->check(CLI::IsMember({"cpu", "gpu"}))
-        ->capture_default_str();
-    cmd->add_option("--scale", options->scale,
-                    "Millimetres per model unit (coefficients are per mm; default: the scale stored in the volume, "
-                    "else the bounding-box diagonal about 75 mm)");
-    cmd->add_option("--ambient", options->ambient, "Ambient irradiance added to every boundary vertex")
-        ->capture_default_str();
-    cmd->add_option("--crease-angle", options->crease_angle,
-                    "Shade and light the surface as folded where neighbouring triangles turn by more than "
-                    "this many degrees (box edges, cut rims); 180 uses one averaged normal per vertex")
-        ->capture_default_str();
     cmd->add_option("--view", options->view, "Direction from the object towards the camera, X,Y,Z")
         ->delimiter(',')
         ->expected(3);

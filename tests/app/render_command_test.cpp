@@ -2,6 +2,7 @@
 #include "io/image_io.h"
 #include "solver/shading_surface.h"
 #include "support/cli_run.h"
+#include "support/fields_table.h"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -11,8 +12,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 namespace waxwork {
 namespace {
@@ -21,41 +20,6 @@ using namespace testing;
 namespace fs = std::filesystem;
 
 constexpr const char* kHeader = "x,y,z,boundary,q_r,q_g,q_b,phi_r,phi_g,phi_b,lo_r,lo_g,lo_b";
-
-struct FieldRow {
-    double x, y, z;
-    bool boundary;
-    std::array<double, 3> q, phi, lo;
-};
-
-struct Fields {
-    std::string header;
-    std::vector<FieldRow> rows;
-    bool all_finite = true;
-};
-
-Fields read_fields(const fs::path& path) {
-    std::ifstream in(path);
-    Fields fields;
-    std::getline(in, fields.header);
-    std::string line;
-    while (std::getline(in, line)) {
-        std::vector<double> v;
-        std::stringstream s(line);
-        std::string item;
-        while (std::getline(s, item, ',')) {
-            // strtod accepts "nan" and "inf", which is what the test must catch.
-            v.push_back(std::strtod(item.c_str(), nullptr));
-            if (!std::isfinite(v.back())) fields.all_finite = false;
-        }
-        if (v.size() != 13) {
-            ADD_FAILURE() << "row with " << v.size() << " columns: " << line;
-            continue;
-        }
-        fields.rows.push_back({v[0], v[1], v[2], v[3] != 0, {v[4], v[5], v[6]}, {v[7], v[8], v[9]}, {v[10], v[11], v[12]}});
-    }
-    return fields;
-}
 
 // Mean lo per channel over boundary vertices whose coordinate `axis` is within 5% of the box of `bound`.
 std::array<double, 3> mean_lo_near(const Fields& f, int axis, bool at_max) {

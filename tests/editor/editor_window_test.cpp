@@ -3,6 +3,8 @@
 // draws, saves a screenshot and exits cleanly; and its 3D view shows exactly what `waxwork render`
 // (OSMesa) writes for the same scene.
 #include "io/volume_file.h"
+#include "support/exported_surface.h"
+#include "tetops/connectivity.h"
 #include "solver/material.h"
 #include "tetops/test_meshes.h"
 #include "editor_window_fixture.h"
@@ -18,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <set>
 
 namespace waxwork {
 namespace {
@@ -452,6 +455,33 @@ TEST(EditorWithoutDisplay, BadOptionsAreRefusedBeforeOpeningAWindow) {
     const auto r = run_waxwork("edit " + kAssets + "/meshes/cube.obj --frames 0");
     EXPECT_NE(r.exit_code, 0);
     EXPECT_EQ(testing::line_count(r.err), 1u) << r.err;
+}
+
+TEST_F(EditorWindow, FileExportWritesTheCutSurfaceWithItsLight) {
+    const fs::path dir = scratch_dir("editor_export");
+    const auto r = run_script(dir, R"([
+        {"event": "tool", "tool": "cut"},
+        {"frame": 2, "event": "drag", "from": [200, 20], "to": [200, 280], "steps": 10},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "cut.vtu"},
+        {"event": "export_surface", "file": "cut.ply"},
+        {"event": "export_surface", "file": "cut.stl"},
+        {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const TetMesh cut = read_volume(dir / "cut.vtu");
+    const TetConnectivity connectivity = build_connectivity(cut);
+    const double volume = total_volume(cut);
+    for (const char* name : {"cut.ply", "cut.stl"}) {
+        const ReadSurface s = read_exported(dir / name);
+        EXPECT_EQ(s.triangles.size(), connectivity.boundary_faces.size()) << name;
+        EXPECT_TRUE(closed_and_oriented(s)) << name;
+        EXPECT_NEAR(enclosed_volume(s), volume, 1e-6 * volume) << name;
+    }
+    // PLY holds the light: lit and shadowed sides differ; STL holds none.
+    const ReadSurface ply = read_exported(dir / "cut.ply");
+    ASSERT_EQ(ply.colours.size(), ply.positions.size());
+    std::set<std::array<uint8_t, 3>> distinct(ply.colours.begin(), ply.colours.end());
+    EXPECT_GT(distinct.size(), 20u);
 }
 
 }  // namespace

@@ -36,8 +36,9 @@ TEST(InputScript, ParsesEveryEventKind) {
         {"event": "idle"},
         {"event": "save_session", "file": "out/s.json"},
         {"event": "save_volume", "file": "/tmp/v.vtu"},
-        {"event": "crease_angle", "degrees": 180}])");
-    ASSERT_EQ(s.events.size(), 10u);
+        {"event": "crease_angle", "degrees": 180},
+        {"event": "export_surface", "file": "out/v.ply"}])");
+    ASSERT_EQ(s.events.size(), 11u);
     EXPECT_EQ(s.events[0].action, ScriptAction::SelectTool);
     EXPECT_EQ(s.events[0].tool, Tool::ExactCut);
     EXPECT_FALSE(s.events[0].frame);
@@ -58,6 +59,8 @@ TEST(InputScript, ParsesEveryEventKind) {
     EXPECT_EQ(s.events[8].file, std::filesystem::path("/tmp/v.vtu"));
     EXPECT_EQ(s.events[9].action, ScriptAction::SetCreaseAngle);
     EXPECT_EQ(s.events[9].degrees, 180.0);
+    EXPECT_EQ(s.events[10].action, ScriptAction::ExportSurface);
+    EXPECT_EQ(s.events[10].file, std::filesystem::path("/scripts/out/v.ply"));
 }
 
 TEST(InputScript, DragExpandsIntoPressMovesAndRelease) {
@@ -147,6 +150,7 @@ public:
     void set_crease_angle(double degrees) override { add("crease " + std::to_string(int(degrees))); }
     void save_session(const std::filesystem::path& f) override { add("session " + f.filename().string()); }
     void save_volume(const std::filesystem::path& f) override { add("volume " + f.filename().string()); }
+    void export_surface(const std::filesystem::path& f) override { add("surface " + f.filename().string()); }
 
 private:
     void add(const std::string& s) { log.push_back(std::to_string(frame) + ": " + s); }
@@ -155,7 +159,8 @@ private:
 TEST(InputScriptPlayer, FiresInOrderOnePerFrameFromTheFirstReadyFrame) {
     InputScriptPlayer player(parse(R"([{"event": "tool", "tool": "cut"}, {"event": "material", "material": "ketchup"},
         {"frame": 3, "event": "drag", "from": [0, 0], "to": [10, 0], "steps": 1},
-        {"event": "idle"}, {"event": "save_volume", "file": "v.vtu"}, {"event": "crease_angle", "degrees": 90}])"));
+        {"event": "idle"}, {"event": "save_volume", "file": "v.vtu"}, {"event": "crease_angle", "degrees": 90},
+        {"event": "export_surface", "file": "v.ply"}])"));
     FakeTarget target;
     // Not ready: nothing fires and frames do not count.
     for (target.frame = 0; target.frame < 3; ++target.frame) player.advance(target);
@@ -164,12 +169,13 @@ TEST(InputScriptPlayer, FiresInOrderOnePerFrameFromTheFirstReadyFrame) {
     for (; target.frame < 14; ++target.frame) {
         target.is_idle = target.frame >= 10;  // the cut is being applied until window frame 10
         player.advance(target);
-        EXPECT_EQ(player.done(), target.frame >= 12) << target.frame;
+        EXPECT_EQ(player.done(), target.frame >= 13) << target.frame;
     }
     // Ready at window frame 3 = script frame 0; the press waits for script frame 3 (window frame 6);
     // one event per frame after it; the save waits for idle (frame 10) and fires one frame later.
     const std::vector<std::string> expected = {"3: tool 1",      "4: material ketchup", "6: cursor 0,0",  "6: press 0",     "7: cursor 10,0",
-                                               "8: cursor 10,0", "8: release 0",   "11: volume v.vtu", "12: crease 90"};
+                                               "8: cursor 10,0", "8: release 0",   "11: volume v.vtu", "12: crease 90",
+                                               "13: surface v.ply"};
     EXPECT_EQ(target.log, expected);
 }
 

@@ -1,0 +1,84 @@
+#include "app/options/scene_light_options.h"
+
+#include "base/error.h"
+#include "solver/conjugate_gradient.h"
+#include "solver/light_spec.h"
+#include "solver/material.h"
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+namespace waxwork {
+
+void add_scene_light_options(CLI::App& command, SceneLightOptions& options) {
+    add_material_options(command, options.material);
+    command
+        .add_option("--light", options.lights,
+                    "dir:X,Y,Z[:R,G,B] (direction of travel) or point:X,Y,Z[:R,G,B] (position, model units); "
+                    "repeatable; intensity 1,1,1 by default")
+        ->expected(1)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    command.add_option("--method", options.method, "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass)")
+        ->check(CLI::IsMember({"transcut", "fem"}))
+        ->capture_default_str();
+    command.add_option("--tol", options.tolerance, "Relative tolerance of the diffusion solve")->capture_default_str();
+    command
+        .add_option("--backend", options.backend,
+                    "Diffusion solver: cpu, or gpu (float CG on OpenGL 4.3 compute shaders in the render context; "
+                    "falls back to the CPU with a warning when the driver cannot run it, and finishes in double on "
+                    "the CPU when float cannot reach --tol)")
+        ->check(CLI::IsMember({"cpu", "gpu"}))
+        ->capture_default_str();
+    command.add_option("--scale", options.scale,
+                       "Millimetres per model unit (coefficients are per mm; default: the scale stored in the volume, "
+                       "else the bounding-box diagonal about 75 mm)");
+    command.add_option("--ambient", options.ambient, "Ambient irradiance added to every boundary vertex")
+        ->capture_default_str();
+    command
+        .add_option("--crease-angle", options.crease_angle,
+                    "Shade and light the surface as folded where neighbouring triangles turn by more than "
+                    "this many degrees (box edges, cut rims); 180 uses one averaged normal per vertex")
+        ->capture_default_str();
+}
+
+void check_scene_light_options(const SceneLightOptions& o) {
+    auto fail = [](const std::string& what) { throw InvalidArgumentError(what); };
+    if (o.scale) validate_mm_per_unit(*o.scale, "--scale");
+    if (!(o.tolerance >= kMinRelativeTolerance && o.tolerance < 1))
+        fail("--tol must be a relative tolerance in [1e-15, 1)");
+    if (!(o.ambient >= 0 && o.ambient <= kMaxLightIntensity)) fail("--ambient must be non-negative and at most 1e15");
+    if (!is_crease_angle(o.crease_angle)) fail("--crease-angle must be between 0 and 180 degrees");
+}
+
+Lighting chosen_lighting(const SceneLightOptions& o) {
+    Lighting lighting;
+    for (const std::string& spec : o.lights) lighting.lights.push_back(parse_light_spec(spec));
+    if (lighting.lights.empty()) lighting.lights.push_back(default_key_light());
+    lighting.ambient = {o.ambient, o.ambient, o.ambient};
+    return lighting;
+}
+
+VolumeRenderSettings scene_light_settings(const SceneLightOptions& o, const ModelScale& scale) {
+    VolumeRenderSettings settings;
+    settings.lighting = chosen_lighting(o);
+    settings.material = chosen_material(o.material);
+    settings.diffusion.discretization = o.method == "fem" ? Discretization::Fem : Discretization::TransCut;
+    settings.diffusion.mm_per_unit = scale.mm_per_unit;
+    settings.diffusion.relative_tolerance = o.tolerance;
+    if (o.backend == "gpu") settings.diffusion.backend = SolverBackend::Gpu;
+    settings.crease_angle_degrees = o.crease_angle;
+    return settings;
+}
+
+ModelScale chosen_scale(const SceneLightOptions& o, const VolumeFile& file) {
+    return choose_model_scale(o.scale, file.metadata.mm_per_unit, bounding_extent(file.mesh.positions));
+}
+
+void report_chosen_scale(const std::string& file, const ModelScale& scale, const TetMesh& mesh) {
+    if (scale.source == ScaleSource::ModelSize)
+        std::cerr << "waxwork: " << file << ": scale: " << describe_model_scale(scale, bounding_extent(mesh.positions))
+                  << "\n";
+}
+
+}  // namespace waxwork

@@ -1,0 +1,63 @@
+// The options that decide the light a volume shows, shared by the commands that solve it converged
+// (`render`, `export --radiance`), so both light a volume the same way from the same words:
+//   --material NAME | --mua R,G,B --musp R,G,B --eta N, --light SPEC..., --method transcut|fem,
+//   --tol T, --backend cpu|gpu, --scale S, --ambient A, --crease-angle DEG
+#pragma once
+
+#include "app/options/material_options.h"
+#include "render/volume_render.h"
+#include "solver/light_spec.h"
+#include "solver/lighting.h"
+#include "solver/shading_surface.h"
+
+#include "io/volume_file.h"
+#include "tetops/model_scale.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace waxwork {
+
+struct SceneLightOptions {
+    MaterialOptions material;
+    std::vector<std::string> lights;
+    std::string method = "transcut";
+    // 1e-2: the resolution study (`waxwork bench --only resolution`; docs/accuracy.md) finds the image
+    // at 1e-2 within 0.05% of the image at 1e-3 on spot at 3 and 30 mm per unit, while 1e-1 is visibly
+    // off (1-4%); the estimate bounds the true error from above, so the fluence itself is typically
+    // closer than 1e-2.
+    double tolerance = 1e-2;
+    std::optional<double> scale;  // nullopt: the volume's stored scale, else chosen from its size
+    double ambient = kDefaultAmbient;
+    double crease_angle = kDefaultCreaseAngleDegrees;
+    std::string backend = "cpu";
+};
+
+// Registers the options on `command`.
+void add_scene_light_options(CLI::App& command, SceneLightOptions& options);
+
+// Throws InvalidArgumentError for a scale, tolerance, ambient or crease angle out of range. Physically
+// meaningless values are refused before any work: a scale beyond validate_mm_per_unit's bounds is a
+// unit error (a nanometre or a kilometre per model unit), not a scene.
+void check_scene_light_options(const SceneLightOptions& options);
+
+// The lights the options name (render's key light when none), with the ambient term.
+Lighting chosen_lighting(const SceneLightOptions& options);
+
+// The solve's part of render_volume's settings: material, lighting, diffusion (at `scale`) and crease
+// angle; the image and view stay at their defaults.
+VolumeRenderSettings scene_light_settings(const SceneLightOptions& options, const ModelScale& scale);
+
+// The scale a volume is lit at: --scale, else the file's stored scale, else one chosen from its size.
+ModelScale chosen_scale(const SceneLightOptions& options, const VolumeFile& file);
+
+// Says on stderr ("waxwork: FILE: scale: ...") a scale chosen from the model's size (nothing for a
+// given or stored one). Called once the output is written, so that an error stays one line.
+void report_chosen_scale(const std::string& file, const ModelScale& scale, const TetMesh& mesh);
+
+}  // namespace waxwork
