@@ -98,8 +98,10 @@ void expect_fills_surface(const MeshingResult& result, const TriangleSurface& su
     EXPECT_EQ(result.quality.min_dihedral_deg, measure_quality(result.mesh).min_dihedral_deg);
 }
 
+// TetGen's coarsest quality mesh (Mesher::Auto would remesh a surface this much finer than the size).
 MeshingOptions coarsest_quality() {
     MeshingOptions options;
+    options.mesher = Mesher::TetGen;
     options.sizing.surface_edge = 1e30;  // no size bound: only the quality bounds refine
     options.sizing.grading = 0;
     return options;
@@ -181,6 +183,7 @@ TEST(TetrahedralizeTest, TwoDisjointCubesBothGetTets) {
 TEST(TetrahedralizeTest, TargetTetCountWithinTwentyPercent) {
     const TriangleSurface spot = asset_surface("spot.obj");
     MeshingOptions options;
+    options.mesher = Mesher::TetGen;
     options.sizing.target_tets = 50'000;
     const MeshingResult tetgen = tetrahedralize(spot, options);
     EXPECT_NEAR(double(tetgen.mesh.tet_count()), 50'000, 10'000);
@@ -194,6 +197,73 @@ TEST(TetrahedralizeTest, TargetTetCountWithinTwentyPercent) {
     const MeshingResult cgal = tetrahedralize(spot, options);
     EXPECT_NEAR(double(cgal.mesh.tet_count()), 5'000, 1'000);
     EXPECT_TRUE(find_invariant_violations(cgal.mesh).empty());
+}
+
+// --max-tets N (N >= 1000) gives N within 20% on every model with the default mesher, Mesher::Auto:
+// TetGen where it keeps the surface's triangles within N, CGAL (which remeshes the surface) where it
+// cannot, and the result says which ran and why.
+TEST(TetrahedralizeTest, AutoKeepsEveryBudgetWithTheMesherThatCan) {
+    struct Case {
+        std::string name;
+        fs::path path;
+        size_t target;
+        Mesher expected;
+        std::string reason;
+    };
+    std::vector<Case> cases = {
+        {"spot", fs::path(WAXWORK_ASSET_DIR) / "meshes" / "spot.obj", 1'000, Mesher::Cgal,
+         "auto: cgal, the surface's 5,856 triangles need more than the budget's 1,000 tets"},
+        {"spot", fs::path(WAXWORK_ASSET_DIR) / "meshes" / "spot.obj", 20'000, Mesher::Cgal,
+         "auto: cgal, the surface's 5,856 triangles need more than the budget's 20,000 tets"},
+        {"spot", fs::path(WAXWORK_ASSET_DIR) / "meshes" / "spot.obj", 80'000, Mesher::TetGen,
+         "auto: tetgen, it keeps the surface's 5,856 triangles within the budget's 80,000 tets"},
+        {"cube", fs::path(WAXWORK_ASSET_DIR) / "meshes" / "cube.obj", 1'000, Mesher::TetGen,
+         "auto: tetgen, it keeps the surface's 48 triangles within the budget's 1,000 tets"},
+    };
+    if (fs::exists(shared_mesh_dir() / "armadillo.obj"))
+        cases.push_back({"armadillo", shared_mesh_dir() / "armadillo.obj", 20'000, Mesher::Cgal,
+                         "auto: cgal, the surface's 29,170 triangles need more than the budget's 20,000 tets"});
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name + " at " + std::to_string(c.target));
+        const TriangleSurface surface = read_test_surface(c.path);
+        MeshingOptions options;
+        options.sizing.target_tets = c.target;
+        const MeshingResult result = tetrahedralize(surface, options);
+        std::printf("%-10s %7zu: %7zu tets, %s, %.0f ms\n", c.name.c_str(), c.target, result.mesh.tet_count(),
+                    result.mesher_reason.c_str(), result.milliseconds);
+        EXPECT_NEAR(double(result.mesh.tet_count()), double(c.target), 0.2 * double(c.target));
+        EXPECT_EQ(result.mesher, c.expected);
+        EXPECT_EQ(result.mesher_reason, c.reason);
+        EXPECT_TRUE(find_invariant_violations(result.mesh).empty());
+        if (c.expected == Mesher::TetGen) expect_fills_surface(result, surface, 1e-6);
+    }
+}
+
+// For a size rather than a count, Mesher::Auto keeps a surface with TetGen unless it has many times the
+// triangles a surface at the size's edge would have: then TetGen's tets at the surface would be as
+// small as its triangles, not as the size, and CGAL remeshes it.
+TEST(TetrahedralizeTest, AutoRemeshesASurfaceFarFinerThanTheSize) {
+    const TriangleSurface spot = asset_surface("spot.obj");
+    Eigen::AlignedBox3d box;
+    for (const auto& p : spot.points) box.extend(p);
+    const double diagonal = box.diagonal().norm();
+    MeshingOptions options;
+    options.sizing.surface_edge = diagonal / 25;  // the default rule's coarsest surface edge
+    options.sizing.max_edge = diagonal / 8;
+    const MeshingResult kept = tetrahedralize(spot, options);
+    EXPECT_EQ(kept.mesher, Mesher::TetGen) << kept.mesher_reason;
+    EXPECT_NE(kept.mesher_reason.find("auto: tetgen, the size's edge"), std::string::npos) << kept.mesher_reason;
+    options.sizing.surface_edge = diagonal / 8;
+    const MeshingResult remeshed = tetrahedralize(spot, options);
+    EXPECT_EQ(remeshed.mesher, Mesher::Cgal) << remeshed.mesher_reason;
+    EXPECT_NE(remeshed.mesher_reason.find("auto: cgal, the surface's 5,856 triangles are more than 10 times"),
+              std::string::npos)
+        << remeshed.mesher_reason;
+    EXPECT_LT(remeshed.mesh.tet_count(), kept.mesh.tet_count());
+    options.mesher = Mesher::TetGen;  // an explicit mesher is used as it is
+    const MeshingResult chosen = tetrahedralize(spot, options);
+    EXPECT_EQ(chosen.mesher, Mesher::TetGen);
+    EXPECT_EQ(chosen.mesher_reason, "chosen");
 }
 
 // A target TetGen cannot reach while keeping the surface's triangles is refused with the count it
@@ -210,6 +280,7 @@ TEST(TetrahedralizeTest, RefusesATargetBelowTetGensFloorNamingTheFloor) {
     ASSERT_LT(2 * bare, coarsest);  // room for a target between the two
     const auto refusal = [&](size_t target) {
         MeshingOptions options;
+        options.mesher = Mesher::TetGen;
         options.sizing.target_tets = target;
         try {
             tetrahedralize(spot, options);
@@ -238,6 +309,7 @@ TEST(TetrahedralizeTest, RefusesATargetBelowTetGensFloorNamingTheFloor) {
     EXPECT_NE(just_below.find("at least " + std::to_string(coarsest) + " tets"), std::string::npos) << just_below;
     // At the floor, the target is met.
     MeshingOptions at_floor;
+    at_floor.mesher = Mesher::TetGen;
     at_floor.sizing.target_tets = coarsest;
     EXPECT_NEAR(double(tetrahedralize(spot, at_floor).mesh.tet_count()), double(coarsest), 0.2 * double(coarsest));
 }
@@ -550,7 +622,7 @@ TEST(TetrahedralizeTest, ReportsItsStagesAndStopsWhenCancelled) {
     options.progress = &progress;
     tetrahedralize(cube, options);
     const std::vector<std::string> tetgen_stages = {"checking the surface for meshing", "meshing (TetGen)",
-                                                    "meshing (TetGen, background mesh)",
+                                                    "meshing (TetGen, coarse mesh)",
                                                     "meshing (TetGen, sizing field)", "meshing (TetGen, graded)",
                                                     "ordering the mesh", "measuring quality"};
     EXPECT_EQ(progress.stages, tetgen_stages);
