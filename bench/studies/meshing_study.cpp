@@ -59,7 +59,9 @@ void measure_row(const std::filesystem::path& path, const MeshingStudyOptions& o
     row.budget_ms = budgeted.milliseconds;
     row.budget_mesher = mesher_name(budgeted.mesher);
 
-    // TetGen's own quality run, as `tetgen -pq1.414` would make it (no dihedral bound, no size).
+    // TetGen's own quality run, as `tetgen -pq1.414` would make it (no dihedral bound, no size). Not run
+    // on surfaces over TetGen's triangle limit: it runs for minutes there (docs/meshing.md, Limits).
+    if (surface.triangles.size() > kMaxTetGenTriangles) return;
     TetGenSettings reference;
     reference.size = SizeField::unbounded();
     reference.max_radius_edge_ratio = 1.414;
@@ -146,6 +148,8 @@ std::string meshing_table_markdown(const std::vector<MeshingStudyRow>& rows) {
             table += format("%.2f s", r.reference_ms / 1000) + " | " + std::to_string(r.reference_tets) + " | " +
                      format("%.2f", r.reference_min_dihedral_deg) + " | " +
                      format("%.2f", r.default_ms / r.reference_ms) + " | ";
+        } else if (r.triangles > kMaxTetGenTriangles) {
+            table += "not run (over TetGen's " + std::to_string(kMaxTetGenTriangles) + " triangles) | | | | ";
         } else {
             table += "failed: " + r.error + " | | | | ";
         }

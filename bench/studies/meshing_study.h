@@ -18,7 +18,7 @@ struct MeshingStudyRow {
     size_t triangles = 0;
     std::string error;  // the surface was refused or a run failed: the rest is what finished
 
-    // TetGen -pq1.414 on the surface, no size bound.
+    // TetGen -pq1.414 on the surface, no size bound (not run over kMaxTetGenTriangles: 0).
     double reference_ms = 0;
     size_t reference_tets = 0;
     double reference_min_dihedral_deg = 0;

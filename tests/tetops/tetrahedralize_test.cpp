@@ -409,6 +409,48 @@ TEST(TetrahedralizeTest, CgalPerturbsSliversTowardsTheBound) {
     EXPECT_EQ(quality.tets_below_5_deg, 0u);
 }
 
+// The mean edge of the tets touching the surface and of the deepest tenth of a sample of the others.
+std::pair<double, double> boundary_and_deep_mean_edge(const TetMesh& mesh) {
+    std::vector<char> on_boundary(mesh.vertex_count(), 0);
+    for (const auto& f : boundary_faces(mesh)) {
+        for (int32_t v : f) on_boundary[v] = 1;
+    }
+    // Depth of a tet: distance of its centroid to the nearest boundary vertex (good enough on a
+    // surface this fine).
+    std::vector<Eigen::Vector3d> boundary_points;
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+        if (on_boundary[v]) boundary_points.push_back(mesh.positions[v]);
+    }
+    double boundary_sum = 0;
+    size_t boundary_count = 0;
+    std::vector<std::pair<double, size_t>> depths;
+    for (size_t t = 0; t < mesh.tet_count(); ++t) {
+        const Tet& tet = mesh.tets[t];
+        if (on_boundary[tet[0]] || on_boundary[tet[1]] || on_boundary[tet[2]] || on_boundary[tet[3]]) {
+            boundary_sum += mean_edge(mesh, t);
+            ++boundary_count;
+            continue;
+        }
+        if (t % 31 != 0) continue;  // a sample of the interior keeps the brute-force depth cheap
+        const Eigen::Vector3d c = (mesh.positions[tet[0]] + mesh.positions[tet[1]] + mesh.positions[tet[2]] +
+                                   mesh.positions[tet[3]]) / 4;
+        double depth = INFINITY;
+        for (const auto& p : boundary_points) depth = std::min(depth, (p - c).squaredNorm());
+        depths.emplace_back(depth, t);
+    }
+    EXPECT_GT(boundary_count, 0u);
+    EXPECT_GT(depths.size(), 20u);
+    std::sort(depths.begin(), depths.end(), std::greater<>());
+    double deep_sum = 0;
+    const size_t deep_count = depths.size() / 10;
+    for (size_t i = 0; i < deep_count; ++i) deep_sum += mean_edge(mesh, depths[i].second);
+    const double boundary_edge = boundary_sum / double(boundary_count);
+    const double deep_edge = deep_sum / double(deep_count);
+    std::printf("graded: %zu tets, boundary mean edge %.4f, deepest mean edge %.4f\n", mesh.tet_count(),
+                boundary_edge, deep_edge);
+    return {boundary_edge, deep_edge};
+}
+
 TEST(TetrahedralizeTest, GradedSizingIsFinerAtTheSurface) {
     const TriangleSurface spot = asset_surface("spot.obj");
     for (const Mesher mesher : {Mesher::TetGen, Mesher::Cgal}) {
@@ -419,47 +461,46 @@ TEST(TetrahedralizeTest, GradedSizingIsFinerAtTheSurface) {
         options.sizing.grading = 0.8;
         options.sizing.max_edge = 0.2;
         const MeshingResult result = tetrahedralize(spot, options);
-        const TetMesh& mesh = result.mesh;
-        std::vector<char> on_boundary(mesh.vertex_count(), 0);
-        for (const auto& f : boundary_faces(mesh)) {
-            for (int32_t v : f) on_boundary[v] = 1;
-        }
-        // Depth of a tet: distance of its centroid to the nearest boundary vertex (good enough on a
-        // surface this fine).
-        std::vector<Eigen::Vector3d> boundary_points;
-        for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-            if (on_boundary[v]) boundary_points.push_back(mesh.positions[v]);
-        }
-        double boundary_sum = 0;
-        size_t boundary_count = 0;
-        std::vector<std::pair<double, size_t>> depths;
-        for (size_t t = 0; t < mesh.tet_count(); ++t) {
-            const Tet& tet = mesh.tets[t];
-            if (on_boundary[tet[0]] || on_boundary[tet[1]] || on_boundary[tet[2]] || on_boundary[tet[3]]) {
-                boundary_sum += mean_edge(mesh, t);
-                ++boundary_count;
-                continue;
-            }
-            if (t % 31 != 0) continue;  // a sample of the interior keeps the brute-force depth cheap
-            const Eigen::Vector3d c = (mesh.positions[tet[0]] + mesh.positions[tet[1]] + mesh.positions[tet[2]] +
-                                       mesh.positions[tet[3]]) / 4;
-            double depth = INFINITY;
-            for (const auto& p : boundary_points) depth = std::min(depth, (p - c).squaredNorm());
-            depths.emplace_back(depth, t);
-        }
-        ASSERT_GT(boundary_count, 0u);
-        ASSERT_GT(depths.size(), 20u);
-        std::sort(depths.begin(), depths.end(), std::greater<>());
-        double deep_sum = 0;
-        const size_t deep_count = depths.size() / 10;
-        for (size_t i = 0; i < deep_count; ++i) deep_sum += mean_edge(mesh, depths[i].second);
-        const double boundary_edge = boundary_sum / double(boundary_count);
-        const double deep_edge = deep_sum / double(deep_count);
-        std::printf("graded: %zu tets, boundary mean edge %.4f, deepest mean edge %.4f\n", mesh.tet_count(),
-                    boundary_edge, deep_edge);
+        const auto [boundary_edge, deep_edge] = boundary_and_deep_mean_edge(result.mesh);
         EXPECT_GT(deep_edge, 1.5 * boundary_edge);
         expect_fills_surface(result, spot, mesher == Mesher::TetGen ? 1e-6 : 0.05);
     }
+}
+
+// Spot at the default size of the sessions and the demo (marble at 30 mm per unit: the rule of
+// solver/mesh_resolution.h gives a surface edge of l_d / 2 = 3.95 mm / 2 / 30 and a largest edge of
+// D / 8). TetGen keeps spot's triangles, and tets touching the few with small angles keep what those
+// force (its own quality mesh without a size, the floor of this one, has 1.85 degrees); away from
+// the surface the graded mesh keeps the dihedral bound's neighbourhood, and it stays graded.
+TEST(TetrahedralizeTest, DefaultMeshOfSpotIsGradedAndWellShapedAwayFromTheSurface) {
+    const TriangleSurface spot = asset_surface("spot.obj");
+    Eigen::AlignedBox3d box;
+    for (const auto& p : spot.points) box.extend(p);
+    MeshingOptions options;
+    options.sizing.surface_edge = 3.95 / 2 / 30;
+    options.sizing.grading = 0.5;
+    options.sizing.max_edge = box.diagonal().norm() / 8;
+    const MeshingResult result = tetrahedralize(spot, options);
+    EXPECT_EQ(result.mesher, Mesher::TetGen) << result.mesher_reason;
+    expect_fills_surface(result, spot, 1e-6);
+    const TetMesh& mesh = result.mesh;
+    std::vector<char> on_boundary(mesh.vertex_count(), 0);
+    for (const auto& f : boundary_faces(mesh))
+        for (int32_t v : f) on_boundary[v] = 1;
+    const std::vector<double> angles = min_dihedral_angles_deg(mesh);
+    double interior_min = 180;
+    for (size_t t = 0; t < mesh.tet_count(); ++t) {
+        const Tet& tet = mesh.tets[t];
+        if (!on_boundary[tet[0]] && !on_boundary[tet[1]] && !on_boundary[tet[2]] && !on_boundary[tet[3]])
+            interior_min = std::min(interior_min, angles[t]);
+    }
+    std::printf("spot default: %zu tets, min dihedral %.2f, interior %.2f, %zu under 5 degrees\n", mesh.tet_count(),
+                result.quality.min_dihedral_deg, interior_min, result.quality.tets_below_5_deg);
+    EXPECT_GE(interior_min, 5.0);
+    EXPECT_GE(result.quality.min_dihedral_deg, 1.5);
+    EXPECT_LT(double(result.quality.tets_below_5_deg), 0.001 * double(mesh.tet_count()));
+    const auto [boundary_edge, deep_edge] = boundary_and_deep_mean_edge(mesh);
+    EXPECT_GT(deep_edge, 1.5 * boundary_edge);
 }
 
 TEST(TetrahedralizeTest, RejectsAbsurdOptions) {
