@@ -51,10 +51,10 @@ void measure_row(const std::filesystem::path& path, const MeshingStudyOptions& o
     row.interior_min_dihedral_deg = interior_min_dihedral_deg(result.mesh);
     row.tets_below_5_deg = result.quality.tets_below_5_deg;
 
+    row.budget = options.budget;
     MeshingOptions budget;
     budget.sizing.target_tets = options.budget;
     const MeshingResult budgeted = tetrahedralize(surface, budget);
-    row.budget = options.budget;
     row.budget_tets = budgeted.mesh.tet_count();
     row.budget_ms = budgeted.milliseconds;
     row.budget_mesher = mesher_name(budgeted.mesher);
