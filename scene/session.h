@@ -4,7 +4,7 @@
 // renderer.
 //
 //   {
-//     "input": {"surface": "spot.obj", "max_tets": 20000, "mesher": "tetgen"}   (or "edge": L; neither:
+//     "input": {"surface": "spot.obj", "max_tets": 20000, "mesher": "auto"}   (or "edge": L; neither:
 //              sized for the material and scale, solver/mesh_resolution.h) | {"volume": "spot.vtu"},
 //     "material": "marble" | {"mua": [..], "musp": [..], "eta": 1.3},   (tets without a stored material)
 //     "scale": 30,                         millimetres per model unit (optional: the input volume's
@@ -62,7 +62,7 @@ struct SessionInput {
     std::filesystem::path volume;
     std::optional<size_t> max_tets;
     std::optional<double> edge;
-    Mesher mesher = Mesher::TetGen;
+    Mesher mesher = Mesher::Auto;
 };
 
 struct RenderStep {

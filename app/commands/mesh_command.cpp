@@ -72,6 +72,8 @@ void run_mesh_command(const MeshCommandOptions& o) {
         {"mean_edge_length", q.mean_edge_length},
         {"repairs", loaded.repairs},
         {"milliseconds", result.milliseconds},
+        {"mesher", mesher_name(result.mesher)},
+        {"mesher_reason", result.mesher_reason},
     };
     std::cout << summary.dump() << "\n";
 }

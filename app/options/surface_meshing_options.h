@@ -1,5 +1,5 @@
 // The options shared by every command that fills a surface file with tets (`mesh`, `bench solvers`):
-//   --mesher tetgen|cgal --min-dihedral DEG --radius-edge R --fill-holes --autorefine
+//   --mesher auto|tetgen|cgal --min-dihedral DEG --radius-edge R --fill-holes --autorefine
 // The size (--edge, --max-tets, the material's default sizing) stays with each command: `mesh` has
 // a default, `bench solvers` asks for a tet count.
 #pragma once
@@ -22,7 +22,7 @@ namespace waxwork {
 class StderrProgress;
 
 struct SurfaceMeshingOptions {
-    std::string mesher = "tetgen";
+    std::string mesher = "auto";
     double min_dihedral = 10.0;
     double radius_edge = 2.0;
     bool fill_holes = false;
