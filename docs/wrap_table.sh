@@ -24,7 +24,12 @@ for path in "$meshes"/*.obj "$meshes"/*.off "$meshes"/*.ply "$meshes"/*.stl; do
   done
   wait $pid 2> /dev/null
   if ! tr '\r' '\n' < "$out/plain.err" | grep -q 'meshing'; then
-    refused="$(tr '\r' '\n' < "$out/plain.err" | grep -v '^ *$' | tail -1 | sed "s|^waxwork: $path: ||" | cut -d';' -f1)"
+    # The blocking defects, without their examples, the safe repairs and the way out.
+    refused="$(tr '\r' '\n' < "$out/plain.err" | grep -v '^ *$' | tail -1 | python3 -c '
+import re, sys
+line = sys.stdin.read().split(": ", 2)[-1].strip()
+line = re.sub(r" \([^()]*\)", "", line)
+print(", ".join(p for p in line.split("; ") if not p.startswith(("also repaired", "--repair wrap"))))')"
   fi
   [ -n "$refused" ] || continue
   start=$(date +%s.%N)

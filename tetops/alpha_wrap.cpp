@@ -145,12 +145,15 @@ WrapResult wrap_surface(const TriangleSurface& soup, const WrapOptions& options,
     // Input to wrap, the direction that sees lost features. Why the bounded-error variant:
     // approximate_Hausdorff_distance samples the input and so can only under-estimate (it misses a
     // narrow cavity between samples), while this one subdivides only the triangles that may still
-    // hold the maximum and guarantees the result within the error bound; on the shared meshes it
-    // takes well under a second.
+    // hold the maximum and guarantees the result within the error bound. Why alpha/10 as the bound:
+    // the wrap cannot represent detail finer than alpha anyway, and the work grows like 1/bound^2
+    // where the whole input lies near the maximum (a convex input, all at about the offset): a unit
+    // cube at 1e-4 of its diagonal took over a minute, at alpha/10 well under a second.
     check_cancelled(progress);
     report_stage(progress, "measuring the wrap's distance");
     report.hausdorff = CGAL::Polygon_mesh_processing::bounded_error_Hausdorff_distance<CGAL::Sequential_tag>(
-        input, wrap, 1e-4 * diagonal, CGAL::parameters::match_faces(false), CGAL::parameters::match_faces(false));
+        input, wrap, kWrapHausdorffErrorFractionOfAlpha * report.alpha, CGAL::parameters::match_faces(false),
+        CGAL::parameters::match_faces(false));
     return result;
 }
 

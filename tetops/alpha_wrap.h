@@ -33,9 +33,12 @@ inline constexpr double kMinWrapAlphaFraction = 1.0 / 2000.0;
 // computed near the limit of double precision relative to the model's size.
 inline constexpr double kMinWrapOffsetFraction = 1e-6;
 
+// The error bound of the reported Hausdorff distance, as a fraction of alpha.
+inline constexpr double kWrapHausdorffErrorFractionOfAlpha = 0.1;
+
 struct WrapOptions {
-    std::optional<double> alpha;   // model units; default kDefaultWrapAlphaFraction * D
-    std::optional<double> offset;  // model units; default kDefaultWrapOffsetFractionOfAlpha * alpha
+    std::optional<double> alpha = std::nullopt;   // model units; default kDefaultWrapAlphaFraction * D
+    std::optional<double> offset = std::nullopt;  // model units; default kDefaultWrapOffsetFractionOfAlpha * alpha
 };
 
 struct WrapReport {
@@ -45,7 +48,7 @@ struct WrapReport {
     size_t triangles = 0;          // in the wrapped surface
     size_t ignored_triangles = 0;  // input triangles with a missing or non-finite vertex (not wrapped)
     // One-sided Hausdorff distance from the input to the wrap: the farthest any input point lies from
-    // the wrapped surface (within 1e-4 D). About the offset where the wrap follows the input; larger
+    // the wrapped surface (within alpha/10). About the offset where the wrap follows the input; larger
     // where it closes over a cavity or gap narrower than alpha (by the cavity's depth) and where input
     // triangles are buried inside the wrapped volume (overlapping or nested shells, inner walls), which
     // the wrap drops. Over the triangles wrapped (CGAL's oracle skips zero-area ones).

@@ -31,7 +31,7 @@ struct SurfaceRepairOptions {
     size_t max_triangles = 0;
     // Set: the file's triangles are wrapped (tetops/alpha_wrap.h) before any check, instead of the
     // repairs above, and the wrap is validated as any surface is.
-    std::optional<WrapOptions> wrap;
+    std::optional<WrapOptions> wrap = std::nullopt;
 };
 
 // The problem of a surface with `triangles` triangles where at most `limit` are taken ("" if none):

@@ -66,10 +66,11 @@ TriangleSurface as_soup(const TriangleSurface& s) {
 // The distance bound for a convex input: the wrap's vertices lie on the offset surface, at distance
 // offset from the input, and its facets are chords of that convex surface, so the wrap lies between
 // the input and the offset surface and every input point is within offset of it (plus the
-// measurement's error bound, 1e-4 of the diagonal). At a concave crease the wrap cannot follow into a
-// gap narrower than alpha, so there the bound is alpha + offset.
-double convex_bound(const WrapReport& r) { return r.offset + 1e-4 * r.diagonal + 1e-12; }
-double crease_bound(const WrapReport& r) { return r.alpha + r.offset + 1e-4 * r.diagonal; }
+// measurement's error bound, alpha/10). At a concave crease the wrap cannot follow into a gap narrower
+// than alpha, so there the bound is alpha + offset.
+double measurement_error(const WrapReport& r) { return kWrapHausdorffErrorFractionOfAlpha * r.alpha; }
+double convex_bound(const WrapReport& r) { return r.offset + measurement_error(r) + 1e-12; }
+double crease_bound(const WrapReport& r) { return r.alpha + r.offset + measurement_error(r); }
 
 TEST(AlphaWrap, DefaultsAreRelativeToTheDiagonal) {
     const WrapResult r = wrap_surface(make_cube_surface(), {});
@@ -81,7 +82,7 @@ TEST(AlphaWrap, DefaultsAreRelativeToTheDiagonal) {
     EXPECT_GT(volume, 1.0);
     EXPECT_LE(volume, std::pow(1.0 + 2.0 * r.report.offset, 3));
     // On the cube's flat faces the wrap lies on the offset plane: the distance is the offset.
-    EXPECT_NEAR(r.report.hausdorff, r.report.offset, 1e-4 * r.report.diagonal);
+    EXPECT_NEAR(r.report.hausdorff, r.report.offset, measurement_error(r.report));
 }
 
 TEST(AlphaWrap, SoupWithUnsharedVerticesAndDuplicatesBecomesOneClosedCube) {
@@ -113,10 +114,11 @@ TEST(AlphaWrap, IntersectingCubesBecomeOneComponent) {
     const TriangleSurface two = combine(make_cube_surface(), make_cube_surface(Eigen::Vector3d(0.5, 0.5, 0.5)));
     ASSERT_GT(find_surface_defects(two).self_intersecting_pairs, 0u);
     const WrapResult r = wrap_surface(two, {});
-    // Each cube's faces inside the other are buried up to 1/4 below the union's surface (the centre of
-    // the square x = 0.5, 0.5 <= y, z <= 1 of the second cube); the distance from the input sees them.
-    const double volume = expect_valid_wrap(r, 1, 0.25 + crease_bound(r.report));
-    EXPECT_GT(r.report.hausdorff, 0.25);
+    // Each cube's faces inside the other are buried up to 1/2 below the union's surface (the second
+    // cube's corner (0.5, 0.5, 0.5) is 0.5 from the first cube's faces x, y, z = 0 and from the parts of
+    // its faces x, y, z = 1 outside the second cube); the distance from the input sees them.
+    const double volume = expect_valid_wrap(r, 1, 0.5 + crease_bound(r.report));
+    EXPECT_GT(r.report.hausdorff, 0.5);
     // The union of the cubes is 2 - 1/8; the wrap holds it and a thin shell around it.
     EXPECT_GT(volume, 1.875);
     EXPECT_LT(volume, 1.875 * 1.05);
