@@ -18,10 +18,11 @@ class Progress;
 
 // Default alpha as a fraction of the bounding-box diagonal D. Why D/100: the material rule's surface
 // edge h_s (solver/mesh_resolution.h) lies in [D/150, D/25], so a feature the default mesh resolves
-// is at least ~D/100 wide and survives; measured on the shared broken meshes (docs/meshing.md) this
-// keeps legs, ears and horns with a Hausdorff distance of a few tenths of a percent of D, gives
-// 20K-60K triangles (under the TetGen limit) and wraps in seconds. D/150 doubles the triangles
-// and the time for no feature the default mesh would resolve better.
+// is wider than alpha and survives. Measured (docs/meshing.md): bad_cow and horse.ply give 18K
+// triangles, well under the TetGen limit; halving alpha gives 66K on the cow for a Hausdorff distance
+// that moves only from 2.07% to 1.83% of D (its distance is buried self-intersecting parts, not lost
+// features), doubling it 5K triangles and 3.15%. An open model whose holes are wider than alpha is
+// wrapped on both sides of its shell (hollow, and slow): it needs a larger alpha.
 inline constexpr double kDefaultWrapAlphaFraction = 1.0 / 100.0;
 // Default offset as a fraction of alpha: CGAL's own default (alpha / 30). A smaller offset hugs sharp
 // features closer but puts more triangles around them; a larger one inflates the model visibly.
