@@ -140,6 +140,11 @@ void EditorApp::open_file(const fs::path& path, std::optional<double> scale) {
     setup.name = path.filename().string();
     (is_volume_path(path) ? setup.input.volume : setup.input.surface) = fs::absolute(path);
     setup.input.max_tets = options_.max_tets;
+    setup.input.edge = options_.edge;
+    setup.input.mesher = options_.mesher;
+    setup.input.min_dihedral_deg = options_.min_dihedral_deg;
+    setup.input.max_radius_edge_ratio = options_.max_radius_edge_ratio;
+    setup.input.repair = options_.repair;
     setup.material = options_.material.value_or(material_preset("marble"));
     setup.scale = scale ? scale : options_.scale;
     setup.tolerance = live_options_.relative_tolerance;

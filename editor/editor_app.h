@@ -45,6 +45,11 @@ struct EditorOptions {
     std::filesystem::path session;       // a session (session.h) to open instead: its input, material,
                                          // lights and camera, with its edit steps replayed
     std::optional<size_t> max_tets;      // meshing a surface: about this many tets (default by material)
+    std::optional<double> edge;          // meshing a surface: this edge length instead (model units)
+    Mesher mesher = Mesher::TetGen;      // meshing a surface: the mesher, its quality bounds and the
+    double min_dihedral_deg = MeshingOptions{}.min_dihedral_deg;  // opt-in repairs (as `waxwork mesh`)
+    double max_radius_edge_ratio = MeshingOptions{}.max_radius_edge_ratio;
+    SurfaceRepairOptions repair;
     std::optional<TetMaterial> material; // applied to the whole volume after loading
     std::filesystem::path screenshot;    // non-empty: render `frames` frames, save the window, exit
     int frames = 10;                     // frames drawn after loading and solving finished

@@ -619,6 +619,41 @@ TriangleSurface read_surface_file(const std::filesystem::path& path) {
     return surface;
 }
 
+namespace {
+
+// Every defect describe() names can be wrapped away except those that leave no geometry to wrap: no
+// triangles, or vertices that are missing or not finite (the wrap would have to drop their triangles).
+bool wrapping_would_fix(const SurfaceDefects& defects) {
+    return defects.triangle_count > 0 && defects.non_finite_points == 0 && defects.invalid_indices == 0;
+}
+
+// The wrap replaces the file's triangles; it is validated as any surface is, so a wrap the meshers
+// could not take is refused here rather than by a mesher.
+LoadedSurface wrapped_surface(TriangleSurface file, const std::string& name, const SurfaceRepairOptions& options,
+                              Progress* progress) {
+    WrapResult wrapped = naming_context(name, [&] { return wrap_surface(file, *options.wrap, progress); });
+    LoadedSurface loaded;
+    loaded.surface = std::move(wrapped.surface);
+    loaded.wrap = wrapped.report;
+    loaded.repairs.push_back(wrapped.report.describe());
+    const size_t triangles = loaded.surface.triangles.size();
+    if (options.max_triangles > 0 && triangles > options.max_triangles)
+        throw InvalidMeshError(name + ": the wrap has " + std::to_string(triangles) +
+                               " triangles, more than the meshers take (" + std::to_string(options.max_triangles) +
+                               "); a larger --wrap-alpha gives fewer");
+    report_stage(progress, "checking the wrapped surface");
+    for (auto& line : repair_safe_defects(loaded.surface)) loaded.repairs.push_back(std::move(line));
+    const std::vector<std::string> problems = find_surface_defects(loaded.surface).describe();
+    if (!problems.empty()) {
+        std::string message = name + ": the wrapped surface is still defective: ";
+        for (size_t k = 0; k < problems.size(); ++k) message += (k ? "; " : "") + problems[k];
+        throw InvalidMeshError(message);
+    }
+    return loaded;
+}
+
+}  // namespace
+
 LoadedSurface load_closed_surface(const std::filesystem::path& path, const SurfaceRepairOptions& options,
                                   Progress* progress) {
     LoadedSurface loaded;
@@ -629,12 +664,14 @@ LoadedSurface load_closed_surface(const std::filesystem::path& path, const Surfa
             !problem.empty())
             throw InvalidMeshError(path.string() + ": " + problem);
     }
+    const std::string name = path.string();
+    if (options.wrap) return wrapped_surface(std::move(loaded.surface), name, options, progress);
     const TriangleSurface file = options.fill_holes || options.autorefine ? loaded.surface : TriangleSurface{};
     report_stage(progress, "checking the surface");
-    const std::string name = path.string();
-    auto reject = [&](const std::vector<std::string>& defects) {
+    auto reject = [&](const std::vector<std::string>& defects, const SurfaceDefects& found) {
         std::string message = name + ": ";
         for (size_t k = 0; k < defects.size(); ++k) message += (k ? "; " : "") + defects[k];
+        if (wrapping_would_fix(found)) message += "; --repair wrap rebuilds it as a closed surface";
         throw InvalidMeshError(message);
     };
 
@@ -646,7 +683,7 @@ LoadedSurface load_closed_surface(const std::filesystem::path& path, const Surfa
     if (!options.fill_holes && !options.autorefine) {
         // The safe repairs were defects of the file too; name them after the blocking ones.
         for (const auto& repair : loaded.repairs) problems.push_back("also repaired: " + repair);
-        reject(problems);
+        reject(problems, defects);
     }
 
     check_cancelled(progress);
@@ -655,7 +692,8 @@ LoadedSurface load_closed_surface(const std::filesystem::path& path, const Surfa
     // After a shape-changing repair the messages still name the file's vertices and faces: those the
     // repairs kept are found again by position; those they made are marked as new.
     const SurfaceIndexMap in_file = file_indices(file, loaded.surface);
-    problems = find_surface_defects(loaded.surface).describe(&in_file);
+    defects = find_surface_defects(loaded.surface);
+    problems = defects.describe(&in_file);
     if (!problems.empty() && std::any_of(problems.begin(), problems.end(), [](const std::string& line) {
             return line.find("[new ") != std::string::npos;
         }))
@@ -667,7 +705,7 @@ LoadedSurface load_closed_surface(const std::filesystem::path& path, const Surfa
             for (size_t k = 0; k < loaded.repairs.size(); ++k) all += (k ? ", " : "") + loaded.repairs[k];
             return all;
         }());
-        reject(problems);
+        reject(problems, defects);
     }
     return loaded;
 }

@@ -198,6 +198,52 @@ Json step_to_json(const SessionStep& step, const Session& session) {
     return Json{{"redo", std::get<RedoStep>(step).count}};
 }
 
+// The optional meshing fields of a surface input, named as the command line's options. Written only
+// when they differ from the defaults, so a session that uses none reads as before.
+const char* const kMeshingFields[] = {"min_dihedral", "radius_edge", "fill_holes", "autorefine",
+                                      "repair", "wrap_alpha", "wrap_offset"};
+
+bool has_meshing_fields(const FieldReader& input) {
+    return std::any_of(std::begin(kMeshingFields), std::end(kMeshingFields),
+                       [&](const char* key) { return input.has(key); });
+}
+
+void read_meshing_fields(FieldReader& input, SessionInput& session_input) {
+    session_input.min_dihedral_deg = input.number("min_dihedral", session_input.min_dihedral_deg);
+    session_input.max_radius_edge_ratio = input.number("radius_edge", session_input.max_radius_edge_ratio);
+    SurfaceRepairOptions& repair = session_input.repair;
+    repair.fill_holes = input.boolean("fill_holes", false);
+    repair.autorefine = input.boolean("autorefine", false);
+    if (input.has("repair")) {
+        if (input.at("repair") != "wrap") fail_json(input.field("repair"), "expected \"wrap\"");
+        if (repair.fill_holes || repair.autorefine)
+            fail_json(input.field("repair"), "wrapping replaces 'fill_holes' and 'autorefine'; give one or the other");
+        repair.wrap = WrapOptions{};
+    }
+    for (const char* key : {"wrap_alpha", "wrap_offset"}) {
+        if (!input.has(key)) continue;
+        if (!repair.wrap) fail_json(input.field(key), "needs \"repair\": \"wrap\"");
+        const double value = input.number(key);
+        if (!(value > 0)) fail_json(input.field(key), "must be positive");
+        (std::string(key) == "wrap_alpha" ? repair.wrap->alpha : repair.wrap->offset) = value;
+    }
+}
+
+void write_meshing_fields(const SessionInput& session_input, Json& input) {
+    const SessionInput defaults;
+    if (session_input.min_dihedral_deg != defaults.min_dihedral_deg) input["min_dihedral"] = session_input.min_dihedral_deg;
+    if (session_input.max_radius_edge_ratio != defaults.max_radius_edge_ratio)
+        input["radius_edge"] = session_input.max_radius_edge_ratio;
+    const SurfaceRepairOptions& repair = session_input.repair;
+    if (repair.fill_holes) input["fill_holes"] = true;
+    if (repair.autorefine) input["autorefine"] = true;
+    if (repair.wrap) {
+        input["repair"] = "wrap";
+        if (repair.wrap->alpha) input["wrap_alpha"] = *repair.wrap->alpha;
+        if (repair.wrap->offset) input["wrap_offset"] = *repair.wrap->offset;
+    }
+}
+
 fs::path relative_if_possible(const fs::path& path, const fs::path& base) {
     std::error_code ec;
     const fs::path relative = fs::relative(path, base, ec);
@@ -240,7 +286,9 @@ Session parse_session(const Json& json, const fs::path& base_directory, const st
                 fail_json(input.field("mesher"), "expected \"auto\", \"tetgen\" or \"cgal\"");
             }
         }
-        if (key == "volume" && (session.input.max_tets || session.input.edge || input.has("mesher")))
+        read_meshing_fields(input, session.input);
+        if (key == "volume" && (session.input.max_tets || session.input.edge || input.has("mesher") ||
+                                has_meshing_fields(input)))
             fail_json(in.field("input"), "meshing options apply to a 'surface' input only");
         input.finish();
     }
@@ -298,6 +346,7 @@ Json session_to_json(const Session& session) {
         if (session.input.max_tets) input["max_tets"] = *session.input.max_tets;
         if (session.input.edge) input["edge"] = *session.input.edge;
         input["mesher"] = mesher_name(session.input.mesher);
+        write_meshing_fields(session.input, input);
     } else {
         input["volume"] = session.input.volume.generic_string();
     }
@@ -343,10 +392,12 @@ SessionVolume read_session_input(const Session& session) {
             choose_model_scale(session.scale, file.metadata.mm_per_unit, bounding_extent(file.mesh.positions));
         return {std::move(file.mesh), scale};
     }
-    const LoadedSurface loaded = load_closed_surface(session.input.surface);
+    const LoadedSurface loaded = load_closed_surface(session.input.surface, session.input.repair);
     const ModelScale scale = choose_model_scale(session.scale, std::nullopt, bounding_extent(loaded.surface.points));
     MeshingOptions meshing;
     meshing.mesher = session.input.mesher;
+    meshing.min_dihedral_deg = session.input.min_dihedral_deg;
+    meshing.max_radius_edge_ratio = session.input.max_radius_edge_ratio;
     if (session.input.edge) {
         meshing.sizing.edge_length = session.input.edge;
     } else if (session.input.max_tets) {

@@ -5,7 +5,9 @@
 //
 //   {
 //     "input": {"surface": "spot.obj", "max_tets": 20000, "mesher": "auto"}   (or "edge": L; neither:
-//              sized for the material and scale, solver/mesh_resolution.h) | {"volume": "spot.vtu"},
+//              sized for the material and scale, solver/mesh_resolution.h; optional, as the command
+//              line's options: "min_dihedral", "radius_edge", "fill_holes", "autorefine",
+//              "repair": "wrap", "wrap_alpha", "wrap_offset") | {"volume": "spot.vtu"},
 //     "material": "marble" | {"mua": [..], "musp": [..], "eta": 1.3},   (tets without a stored material)
 //     "scale": 30,                         millimetres per model unit (optional: the input volume's
 //                                          stored scale, else chosen from the model's size)
@@ -44,6 +46,7 @@
 #include "solver/lighting.h"
 #include "solver/shading_surface.h"
 #include "tetops/model_scale.h"
+#include "tetops/surface_check.h"
 #include "tetops/tet_mesh.h"
 #include "tetops/tetrahedralize.h"
 
@@ -63,6 +66,9 @@ struct SessionInput {
     std::optional<size_t> max_tets;
     std::optional<double> edge;
     Mesher mesher = Mesher::Auto;
+    double min_dihedral_deg = MeshingOptions{}.min_dihedral_deg;  // the mesher's quality bounds
+    double max_radius_edge_ratio = MeshingOptions{}.max_radius_edge_ratio;
+    SurfaceRepairOptions repair;  // the opt-in repairs: fill_holes, autorefine, wrap
 };
 
 struct RenderStep {

@@ -5,13 +5,16 @@
 // TriangleSurface falls short; repair_safe_defects() fixes only what has a single obvious answer
 // (duplicate or unused vertices, triangles that repeat a vertex, zero-area slivers whose removal
 // leaves no hole, orientation); repair_hard_defects() changes the shape (fills holes, removes
-// self-intersections) and runs only when the user opts in.
+// self-intersections) and runs only when the user opts in. Rebuilding a surface by alpha wrapping,
+// which replaces all of these, is tetops/alpha_wrap.h.
 #pragma once
 
+#include "tetops/alpha_wrap.h"
 #include "tetops/triangle_surface.h"
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +29,9 @@ struct SurfaceRepairOptions {
     // More triangles than this are refused before any check or repair (0: no limit): the meshers'
     // limit (kMaxSurfaceTriangles), so that a surface too large to mesh is refused at once.
     size_t max_triangles = 0;
+    // Set: the file's triangles are wrapped (tetops/alpha_wrap.h) before any check, instead of the
+    // repairs above, and the wrap is validated as any surface is.
+    std::optional<WrapOptions> wrap = std::nullopt;
 };
 
 // The problem of a surface with `triangles` triangles where at most `limit` are taken ("" if none):

@@ -29,6 +29,7 @@ struct EditCommandOptions {
     std::string show = "radiance";
     std::string slice_normal;
     LiveSolverChoice solver;
+    SurfaceMeshingOptions meshing;
 };
 
 void run_edit_command(const EditCommandOptions& o) {
@@ -43,6 +44,11 @@ void run_edit_command(const EditCommandOptions& o) {
     options.view.mode = parse_view_mode(o.show);
     if (!o.slice_normal.empty()) options.view.slice_normal = parse_slice_normal(o.slice_normal);
     validate(options.view);
+    const MeshingOptions meshing = meshing_options(o.meshing);
+    options.mesher = meshing.mesher;
+    options.min_dihedral_deg = meshing.min_dihedral_deg;
+    options.max_radius_edge_ratio = meshing.max_radius_edge_ratio;
+    options.repair = surface_repair_options(o.meshing);
     options.material = chosen_material(o.material);
     options.solver_backend = parse_live_backend(o.solver.backend);
     options.solver_method = parse_live_method(o.solver.method);
@@ -93,7 +99,10 @@ void add_edit_command(CLI::App& app) {
     cmd->add_flag("--hide-ui", options->editor.hide_ui, "Show the 3D view alone (Tab toggles it)");
     cmd->add_option("--width", options->editor.width, "Window width")->capture_default_str();
     cmd->add_option("--height", options->editor.height, "Window height")->capture_default_str();
-    add_max_tets_option(*cmd, options->editor.max_tets, "Meshing a surface: about this many tets");
+    auto* tets = add_max_tets_option(*cmd, options->editor.max_tets, "Meshing a surface: about this many tets");
+    cmd->add_option("--edge", options->editor.edge, "Meshing a surface: target edge length in model units")
+        ->excludes(tets);
+    add_surface_meshing_options(*cmd, options->meshing);
     add_material_options(*cmd, options->material);
     cmd->add_option("--light", options->lights, "dir:X,Y,Z[:R,G,B] or point:X,Y,Z[:R,G,B], as for render")
         ->expected(1)

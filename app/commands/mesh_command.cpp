@@ -75,6 +75,12 @@ void run_mesh_command(const MeshCommandOptions& o) {
         {"mesher", mesher_name(result.mesher)},
         {"mesher_reason", result.mesher_reason},
     };
+    if (const auto& wrap = loaded.wrap)
+        summary["wrap"] = {{"alpha", wrap->alpha},
+                           {"offset", wrap->offset},
+                           {"triangles", wrap->triangles},
+                           {"hausdorff", wrap->hausdorff},
+                           {"hausdorff_percent_of_diagonal", 100.0 * wrap->hausdorff / wrap->diagonal}};
     std::cout << summary.dump() << "\n";
 }
 

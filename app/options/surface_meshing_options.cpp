@@ -30,15 +30,40 @@ void add_surface_meshing_options(CLI::App& command, SurfaceMeshingOptions& optio
                        "the target of CGAL's sliver perturber and exuder")
         ->capture_default_str();
     command.add_option("--radius-edge", options.radius_edge, "Radius-edge ratio bound")->capture_default_str();
-    command.add_flag("--fill-holes", options.fill_holes, "Opt-in repair: close holes in an open surface");
-    command.add_flag("--autorefine", options.autorefine, "Opt-in repair: remove self-intersections");
+    auto* fill_holes = command.add_flag("--fill-holes", options.fill_holes, "Opt-in repair: close holes in an open surface");
+    auto* autorefine = command.add_flag("--autorefine", options.autorefine, "Opt-in repair: remove self-intersections");
+    auto* repair = command
+                       .add_option("--repair", options.repair,
+                                   "wrap: rebuild any surface (soup, holes, non-manifold, self-intersecting) as the "
+                                   "closed surface CGAL's alpha wrap lays around it, instead of the other repairs")
+                       ->check(CLI::IsMember({"wrap"}))
+                       ->excludes(fill_holes)
+                       ->excludes(autorefine);
+    command
+        .add_option("--wrap-alpha", options.wrap_alpha,
+                    "--repair wrap: cavities and gaps narrower than about this are closed over (model units; "
+                    "default 1/100 of the bounding-box diagonal)")
+        ->needs(repair);
+    command
+        .add_option("--wrap-offset", options.wrap_offset,
+                    "--repair wrap: distance of the wrap from the input (model units; default alpha/30)")
+        ->needs(repair);
+}
+
+SurfaceRepairOptions surface_repair_options(const SurfaceMeshingOptions& options) {
+    SurfaceRepairOptions repair;
+    repair.fill_holes = options.fill_holes;
+    repair.autorefine = options.autorefine;
+    if (options.repair == "wrap") {
+        repair.wrap = WrapOptions{.alpha = options.wrap_alpha, .offset = options.wrap_offset};
+        validate_wrap_options(*repair.wrap, 0.0);  // sign and finiteness now; the size floor once read
+    }
+    return repair;
 }
 
 LoadedSurface load_surface_to_mesh(const std::string& path, const SurfaceMeshingOptions& options,
                                    StderrProgress* progress) {
-    SurfaceRepairOptions repair;
-    repair.fill_holes = options.fill_holes;
-    repair.autorefine = options.autorefine;
+    SurfaceRepairOptions repair = surface_repair_options(options);
     repair.max_triangles = kMaxSurfaceTriangles;  // refused before the checks, which take long too
     LoadedSurface loaded = load_closed_surface(path, repair, progress);
     if (progress) progress->finish();

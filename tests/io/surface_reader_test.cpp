@@ -116,6 +116,8 @@ TEST(SurfaceReaderShared, BadCowIsPinchedAndSelfIntersecting) {
     EXPECT_NE(message.find("81 self-intersecting triangle pairs"), std::string::npos) << message;
     // Most important first: topology before intersections.
     EXPECT_LT(message.find("non-manifold"), message.find("self-intersecting")) << message;
+    // The way out, last.
+    EXPECT_TRUE(message.ends_with("; --repair wrap rebuilds it as a closed surface")) << message;
 }
 
 TEST(SurfaceReaderShared, BadBunnyIsOpenWithUnreferencedVertices) {
@@ -123,6 +125,7 @@ TEST(SurfaceReaderShared, BadBunnyIsOpenWithUnreferencedVertices) {
     const std::string message = load_error(shared_meshes / "bad_stanford-bunny.obj");
     EXPECT_NE(message.find("223 boundary edges"), std::string::npos) << message;
     EXPECT_NE(message.find("removed 1113 unreferenced vertices"), std::string::npos) << message;
+    EXPECT_TRUE(message.ends_with("; --repair wrap rebuilds it as a closed surface")) << message;
 }
 
 TEST(SurfaceReaderShared, BadBunnyHolesCanBeFilledOnRequest) {
@@ -135,10 +138,25 @@ TEST(SurfaceReaderShared, BadBunnyHolesCanBeFilledOnRequest) {
     EXPECT_TRUE(filled);
 }
 
+// With the wrap asked for, the file's triangles go to the wrap before any check (the pinched vertex and
+// the intersections never reach the validation) and the wrap passes the validation untouched.
+TEST(SurfaceReaderShared, BadCowIsWrappedInsteadOfRefused) {
+    SKIP_WITHOUT_SHARED();
+    SurfaceRepairOptions options;
+    options.wrap = WrapOptions{};
+    const LoadedSurface loaded = load_closed_surface(shared_meshes / "bad_cow.obj", options);
+    EXPECT_TRUE(find_surface_defects(loaded.surface).is_clean());
+    ASSERT_TRUE(loaded.wrap.has_value());
+    ASSERT_EQ(loaded.repairs.size(), 1u);  // the wrap alone: no safe repair was needed after it
+    EXPECT_EQ(loaded.repairs[0], loaded.wrap->describe());
+    EXPECT_EQ(loaded.wrap->triangles, loaded.surface.triangles.size());
+}
+
 TEST(SurfaceReaderShared, HorseSelfIntersects) {
     SKIP_WITHOUT_SHARED();
     const std::string message = load_error(shared_meshes / "horse.ply");
     EXPECT_NE(message.find("4 self-intersecting triangle pairs"), std::string::npos) << message;
+    EXPECT_TRUE(message.ends_with("; --repair wrap rebuilds it as a closed surface")) << message;
 }
 
 TEST(SurfaceReaderShared, HorseRawSoupMatchesTheFile) {
@@ -256,6 +274,7 @@ TEST_F(SurfaceReaderFiles, OpenSurfaceNamesFileAndDefect) {
     const fs::path path = write_text("open.obj", text);
     const std::string message = load_error(path);
     EXPECT_EQ(message.rfind(path.string() + ": 3 boundary edges", 0), 0u) << message;
+    EXPECT_TRUE(message.ends_with("; --repair wrap rebuilds it as a closed surface")) << message;
 }
 
 TEST_F(SurfaceReaderFiles, PinchedCubesAreRejected) {
@@ -272,6 +291,7 @@ TEST_F(SurfaceReaderFiles, PinchedCubesAreRejected) {
     const std::string message = load_error(write_text("pinched.obj", text));
     EXPECT_NE(message.find("1 non-manifold vertex"), std::string::npos) << message;
     EXPECT_EQ(message.find("self-intersecting"), std::string::npos) << message;
+    EXPECT_TRUE(message.ends_with("; --repair wrap rebuilds it as a closed surface")) << message;
 }
 
 // ---- broken files ------------------------------------------------------------------------------------
@@ -512,6 +532,30 @@ TEST_F(SurfaceReaderFiles, DefectsAfterHardRepairsAreNamedByTheFilesNumbers) {
     const std::string after = load_error(crossed, {.fill_holes = true, .autorefine = false});
     EXPECT_EQ(after.find("(the surface is open"), std::string::npos) << after;  // the hole was filled
     EXPECT_EQ(first_pair(after), first_pair(before)) << before << "\n" << after;
+}
+
+// A wrap finer than the meshers take is refused naming the option that coarsens it; a bad option names
+// the file and the option.
+TEST_F(SurfaceReaderFiles, WrapLimitsAndOptionErrorsNameTheFile) {
+    const fs::path path = write_text("cube.obj", cube_obj());
+    SurfaceRepairOptions options{.fill_holes = false, .autorefine = false, .max_triangles = 100};
+    options.wrap = WrapOptions{.alpha = 0.02, .offset = {}};
+    try {
+        load_closed_surface(path, options);
+        ADD_FAILURE() << "loaded";
+    } catch (const InvalidMeshError& e) {
+        const std::string message = e.what();
+        EXPECT_EQ(message.rfind(path.string() + ": the wrap has ", 0), 0u) << message;
+        EXPECT_NE(message.find("more than the meshers take (100); a larger --wrap-alpha gives fewer"), std::string::npos)
+            << message;
+    }
+    options.wrap = WrapOptions{.alpha = 1e-5, .offset = {}};
+    try {
+        load_closed_surface(path, options);
+        ADD_FAILURE() << "loaded";
+    } catch (const InvalidArgumentError& e) {
+        EXPECT_EQ(std::string(e.what()).rfind(path.string() + ": --wrap-alpha: 1e-05 is below", 0), 0u) << e.what();
+    }
 }
 
 // A surface with more triangles than the meshers take is refused right after reading, before the
