@@ -4,7 +4,7 @@
 // renderer.
 //
 //   {
-//     "input": {"surface": "spot.obj", "max_tets": 20000, "mesher": "auto"}   (or "edge": L; neither:
+//     "input": {"surface": "spot.obj", "max_tets": 20000, "mesher": "tetgen"}   (or "edge": L; neither:
 //              sized for the material and scale, solver/mesh_resolution.h; optional, as the command
 //              line's options: "min_dihedral", "radius_edge", "fill_holes", "autorefine",
 //              "repair": "wrap", "wrap_alpha", "wrap_offset") | {"volume": "spot.vtu"},
@@ -65,7 +65,7 @@ struct SessionInput {
     std::filesystem::path volume;
     std::optional<size_t> max_tets;
     std::optional<double> edge;
-    Mesher mesher = Mesher::Auto;
+    Mesher mesher = Mesher::TetGen;
     double min_dihedral_deg = MeshingOptions{}.min_dihedral_deg;  // the mesher's quality bounds
     double max_radius_edge_ratio = MeshingOptions{}.max_radius_edge_ratio;
     SurfaceRepairOptions repair;  // the opt-in repairs: fill_holes, autorefine, wrap

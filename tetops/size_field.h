@@ -28,7 +28,7 @@ struct SizeField {
 };
 
 // Unsigned distance from points to a triangle surface, answered by a CGAL AABB tree. Built once per
-// meshing run: the graded size field asks it for every vertex of the coarse mesh a graded TetGen run refines or for
+// meshing run: the graded size field asks it for every vertex of a background mesh (TetGen) or for
 // every refinement query (CGAL).
 class SurfaceDistance {
 public:

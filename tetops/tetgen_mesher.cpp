@@ -74,13 +74,13 @@ std::string format_number(double value) {
 }
 
 // -p: the input is a PLC; -z: zero-based indices; -q: quality; -a: volume bound; -m: sizes from the
-// metric of the input's points; -S: a limit on added points. No -V (verbose) ever: TetGen would
+// metric of the background mesh; -S: a limit on added points. No -V (verbose) ever: TetGen would
 // print per element.
 std::string make_switches(const TetGenSettings& settings, bool volume_bound, bool metric) {
     std::string switches = "pz";
     if (settings.quality) {
-        switches += "q" + format_number(settings.max_radius_edge_ratio);
-        if (settings.min_dihedral_deg > 0) switches += "/" + format_number(settings.min_dihedral_deg);
+        switches += "q" + format_number(settings.max_radius_edge_ratio) + "/" +
+                    format_number(settings.min_dihedral_deg);
     }
     if (volume_bound) switches += "a" + format_number(tetgen_volume_bound_for_edge(settings.size.max_edge));
     if (metric) switches += "m";
@@ -91,10 +91,10 @@ std::string make_switches(const TetGenSettings& settings, bool volume_bound, boo
 
 // Runs TetGen and turns what it throws into Waxwork errors. TetGen built as a library (TETLIBRARY)
 // throws an int from terminatetetgen() instead of calling exit().
-void run_tetgen(const std::string& switches, tetgenio& in, tetgenio& out) {
+void run_tetgen(const std::string& switches, tetgenio& in, tetgenio& out, tetgenio* background) {
     std::string mutable_switches = switches;  // TetGen's signature takes a non-const char*
     try {
-        tetrahedralize(mutable_switches.data(), &in, &out);
+        tetrahedralize(mutable_switches.data(), &in, &out, nullptr, background);
     } catch (int code) {
         throw AlgorithmError("TetGen (-" + switches + ") failed: " + tetgen_reason(code));
     } catch (const std::bad_alloc&) {
@@ -134,51 +134,38 @@ TetMesh to_tet_mesh(const tetgenio& out) {
     return make_tet_mesh(std::move(positions), std::move(tets));
 }
 
-// Each vertex of `mesh` gets the metric kMetricPerEdge edge(depth) (TetGen's -m reads one size per
-// point and interpolates it linearly inside the tets).
-void set_point_sizes(const TriangleSurface& surface, const SizeField& size, tetgenio& mesh) {
-    const SurfaceDistance distance(surface);
-    delete[] mesh.pointmtrlist;
-    mesh.numberofpointmtrs = 1;
-    mesh.pointmtrlist = new REAL[mesh.numberofpoints];
-    for (int i = 0; i < mesh.numberofpoints; ++i) {
-        const REAL* p = &mesh.pointlist[3 * i];
-        mesh.pointmtrlist[i] = kMetricPerEdge * size.edge_at_depth(distance({p[0], p[1], p[2]}));
-    }
-}
-
-// A graded run in two passes over one mesh: a quality mesh at the coarsest size, whose vertices then
-// carry edge(depth), refined in place (-r -m). The points TetGen adds take their size from the tet
-// they split, which it holds already; sizing from a separate background mesh (-m with a background)
-// instead locates every new point in that mesh by walking, and a walk that leaves the non-convex
-// background ends in a search of every background tet, which dominated the graded runs.
-// The point limit bounds each pass; the coarse pass only carries sizes, so when it is cut short the
-// refinement goes on from it, and only the refinement's stop is reported.
-TetMesh tetgen_graded(const TriangleSurface& surface, const TetGenSettings& graded, bool* stopped_at_point_limit) {
+// The background mesh of a graded run: a quality mesh at the coarsest size, each of its vertices
+// carrying kMetricPerEdge edge(depth); TetGen interpolates it linearly inside its tets. Its run is
+// bounded by the same limit on added points as the graded run; cut short, it still carries sizes.
+void make_background_mesh(const TriangleSurface& surface, const TetGenSettings& graded, tetgenio& background) {
     const SizeField& size = graded.size;
-    report_stage(graded.progress, "meshing (TetGen, coarse mesh)");
-    tetgenio coarse;
     {
         tetgenio in;
         fill_plc(surface, in);
-        run_tetgen(make_switches(graded, std::isfinite(size.max_edge), false), in, coarse);
+        run_tetgen(make_switches(graded, std::isfinite(size.max_edge), false), in, background, nullptr);
     }
     report_stage(graded.progress, "meshing (TetGen, sizing field)");
-    set_point_sizes(surface, size, coarse);
-    report_stage(graded.progress, "meshing (TetGen, graded)");
-    tetgenio out;
-    std::string switches = make_switches(graded, false, true);
-    switches.replace(0, 1, "r");  // refine the coarse mesh instead of meshing the surface again
-    run_tetgen(switches, coarse, out);
-    if (stopped_at_point_limit && graded.max_added_points >= 0)
-        *stopped_at_point_limit = out.numberofpoints - coarse.numberofpoints >= graded.max_added_points;
-    return to_tet_mesh(out);
+    const SurfaceDistance distance(surface);
+    background.numberofpointmtrs = 1;
+    background.pointmtrlist = new REAL[background.numberofpoints];
+    for (int i = 0; i < background.numberofpoints; ++i) {
+        const REAL* p = &background.pointlist[3 * i];
+        background.pointmtrlist[i] = kMetricPerEdge * size.edge_at_depth(distance({p[0], p[1], p[2]}));
+    }
 }
 
 }  // namespace
 
 double tetgen_volume_bound_for_edge(double edge) {
     return kVolumeBoundPerRegularVolume * edge * edge * edge / (6 * std::sqrt(2.0));
+}
+
+TetMesh tetgen_background_mesh(const TriangleSurface& surface, const TetGenSettings& settings) {
+    TetGenSettings graded = settings;
+    graded.max_added_points = -1;
+    tetgenio background;
+    make_background_mesh(surface, graded, background);
+    return to_tet_mesh(background);
 }
 
 TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettings& settings,
@@ -198,13 +185,29 @@ TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettin
         tetgenio in;
         tetgenio out;
         fill_plc(surface, in);
-        run_tetgen(make_switches(uniform, std::isfinite(uniform.size.max_edge), false), in, out);
+        run_tetgen(make_switches(uniform, std::isfinite(uniform.size.max_edge), false), in, out, nullptr);
         if (stopped_at_point_limit && settings.max_added_points >= 0)
             *stopped_at_point_limit = out.numberofpoints - in.numberofpoints >= settings.max_added_points;
         return to_tet_mesh(out);
     }
 
-    return tetgen_graded(surface, settings, stopped_at_point_limit);
+    // The point limit bounds both runs; the background mesh only carries sizes, so when it is cut
+    // short the run goes on with it, and only the graded run's stop is reported.
+    const TetGenSettings& graded = settings;
+    report_stage(settings.progress, "meshing (TetGen, background mesh)");
+    tetgenio background;
+    make_background_mesh(surface, graded, background);
+    tetgenio in;
+    tetgenio out;
+    fill_plc(surface, in);
+    in.numberofpointmtrs = 1;
+    in.pointmtrlist = new REAL[in.numberofpoints];
+    for (int i = 0; i < in.numberofpoints; ++i) in.pointmtrlist[i] = kMetricPerEdge * size.surface_edge;
+    report_stage(settings.progress, "meshing (TetGen, graded)");
+    run_tetgen(make_switches(graded, false, true), in, out, &background);
+    if (stopped_at_point_limit && settings.max_added_points >= 0)
+        *stopped_at_point_limit = out.numberofpoints - in.numberofpoints >= settings.max_added_points;
+    return to_tet_mesh(out);
 }
 
 }  // namespace waxwork

@@ -33,43 +33,10 @@ constexpr int kMaxTargetPasses = 4;
 // has 1.4-2.8 tets per surface triangle on the shared meshes; a target below this many per triangle
 // may be out of reach and is checked against it, then against the coarsest quality mesh, first.
 constexpr double kBareCheckTetsPerTriangle = 4.0;
-// The fewest tets per surface triangle of that bare tetrahedralization on the shared meshes.
-constexpr double kBareTetsPerTriangleAtLeast = 1.4;
-// Auto picks CGAL for a uniform or graded size when the surface has more than kAutoDetailFactor times
-// the triangles a surface at the size's edge would have (area / (0.433 h^2)): TetGen keeps every one
-// of them, so its tets at the surface are as small as the triangles, not as the size, and its
-// quality bound grades them inward; CGAL remeshes the surface at the size. Below the factor TetGen
-// is kept: CGAL's protection of sharp features and its sliver perturbation cost more than TetGen's
-// whole run on a CAD part (docs/meshing.md). Surfaces of up to kAutoDetailMinTriangles cost TetGen
-// next to nothing to keep, and it keeps their corners exactly.
-constexpr double kAutoDetailFactor = 10.0;
-constexpr size_t kAutoDetailMinTriangles = 2'000;
-// The area of an equilateral triangle over its squared edge (sqrt(3) / 4).
-constexpr double kEquilateralAreaPerSquaredEdge = 0.433;
 // The quality floor check stops TetGen after this many added points per tet the target allows. Its
 // quality meshes have 3.2 (skull, cut short) to 6 tets per vertex, so with fewer tets per point than
 // any of them the run stopped there has more tets than allowed.
 constexpr double kTetsPerAddedPointForFloorCheck = 3.0;
-
-// 100002 as "100,002": counts in the auto mesher's reasons.
-std::string count_text(size_t count) {
-    std::string digits = std::to_string(count);
-    for (auto at = static_cast<std::ptrdiff_t>(digits.size()) - 3; at > 0; at -= 3) digits.insert(size_t(at), ",");
-    return digits;
-}
-
-// TetGen cannot keep the surface's triangles within the size asked for. An InvalidArgumentError for
-// an explicit --mesher tetgen (what() says what it needs and suggests CGAL); Mesher::Auto catches it
-// and meshes with CGAL, giving `auto_reason` as its reason.
-class OutOfTetGenReach : public InvalidArgumentError {
-public:
-    OutOfTetGenReach(const std::string& message, std::string auto_reason)
-        : InvalidArgumentError(message), auto_reason_(std::move(auto_reason)) {}
-    const std::string& auto_reason() const { return auto_reason_; }
-
-private:
-    std::string auto_reason_;
-};
 
 // " (about T s at the measured N tets per second; the limit takes about M s)" for a mesh of `tets`.
 std::string predicted_time(double tets) {
@@ -79,7 +46,7 @@ std::string predicted_time(double tets) {
 }
 
 void validate_options(const MeshingOptions& options) {
-    if (options.mesher != Mesher::TetGen && options.mesher != Mesher::Cgal && options.mesher != Mesher::Auto) {
+    if (options.mesher != Mesher::TetGen && options.mesher != Mesher::Cgal) {
         throw InvalidArgumentError("meshing option mesher: unknown mesher");
     }
     // TetGen's Delaunay refinement is proven to end for bounds of 2 and ends in practice down to
@@ -295,26 +262,21 @@ TetMesh run_mesher(const TriangleSurface& surface, const MeshingOptions& options
     bool stopped = false;
     TetMesh mesh = tetgen_tetrahedralize(surface, settings, &stopped);
     if (stopped)
-        throw OutOfTetGenReach(
+        throw InvalidArgumentError(
             "TetGen stopped at its limit of " + std::to_string(settings.max_added_points) +
             " added points, where this size needs about " + std::to_string(static_cast<long>(std::ceil(predicted))) +
             " vertices: it keeps the surface's " + std::to_string(surface.triangles.size()) +
             " triangles, and they need far more refinement than the size asks for; use the CGAL mesher "
-            "(--mesher cgal), which remeshes the surface",
-            "TetGen stopped at its limit of " + count_text(size_t(settings.max_added_points)) +
-                " added points: the surface's " + count_text(surface.triangles.size()) +
-                " triangles need far more refinement than the size asks for");
+            "(--mesher cgal), which remeshes the surface");
     return mesh;
 }
 
 // The error for a target below TetGen's floor on this surface (`floor`: what it needs).
-[[noreturn]] void refuse_tetgen_target(const TriangleSurface& surface, size_t target, const std::string& floor) {
-    throw OutOfTetGenReach("meshing option sizing.target_tets = " + std::to_string(target) +
+[[noreturn]] void refuse_tetgen_target(size_t target, const std::string& floor) {
+    throw InvalidArgumentError("meshing option sizing.target_tets = " + std::to_string(target) +
                                ": TetGen keeps the surface's triangles and needs " + floor +
                                "; ask for more tets or use the CGAL mesher "
-                               "(--mesher cgal), which remeshes the surface",
-                           "the surface's " + count_text(surface.triangles.size()) +
-                               " triangles need more than the budget's " + count_text(target) + " tets");
+                               "(--mesher cgal), which remeshes the surface");
 }
 
 // TetGen keeps every input triangle, so a small target may be out of its reach. Its bare constrained
@@ -330,7 +292,7 @@ void check_tetgen_bare_floor(const TriangleSurface& surface, const MeshingOption
     bare.quiet = options.quiet;
     const size_t bare_count = tetgen_tetrahedralize(surface, bare).tet_count();
     if (double(bare_count) > (1 + kTargetPromise) * double(target))
-        refuse_tetgen_target(surface, target, "more than " + std::to_string(bare_count) +
+        refuse_tetgen_target(target, "more than " + std::to_string(bare_count) +
                                          " tets on this surface (its tetrahedralization without quality bounds "
                                          "has that many)");
 }
@@ -376,12 +338,12 @@ TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& opt
         bool stopped = false;
         TetMesh coarsest = run_capped(SizeField::unbounded(), stopped);
         if (stopped && double(coarsest.tet_count()) > most)
-            refuse_tetgen_target(surface, target, "more than " + std::to_string(coarsest.tet_count()) +
+            refuse_tetgen_target(target, "more than " + std::to_string(coarsest.tet_count()) +
                                              " tets on this surface at this quality (its refinement had made that "
                                              "many when it was stopped, unfinished)");
         if (stopped) coarsest = run_mesher(surface, options, SizeField::unbounded());
         if (double(coarsest.tet_count()) > most)
-            refuse_tetgen_target(surface, target, "at least " + std::to_string(coarsest.tet_count()) +
+            refuse_tetgen_target(target, "at least " + std::to_string(coarsest.tet_count()) +
                                              " tets on this surface at this quality");
         consider(std::move(coarsest));
     };
@@ -434,50 +396,7 @@ TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& opt
     return best;
 }
 
-// The surface edge a size asks for, or none (a target count).
-std::optional<double> asked_surface_edge(const MeshSizing& sizing) {
-    if (sizing.edge_length) return *sizing.edge_length;
-    if (sizing.target_tets) return std::nullopt;
-    return sizing.surface_edge;
-}
-
-// Mesher::Auto's choice before any meshing: CGAL with its reason when the surface alone rules TetGen
-// out, otherwise TetGen with its reason (which meshing may still overturn: OutOfTetGenReach).
-std::pair<Mesher, std::string> choose_mesher(const TriangleSurface& surface, const MeshSizing& sizing, double area) {
-    const size_t triangles = surface.triangles.size();
-    if (triangles > kMaxTetGenTriangles)
-        return {Mesher::Cgal, "the surface's " + count_text(triangles) + " triangles are more than TetGen takes (" +
-                                  count_text(kMaxTetGenTriangles) + ")"};
-    if (sizing.target_tets) {
-        // TetGen's bare tetrahedralization of a surface has at least 1.4 tets per triangle (the shared
-        // meshes: 1.4 to 2.8), and its quality meshes more: a smaller budget is out of its reach.
-        if ((1 + kTargetPromise) * double(*sizing.target_tets) < kBareTetsPerTriangleAtLeast * double(triangles))
-            return {Mesher::Cgal, "the surface's " + count_text(triangles) + " triangles need more than the budget's " +
-                                      count_text(*sizing.target_tets) + " tets"};
-        return {Mesher::TetGen, "it keeps the surface's " + count_text(triangles) + " triangles within the budget's " +
-                                    count_text(*sizing.target_tets) + " tets"};
-    }
-    const double edge = *asked_surface_edge(sizing);
-    const double remeshed = area / (kEquilateralAreaPerSquaredEdge * edge * edge);
-    if (triangles > kAutoDetailMinTriangles && double(triangles) > kAutoDetailFactor * remeshed)
-        return {Mesher::Cgal, "the surface's " + count_text(triangles) + " triangles are more than " +
-                                  number_text(kAutoDetailFactor) + " times the " +
-                                  count_text(size_t(std::ceil(remeshed))) + " of a surface at the size's edge (" +
-                                  number_text(edge) + ")"};
-    return {Mesher::TetGen, "the size's edge (" + number_text(edge) + ") suits the surface's " +
-                                count_text(triangles) + " triangles"};
-}
-
 }  // namespace
-
-std::string mesher_name(Mesher mesher) {
-    switch (mesher) {
-    case Mesher::TetGen: return "tetgen";
-    case Mesher::Cgal: return "cgal";
-    case Mesher::Auto: return "auto";
-    }
-    return "unknown";
-}
 
 MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOptions& options) {
     const auto start = std::chrono::steady_clock::now();
@@ -493,40 +412,19 @@ MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOption
     const double volume = enclosed_volume(surface);
     const double area = surface_area(surface);
 
-    const MeshSizing& sizing = options.sizing;
-    std::optional<SizeField> size;  // none: a target count
-    if (sizing.edge_length) {
-        size = SizeField::uniform(*sizing.edge_length);
-        check_predicted_size(*size, volume, area, "sizing.edge_length = " + number_text(*sizing.edge_length));
-    } else if (!sizing.target_tets) {
-        size = SizeField{sizing.surface_edge, sizing.grading,
-                         sizing.max_edge > 0 ? sizing.max_edge : SizeField::unbounded().max_edge};
-        check_predicted_size(*size, volume, area, "sizing.surface_edge = " + number_text(sizing.surface_edge));
-    }
-    const auto mesh_with = [&](Mesher mesher) {
-        MeshingOptions chosen = options;
-        chosen.mesher = mesher;
-        return size ? run_mesher(surface, chosen, *size) : mesh_to_target(surface, chosen, *sizing.target_tets, volume);
-    };
-
     MeshingResult result;
-    if (options.mesher != Mesher::Auto) {
-        result.mesh = mesh_with(options.mesher);
-        result.mesher = options.mesher;
-        result.mesher_reason = "chosen";
+    const MeshSizing& sizing = options.sizing;
+    if (sizing.edge_length) {
+        const SizeField size = SizeField::uniform(*sizing.edge_length);
+        check_predicted_size(size, volume, area, "sizing.edge_length = " + number_text(*sizing.edge_length));
+        result.mesh = run_mesher(surface, options, size);
+    } else if (sizing.target_tets) {
+        result.mesh = mesh_to_target(surface, options, *sizing.target_tets, volume);
     } else {
-        auto [mesher, reason] = choose_mesher(surface, sizing, area);
-        if (mesher == Mesher::TetGen) {
-            try {
-                result.mesh = mesh_with(Mesher::TetGen);
-            } catch (const OutOfTetGenReach& out_of_reach) {
-                mesher = Mesher::Cgal;
-                reason = out_of_reach.auto_reason();
-            }
-        }
-        if (mesher == Mesher::Cgal) result.mesh = mesh_with(Mesher::Cgal);
-        result.mesher = mesher;
-        result.mesher_reason = "auto: " + mesher_name(mesher) + ", " + reason;
+        SizeField size{sizing.surface_edge, sizing.grading,
+                       sizing.max_edge > 0 ? sizing.max_edge : SizeField::unbounded().max_edge};
+        check_predicted_size(size, volume, area, "sizing.surface_edge = " + number_text(sizing.surface_edge));
+        result.mesh = run_mesher(surface, options, size);
     }
     check_cancelled(options.progress);
     report_stage(options.progress, "ordering the mesh");

@@ -7,18 +7,12 @@
 
 #include <filesystem>
 #include <optional>
-#include <string>
 
 namespace waxwork {
 
 class Progress;
 
-// Auto: TetGen where it can keep the surface's triangles within the size asked for, CGAL Mesh_3
-// (which remeshes the surface) where it cannot: a tet target under what TetGen needs to keep them,
-// more triangles than TetGen takes (kMaxTetGenTriangles), or a surface far more detailed than the
-// size asks for (over 10 times the triangles of a surface at the size's edge; tetrahedralize.cpp says
-// why). MeshingResult says which ran and why.
-enum class Mesher { TetGen, Cgal, Auto };
+enum class Mesher { TetGen, Cgal };
 
 // How fine the volume is. Exactly one of the three ways is used, in this order of precedence:
 // an explicit edge length, a target tet count, or a graded size (fine near the surface, where the
@@ -30,7 +24,7 @@ enum class Mesher { TetGen, Cgal, Auto };
 //   TetGen keeps every input triangle, so below the tet count of its unbounded quality mesh (spot:
 //   ~50K) it throws InvalidArgumentError; CGAL remeshes the surface and can go coarser.
 // - graded: edge(d) = min(surface_edge + grading * d, max_edge) at depth d; max_edge == 0: no cap.
-//   TetGen: a quality mesh at max_edge whose vertices carry 0.9 edge(d) (-m), refined in place (-r);
+//   TetGen: a quality mesh at max_edge is the background mesh (-m) carrying 0.9 edge(d) per vertex;
 //   CGAL: the same rule as a sizing field, d from an AABB tree.
 // Targets above kMaxMeshTets, and sizes whose predicted count (1.2 V / regular-tet volume, or the
 // graded shell integral) exceeds it, are refused with InvalidArgumentError before any meshing.
@@ -67,7 +61,7 @@ inline constexpr size_t kMaxTetGenTriangles = 75'000;
 inline constexpr double kMinRadiusEdgeRatio = 1.2;
 
 struct MeshingOptions {
-    Mesher mesher = Mesher::Auto;
+    Mesher mesher = Mesher::TetGen;
     MeshSizing sizing;
     double max_radius_edge_ratio = 2.0;  // TetGen -q bound, >= kMinRadiusEdgeRatio
     double min_dihedral_deg = 10.0;      // TetGen -q/ bound (and CGAL exuder goal)
@@ -81,14 +75,7 @@ struct MeshingResult {
     TetMesh mesh;
     QualityReport quality;
     double milliseconds = 0;
-    Mesher mesher = Mesher::TetGen;  // the one that made the mesh (never Auto)
-    // Why that mesher: for Mesher::Auto "auto: cgal, the surface's 100,002 triangles need more than the
-    // budget's 20,000 tets" or "auto: tetgen, ..."; for an explicit mesher "chosen".
-    std::string mesher_reason;
 };
-
-// "tetgen" or "cgal" ("auto" for Mesher::Auto).
-std::string mesher_name(Mesher mesher);
 
 // Fills a closed, outward-oriented, self-intersection-free surface with tets. Throws
 // InvalidArgumentError on absurd options and AlgorithmError when the mesher fails.

@@ -1,6 +1,6 @@
 // `waxwork bench`: measurements that back docs/ (performance, accuracy, stability), written as JSON and SVG.
 //   waxwork bench solvers --mesh MESH [--max-tets N] -o DIR [--backend cpu|gpu] [--material NAME | ...]
-//                         [--mesher auto|tetgen|cgal] [--fill-holes] [--autorefine] [...]
+//                         [--mesher tetgen|cgal] [--fill-holes] [--autorefine] [...]
 // `bench` itself takes the subcommand; it is a CLI11 app with an optional subcommand so that a later
 // `waxwork bench [--quick] -o DIR` (all benchmarks) can be the parent's own action.
 #include "app/commands.h"
@@ -118,10 +118,8 @@ void add_bench_command(CLI::App& app) {
     bench->add_option("-o,--output", *suite_output, "Output directory of the whole suite");
     bench->add_flag("--quick", suite->quick, "Smaller meshes and fewer samples (under 2 minutes)");
     bench->add_option("--only", suite->only, "Run only these parts (solvers_50k, solvers_500k, coarse_start, accuracy, cut_modes, "
-                                             "table1, stability, resolution, meshing)")
+                                             "table1, stability, resolution)")
         ->delimiter(',');
-    bench->add_option("--meshes", suite->mesh_dir, "Surfaces of the meshing part (default: the shipped meshes)")
-        ->check(CLI::ExistingDirectory);
     bench->footer("Without a subcommand runs every part (bench/studies/bench_suite.h) and writes JSON, SVG charts and\n"
                   "markdown tables into the output directory.");
     bench->callback([bench, suite, suite_output] {

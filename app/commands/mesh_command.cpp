@@ -72,8 +72,6 @@ void run_mesh_command(const MeshCommandOptions& o) {
         {"mean_edge_length", q.mean_edge_length},
         {"repairs", loaded.repairs},
         {"milliseconds", result.milliseconds},
-        {"mesher", mesher_name(result.mesher)},
-        {"mesher_reason", result.mesher_reason},
     };
     if (const auto& wrap = loaded.wrap)
         summary["wrap"] = {{"alpha", wrap->alpha},

@@ -4,7 +4,6 @@
 #include "bench/studies/accuracy_study.h"
 #include "bench/studies/coarse_start_bound.h"
 #include "bench/studies/cut_study.h"
-#include "bench/studies/meshing_study.h"
 #include "bench/studies/resolution_study.h"
 #include "bench/studies/solver_comparison.h"
 #include "bench/studies/stability_study.h"
@@ -333,18 +332,6 @@ void run_resolution_part(const BenchSuiteOptions& o, Json& index) {
     index["resolution"] = "resolution.json";
 }
 
-void run_meshing_part(const BenchSuiteOptions& o, Json& index) {
-    MeshingStudyOptions options;
-    options.surfaces = surface_files(o.mesh_dir.empty() ? o.asset_dir / "meshes" : o.mesh_dir);
-    // --quick: the small shipped surfaces only (the skull alone takes minutes with CGAL).
-    if (o.quick)
-        std::erase_if(options.surfaces, [](const std::filesystem::path& p) { return p.stem() != "spot" && p.stem() != "torus"; });
-    const std::vector<MeshingStudyRow> rows = run_meshing_study(options);
-    write_json(o.output_dir / "meshing.json", to_json(rows));
-    write_text(o.output_dir / "meshing.md", meshing_table_markdown(rows));
-    index["meshing"] = "meshing.md";
-}
-
 }  // namespace
 
 void run_bench_suite(const BenchSuiteOptions& o) {
@@ -380,7 +367,6 @@ void run_bench_suite(const BenchSuiteOptions& o) {
     parts.emplace_back("table1", [&](Json& i) { run_table1_part(o, i); });
     parts.emplace_back("stability", [&](Json& i) { run_stability_part(o, i); });
     parts.emplace_back("resolution", [&](Json& i) { run_resolution_part(o, i); });
-    parts.emplace_back("meshing", [&](Json& i) { run_meshing_part(o, i); });
 
     for (const std::string& wanted : o.only)
         if (std::none_of(parts.begin(), parts.end(), [&](const auto& part) { return part.first == wanted; }))

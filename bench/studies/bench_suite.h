@@ -9,8 +9,6 @@
 //   table1.json/.md       T_b, T_m, T_s, cut and paint per shipped model beside the paper's Table 1
 //   stability.json/.md    where the methods fail and what Waxwork does (bench/studies/stability_study.h)
 //   resolution.json/.svg  image error against per-frame cost over mesh size x tolerance
-//   meshing.json/.md      per surface in mesh_dir: default meshing against a plain TetGen quality run,
-//                         the mesher chosen, tets, dihedral angles, a tet budget (bench/studies/meshing_study.h)
 //   bench.json            what ran, with what settings, how long each part took, on which machine
 // --quick (under 2 minutes here) uses smaller meshes and fewer samples; the full suite takes under 20.
 #pragma once
@@ -26,10 +24,9 @@ struct BenchSuiteOptions {
     std::filesystem::path output_dir;
     bool quick = false;
     std::filesystem::path asset_dir;                    // holds meshes/spot.obj, torus.obj, skull.obj
-    std::filesystem::path mesh_dir;                     // the meshing part's surfaces; empty: asset_dir/meshes
     std::function<void(const std::string&)> progress;   // one line per part started; may be empty
     // Run only these parts (names as in bench.json: solvers_50k, solvers_500k, coarse_start, accuracy, cut_modes, table1,
-    // stability, resolution, meshing); empty: all. An unknown name is an InvalidArgumentError.
+    // stability, resolution); empty: all. An unknown name is an InvalidArgumentError.
     std::vector<std::string> only;
 };
 

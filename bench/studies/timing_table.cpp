@@ -33,8 +33,15 @@ TimingRow measure_timing_row(const std::filesystem::path& surface_path, const Ti
     MeshingOptions meshing;
     meshing.sizing.target_tets = options.target_tets;
     TimingRow row;
-    MeshingResult meshed = tetrahedralize(surface, meshing);  // Mesher::Auto: CGAL below TetGen's floor
-    row.mesher = mesher_name(meshed.mesher);
+    row.mesher = "tetgen";
+    MeshingResult meshed;
+    try {
+        meshed = tetrahedralize(surface, meshing);
+    } catch (const InvalidArgumentError&) {  // TetGen's floor on the count for this surface
+        meshing.mesher = Mesher::Cgal;
+        row.mesher = "cgal";
+        meshed = tetrahedralize(surface, meshing);
+    }
     TetMesh mesh = std::move(meshed.mesh);
 
     row.model = surface_path.stem().string();

@@ -227,37 +227,15 @@ TEST(Cli, AbsurdParametersAreRejected) {
 }
 
 // A size the mesher refuses for this surface is reported with the surface file's name: spot's
-// triangles, which TetGen keeps, need more than 3,000 tets (so only an explicit --mesher tetgen refuses).
+// triangles, which TetGen keeps, need more than 3,000 tets.
 TEST(Cli, AMeshingRefusalNamesTheSurfaceFile) {
     const auto dir = scratch_dir("cli_refusal");
     const std::string surface = kAssets + "/meshes/spot.obj";
-    const auto r = run_waxwork("mesh " + surface + " -o " + (dir / "x.vtu").string() + " --max-tets 3000 --mesher tetgen");
+    const auto r = run_waxwork("mesh " + surface + " -o " + (dir / "x.vtu").string() + " --max-tets 3000");
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_EQ(line_count(r.err), 1u) << r.err;
     EXPECT_NE(r.err.find(surface + ": meshing option sizing.target_tets = 3000"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "x.vtu"));
-}
-
-// The default mesher, auto, keeps any budget from 1000 tets: with CGAL, which remeshes the surface,
-// where TetGen cannot keep the surface's triangles within it, and the summary says which ran and why.
-TEST(Cli, AutoMeshesABudgetTetGenCannotKeepWithCgalAndSaysWhy) {
-    const auto dir = scratch_dir("cli_auto");
-    const std::string surface = kAssets + "/meshes/spot.obj";
-    const auto r = run_waxwork("mesh " + surface + " -o " + (dir / "x.vtu").string() + " --max-tets 1000");
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    const auto summary = nlohmann::json::parse(r.out);
-    EXPECT_NEAR(double(summary["tets"]), 1000, 200);
-    EXPECT_EQ(summary["mesher"], "cgal");
-    EXPECT_EQ(summary["mesher_reason"], "auto: cgal, the surface's 5,856 triangles need more than the budget's 1,000 tets");
-    const auto cube = run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + (dir / "c.vtu").string() + " --max-tets 3000");
-    ASSERT_EQ(cube.exit_code, 0) << cube.err;
-    const auto cube_summary = nlohmann::json::parse(cube.out);
-    EXPECT_EQ(cube_summary["mesher"], "tetgen");
-    EXPECT_EQ(cube_summary["mesher_reason"], "auto: tetgen, it keeps the surface's 48 triangles within the budget's 3,000 tets");
-    const auto chosen = run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + (dir / "c.vtu").string() +
-                                    " --max-tets 3000 --mesher cgal");
-    ASSERT_EQ(chosen.exit_code, 0) << chosen.err;
-    EXPECT_EQ(nlohmann::json::parse(chosen.out)["mesher_reason"], "chosen");
 }
 
 // The documented maximum of --max-tets (50M) ran for minutes: a target beyond what is made here in

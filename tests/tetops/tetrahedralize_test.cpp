@@ -98,10 +98,8 @@ void expect_fills_surface(const MeshingResult& result, const TriangleSurface& su
     EXPECT_EQ(result.quality.min_dihedral_deg, measure_quality(result.mesh).min_dihedral_deg);
 }
 
-// TetGen's coarsest quality mesh (Mesher::Auto would remesh a surface this much finer than the size).
 MeshingOptions coarsest_quality() {
     MeshingOptions options;
-    options.mesher = Mesher::TetGen;
     options.sizing.surface_edge = 1e30;  // no size bound: only the quality bounds refine
     options.sizing.grading = 0;
     return options;
@@ -183,7 +181,6 @@ TEST(TetrahedralizeTest, TwoDisjointCubesBothGetTets) {
 TEST(TetrahedralizeTest, TargetTetCountWithinTwentyPercent) {
     const TriangleSurface spot = asset_surface("spot.obj");
     MeshingOptions options;
-    options.mesher = Mesher::TetGen;
     options.sizing.target_tets = 50'000;
     const MeshingResult tetgen = tetrahedralize(spot, options);
     EXPECT_NEAR(double(tetgen.mesh.tet_count()), 50'000, 10'000);
@@ -197,73 +194,6 @@ TEST(TetrahedralizeTest, TargetTetCountWithinTwentyPercent) {
     const MeshingResult cgal = tetrahedralize(spot, options);
     EXPECT_NEAR(double(cgal.mesh.tet_count()), 5'000, 1'000);
     EXPECT_TRUE(find_invariant_violations(cgal.mesh).empty());
-}
-
-// --max-tets N (N >= 1000) gives N within 20% on every model with the default mesher, Mesher::Auto:
-// TetGen where it keeps the surface's triangles within N, CGAL (which remeshes the surface) where it
-// cannot, and the result says which ran and why.
-TEST(TetrahedralizeTest, AutoKeepsEveryBudgetWithTheMesherThatCan) {
-    struct Case {
-        std::string name;
-        fs::path path;
-        size_t target;
-        Mesher expected;
-        std::string reason;
-    };
-    std::vector<Case> cases = {
-        {"spot", fs::path(WAXWORK_ASSET_DIR) / "meshes" / "spot.obj", 1'000, Mesher::Cgal,
-         "auto: cgal, the surface's 5,856 triangles need more than the budget's 1,000 tets"},
-        {"spot", fs::path(WAXWORK_ASSET_DIR) / "meshes" / "spot.obj", 20'000, Mesher::Cgal,
-         "auto: cgal, the surface's 5,856 triangles need more than the budget's 20,000 tets"},
-        {"spot", fs::path(WAXWORK_ASSET_DIR) / "meshes" / "spot.obj", 80'000, Mesher::TetGen,
-         "auto: tetgen, it keeps the surface's 5,856 triangles within the budget's 80,000 tets"},
-        {"cube", fs::path(WAXWORK_ASSET_DIR) / "meshes" / "cube.obj", 1'000, Mesher::TetGen,
-         "auto: tetgen, it keeps the surface's 48 triangles within the budget's 1,000 tets"},
-    };
-    if (fs::exists(shared_mesh_dir() / "armadillo.obj"))
-        cases.push_back({"armadillo", shared_mesh_dir() / "armadillo.obj", 20'000, Mesher::Cgal,
-                         "auto: cgal, the surface's 29,170 triangles need more than the budget's 20,000 tets"});
-    for (const Case& c : cases) {
-        SCOPED_TRACE(c.name + " at " + std::to_string(c.target));
-        const TriangleSurface surface = read_test_surface(c.path);
-        MeshingOptions options;
-        options.sizing.target_tets = c.target;
-        const MeshingResult result = tetrahedralize(surface, options);
-        std::printf("%-10s %7zu: %7zu tets, %s, %.0f ms\n", c.name.c_str(), c.target, result.mesh.tet_count(),
-                    result.mesher_reason.c_str(), result.milliseconds);
-        EXPECT_NEAR(double(result.mesh.tet_count()), double(c.target), 0.2 * double(c.target));
-        EXPECT_EQ(result.mesher, c.expected);
-        EXPECT_EQ(result.mesher_reason, c.reason);
-        EXPECT_TRUE(find_invariant_violations(result.mesh).empty());
-        if (c.expected == Mesher::TetGen) expect_fills_surface(result, surface, 1e-6);
-    }
-}
-
-// For a size rather than a count, Mesher::Auto keeps a surface with TetGen unless it has many times the
-// triangles a surface at the size's edge would have: then TetGen's tets at the surface would be as
-// small as its triangles, not as the size, and CGAL remeshes it.
-TEST(TetrahedralizeTest, AutoRemeshesASurfaceFarFinerThanTheSize) {
-    const TriangleSurface spot = asset_surface("spot.obj");
-    Eigen::AlignedBox3d box;
-    for (const auto& p : spot.points) box.extend(p);
-    const double diagonal = box.diagonal().norm();
-    MeshingOptions options;
-    options.sizing.surface_edge = diagonal / 25;  // the default rule's coarsest surface edge
-    options.sizing.max_edge = diagonal / 8;
-    const MeshingResult kept = tetrahedralize(spot, options);
-    EXPECT_EQ(kept.mesher, Mesher::TetGen) << kept.mesher_reason;
-    EXPECT_NE(kept.mesher_reason.find("auto: tetgen, the size's edge"), std::string::npos) << kept.mesher_reason;
-    options.sizing.surface_edge = diagonal / 8;
-    const MeshingResult remeshed = tetrahedralize(spot, options);
-    EXPECT_EQ(remeshed.mesher, Mesher::Cgal) << remeshed.mesher_reason;
-    EXPECT_NE(remeshed.mesher_reason.find("auto: cgal, the surface's 5,856 triangles are more than 10 times"),
-              std::string::npos)
-        << remeshed.mesher_reason;
-    EXPECT_LT(remeshed.mesh.tet_count(), kept.mesh.tet_count());
-    options.mesher = Mesher::TetGen;  // an explicit mesher is used as it is
-    const MeshingResult chosen = tetrahedralize(spot, options);
-    EXPECT_EQ(chosen.mesher, Mesher::TetGen);
-    EXPECT_EQ(chosen.mesher_reason, "chosen");
 }
 
 // A target TetGen cannot reach while keeping the surface's triangles is refused with the count it
@@ -280,7 +210,6 @@ TEST(TetrahedralizeTest, RefusesATargetBelowTetGensFloorNamingTheFloor) {
     ASSERT_LT(2 * bare, coarsest);  // room for a target between the two
     const auto refusal = [&](size_t target) {
         MeshingOptions options;
-        options.mesher = Mesher::TetGen;
         options.sizing.target_tets = target;
         try {
             tetrahedralize(spot, options);
@@ -309,7 +238,6 @@ TEST(TetrahedralizeTest, RefusesATargetBelowTetGensFloorNamingTheFloor) {
     EXPECT_NE(just_below.find("at least " + std::to_string(coarsest) + " tets"), std::string::npos) << just_below;
     // At the floor, the target is met.
     MeshingOptions at_floor;
-    at_floor.mesher = Mesher::TetGen;
     at_floor.sizing.target_tets = coarsest;
     EXPECT_NEAR(double(tetrahedralize(spot, at_floor).mesh.tet_count()), double(coarsest), 0.2 * double(coarsest));
 }
@@ -409,48 +337,6 @@ TEST(TetrahedralizeTest, CgalPerturbsSliversTowardsTheBound) {
     EXPECT_EQ(quality.tets_below_5_deg, 0u);
 }
 
-// The mean edge of the tets touching the surface and of the deepest tenth of a sample of the others.
-std::pair<double, double> boundary_and_deep_mean_edge(const TetMesh& mesh) {
-    std::vector<char> on_boundary(mesh.vertex_count(), 0);
-    for (const auto& f : boundary_faces(mesh)) {
-        for (int32_t v : f) on_boundary[v] = 1;
-    }
-    // Depth of a tet: distance of its centroid to the nearest boundary vertex (good enough on a
-    // surface this fine).
-    std::vector<Eigen::Vector3d> boundary_points;
-    for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-        if (on_boundary[v]) boundary_points.push_back(mesh.positions[v]);
-    }
-    double boundary_sum = 0;
-    size_t boundary_count = 0;
-    std::vector<std::pair<double, size_t>> depths;
-    for (size_t t = 0; t < mesh.tet_count(); ++t) {
-        const Tet& tet = mesh.tets[t];
-        if (on_boundary[tet[0]] || on_boundary[tet[1]] || on_boundary[tet[2]] || on_boundary[tet[3]]) {
-            boundary_sum += mean_edge(mesh, t);
-            ++boundary_count;
-            continue;
-        }
-        if (t % 31 != 0) continue;  // a sample of the interior keeps the brute-force depth cheap
-        const Eigen::Vector3d c = (mesh.positions[tet[0]] + mesh.positions[tet[1]] + mesh.positions[tet[2]] +
-                                   mesh.positions[tet[3]]) / 4;
-        double depth = INFINITY;
-        for (const auto& p : boundary_points) depth = std::min(depth, (p - c).squaredNorm());
-        depths.emplace_back(depth, t);
-    }
-    EXPECT_GT(boundary_count, 0u);
-    EXPECT_GT(depths.size(), 20u);
-    std::sort(depths.begin(), depths.end(), std::greater<>());
-    double deep_sum = 0;
-    const size_t deep_count = depths.size() / 10;
-    for (size_t i = 0; i < deep_count; ++i) deep_sum += mean_edge(mesh, depths[i].second);
-    const double boundary_edge = boundary_sum / double(boundary_count);
-    const double deep_edge = deep_sum / double(deep_count);
-    std::printf("graded: %zu tets, boundary mean edge %.4f, deepest mean edge %.4f\n", mesh.tet_count(),
-                boundary_edge, deep_edge);
-    return {boundary_edge, deep_edge};
-}
-
 TEST(TetrahedralizeTest, GradedSizingIsFinerAtTheSurface) {
     const TriangleSurface spot = asset_surface("spot.obj");
     for (const Mesher mesher : {Mesher::TetGen, Mesher::Cgal}) {
@@ -461,46 +347,47 @@ TEST(TetrahedralizeTest, GradedSizingIsFinerAtTheSurface) {
         options.sizing.grading = 0.8;
         options.sizing.max_edge = 0.2;
         const MeshingResult result = tetrahedralize(spot, options);
-        const auto [boundary_edge, deep_edge] = boundary_and_deep_mean_edge(result.mesh);
+        const TetMesh& mesh = result.mesh;
+        std::vector<char> on_boundary(mesh.vertex_count(), 0);
+        for (const auto& f : boundary_faces(mesh)) {
+            for (int32_t v : f) on_boundary[v] = 1;
+        }
+        // Depth of a tet: distance of its centroid to the nearest boundary vertex (good enough on a
+        // surface this fine).
+        std::vector<Eigen::Vector3d> boundary_points;
+        for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+            if (on_boundary[v]) boundary_points.push_back(mesh.positions[v]);
+        }
+        double boundary_sum = 0;
+        size_t boundary_count = 0;
+        std::vector<std::pair<double, size_t>> depths;
+        for (size_t t = 0; t < mesh.tet_count(); ++t) {
+            const Tet& tet = mesh.tets[t];
+            if (on_boundary[tet[0]] || on_boundary[tet[1]] || on_boundary[tet[2]] || on_boundary[tet[3]]) {
+                boundary_sum += mean_edge(mesh, t);
+                ++boundary_count;
+                continue;
+            }
+            if (t % 31 != 0) continue;  // a sample of the interior keeps the brute-force depth cheap
+            const Eigen::Vector3d c = (mesh.positions[tet[0]] + mesh.positions[tet[1]] + mesh.positions[tet[2]] +
+                                       mesh.positions[tet[3]]) / 4;
+            double depth = INFINITY;
+            for (const auto& p : boundary_points) depth = std::min(depth, (p - c).squaredNorm());
+            depths.emplace_back(depth, t);
+        }
+        ASSERT_GT(boundary_count, 0u);
+        ASSERT_GT(depths.size(), 20u);
+        std::sort(depths.begin(), depths.end(), std::greater<>());
+        double deep_sum = 0;
+        const size_t deep_count = depths.size() / 10;
+        for (size_t i = 0; i < deep_count; ++i) deep_sum += mean_edge(mesh, depths[i].second);
+        const double boundary_edge = boundary_sum / double(boundary_count);
+        const double deep_edge = deep_sum / double(deep_count);
+        std::printf("graded: %zu tets, boundary mean edge %.4f, deepest mean edge %.4f\n", mesh.tet_count(),
+                    boundary_edge, deep_edge);
         EXPECT_GT(deep_edge, 1.5 * boundary_edge);
         expect_fills_surface(result, spot, mesher == Mesher::TetGen ? 1e-6 : 0.05);
     }
-}
-
-// Spot at the default size of the sessions and the demo (marble at 30 mm per unit: the rule of
-// solver/mesh_resolution.h gives a surface edge of l_d / 2 = 3.95 mm / 2 / 30 and a largest edge of
-// D / 8). TetGen keeps spot's triangles, and tets touching the few with small angles keep what those
-// force (its own quality mesh without a size, the floor of this one, has 1.85 degrees); away from
-// the surface the graded mesh keeps the dihedral bound's neighbourhood, and it stays graded.
-TEST(TetrahedralizeTest, DefaultMeshOfSpotIsGradedAndWellShapedAwayFromTheSurface) {
-    const TriangleSurface spot = asset_surface("spot.obj");
-    Eigen::AlignedBox3d box;
-    for (const auto& p : spot.points) box.extend(p);
-    MeshingOptions options;
-    options.sizing.surface_edge = 3.95 / 2 / 30;
-    options.sizing.grading = 0.5;
-    options.sizing.max_edge = box.diagonal().norm() / 8;
-    const MeshingResult result = tetrahedralize(spot, options);
-    EXPECT_EQ(result.mesher, Mesher::TetGen) << result.mesher_reason;
-    expect_fills_surface(result, spot, 1e-6);
-    const TetMesh& mesh = result.mesh;
-    std::vector<char> on_boundary(mesh.vertex_count(), 0);
-    for (const auto& f : boundary_faces(mesh))
-        for (int32_t v : f) on_boundary[v] = 1;
-    const std::vector<double> angles = min_dihedral_angles_deg(mesh);
-    double interior_min = 180;
-    for (size_t t = 0; t < mesh.tet_count(); ++t) {
-        const Tet& tet = mesh.tets[t];
-        if (!on_boundary[tet[0]] && !on_boundary[tet[1]] && !on_boundary[tet[2]] && !on_boundary[tet[3]])
-            interior_min = std::min(interior_min, angles[t]);
-    }
-    std::printf("spot default: %zu tets, min dihedral %.2f, interior %.2f, %zu under 5 degrees\n", mesh.tet_count(),
-                result.quality.min_dihedral_deg, interior_min, result.quality.tets_below_5_deg);
-    EXPECT_GE(interior_min, 5.0);
-    EXPECT_GE(result.quality.min_dihedral_deg, 1.5);
-    EXPECT_LT(double(result.quality.tets_below_5_deg), 0.001 * double(mesh.tet_count()));
-    const auto [boundary_edge, deep_edge] = boundary_and_deep_mean_edge(mesh);
-    EXPECT_GT(deep_edge, 1.5 * boundary_edge);
 }
 
 TEST(TetrahedralizeTest, RejectsAbsurdOptions) {
@@ -663,7 +550,7 @@ TEST(TetrahedralizeTest, ReportsItsStagesAndStopsWhenCancelled) {
     options.progress = &progress;
     tetrahedralize(cube, options);
     const std::vector<std::string> tetgen_stages = {"checking the surface for meshing", "meshing (TetGen)",
-                                                    "meshing (TetGen, coarse mesh)",
+                                                    "meshing (TetGen, background mesh)",
                                                     "meshing (TetGen, sizing field)", "meshing (TetGen, graded)",
                                                     "ordering the mesh", "measuring quality"};
     EXPECT_EQ(progress.stages, tetgen_stages);
