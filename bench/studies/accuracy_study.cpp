@@ -96,6 +96,7 @@ ConvergenceSeries study_surface_convergence(const SurfaceConvergenceOptions& opt
     using Key = std::tuple<double, double, double>;
     auto solve_at_surface = [&](double factor, ConvergencePoint* point) {
         MeshingOptions meshing;
+        meshing.mesher = Mesher::TetGen;  // the comparison needs the input's vertices, which CGAL remeshes
         meshing.sizing = default_mesh_sizing(surface, material, options.mm_per_unit, {.size_factor = factor});
         const TetMesh mesh = tetrahedralize(surface, meshing).mesh;
         const TetConnectivity connectivity = build_connectivity(mesh);
