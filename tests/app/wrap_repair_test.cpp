@@ -48,7 +48,7 @@ TEST(WrapRepair, BadCowIsWrappedAndMeshedAsOneComponent) {
 TEST(WrapRepair, ExplicitAlphaAndOffsetAreUsed) {
     const auto dir = scratch_dir("wrap_explicit");
     const auto r = run_waxwork("mesh " + kAssets + "/meshes/cube.obj --repair wrap --wrap-alpha 0.2 --wrap-offset 0.01 "
-                               "--max-tets 3000 -o " + (dir / "cube.vtu").string());
+                               "--max-tets 3000 --mesher cgal -o " + (dir / "cube.vtu").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto summary = nlohmann::json::parse(r.out);
     EXPECT_EQ(double(summary["wrap"]["alpha"]), 0.2);

@@ -82,7 +82,7 @@ TEST_F(EditorWindow, ViewWithoutPanelsEqualsWaxworkRender) {
 TEST_F(EditorWindow, OpensAtTheStoredScaleElseTheModelsElseTheGivenOne) {
     const fs::path dir = scratch_dir("editor_scale");
     const fs::path volume = dir / "torus.vtu";
-    ASSERT_EQ(run_waxwork("mesh " + kAssets + "/meshes/torus.obj -o " + volume.string() + " --max-tets 3000 --scale 7")
+    ASSERT_EQ(run_waxwork("mesh " + kAssets + "/meshes/torus.obj -o " + volume.string() + " --max-tets 12000 --scale 7")
                   .exit_code,
               0);
     const std::string window = " --hide-ui --width 160 --height 120 --frames 1 --screenshot " + (dir / "s.png").string();
@@ -93,7 +93,7 @@ TEST_F(EditorWindow, OpensAtTheStoredScaleElseTheModelsElseTheGivenOne) {
     ASSERT_EQ(given.exit_code, 0) << given.err;
     EXPECT_EQ(summary_of(given)["mm_per_unit"], 12.0);
     // torus.obj is 2.5 x 0.5 x 2.5 units: a 3.57-unit diagonal, 20 mm per unit.
-    const auto surface = run_under_xvfb("edit " + kAssets + "/meshes/torus.obj --max-tets 3000" + window);
+    const auto surface = run_under_xvfb("edit " + kAssets + "/meshes/torus.obj --max-tets 12000" + window);
     ASSERT_EQ(surface.exit_code, 0) << surface.err;
     EXPECT_EQ(summary_of(surface)["mm_per_unit"], 20.0);
 }
