@@ -3,6 +3,7 @@
 #include "base/error.h"
 #include "solver/material.h"
 #include "tetops/connectivity.h"
+#include "tetops/model_scale.h"
 
 #include <algorithm>
 #include <cmath>
@@ -39,12 +40,7 @@ MeshSizing default_mesh_sizing(const TriangleSurface& surface, const TetMaterial
     if (surface.points.empty()) throw InvalidArgumentError("cannot size an empty surface");
     if (!(rule.size_factor > 0) || !std::isfinite(rule.size_factor))
         throw InvalidArgumentError("mesh size factor must be a positive number");
-    Eigen::Vector3d lo = surface.points.front(), hi = lo;
-    for (const auto& p : surface.points) {
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-    }
-    const double diagonal = (hi - lo).norm();
+    const double diagonal = bounding_extent(surface.points).norm();
     if (!(diagonal > 0)) throw InvalidArgumentError("cannot size a surface whose bounding box is a point");
 
     MeshSizing sizing;
