@@ -1,9 +1,6 @@
 #include "multires/bicgstab.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
-#include <tbb/partitioner.h>
+#include "base/parallel_rows.h"
 
 #include <algorithm>
 #include <cmath>
@@ -28,29 +25,15 @@ namespace {
 
 constexpr size_t kGrain = 4096;
 
-// Deterministic: parallel_deterministic_reduce with a simple partitioner splits the range the same way
-// every time, so the sum's rounding does not depend on scheduling.
+// Deterministic (base/parallel_rows.h): the sum's rounding does not depend on scheduling.
 double dot(std::span<const double> a, std::span<const double> b) {
-    return tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<size_t>(0, a.size(), kGrain), 0.0,
-        [&](const tbb::blocked_range<size_t>& r, double sum) {
-            for (size_t i = r.begin(); i != r.end(); ++i) sum += a[i] * b[i];
-            return sum;
-        },
-        [](double x, double y) { return x + y; }, tbb::simple_partitioner());
-}
-
-template <typename F>
-void for_each_index(size_t n, F&& f) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) f(i);
-    });
+    return sum_rows(a.size(), kGrain, [&](size_t i) { return a[i] * b[i]; });
 }
 
 double true_residual(const CsrMatrixView<double>& a, std::span<const double> b, std::span<const double> x,
                      std::vector<double>& r) {
     multiply<double>(a, x, r);
-    for_each_index(r.size(), [&](size_t i) { r[i] = b[i] - r[i]; });
+    for_rows(r.size(), kGrain, [&](size_t i) { r[i] = b[i] - r[i]; });
     return std::sqrt(dot(r, r));
 }
 
@@ -112,7 +95,7 @@ BicgstabResult solve_jacobi_bicgstab(const CsrMatrixView<double>& a, std::span<c
         }
         const double beta = (rho_new / rho) * (alpha / omega);
         rho = rho_new;
-        for_each_index(n, [&](size_t i) {
+        for_rows(n, kGrain, [&](size_t i) {
             p[i] = r[i] + beta * (p[i] - omega * v[i]);
             y[i] = inv_d[i] * p[i];
         });
@@ -123,14 +106,14 @@ BicgstabResult solve_jacobi_bicgstab(const CsrMatrixView<double>& a, std::span<c
             break;
         }
         alpha = rho / r0v;
-        for_each_index(n, [&](size_t i) {
+        for_rows(n, kGrain, [&](size_t i) {
             s[i] = r[i] - alpha * v[i];
             z[i] = inv_d[i] * s[i];
         });
         result.iterations = k + 1;
         const double s_norm = std::sqrt(dot(s, s));
         if (s_norm <= target) {  // the half step already converged
-            for_each_index(n, [&](size_t i) { x[i] += alpha * y[i]; });
+            for_rows(n, kGrain, [&](size_t i) { x[i] += alpha * y[i]; });
             r.swap(s);
             r_norm = s_norm;
             break;
@@ -140,7 +123,7 @@ BicgstabResult solve_jacobi_bicgstab(const CsrMatrixView<double>& a, std::span<c
         const double ts = dot(t, s);
         if (!(tt > 0) || tiny(ts, std::sqrt(tt) * s_norm, options.breakdown_tolerance)) {
             // omega would be ~0: BiCGSTAB cannot continue; keep the half step, which is still valid.
-            for_each_index(n, [&](size_t i) { x[i] += alpha * y[i]; });
+            for_rows(n, kGrain, [&](size_t i) { x[i] += alpha * y[i]; });
             r.swap(s);
             r_norm = s_norm;
             result.status = std::isfinite(ts) && std::isfinite(tt) ? BicgstabStatus::OmegaBreakdown
@@ -148,7 +131,7 @@ BicgstabResult solve_jacobi_bicgstab(const CsrMatrixView<double>& a, std::span<c
             break;
         }
         omega = ts / tt;
-        for_each_index(n, [&](size_t i) {
+        for_rows(n, kGrain, [&](size_t i) {
             x[i] += alpha * y[i] + omega * z[i];
             r[i] = s[i] - omega * t[i];
         });

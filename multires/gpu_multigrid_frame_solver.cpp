@@ -1,7 +1,7 @@
 #include "multires/gpu_multigrid_frame_solver.h"
 
 #include "base/error.h"
-#include "multires/parallel_rows.h"
+#include "base/parallel_rows.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
 #include "multires/independent_set.h"
 
 #include "base/error.h"
+#include "base/parallel_rows.h"
 #include "multires/link_union.h"
-#include "multires/parallel_rows.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>

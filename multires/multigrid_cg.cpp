@@ -1,11 +1,7 @@
 #include "multires/multigrid_cg.h"
 
 #include "base/error.h"
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
-#include <tbb/partitioner.h>
+#include "base/parallel_rows.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,26 +13,6 @@ namespace waxwork {
 namespace {
 
 constexpr size_t kGrain = 4096;
-
-struct Pair {
-    double a = 0, b = 0;
-};
-
-// Fixed chunks, fixed combination order: bit-identical sums on any thread count.
-template <typename Body>
-Pair reduce_pairs(size_t n, const Body& body) {
-    return tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<size_t>(0, n, kGrain), Pair{},
-        [&](const tbb::blocked_range<size_t>& r, Pair acc) {
-            for (size_t i = r.begin(); i != r.end(); ++i) {
-                const Pair p = body(i);
-                acc.a += p.a;
-                acc.b += p.b;
-            }
-            return acc;
-        },
-        [](Pair x, Pair y) { return Pair{x.a + y.a, x.b + y.b}; }, tbb::simple_partitioner());
-}
 
 double row_product(const CsrMatrixView<double>& m, const double* x, size_t i) {
     double sum = 0;
@@ -74,16 +50,21 @@ ConjugateGradientResult solve_multigrid_cg(MultigridPreconditioner& precondition
     }
     std::vector<double> r(n), z(n), p(n), q(n);
 
+    // (r . z, x . M x), with M x = b - r.
+    auto rz_and_xmx = [&] {
+        return reduce_rows<2>(n, kGrain, [&](size_t i, std::array<double, 2>& sums) {
+            sums[0] += r[i] * z[i];
+            sums[1] += x[i] * (b[i] - r[i]);
+        });
+    };
     // r = b - M x, z = B r; returns (r . z, x . M x).
     auto refresh = [&]() {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& range) {
-            for (size_t i = range.begin(); i != range.end(); ++i) r[i] = b[i] - row_product(m, x.data(), i);
-        });
+        for_rows(n, kGrain, [&](size_t i) { r[i] = b[i] - row_product(m, x.data(), i); });
         preconditioner.apply(channel, r, z);
-        return reduce_pairs(n, [&](size_t i) { return Pair{r[i] * z[i], x[i] * (b[i] - r[i])}; });
+        return rz_and_xmx();
     };
-    Pair sums = refresh();
-    double rz = sums.a, xmx = sums.b;
+    std::array<double, 2> sums = refresh();
+    double rz = sums[0], xmx = sums[1];
     if (!(rz >= 0) || !std::isfinite(rz)) breakdown(0, "r.Br = " + std::to_string(rz));
 
     const double hint = options.smallest_eigenvalue_hint > 0 ? options.smallest_eigenvalue_hint
@@ -108,31 +89,28 @@ ConjugateGradientResult solve_multigrid_cg(MultigridPreconditioner& precondition
     double alpha_prev = 0, beta_prev = 0;
     int k = 0;
     for (; k < options.max_iterations; ++k) {
-        const Pair pq_sum = reduce_pairs(n, [&](size_t i) {
+        const double pq = sum_rows(n, kGrain, [&](size_t i) {
             q[i] = row_product(m, p.data(), i);
-            return Pair{p[i] * q[i], 0};
+            return p[i] * q[i];
         });
-        const double pq = pq_sum.a;
         if (!(pq > 0) || !std::isfinite(pq)) breakdown(k, "p.Mp = " + std::to_string(pq));
         const double alpha = rz / pq;
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& range) {
-            for (size_t i = range.begin(); i != range.end(); ++i) {
-                x[i] += alpha * p[i];
-                r[i] -= alpha * q[i];
-            }
+        for_rows(n, kGrain, [&](size_t i) {
+            x[i] += alpha * p[i];
+            r[i] -= alpha * q[i];
         });
         preconditioner.apply(channel, r, z);
-        sums = reduce_pairs(n, [&](size_t i) { return Pair{r[i] * z[i], x[i] * (b[i] - r[i])}; });
-        if (!std::isfinite(sums.a) || !std::isfinite(sums.b)) breakdown(k, "the iterate became non-finite");
-        if (sums.a < 0) breakdown(k, "r.Br = " + std::to_string(sums.a));
-        const double beta = sums.a / rz;
+        sums = rz_and_xmx();
+        if (!std::isfinite(sums[0]) || !std::isfinite(sums[1])) breakdown(k, "the iterate became non-finite");
+        if (sums[0] < 0) breakdown(k, "r.Br = " + std::to_string(sums[0]));
+        const double beta = sums[0] / rz;
         // Lanczos coefficients of B M (Saad, Iterative Methods, Sec. 6.7.3).
         t_diag.push_back(1.0 / alpha + (t_diag.empty() ? 0.0 : beta_prev / alpha_prev));
         if (t_diag.size() > 1) t_off.push_back(std::sqrt(beta_prev) / alpha_prev);
         alpha_prev = alpha;
         beta_prev = beta;
-        rz = sums.a;
-        xmx = sums.b;
+        rz = sums[0];
+        xmx = sums[1];
         const double lam = lambda();
         double est = estimate(rz, xmx, lam);
         if (options.on_iteration) options.on_iteration(k + 1, est);
@@ -140,8 +118,8 @@ ConjugateGradientResult solve_multigrid_cg(MultigridPreconditioner& precondition
         if (est <= options.relative_tolerance) {
             // Confirm with the true residual; restart from it if the recursive one drifted.
             sums = refresh();
-            rz = sums.a;
-            xmx = sums.b;
+            rz = sums[0];
+            xmx = sums[1];
             est = estimate(rz, xmx, lam);
             result.estimated_relative_error = est;
             if (est <= options.relative_tolerance) {
@@ -161,9 +139,7 @@ ConjugateGradientResult solve_multigrid_cg(MultigridPreconditioner& precondition
             std::copy(z.begin(), z.end(), p.begin());
             continue;
         }
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& range) {
-            for (size_t i = range.begin(); i != range.end(); ++i) p[i] = z[i] + beta * p[i];
-        });
+        for_rows(n, kGrain, [&](size_t i) { p[i] = z[i] + beta * p[i]; });
     }
     result.iterations = k;
     result.smallest_eigenvalue_estimate = lambda();

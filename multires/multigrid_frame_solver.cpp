@@ -1,10 +1,8 @@
 #include "multires/multigrid_frame_solver.h"
 
-#include "multires/parallel_rows.h"
-
 #include "base/error.h"
+#include "base/parallel_rows.h"
 #include "solver/conjugate_gradient.h"
-
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
 #include "multires/multigrid_preconditioner.h"
 
+#include "base/parallel_rows.h"
 #include "multires/carried_rows.h"
 #include "multires/link_union.h"
-#include "multires/parallel_rows.h"
 #include "solver/reference/reference_solvers.h"
 
 #include "base/error.h"

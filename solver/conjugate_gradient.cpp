@@ -1,12 +1,11 @@
 #include "solver/conjugate_gradient.h"
 
 #include "base/error.h"
+#include "base/parallel_rows.h"
 #include "solver/cg_channel_state.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
-#include <tbb/partitioner.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,32 +15,9 @@
 namespace waxwork {
 namespace {
 
-// Fixed chunks and a deterministic reduction: the same input gives bit-identical iterates on any
-// number of threads, which keeps tests and frame-to-frame results reproducible.
+// Rows per parallel chunk; the chunks are fixed, so the sums and iterates do not depend on the
+// thread count (base/parallel_rows.h).
 constexpr size_t kGrain = 4096;
-
-struct Sums {
-    double a = 0, b = 0;
-};
-
-template <typename Body>
-double reduce_rows(size_t n, const Body& body) {
-    return tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<size_t>(0, n, kGrain), 0.0,
-        [&](const tbb::blocked_range<size_t>& r, double acc) { return acc + body(r.begin(), r.end()); },
-        [](double x, double y) { return x + y; }, tbb::simple_partitioner());
-}
-
-template <typename Body>
-Sums reduce_rows2(size_t n, const Body& body) {
-    return tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<size_t>(0, n, kGrain), Sums{},
-        [&](const tbb::blocked_range<size_t>& r, Sums acc) {
-            const Sums s = body(r.begin(), r.end());
-            return Sums{acc.a + s.a, acc.b + s.b};
-        },
-        [](Sums x, Sums y) { return Sums{x.a + y.a, x.b + y.b}; }, tbb::simple_partitioner());
-}
 
 template <typename Scalar>
 double row_product(const CsrMatrixView<Scalar>& m, const Scalar* x, size_t i) {
@@ -55,15 +31,11 @@ double row_product(const CsrMatrixView<Scalar>& m, const Scalar* x, size_t i) {
 template <typename Scalar>
 double true_residual(const CsrMatrixView<Scalar>& m, const Scalar* b, const Scalar* x, const Scalar* inv_diag,
                      Scalar* r, Scalar* z) {
-    return reduce_rows(m.rows, [&](size_t begin, size_t end) {
-        double acc = 0;
-        for (size_t i = begin; i < end; ++i) {
-            const double ri = static_cast<double>(b[i]) - row_product(m, x, i);
-            r[i] = static_cast<Scalar>(ri);
-            z[i] = static_cast<Scalar>(ri * static_cast<double>(inv_diag[i]));
-            acc += static_cast<double>(r[i]) * static_cast<double>(z[i]);
-        }
-        return acc;
+    return sum_rows(m.rows, kGrain, [&](size_t i) {
+        const double ri = static_cast<double>(b[i]) - row_product(m, x, i);
+        r[i] = static_cast<Scalar>(ri);
+        z[i] = static_cast<Scalar>(ri * static_cast<double>(inv_diag[i]));
+        return static_cast<double>(r[i]) * static_cast<double>(z[i]);
     });
 }
 
@@ -155,11 +127,7 @@ ConjugateGradientResult solve_jacobi_cg(const CsrMatrixView<Scalar>& m, std::spa
 
     const double tol = options.relative_tolerance;
     const double rz = true_residual(m, b.data(), x.data(), inv_diag.data(), r.data(), z.data());
-    double bnorm2 = reduce_rows(n, [&](size_t begin, size_t end) {
-        double acc = 0;
-        for (size_t i = begin; i < end; ++i) acc += static_cast<double>(b[i]) * b[i] / diag[i];
-        return acc;
-    });
+    const double bnorm2 = sum_rows(n, kGrain, [&](size_t i) { return static_cast<double>(b[i]) * b[i] / diag[i]; });
     if (bnorm2 == 0) {  // the solution is exactly zero
         std::fill(x.begin(), x.end(), Scalar(0));
         result.converged = true;
@@ -167,11 +135,7 @@ ConjugateGradientResult solve_jacobi_cg(const CsrMatrixView<Scalar>& m, std::spa
     }
     CgChannelState st;
     st.rz = rz;
-    st.xnorm2 = reduce_rows(n, [&](size_t begin, size_t end) {
-        double acc = 0;
-        for (size_t i = begin; i < end; ++i) acc += diag[i] * static_cast<double>(x[i]) * x[i];
-        return acc;
-    });
+    st.xnorm2 = sum_rows(n, kGrain, [&](size_t i) { return diag[i] * static_cast<double>(x[i]) * x[i]; });
     std::copy(z.begin(), z.end(), p.begin());
 
     // A known lower bound of lambda_min acts as the Ritz floor from the start (an infinite "hint", e.g.
@@ -192,33 +156,26 @@ ConjugateGradientResult solve_jacobi_cg(const CsrMatrixView<Scalar>& m, std::spa
     // The deadline is read last (short-circuit): only when another iteration would otherwise run.
     for (; k < options.max_iterations && st.active && !(k > 0 && options.deadline.expired()); ++k) {
         // q = M p and p . q in one pass.
-        const double pq = reduce_rows(n, [&](size_t begin, size_t end) {
-            double acc = 0;
-            for (size_t i = begin; i < end; ++i) {
-                const double qi = row_product(m, p.data(), i);
-                q[i] = static_cast<Scalar>(qi);
-                acc += static_cast<double>(p[i]) * qi;
-            }
-            return acc;
+        const double pq = sum_rows(n, kGrain, [&](size_t i) {
+            const double qi = row_product(m, p.data(), i);
+            q[i] = static_cast<Scalar>(qi);
+            return static_cast<double>(p[i]) * qi;
         });
         if (!std::isfinite(pq)) breakdown(k, "p.Mp is not finite");
         if (!(pq > 0)) breakdown(k, "p.Mp = " + std::to_string(pq) + " is not positive");
         const double alpha = st.rz / pq;
         const Scalar a = static_cast<Scalar>(alpha);
         // x += alpha p, r -= alpha q, z = D^-1 r, and the two norms, in one pass.
-        const Sums s = reduce_rows2(n, [&](size_t begin, size_t end) {
-            Sums acc;
-            for (size_t i = begin; i < end; ++i) {
-                x[i] += a * p[i];
-                r[i] -= a * q[i];
-                z[i] = inv_diag[i] * r[i];
-                acc.a += static_cast<double>(r[i]) * static_cast<double>(z[i]);
-                acc.b += diag[i] * static_cast<double>(x[i]) * static_cast<double>(x[i]);
-            }
-            return acc;
+        // rz and the x norm (the stopping rule's), for the new iterate.
+        const auto [rz_new, xnorm2] = reduce_rows<2>(n, kGrain, [&](size_t i, std::array<double, 2>& sums) {
+            x[i] += a * p[i];
+            r[i] -= a * q[i];
+            z[i] = inv_diag[i] * r[i];
+            sums[0] += static_cast<double>(r[i]) * static_cast<double>(z[i]);
+            sums[1] += diag[i] * static_cast<double>(x[i]) * static_cast<double>(x[i]);
         });
-        if (!std::isfinite(s.a) || !std::isfinite(s.b)) breakdown(k, "the iterate became non-finite");
-        const double beta = st.record_step(alpha, s.a, s.b);
+        if (!std::isfinite(rz_new) || !std::isfinite(xnorm2)) breakdown(k, "the iterate became non-finite");
+        const double beta = st.record_step(alpha, rz_new, xnorm2);
         double lam = 0;
         const double est = st.current_estimate(k, tol, static_cast<bool>(options.on_iteration), lam);
         if (options.on_iteration) options.on_iteration(k + 1, est);

@@ -1,6 +1,7 @@
 #include "solver/diffusion_solve.h"
 
 #include "base/error.h"
+#include "base/parallel_rows.h"
 #include "base/timing.h"
 #include "solver/cg_channel_state.h"
 #include "solver/conjugate_gradient.h"
@@ -8,8 +9,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
-#include <tbb/partitioner.h>
 
 #include <algorithm>
 #include <chrono>
@@ -37,29 +36,6 @@ namespace {
 // DiffusionMatrix.
 constexpr size_t kGrain = 4096;  // as conjugate_gradient.cpp: fixed chunks, deterministic reductions
 
-struct Sums3 {
-    std::array<double, 3> v{};
-};
-struct Sums6 {
-    std::array<double, 6> v{};
-};
-
-template <typename Sums, typename Body>
-Sums reduce_rows(size_t n, const Body& body) {
-    return tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<size_t>(0, n, kGrain), Sums{},
-        [&](const tbb::blocked_range<size_t>& r, Sums acc) {
-            const Sums s = body(r.begin(), r.end());
-            for (size_t c = 0; c < acc.v.size(); ++c) acc.v[c] = acc.v[c] + s.v[c];
-            return acc;
-        },
-        [](Sums x, const Sums& y) {
-            for (size_t c = 0; c < x.v.size(); ++c) x.v[c] = x.v[c] + y.v[c];
-            return x;
-        },
-        tbb::simple_partitioner());
-}
-
 [[noreturn]] void breakdown(int iteration, const std::string& what) {
     throw AlgorithmError("conjugate gradient: " + what + " at iteration " + std::to_string(iteration) +
                          " (matrix not positive definite, or values lost to rounding: degenerate tets?)");
@@ -75,21 +51,17 @@ struct Rgb {
 
     // r = b - M x for channel c (double accumulation); fills z = D^-1 r, returns r . z.
     double true_residual(int c) {
-        return reduce_rows<Sums3>(n, [&](size_t begin, size_t end) {
-                   Sums3 acc;
-                   for (size_t i = begin; i < end; ++i) {
-                       double sum = 0;
-                       for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k)
-                           sum += static_cast<double>(values[3 * k + c]) *
-                                  static_cast<double>(x[3 * static_cast<size_t>(m.columns[k]) + c]);
-                       const size_t j = 3 * i + c;
-                       const double ri = static_cast<double>(b[j]) - sum;
-                       r[j] = static_cast<Scalar>(ri);
-                       z[j] = static_cast<Scalar>(ri * static_cast<double>(inv_diag[j]));
-                       acc.v[0] += static_cast<double>(r[j]) * static_cast<double>(z[j]);
-                   }
-                   return acc;
-               }).v[0];
+        return sum_rows(n, kGrain, [&](size_t i) {
+            double sum = 0;
+            for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k)
+                sum += static_cast<double>(values[3 * k + c]) *
+                       static_cast<double>(x[3 * static_cast<size_t>(m.columns[k]) + c]);
+            const size_t j = 3 * i + c;
+            const double ri = static_cast<double>(b[j]) - sum;
+            r[j] = static_cast<Scalar>(ri);
+            z[j] = static_cast<Scalar>(ri * static_cast<double>(inv_diag[j]));
+            return static_cast<double>(r[j]) * static_cast<double>(z[j]);
+        });
     }
 };
 
@@ -134,21 +106,18 @@ std::array<ConjugateGradientResult, 3> solve_rgb(const DiffusionMatrix& m, const
     const double tol = options.relative_tolerance;
     for (int c = 0; c < 3; ++c) {
         ch[c].rz = s.true_residual(c);
-        const Sums6 norms = reduce_rows<Sums6>(n, [&](size_t begin, size_t end) {
-            Sums6 acc;
-            for (size_t i = begin; i < end; ++i) {
-                const size_t j = 3 * i + c;
-                acc.v[0] += static_cast<double>(s.b[j]) * s.b[j] / s.diag[j];
-                acc.v[1] += s.diag[j] * static_cast<double>(s.x[j]) * s.x[j];
-            }
-            return acc;
+        // b . D^-1 b and x . D x.
+        const auto norms = reduce_rows<2>(n, kGrain, [&](size_t i, std::array<double, 2>& sums) {
+            const size_t j = 3 * i + c;
+            sums[0] += static_cast<double>(s.b[j]) * s.b[j] / s.diag[j];
+            sums[1] += s.diag[j] * static_cast<double>(s.x[j]) * s.x[j];
         });
-        if (norms.v[0] == 0) {  // the solution is exactly zero
+        if (norms[0] == 0) {  // the solution is exactly zero
             for (size_t i = 0; i < n; ++i) s.x[3 * i + c] = Scalar(0);
             ch[c].active = false;
             ch[c].result.converged = true;
         }
-        ch[c].xnorm2 = norms.v[1];
+        ch[c].xnorm2 = norms[1];
     }
     s.p = s.z;
 
@@ -160,35 +129,31 @@ std::array<ConjugateGradientResult, 3> solve_rgb(const DiffusionMatrix& m, const
         const std::array<bool, 3> act = {ch[0].active, ch[1].active, ch[2].active};
         // q = M p and p . q for the three channels in one pass (frozen channels are computed and ignored:
         // cheaper than branching in the inner loop, and their p stays finite).
-        const Sums3 pq = reduce_rows<Sums3>(n, [&](size_t begin, size_t end) {
-            Sums3 acc;
-            const Scalar* p = s.p.data();
-            Scalar* q = s.q.data();
-            for (size_t i = begin; i < end; ++i) {
-                double s0 = 0, s1 = 0, s2 = 0;
-                for (int32_t kk = offsets[i]; kk < offsets[i + 1]; ++kk) {
-                    const Scalar* v = values + 3 * static_cast<size_t>(kk);
-                    const Scalar* pj = p + 3 * static_cast<size_t>(columns[kk]);
-                    s0 += static_cast<double>(v[0]) * static_cast<double>(pj[0]);
-                    s1 += static_cast<double>(v[1]) * static_cast<double>(pj[1]);
-                    s2 += static_cast<double>(v[2]) * static_cast<double>(pj[2]);
-                }
-                q[3 * i] = static_cast<Scalar>(s0);
-                q[3 * i + 1] = static_cast<Scalar>(s1);
-                q[3 * i + 2] = static_cast<Scalar>(s2);
-                acc.v[0] += static_cast<double>(p[3 * i]) * s0;
-                acc.v[1] += static_cast<double>(p[3 * i + 1]) * s1;
-                acc.v[2] += static_cast<double>(p[3 * i + 2]) * s2;
+        const Scalar* p = s.p.data();
+        Scalar* q = s.q.data();
+        const auto pq = reduce_rows<3>(n, kGrain, [&](size_t i, std::array<double, 3>& sums) {
+            double s0 = 0, s1 = 0, s2 = 0;
+            for (int32_t kk = offsets[i]; kk < offsets[i + 1]; ++kk) {
+                const Scalar* v = values + 3 * static_cast<size_t>(kk);
+                const Scalar* pj = p + 3 * static_cast<size_t>(columns[kk]);
+                s0 += static_cast<double>(v[0]) * static_cast<double>(pj[0]);
+                s1 += static_cast<double>(v[1]) * static_cast<double>(pj[1]);
+                s2 += static_cast<double>(v[2]) * static_cast<double>(pj[2]);
             }
-            return acc;
+            q[3 * i] = static_cast<Scalar>(s0);
+            q[3 * i + 1] = static_cast<Scalar>(s1);
+            q[3 * i + 2] = static_cast<Scalar>(s2);
+            sums[0] += static_cast<double>(p[3 * i]) * s0;
+            sums[1] += static_cast<double>(p[3 * i + 1]) * s1;
+            sums[2] += static_cast<double>(p[3 * i + 2]) * s2;
         });
         std::array<Scalar, 3> a{};
         std::array<double, 3> alpha{};
         for (int c = 0; c < 3; ++c) {
             if (!act[c]) continue;
-            if (!std::isfinite(pq.v[c])) breakdown(k, "p.Mp is not finite");
-            if (!(pq.v[c] > 0)) breakdown(k, "p.Mp = " + std::to_string(pq.v[c]) + " is not positive");
-            alpha[c] = ch[c].rz / pq.v[c];
+            if (!std::isfinite(pq[c])) breakdown(k, "p.Mp is not finite");
+            if (!(pq[c] > 0)) breakdown(k, "p.Mp = " + std::to_string(pq[c]) + " is not positive");
+            alpha[c] = ch[c].rz / pq[c];
             a[c] = static_cast<Scalar>(alpha[c]);
         }
         // x += alpha p, r -= alpha q, z = D^-1 r, and the two norms per channel, in one pass.
@@ -196,31 +161,27 @@ std::array<ConjugateGradientResult, 3> solve_rgb(const DiffusionMatrix& m, const
         // other), the branch-free instance of the loop is taken.
         const bool all_active = act[0] && act[1] && act[2];
         const auto update = [&](auto every_channel) {
-            return reduce_rows<Sums6>(n, [&](size_t begin, size_t end) {
-                Sums6 acc;
-                for (size_t i = begin; i < end; ++i) {
-                    for (int c = 0; c < 3; ++c) {
-                        if (!every_channel && !act[c]) continue;
-                        const size_t j = 3 * i + c;
-                        s.x[j] += a[c] * s.p[j];
-                        s.r[j] -= a[c] * s.q[j];
-                        s.z[j] = s.inv_diag[j] * s.r[j];
-                        acc.v[2 * c] += static_cast<double>(s.r[j]) * static_cast<double>(s.z[j]);
-                        acc.v[2 * c + 1] += s.diag[j] * static_cast<double>(s.x[j]) * static_cast<double>(s.x[j]);
-                    }
+            return reduce_rows<6>(n, kGrain, [&](size_t i, std::array<double, 6>& sums) {
+                for (int c = 0; c < 3; ++c) {
+                    if (!every_channel && !act[c]) continue;
+                    const size_t j = 3 * i + c;
+                    s.x[j] += a[c] * s.p[j];
+                    s.r[j] -= a[c] * s.q[j];
+                    s.z[j] = s.inv_diag[j] * s.r[j];
+                    sums[2 * c] += static_cast<double>(s.r[j]) * static_cast<double>(s.z[j]);
+                    sums[2 * c + 1] += s.diag[j] * static_cast<double>(s.x[j]) * static_cast<double>(s.x[j]);
                 }
-                return acc;
             });
         };
-        const Sums6 upd = all_active ? update(std::true_type{}) : update(std::false_type{});
+        const std::array<double, 6> upd = all_active ? update(std::true_type{}) : update(std::false_type{});
         std::array<double, 3> beta{};
         std::array<bool, 3> update_p{};
         for (int c = 0; c < 3; ++c) {
             if (!act[c]) continue;
             CgChannelState& st = ch[c];
-            if (!std::isfinite(upd.v[2 * c]) || !std::isfinite(upd.v[2 * c + 1]))
+            if (!std::isfinite(upd[2 * c]) || !std::isfinite(upd[2 * c + 1]))
                 breakdown(k, "the iterate became non-finite");
-            beta[c] = st.record_step(alpha[c], upd.v[2 * c], upd.v[2 * c + 1]);
+            beta[c] = st.record_step(alpha[c], upd[2 * c], upd[2 * c + 1]);
             double lam = 0;
             const double est = st.current_estimate(k, tol, false, lam);
             if (est <= tol && st.may_stop(k, n)) {

@@ -1,9 +1,7 @@
 #include "tetops/tet_mesh.h"
 
 #include "base/error.h"
-
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
+#include "base/parallel_rows.h"
 
 #include <algorithm>
 #include <cmath>
@@ -49,13 +47,7 @@ TetMesh make_tet_mesh(std::vector<Eigen::Vector3d> positions, std::vector<Tet> t
 
 double total_volume(const TetMesh& mesh) {
     // Deterministic: the same sum in the same order whatever the threads (`info` prints it).
-    return tbb::parallel_deterministic_reduce(
-        tbb::blocked_range<size_t>(0, mesh.tets.size(), 4096), 0.0,
-        [&](const tbb::blocked_range<size_t>& r, double sum) {
-            for (size_t t = r.begin(); t != r.end(); ++t) sum += signed_volume(mesh, t);
-            return sum;
-        },
-        std::plus<>());
+    return sum_rows(mesh.tets.size(), 4096, [&](size_t t) { return signed_volume(mesh, t); });
 }
 
 std::array<Eigen::Vector3d, 2> bounding_box(const TetMesh& mesh) {

@@ -1,5 +1,7 @@
-// Row loops of the multires code: each row is independent, so TBB splits the range into chunks of
-// `grain` rows (large enough that scheduling costs less than the rows themselves).
+// Parallel loops over independent rows (of a matrix, a vector, a mesh's tets): TBB splits the range
+// into chunks of `grain` rows, large enough that scheduling costs less than the rows themselves.
+// Sums use fixed chunks and a fixed combination order, so the same input gives bit-identical sums
+// (and solver iterates) on any thread count: tests, `info` and frame-to-frame results rely on it.
 #pragma once
 
 #include <tbb/blocked_range.h>
@@ -38,6 +40,12 @@ std::array<double, N> reduce_rows(size_t n, size_t grain, const Body& body) {
             return a;
         },
         tbb::simple_partitioner());
+}
+
+// One sum over rows, body(i) giving row i's term.
+template <typename Body>
+double sum_rows(size_t n, size_t grain, const Body& body) {
+    return reduce_rows<1>(n, grain, [&](size_t i, std::array<double, 1>& sum) { sum[0] += body(i); })[0];
 }
 
 // Compressed rows whose lengths are only known once each row is built, in one pass: rows are built
