@@ -3,6 +3,7 @@
 #include "base/error.h"
 #include "base/progress.h"
 #include "tetops/mesher_scale.h"
+#include "tetops/sharp_tips.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
@@ -17,6 +18,7 @@
 #include <CGAL/make_mesh_3.h>
 #include <CGAL/perturb_mesh_3.h>
 
+#include <algorithm>
 #include <unordered_map>
 
 namespace waxwork {
@@ -36,6 +38,9 @@ using Criteria = CGAL::Mesh_criteria_3<Triangulation>;
 constexpr double kCellSizePerEdge = 0.9;
 constexpr double kFacetSizePerEdge = 0.8;
 constexpr double kEdgeSizePerEdge = 1.0;
+// The most protection work a tip may make (sharp_tip_work: 495 took 24 s, the time growing like the
+// work to the power 2.5 above that).
+constexpr double kMaxSharpTipWork = 500;
 // Surface approximation error relative to the local edge length.
 constexpr double kFacetDistancePerEdge = 0.1;
 
@@ -49,6 +54,23 @@ struct GradedSize {
         return factor * field->edge_at_depth((*distance)(Eigen::Vector3d(p.x(), p.y(), p.z())));
     }
 };
+
+// Refuses, before any work, a surface with a tip CGAL's protection of sharp edges would take minutes
+// to hours over (sharp_tips.h).
+void refuse_needle_tips(const TriangleSurface& surface, double edge) {
+    const std::vector<SharpTip> tips = sharp_tips(surface);
+    const auto hardest = std::max_element(tips.begin(), tips.end(), [&](const SharpTip& a, const SharpTip& b) {
+        return sharp_tip_work(a, edge) < sharp_tip_work(b, edge);
+    });
+    if (hardest == tips.end() || !(sharp_tip_work(*hardest, edge) > kMaxSharpTipWork)) return;
+    const Eigen::Vector3d& p = surface.points[hardest->vertex];
+    throw AlgorithmError("CGAL Mesh_3 cannot mesh this surface in bounded time: two sharp edges " +
+                         number_text(hardest->shorter_edge / edge) + " mesh edges long meet at " +
+                         number_text(hardest->angle_deg) + " degrees at point " + std::to_string(hardest->vertex) +
+                         " (" + number_text(p.x()) + ", " + number_text(p.y()) + ", " + number_text(p.z()) +
+                         "), a needle its protection of sharp edges would take minutes to hours over; use the "
+                         "TetGen mesher (--mesher tetgen), which keeps the surface's triangles");
+}
 
 Polyhedron to_polyhedron(const TriangleSurface& surface) {
     std::vector<Kernel::Point_3> points;
@@ -109,6 +131,7 @@ TetMesh cgal_tetrahedralize(const TriangleSurface& surface, const CgalSettings& 
         for (const auto& p : surface.points) box.extend(p);
         size = SizeField::uniform(box.diagonal().norm() / 20);
     }
+    refuse_needle_tips(surface, size.surface_edge);
     try {
         report_stage(settings.progress, "meshing (CGAL, surface domain)");
         // Seeded generators: the domain's initial points and the exuder draw from them.

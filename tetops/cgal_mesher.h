@@ -18,10 +18,10 @@ struct CgalSettings {
     // armadillo (29K) at 3.5; with the perturber first, 8.8 and 5.0 (spot at 50K: 6.6 -> 10.0) for
     // about 1 s more (TetrahedralizeTest.CgalPerturbsSliversTowardsTheBound).
     double min_dihedral_deg = 10.0;
-    // Mesh_3's own bound on its work: refinement (sharp-edge protection included) stops at this many
-    // vertices and the run fails with AlgorithmError. 0: no limit. tetrahedralize() sets it to many
-    // times the vertices the size predicts: sharp features meeting at a tiny angle (a needle-like
-    // part) make the protecting balls shrink without end, and the refinement never finishes.
+    // Mesh_3's own bound on its work: refinement stops at this many vertices and the run fails with
+    // AlgorithmError. 0: no limit. tetrahedralize() sets it to many times the vertices the size
+    // predicts. It does not bound the protection of sharp edges, which can shrink its balls for hours
+    // without adding vertices; needle tips that would make it do so are refused first (sharp_tips.h).
     size_t max_vertices = 0;
     size_t predicted_vertices = 0;  // for the message when max_vertices is reached
     Progress* progress = nullptr;   // stages, and its cancel flag stops the refinement
@@ -29,7 +29,8 @@ struct CgalSettings {
 
 // Sharp edges (dihedral angle under 120 degrees, CGAL's 60-degree feature angle) are protected so
 // that cubes and CAD parts keep their corners. Deterministic: every random generator is seeded.
-// Throws AlgorithmError when CGAL fails, reaches settings.max_vertices or produces no tets, and
+// Throws AlgorithmError when the surface has a needle tip (sharp_tips.h), CGAL fails, reaches
+// settings.max_vertices or produces no tets, and
 // CancelledError when settings.progress asks it to stop.
 TetMesh cgal_tetrahedralize(const TriangleSurface& surface, const CgalSettings& settings);
 
