@@ -40,7 +40,11 @@ public:
     bool poll();
     // Blocks until the running work finishes (screenshot mode and shutdown only, never per frame).
     void wait();
+    // Asks the work to stop (its TaskProgress's cancel flag); it ends when the work next checks.
     void cancel();
+    // cancel() was called for the task started last: an Apply that would install a result the user
+    // no longer wants checks this.
+    bool cancel_requested() const { return progress_ && progress_->cancel_requested(); }
 
     const std::string& label() const { return label_; }
     double elapsed_seconds() const;

@@ -1,6 +1,7 @@
 #include "editor/editor_app.h"
 
 #include "base/error.h"
+#include "base/progress.h"
 #include "base/timing.h"
 #include "editor/stroke_tools.h"
 #include "io/surface_reader.h"
@@ -122,12 +123,74 @@ EditorApp::~EditorApp() {
 
 void EditorApp::set_error(const std::string& message) {
     if (last_error_.empty()) last_error_ = message;
+    show_error(message);
+}
+
+void EditorApp::show_error(const std::string& message) {
     status_ = "Error: " + message;
     error_message_ = message;
     show_error_popup_ = true;
+    close_error_popup_ = false;
+    refusal_.reset();
 }
 
-void EditorApp::open_file(const fs::path& path, std::optional<double> scale) {
+const std::string& EditorApp::unanswered_refusal() const {
+    static const std::string none;
+    return refusal_ ? refusal_->message : none;
+}
+
+void EditorApp::load_failed(const std::exception& error) {
+    // Whatever the work ended with after Cancel (CancelledError, or a mesher's own error on the way
+    // out), the user asked for it to stop: nothing was installed.
+    if (load_task_.cancel_requested()) {
+        status_ = "Cancelled loading " + load_task_.label();
+        return;
+    }
+    const auto* refused = dynamic_cast<const SurfaceRefusedError*>(&error);
+    if (!refused || !loading_) {
+        set_error(error.what());
+        return;
+    }
+    Refusal refusal{*loading_, error.what(),
+                    repair_choices(refused->defects(), refused->wrapping_would_fix(), loading_->repair)};
+    if (refusal.choices.empty()) {
+        set_error(refusal.message);
+        return;
+    }
+    show_error(refusal.message);
+    refusal_ = std::move(refusal);
+}
+
+bool EditorApp::cancel_loading() {
+    if (!load_task_.busy()) return false;
+    load_task_.cancel();
+    status_ = "Cancelling loading " + load_task_.label();
+    return true;
+}
+
+void EditorApp::choose_repair(const std::string& id) {
+    if (!refusal_) {
+        set_error("repair '" + id + "': no refused surface is waiting for a repair");
+        return;
+    }
+    const auto& choices = refusal_->choices;
+    const auto it = std::find_if(choices.begin(), choices.end(), [&](const RepairChoice& c) { return c.id == id; });
+    if (it == choices.end()) {
+        std::string offered;
+        for (const RepairChoice& c : choices) offered += (offered.empty() ? "" : ", ") + c.id;
+        set_error("repair '" + id + "' is not offered for " + refusal_->request.path.filename().string() +
+                  " (offered: " + offered + ")");
+        return;
+    }
+    const LoadRequest request = refusal_->request;
+    const SurfaceRepairOptions repair = it->repair;
+    refusal_.reset();
+    show_error_popup_ = false;
+    close_error_popup_ = true;
+    open_file(request.path, request.scale, repair);
+}
+
+void EditorApp::open_file(const fs::path& path, std::optional<double> scale, std::optional<SurfaceRepairOptions> repair) {
     if (load_task_.busy()) {
         set_error("still loading " + load_task_.label() + "; try again when it finishes");
         return;
@@ -144,7 +207,7 @@ void EditorApp::open_file(const fs::path& path, std::optional<double> scale) {
     setup.input.mesher = options_.mesher;
     setup.input.min_dihedral_deg = options_.min_dihedral_deg;
     setup.input.max_radius_edge_ratio = options_.max_radius_edge_ratio;
-    setup.input.repair = options_.repair;
+    setup.input.repair = repair ? *repair : options_.repair;
     setup.material = options_.material.value_or(material_preset("marble"));
     setup.scale = scale ? scale : options_.scale;
     setup.tolerance = live_options_.relative_tolerance;
@@ -155,26 +218,31 @@ void EditorApp::open_file(const fs::path& path, std::optional<double> scale) {
     if (frame_budget_in_ms_) setup.frame_ms = frame_ms_;
     const std::string material_name = options_.material ? "custom" : "marble (or stored)";
     status_ = "Loading " + path.string();
+    loading_ = LoadRequest{path, scale, setup.input.repair};
     load_task_.start(path.filename().string(), [this, path, setup, material_name, solver = live_options_](TaskProgress& progress) {
-        progress.set_stage(setup.input.volume.empty() ? "meshing the surface" : "reading the volume");
-        SessionVolume input = read_session_input(setup);
+        // The reading, repair and meshing stages report themselves, and stop at the task's Cancel.
+        SessionVolume input = read_session_input(setup, &progress);
         const LoadedModel model = measure_loaded_model(input);
         Session resolved = setup;
         resolved.scale = input.scale.mm_per_unit;
+        progress.throw_if_cancelled();
         progress.set_stage("building the document and the live scene");
         auto core = std::make_shared<SceneCore>(std::move(input.mesh), resolved, solver);
-        return BackgroundTask::Apply(
-            [this, path, core, material_name, model] { install_core(core, path, material_name, {}, model); });
+        return BackgroundTask::Apply([this, path, core, material_name, model] {
+            // Cancel pressed after the work's last check: the open document stays.
+            if (load_task_.cancel_requested()) throw CancelledError("cancelled");
+            install_core(core, path, material_name, {}, model);
+        });
     });
 }
 
 void EditorApp::open_session(const fs::path& path) {
     status_ = "Loading session " + path.string();
+    loading_.reset();
     load_task_.start(path.filename().string(), [this, path, solver = live_options_](TaskProgress& progress) {
         progress.set_stage("reading the session");
         Session session = read_session(path);
-        progress.set_stage(session.input.volume.empty() ? "meshing the surface" : "reading the volume");
-        SessionVolume input = load_session_input(session);
+        SessionVolume input = load_session_input(session, &progress);
         const LoadedModel model = measure_loaded_model(input);
         // Edits are replayed (and become undoable); the last light and camera steps set the scene's.
         std::vector<EditOperation> edits;
@@ -186,9 +254,11 @@ void EditorApp::open_session(const fs::path& path) {
         Session setup = session;
         setup.steps.clear();
         setup.scale = input.scale.mm_per_unit;
+        progress.throw_if_cancelled();
         progress.set_stage("building the document and the live scene");
         auto core = std::make_shared<SceneCore>(std::move(input.mesh), setup, solver);
         return BackgroundTask::Apply([this, path, core, edits, model] {
+            if (load_task_.cancel_requested()) throw CancelledError("cancelled");
             install_core(core, path, "session", edits, model);
             adopt_frame_budget(core->setup());
         });
@@ -214,6 +284,7 @@ void EditorApp::install_core(std::shared_ptr<SceneCore> core, const fs::path& pa
     scene_->surface_edge = model.surface_edge;
     scene_->setup_material = core->setup().material;
     scene_->source_surface = core->setup().input.surface;
+    scene_->source_repair = core->setup().input.repair;
     live_options_.relative_tolerance = core->setup().tolerance;
     live_options_.crease_angle_degrees = core->setup().crease_angle_degrees;
     options_.camera = core->setup().camera;
@@ -423,7 +494,7 @@ void EditorApp::poll_tasks() {
     try {
         load_task_.poll();
     } catch (const std::exception& e) {
-        set_error(e.what());
+        load_failed(e);
     }
     try {
         tick_task_.poll();
@@ -631,6 +702,8 @@ EditorRunStats run_editor(const EditorOptions& options) {
             app.frame();
             if (screenshot) {
                 if (!app.last_error().empty()) throw Error(app.last_error());
+            // A refused surface's dialog waits for a repair the script may still choose.
+            if (!app.unanswered_refusal().empty() && !script_running()) throw Error(app.unanswered_refusal());
                 if (!app.idle() || script_running()) {
                     stats.frames = 0;
                     frame_ms_sum = view_ms_sum = 0;

@@ -15,6 +15,7 @@
 #include "editor/file_dialog.h"
 #include "editor/input_script.h"
 #include "editor/orbit_camera.h"
+#include "editor/repair_choices.h"
 #include "editor/view_cache.h"
 #include "editor/viewport_tools.h"
 #include "render/render_input.h"
@@ -126,6 +127,7 @@ struct EditorScene {
     double surface_edge = 0;                           // mean_surface_edge_length, model units
     TetMaterial setup_material;                        // the material the rule sizes for
     std::filesystem::path source_surface;              // the surface it was meshed from (empty: a volume)
+    SurfaceRepairOptions source_repair;                // and the repairs it was opened with
     LiveBackend solver_backend = LiveBackend::Cpu;  // after the latest tick (Cpu after a fallback)
     std::string solver_description;
     std::string gpu_fallback_reason;
@@ -155,14 +157,27 @@ public:
     bool viewport_ready() const { return camera_.has_value() && scene_->render_input.has_value(); }
     // The first error of a failed load or solve (screenshot mode turns it into the exit status).
     const std::string& last_error() const { return last_error_; }
+    // The refusal of a surface whose error dialog offers repairs, while none was chosen ("" if none):
+    // screenshot mode waits for a script to answer it and fails with it otherwise.
+    const std::string& unanswered_refusal() const;
     const GlApi& gl() const { return gl_; }
     const EditorScene& scene() const { return *scene_; }
     double view_ms() const { return last_render_ms_; }
     double mm_per_unit() const { return live_options_.mm_per_unit; }
 
     // Loads a surface (meshed with the current options) or a volume file, in the background, at
-    // `scale` mm per unit when given (else --scale, else the volume's stored scale, else the model's).
-    void open_file(const std::filesystem::path& path, std::optional<double> scale = std::nullopt);
+    // `scale` mm per unit when given (else --scale, else the volume's stored scale, else the model's),
+    // with `repair` instead of the command line's repairs when given. The status bar shows its stages
+    // with Cancel; a surface refused for its defects gets an error dialog offering the repairs that
+    // apply (repair_choices.h).
+    void open_file(const std::filesystem::path& path, std::optional<double> scale = std::nullopt,
+                   std::optional<SurfaceRepairOptions> repair = std::nullopt);
+    // The status bar's Cancel: asks the load running to stop; the document open before stays as it
+    // was and the status says "Cancelled loading FILE". Returns false when nothing is loading.
+    bool cancel_loading();
+    // A button of the refused surface's error dialog: reopens the file with the repair whose id is
+    // `id` (RepairChoice::id). An error when no refusal is shown or it does not offer that repair.
+    void choose_repair(const std::string& id);
     void save_volume(const std::filesystem::path& path);
     void on_drop(const std::vector<std::filesystem::path>& paths);
     void on_key(int key, int mods);
@@ -248,6 +263,8 @@ private:
     void handle_viewport_input();
     void draw_viewport(int fb_h);
     void set_error(const std::string& message);
+    void show_error(const std::string& message);  // as set_error, not counted as the run's error
+    void load_failed(const std::exception& error);
 
     static constexpr float kToolPaletteWidth = 132;  // logical pixels (times the UI scale)
     static constexpr float kSidePanelWidth = 340;
@@ -277,6 +294,21 @@ private:
     std::filesystem::path current_file_;
 
     BackgroundTask load_task_;
+    // What open_file asked load_task_ for (nullopt: a session), to reopen it with a repair.
+    struct LoadRequest {
+        std::filesystem::path path;
+        std::optional<double> scale;
+        SurfaceRepairOptions repair;
+    };
+    std::optional<LoadRequest> loading_;
+    // A refused surface and the repairs its error dialog offers (cleared by the next error or a choice).
+    struct Refusal {
+        LoadRequest request;
+        std::string message;
+        std::vector<RepairChoice> choices;
+    };
+    std::optional<Refusal> refusal_;
+    bool close_error_popup_ = false;  // a repair was chosen by a script: the dialog goes
     BackgroundTask tick_task_;
     std::deque<std::pair<std::string, SceneJob>> pending_jobs_;  // for the next tick, in order
     bool lighting_dirty_ = false;                                // send lighting_ with the next tick

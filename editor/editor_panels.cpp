@@ -103,13 +103,30 @@ void EditorApp::draw_ui() {
         ImGui::OpenPopup("Error");
         show_error_popup_ = false;
     }
+    std::string chosen_repair;
     if (ImGui::BeginPopupModal("Error", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
         ImGui::PushTextWrapPos(ImGui::GetFontSize() * 36);
         ImGui::TextUnformatted(error_message_.c_str());
         ImGui::PopTextWrapPos();
-        if (ImGui::Button("OK", ImVec2(100 * ui_scale_, 0))) ImGui::CloseCurrentPopup();
+        // A refused surface: the repairs that apply, each reopening it (with progress and Cancel).
+        if (refusal_) {
+            ImGui::Separator();
+            ImGui::TextUnformatted("Repair the surface and open it again:");
+            for (const RepairChoice& choice : refusal_->choices) {
+                if (ImGui::Button(choice.label.c_str())) chosen_repair = choice.id;
+                ImGui::SameLine();
+            }
+            ImGui::NewLine();
+        }
+        if (ImGui::Button(refusal_ ? "Close" : "OK", ImVec2(100 * ui_scale_, 0))) {
+            refusal_.reset();
+            ImGui::CloseCurrentPopup();
+        }
+        if (close_error_popup_ || !chosen_repair.empty()) ImGui::CloseCurrentPopup();
         ImGui::EndPopup();
     }
+    close_error_popup_ = false;
+    if (!chosen_repair.empty()) choose_repair(chosen_repair);  // may show a new error: after EndPopup
 }
 
 void EditorApp::draw_menu_bar() {
@@ -297,7 +314,7 @@ void EditorApp::draw_scale_fit() {
     else
         ImGui::TextDisabled("mesh %.1fx finer than the light needs at this scale (slower)", 1.0 / ratio);
     if (s.source_surface.empty()) return;
-    if (ImGui::SmallButton("Remesh at this scale")) open_file(s.source_surface, mm);
+    if (ImGui::SmallButton("Remesh at this scale")) open_file(s.source_surface, mm, s.source_repair);
     if (ImGui::IsItemHovered())
         ImGui::SetTooltip("Meshes %s again for %.3g mm per unit (edits are not kept)",
                           s.source_surface.filename().string().c_str(), mm);
@@ -334,6 +351,14 @@ void EditorApp::draw_status_bar() {
         const float shown = fraction >= 0 ? fraction : 0.5f + 0.5f * std::sin(static_cast<float>(ImGui::GetTime()) * 3.0f);
         ImGui::ProgressBar(shown, ImVec2(300 * ui_scale_, 0), overlay);
         ImGui::SameLine();
+        // Loading can stop between any two stages (and CGAL's mesher within its refinement); a tick
+        // holds queued edits, so it always runs to its end.
+        if (task == &load_task_) {
+            ImGui::BeginDisabled(load_task_.cancel_requested());
+            if (ImGui::SmallButton("Cancel")) cancel_loading();
+            ImGui::EndDisabled();
+            ImGui::SameLine();
+        }
     }
     ImGui::TextUnformatted(status_.c_str());
     ImGui::End();

@@ -177,18 +177,30 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
     } else if (kind == "idle") {
         e.action = ScriptAction::WaitIdle;
         events.push_back(e);
-    } else if (kind == "save_session" || kind == "save_volume" || kind == "export_surface") {
-        e.action = kind == "save_session"  ? ScriptAction::SaveSession
-                   : kind == "save_volume" ? ScriptAction::SaveVolume
-                                           : ScriptAction::ExportSurface;
+    } else if (kind == "save_session" || kind == "save_volume" || kind == "export_surface" || kind == "open") {
+        e.action = kind == "save_session"     ? ScriptAction::SaveSession
+                   : kind == "save_volume"    ? ScriptAction::SaveVolume
+                   : kind == "export_surface" ? ScriptAction::ExportSurface
+                                              : ScriptAction::Open;
         const Json& f = in.at("file");
         if (!f.is_string() || f.get<std::string>().empty()) fail_json(in.field("file"), "expected a file path");
         e.file = fs::absolute(base / fs::path(f.get<std::string>()));
         events.push_back(e);
+    } else if (kind == "cancel_task") {
+        e.action = ScriptAction::CancelTask;
+        events.push_back(e);
+    } else if (kind == "repair") {
+        e.action = ScriptAction::Repair;
+        const Json& r = in.at("repair");
+        static const std::vector<std::string> ids = {"wrap", "fill_holes", "autorefine", "fill_holes_autorefine"};
+        if (!r.is_string() || std::find(ids.begin(), ids.end(), r.get<std::string>()) == ids.end())
+            fail_json(in.field("repair"), "expected \"wrap\", \"fill_holes\", \"autorefine\" or \"fill_holes_autorefine\"");
+        e.repair = r.get<std::string>();
+        events.push_back(e);
     } else {
         fail_json(entry, "unknown event \"" + kind +
                              "\" (expected press, move, release, drag, scroll, key, tool, material, crease_angle, "
-                             "idle, save_session, save_volume, export_surface)");
+                             "idle, save_session, save_volume, export_surface, open, cancel_task, repair)");
     }
     in.finish();
 }
@@ -234,6 +246,9 @@ void InputScriptPlayer::advance(ScriptTarget& target) {
         case ScriptAction::SaveSession: target.save_session(e.file); break;
         case ScriptAction::SaveVolume: target.save_volume(e.file); break;
         case ScriptAction::ExportSurface: target.export_surface(e.file); break;
+        case ScriptAction::Open: target.open_file(e.file); break;
+        case ScriptAction::CancelTask: target.cancel_task(); break;
+        case ScriptAction::Repair: target.choose_repair(e.repair); break;
         }
         last_fired_ = frame_;
         ++next_;

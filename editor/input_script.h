@@ -17,7 +17,12 @@
 //     {"event": "idle"},                                      wait until edits are applied and solved
 //     {"event": "save_session", "file": "s.json"},            as File > Save session / Save volume
 //     {"event": "save_volume", "file": "v.vtu"},
-//     {"event": "export_surface", "file": "v.ply"}            as File > Export surface
+//     {"event": "export_surface", "file": "v.ply"},           as File > Export surface
+//     {"event": "open", "file": "other.obj"},                 as File > Open (loads in the background)
+//     {"event": "cancel_task"},                               the status bar's Cancel of that load
+//     {"event": "repair", "repair": "wrap"}                   a refused surface's repair button: "wrap",
+//                                                             "fill_holes", "autorefine" or
+//                                                             "fill_holes_autorefine" (repair_choices.h)
 //   ]
 //
 // Positions are window coordinates (GLFW's: screen units, origin top-left; with --hide-ui the view
@@ -40,7 +45,7 @@ namespace waxwork {
 
 enum class ScriptAction {
     Move, Press, Release, Scroll, Key, SelectTool, SelectMaterial, SetCreaseAngle, WaitIdle, SaveSession, SaveVolume,
-    ExportSurface
+    ExportSurface, Open, CancelTask, Repair
 };
 
 struct ScriptEvent {
@@ -54,7 +59,8 @@ struct ScriptEvent {
     Tool tool = Tool::Orbit;
     std::string material;        // SelectMaterial: a preset name (material_preset_names())
     double degrees = 0;          // SetCreaseAngle: in [0, 180]
-    std::filesystem::path file;  // SaveSession, SaveVolume, ExportSurface (absolute after parsing)
+    std::filesystem::path file;  // SaveSession, SaveVolume, ExportSurface, Open (absolute after parsing)
+    std::string repair;          // Repair: a RepairChoice id
     std::string context;         // "SCRIPT: entry N (kind)" for messages
 };
 
@@ -90,6 +96,9 @@ public:
     virtual void save_session(const std::filesystem::path& file) = 0;
     virtual void save_volume(const std::filesystem::path& file) = 0;
     virtual void export_surface(const std::filesystem::path& file) = 0;
+    virtual void open_file(const std::filesystem::path& file) = 0;  // as File > Open
+    virtual void cancel_task() = 0;                                 // the status bar's Cancel
+    virtual void choose_repair(const std::string& id) = 0;          // a refused surface's repair button
 };
 
 // Replays a script, a frame at a time.

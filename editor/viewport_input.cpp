@@ -232,6 +232,9 @@ public:
     void save_session(const std::filesystem::path& file) override { app_.save_session(file); }
     void save_volume(const std::filesystem::path& file) override { app_.save_volume(file); }
     void export_surface(const std::filesystem::path& file) override { app_.export_surface(file); }
+    void open_file(const std::filesystem::path& file) override { app_.open_file(file); }
+    void cancel_task() override { app_.cancel_loading(); }
+    void choose_repair(const std::string& id) override { app_.choose_repair(id); }
 
 private:
     GLFWwindow* window_;

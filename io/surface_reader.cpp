@@ -671,8 +671,9 @@ LoadedSurface load_closed_surface(const std::filesystem::path& path, const Surfa
     auto reject = [&](const std::vector<std::string>& defects, const SurfaceDefects& found) {
         std::string message = name + ": ";
         for (size_t k = 0; k < defects.size(); ++k) message += (k ? "; " : "") + defects[k];
-        if (wrapping_would_fix(found)) message += "; --repair wrap rebuilds it as a closed surface";
-        throw InvalidMeshError(message);
+        const bool wrappable = wrapping_would_fix(found);
+        if (wrappable) message += "; --repair wrap rebuilds it as a closed surface";
+        throw SurfaceRefusedError(message, found, wrappable);
     };
 
     SurfaceIndexMap origin;

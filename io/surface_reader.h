@@ -5,6 +5,7 @@
 // reads, applies the safe repairs of tetops/surface_check.h, and refuses anything a mesher cannot fill.
 #pragma once
 
+#include "base/error.h"
 #include "tetops/surface_check.h"
 #include "tetops/triangle_surface.h"
 
@@ -29,10 +30,28 @@ struct LoadedSurface {
     std::optional<WrapReport> wrap;   // when the options asked for the alpha wrap: what it did
 };
 
+// The refusal of a surface that stays defective after the repairs asked for: what() is the message
+// load_closed_surface documents; defects() are those of the refused surface (after the safe repairs
+// and any hard repairs tried), so that a caller can offer the repairs that apply instead of parsing
+// the text. Only surfaces refused for their defects throw it: an unreadable file is a FileError, a
+// surface with too many triangles or a wrap that stays defective a plain InvalidMeshError.
+class SurfaceRefusedError : public InvalidMeshError {
+public:
+    SurfaceRefusedError(const std::string& message, const SurfaceDefects& defects, bool wrapping_would_fix)
+        : InvalidMeshError(message), defects_(defects), wrapping_would_fix_(wrapping_would_fix) {}
+    const SurfaceDefects& defects() const { return defects_; }
+    // --repair wrap would give a surface the meshers take (every defect but missing or non-finite vertices).
+    bool wrapping_would_fix() const { return wrapping_would_fix_; }
+
+private:
+    SurfaceDefects defects_;
+    bool wrapping_would_fix_ = false;
+};
+
 // Reads the file, applies the safe repairs, then (only if asked in options) the hard repairs, and
 // validates the result. With options.wrap the file's triangles are wrapped instead (before any check:
 // tetops/alpha_wrap.h) and the wrap is validated the same way. Throws FileError for unreadable files
-// and InvalidMeshError for surfaces that stay defective; what() is "FILE: DEFECT; DEFECT; ...", FILE as
+// and SurfaceRefusedError (an InvalidMeshError) for surfaces that stay defective; what() is "FILE: DEFECT; DEFECT; ...", FILE as
 // the caller spelled it, e.g. "bad_cow.obj: 81 self-intersecting triangle pairs (first: faces 10 and
 // 2411)", followed by "; --repair wrap rebuilds it as a closed surface" when wrapping would give a
 // surface the meshers take (any defect but a missing or non-finite vertex).

@@ -1,6 +1,7 @@
 #include "scene/session.h"
 
 #include "base/error.h"
+#include "base/progress.h"
 #include "base/timing.h"
 #include "gl/gl_context.h"
 #include "io/atomic_file.h"
@@ -383,19 +384,22 @@ Session record_session(const Session& setup, const Document& document, const std
     return session;
 }
 
-SessionVolume read_session_input(const Session& session) {
+SessionVolume read_session_input(const Session& session, Progress* progress) {
     if (!session.input.volume.empty()) {
+        report_stage(progress, "reading the volume");
         VolumeFile file = read_volume_file(session.input.volume);
+        check_cancelled(progress);
         const ModelScale scale =
             choose_model_scale(session.scale, file.metadata.mm_per_unit, bounding_extent(file.mesh.positions));
         return {std::move(file.mesh), scale};
     }
-    const LoadedSurface loaded = load_closed_surface(session.input.surface, session.input.repair);
+    const LoadedSurface loaded = load_closed_surface(session.input.surface, session.input.repair, progress);
     const ModelScale scale = choose_model_scale(session.scale, std::nullopt, bounding_extent(loaded.surface.points));
     MeshingOptions meshing;
     meshing.mesher = session.input.mesher;
     meshing.min_dihedral_deg = session.input.min_dihedral_deg;
     meshing.max_radius_edge_ratio = session.input.max_radius_edge_ratio;
+    meshing.progress = progress;
     if (session.input.edge) {
         meshing.sizing.edge_length = session.input.edge;
     } else if (session.input.max_tets) {
@@ -406,10 +410,10 @@ SessionVolume read_session_input(const Session& session) {
     return {tetrahedralize_surface_file(session.input.surface, loaded.surface, meshing).mesh, scale};
 }
 
-SessionVolume load_session_input(const Session& session) {
+SessionVolume load_session_input(const Session& session, Progress* progress) {
     const std::string context = session.name + ": input";
     try {
-        return naming_context(context, [&] { return read_session_input(session); });
+        return naming_context(context, [&] { return read_session_input(session, progress); });
     } catch (const FileError& e) {  // still "PATH: PROBLEM" with path() the input; the session follows
         throw FileError(e.path(), e.problem() + " (" + context + ")");
     }

@@ -60,6 +60,8 @@
 
 namespace waxwork {
 
+class Progress;
+
 struct SessionInput {
     std::filesystem::path surface;  // exactly one of surface / volume (absolute after reading)
     std::filesystem::path volume;
@@ -139,11 +141,13 @@ struct SessionVolume {
 
 // The volume a session starts from (meshing the surface at the scale, or reading the volume); errors
 // name the input file only. For a session that is not a file: the editor opening a mesh.
-SessionVolume read_session_input(const Session& session);
+// `progress`, when given, is told each stage (reading, repairing, meshing) and its cancel request
+// stops the work with CancelledError (base/progress.h).
+SessionVolume read_session_input(const Session& session, Progress* progress = nullptr);
 
 // As read_session_input, with the session before every error ("s.json: input: bad.stl: no faces"): a
 // session's input is often a path relative to it, and the user runs the session, not the mesh.
-SessionVolume load_session_input(const Session& session);
+SessionVolume load_session_input(const Session& session, Progress* progress = nullptr);
 
 struct StepMetrics {
     std::string name;

@@ -1,8 +1,9 @@
-// The editor's window-free pieces: directory listing for the file dialog, material swatches and the
-// background task.
+// The editor's window-free pieces: directory listing for the file dialog, material swatches, the
+// background task and the repairs a refused surface's dialog offers.
 #include "editor/background_task.h"
 #include "editor/file_dialog.h"
 #include "editor/material_swatch.h"
+#include "editor/repair_choices.h"
 #include "solver/material.h"
 
 #include <gtest/gtest.h>
@@ -78,6 +79,74 @@ TEST(BackgroundTask, RethrowsTheWorkersErrorOnPoll) {
     task.cancel();
     task.wait();
     EXPECT_TRUE(task.poll());
+}
+
+TEST(BackgroundTask, RemembersThatCancelWasRequestedUntilTheNextStart) {
+    BackgroundTask task;
+    EXPECT_FALSE(task.cancel_requested());  // nothing started
+    task.start("slow", [](TaskProgress& progress) {
+        while (!progress.cancel_requested()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        progress.throw_if_cancelled();
+        return BackgroundTask::Apply{};
+    });
+    EXPECT_FALSE(task.cancel_requested());
+    task.cancel();
+    EXPECT_TRUE(task.cancel_requested());
+    task.wait();
+    EXPECT_THROW(task.poll(), CancelledError);
+    EXPECT_TRUE(task.cancel_requested());  // still known after the work ended
+    task.start("next", [](TaskProgress&) { return BackgroundTask::Apply{}; });
+    EXPECT_FALSE(task.cancel_requested());
+    task.wait();
+    EXPECT_TRUE(task.poll());
+}
+
+std::vector<std::string> choice_ids(const std::vector<RepairChoice>& choices) {
+    std::vector<std::string> ids;
+    for (const RepairChoice& c : choices) ids.push_back(c.id);
+    return ids;
+}
+
+TEST(RepairChoices, OfferTheHardRepairsThatApplyThenWrapping) {
+    SurfaceRepairOptions none;
+    none.max_triangles = 500;
+    SurfaceDefects open;
+    open.boundary_edges = 4;
+    const auto holes = repair_choices(open, true, none);
+    ASSERT_EQ(choice_ids(holes), (std::vector<std::string>{"fill_holes", "wrap"}));
+    EXPECT_TRUE(holes[0].repair.fill_holes);
+    EXPECT_FALSE(holes[0].repair.autorefine);
+    EXPECT_FALSE(holes[0].repair.wrap);
+    EXPECT_EQ(holes[0].repair.max_triangles, 500u);  // the other settings stay
+    EXPECT_TRUE(holes[1].repair.wrap);
+    EXPECT_FALSE(holes[1].repair.fill_holes);
+    EXPECT_EQ(holes[1].repair.max_triangles, 500u);
+    EXPECT_EQ(holes[1].label, "Repair by wrapping");
+
+    SurfaceDefects crossing;
+    crossing.self_intersecting_pairs = 3;
+    EXPECT_EQ(choice_ids(repair_choices(crossing, true, none)), (std::vector<std::string>{"autorefine", "wrap"}));
+    crossing.boundary_edges = 2;
+    const auto both = repair_choices(crossing, true, none);
+    ASSERT_EQ(choice_ids(both), (std::vector<std::string>{"fill_holes_autorefine", "wrap"}));
+    EXPECT_TRUE(both[0].repair.fill_holes && both[0].repair.autorefine);
+}
+
+TEST(RepairChoices, OnlyWrappingWhereTheHardRepairsCannotStartOrAlreadyRan) {
+    SurfaceDefects pinched;
+    pinched.boundary_edges = 4;
+    pinched.non_manifold_vertices = 1;  // repair_hard_defects refuses non-manifold surfaces
+    EXPECT_EQ(choice_ids(repair_choices(pinched, true, {})), (std::vector<std::string>{"wrap"}));
+    SurfaceDefects open;
+    open.boundary_edges = 4;
+    SurfaceRepairOptions filled;
+    filled.fill_holes = true;
+    EXPECT_EQ(choice_ids(repair_choices(open, true, filled)), (std::vector<std::string>{"wrap"}));
+    // Nothing to wrap (missing vertices) and nothing the hard repairs take: no offer.
+    SurfaceDefects missing;
+    missing.invalid_indices = 1;
+    missing.boundary_edges = 3;
+    EXPECT_TRUE(repair_choices(missing, false, {}).empty());
 }
 
 }  // namespace

@@ -487,3 +487,112 @@ TEST_F(EditorWindow, FileExportWritesTheCutSurfaceWithItsLight) {
 
 }  // namespace
 }  // namespace waxwork
+
+namespace waxwork {
+namespace {
+
+using namespace testing;
+namespace fs = std::filesystem;
+
+class EditorLoading : public WindowTest {};
+
+// `edit VOLUME --input SCRIPT` with the panels shown (the status bar's progress and Cancel, the error
+// dialog's repair buttons are drawn), screenshot mode so that it ends when the script has.
+CommandResult edit_with_script(const fs::path& dir, const fs::path& volume, const std::string& script,
+                               const std::string& options) {
+    std::ofstream(dir / "input.json") << script;
+    return run_under_xvfb("edit " + volume.string() + " " + options + " --width 640 --height 400 --input " +
+                          (dir / "input.json").string() + " --frames 2 --screenshot " + (dir / "shot.png").string());
+}
+
+// Cancel in the status bar stops a slow meshing (CGAL's refinement polls the cancel flag) and leaves
+// the document that was open before as it was: nothing of the surface is installed, whenever during
+// the load the cancel arrives (the load checks it between stages and once more before installing).
+TEST_F(EditorLoading, CancelledMeshingLeavesTheOpenDocumentUntouched) {
+    const fs::path dir = scratch_dir("editor_cancel_loading");
+    const TetMesh cube = make_cube_mesh(3);
+    write_volume(cube, dir / "cube.vtu");
+    // The torus at 1.5 million tets takes CGAL far longer than the frame between the two events.
+    const auto r = edit_with_script(dir, dir / "cube.vtu", R"([
+        {"frame": 1, "event": "save_volume", "file": "before.vtu"},
+        {"event": "idle"},
+        {"event": "open", "file": ")" + kAssets + R"(/meshes/torus.obj"},
+        {"event": "cancel_task"},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "after.vtu"},
+        {"event": "idle"}])",
+                                    "--mesher cgal --max-tets 1500000");
+    ASSERT_EQ(r.exit_code, 0) << r.err;  // a cancelled load is no error
+    const TetMesh before = read_volume(dir / "before.vtu");
+    EXPECT_EQ(before.tet_count(), cube.tet_count());
+    EXPECT_TRUE(read_volume(dir / "after.vtu") == before);
+    const nlohmann::json summary = summary_of(r);
+    EXPECT_EQ(summary["tets"], cube.tet_count());
+}
+
+// A box without its top face: refused as open; its error dialog offers filling the hole and wrapping.
+// A needle (10 x 0.05 x 0.05): the default wrap (alpha a hundredth of the diagonal) of anything
+// bulkier has hundreds of thousands of triangles, more than TetGen meshes in a test's time.
+fs::path write_open_box(const fs::path& dir) {
+    const fs::path path = dir / "open_box.obj";
+    std::ofstream out(path);
+    for (int k = 0; k < 8; ++k)
+        out << "v " << 10 * (k & 1) << " " << 0.05 * ((k >> 1) & 1) << " " << 0.05 * ((k >> 2) & 1) << "\n";
+    // Outward triangles of the box (vertex k at the corner (k&1, k>>1&1, k>>2&1)), the two of z = top left out.
+    const int faces[10][3] = {{0, 2, 1}, {1, 2, 3}, {0, 1, 4}, {1, 5, 4}, {2, 6, 3},
+                              {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    for (const auto& f : faces) out << "f " << f[0] + 1 << " " << f[1] + 1 << " " << f[2] + 1 << "\n";
+    return path;
+}
+
+// The editor opens what the command line opens: a refused surface's dialog reopens it with the
+// repair chosen (as `mesh --fill-holes` / `--repair wrap`), and left unanswered the refusal is still
+// the run's one-line error.
+TEST_F(EditorLoading, RefusedSurfaceReopensWithTheRepairChosenInItsDialog) {
+    const fs::path dir = scratch_dir("editor_repair_dialog");
+    const fs::path box = write_open_box(dir);
+    write_volume(make_cube_mesh(2), dir / "cube.vtu");
+    const std::string meshing = "--max-tets 30000";
+    const auto r = edit_with_script(dir, dir / "cube.vtu", R"([
+        {"frame": 1, "event": "open", "file": "open_box.obj"},
+        {"event": "idle"},
+        {"event": "repair", "repair": "fill_holes"},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "filled.vtu"},
+        {"event": "open", "file": "open_box.obj"},
+        {"event": "idle"},
+        {"event": "repair", "repair": "wrap"},
+        {"event": "idle"},
+        {"event": "save_volume", "file": "wrapped.vtu"},
+        {"event": "idle"}])",
+                                    meshing);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (const std::string repair : {"fill-holes", "repair wrap"}) {
+        const std::string name = repair == "fill-holes" ? "filled" : "wrapped";
+        const fs::path cli = dir / (name + "_cli.vtu");
+        const auto mesh = run_waxwork("mesh " + box.string() + " --" + repair + " " + meshing + " -o " + cli.string());
+        ASSERT_EQ(mesh.exit_code, 0) << mesh.err;
+        const TetMesh edited = read_volume(dir / (name + ".vtu")), expected = read_volume(cli);
+        EXPECT_GT(edited.tet_count(), 0u) << name;
+        EXPECT_EQ(edited.tet_count(), expected.tet_count()) << name;
+        EXPECT_EQ(edited.vertex_count(), expected.vertex_count()) << name;
+    }
+    EXPECT_EQ(summary_of(r)["tets"], read_volume(dir / "wrapped.vtu").tet_count());  // the document open last
+
+    // Not answered (the script ends first, or there is none): the refusal fails the run as before.
+    const auto unanswered = edit_with_script(dir, dir / "cube.vtu", R"([{"frame": 1, "event": "open", "file": "open_box.obj"}])",
+                                             meshing);
+    EXPECT_NE(unanswered.exit_code, 0);
+    EXPECT_NE(unanswered.err.find("boundary edges"), std::string::npos) << unanswered.err;
+    EXPECT_EQ(line_count(unanswered.err), 1u) << unanswered.err;
+    // A repair the dialog does not offer is an error naming the ones it does.
+    const auto wrong = edit_with_script(dir, dir / "cube.vtu", R"([
+        {"frame": 1, "event": "open", "file": "open_box.obj"}, {"event": "idle"},
+        {"event": "repair", "repair": "autorefine"}, {"event": "idle"}])",
+                                        meshing);
+    EXPECT_NE(wrong.exit_code, 0);
+    EXPECT_NE(wrong.err.find("offered: fill_holes, wrap"), std::string::npos) << wrong.err;
+}
+
+}  // namespace
+}  // namespace waxwork

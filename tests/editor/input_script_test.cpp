@@ -63,6 +63,29 @@ TEST(InputScript, ParsesEveryEventKind) {
     EXPECT_EQ(s.events[10].file, std::filesystem::path("/scripts/out/v.ply"));
 }
 
+TEST(InputScript, ParsesOpenCancelAndRepairAndPlaysThemIntoTheTarget) {
+    const InputScript s = parse(R"([
+        {"event": "open", "file": "meshes/box.obj"},
+        {"event": "cancel_task"},
+        {"event": "repair", "repair": "wrap"},
+        {"event": "repair", "repair": "fill_holes_autorefine"}])");
+    ASSERT_EQ(s.events.size(), 4u);
+    EXPECT_EQ(s.events[0].action, ScriptAction::Open);
+    EXPECT_EQ(s.events[0].file, std::filesystem::path("/scripts/meshes/box.obj"));
+    EXPECT_EQ(s.events[1].action, ScriptAction::CancelTask);
+    EXPECT_EQ(s.events[2].action, ScriptAction::Repair);
+    EXPECT_EQ(s.events[2].repair, "wrap");
+    EXPECT_EQ(s.events[3].repair, "fill_holes_autorefine");
+    for (const auto& [text, expected] : std::vector<std::pair<std::string, std::string>>{
+             {R"([{"event": "open"}])", "s.json: entry 0 (open): missing field 'file'"},
+             {R"([{"event": "repair", "repair": "glue"}])", "s.json: entry 0 (repair): field 'repair': expected \"wrap\""},
+             {R"([{"event": "repair"}])", "missing field 'repair'"},
+             {R"([{"event": "cancel_task", "file": "x"}])", "unknown field 'file'"}}) {
+        const std::string message = parse_error(text);
+        EXPECT_NE(message.find(expected), std::string::npos) << text << " -> " << message;
+    }
+}
+
 TEST(InputScript, DragExpandsIntoPressMovesAndRelease) {
     const InputScript s = parse(R"([{"frame": 5, "event": "drag", "from": [0, 100], "to": [40, 60], "steps": 4,
                                     "button": "middle"}])");
@@ -151,6 +174,9 @@ public:
     void save_session(const std::filesystem::path& f) override { add("session " + f.filename().string()); }
     void save_volume(const std::filesystem::path& f) override { add("volume " + f.filename().string()); }
     void export_surface(const std::filesystem::path& f) override { add("surface " + f.filename().string()); }
+    void open_file(const std::filesystem::path& f) override { add("open " + f.filename().string()); }
+    void cancel_task() override { add("cancel"); }
+    void choose_repair(const std::string& id) override { add("repair " + id); }
 
 private:
     void add(const std::string& s) { log.push_back(std::to_string(frame) + ": " + s); }
@@ -177,6 +203,15 @@ TEST(InputScriptPlayer, FiresInOrderOnePerFrameFromTheFirstReadyFrame) {
                                                "8: cursor 10,0", "8: release 0",   "11: volume v.vtu", "12: crease 90",
                                                "13: surface v.ply"};
     EXPECT_EQ(target.log, expected);
+}
+
+TEST(InputScriptPlayer, PlaysOpenCancelAndRepair) {
+    InputScriptPlayer player(parse(R"([{"event": "open", "file": "big.obj"}, {"event": "cancel_task"},
+        {"event": "repair", "repair": "autorefine"}])"));
+    FakeTarget target;
+    target.is_ready = true;
+    for (target.frame = 0; target.frame < 4; ++target.frame) player.advance(target);
+    EXPECT_EQ(target.log, (std::vector<std::string>{"0: open big.obj", "1: cancel", "2: repair autorefine"}));
 }
 
 TEST(InputScript, ExampleScriptsParse) {

@@ -277,6 +277,32 @@ TEST_F(SurfaceReaderFiles, OpenSurfaceNamesFileAndDefect) {
     EXPECT_TRUE(message.ends_with("; --repair wrap rebuilds it as a closed surface")) << message;
 }
 
+// The refusal is typed, with the defects found, so a front end can offer the repairs that apply.
+TEST_F(SurfaceReaderFiles, RefusalCarriesTheDefectsAndWhetherWrappingFixesThem) {
+    std::string text = cube_obj();
+    text.erase(text.rfind("f "));
+    const fs::path path = write_text("open.obj", text);
+    try {
+        load_closed_surface(path);
+        ADD_FAILURE() << "an open cube was accepted";
+    } catch (const SurfaceRefusedError& e) {
+        EXPECT_EQ(std::string(e.what()), load_error(path));  // the same message as before
+        EXPECT_EQ(e.defects().boundary_edges, 3u);
+        EXPECT_EQ(e.defects().self_intersecting_pairs, 0u);
+        EXPECT_TRUE(e.wrapping_would_fix());
+    }
+    // A surface too large to check is refused before any defect is measured: not a SurfaceRefusedError.
+    SurfaceRepairOptions small;
+    small.max_triangles = 5;
+    try {
+        load_closed_surface(write_text("cube.obj", cube_obj()), small);
+        ADD_FAILURE() << "12 triangles passed a limit of 5";
+    } catch (const SurfaceRefusedError&) {
+        ADD_FAILURE() << "a triangle count refusal carries no defects";
+    } catch (const InvalidMeshError&) {
+    }
+}
+
 TEST_F(SurfaceReaderFiles, PinchedCubesAreRejected) {
     std::string text = cube_obj();
     for (int k = 0; k < 8; ++k)
