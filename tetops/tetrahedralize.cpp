@@ -323,8 +323,9 @@ void check_tetgen_bare_floor(const TriangleSurface& surface, const MeshingOption
 // a target the first pass overshoots, or one under kBareCheckTetsPerTriangle tets per triangle, is
 // checked against it (for the latter first, after the bare check: a pass at the target's edge would
 // only overshoot too). Both runs that may overshoot are cut short by a limit on added points.
+// `closest`, when given, is told the count of the closest pass when the target is missed.
 TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& options, size_t target,
-                       double volume) {
+                       double volume, size_t* closest = nullptr) {
     const bool tetgen = options.mesher == Mesher::TetGen;
     const bool small_target = tetgen && (1 + kTargetPromise) * double(target) <
                                             kBareCheckTetsPerTriangle * double(surface.triangles.size());
@@ -409,6 +410,7 @@ TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& opt
         edge = std::exp(log_edge + (log_count - log_target) / slope);
     }
     if (best_error > kTargetPromise) {
+        if (closest) *closest = best.tet_count();
         throw AlgorithmError("sizing.target_tets = " + std::to_string(target) + ": the closest of " +
                              std::to_string(kMaxTargetPasses) + " meshing passes had " +
                              std::to_string(best.tet_count()) + " tets");
@@ -519,18 +521,24 @@ AutoMeshing auto_mesh_to_target(const TriangleSurface& surface, const MeshingOpt
             failure = e.what();
             break;
         }
+        size_t closest = 0;
         try {
             const double remeshed_volume = enclosed_volume(remeshed.surface);
-            return {mesh_to_target(remeshed.surface, tetgen, target, remeshed_volume), Mesher::TetGen,
+            return {mesh_to_target(remeshed.surface, tetgen, target, remeshed_volume, &closest), Mesher::TetGen,
                     why + remeshed_text(remeshed.report), remeshed.report};
         } catch (const OutOfTetGenReach& e) {
             failure = e.reason();  // the remeshed surface is still too fine for the budget: coarser
             edge *= kRemeshCoarsening;
         } catch (const AlgorithmError& e) {
-            // Every volume bound missed the budget: a surface this coarse leaves TetGen too few
-            // tets to work with (spot at 1,000 tets: 747 at best), so finer.
+            // Every volume bound missed the budget: the surface decides the count (too coarse: spot
+            // at 1,000 tets had 747 at best; too fine: a sphere at 2,000 had 2,610), so its edge
+            // moves the way the closest count asks.
             failure = e.what();
-            edge /= kRemeshCoarsening;
+            if (closest > target) {
+                edge *= kRemeshCoarsening;
+            } else {
+                edge /= kRemeshCoarsening;
+            }
         }
     }
     return {mesh_to_target(surface, with_mesher(options, Mesher::Cgal), target, volume), Mesher::Cgal,

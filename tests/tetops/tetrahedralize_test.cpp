@@ -199,7 +199,7 @@ TEST(TetrahedralizeTest, TargetTetCountWithinTwentyPercent) {
 
 // Mesher::Auto honours a budget TetGen cannot meet on spot's 5,856 triangles (its floor is about
 // 50K tets) by remeshing the surface at the edge the budget allows and filling that with TetGen; the
-// result says so. The remeshed mesh fills spot's volume to within the remeshing's smoothing.
+// result says so. The remeshed mesh fills spot's volume to within what the coarser triangles cut off.
 TEST(TetrahedralizeTest, AutoKeepsABudgetUnderTetGensFloorByRemeshing) {
     const TriangleSurface spot = asset_surface("spot.obj");
     for (const size_t target : {size_t(1'000), size_t(20'000)}) {
@@ -218,7 +218,10 @@ TEST(TetrahedralizeTest, AutoKeepsABudgetUnderTetGensFloorByRemeshing) {
         EXPECT_NE(result.mesher_reason.find("auto: "), std::string::npos);
         EXPECT_NE(result.mesher_reason.find("remeshed at edge"), std::string::npos) << result.mesher_reason;
         EXPECT_TRUE(find_invariant_violations(result.mesh).empty());
-        EXPECT_NEAR(total_volume(result.mesh), enclosed_volume_of(spot), 0.05 * enclosed_volume_of(spot));
+        // The remeshed surface's flat triangles cut inside the curved one, by more the coarser they are
+        // (380 triangles at 1,000 tets: 8.3% of the volume).
+        const double volume_tolerance = target == 1'000 ? 0.10 : 0.02;
+        EXPECT_NEAR(total_volume(result.mesh), enclosed_volume_of(spot), volume_tolerance * enclosed_volume_of(spot));
     }
     // Where TetGen keeps the triangles within the budget, auto keeps them.
     MeshingOptions kept;
@@ -248,7 +251,8 @@ TEST(TetrahedralizeTest, AutoRemeshesAFineSphereForASmallBudget) {
         ASSERT_TRUE(result.surface_remeshed.has_value()) << result.mesher_reason;
         EXPECT_EQ(result.surface_remeshed->triangles_in, sphere.triangles.size());
         EXPECT_LT(result.surface_remeshed->triangles_out, sphere.triangles.size() / 10);
-        EXPECT_NEAR(total_volume(result.mesh), 4.0 / 3.0 * M_PI, 0.03 * 4.0 / 3.0 * M_PI);
+        // About 300 flat triangles of edge 0.35 inside the unit sphere: 4% less volume.
+        EXPECT_NEAR(total_volume(result.mesh), 4.0 / 3.0 * M_PI, 0.05 * 4.0 / 3.0 * M_PI);
         if (level == 6) {
             EXPECT_NE(result.mesher_reason.find("more than TetGen takes"), std::string::npos) << result.mesher_reason;
         }
