@@ -74,8 +74,9 @@ inline constexpr double kMinRadiusEdgeRatio = 1.2;
 // Mesher::Auto remeshes the surface for a size (graded or --edge) when its mean edge is this many
 // times finer than the size's surface edge: TetGen keeps every triangle, so its tets at the surface
 // follow them, not the size. The skull (4.5 times finer than the default marble size, 100K
-// triangles) made 1.7M tets where the size predicts 18K; armadillo (3.5 times) 41K against 11K and
-// spot (1.4 times) the predicted 12K are kept as they are (docs/meshing.md).
+// triangles) has a coarsest quality mesh of 1.7M tets, remeshed 20K at the default size; armadillo
+// (3.5 times finer, 41K tets at the default size) and spot (1.4 times) are kept as they are, so their
+// default meshes stay what explicit TetGen makes (docs/meshing.md).
 inline constexpr double kAutoRemeshEdgeRatio = 4.0;
 
 struct MeshingOptions {
