@@ -674,6 +674,24 @@ TEST(TetrahedralizeTest, ReportsItsStagesAndStopsWhenCancelled) {
     }
 }
 
+// Auto's remeshing is a stage of its own, and a cancel asked for during it stops the meshing there.
+TEST(TetrahedralizeTest, AutoReportsTheRemeshingAndStopsWhenCancelledInIt) {
+    const TriangleSurface sphere = make_icosphere(5, 1.0);
+    MeshingOptions options;
+    options.mesher = Mesher::Auto;
+    options.sizing.target_tets = 2'000;
+    RecordingProgress progress;
+    options.progress = &progress;
+    tetrahedralize(sphere, options);
+    EXPECT_NE(std::find(progress.stages.begin(), progress.stages.end(), "remeshing the surface (CGAL)"),
+              progress.stages.end());
+    RecordingProgress cancelling;
+    cancelling.cancel_at = "remeshing the surface (CGAL)";
+    options.progress = &cancelling;
+    EXPECT_THROW(tetrahedralize(sphere, options), CancelledError);
+    EXPECT_EQ(cancelling.stages.back(), "remeshing the surface (CGAL)");
+}
+
 // Up front, by prediction: a target beyond the largest mesh that is made here in about a minute, and
 // a surface with more triangles than the meshers take in that time, are refused before any meshing
 // (the documented maximum of 50M tets did not finish in minutes; a 2M-triangle sphere ran past 180 s
