@@ -281,8 +281,10 @@ Session parse_session(const Json& json, const fs::path& base_directory, const st
                 session.input.mesher = Mesher::TetGen;
             } else if (m == "cgal") {
                 session.input.mesher = Mesher::Cgal;
+            } else if (m == "auto") {
+                session.input.mesher = Mesher::Auto;
             } else {
-                fail_json(input.field("mesher"), "expected \"tetgen\" or \"cgal\"");
+                fail_json(input.field("mesher"), "expected \"auto\", \"tetgen\" or \"cgal\"");
             }
         }
         read_meshing_fields(input, session.input);
@@ -344,7 +346,7 @@ Json session_to_json(const Session& session) {
         input["surface"] = session.input.surface.generic_string();
         if (session.input.max_tets) input["max_tets"] = *session.input.max_tets;
         if (session.input.edge) input["edge"] = *session.input.edge;
-        input["mesher"] = session.input.mesher == Mesher::TetGen ? "tetgen" : "cgal";
+        input["mesher"] = mesher_name(session.input.mesher);
         write_meshing_fields(session.input, input);
     } else {
         input["volume"] = session.input.volume.generic_string();

@@ -4,7 +4,7 @@
 // renderer.
 //
 //   {
-//     "input": {"surface": "spot.obj", "max_tets": 20000, "mesher": "tetgen"}   (or "edge": L; neither:
+//     "input": {"surface": "spot.obj", "max_tets": 20000, "mesher": "tetgen"|"auto"|"cgal"}   (or "edge": L; neither:
 //              sized for the material and scale, solver/mesh_resolution.h; optional, as the command
 //              line's options: "min_dihedral", "radius_edge", "fill_holes", "autorefine",
 //              "repair": "wrap", "wrap_alpha", "wrap_offset") | {"volume": "spot.vtu"},

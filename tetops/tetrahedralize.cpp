@@ -6,6 +6,7 @@
 #include "tetops/size_field.h"
 #include "tetops/spatial_order.h"
 #include "tetops/surface_check.h"
+#include "tetops/surface_remesh.h"
 #include "tetops/tetgen_mesher.h"
 
 #include <Eigen/Geometry>
@@ -14,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,6 +40,19 @@ constexpr double kBareCheckTetsPerTriangle = 4.0;
 // any of them the run stopped there has more tets than allowed.
 constexpr double kTetsPerAddedPointForFloorCheck = 3.0;
 
+// TetGen cannot keep the surface's triangles within the size or budget asked for: an
+// InvalidArgumentError for an explicit --mesher tetgen (what() says what it needs and suggests CGAL);
+// Mesher::Auto catches it and remeshes the surface instead, giving `reason` as why.
+class OutOfTetGenReach : public InvalidArgumentError {
+public:
+    OutOfTetGenReach(const std::string& message, std::string reason)
+        : InvalidArgumentError(message), reason_(std::move(reason)) {}
+    const std::string& reason() const { return reason_; }
+
+private:
+    std::string reason_;
+};
+
 // " (about T s at the measured N tets per second; the limit takes about M s)" for a mesh of `tets`.
 std::string predicted_time(double tets) {
     return " (about " + number_text(std::round(tets / kMeasuredTetsPerSecond)) + " s at the measured " +
@@ -46,7 +61,7 @@ std::string predicted_time(double tets) {
 }
 
 void validate_options(const MeshingOptions& options) {
-    if (options.mesher != Mesher::TetGen && options.mesher != Mesher::Cgal) {
+    if (options.mesher != Mesher::TetGen && options.mesher != Mesher::Cgal && options.mesher != Mesher::Auto) {
         throw InvalidArgumentError("meshing option mesher: unknown mesher");
     }
     // TetGen's Delaunay refinement is proven to end for bounds of 2 and ends in practice down to
@@ -262,21 +277,26 @@ TetMesh run_mesher(const TriangleSurface& surface, const MeshingOptions& options
     bool stopped = false;
     TetMesh mesh = tetgen_tetrahedralize(surface, settings, &stopped);
     if (stopped)
-        throw InvalidArgumentError(
+        throw OutOfTetGenReach(
             "TetGen stopped at its limit of " + std::to_string(settings.max_added_points) +
-            " added points, where this size needs about " + std::to_string(static_cast<long>(std::ceil(predicted))) +
-            " vertices: it keeps the surface's " + std::to_string(surface.triangles.size()) +
-            " triangles, and they need far more refinement than the size asks for; use the CGAL mesher "
-            "(--mesher cgal), which remeshes the surface");
+                " added points, where this size needs about " +
+                std::to_string(static_cast<long>(std::ceil(predicted))) + " vertices: it keeps the surface's " +
+                std::to_string(surface.triangles.size()) +
+                " triangles, and they need far more refinement than the size asks for; use the CGAL mesher "
+                "(--mesher cgal), which remeshes the surface",
+            "TetGen stopped at its limit of " + std::to_string(settings.max_added_points) +
+                " added points: the surface's " + std::to_string(surface.triangles.size()) +
+                " triangles need far more refinement than the size asks for");
     return mesh;
 }
 
 // The error for a target below TetGen's floor on this surface (`floor`: what it needs).
 [[noreturn]] void refuse_tetgen_target(size_t target, const std::string& floor) {
-    throw InvalidArgumentError("meshing option sizing.target_tets = " + std::to_string(target) +
+    throw OutOfTetGenReach("meshing option sizing.target_tets = " + std::to_string(target) +
                                ": TetGen keeps the surface's triangles and needs " + floor +
                                "; ask for more tets or use the CGAL mesher "
-                               "(--mesher cgal), which remeshes the surface");
+                               "(--mesher cgal), which remeshes the surface",
+                           "TetGen keeps the surface's triangles and needs " + floor);
 }
 
 // TetGen keeps every input triangle, so a small target may be out of its reach. Its bare constrained
@@ -303,8 +323,9 @@ void check_tetgen_bare_floor(const TriangleSurface& surface, const MeshingOption
 // a target the first pass overshoots, or one under kBareCheckTetsPerTriangle tets per triangle, is
 // checked against it (for the latter first, after the bare check: a pass at the target's edge would
 // only overshoot too). Both runs that may overshoot are cut short by a limit on added points.
+// `closest`, when given, is told the count of the closest pass when the target is missed.
 TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& options, size_t target,
-                       double volume) {
+                       double volume, size_t* closest = nullptr) {
     const bool tetgen = options.mesher == Mesher::TetGen;
     const bool small_target = tetgen && (1 + kTargetPromise) * double(target) <
                                             kBareCheckTetsPerTriangle * double(surface.triangles.size());
@@ -389,6 +410,7 @@ TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& opt
         edge = std::exp(log_edge + (log_count - log_target) / slope);
     }
     if (best_error > kTargetPromise) {
+        if (closest) *closest = best.tet_count();
         throw AlgorithmError("sizing.target_tets = " + std::to_string(target) + ": the closest of " +
                              std::to_string(kMaxTargetPasses) + " meshing passes had " +
                              std::to_string(best.tet_count()) + " tets");
@@ -396,7 +418,143 @@ TetMesh mesh_to_target(const TriangleSurface& surface, const MeshingOptions& opt
     return best;
 }
 
+
+// Mesher::Auto. TetGen's bare tetrahedralization of a surface has at least this many tets per
+// triangle (1.4 to 2.8 on the shared meshes) and its quality meshes more: a budget under it is out of
+// TetGen's reach on the input without trying.
+constexpr double kBareTetsPerTriangleAtLeast = 1.4;
+// A remeshed surface whose own TetGen floor is still above the budget is remeshed this much coarser,
+// one on which no volume bound meets the budget this much finer, at most kMaxRemeshes times in all.
+constexpr double kRemeshCoarsening = 1.25;
+constexpr int kMaxRemeshes = 3;
+
+struct AutoMeshing {
+    TetMesh mesh;
+    Mesher mesher = Mesher::TetGen;
+    std::string reason;
+    std::optional<SurfaceRemeshReport> remeshed;
+};
+
+MeshingOptions with_mesher(const MeshingOptions& options, Mesher mesher) {
+    MeshingOptions chosen = options;
+    chosen.mesher = mesher;
+    return chosen;
+}
+
+// Why the input surface is not kept before trying TetGen on it, or "" when it may be.
+std::string triangle_limit_reason(const TriangleSurface& surface) {
+    if (surface.triangles.size() <= kMaxTetGenTriangles) return "";
+    return "the surface's " + std::to_string(surface.triangles.size()) + " triangles are more than TetGen takes (" +
+           std::to_string(kMaxTetGenTriangles) + ")";
+}
+
+std::string remeshed_text(const SurfaceRemeshReport& report) {
+    return "; remeshed at edge " + number_text(report.edge) + " (" + std::to_string(report.triangles_out) +
+           " triangles) for TetGen";
+}
+
+// A size (graded or uniform): TetGen on the input unless the input is far finer than the size's
+// surface edge, has more triangles than TetGen takes, or stops TetGen at its point limit; then TetGen
+// on the surface remeshed at the surface edge; CGAL on the input when the remeshing fails.
+AutoMeshing auto_mesh_to_size(const TriangleSurface& surface, const MeshingOptions& options, const SizeField& size) {
+    const MeshingOptions tetgen = with_mesher(options, Mesher::TetGen);
+    const double edge = size.surface_edge;
+    std::string why = triangle_limit_reason(surface);
+    if (why.empty()) {
+        if (const double mean = mean_edge_length(surface); kAutoRemeshEdgeRatio * mean < edge) {
+            why = "the surface's mean edge (" + number_text(mean) + ") is over " + number_text(kAutoRemeshEdgeRatio) +
+                  " times finer than the size's surface edge (" + number_text(edge) + ")";
+        } else {
+            try {
+                return {run_mesher(surface, tetgen, size), Mesher::TetGen,
+                        "TetGen keeps the surface's " + std::to_string(surface.triangles.size()) + " triangles",
+                        std::nullopt};
+            } catch (const OutOfTetGenReach& out_of_reach) {
+                why = out_of_reach.reason();
+            }
+        }
+    }
+    std::string failure;
+    try {
+        RemeshedSurface remeshed = remesh_surface(surface, edge, options.progress);
+        return {run_mesher(remeshed.surface, tetgen, size), Mesher::TetGen, why + remeshed_text(remeshed.report),
+                remeshed.report};
+    } catch (const OutOfTetGenReach& e) {
+        failure = e.reason();
+    } catch (const AlgorithmError& e) {
+        failure = e.what();
+    }
+    return {run_mesher(surface, with_mesher(options, Mesher::Cgal), size), Mesher::Cgal,
+            why + "; remeshing for TetGen failed (" + failure + "), so CGAL", std::nullopt};
+}
+
+// A budget: TetGen on the input where its triangles fit; otherwise TetGen on the surface remeshed at
+// the uniform edge the budget allows (what mesh_to_target starts from), coarser while that surface's
+// own floor is above the budget; CGAL on the input when the remeshing fails.
+AutoMeshing auto_mesh_to_target(const TriangleSurface& surface, const MeshingOptions& options, size_t target,
+                                double volume) {
+    const MeshingOptions tetgen = with_mesher(options, Mesher::TetGen);
+    std::string why = triangle_limit_reason(surface);
+    if (why.empty()) {
+        if ((1 + kTargetPromise) * double(target) < kBareTetsPerTriangleAtLeast * double(surface.triangles.size())) {
+            why = "the surface's " + std::to_string(surface.triangles.size()) +
+                  " triangles need more tets than the budget allows (TetGen keeps them, at least " +
+                  number_text(kBareTetsPerTriangleAtLeast) + " tets per triangle)";
+        } else {
+            try {
+                return {mesh_to_target(surface, tetgen, target, volume), Mesher::TetGen,
+                        "TetGen keeps the surface's " + std::to_string(surface.triangles.size()) +
+                            " triangles within the budget",
+                        std::nullopt};
+            } catch (const OutOfTetGenReach& out_of_reach) {
+                why = out_of_reach.reason();
+            }
+        }
+    }
+    std::string failure;
+    double edge = std::cbrt(kTetsPerRegularVolume * 6 * std::sqrt(2.0) * volume / double(target));
+    for (int remesh = 0; remesh < kMaxRemeshes; ++remesh) {
+        RemeshedSurface remeshed;
+        try {
+            remeshed = remesh_surface(surface, edge, options.progress);
+        } catch (const AlgorithmError& e) {
+            failure = e.what();
+            break;
+        }
+        size_t closest = 0;
+        try {
+            const double remeshed_volume = enclosed_volume(remeshed.surface);
+            return {mesh_to_target(remeshed.surface, tetgen, target, remeshed_volume, &closest), Mesher::TetGen,
+                    why + remeshed_text(remeshed.report), remeshed.report};
+        } catch (const OutOfTetGenReach& e) {
+            failure = e.reason();  // the remeshed surface is still too fine for the budget: coarser
+            edge *= kRemeshCoarsening;
+        } catch (const AlgorithmError& e) {
+            // Every volume bound missed the budget: the surface decides the count (too coarse: spot
+            // at 1,000 tets had 747 at best; too fine: a sphere at 2,000 had 2,610), so its edge
+            // moves the way the closest count asks.
+            failure = e.what();
+            if (closest > target) {
+                edge *= kRemeshCoarsening;
+            } else {
+                edge /= kRemeshCoarsening;
+            }
+        }
+    }
+    return {mesh_to_target(surface, with_mesher(options, Mesher::Cgal), target, volume), Mesher::Cgal,
+            why + "; remeshing for TetGen failed (" + failure + "), so CGAL", std::nullopt};
+}
+
 }  // namespace
+
+std::string mesher_name(Mesher mesher) {
+    switch (mesher) {
+    case Mesher::TetGen: return "tetgen";
+    case Mesher::Cgal: return "cgal";
+    case Mesher::Auto: return "auto";
+    }
+    return "unknown";
+}
 
 MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOptions& options) {
     const auto start = std::chrono::steady_clock::now();
@@ -414,17 +572,27 @@ MeshingResult tetrahedralize(const TriangleSurface& surface, const MeshingOption
 
     MeshingResult result;
     const MeshSizing& sizing = options.sizing;
+    std::optional<SizeField> size;  // none: a target count
     if (sizing.edge_length) {
-        const SizeField size = SizeField::uniform(*sizing.edge_length);
-        check_predicted_size(size, volume, area, "sizing.edge_length = " + number_text(*sizing.edge_length));
-        result.mesh = run_mesher(surface, options, size);
-    } else if (sizing.target_tets) {
-        result.mesh = mesh_to_target(surface, options, *sizing.target_tets, volume);
+        size = SizeField::uniform(*sizing.edge_length);
+        check_predicted_size(*size, volume, area, "sizing.edge_length = " + number_text(*sizing.edge_length));
+    } else if (!sizing.target_tets) {
+        size = SizeField{sizing.surface_edge, sizing.grading,
+                         sizing.max_edge > 0 ? sizing.max_edge : SizeField::unbounded().max_edge};
+        check_predicted_size(*size, volume, area, "sizing.surface_edge = " + number_text(sizing.surface_edge));
+    }
+    if (options.mesher == Mesher::Auto) {
+        AutoMeshing chosen = size ? auto_mesh_to_size(surface, options, *size)
+                                  : auto_mesh_to_target(surface, options, *sizing.target_tets, volume);
+        result.mesh = std::move(chosen.mesh);
+        result.mesher = chosen.mesher;
+        result.mesher_reason = "auto: " + chosen.reason;
+        result.surface_remeshed = chosen.remeshed;
     } else {
-        SizeField size{sizing.surface_edge, sizing.grading,
-                       sizing.max_edge > 0 ? sizing.max_edge : SizeField::unbounded().max_edge};
-        check_predicted_size(size, volume, area, "sizing.surface_edge = " + number_text(sizing.surface_edge));
-        result.mesh = run_mesher(surface, options, size);
+        result.mesh = size ? run_mesher(surface, options, *size)
+                           : mesh_to_target(surface, options, *sizing.target_tets, volume);
+        result.mesher = options.mesher;
+        result.mesher_reason = "chosen";
     }
     check_cancelled(options.progress);
     report_stage(options.progress, "ordering the mesh");

@@ -2,17 +2,27 @@
 #pragma once
 
 #include "tetops/quality.h"
+#include "tetops/surface_remesh.h"
 #include "tetops/tet_mesh.h"
 #include "tetops/triangle_surface.h"
 
 #include <filesystem>
 #include <optional>
+#include <string>
 
 namespace waxwork {
 
 class Progress;
 
-enum class Mesher { TetGen, Cgal };
+// Auto: TetGen on the input surface where it can keep the surface's triangles within the size or the
+// budget asked for; where it cannot (a budget under what those triangles need, more triangles than
+// TetGen takes, or a surface far finer than the size: kAutoRemeshEdgeRatio), TetGen on the surface
+// remeshed at the edge the size or budget allows (tetops/surface_remesh.h); CGAL Mesh_3 on the input
+// when the remeshing fails. MeshingResult says which ran, why, and whether the surface was remeshed.
+enum class Mesher { TetGen, Cgal, Auto };
+
+// "tetgen", "cgal" or "auto".
+std::string mesher_name(Mesher mesher);
 
 // How fine the volume is. Exactly one of the three ways is used, in this order of precedence:
 // an explicit edge length, a target tet count, or a graded size (fine near the surface, where the
@@ -22,7 +32,8 @@ enum class Mesher { TetGen, Cgal };
 // - target_tets N: starts from L = (1.2 * 6 sqrt 2 * V / N)^(1/3), then secant steps on
 //   log(count) vs log(L), at most 4 passes, stopping within 10% and failing (AlgorithmError) beyond 20%.
 //   TetGen keeps every input triangle, so below the tet count of its unbounded quality mesh (spot:
-//   ~50K) it throws InvalidArgumentError; CGAL remeshes the surface and can go coarser.
+//   ~50K) it throws InvalidArgumentError; CGAL remeshes the surface and can go coarser, and so does
+//   Mesher::Auto (TetGen on the surface remeshed at the edge the target allows).
 // - graded: edge(d) = min(surface_edge + grading * d, max_edge) at depth d; max_edge == 0: no cap.
 //   TetGen: a quality mesh at max_edge is the background mesh (-m) carrying 0.9 edge(d) per vertex;
 //   CGAL: the same rule as a sizing field, d from an AABB tree.
@@ -60,6 +71,14 @@ inline constexpr size_t kMaxTetGenTriangles = 75'000;
 // The smallest radius-edge bound TetGen's refinement ends with (validate_options says why).
 inline constexpr double kMinRadiusEdgeRatio = 1.2;
 
+// Mesher::Auto remeshes the surface for a size (graded or --edge) when its mean edge is this many
+// times finer than the size's surface edge: TetGen keeps every triangle, so its tets at the surface
+// follow them, not the size. The skull (4.5 times finer than the default marble size, 100K
+// triangles) has a coarsest quality mesh of 1.7M tets, remeshed 20K at the default size; armadillo
+// (3.5 times finer, 41K tets at the default size) and spot (1.4 times) are kept as they are, so their
+// default meshes stay what explicit TetGen makes (docs/meshing.md).
+inline constexpr double kAutoRemeshEdgeRatio = 4.0;
+
 struct MeshingOptions {
     Mesher mesher = Mesher::TetGen;
     MeshSizing sizing;
@@ -75,6 +94,12 @@ struct MeshingResult {
     TetMesh mesh;
     QualityReport quality;
     double milliseconds = 0;
+    Mesher mesher = Mesher::TetGen;  // the one that made the mesh (never Auto)
+    // Why: "chosen" for an explicit mesher; for Mesher::Auto what decided, e.g. "auto: the surface's
+    // 100002 triangles are more than TetGen takes (75000); remeshed for TetGen".
+    std::string mesher_reason;
+    // Set when Mesher::Auto remeshed the surface before TetGen filled it.
+    std::optional<SurfaceRemeshReport> surface_remeshed;
 };
 
 // Fills a closed, outward-oriented, self-intersection-free surface with tets. Throws

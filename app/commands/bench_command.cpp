@@ -1,6 +1,6 @@
 // `waxwork bench`: measurements that back docs/ (performance, accuracy, stability), written as JSON and SVG.
 //   waxwork bench solvers --mesh MESH [--max-tets N] -o DIR [--backend cpu|gpu] [--material NAME | ...]
-//                         [--mesher tetgen|cgal] [--fill-holes] [--autorefine] [...]
+//                         [--mesher auto|tetgen|cgal] [--fill-holes] [--autorefine] [...]
 // `bench` itself takes the subcommand; it is a CLI11 app with an optional subcommand so that a later
 // `waxwork bench [--quick] -o DIR` (all benchmarks) can be the parent's own action.
 #include "app/commands.h"

@@ -72,7 +72,13 @@ void run_mesh_command(const MeshCommandOptions& o) {
         {"mean_edge_length", q.mean_edge_length},
         {"repairs", loaded.repairs},
         {"milliseconds", result.milliseconds},
+        {"mesher", mesher_name(result.mesher)},
+        {"mesher_reason", result.mesher_reason},
     };
+    if (const auto& remeshed = result.surface_remeshed)
+        summary["surface_remeshed"] = {{"triangles_in", remeshed->triangles_in},
+                                       {"triangles_out", remeshed->triangles_out},
+                                       {"edge", remeshed->edge}};
     if (const auto& wrap = loaded.wrap)
         summary["wrap"] = {{"alpha", wrap->alpha},
                            {"offset", wrap->offset},

@@ -20,8 +20,11 @@ CLI::Option* add_max_tets_option(CLI::App& command, std::optional<size_t>& max_t
 }
 
 void add_surface_meshing_options(CLI::App& command, SurfaceMeshingOptions& options) {
-    command.add_option("--mesher", options.mesher, "tetgen (keeps the surface's triangles) or cgal (remeshes it)")
-        ->check(CLI::IsMember({"tetgen", "cgal"}))
+    command
+        .add_option("--mesher", options.mesher,
+                    "auto (TetGen, on the surface remeshed where its triangles do not fit the size or "
+                    "--max-tets), tetgen (keeps the surface's triangles) or cgal (remeshes it)")
+        ->check(CLI::IsMember({"auto", "tetgen", "cgal"}))
         ->capture_default_str();
     command.add_option("--min-dihedral", options.min_dihedral, "Minimum dihedral angle in degrees: TetGen's bound (away from the input's triangles), "
                        "the target of CGAL's sliver perturber and exuder")
@@ -70,7 +73,9 @@ LoadedSurface load_surface_to_mesh(const std::string& path, const SurfaceMeshing
 
 MeshingOptions meshing_options(const SurfaceMeshingOptions& options) {
     MeshingOptions meshing;
-    meshing.mesher = options.mesher == "cgal" ? Mesher::Cgal : Mesher::TetGen;
+    meshing.mesher = options.mesher == "cgal"     ? Mesher::Cgal
+                     : options.mesher == "tetgen" ? Mesher::TetGen
+                                                  : Mesher::Auto;
     meshing.min_dihedral_deg = options.min_dihedral;
     meshing.max_radius_edge_ratio = options.radius_edge;
     return meshing;

@@ -1,6 +1,6 @@
 // The options shared by every command that fills a surface file with tets (`mesh`, `bench solvers`,
 // `edit`):
-//   --mesher tetgen|cgal --min-dihedral DEG --radius-edge R --fill-holes --autorefine
+//   --mesher auto|tetgen|cgal --min-dihedral DEG --radius-edge R --fill-holes --autorefine
 //   --repair wrap [--wrap-alpha A] [--wrap-offset D]
 // The size (--edge, --max-tets, the material's default sizing) stays with each command: `mesh` has
 // a default, `bench solvers` asks for a tet count.
@@ -24,7 +24,7 @@ namespace waxwork {
 class StderrProgress;
 
 struct SurfaceMeshingOptions {
-    std::string mesher = "tetgen";
+    std::string mesher = "auto";
     double min_dihedral = 10.0;
     double radius_edge = 2.0;
     bool fill_holes = false;

@@ -156,14 +156,14 @@ TEST(BenchSolversCommand, GpuBackendAddsGpuCurvesOrWarns) {
 }
 
 // A surface is meshed with the meshing options `waxwork mesh` takes, and --material fills every tet:
-// spot at 3,000 tets is below what TetGen can do while keeping its triangles (the error says to use
-// CGAL), CGAL remeshes it, and ketchup's short diffusion lengths take Jacobi CG more iterations to 1%
+// spot at 3,000 tets is below what TetGen can do while keeping its triangles (--mesher tetgen: the
+// error says to use CGAL), CGAL remeshes it, and ketchup's short diffusion lengths take Jacobi CG more iterations to 1%
 // than the marble default on the same mesh (10 against 7 here).
 TEST(BenchSolversCommand, MeshesASurfaceWithTheChosenMesherAndMaterial) {
     const auto dir = scratch_dir("bench_solvers_meshing");
     const std::string args = "bench solvers --mesh " + std::string(WAXWORK_ASSET_DIR) +
                              "/meshes/spot.obj --max-tets 3000 --floor 1e-2 --max-seconds 5";
-    const auto tetgen = run_waxwork(args + " -o " + (dir / "tetgen").string());
+    const auto tetgen = run_waxwork(args + " --mesher tetgen -o " + (dir / "tetgen").string());
     EXPECT_EQ(tetgen.exit_code, 1);
     EXPECT_EQ(testing::line_count(tetgen.err), 1u) << tetgen.err;
     EXPECT_NE(tetgen.err.find("--mesher cgal"), std::string::npos) << tetgen.err;

@@ -227,15 +227,46 @@ TEST(Cli, AbsurdParametersAreRejected) {
 }
 
 // A size the mesher refuses for this surface is reported with the surface file's name: spot's
-// triangles, which TetGen keeps, need more than 3,000 tets.
+// triangles, which TetGen keeps (--mesher tetgen; auto would remesh them), need more than 3,000 tets.
 TEST(Cli, AMeshingRefusalNamesTheSurfaceFile) {
     const auto dir = scratch_dir("cli_refusal");
     const std::string surface = kAssets + "/meshes/spot.obj";
-    const auto r = run_waxwork("mesh " + surface + " -o " + (dir / "x.vtu").string() + " --max-tets 3000");
+    const auto r =
+        run_waxwork("mesh " + surface + " -o " + (dir / "x.vtu").string() + " --max-tets 3000 --mesher tetgen");
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_EQ(line_count(r.err), 1u) << r.err;
     EXPECT_NE(r.err.find(surface + ": meshing option sizing.target_tets = 3000"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "x.vtu"));
+}
+
+// The default mesher, auto, keeps a budget TetGen cannot meet on spot's triangles by remeshing the
+// surface, and the summary says which mesher ran, why, and that the surface was remeshed; a budget
+// the input's triangles fit is meshed as before, without the remeshing field.
+TEST(Cli, AutoRemeshesASurfaceForABudgetAndSaysSo) {
+    const auto dir = scratch_dir("cli_auto");
+    const std::string surface = kAssets + "/meshes/spot.obj";
+    const auto r = run_waxwork("mesh " + surface + " -o " + (dir / "x.vtu").string() + " --max-tets 1000");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto summary = nlohmann::json::parse(r.out);
+    EXPECT_NEAR(summary["tets"].get<double>(), 1000, 200);
+    EXPECT_EQ(summary["mesher"], "tetgen");
+    EXPECT_NE(summary["mesher_reason"].get<std::string>().find("remeshed at edge"), std::string::npos)
+        << summary["mesher_reason"];
+    ASSERT_TRUE(summary.contains("surface_remeshed")) << r.out;
+    EXPECT_EQ(summary["surface_remeshed"]["triangles_in"], 5856);
+    EXPECT_LT(summary["surface_remeshed"]["triangles_out"].get<int>(), 5856);
+    EXPECT_GT(summary["surface_remeshed"]["edge"].get<double>(), 0);
+
+    const auto cube = run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + (dir / "c.vtu").string() +
+                                  " --max-tets 3000");
+    ASSERT_EQ(cube.exit_code, 0) << cube.err;
+    const auto kept = nlohmann::json::parse(cube.out);
+    EXPECT_EQ(kept["mesher"], "tetgen");
+    EXPECT_FALSE(kept.contains("surface_remeshed")) << cube.out;
+    const auto chosen = run_waxwork("mesh " + kAssets + "/meshes/cube.obj -o " + (dir / "c.vtu").string() +
+                                    " --max-tets 3000 --mesher cgal");
+    ASSERT_EQ(chosen.exit_code, 0) << chosen.err;
+    EXPECT_EQ(nlohmann::json::parse(chosen.out)["mesher_reason"], "chosen");
 }
 
 // The documented maximum of --max-tets (50M) ran for minutes: a target beyond what is made here in

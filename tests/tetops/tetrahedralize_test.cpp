@@ -5,6 +5,7 @@
 #include "tetops/quality.h"
 #include "tetops/sharp_tips.h"
 #include "tetops/size_field.h"
+#include "tetops/surface_remesh.h"
 #include "tetops/tetgen_mesher.h"
 #include "tetops/tetrahedralize.h"
 
@@ -197,6 +198,113 @@ TEST(TetrahedralizeTest, TargetTetCountWithinTwentyPercent) {
     const MeshingResult cgal = tetrahedralize(spot, options);
     EXPECT_NEAR(double(cgal.mesh.tet_count()), 5'000, 1'000);
     EXPECT_TRUE(find_invariant_violations(cgal.mesh).empty());
+}
+
+// Mesher::Auto honours a budget TetGen cannot meet on spot's 5,856 triangles (its floor is about
+// 50K tets) by remeshing the surface at the edge the budget allows and filling that with TetGen; the
+// result says so. The remeshed mesh fills spot's volume to within what the coarser triangles cut off.
+TEST(TetrahedralizeTest, AutoKeepsABudgetUnderTetGensFloorByRemeshing) {
+    const TriangleSurface spot = asset_surface("spot.obj");
+    for (const size_t target : {size_t(1'000), size_t(20'000)}) {
+        SCOPED_TRACE(target);
+        MeshingOptions options;
+        options.mesher = Mesher::Auto;
+        options.sizing.target_tets = target;
+        const MeshingResult result = tetrahedralize(spot, options);
+        std::printf("spot %zu: %zu tets, %s, %.0f ms, min dihedral %.2f\n", target, result.mesh.tet_count(),
+                    result.mesher_reason.c_str(), result.milliseconds, result.quality.min_dihedral_deg);
+        EXPECT_NEAR(double(result.mesh.tet_count()), double(target), 0.2 * double(target));
+        EXPECT_EQ(result.mesher, Mesher::TetGen) << result.mesher_reason;
+        ASSERT_TRUE(result.surface_remeshed.has_value()) << result.mesher_reason;
+        EXPECT_EQ(result.surface_remeshed->triangles_in, spot.triangles.size());
+        EXPECT_LT(result.surface_remeshed->triangles_out, spot.triangles.size());
+        EXPECT_NE(result.mesher_reason.find("auto: "), std::string::npos);
+        EXPECT_NE(result.mesher_reason.find("remeshed at edge"), std::string::npos) << result.mesher_reason;
+        EXPECT_TRUE(find_invariant_violations(result.mesh).empty());
+        // The remeshed surface's flat triangles cut inside the curved one, by more the coarser they are
+        // (380 triangles at 1,000 tets: 8.3% of the volume).
+        const double volume_tolerance = target == 1'000 ? 0.10 : 0.02;
+        EXPECT_NEAR(total_volume(result.mesh), enclosed_volume_of(spot), volume_tolerance * enclosed_volume_of(spot));
+    }
+    // Where TetGen keeps the triangles within the budget, auto keeps them.
+    MeshingOptions kept;
+    kept.mesher = Mesher::Auto;
+    kept.sizing.target_tets = 3'000;
+    const TriangleSurface cube = asset_surface("cube.obj");
+    const MeshingResult result = tetrahedralize(cube, kept);
+    EXPECT_EQ(result.mesher, Mesher::TetGen);
+    EXPECT_FALSE(result.surface_remeshed.has_value());
+    expect_fills_surface(result, cube, 1e-6);
+}
+
+// A surface far finer than the budget (an icosphere of 20,480 triangles, 2,000 tets) is remeshed
+// for TetGen, within the promised 20%; so is one with more triangles than TetGen takes (81,920).
+TEST(TetrahedralizeTest, AutoRemeshesAFineSphereForASmallBudget) {
+    for (const int level : {5, 6}) {
+        SCOPED_TRACE(level);
+        const TriangleSurface sphere = make_icosphere(level, 1.0);
+        MeshingOptions options;
+        options.mesher = Mesher::Auto;
+        options.sizing.target_tets = 2'000;
+        const MeshingResult result = tetrahedralize(sphere, options);
+        std::printf("icosphere %zu triangles: %zu tets, %s, %.0f ms\n", sphere.triangles.size(),
+                    result.mesh.tet_count(), result.mesher_reason.c_str(), result.milliseconds);
+        EXPECT_NEAR(double(result.mesh.tet_count()), 2'000, 400);
+        EXPECT_EQ(result.mesher, Mesher::TetGen) << result.mesher_reason;
+        ASSERT_TRUE(result.surface_remeshed.has_value()) << result.mesher_reason;
+        EXPECT_EQ(result.surface_remeshed->triangles_in, sphere.triangles.size());
+        EXPECT_LT(result.surface_remeshed->triangles_out, sphere.triangles.size() / 10);
+        // About 300 flat triangles of edge 0.35 inside the unit sphere: 4% less volume.
+        EXPECT_NEAR(total_volume(result.mesh), 4.0 / 3.0 * M_PI, 0.05 * 4.0 / 3.0 * M_PI);
+        if (level == 6) {
+            EXPECT_NE(result.mesher_reason.find("more than TetGen takes"), std::string::npos) << result.mesher_reason;
+        }
+    }
+    // Explicit TetGen keeps the triangles and refuses the budget, as before.
+    MeshingOptions tetgen;
+    tetgen.mesher = Mesher::TetGen;
+    tetgen.sizing.target_tets = 2'000;
+    EXPECT_THROW(tetrahedralize(make_icosphere(5, 1.0), tetgen), InvalidArgumentError);
+}
+
+// For a size, auto remeshes only a surface far finer than the size's surface edge: the sphere of
+// 20,480 triangles (mean edge 0.024) at a surface edge 8 times its edge is remeshed and gets about the
+// tets of a sphere made at that edge; the torus, as detailed as its default size, is meshed as it is,
+// exactly as explicit TetGen meshes it.
+TEST(TetrahedralizeTest, AutoRemeshesForASizeOnlyASurfaceFarFinerThanIt) {
+    const TriangleSurface fine = make_icosphere(5, 1.0);
+    const double edge = 8 * mean_edge_length(fine);
+    MeshingOptions options;
+    options.mesher = Mesher::Auto;
+    options.sizing.surface_edge = edge;
+    options.sizing.grading = 0.5;
+    options.sizing.max_edge = 0.5;
+    const MeshingResult remeshed = tetrahedralize(fine, options);
+    EXPECT_EQ(remeshed.mesher, Mesher::TetGen);
+    ASSERT_TRUE(remeshed.surface_remeshed.has_value()) << remeshed.mesher_reason;
+    EXPECT_NE(remeshed.mesher_reason.find("times finer than the size's surface edge"), std::string::npos)
+        << remeshed.mesher_reason;
+    const int coarse_level = 2;  // mean edge 0.19, about 8 times the level-5 sphere's
+    MeshingOptions tetgen = options;
+    tetgen.mesher = Mesher::TetGen;
+    const size_t reference = tetrahedralize(make_icosphere(coarse_level, 1.0), tetgen).mesh.tet_count();
+    std::printf("sphere remeshed at %.3f: %zu tets; level-%d sphere %zu\n", edge, remeshed.mesh.tet_count(),
+                coarse_level, reference);
+    EXPECT_LT(remeshed.mesh.tet_count(), 2 * reference);
+
+    const TriangleSurface torus = asset_surface("torus.obj");
+    MeshingOptions graded;
+    graded.mesher = Mesher::Auto;
+    graded.sizing.surface_edge = 1.25 * mean_edge_length(torus);
+    graded.sizing.max_edge = 0.45;
+    const MeshingResult kept = tetrahedralize(torus, graded);
+    EXPECT_EQ(kept.mesher, Mesher::TetGen);
+    EXPECT_FALSE(kept.surface_remeshed.has_value()) << kept.mesher_reason;
+    graded.mesher = Mesher::TetGen;
+    const MeshingResult chosen = tetrahedralize(torus, graded);
+    EXPECT_EQ(chosen.mesher_reason, "chosen");
+    EXPECT_EQ(kept.mesh.positions, chosen.mesh.positions);
+    EXPECT_EQ(kept.mesh.tets, chosen.mesh.tets);
 }
 
 // A target TetGen cannot reach while keeping the surface's triangles is refused with the count it
@@ -606,6 +714,24 @@ TEST(TetrahedralizeTest, ReportsItsStagesAndStopsWhenCancelled) {
         EXPECT_THROW(tetrahedralize(cube, options), CancelledError);
         EXPECT_EQ(cancelling.stages.back(), stage);
     }
+}
+
+// Auto's remeshing is a stage of its own, and a cancel asked for during it stops the meshing there.
+TEST(TetrahedralizeTest, AutoReportsTheRemeshingAndStopsWhenCancelledInIt) {
+    const TriangleSurface sphere = make_icosphere(5, 1.0);
+    MeshingOptions options;
+    options.mesher = Mesher::Auto;
+    options.sizing.target_tets = 2'000;
+    RecordingProgress progress;
+    options.progress = &progress;
+    tetrahedralize(sphere, options);
+    EXPECT_NE(std::find(progress.stages.begin(), progress.stages.end(), "remeshing the surface (CGAL)"),
+              progress.stages.end());
+    RecordingProgress cancelling;
+    cancelling.cancel_at = "remeshing the surface (CGAL)";
+    options.progress = &cancelling;
+    EXPECT_THROW(tetrahedralize(sphere, options), CancelledError);
+    EXPECT_EQ(cancelling.stages.back(), "remeshing the surface (CGAL)");
 }
 
 // Up front, by prediction: a target beyond the largest mesh that is made here in about a minute, and
