@@ -23,7 +23,9 @@ for path in "$meshes"/*.obj "$meshes"/*.off "$meshes"/*.ply "$meshes"/*.stl; do
     sleep 0.5
   done
   wait $pid 2> /dev/null
-  if ! tr '\r' '\n' < "$out/plain.err" | grep -q 'meshing'; then
+  plain_status=$?
+  # Accepted: meshed at once (too fast to show a stage), or stopped once it reached the mesher.
+  if [ $plain_status -ne 0 ] && ! tr '\r' '\n' < "$out/plain.err" | grep -q 'meshing'; then
     # The blocking defects, without their examples, the safe repairs and the way out.
     refused="$(tr '\r' '\n' < "$out/plain.err" | grep -v '^ *$' | tail -1 | python3 -c '
 import re, sys

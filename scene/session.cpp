@@ -402,6 +402,7 @@ SessionVolume read_session_input(const Session& session, Progress* progress) {
     meshing.min_dihedral_deg = session.input.min_dihedral_deg;
     meshing.max_radius_edge_ratio = session.input.max_radius_edge_ratio;
     meshing.progress = progress;
+    if (loaded.wrap) meshing.remesh_edge_ratio = kWrapRemeshEdgeRatio;
     if (session.input.edge) {
         meshing.sizing.edge_length = session.input.edge;
     } else if (session.input.max_tets) {

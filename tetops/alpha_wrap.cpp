@@ -2,6 +2,7 @@
 
 #include "base/error.h"
 #include "base/progress.h"
+#include "tetops/disjoint_sets.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/distance.h>
@@ -10,9 +11,11 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <vector>
 
 namespace waxwork {
@@ -75,6 +78,33 @@ std::string WrapReport::describe() const {
     return line;
 }
 
+namespace {
+
+// The bounding-box diagonal of the widest hole of `triangles` (a loop of edges each in one triangle
+// only; orientation ignored, as a soup's may be inconsistent), or 0 when it is closed.
+double widest_hole_extent(const std::vector<Point3>& points, const std::vector<std::array<size_t, 3>>& triangles) {
+    std::map<std::pair<size_t, size_t>, int> edge_uses;
+    for (const auto& t : triangles)
+        for (int k = 0; k < 3; ++k) ++edge_uses[std::minmax(t[k], t[(k + 1) % 3])];
+    DisjointSets loops(points.size());
+    std::vector<bool> on_hole(points.size(), false);
+    for (const auto& [edge, uses] : edge_uses) {
+        if (uses != 1) continue;
+        loops.unite(static_cast<int32_t>(edge.first), static_cast<int32_t>(edge.second));
+        on_hole[edge.first] = on_hole[edge.second] = true;
+    }
+    std::map<int32_t, Eigen::AlignedBox3d> boxes;
+    for (size_t v = 0; v < points.size(); ++v)
+        if (on_hole[v])
+            boxes[loops.find(static_cast<int32_t>(v))].extend(
+                Eigen::Vector3d(points[v].x(), points[v].y(), points[v].z()));
+    double widest = 0;
+    for (const auto& [root, box] : boxes) widest = std::max(widest, box.diagonal().norm());
+    return widest;
+}
+
+}  // namespace
+
 WrapResult wrap_surface(const TriangleSurface& soup, const WrapOptions& options, Progress* progress) {
     validate_wrap_options(options, 0.0);  // the sign and finiteness before any work
 
@@ -113,7 +143,9 @@ WrapResult wrap_surface(const TriangleSurface& soup, const WrapOptions& options,
 
     WrapReport& report = result.report;
     report.diagonal = diagonal;
-    report.alpha = options.alpha.value_or(kDefaultWrapAlphaFraction * diagonal);
+    report.alpha = options.alpha.value_or(
+        std::clamp(kDefaultWrapAlphaPerHole * widest_hole_extent(points, triangles), kDefaultWrapAlphaFraction * diagonal,
+                   kMaxDefaultWrapAlphaFraction * diagonal));
     report.offset = options.offset.value_or(kDefaultWrapOffsetFractionOfAlpha * report.alpha);
 
     check_cancelled(progress);

@@ -22,8 +22,18 @@ class Progress;
 // triangles, well under the TetGen limit; halving alpha gives 66K on the cow for a Hausdorff distance
 // that moves only from 2.07% to 1.83% of D (its distance is buried self-intersecting parts, not lost
 // features), doubling it 5K triangles and 3.15%. An open model whose holes are wider than alpha is
-// wrapped on both sides of its shell (hollow, and slow): it needs a larger alpha.
+// wrapped on both sides of its shell (hollow, and slow): the default alpha grows to close its holes
+// (kDefaultWrapAlphaPerHole), up to kMaxDefaultWrapAlphaFraction.
 inline constexpr double kDefaultWrapAlphaFraction = 1.0 / 100.0;
+// With holes (loops of edges with one triangle), the default alpha is at least this fraction of the
+// widest hole's bounding-box diagonal: a ball of radius alpha passes an opening only if alpha is under
+// half its width, and a hole's width is under its box's diagonal. Measured on bad_stanford-bunny.obj
+// (widest hole 0.18 D): alpha D/20 closes its holes (one solid component, 8 s), D/100 wraps both
+// sides of its shell and ran past 300 s.
+inline constexpr double kDefaultWrapAlphaPerHole = 0.3;
+// The default alpha never exceeds this fraction of D: a model open that widely (a sheet, a shell
+// with its side missing) is better wrapped with an alpha the user chooses.
+inline constexpr double kMaxDefaultWrapAlphaFraction = 1.0 / 10.0;
 // Default offset as a fraction of alpha: CGAL's own default (alpha / 30). A smaller offset hugs sharp
 // features closer but puts more triangles around them; a larger one inflates the model visibly.
 inline constexpr double kDefaultWrapOffsetFractionOfAlpha = 1.0 / 30.0;

@@ -64,6 +64,10 @@ void validate_options(const MeshingOptions& options) {
     if (options.mesher != Mesher::TetGen && options.mesher != Mesher::Cgal && options.mesher != Mesher::Auto) {
         throw InvalidArgumentError("meshing option mesher: unknown mesher");
     }
+    if (!(options.remesh_edge_ratio > 0) || !std::isfinite(options.remesh_edge_ratio)) {
+        throw InvalidArgumentError("meshing option remesh_edge_ratio = " + number_text(options.remesh_edge_ratio) +
+                                   ": must be positive and finite");
+    }
     // TetGen's Delaunay refinement is proven to end for bounds of 2 and ends in practice down to
     // about 1.2; at 1.1 and under it refines for ever (spot: 1.2 takes 6 s, 1.1 did not end in 40 s).
     if (!(options.max_radius_edge_ratio >= kMinRadiusEdgeRatio) || !std::isfinite(options.max_radius_edge_ratio)) {
@@ -461,8 +465,8 @@ AutoMeshing auto_mesh_to_size(const TriangleSurface& surface, const MeshingOptio
     const double edge = size.surface_edge;
     std::string why = triangle_limit_reason(surface);
     if (why.empty()) {
-        if (const double mean = mean_edge_length(surface); kAutoRemeshEdgeRatio * mean < edge) {
-            why = "the surface's mean edge (" + number_text(mean) + ") is over " + number_text(kAutoRemeshEdgeRatio) +
+        if (const double mean = mean_edge_length(surface); options.remesh_edge_ratio * mean < edge) {
+            why = "the surface's mean edge (" + number_text(mean) + ") is over " + number_text(options.remesh_edge_ratio) +
                   " times finer than the size's surface edge (" + number_text(edge) + ")";
         } else {
             try {

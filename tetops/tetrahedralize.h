@@ -78,12 +78,20 @@ inline constexpr double kMinRadiusEdgeRatio = 1.2;
 // (3.5 times finer, 41K tets at the default size) and spot (1.4 times) are kept as they are, so their
 // default meshes stay what explicit TetGen makes (docs/meshing.md).
 inline constexpr double kAutoRemeshEdgeRatio = 4.0;
+// The same for a surface made by alpha wrapping (tetops/alpha_wrap.h): any wrap finer than the size is
+// remeshed. A wrap approximates its input only to about its alpha anyway, and where the input is a
+// sheet its offset leaves slabs two offsets thick that TetGen refines around for minutes (the wrapped
+// bad_cow.obj and horse.ply: 18K triangles each, about 100 s kept as they are, 1.5 s remeshed).
+inline constexpr double kWrapRemeshEdgeRatio = 1.0;
 
 struct MeshingOptions {
     Mesher mesher = Mesher::TetGen;
     MeshSizing sizing;
     double max_radius_edge_ratio = 2.0;  // TetGen -q bound, >= kMinRadiusEdgeRatio
     double min_dihedral_deg = 10.0;      // TetGen -q/ bound (and CGAL exuder goal)
+    // Mesher::Auto with a size remeshes a surface whose mean edge is this many times finer than the
+    // size's surface edge (kAutoRemeshEdgeRatio; kWrapRemeshEdgeRatio for a wrapped surface).
+    double remesh_edge_ratio = kAutoRemeshEdgeRatio;
     bool quiet = true;
     // Told each stage (checks, each mesher run, ordering, quality) and asked between them whether to
     // stop (CancelledError); CGAL's refinement also stops on its cancel flag. Not owned; may be null.

@@ -47,6 +47,7 @@ TetMesh load_or_mesh(const SolversCommandOptions& o) {
     const LoadedSurface surface = load_surface_to_mesh(o.mesh, o.meshing);
     MeshingOptions meshing = meshing_options(o.meshing);
     meshing.sizing.target_tets = o.max_tets;
+    if (surface.wrap) meshing.remesh_edge_ratio = kWrapRemeshEdgeRatio;
     return tetrahedralize_surface_file(o.mesh, surface.surface, meshing).mesh;
 }
 

@@ -39,6 +39,7 @@ void run_mesh_command(const MeshCommandOptions& o) {
     const ModelScale scale = choose_model_scale(o.scale, std::nullopt, extent);
     MeshingOptions options = meshing_options(o.meshing);
     options.progress = &progress;
+    if (loaded.wrap) options.remesh_edge_ratio = kWrapRemeshEdgeRatio;
     // tetrahedralize() validates the explicit sizes (positive, finite, not absurdly many tets).
     if (o.edge) {
         options.sizing.edge_length = o.edge;

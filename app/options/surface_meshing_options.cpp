@@ -42,7 +42,8 @@ void add_surface_meshing_options(CLI::App& command, SurfaceMeshingOptions& optio
     command
         .add_option("--wrap-alpha", options.wrap_alpha,
                     "--repair wrap: cavities and gaps narrower than about this are closed over (model units; "
-                    "default 1/100 of the bounding-box diagonal)")
+                    "default 1/100 of the bounding-box diagonal, or wide enough to close the input's holes, "
+                    "up to 1/10)")
         ->needs(repair);
     command
         .add_option("--wrap-offset", options.wrap_offset,

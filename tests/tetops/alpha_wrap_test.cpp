@@ -7,9 +7,11 @@
 #include "tetops/surface_check.h"
 #include "tetops/test_surfaces.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <limits>
 #include <set>
 
@@ -108,6 +110,21 @@ TEST(AlphaWrap, CubeWithHolesIsClosed) {
     // alpha, so the wrap also dips into it, but it stays closed and outside the input).
     const double volume = expect_valid_wrap(r, 1, crease_bound(r.report));
     EXPECT_GT(volume, 0.0);
+}
+
+// An open model's holes set the default alpha: wide enough to close the widest hole, so the wrap is a
+// solid of about the sphere's volume, not a hollow skin around both sides of the shell (the diagonal's
+// D/100 entered bad_stanford-bunny.obj's holes so).
+TEST(AlphaWrap, DefaultAlphaClosesTheWidestHole) {
+    TriangleSurface open = make_icosphere(2, 1.0);
+    Eigen::AlignedBox3d hole;  // one triangle removed: a triangular hole
+    for (const int32_t v : open.triangles[0]) hole.extend(open.points[v]);
+    open.triangles.erase(open.triangles.begin());
+    const WrapResult r = wrap_surface(open, {});
+    EXPECT_DOUBLE_EQ(r.report.alpha, kDefaultWrapAlphaPerHole * hole.diagonal().norm());
+    EXPECT_GT(r.report.alpha, kDefaultWrapAlphaFraction * r.report.diagonal);
+    const double volume = expect_valid_wrap(r, 1, crease_bound(r.report));
+    EXPECT_GT(volume, 0.8 * 4.0 / 3.0 * std::numbers::pi);
 }
 
 TEST(AlphaWrap, IntersectingCubesBecomeOneComponent) {
