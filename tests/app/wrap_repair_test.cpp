@@ -20,9 +20,9 @@ TEST(WrapRepair, BadCowIsWrappedAndMeshedAsOneComponent) {
     if (!fs::exists(cow)) GTEST_SKIP() << "../shared is not present";
     const auto dir = scratch_dir("wrap_cow");
     const fs::path volume = dir / "cow.vtu";
-    // A uniform size: TetGen's graded pass (the default size) takes minutes on the wrapped cow, and CGAL
-    // at the default size splits the wrap's thin slabs into several components (docs/meshing.md).
-    const auto r = run_waxwork("mesh " + cow + " --repair wrap --edge 0.3 -o " + volume.string());
+    // The default size and mesher: the wrap, finer than the size, is remeshed for TetGen (kept as it
+    // is, its offset slabs held TetGen's graded pass for minutes; CGAL split them into components).
+    const auto r = run_waxwork("mesh " + cow + " --repair wrap -o " + volume.string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("bad_cow.obj: repaired: wrapped (alpha "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("% of the diagonal)"), std::string::npos) << r.err;
@@ -37,6 +37,9 @@ TEST(WrapRepair, BadCowIsWrappedAndMeshedAsOneComponent) {
     EXPECT_LT(double(wrap["hausdorff_percent_of_diagonal"]), 5.0);  // the cow keeps its shape
     ASSERT_EQ(summary["repairs"].size(), 1u) << r.out;               // the wrap needs no other repair
     EXPECT_EQ(std::string(summary["repairs"][0]).rfind("wrapped (alpha ", 0), 0u) << r.out;
+    EXPECT_EQ(summary["mesher"], "tetgen") << r.out;
+    ASSERT_TRUE(summary.contains("surface_remeshed")) << r.out;
+    EXPECT_LT(int(summary["surface_remeshed"]["triangles_out"]), int(wrap["triangles"])) << r.out;
 
     const auto i = run_waxwork("info " + volume.string());
     ASSERT_EQ(i.exit_code, 0) << i.err;
