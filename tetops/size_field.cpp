@@ -38,6 +38,8 @@ SurfaceDistance::SurfaceDistance(const TriangleSurface& surface) : tree_(std::ma
                                       to_cgal(surface.points[t[2]]));
     }
     tree_->tree.insert(tree_->triangles.cbegin(), tree_->triangles.cend());
+    // Built here rather than at the first query, so that queries from many threads only read.
+    tree_->tree.build();
     tree_->tree.accelerate_distance_queries();
 }
 
@@ -45,6 +47,18 @@ SurfaceDistance::~SurfaceDistance() = default;
 
 double SurfaceDistance::operator()(const Eigen::Vector3d& p) const {
     return std::sqrt(tree_->tree.squared_distance(to_cgal(p)));
+}
+
+bool SurfaceDistance::contains(const Eigen::Vector3d& p) const {
+    // Directions with no simple relation to the axes, which CAD faces and grids are aligned with.
+    static const Kernel::Vector_3 kDirections[3] = {{0.5773, 0.6109, 0.5417}, {-0.7071, 0.1283, 0.6953},
+                                                    {0.2672, -0.9161, 0.2985}};
+    int inside_votes = 0;
+    for (const auto& direction : kDirections) {
+        const Kernel::Ray_3 ray(to_cgal(p), direction);
+        if (tree_->tree.number_of_intersected_primitives(ray) % 2 == 1) ++inside_votes;
+    }
+    return inside_votes >= 2;
 }
 
 double enclosed_volume(const TriangleSurface& surface) {

@@ -27,9 +27,10 @@ struct SizeField {
     static SizeField unbounded() { return {}; }
 };
 
-// Unsigned distance from points to a triangle surface, answered by a CGAL AABB tree. Built once per
-// meshing run: the graded size field asks it for every vertex of a background mesh (TetGen) or for
-// every refinement query (CGAL).
+// Unsigned distance from points to a triangle surface, and which side of it they lie on, answered
+// by a CGAL AABB tree. Built once per meshing run: the graded size field asks it for every point of a
+// background mesh (TetGen) or for every refinement query (CGAL). Its queries are safe from many
+// threads at once.
 class SurfaceDistance {
 public:
     explicit SurfaceDistance(const TriangleSurface& surface);
@@ -38,6 +39,9 @@ public:
     SurfaceDistance& operator=(const SurfaceDistance&) = delete;
 
     double operator()(const Eigen::Vector3d& p) const;
+    // Whether p lies inside the (closed) surface: the parity of the triangles three rays from p
+    // cross, by majority, so that a ray grazing an edge or vertex (counted twice) is outvoted.
+    bool contains(const Eigen::Vector3d& p) const;
 
 private:
     struct Tree;

@@ -4,13 +4,17 @@
 #include "base/progress.h"
 #include "tetops/mesher_scale.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tetgen.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <new>
+#include <random>
 #include <string>
+#include <vector>
 
 namespace waxwork {
 
@@ -22,6 +26,16 @@ constexpr double kVolumeBoundPerRegularVolume = 2.85;
 // TetGen's -m metric bounds the circumradius of each tet; this maps a wanted mean edge to it (a
 // regular tet has circumradius 0.61 L; Delaunay refinement leaves tets smaller than the bound).
 constexpr double kMetricPerEdge = 0.9;
+// A graded run refines less than its quality bound asks: TetGen rejects a refinement point inside the
+// size ball of a vertex, so slivers stay where the surface's triangles meet the interior. TetGen's
+// optimisation after refinement (flips and vertex smoothing) works on tets with a dihedral angle over
+// this bound (165 by default); 150 also reaches most slivers at the surface (docs/meshing.md).
+constexpr double kGradedOptimizeAboveDihedralDeg = 150;
+// The grid of interior points the background mesh is made of: half the largest edge apart, and
+// between these many cells along the bounding box's diagonal (the size grows 0.5 per unit of depth,
+// so a cell of half the largest edge resolves it where it is not capped).
+constexpr double kMinGridCellsPerDiagonal = 16;
+constexpr double kMaxGridCellsPerDiagonal = 64;
 
 std::string tetgen_reason(int code) {
     switch (code) {
@@ -74,7 +88,8 @@ std::string format_number(double value) {
 }
 
 // -p: the input is a PLC; -z: zero-based indices; -q: quality; -a: volume bound; -m: sizes from the
-// metric of the background mesh; -S: a limit on added points. No -V (verbose) ever: TetGen would
+// metric of the background mesh, with -o/: flips and smoothing for every tet with a dihedral angle over
+// kGradedOptimizeAboveDihedralDeg; -S: a limit on added points. No -V (verbose) ever: TetGen would
 // print per element.
 std::string make_switches(const TetGenSettings& settings, bool volume_bound, bool metric) {
     std::string switches = "pz";
@@ -83,7 +98,7 @@ std::string make_switches(const TetGenSettings& settings, bool volume_bound, boo
                     format_number(settings.min_dihedral_deg);
     }
     if (volume_bound) switches += "a" + format_number(tetgen_volume_bound_for_edge(settings.size.max_edge));
-    if (metric) switches += "m";
+    if (metric) switches += "mo/" + format_number(kGradedOptimizeAboveDihedralDeg);
     if (settings.max_added_points >= 0) switches += "S" + std::to_string(settings.max_added_points);
     if (settings.quiet) switches += "Q";
     return switches;
@@ -134,38 +149,88 @@ TetMesh to_tet_mesh(const tetgenio& out) {
     return make_tet_mesh(std::move(positions), std::move(tets));
 }
 
-// The background mesh of a graded run: a quality mesh at the coarsest size, each of its vertices
-// carrying kMetricPerEdge edge(depth); TetGen interpolates it linearly inside its tets. Its run is
-// bounded by the same limit on added points as the graded run; cut short, it still carries sizes.
-void make_background_mesh(const TriangleSurface& surface, const TetGenSettings& graded, tetgenio& background) {
-    const SizeField& size = graded.size;
-    {
-        tetgenio in;
-        fill_plc(surface, in);
-        run_tetgen(make_switches(graded, std::isfinite(size.max_edge), false), in, background, nullptr);
-    }
-    report_stage(graded.progress, "meshing (TetGen, sizing field)");
+// The background mesh of a graded run: the Delaunay tetrahedralization of the surface's points, a
+// grid of points inside it and the corners of a box around it, each point carrying
+// kMetricPerEdge edge(depth) (points outside carry the surface edge); TetGen interpolates it linearly
+// inside its tets. It is convex on purpose: TetGen locates every point of the graded run in it by
+// a walk that falls back to a scan of all its tets when the walk leaves the mesh, which it does at
+// every concavity of a background mesh shaped like the object (docs/meshing.md measures it). A point
+// set also costs no quality run: the Delaunay tetrahedralization of a few thousand points takes
+// milliseconds where a quality mesh of the surface takes as long as the graded run itself.
+void make_background_mesh(const TriangleSurface& surface, const SizeField& size, tetgenio& background) {
     const SurfaceDistance distance(surface);
+    Eigen::Vector3d lo = surface.points.front();
+    Eigen::Vector3d hi = lo;
+    for (const auto& p : surface.points) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+    }
+    const double diagonal = (hi - lo).norm();
+    const double spacing = std::clamp(size.max_edge / 2, diagonal / kMaxGridCellsPerDiagonal,
+                                      diagonal / kMinGridCellsPerDiagonal);
+    const Eigen::Array3i cells = ((hi - lo) / spacing).array().ceil().cast<int>().max(1);
+
+    // Each grid point is moved by up to a fifth of a cell, the same way on every run: a regular grid
+    // is the most degenerate input Delaunay has (eight cospherical points per cell), and TetGen's
+    // point location falls back to inexact orientation tests that assert on the flat tets it leaves.
+    std::vector<Eigen::Vector3d> grid;
+    grid.reserve(size_t(cells.x() + 1) * (cells.y() + 1) * (cells.z() + 1));
+    std::mt19937 random(12345);
+    std::uniform_real_distribution<double> jitter(-0.2 * spacing, 0.2 * spacing);
+    for (int i = 0; i <= cells.x(); ++i) {
+        for (int j = 0; j <= cells.y(); ++j) {
+            for (int k = 0; k <= cells.z(); ++k) {
+                const Eigen::Vector3d offset(jitter(random), jitter(random), jitter(random));
+                grid.push_back(lo + spacing * Eigen::Vector3d(i, j, k) + offset);
+            }
+        }
+    }
+    // The depth of each grid point inside the surface; points outside, or nearer the surface than a
+    // quarter cell (they add nothing the surface's own points do not, and make needle tets), are
+    // left out (negative).
+    std::vector<double> grid_depth(grid.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+            const double depth = distance(grid[i]);
+            grid_depth[i] = depth >= spacing / 4 && distance.contains(grid[i]) ? depth : -1.0;
+        }
+    });
+
+    std::vector<Eigen::Vector3d> points = surface.points;
+    std::vector<double> sizes(points.size(), size.surface_edge);
+    for (size_t i = 0; i < grid.size(); ++i) {
+        if (grid_depth[i] < 0) continue;
+        points.push_back(grid[i]);
+        sizes.push_back(size.edge_at_depth(grid_depth[i]));
+    }
+    for (int corner = 0; corner < 8; ++corner) {
+        points.emplace_back(corner & 1 ? hi.x() + spacing : lo.x() - spacing,
+                            corner & 2 ? hi.y() + spacing : lo.y() - spacing,
+                            corner & 4 ? hi.z() + spacing : lo.z() - spacing);
+        sizes.push_back(size.surface_edge);
+    }
+
+    tetgenio in;
+    in.firstnumber = 0;
+    in.numberofpoints = static_cast<int>(points.size());
+    in.pointlist = new REAL[3 * points.size()];
+    for (size_t i = 0; i < points.size(); ++i) {
+        for (int k = 0; k < 3; ++k) in.pointlist[3 * i + k] = points[i][k];
+    }
+    run_tetgen("zQ", in, background, nullptr);  // Delaunay of the points: no -p, no refinement
+    // Without -p TetGen adds no points and keeps the input's order (duplicates included, unused).
+    if (background.numberofpoints != in.numberofpoints)
+        throw AlgorithmError("TetGen's background mesh has " + std::to_string(background.numberofpoints) +
+                             " points for " + std::to_string(in.numberofpoints) + " given");
     background.numberofpointmtrs = 1;
     background.pointmtrlist = new REAL[background.numberofpoints];
-    for (int i = 0; i < background.numberofpoints; ++i) {
-        const REAL* p = &background.pointlist[3 * i];
-        background.pointmtrlist[i] = kMetricPerEdge * size.edge_at_depth(distance({p[0], p[1], p[2]}));
-    }
+    for (size_t i = 0; i < sizes.size(); ++i) background.pointmtrlist[i] = kMetricPerEdge * sizes[i];
 }
 
 }  // namespace
 
 double tetgen_volume_bound_for_edge(double edge) {
     return kVolumeBoundPerRegularVolume * edge * edge * edge / (6 * std::sqrt(2.0));
-}
-
-TetMesh tetgen_background_mesh(const TriangleSurface& surface, const TetGenSettings& settings) {
-    TetGenSettings graded = settings;
-    graded.max_added_points = -1;
-    tetgenio background;
-    make_background_mesh(surface, graded, background);
-    return to_tet_mesh(background);
 }
 
 TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettings& settings,
@@ -194,9 +259,9 @@ TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettin
     // The point limit bounds both runs; the background mesh only carries sizes, so when it is cut
     // short the run goes on with it, and only the graded run's stop is reported.
     const TetGenSettings& graded = settings;
-    report_stage(settings.progress, "meshing (TetGen, background mesh)");
+    report_stage(settings.progress, "meshing (TetGen, sizing field)");
     tetgenio background;
-    make_background_mesh(surface, graded, background);
+    make_background_mesh(surface, size, background);
     tetgenio in;
     tetgenio out;
     fill_plc(surface, in);

@@ -19,20 +19,16 @@ struct TetGenSettings {
     // -S: the points TetGen may add to the surface's (boundary recovery and refinement; -1: no limit).
     // A graded size applies it to both of its runs.
     long max_added_points = -1;
-    Progress* progress = nullptr;  // told the stage of a graded run (background mesh, sizing, graded)
+    Progress* progress = nullptr;  // told the stage of a graded run (sizing field, graded)
 };
 
-// Uniform size: one run with a volume bound (-a). Graded size: a first quality run at max_edge gives
-// a background mesh whose vertices carry edge(depth) (-m), then a second run from the surface
-// refines to it. Throws AlgorithmError with TetGen's reason when it gives up.
+// Uniform size: one run with a volume bound (-a). Graded size: one run from the surface refines to
+// a background mesh whose vertices carry edge(depth) (-m): the Delaunay tetrahedralization of the
+// surface's points and a grid of points inside it. Throws AlgorithmError with TetGen's reason when it gives up.
 // With settings.max_added_points, `stopped_at_point_limit` (when given) says whether TetGen added
 // that many points, so that the mesh is its refinement cut short rather than a finished one.
 TetMesh tetgen_tetrahedralize(const TriangleSurface& surface, const TetGenSettings& settings,
                               bool* stopped_at_point_limit = nullptr);
-
-// The background mesh a graded run sizes itself from (tetgen_tetrahedralize with a graded size): a
-// quality mesh at settings.size.max_edge. For tests.
-TetMesh tetgen_background_mesh(const TriangleSurface& surface, const TetGenSettings& settings);
 
 // The TetGen volume bound (-a) that gives tets of mean edge length `edge`: a regular tet of edge L has
 // volume L^3 / (6 sqrt 2); TetGen's tets under a bound a have mean volume ~0.31 a and mean edge

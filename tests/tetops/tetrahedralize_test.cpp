@@ -700,7 +700,6 @@ TEST(TetrahedralizeTest, ReportsItsStagesAndStopsWhenCancelled) {
     options.progress = &progress;
     tetrahedralize(cube, options);
     const std::vector<std::string> tetgen_stages = {"checking the surface for meshing", "meshing (TetGen)",
-                                                    "meshing (TetGen, background mesh)",
                                                     "meshing (TetGen, sizing field)", "meshing (TetGen, graded)",
                                                     "ordering the mesh", "measuring quality"};
     EXPECT_EQ(progress.stages, tetgen_stages);
