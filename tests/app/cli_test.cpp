@@ -206,6 +206,26 @@ TEST(Cli, BrokenSharedMeshesGiveClearErrors) {
     }
 }
 
+// The bunny with its holes filled keeps 70,000 fine triangles; auto remeshes them, and TetGen, asked
+// for by name, keeps them and grades the volume from them (its size lookups once searched every tet of
+// a background mesh shaped like the bunny, which ran past 90 s).
+TEST(Cli, FilledBadBunnyMeshesWithAutoAndWithTetGen) {
+    if (!fs::exists(kShared + "/data/meshes")) GTEST_SKIP() << "../shared is not present";
+    const auto dir = scratch_dir("cli_filled_bunny");
+    const std::string in = kShared + "/data/meshes/bad_stanford-bunny.obj --fill-holes -o " + (dir / "x.vtu").string();
+    for (const std::string mesher : {"auto", "tetgen"}) {
+        const auto r = run_waxwork("mesh " + in + " --mesher " + mesher);
+        ASSERT_EQ(r.exit_code, 0) << mesher << ": " << r.err;
+        const auto summary = nlohmann::json::parse(r.out);
+        EXPECT_EQ(summary["mesher"], "tetgen") << mesher;
+        EXPECT_EQ(summary.contains("surface_remeshed"), mesher == "auto") << summary.dump();
+        EXPECT_GT(summary["tets"].get<int>(), 10000) << mesher;
+        EXPECT_NE(summary["repairs"].dump().find("filled 5 holes"), std::string::npos) << summary.dump();
+        const auto info = run_waxwork("info " + (dir / "x.vtu").string());
+        EXPECT_EQ(info.exit_code, 0) << info.err;
+    }
+}
+
 TEST(Cli, AbsurdParametersAreRejected) {
     const auto dir = scratch_dir("cli_absurd");
     const std::string in = kAssets + "/meshes/cube.obj -o " + (dir / "x.vtu").string();
