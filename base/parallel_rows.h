@@ -32,7 +32,11 @@ std::array<double, N> reduce_rows(size_t n, size_t grain, const Body& body) {
     return tbb::parallel_deterministic_reduce(
         tbb::blocked_range<size_t>(0, n, grain), Sums{},
         [&](const tbb::blocked_range<size_t>& r, Sums acc) {
-            for (size_t i = r.begin(); i != r.end(); ++i) body(i, acc);
+            // A fresh local per chunk, added once: the compiler keeps it in registers, where adding
+            // into `acc` (which TBB passes through memory) made one-channel CG a fifth slower.
+            Sums chunk{};
+            for (size_t i = r.begin(); i != r.end(); ++i) body(i, chunk);
+            for (size_t k = 0; k < N; ++k) acc[k] += chunk[k];
             return acc;
         },
         [](Sums a, const Sums& b) {
