@@ -1,6 +1,6 @@
-// `waxwork bench`: measurements that back docs/ (performance, accuracy, stability), written as JSON and SVG.
+// `waxwork bench`: measurements that back docs/ (performance, accuracy, stability), written as JSON, SVG and PDF.
 //   waxwork bench solvers --mesh MESH [--max-tets N] -o DIR [--backend cpu|gpu] [--material NAME | ...]
-//                         [--mesher auto|tetgen|cgal] [--fill-holes] [--autorefine] [...]
+//                         [--repeats N] [--include-setup] [--mesher auto|tetgen|cgal] [--fill-holes] [...]
 // `bench` itself takes the subcommand; it is a CLI11 app with an optional subcommand so that a later
 // `waxwork bench [--quick] -o DIR` (all benchmarks) can be the parent's own action.
 #include "app/commands.h"
@@ -36,6 +36,8 @@ struct SolversCommandOptions {
     std::optional<double> scale;
     double floor_error = 1e-4;
     double max_seconds = 60;
+    int repeats = 0;  // 0: the comparison's default statistic
+    bool include_setup = false;
     SurfaceMeshingOptions meshing;
     MaterialOptions material;
 };
@@ -77,6 +79,7 @@ void run_solvers_command(const SolversCommandOptions& o) {
     options.mm_per_unit = mm_per_unit(mesh, o.scale);
     options.floor_error = o.floor_error;
     options.max_seconds = o.max_seconds;
+    options.repeats = o.repeats;
     // --backend gpu adds the GPU curves (OpenGL compute shaders; OSMesa's llvmpipe unless
     // WAXWORK_GL_DEVICE=egl finds a GPU); the CPU curves stay for comparison.
     std::unique_ptr<HeadlessGlContext> context;
@@ -90,7 +93,10 @@ void run_solvers_command(const SolversCommandOptions& o) {
     std::filesystem::create_directories(dir, error);
     if (error) throw FileError(dir, "cannot create the directory (" + error.message() + ")");
     const std::string material_name = resolved_materials_name(mesh, material);
-    write_solver_comparison(dir, "solvers", {o.mesh, material_name, options.mm_per_unit}, comparison);
+    SolverChartOptions chart;
+    chart.include_setup = o.include_setup;
+    chart.caption = solver_chart_caption(comparison, context ? context->renderer() : "");
+    write_solver_comparison(dir, "solvers", {o.mesh, material_name, options.mm_per_unit}, comparison, chart);
 
     nlohmann::ordered_json summary_times = nlohmann::ordered_json::object();
     for (const SolverCurve& s : comparison.solvers)
@@ -121,6 +127,10 @@ void add_bench_command(CLI::App& app) {
     bench->add_option("--only", suite->only, "Run only these parts (solvers_50k, solvers_500k, coarse_start, accuracy, cut_modes, "
                                              "table1, stability, resolution)")
         ->delimiter(',');
+    bench->add_option("--repeats", suite->repeats,
+                      "Report the median of N runs per timed point, with min and max (default: the fastest of 3 "
+                      "short runs; Table 1: median of 3)")
+        ->check(CLI::Range(1, 1000));
     bench->footer("Without a subcommand runs every part (bench/studies/bench_suite.h) and writes JSON, SVG charts and\n"
                   "markdown tables into the output directory.");
     bench->callback([bench, suite, suite_output] {
@@ -155,6 +165,11 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--floor", options->floor_error, "Stop each curve below this relative error")
         ->capture_default_str();
     cmd->add_option("--max-seconds", options->max_seconds, "Measuring time limit per solver")->capture_default_str();
+    cmd->add_option("--repeats", options->repeats,
+                    "Median of N runs per point, with min and max (default: fastest of 3 for runs under 100 ms)")
+        ->check(CLI::Range(1, 1000));
+    cmd->add_flag("--include-setup", options->include_setup,
+                  "Chart setup + solve time (default: solve time; the JSON has both)");
     add_surface_meshing_options(*cmd, options->meshing);
     add_material_options(*cmd, options->material);
     cmd->footer(

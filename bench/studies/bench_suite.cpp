@@ -45,6 +45,19 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
     write_file_atomically(path, [&](std::ostream& out) { out << text; });
 }
 
+// A chart or table title, marked when the run was --quick (smaller meshes, fewer samples).
+std::string titled(const BenchSuiteOptions& o, const std::string& title) {
+    return o.quick ? title + " (quick run)" : title;
+}
+
+// The caption line of the suite's charts: the UTC date.
+std::string chart_caption() {
+    const std::time_t now = std::time(nullptr);
+    char date[32];
+    std::strftime(date, sizeof date, "%Y-%m-%d", std::gmtime(&now));
+    return date;
+}
+
 // The shipped spot meshed by TetGen to about target_tets.
 TetMesh spot_volume(const BenchSuiteOptions& o, size_t target_tets) {
     MeshingOptions meshing;
@@ -76,14 +89,18 @@ void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index
     SolverComparisonOptions options;
     options.mm_per_unit = solver_scene_mm_per_unit;
     options.max_seconds = o.quick ? 8.0 : 60.0;
+    options.repeats = o.repeats;
     // Every path, the GPU one included (llvmpipe here: a CPU, so its times are not GPU times).
     const std::unique_ptr<HeadlessGlContext> context = open_gpu_for_comparison(options);
     const SolverComparison comparison = compare_solvers(scene.mesh, scene.connectivity, scene.materials, scene.lighting, options);
     if (!comparison.gpu_fallback_reason.empty())
         std::cerr << "warning: no GPU curves: " << comparison.gpu_fallback_reason << "\n";
     const std::string stem = "solvers_spot_" + std::to_string((target_tets + 500) / 1000) + "k";
+    SolverChartOptions chart;
+    chart.quick = o.quick;
+    chart.caption = solver_chart_caption(comparison, context ? context->renderer() : "");
     write_solver_comparison(o.output_dir, stem, {"assets/meshes/spot.obj", "marble", solver_scene_mm_per_unit},
-                            comparison);
+                            comparison, chart);
     Json& listed = index["solvers"];
     if (!listed.is_array()) listed = Json::array();
     if (std::find(listed.begin(), listed.end(), Json(stem + ".json")) == listed.end()) listed.push_back(stem + ".json");
@@ -224,13 +241,15 @@ void run_cut_modes_part(const BenchSuiteOptions& o, Json& index) {
                                  }), false});
     }
     ChartOptions distance_chart;
-    distance_chart.title = "Cross-section vertices' distance to the cutting plane (spot, " +
-                           std::to_string(mesh.tet_count()) + " tets)";
+    distance_chart.title = titled(o, "Cross-section vertices' distance to the cutting plane (spot, " +
+                                         std::to_string(mesh.tet_count()) + " tets)");
+    distance_chart.caption = chart_caption();
     distance_chart.x = {"fraction of cross-section vertices (sorted)", AxisScale::Linear, 0, 1};
     distance_chart.y = {"distance / mean edge length", AxisScale::Log};
     write_svg_chart(o.output_dir / "cut_modes.svg", distance_lines, distance_chart);
     ChartOptions quality_chart;
-    quality_chart.title = "Tets under a minimum dihedral angle after the cut";
+    quality_chart.title = titled(o, "Tets under a minimum dihedral angle after the cut");
+    quality_chart.caption = chart_caption();
     quality_chart.x = {"minimum dihedral angle (degrees)", AxisScale::Log, 0.1, 10};
     quality_chart.y = {"tets below", AxisScale::Log};
     write_svg_chart(o.output_dir / "cut_quality.svg", quality_lines, quality_chart);
@@ -262,9 +281,11 @@ void run_accuracy_part(const BenchSuiteOptions& o, Json& index) {
             lines.push_back(std::move(line));
         }
         ChartOptions options;
-        options.title = title;
+        options.title = titled(o, title);
         options.x = {"mean tet size (mm)", AxisScale::Log};
         options.y = {"relative L2 error of phi", AxisScale::Log};
+        options.slope_orders = {1, 2};
+        options.caption = chart_caption();
         write_svg_chart(path, lines, options);
     };
     chart(ball, "Ball (R = 10 mm) against the analytic solution", o.output_dir / "accuracy_ball.svg");
@@ -276,22 +297,29 @@ void run_table1_part(const BenchSuiteOptions& o, Json& index) {
     std::vector<TimingRow> rows;
     TimingOptions options;
     options.target_tets = o.quick ? 100'000 : 500'000;
+    if (o.repeats > 0) options.runs = o.repeats;
     const std::vector<std::string> models =
         o.quick ? std::vector<std::string>{"spot"} : std::vector<std::string>{"spot", "torus", "skull"};
     for (const std::string& model : models)
         rows.push_back(measure_timing_row(o.asset_dir / "meshes" / (model + ".obj"), options));
     write_json(o.output_dir / "table1.json", to_json(rows));
-    write_text(o.output_dir / "table1.md", timing_table_markdown(rows));
+    write_text(o.output_dir / "table1.md", "### " + titled(o, "Table 1: build, matrix, solve, cut and paint times") +
+                                               "\n\nTimes: median of " + std::to_string(options.runs) +
+                                               " runs per stage (the paper's rows: as published).\n\n" +
+                                               timing_table_markdown(rows));
     index["table1"] = "table1.md";
 }
 
 void run_stability_part(const BenchSuiteOptions& o, Json& index) {
     const std::vector<StudyTable> tables = run_stability_studies({.quick = o.quick});
     Json json = Json::array();
-    std::string markdown;
+    std::string markdown = "## " + titled(o, "Stability studies") +
+                           "\n\nValues: one run per row (errors and iteration counts, no timings).\n\n";
     for (const StudyTable& t : tables) {
         json.push_back(t.to_json());
-        markdown += t.to_markdown() + "\n";
+        StudyTable titled_table = t;
+        titled_table.name = titled(o, t.name);
+        markdown += titled_table.to_markdown() + "\n";
     }
     write_json(o.output_dir / "stability.json", json);
     write_text(o.output_dir / "stability.md", markdown);
@@ -325,7 +353,10 @@ void run_resolution_part(const BenchSuiteOptions& o, Json& index) {
     std::vector<ChartSeries> lines;
     for (auto& [factor, line] : by_factor) lines.push_back(std::move(line));
     ChartOptions chart;
-    chart.title = "Rendered image error against solve time (tolerances along each line)";
+    chart.title = titled(o, "Rendered image error against solve time (tolerances along each line)");
+    chart.target_line = options.error_bound;
+    chart.target_label = "error bound";
+    chart.caption = chart_caption() + " | times: one run per sample";
     chart.x = {"assembly + solve (ms)", AxisScale::Log};
     chart.y = {"relative image error", AxisScale::Log};
     write_svg_chart(o.output_dir / "resolution.svg", lines, chart);
@@ -349,6 +380,7 @@ void run_bench_suite(const BenchSuiteOptions& o) {
         }
     }
     index["quick"] = o.quick;
+    index["repeats"] = o.repeats;
     index["hardware_threads"] = std::thread::hardware_concurrency();
     const std::time_t now = std::time(nullptr);
     char date[32];

@@ -10,7 +10,9 @@
 //   stability.json/.md    where the methods fail and what Waxwork does (bench/studies/stability_study.h)
 //   resolution.json/.svg  image error against per-frame cost over mesh size x tolerance
 //   bench.json            what ran, with what settings, how long each part took, on which machine
-// --quick (under 2 minutes here) uses smaller meshes and fewer samples; the full suite takes under 20.
+// --quick (under 2 minutes here) uses smaller meshes and fewer samples, and says "(quick run)" in every
+// chart and table title; the full suite takes under 20. Every chart is also written as PDF beside its
+// SVG, with a caption line (date, statistic, device); every markdown table names its statistic.
 #pragma once
 
 #include <filesystem>
@@ -28,6 +30,10 @@ struct BenchSuiteOptions {
     // Run only these parts (names as in bench.json: solvers_50k, solvers_500k, coarse_start, accuracy, cut_modes, table1,
     // stability, resolution); empty: all. An unknown name is an InvalidArgumentError.
     std::vector<std::string> only;
+    // Timing statistic: 0 keeps each part's own (the solver comparison's fastest of 3 short runs, Table 1's
+    // median of 3); N >= 1 makes the solver comparison and Table 1 report the median of N runs (with the
+    // fastest and slowest in the solver JSON).
+    int repeats = 0;
 };
 
 // Runs every part; a part that throws is recorded in bench.json with its error and the suite goes

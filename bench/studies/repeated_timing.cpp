@@ -1,16 +1,21 @@
 #include "bench/studies/repeated_timing.h"
 
 #include <algorithm>
-#include <vector>
 
 namespace waxwork {
+
+RunTimes median_min_max(std::vector<double> samples) {
+    if (samples.empty()) return {};
+    std::sort(samples.begin(), samples.end());
+    const size_t half = samples.size() / 2;
+    const double median = samples.size() % 2 ? samples[half] : 0.5 * (samples[half - 1] + samples[half]);
+    return {median, samples.front(), samples.back()};
+}
 
 double median_run_ms(int runs, const std::function<double()>& run) {
     std::vector<double> ms(static_cast<size_t>(std::max(runs, 1)));
     for (double& m : ms) m = run();
-    std::sort(ms.begin(), ms.end());
-    const size_t half = ms.size() / 2;
-    return ms.size() % 2 ? ms[half] : 0.5 * (ms[half - 1] + ms[half]);
+    return median_min_max(std::move(ms)).ms;
 }
 
 }  // namespace waxwork

@@ -10,19 +10,27 @@
 // Curves. Each iterative solver is run from a cold start (zero; multires: its coarse-to-fine pass) for
 // an increasing schedule of iteration caps (0, 1, 2, ... growing by a quarter), all three channels per
 // run; a point is (time of that run, its error). Measuring the error is outside the timed region.
-// Runs shorter than 100 ms are repeated three times and the fastest kept, after one untimed warm-up
-// run. A point is kept only if it ran faster than every later point (noise that made a small cap
-// slower than a larger one drops the small cap), so every curve is strictly monotone in time. A curve ends below floor_error, when the error stops falling (float's
-// precision floor), or after max_seconds of measuring. time_to_1pct_ms: the smallest cap with error
-// <= target_error is found by bisection between the curve's bracketing caps and timed again.
+// Statistic (timing_statistic): by default a run under 100 ms is repeated three times and the fastest
+// kept; with options.repeats = N every point is the median of N runs, and its fastest and slowest run
+// are kept too (the chart's error band). Each iterative solver gets one untimed warm-up run first. A
+// point is kept only if it ran faster than every later point (noise that made a small cap slower than a
+// larger one drops the small cap), so every curve is strictly monotone in time. A curve ends below
+// floor_error, when the error stops falling (float's precision floor), or after max_seconds of
+// measuring. time_to_1pct_ms: the smallest cap with error <= target_error is found by bisection between
+// the curve's bracketing caps and timed again.
 //
-// What is timed. Per-mesh setup that a frame does not repeat is excluded and reported separately, as
-// its first run and as a rebuild (SolverComparison): the multires hierarchy (hierarchy_ms), the
-// multigrid Galerkin operators and coarsest factorisation (multigrid_setup_ms; cascadic_cg borrows
-// them), the frame solver's own
-// hierarchy, Galerkin operators and interleaved matrix (multigrid_rgb_setup_ms), the float copies of the matrices and the Eigen sparse matrices. Eigen's
-// incomplete Cholesky factorisation is part of every eigen_ic_cg run (its API factorises per solve),
-// and the direct solver's time is factorisation plus solve.
+// What is timed. The curves are solve time only. Each solver's per-mesh setup, which a frame does not
+// repeat, is its setup_ms (0 where there is none): the multires hierarchy (multires), the hierarchy
+// plus the multigrid Galerkin operators and coarsest factorisation (multigrid_cg, and cascadic_cg,
+// which borrows them), the frame solver's own hierarchy, Galerkin operators and interleaved matrix
+// (multigrid_cg_rgb), Eigen's incomplete Cholesky factorisation of the three channels (eigen_ic_cg),
+// the direct solver's symbolic and numeric factorisation of the three channels (direct: its point is
+// the three triangular solves; it has no warm-up run, a factorisation being the costliest step here),
+// and the GPU solvers' construction (uploads, and their own hierarchies where they build one). Setup
+// plus solve is setup_ms + a point's time. The hierarchy and multigrid setups are also reported
+// separately, as their first run in the process and as a rebuild (SolverComparison); setup_ms uses the
+// first run for those and the statistic for the two factorisations. The float copies of the matrices
+// and the Eigen sparse matrices are not timed.
 #pragma once
 
 #include "gl/gl_context.h"
@@ -44,6 +52,7 @@ struct SolverComparisonOptions {
     double target_error = 1e-2;   // time_to_1pct_ms
     double floor_error = 1e-4;    // a curve stops once below this
     double max_seconds = 60.0;    // per solver, measuring included
+    int repeats = 0;              // 0: fastest of 3 for runs under 100 ms; N >= 1: median of N runs
     // When set (a current OpenGL >= 4.3 context): also the GPU curves gpu_cg (solver/gpu/gpu_conjugate_gradient.h),
     // gpu_multires (multires/gpu_multires_solver.h) and gpu_multigrid_cg (multires/gpu_multigrid_frame_solver.h);
     // their times include reading phi back.
@@ -52,8 +61,11 @@ struct SolverComparisonOptions {
 
 struct SolverCurve {
     std::string name;
-    std::vector<std::pair<double, double>> curve;  // (ms, relative error), time strictly increasing
-    std::optional<double> time_to_target_ms;       // nullopt when the target was not reached
+    std::vector<std::pair<double, double>> curve;     // (ms, relative error), time strictly increasing
+    std::vector<std::pair<double, double>> ms_range;  // per curve point, (fastest, slowest) of its runs
+    std::optional<double> time_to_target_ms;          // nullopt when the target was not reached
+    std::pair<double, double> time_to_target_range{};  // its (fastest, slowest) run
+    double setup_ms = 0;                               // per-mesh setup, not in the curve's times
     std::optional<int> cap_to_target;              // the smallest cap reaching it (nullopt: not reached,
                                                    // or no cap, as for direct)
 };
@@ -70,7 +82,11 @@ struct SolverComparison {
     std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, cascadic_cg, multigrid_cg_rgb,
                                        // eigen_ic_cg, [gpu_cg, gpu_multires, gpu_multigrid_cg,] direct
     std::string gpu_fallback_reason;   // options.gl given but the GPU could not run (curves left out)
+    int repeats = 0;                   // options.repeats, for timing_statistic
 };
+
+// The statistic a comparison's times are, in words, e.g. "median of 5 runs after one warm-up".
+std::string timing_statistic(int repeats);
 
 // Assembles the TransCut system (materials per tet), lights it (q from `lighting`) and compares the
 // solvers. Throws InvalidArgumentError for bad materials, lighting or options, AlgorithmError when a
@@ -92,11 +108,27 @@ struct ComparedScene {
     double mm_per_unit = 0;
 };
 
+// How the comparison's chart is drawn: solve time (default) or setup + solve on the x axis, "(quick
+// run)" in the title, and the caption line under it (date, statistic, device, ...).
+struct SolverChartOptions {
+    bool include_setup = false;
+    bool quick = false;
+    std::string caption;
+};
+
 // Writes DIR/STEM.json, {"mesh", "material", "mm_per_unit", "tets", "vertices", "levels",
-// setup_times..., "solvers": {NAME: {"time_to_1pct_ms", "cap_to_1pct", "curve": [[ms, rel_error],
-// ...]}}}, and DIR/STEM.svg (error against time, one line per solver), atomically.
+// setup_times..., "statistic", "repeats", "solvers": {NAME: {"time_to_1pct_ms", "time_to_1pct_ms_min",
+// "time_to_1pct_ms_max", "cap_to_1pct", "setup_ms", "curve": [[ms, rel_error], ...], "curve_ms_min":
+// [...], "curve_ms_max": [...]}}} (ms: the statistic; _min, _max: the fastest and slowest run), and
+// DIR/STEM.svg and STEM.pdf (error against time, one line per solver, the direct solve pinned to the
+// bottom edge, the 1% target dashed), atomically.
 void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const ComparedScene& scene,
-                             const SolverComparison& comparison);
+                             const SolverComparison& comparison, const SolverChartOptions& chart = {});
+
+// The caption of a comparison's chart: the UTC date, the statistic and, when the GPU curves ran on a
+// software rasteriser, "GPU curves: software GPU (llvmpipe)" (gpu_renderer: the GL renderer string, or
+// empty).
+std::string solver_chart_caption(const SolverComparison& comparison, const std::string& gpu_renderer);
 
 // For the GPU curves: a headless OpenGL context (OSMesa's llvmpipe unless WAXWORK_GL_DEVICE=egl finds a
 // GPU) set as options.gl. Returns null, with one warning line on stderr, when none can be created; the

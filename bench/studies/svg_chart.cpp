@@ -1,41 +1,18 @@
 #include "bench/studies/svg_chart.h"
 
 #include "base/error.h"
+#include "bench/studies/method_style.h"
+#include "bench/studies/pdf_chart.h"
 #include "io/atomic_file.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
-#include <sstream>
 
 namespace waxwork {
 namespace {
-
-// Colour-blind-safe palette (Okabe and Ito), cycled; each further cycle draws dashed (the solver
-// comparison has ten series), so no two series of a chart look alike.
-constexpr const char* kColours[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000", "#F0E442"};
-constexpr const char* kDashes[] = {"", " stroke-dasharray=\"7 4\"", " stroke-dasharray=\"2 3\""};
-
-std::string escape(const std::string& text) {
-    std::string out;
-    for (char c : text) {
-        switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            default: out += c;
-        }
-    }
-    return out;
-}
-
-std::string number(double v) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.2f", v);
-    return buffer;
-}
 
 std::string tick_label(double v, AxisScale scale) {
     char buffer[32];
@@ -55,16 +32,27 @@ struct Range {
     double lo, hi;
 };
 
-Range data_range(const std::vector<ChartSeries>& series, const ChartAxis& axis, bool is_x) {
+// The axis range: given, or from the data (pinned series count for x only) and `extra` values.
+Range data_range(const std::vector<ChartSeries>& series, const ChartAxis& axis, bool is_x,
+                 const std::vector<double>& extra) {
     if (axis.min < axis.max) return {axis.min, axis.max};
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const auto& s : series)
-        for (const auto& [x, y] : s.points) {
-            const double v = is_x ? x : y;
-            if (axis.scale == AxisScale::Log && !(v > 0)) continue;
-            lo = std::min(lo, v);
-            hi = std::max(hi, v);
-        }
+    auto add = [&](double v) {
+        if (axis.scale == AxisScale::Log && !(v > 0)) return;
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+    };
+    for (const auto& s : series) {
+        if (s.pinned_to_bottom && !is_x) continue;
+        for (const auto& [x, y] : s.points) add(is_x ? x : y);
+        if (is_x)
+            for (const auto& [a, b] : s.x_spread) {
+                add(a);
+                add(b);
+            }
+    }
+    if (lo <= hi)  // extra values widen a range the data gave, never make one
+        for (double v : extra) add(v);
     if (!(lo <= hi)) return axis.scale == AxisScale::Log ? Range{1, 10} : Range{0, 1};
     if (axis.scale == AxisScale::Log) {
         lo = std::pow(10.0, std::floor(std::log10(lo)));
@@ -101,96 +89,238 @@ std::vector<double> ticks(Range r, AxisScale scale) {
     return out;
 }
 
+// A series' look: its method's, else the palette's i-th colour, dashed (then dotted) past the palette.
+struct Look {
+    std::string colour;
+    Marker marker = Marker::Circle;
+    std::vector<double> dash;
+};
+
+Look look_of(const ChartSeries& s, size_t index) {
+    if (const MethodStyle* style = find_method_style(s.method))
+        return {style->colour, style->marker, style->dashed ? std::vector<double>{6, 3} : std::vector<double>{}};
+    const std::vector<std::string>& palette = chart_palette();
+    static const std::vector<double> dashes[] = {{}, {7, 4}, {2, 3}};
+    return {palette[index % palette.size()], Marker::Circle, dashes[(index / palette.size()) % std::size(dashes)]};
+}
+
+std::string label_of(const ChartSeries& s) {
+    if (!s.name.empty()) return s.name;
+    const MethodStyle* style = find_method_style(s.method);
+    return style ? style->label : s.method;
+}
+
+// The colour a quarter of the way from white to `colour`: the fill of an error band under its line.
+std::string tint(const std::string& colour) {
+    if (colour.size() != 7) return "#dddddd";
+    std::string out = "#";
+    for (size_t i = 0; i < 3; ++i) {
+        const long v = std::strtol(colour.substr(1 + 2 * i, 2).c_str(), nullptr, 16);
+        char hex[4];
+        std::snprintf(hex, sizeof hex, "%02x", static_cast<int>(std::lround(255 - 0.25 * (255 - static_cast<double>(v)))));
+        out += hex;
+    }
+    return out;
+}
+
+void add_marker(Drawing& d, Marker marker, double x, double y, const std::string& colour) {
+    const double r = 3.5;
+    auto polygon = [&](std::vector<std::pair<double, double>> points) {
+        d.shapes.push_back(PathShape{std::move(points), true, std::nullopt, colour});
+    };
+    switch (marker) {
+        case Marker::Circle: d.shapes.push_back(CircleShape{x, y, r, colour}); break;
+        case Marker::Square: polygon({{x - r, y - r}, {x + r, y - r}, {x + r, y + r}, {x - r, y + r}}); break;
+        case Marker::TriangleUp: polygon({{x, y - 1.2 * r}, {x + 1.1 * r, y + 0.8 * r}, {x - 1.1 * r, y + 0.8 * r}}); break;
+        case Marker::TriangleDown: polygon({{x, y + 1.2 * r}, {x + 1.1 * r, y - 0.8 * r}, {x - 1.1 * r, y - 0.8 * r}}); break;
+        case Marker::Diamond: polygon({{x, y - 1.3 * r}, {x + r, y}, {x, y + 1.3 * r}, {x - r, y}}); break;
+        case Marker::Plus:
+        case Marker::Cross: {
+            const Stroke stroke{colour, 2, {}};
+            const double a = marker == Marker::Plus ? 1.3 * r : r;
+            if (marker == Marker::Plus) {
+                d.shapes.push_back(LineShape{x - a, y, x + a, y, stroke});
+                d.shapes.push_back(LineShape{x, y - a, x, y + a, stroke});
+            } else {
+                d.shapes.push_back(LineShape{x - a, y - a, x + a, y + a, stroke});
+                d.shapes.push_back(LineShape{x - a, y + a, x + a, y - a, stroke});
+            }
+            break;
+        }
+    }
+}
+
 }  // namespace
 
-std::string render_svg_chart(const std::vector<ChartSeries>& series, const ChartOptions& o) {
+Drawing chart_drawing(const std::vector<ChartSeries>& series, const ChartOptions& o) {
     if (o.width < 200 || o.height < 150 || o.width > 10000 || o.height > 10000)
         throw InvalidArgumentError("svg chart: size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
                                    " outside 200x150 .. 10000x10000");
-    for (const auto& s : series)
+    for (const auto& s : series) {
         for (const auto& [x, y] : s.points)
             if (!std::isfinite(x) || !std::isfinite(y))
-                throw InvalidArgumentError("svg chart: series '" + s.name + "' has a non-finite point");
-    const Range xr = data_range(series, o.x, true), yr = data_range(series, o.y, false);
-    const double left = 80, right = 190, top = o.title.empty() ? 20 : 45, bottom = 60;
-    const double plot_w = o.width - left - right, plot_h = o.height - top - bottom;
+                throw InvalidArgumentError("svg chart: series '" + label_of(s) + "' has a non-finite point");
+        for (const auto& [a, b] : s.x_spread)
+            if (!std::isfinite(a) || !std::isfinite(b))
+                throw InvalidArgumentError("svg chart: series '" + label_of(s) + "' has a non-finite spread");
+    }
+    std::vector<double> extra_y;
+    if (o.target_line) extra_y.push_back(*o.target_line);
+    const Range xr = data_range(series, o.x, true, {}), yr = data_range(series, o.y, false, extra_y);
+    const double left = 80, top = o.title.empty() ? 20 : 45, bottom = 60;
+    const double plot_w = o.width - left - 190, plot_h = o.height - top - bottom;
+    const double legend_x = left + plot_w + 15;
+    double legend_w = 0;
+    for (const auto& s : series) legend_w = std::max(legend_w, 32 + text_width(label_of(s), 12));
+    Drawing d;
+    d.width = std::max<double>(o.width, legend_x + legend_w + 10);
+    d.height = o.height + (o.caption.empty() ? 0 : 18);
+    if (!o.caption.empty()) d.width = std::max(d.width, 20 + text_width(o.caption, 10));
+    const double title_w = text_width(o.title, 15);
+    const double title_x = std::max(left + plot_w / 2, 5 + title_w / 2);
+    d.width = std::max(d.width, title_x + title_w / 2 + 5);
+
     auto map = [](double v, Range r, AxisScale scale) {
         return scale == AxisScale::Log ? (std::log10(v) - std::log10(r.lo)) / (std::log10(r.hi) - std::log10(r.lo))
                                        : (v - r.lo) / (r.hi - r.lo);
     };
     auto px = [&](double x) { return left + plot_w * map(x, xr, o.x.scale); };
     auto py = [&](double y) { return top + plot_h * (1 - map(y, yr, o.y.scale)); };
-    auto visible = [&](double x, double y) {
+    auto in_x = [&](double x) {
         if (o.x.scale == AxisScale::Log && !(x > 0)) return false;
-        if (o.y.scale == AxisScale::Log && !(y > 0)) return false;
-        const double u = map(x, xr, o.x.scale), v = map(y, yr, o.y.scale);
-        return u >= -1e-9 && u <= 1 + 1e-9 && v >= -1e-9 && v <= 1 + 1e-9;
+        const double u = map(x, xr, o.x.scale);
+        return u >= -1e-9 && u <= 1 + 1e-9;
+    };
+    auto visible = [&](double x, double y) {
+        if (!in_x(x) || (o.y.scale == AxisScale::Log && !(y > 0))) return false;
+        const double v = map(y, yr, o.y.scale);
+        return v >= -1e-9 && v <= 1 + 1e-9;
+    };
+    auto text = [&](double x, double y, std::string s, double size, TextAnchor anchor, bool vertical = false) {
+        d.shapes.push_back(TextShape{x, y, std::move(s), size, anchor, vertical});
     };
 
-    std::ostringstream svg;
-    svg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-        << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << o.width << "\" height=\"" << o.height
-        << "\" viewBox=\"0 0 " << o.width << " " << o.height << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
-        << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-    if (!o.title.empty())
-        svg << "<text x=\"" << number(left + plot_w / 2) << "\" y=\"25\" text-anchor=\"middle\" font-size=\"15\">"
-            << escape(o.title) << "</text>\n";
+    if (!o.title.empty()) text(title_x, 25, o.title, 15, TextAnchor::Middle);
     // Grid, ticks and tick labels.
+    const Stroke grid{"#dddddd", 1, {}};
     for (double t : ticks(xr, o.x.scale)) {
-        const std::string x = number(px(t));
-        svg << "<line x1=\"" << x << "\" y1=\"" << number(top) << "\" x2=\"" << x << "\" y2=\"" << number(top + plot_h)
-            << "\" stroke=\"#dddddd\"/>\n"
-            << "<text x=\"" << x << "\" y=\"" << number(top + plot_h + 16) << "\" text-anchor=\"middle\">"
-            << tick_label(t, o.x.scale) << "</text>\n";
+        d.shapes.push_back(LineShape{px(t), top, px(t), top + plot_h, grid});
+        text(px(t), top + plot_h + 16, tick_label(t, o.x.scale), 12, TextAnchor::Middle);
     }
     for (double t : ticks(yr, o.y.scale)) {
-        const std::string y = number(py(t));
-        svg << "<line x1=\"" << number(left) << "\" y1=\"" << y << "\" x2=\"" << number(left + plot_w) << "\" y2=\"" << y
-            << "\" stroke=\"#dddddd\"/>\n"
-            << "<text x=\"" << number(left - 6) << "\" y=\"" << y << "\" dy=\"4\" text-anchor=\"end\">"
-            << tick_label(t, o.y.scale) << "</text>\n";
+        d.shapes.push_back(LineShape{left, py(t), left + plot_w, py(t), grid});
+        text(left - 6, py(t) + 4, tick_label(t, o.y.scale), 12, TextAnchor::End);
     }
-    svg << "<rect x=\"" << number(left) << "\" y=\"" << number(top) << "\" width=\"" << number(plot_w) << "\" height=\""
-        << number(plot_h) << "\" fill=\"none\" stroke=\"black\"/>\n";
-    svg << "<text x=\"" << number(left + plot_w / 2) << "\" y=\"" << number(o.height - 15)
-        << "\" text-anchor=\"middle\">" << escape(o.x.label) << "</text>\n";
-    svg << "<text transform=\"translate(18," << number(top + plot_h / 2) << ") rotate(-90)\" text-anchor=\"middle\">"
-        << escape(o.y.label) << "</text>\n";
-    // Series, clipped to the plot area, then the legend.
-    svg << "<defs><clipPath id=\"plot\"><rect x=\"" << number(left) << "\" y=\"" << number(top) << "\" width=\""
-        << number(plot_w) << "\" height=\"" << number(plot_h) << "\"/></clipPath></defs>\n";
+    d.shapes.push_back(PathShape{{{left, top}, {left + plot_w, top}, {left + plot_w, top + plot_h}, {left, top + plot_h}},
+                                 true, Stroke{}, ""});
+    text(left + plot_w / 2, o.height - 15, o.x.label, 12, TextAnchor::Middle);
+    text(18, top + plot_h / 2, o.y.label, 12, TextAnchor::Middle, true);
+
+    // Inside the plot: the target line, error bands, then the series.
+    d.shapes.push_back(ClipBegin{left, top, plot_w, plot_h});
+    if (o.target_line && visible(xr.lo, *o.target_line)) {
+        d.shapes.push_back(GroupBegin{"target"});
+        d.shapes.push_back(LineShape{left, py(*o.target_line), left + plot_w, py(*o.target_line), Stroke{"#555555", 1, {5, 4}}});
+        text(left + 6, py(*o.target_line) - 4, o.target_label, 11, TextAnchor::Start);
+        d.shapes.push_back(GroupEnd{});
+    }
     for (size_t i = 0; i < series.size(); ++i) {
         const ChartSeries& s = series[i];
-        const char* colour = kColours[i % std::size(kColours)];
-        const char* dash = kDashes[(i / std::size(kColours)) % std::size(kDashes)];
+        if (s.pinned_to_bottom || s.x_spread.size() != s.points.size()) continue;
+        std::vector<std::pair<double, double>> lower, upper;
+        bool spread = false;
+        for (size_t k = 0; k < s.points.size(); ++k) {
+            const auto [a, b] = s.x_spread[k];
+            const double y = s.points[k].second;
+            if (!visible(s.points[k].first, y) || !in_x(a) || !in_x(b)) continue;
+            spread = spread || a < b;
+            lower.emplace_back(px(a), py(y));
+            upper.emplace_back(px(b), py(y));
+        }
+        if (!spread || lower.size() < 2) continue;
+        lower.insert(lower.end(), upper.rbegin(), upper.rend());
+        d.shapes.push_back(GroupBegin{"band"});
+        d.shapes.push_back(PathShape{std::move(lower), true, std::nullopt, tint(look_of(s, i).colour)});
+        d.shapes.push_back(GroupEnd{});
+    }
+    std::vector<std::pair<size_t, std::pair<double, double>>> pins;  // (series, pixel point) on the bottom edge
+    for (size_t i = 0; i < series.size(); ++i) {
+        const ChartSeries& s = series[i];
+        const Look look = look_of(s, i);
+        if (s.pinned_to_bottom) {
+            for (const auto& [x, y] : s.points)
+                if (in_x(x)) pins.emplace_back(i, std::pair{px(x), top + plot_h});
+            continue;
+        }
         std::vector<std::pair<double, double>> shown;
         for (const auto& [x, y] : s.points)
             if (visible(x, y)) shown.emplace_back(px(x), py(y));
-        svg << "<g clip-path=\"url(#plot)\">";
-        if (shown.size() > 1) {
-            svg << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"2\"" << dash << " points=\"";
-            for (const auto& [x, y] : shown) svg << number(x) << "," << number(y) << " ";
-            svg << "\"/>";
-        }
+        d.shapes.push_back(GroupBegin{s.method.empty() ? "series" : s.method});
+        if (shown.size() > 1) d.shapes.push_back(PathShape{shown, false, Stroke{look.colour, 2, look.dash}, ""});
         if (s.markers || shown.size() == 1)
-            for (const auto& [x, y] : shown)
-                svg << "<circle cx=\"" << number(x) << "\" cy=\"" << number(y) << "\" r=\"3\" fill=\"" << colour << "\"/>";
-        svg << "</g>\n";
-        const double ly = top + 10 + 20.0 * static_cast<double>(i);
-        const double lx = left + plot_w + 15;
-        svg << "<line x1=\"" << number(lx) << "\" y1=\"" << number(ly) << "\" x2=\"" << number(lx + 25) << "\" y2=\""
-            << number(ly) << "\" stroke=\"" << colour << "\" stroke-width=\"2\"" << dash << "/>"
-            << "<text x=\"" << number(lx + 32) << "\" y=\"" << number(ly) << "\" dy=\"4\">" << escape(s.name)
-            << "</text>\n";
+            for (const auto& [x, y] : shown) add_marker(d, look.marker, x, y, look.colour);
+        d.shapes.push_back(GroupEnd{});
     }
-    svg << "</svg>\n";
-    return svg.str();
+    d.shapes.push_back(ClipEnd{});
+
+    // Pinned points: the marker on the bottom edge (unclipped, so whole), the label above it, kept inside.
+    for (const auto& [i, point] : pins) {
+        const ChartSeries& s = series[i];
+        d.shapes.push_back(GroupBegin{s.method.empty() ? "pinned" : s.method});
+        add_marker(d, look_of(s, i).marker, point.first, point.second, look_of(s, i).colour);
+        const std::string label = s.pin_label.empty() ? label_of(s) : s.pin_label;
+        const bool right_half = point.first > left + plot_w / 2;
+        text(right_half ? point.first - 4 : point.first + 4, point.second - 8, label, 11,
+             right_half ? TextAnchor::End : TextAnchor::Start);
+        d.shapes.push_back(GroupEnd{});
+    }
+
+    // Reference slopes on a log-log chart: triangles along the bottom right, legs in decades.
+    if (o.x.scale == AxisScale::Log && o.y.scale == AxisScale::Log && !o.slope_orders.empty()) {
+        const double x_decades = std::log10(xr.hi / xr.lo), y_decades = std::log10(yr.hi / yr.lo);
+        const double base = 0.12 * plot_w;
+        double right_end = left + plot_w - 20;
+        for (double order : o.slope_orders) {
+            const double rise = order * (base / plot_w * x_decades) / y_decades * plot_h;
+            if (!(rise > 0) || rise > 0.8 * plot_h) continue;
+            const double y0 = top + plot_h - 12;
+            d.shapes.push_back(GroupBegin{"slope"});
+            d.shapes.push_back(PathShape{{{right_end - base, y0}, {right_end, y0}, {right_end, y0 - rise}}, true,
+                                         Stroke{"#555555", 1, {}}, ""});
+            char label[32];
+            std::snprintf(label, sizeof label, "order %g", order);
+            text(right_end - base / 2, y0 - rise / 2 - 4, label, 11, TextAnchor::End);
+            d.shapes.push_back(GroupEnd{});
+            right_end -= base + 40;
+        }
+    }
+
+    // Legend, right of the plot.
+    for (size_t i = 0; i < series.size(); ++i) {
+        const ChartSeries& s = series[i];
+        const Look look = look_of(s, i);
+        const double ly = top + 10 + 20.0 * static_cast<double>(i);
+        d.shapes.push_back(GroupBegin{"legend"});
+        if (!s.pinned_to_bottom) d.shapes.push_back(LineShape{legend_x, ly, legend_x + 25, ly, Stroke{look.colour, 2, look.dash}});
+        if (s.markers || s.pinned_to_bottom) add_marker(d, look.marker, legend_x + 12.5, ly, look.colour);
+        text(legend_x + 32, ly + 4, label_of(s), 12, TextAnchor::Start);
+        d.shapes.push_back(GroupEnd{});
+    }
+    if (!o.caption.empty()) text(10, d.height - 8, o.caption, 10, TextAnchor::Start);
+    return d;
+}
+
+std::string render_svg_chart(const std::vector<ChartSeries>& series, const ChartOptions& options) {
+    return drawing_to_svg(chart_drawing(series, options));
 }
 
 void write_svg_chart(const std::filesystem::path& path, const std::vector<ChartSeries>& series,
                      const ChartOptions& options) {
-    const std::string text = render_svg_chart(series, options);
+    const Drawing drawing = chart_drawing(series, options);
+    const std::string text = drawing_to_svg(drawing);
     write_file_atomically(path, [&](std::ostream& out) { out << text; });
+    std::filesystem::path pdf = path;
+    write_pdf_drawing(pdf.replace_extension(".pdf"), drawing);
 }
 
 }  // namespace waxwork

@@ -24,7 +24,13 @@ using testing::scratch_dir;
 void expect_valid_curve(const nlohmann::json& solvers, const std::string& name) {
     ASSERT_TRUE(solvers.contains(name)) << name;
     const auto& s = solvers[name];
-    EXPECT_EQ(s.size(), 3u) << name;
+    EXPECT_EQ(s.size(), 8u) << name;
+    // Setup apart from the solve: only the two Jacobi CGs have none.
+    ASSERT_TRUE(s["setup_ms"].is_number()) << name;
+    if (name == "jacobi_cg" || name == "jacobi_cg_double")
+        EXPECT_EQ(s["setup_ms"].get<double>(), 0.0) << name;
+    else
+        EXPECT_GT(s["setup_ms"].get<double>(), 0.0) << name;
     ASSERT_TRUE(s.contains("cap_to_1pct")) << name;
     if (name == "direct")
         EXPECT_TRUE(s["cap_to_1pct"].is_null());
@@ -46,6 +52,15 @@ void expect_valid_curve(const nlohmann::json& solvers, const std::string& name) 
     EXPECT_GT(s["time_to_1pct_ms"].get<double>(), 0.0) << name;
     // The last cap is always kept (noise only drops earlier points) and is below 1%.
     EXPECT_LT(curve.back()[1].get<double>(), 1e-2) << name;
+    // Every point's time lies within its fastest and slowest run.
+    ASSERT_EQ(s["curve_ms_min"].size(), curve.size()) << name;
+    ASSERT_EQ(s["curve_ms_max"].size(), curve.size()) << name;
+    for (size_t i = 0; i < curve.size(); ++i) {
+        EXPECT_LE(s["curve_ms_min"][i].get<double>(), curve[i][0].get<double>()) << name << " point " << i;
+        EXPECT_GE(s["curve_ms_max"][i].get<double>(), curve[i][0].get<double>()) << name << " point " << i;
+    }
+    EXPECT_LE(s["time_to_1pct_ms_min"].get<double>(), s["time_to_1pct_ms"].get<double>()) << name;
+    EXPECT_GE(s["time_to_1pct_ms_max"].get<double>(), s["time_to_1pct_ms"].get<double>()) << name;
 }
 
 // `bench solvers` on a cube of 4,374 tets (CPU curves), run once per test process and shared by the
@@ -76,8 +91,10 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
     for (const auto& [key, value] : json.items()) keys.push_back(key);
     EXPECT_EQ(keys, (std::vector<std::string>{"hierarchy_ms", "hierarchy_rebuild_ms", "levels", "material", "mesh",
                                               "mm_per_unit", "multigrid_rgb_setup_ms", "multigrid_rgb_setup_rebuild_ms",
-                                              "multigrid_setup_ms", "multigrid_setup_rebuild_ms", "solvers", "tets",
-                                              "vertices"}));
+                                              "multigrid_setup_ms", "multigrid_setup_rebuild_ms", "repeats", "solvers",
+                                              "statistic", "tets", "vertices"}));
+    EXPECT_EQ(json["statistic"], "fastest of 3 runs (runs over 100 ms: one run) after one warm-up");
+    EXPECT_EQ(json["repeats"], 0);
     EXPECT_EQ(json["material"], "marble");  // the cube stores no materials
     EXPECT_DOUBLE_EQ(json["mm_per_unit"].get<double>(), 100.0);  // its longest side becomes 100 mm
     for (const char* key : {"hierarchy_rebuild_ms", "multigrid_setup_rebuild_ms", "multigrid_rgb_setup_rebuild_ms"})
@@ -95,7 +112,13 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
     const std::string svg = testing::read_text(out / "solvers.svg");
     EXPECT_NE(svg.find("<svg"), std::string::npos);
     for (const std::string name : {"jacobi_cg", "multigrid_cg", "direct"}) EXPECT_NE(svg.find(name), std::string::npos);
-    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(out), std::filesystem::directory_iterator{}), 2);
+    // Legend labels, the direct solve pinned with its error, the 1% line, the caption with the statistic.
+    for (const std::string label : {">Jacobi CG (float)<", ">Multigrid CG<", ">Eigen IC-CG<", "direct: ", "1% error",
+                                    "times: fastest of 3 runs"})
+        EXPECT_NE(svg.find(label), std::string::npos) << label;
+    EXPECT_EQ(svg.find(">1e-16<"), std::string::npos);
+    EXPECT_EQ(testing::read_text(out / "solvers.pdf").rfind("%PDF-", 0), 0u);
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(out), std::filesystem::directory_iterator{}), 3);
 }
 
 // --backend gpu adds the GPU curves (llvmpipe here); a driver that rejects a shader leaves them out
@@ -126,6 +149,30 @@ TEST(BenchSolversCommand, FrameSolverCurveFallsWithTheVcycleCap) {
     const int per_channel_cap = solvers["multigrid_cg"]["cap_to_1pct"].get<int>();
     EXPECT_LE(std::abs(rgb_cap - per_channel_cap), 1) << rgb_cap << " vs " << per_channel_cap;
     EXPECT_NE(testing::read_text(out / "solvers.svg").find("multigrid_cg_rgb"), std::string::npos);
+}
+
+// --repeats N: every point is the median of N runs, within their min and max, and the JSON and the chart
+// name the statistic; --include-setup charts setup + solve.
+TEST(BenchSolversCommand, RepeatsReportMedianMinMaxAndTheStatistic) {
+    const auto dir = scratch_dir("bench_solvers_repeats");
+    const auto volume = dir / "cube.vtu";
+    write_volume(testing::make_cube_mesh(6, Eigen::Vector3d::Zero(), 1.0), volume);
+    const auto result = run_waxwork("bench solvers --mesh " + volume.string() + " -o " + (dir / "out").string() +
+                                    " --backend cpu --floor 1e-3 --max-seconds 5 --repeats 3 --include-setup");
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const auto json = nlohmann::json::parse(testing::read_text(dir / "out" / "solvers.json"));
+    EXPECT_EQ(json["statistic"], "median of 3 runs after one warm-up");
+    EXPECT_EQ(json["repeats"], 3);
+    for (const auto& [name, s] : json["solvers"].items()) expect_valid_curve(json["solvers"], name);
+    const std::string svg = testing::read_text(dir / "out" / "solvers.svg");
+    EXPECT_NE(svg.find("setup + solve time"), std::string::npos);
+    EXPECT_NE(svg.find("times: median of 3 runs after one warm-up"), std::string::npos);
+    // The direct point with its factorisation: its label's time is setup + solve.
+    EXPECT_NE(svg.find(" ms with factorisation, error "), std::string::npos);
+
+    const auto refused = run_waxwork("bench solvers --mesh " + volume.string() + " -o " + (dir / "bad").string() +
+                                     " --repeats 0");
+    EXPECT_NE(refused.exit_code, 0);
 }
 
 TEST(BenchSolversCommand, GpuBackendAddsGpuCurvesOrWarns) {
