@@ -26,12 +26,12 @@ struct ChartSeries {
     std::string name;                               // legend label (empty with a method: the method's label)
     std::vector<std::pair<double, double>> points;  // (x, y), drawn in the given order
     bool markers = true;                            // a marker on every point (a lone point always gets one)
-    std::string method;                             // a method_style key, or empty
+    std::string method{};                           // a method_style key, or empty
     // Per point, the (min, max) of x over repeated measurements: drawn as a band where min < max.
-    std::vector<std::pair<double, double>> x_spread;
+    std::vector<std::pair<double, double>> x_spread{};
     // Drawn as markers on the bottom edge of the plot with pin_label beside them, left out of the y range.
     bool pinned_to_bottom = false;
-    std::string pin_label;
+    std::string pin_label{};
 };
 
 enum class AxisScale { Linear, Log };
