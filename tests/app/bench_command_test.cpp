@@ -156,7 +156,7 @@ TEST(BenchSolversCommand, FrameSolverCurveFallsWithTheVcycleCap) {
 TEST(BenchSolversCommand, RepeatsReportMedianMinMaxAndTheStatistic) {
     const auto dir = scratch_dir("bench_solvers_repeats");
     const auto volume = dir / "cube.vtu";
-    write_volume(testing::make_cube_mesh(6, Eigen::Vector3d::Zero(), 1.0), volume);
+    write_volume(testing::make_cube_mesh(9, Eigen::Vector3d::Zero(), 1.0), volume);
     const auto result = run_waxwork("bench solvers --mesh " + volume.string() + " -o " + (dir / "out").string() +
                                     " --backend cpu --floor 1e-3 --max-seconds 5 --repeats 3 --include-setup");
     ASSERT_EQ(result.exit_code, 0) << result.err;
