@@ -306,9 +306,8 @@ void EditorApp::draw_scale_fit() {
     ImGui::TextDisabled("object %s", size_in_mm(s.extent, mm).c_str());
     const double wanted = default_surface_edge(s.extent.norm(), s.setup_material, mm);
     const double ratio = s.surface_edge / wanted;
-    // Within a factor 1.5 either way the rule's error estimate (about h^2) changes by at most 2.25x.
-    if (ratio >= 1.0 / 1.5 && ratio <= 1.5) return;
-    if (ratio > 1.5)
+    if (ratio >= 1.0 / kResolutionTolerance && ratio <= kResolutionTolerance) return;
+    if (ratio > kResolutionTolerance)
         ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "mesh %.1fx coarser than the light needs at this scale",
                            ratio);
     else

@@ -93,6 +93,16 @@ void write_lighting_fields(const Lighting& lighting, Json& j) {
     j["shadows"] = lighting.shadows;
 }
 
+}  // namespace
+
+Json lighting_to_json(const Lighting& lighting) {
+    Json j = Json::object();
+    write_lighting_fields(lighting, j);
+    return j;
+}
+
+namespace {
+
 CameraSettings camera_from_json(const Json& json, const std::string& context, CameraSettings camera) {
     FieldReader in(json, context);
     if (in.has("eye_direction")) camera.eye_direction = in.vector("eye_direction");

@@ -123,6 +123,10 @@ Session parse_session(const nlohmann::ordered_json& json, const std::filesystem:
 Session read_session(const std::filesystem::path& path);
 
 nlohmann::ordered_json session_to_json(const Session& session);
+
+// A lighting as the session file writes it: {"lights": [{"direction" | "position", "intensity"}, ...],
+// "ambient", "shadows"}.
+nlohmann::ordered_json lighting_to_json(const Lighting& lighting);
 // Writes atomically. Input paths are written relative to the file's directory when possible.
 void write_session(const std::filesystem::path& path, const Session& session);
 

@@ -19,6 +19,9 @@
 #include "tetops/tetrahedralize.h"
 #include "tetops/triangle_surface.h"
 
+#include <string>
+#include <vector>
+
 namespace waxwork {
 
 struct MeshResolutionRule {
@@ -44,6 +47,31 @@ double default_surface_edge(double diagonal, const TetMaterial& material, double
 // two faces count twice, which weights them alike): what default_surface_edge asks of a mesh, to say
 // how far an existing mesh is from the rule at another scale. Zero for a mesh without tets.
 double mean_surface_edge_length(const TetMesh& mesh);
+
+// An existing mesh against the rule (lengths in mm): the mean surface edge, the rule's h_s for the
+// mesh's bounding box, and the smallest diffusion length, for the material the rule is hardest on.
+struct ResolutionFit {
+    double surface_edge_mm = 0;
+    double rule_edge_mm = 0;
+    double diffusion_length_mm = 0;
+    std::string material;  // which material set the rule (its name or "the finest of N materials")
+};
+
+// `materials`: per tet (the hardest one counts: the smallest diffusion length). Throws
+// InvalidArgumentError for an empty mesh or material list.
+ResolutionFit fit_to_resolution_rule(const TetMesh& mesh, const std::vector<TetMaterial>& materials,
+                                     double mm_per_unit);
+
+// Within this factor of the rule's edge either way, the rule's error estimate (about h^2) changes by at
+// most 2.25x: what the editor's scale panel and the benchmarks' warnings accept.
+inline constexpr double kResolutionTolerance = 1.5;
+
+// A warning, or "" when the mesh resolves the light: its mean surface edge is more than
+// kResolutionTolerance times the rule's light term (l_d / 2). The rule's clamps are left out: its cost
+// floor D/150 can ask for edges longer than l_d (each linear element then interpolates exp(-x/l_d) with
+// over 10% error; the stability study measures 20-40% there), and its shape cap D/25 asks for shorter
+// edges than the light needs.
+std::string under_resolution_warning(const ResolutionFit& fit);
 
 // Graded sizing for `surface` filled with `material` at mm_per_unit millimetres per model unit.
 MeshSizing default_mesh_sizing(const TriangleSurface& surface, const TetMaterial& material, double mm_per_unit,

@@ -1,6 +1,6 @@
 // `waxwork bench`: measurements that back docs/ (performance, accuracy, stability), written as JSON, SVG and PDF.
 //   waxwork bench solvers --mesh MESH [--max-tets N] -o DIR [--backend cpu|gpu] [--material NAME | ...]
-//                         [--repeats N] [--include-setup] [--mesher auto|tetgen|cgal] [--fill-holes] [...]
+//                         [--repeats N] [--threads N] [--include-setup] [--mesher auto|tetgen|cgal] [--fill-holes] [...]
 // `bench` itself takes the subcommand; it is a CLI11 app with an optional subcommand so that a later
 // `waxwork bench [--quick] -o DIR` (all benchmarks) can be the parent's own action.
 #include "app/commands.h"
@@ -8,9 +8,12 @@
 #include "app/options/surface_meshing_options.h"
 #include "base/error.h"
 #include "bench/studies/bench_suite.h"
+#include "bench/studies/provenance.h"
+#include "bench/studies/thread_limit.h"
 #include "bench/studies/solver_comparison.h"
 #include "io/surface_reader.h"
 #include "io/volume_file.h"
+#include "scene/session.h"
 #include "solver/light_spec.h"
 #include "solver/material.h"
 #include "tetops/tetrahedralize.h"
@@ -37,20 +40,30 @@ struct SolversCommandOptions {
     double floor_error = 1e-4;
     double max_seconds = 60;
     int repeats = 0;  // 0: the comparison's default statistic
+    int threads = 1;  // every library alike (bench/studies/thread_limit.h); 0: every hardware thread
     bool include_setup = false;
     SurfaceMeshingOptions meshing;
     MaterialOptions material;
 };
 
-TetMesh load_or_mesh(const SolversCommandOptions& o) {
-    if (is_volume_path(o.mesh)) return read_volume(o.mesh);
+// The volume to compare on, and how it was made (the provenance's "meshing").
+std::pair<TetMesh, nlohmann::ordered_json> load_or_mesh(const SolversCommandOptions& o) {
+    if (is_volume_path(o.mesh)) return {read_volume(o.mesh), {{"mesher", "none: read from the volume file"}}};
     if (!o.max_tets)
         throw InvalidArgumentError(o.mesh + ": a surface needs --max-tets (or pass a volume file)");
     const LoadedSurface surface = load_surface_to_mesh(o.mesh, o.meshing);
     MeshingOptions meshing = meshing_options(o.meshing);
     meshing.sizing.target_tets = o.max_tets;
     if (surface.wrap) meshing.remesh_edge_ratio = kWrapRemeshEdgeRatio;
-    return tetrahedralize_surface_file(o.mesh, surface.surface, meshing).mesh;
+    MeshingResult result = tetrahedralize_surface_file(o.mesh, surface.surface, meshing);
+    nlohmann::ordered_json made = {{"mesher", mesher_name(result.mesher)},
+                                   {"why", result.mesher_reason},
+                                   {"target_tets", *o.max_tets},
+                                   {"max_radius_edge_ratio", meshing.max_radius_edge_ratio},
+                                   {"min_dihedral_bound_deg", meshing.min_dihedral_deg},
+                                   {"repair", o.meshing.repair.empty() ? "none" : o.meshing.repair},
+                                   {"fill_holes", o.meshing.fill_holes}};
+    return {std::move(result.mesh), std::move(made)};
 }
 
 // The longest side of the bounding box becomes 100 mm unless --scale says otherwise.
@@ -68,7 +81,9 @@ void run_solvers_command(const SolversCommandOptions& o) {
     if (!(o.max_seconds > 0) || !std::isfinite(o.max_seconds))
         throw InvalidArgumentError("--max-seconds must be positive");
     const std::optional<TetMaterial> material = chosen_material(o.material);  // before the (long) meshing
-    const TetMesh mesh = load_or_mesh(o);
+    const ThreadLimit threads(o.threads);  // before the OpenGL context: llvmpipe sizes its pool once
+    RunProvenance provenance(threads);
+    const auto [mesh, meshing] = load_or_mesh(o);
     if (mesh.tet_count() == 0) throw InvalidArgumentError(o.mesh + ": the volume has no tets");
     const TetConnectivity connectivity = build_connectivity(mesh);
     const std::vector<TetMaterial> materials = resolve_materials(mesh, material);
@@ -77,6 +92,7 @@ void run_solvers_command(const SolversCommandOptions& o) {
 
     SolverComparisonOptions options;
     options.mm_per_unit = mm_per_unit(mesh, o.scale);
+    provenance.warn_if_under_resolved(mesh, materials, options.mm_per_unit);
     options.floor_error = o.floor_error;
     options.max_seconds = o.max_seconds;
     options.repeats = o.repeats;
@@ -95,8 +111,13 @@ void run_solvers_command(const SolversCommandOptions& o) {
     const std::string material_name = resolved_materials_name(mesh, material);
     SolverChartOptions chart;
     chart.include_setup = o.include_setup;
-    chart.caption = solver_chart_caption(comparison, context ? context->renderer() : "");
-    write_solver_comparison(dir, "solvers", {o.mesh, material_name, options.mm_per_unit}, comparison, chart);
+    if (context) provenance.set_gl_renderer(context->renderer());
+    nlohmann::ordered_json inputs = mesh_inputs(o.mesh, mesh, options.mm_per_unit);
+    inputs["meshing"] = meshing;
+    inputs["material"] = material_name;
+    inputs["lighting"] = lighting_to_json(lighting);
+    const nlohmann::ordered_json block = provenance.to_json(inputs, solver_comparison_definitions(options));
+    write_solver_comparison(dir, "solvers", {o.mesh, material_name, options.mm_per_unit}, comparison, block, chart);
 
     nlohmann::ordered_json summary_times = nlohmann::ordered_json::object();
     for (const SolverCurve& s : comparison.solvers)
@@ -111,6 +132,8 @@ void run_solvers_command(const SolversCommandOptions& o) {
     for (const auto& [key, ms] : setup_times(comparison)) summary[key] = ms;
     summary["time_to_1pct_ms"] = summary_times;
     if (context) summary["gpu_renderer"] = context->renderer();
+    summary["threads"] = threads.threads();
+    summary["warnings"] = block.at("warnings");
     std::cout << summary.dump() << "\n";
 }
 
@@ -131,6 +154,10 @@ void add_bench_command(CLI::App& app) {
                       "Report the median of N runs per timed point, with min and max (default: the fastest of 3 "
                       "short runs; Table 1: median of 3)")
         ->check(CLI::Range(1, 1000));
+    bench->add_option("--threads", suite->threads,
+                      "Threads for every library, 0 for all (default: 1 in the solver comparisons, so every "
+                      "solver gets the same; all in the other parts)")
+        ->check(CLI::Range(0, kMaxBenchThreads));
     bench->footer("Without a subcommand runs every part (bench/studies/bench_suite.h) and writes JSON, SVG charts and\n"
                   "markdown tables into the output directory.");
     bench->callback([bench, suite, suite_output] {
@@ -168,6 +195,10 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--repeats", options->repeats,
                     "Median of N runs per point, with min and max (default: fastest of 3 for runs under 100 ms)")
         ->check(CLI::Range(1, 1000));
+    cmd->add_option("--threads", options->threads,
+                    "Threads for every library alike (TBB, OpenMP, BLAS, llvmpipe), 0 for all hardware threads")
+        ->check(CLI::Range(0, kMaxBenchThreads))
+        ->capture_default_str();
     cmd->add_flag("--include-setup", options->include_setup,
                   "Chart setup + solve time (default: solve time; the JSON has both)");
     add_surface_meshing_options(*cmd, options->meshing);

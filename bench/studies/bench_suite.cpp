@@ -4,6 +4,7 @@
 #include "bench/studies/accuracy_study.h"
 #include "bench/studies/coarse_start_bound.h"
 #include "bench/studies/cut_study.h"
+#include "bench/studies/provenance.h"
 #include "bench/studies/resolution_study.h"
 #include "bench/studies/solver_comparison.h"
 #include "bench/studies/stability_study.h"
@@ -14,6 +15,7 @@
 #include "io/surface_reader.h"
 #include "multires/multigrid_preconditioner.h"
 #include "multires/multires_solver.h"
+#include "scene/session.h"
 #include "solver/light_spec.h"
 #include "solver/material.h"
 #include "solver/reference/reference_solvers.h"
@@ -45,17 +47,16 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
     write_file_atomically(path, [&](std::ostream& out) { out << text; });
 }
 
+// A part's JSON: its provenance block (bench/studies/provenance.h) first, then the part's own fields.
+Json with_provenance(RunProvenance& provenance, const Json& inputs, const Json& definitions, const Json& body) {
+    Json out = {{"provenance", provenance.to_json(inputs, definitions)}};
+    for (const auto& [key, value] : body.items()) out[key] = value;
+    return out;
+}
+
 // A chart or table title, marked when the run was --quick (smaller meshes, fewer samples).
 std::string titled(const BenchSuiteOptions& o, const std::string& title) {
     return o.quick ? title + " (quick run)" : title;
-}
-
-// The caption line of the suite's charts: the UTC date.
-std::string chart_caption() {
-    const std::time_t now = std::time(nullptr);
-    char date[32];
-    std::strftime(date, sizeof date, "%Y-%m-%d", std::gmtime(&now));
-    return date;
 }
 
 // The shipped spot meshed by TetGen to about target_tets.
@@ -69,14 +70,25 @@ TetMesh spot_volume(const BenchSuiteOptions& o, size_t target_tets) {
 constexpr double solver_scene_mm_per_unit = 30;
 
 struct SolverScene {
+    size_t target_tets = 0;
     TetMesh mesh;
     TetConnectivity connectivity;
     std::vector<TetMaterial> materials;
     Lighting lighting;
 };
 
+// The inputs block of a part measured on `scene` (provenance.h).
+Json scene_inputs(const BenchSuiteOptions& o, const SolverScene& scene, double mm_per_unit) {
+    Json inputs = mesh_inputs(o.asset_dir / "meshes/spot.obj", scene.mesh, mm_per_unit);
+    inputs["meshing"] = {{"mesher", "tetgen"}, {"target_tets", scene.target_tets}};
+    inputs["material"] = "marble";
+    inputs["lighting"] = lighting_to_json(scene.lighting);
+    return inputs;
+}
+
 SolverScene solver_scene(const BenchSuiteOptions& o, size_t target_tets) {
     SolverScene scene;
+    scene.target_tets = target_tets;
     scene.mesh = spot_volume(o, target_tets);
     scene.connectivity = build_connectivity(scene.mesh);
     scene.materials.assign(scene.mesh.tet_count(), material_preset("marble"));
@@ -84,8 +96,9 @@ SolverScene solver_scene(const BenchSuiteOptions& o, size_t target_tets) {
     return scene;
 }
 
-void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index) {
+void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index, RunProvenance& provenance) {
     const SolverScene scene = solver_scene(o, target_tets);
+    provenance.warn_if_under_resolved(scene.mesh, scene.materials, solver_scene_mm_per_unit);
     SolverComparisonOptions options;
     options.mm_per_unit = solver_scene_mm_per_unit;
     options.max_seconds = o.quick ? 8.0 : 60.0;
@@ -98,9 +111,11 @@ void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index
     const std::string stem = "solvers_spot_" + std::to_string((target_tets + 500) / 1000) + "k";
     SolverChartOptions chart;
     chart.quick = o.quick;
-    chart.caption = solver_chart_caption(comparison, context ? context->renderer() : "");
+    if (context) provenance.set_gl_renderer(context->renderer());
+    const Json block = provenance.to_json(scene_inputs(o, scene, solver_scene_mm_per_unit),
+                                          solver_comparison_definitions(options));
     write_solver_comparison(o.output_dir, stem, {"assets/meshes/spot.obj", "marble", solver_scene_mm_per_unit},
-                            comparison, chart);
+                            comparison, block, chart);
     Json& listed = index["solvers"];
     if (!listed.is_array()) listed = Json::array();
     if (std::find(listed.begin(), listed.end(), Json(stem + ".json")) == listed.end()) listed.push_back(stem + ".json");
@@ -171,7 +186,7 @@ Json coarse_start_row(const SolverScene& scene, const std::vector<TetMaterial>& 
 // The best start the paper's coarse level can give the level-0 CG, on the solver parts' systems and, at
 // 50K tets, across the measured materials and scales (the diffusion length against the mesh size), with
 // the paper's weights and linear-exact ones: why its coarse-to-fine scheme saves so few iterations.
-void run_coarse_start_part(const BenchSuiteOptions& o, Json& index) {
+void run_coarse_start_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
     Json sizes = Json::array();
     const std::vector<size_t> targets = o.quick ? std::vector<size_t>{50'000} : std::vector<size_t>{50'000, 500'000};
     for (const size_t target : targets) {
@@ -199,23 +214,37 @@ void run_coarse_start_part(const BenchSuiteOptions& o, Json& index) {
         row["mean_edge_mm"] = mean_edge * scale;
         sweep.push_back(std::move(row));
     }
-    write_json(o.output_dir / "coarse_start.json", {{"mesh", "assets/meshes/spot.obj"},
-                                                    {"material", "marble"},
-                                                    {"mm_per_unit", solver_scene_mm_per_unit},
-                                                    {"sizes", sizes},
-                                                    {"materials", sweep}});
+    const Json definitions = {
+        {"error", "relative L2 error of phi over every vertex and the three channels against the direct solution "
+                  "(plus one refinement step)"},
+        {"iterations_to_1pct", "level-0 Jacobi CG iterations until the true error is at most 1%"},
+        {"multigrid_cg_iterations", "V-cycle-preconditioned CG iterations until the true error reaches the target"},
+        {"iteration_ratio", "iterations from the coarse start over iterations from zero"},
+        {"lengths", "mm"}};
+    write_json(o.output_dir / "coarse_start.json",
+               with_provenance(provenance, scene_inputs(o, scene, solver_scene_mm_per_unit), definitions,
+                               {{"mesh", "assets/meshes/spot.obj"},
+                                {"material", "marble"},
+                                {"mm_per_unit", solver_scene_mm_per_unit},
+                                {"sizes", sizes},
+                                {"materials", sweep}}));
     index["coarse_start"] = "coarse_start.json";
 }
 
 // Cross-section distance and dihedral distributions of both cut modes.
-void run_cut_modes_part(const BenchSuiteOptions& o, Json& index) {
+void run_cut_modes_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
     const TetMesh mesh = spot_volume(o, o.quick ? 50'000 : 500'000);
     const auto box = bounding_box(mesh);
     const Eigen::Vector3d normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
     const std::vector<CutModeResult> results =
         compare_cut_modes(mesh, PlaneCut(normal, normal.dot(0.5 * (box[0] + box[1]))));
-    Json json = {{"tets_before", mesh.tet_count()}, {"modes", to_json(results)}};
-    write_json(o.output_dir / "cut_modes.json", json);
+    const Json definitions = {
+        {"distance", "each cross-section vertex's distance to the cutting plane, over the mesh's mean edge length"},
+        {"dihedral", "each tet's smallest dihedral angle after the cut, in degrees"},
+        {"times", "milliseconds of wall clock, one run"}};
+    write_json(o.output_dir / "cut_modes.json",
+               with_provenance(provenance, mesh_inputs(o.asset_dir / "meshes/spot.obj", mesh, 1.0), definitions,
+                               {{"tets_before", mesh.tet_count()}, {"modes", to_json(results)}}));
 
     // At most ~200 points per line: every k-th sample of a sorted distribution, the last one always.
     auto thin = [](size_t n, auto&& point) {
@@ -243,20 +272,20 @@ void run_cut_modes_part(const BenchSuiteOptions& o, Json& index) {
     ChartOptions distance_chart;
     distance_chart.title = titled(o, "Cross-section vertices' distance to the cutting plane (spot, " +
                                          std::to_string(mesh.tet_count()) + " tets)");
-    distance_chart.caption = chart_caption();
+    distance_chart.caption = provenance.caption();
     distance_chart.x = {"fraction of cross-section vertices (sorted)", AxisScale::Linear, 0, 1};
     distance_chart.y = {"distance / mean edge length", AxisScale::Log};
     write_svg_chart(o.output_dir / "cut_modes.svg", distance_lines, distance_chart);
     ChartOptions quality_chart;
     quality_chart.title = titled(o, "Tets under a minimum dihedral angle after the cut");
-    quality_chart.caption = chart_caption();
+    quality_chart.caption = provenance.caption();
     quality_chart.x = {"minimum dihedral angle (degrees)", AxisScale::Log, 0.1, 10};
     quality_chart.y = {"tets below", AxisScale::Log};
     write_svg_chart(o.output_dir / "cut_quality.svg", quality_lines, quality_chart);
     index["cut_modes"] = "cut_modes.json";
 }
 
-void run_accuracy_part(const BenchSuiteOptions& o, Json& index) {
+void run_accuracy_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
     const StudySize size{.quick = o.quick};
     const std::vector<ConvergenceSeries> ball = study_ball_convergence(size);
     SurfaceConvergenceOptions spot_options;
@@ -267,7 +296,25 @@ void run_accuracy_part(const BenchSuiteOptions& o, Json& index) {
         spot_options.reference_size_factor = 0.6;
     }
     const ConvergenceSeries spot = study_surface_convergence(spot_options);
-    write_json(o.output_dir / "accuracy.json", Json{{"ball", to_json(ball)}, {"surface", to_json({spot})}});
+    const Json inputs = {
+        {"ball", "icosphere of radius 10 mm meshed by TetGen; mu_a 0.01, mu_s' 1 per mm, eta 1.3"},
+        {"surface", {{"mesh_file", spot_options.surface.string()},
+                     {"mesh_sha256", file_sha256(spot_options.surface)},
+                     {"material", spot_options.material},
+                     {"mm_per_unit", spot_options.mm_per_unit},
+                     {"size_factors", spot_options.size_factors},
+                     {"reference_size_factor", spot_options.reference_size_factor},
+                     {"lighting", lighting_to_json(Lighting{{default_key_light()}})}}}};
+    const Json definitions = {
+        {"ball_error", "relative L2 error of phi (channel 0, weighted by lumped vertex volume) against the analytic "
+                       "series (60 Legendre terms for the directional light); solves to relative tolerance 1e-8"},
+        {"surface_error", "relative L2 error of phi at the input surface's vertices, three channels, against the "
+                          "mesh of reference_size_factor x the default size; solves to 1e-8"},
+        {"tet_size_mm", "(volume / tets)^(1/3)"},
+        {"observed_order", "least-squares slope of log(error) against log(tet_size_mm)"},
+        {"solve_ms", "assembly + solve, milliseconds of wall clock, one run"}};
+    write_json(o.output_dir / "accuracy.json",
+               with_provenance(provenance, inputs, definitions, {{"ball", to_json(ball)}, {"surface", to_json({spot})}}));
 
     auto chart = [&](const std::vector<ConvergenceSeries>& series, const std::string& title,
                      const std::filesystem::path& path) {
@@ -285,7 +332,7 @@ void run_accuracy_part(const BenchSuiteOptions& o, Json& index) {
         options.x = {"mean tet size (mm)", AxisScale::Log};
         options.y = {"relative L2 error of phi", AxisScale::Log};
         options.slope_orders = {1, 2};
-        options.caption = chart_caption();
+        options.caption = provenance.caption();
         write_svg_chart(path, lines, options);
     };
     chart(ball, "Ball (R = 10 mm) against the analytic solution", o.output_dir / "accuracy_ball.svg");
@@ -293,7 +340,7 @@ void run_accuracy_part(const BenchSuiteOptions& o, Json& index) {
     index["accuracy"] = "accuracy.json";
 }
 
-void run_table1_part(const BenchSuiteOptions& o, Json& index) {
+void run_table1_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
     std::vector<TimingRow> rows;
     TimingOptions options;
     options.target_tets = o.quick ? 100'000 : 500'000;
@@ -302,7 +349,17 @@ void run_table1_part(const BenchSuiteOptions& o, Json& index) {
         o.quick ? std::vector<std::string>{"spot"} : std::vector<std::string>{"spot", "torus", "skull"};
     for (const std::string& model : models)
         rows.push_back(measure_timing_row(o.asset_dir / "meshes" / (model + ".obj"), options));
-    write_json(o.output_dir / "table1.json", to_json(rows));
+    Json inputs = Json::array();
+    for (const std::string& model : models) {
+        const std::filesystem::path file = o.asset_dir / "meshes" / (model + ".obj");
+        inputs.push_back({{"mesh_file", file.string()}, {"mesh_sha256", file_sha256(file)}});
+    }
+    const Json definitions = {
+        {"times", "milliseconds of wall clock, the median of " + std::to_string(options.runs) + " runs per stage"},
+        {"stages", "timing_table.h: T_b = neighbourhood + hierarchy, T_m = matrix, T_s = solve from zero to the "
+                   "solver's default tolerance, cut and paint with everything they rebuild"},
+        {"target_tets", options.target_tets}};
+    write_json(o.output_dir / "table1.json", with_provenance(provenance, inputs, definitions, {{"rows", to_json(rows)}}));
     write_text(o.output_dir / "table1.md", "### " + titled(o, "Table 1: build, matrix, solve, cut and paint times") +
                                                "\n\nTimes: median of " + std::to_string(options.runs) +
                                                " runs per stage (the paper's rows: as published).\n\n" +
@@ -310,7 +367,7 @@ void run_table1_part(const BenchSuiteOptions& o, Json& index) {
     index["table1"] = "table1.md";
 }
 
-void run_stability_part(const BenchSuiteOptions& o, Json& index) {
+void run_stability_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
     const std::vector<StudyTable> tables = run_stability_studies({.quick = o.quick});
     Json json = Json::array();
     std::string markdown = "## " + titled(o, "Stability studies") +
@@ -321,12 +378,15 @@ void run_stability_part(const BenchSuiteOptions& o, Json& index) {
         titled_table.name = titled(o, t.name);
         markdown += titled_table.to_markdown() + "\n";
     }
-    write_json(o.output_dir / "stability.json", json);
+    const Json definitions = {{"values", "one run per row; each table names its columns and their units"}};
+    write_json(o.output_dir / "stability.json",
+               with_provenance(provenance, {{"scenes", "generated by each study (stability_study.h)"}}, definitions,
+                               {{"tables", json}}));
     write_text(o.output_dir / "stability.md", markdown);
     index["stability"] = "stability.md";
 }
 
-void run_resolution_part(const BenchSuiteOptions& o, Json& index) {
+void run_resolution_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
     ResolutionStudyOptions options;
     options.surface = o.asset_dir / "meshes/spot.obj";
     if (o.quick) {
@@ -340,7 +400,17 @@ void run_resolution_part(const BenchSuiteOptions& o, Json& index) {
     json["material"] = options.material;
     json["mm_per_unit"] = options.mm_per_unit;
     json["error_bound"] = options.error_bound;
-    write_json(o.output_dir / "resolution.json", json);
+    const Json inputs = {{"mesh_file", options.surface.string()},
+                         {"mesh_sha256", file_sha256(options.surface)},
+                         {"material", options.material},
+                         {"mm_per_unit", options.mm_per_unit},
+                         {"image", {options.width, options.height}}};
+    const Json definitions = {
+        {"image_error", "relative L2 difference of the rendered image from the reference image (mesh at "
+                        "reference_size_factor x the default size, tolerance reference_tolerance), same view and "
+                        "exposure"},
+        {"solve_ms", "assembly + solve, milliseconds of wall clock, one run per sample"}};
+    write_json(o.output_dir / "resolution.json", with_provenance(provenance, inputs, definitions, json));
 
     std::map<double, ChartSeries> by_factor;
     for (const ResolutionSample& s : study.samples) {
@@ -356,7 +426,7 @@ void run_resolution_part(const BenchSuiteOptions& o, Json& index) {
     chart.title = titled(o, "Rendered image error against solve time (tolerances along each line)");
     chart.target_line = options.error_bound;
     chart.target_label = "error bound";
-    chart.caption = chart_caption() + " | times: one run per sample";
+    chart.caption = provenance.caption() + " | times: one run per sample";
     chart.x = {"assembly + solve (ms)", AxisScale::Log};
     chart.y = {"relative image error", AxisScale::Log};
     write_svg_chart(o.output_dir / "resolution.svg", lines, chart);
@@ -382,23 +452,25 @@ void run_bench_suite(const BenchSuiteOptions& o) {
     index["quick"] = o.quick;
     index["repeats"] = o.repeats;
     index["hardware_threads"] = std::thread::hardware_concurrency();
+    index["command"] = command_line();
+    index["build"] = build_provenance();
     const std::time_t now = std::time(nullptr);
     char date[32];
     std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
     index["date"] = date;
     if (!index.contains("parts") || !index["parts"].is_object()) index["parts"] = Json::object();
 
-    using Part = std::function<void(Json&)>;
+    using Part = std::function<void(Json&, RunProvenance&)>;
     std::vector<std::pair<std::string, Part>> parts = {
-        {"solvers_50k", [&](Json& i) { run_solver_part(o, 50'000, i); }},
+        {"solvers_50k", [&](Json& i, RunProvenance& p) { run_solver_part(o, 50'000, i, p); }},
     };
-    if (!o.quick) parts.emplace_back("solvers_500k", [&](Json& i) { run_solver_part(o, 500'000, i); });
-    parts.emplace_back("coarse_start", [&](Json& i) { run_coarse_start_part(o, i); });
-    parts.emplace_back("accuracy", [&](Json& i) { run_accuracy_part(o, i); });
-    parts.emplace_back("cut_modes", [&](Json& i) { run_cut_modes_part(o, i); });
-    parts.emplace_back("table1", [&](Json& i) { run_table1_part(o, i); });
-    parts.emplace_back("stability", [&](Json& i) { run_stability_part(o, i); });
-    parts.emplace_back("resolution", [&](Json& i) { run_resolution_part(o, i); });
+    if (!o.quick) parts.emplace_back("solvers_500k", [&](Json& i, RunProvenance& p) { run_solver_part(o, 500'000, i, p); });
+    parts.emplace_back("coarse_start", [&](Json& i, RunProvenance& p) { run_coarse_start_part(o, i, p); });
+    parts.emplace_back("accuracy", [&](Json& i, RunProvenance& p) { run_accuracy_part(o, i, p); });
+    parts.emplace_back("cut_modes", [&](Json& i, RunProvenance& p) { run_cut_modes_part(o, i, p); });
+    parts.emplace_back("table1", [&](Json& i, RunProvenance& p) { run_table1_part(o, i, p); });
+    parts.emplace_back("stability", [&](Json& i, RunProvenance& p) { run_stability_part(o, i, p); });
+    parts.emplace_back("resolution", [&](Json& i, RunProvenance& p) { run_resolution_part(o, i, p); });
 
     for (const std::string& wanted : o.only)
         if (std::none_of(parts.begin(), parts.end(), [&](const auto& part) { return part.first == wanted; }))
@@ -412,7 +484,14 @@ void run_bench_suite(const BenchSuiteOptions& o) {
         const auto start = std::chrono::steady_clock::now();
         Json entry;
         try {
-            part(index);
+            // The solver comparisons run every solver on the same count (one thread unless --threads says
+            // otherwise: Eigen's and CHOLMOD's solvers use one); the other parts measure Waxwork as it
+            // runs, on every hardware thread.
+            const bool comparison = name.rfind("solvers_", 0) == 0;
+            const ThreadLimit limit(o.threads.value_or(comparison ? 1 : 0));
+            RunProvenance provenance(limit);
+            entry["threads"] = limit.threads();
+            part(index, provenance);
             entry["status"] = "ok";
         } catch (const std::exception& e) {
             entry["status"] = std::string("failed: ") + e.what();

@@ -10,6 +10,8 @@
 //   stability.json/.md    where the methods fail and what Waxwork does (bench/studies/stability_study.h)
 //   resolution.json/.svg  image error against per-frame cost over mesh size x tolerance
 //   bench.json            what ran, with what settings, how long each part took, on which machine
+// Every part's JSON starts with a "provenance" block (bench/studies/provenance.h): the command, machine,
+// threads, build, inputs, definitions and warnings.
 // --quick (under 2 minutes here) uses smaller meshes and fewer samples, and says "(quick run)" in every
 // chart and table title; the full suite takes under 20. Every chart is also written as PDF beside its
 // SVG, with a caption line (date, statistic, device); every markdown table names its statistic.
@@ -17,6 +19,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +37,9 @@ struct BenchSuiteOptions {
     // median of 3); N >= 1 makes the solver comparison and Table 1 report the median of N runs (with the
     // fastest and slowest in the solver JSON).
     int repeats = 0;
+    // Threads for every library (thread_limit.h; 0: every hardware thread). Unset: the solver parts run
+    // every solver on one thread, the others on every hardware thread. Each part's JSON records it.
+    std::optional<int> threads;
 };
 
 // Runs every part; a part that throws is recorded in bench.json with its error and the suite goes

@@ -2,6 +2,8 @@
 
 #include "base/error.h"
 #include "base/timing.h"
+#include "bench/studies/cpu_usage.h"
+#include "bench/studies/provenance.h"
 #include "bench/studies/repeated_timing.h"
 #include "bench/studies/svg_chart.h"
 #include "io/atomic_file.h"
@@ -95,6 +97,14 @@ public:
     double setup(const std::function<double()>& run_ms) const { return repeated_times(options_.repeats, run_ms).ms; }
 
     SolverCurve curve(const std::string& name, const CappedSolve& solve) {
+        const CpuSample cpu_start = sample_cpu_usage();
+        SolverCurve out = measure_curve(name, solve);
+        out.parallelism = cpu_usage_between(cpu_start, sample_cpu_usage()).parallelism;
+        return out;
+    }
+
+private:
+    SolverCurve measure_curve(const std::string& name, const CappedSolve& solve) {
         SolverCurve out;
         out.name = name;
         const auto start = std::chrono::steady_clock::now();
@@ -160,7 +170,6 @@ public:
         return out;
     }
 
-private:
     const Fields& reference_;
     const SolverComparisonOptions& options_;
     Fields x_;
@@ -383,6 +392,7 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
     direct.name = "direct";
     Fields x_direct;
     std::vector<double> factor_samples;
+    const CpuSample direct_cpu_start = sample_cpu_usage();
     const RunTimes solve_times = repeated_times(options.repeats, [&] {
         double factor_ms = 0, solve_ms = 0;
         for (size_t c = 0; c < 3; ++c) {
@@ -397,6 +407,7 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
         factor_samples.push_back(factor_ms);
         return solve_ms;
     });
+    direct.parallelism = cpu_usage_between(direct_cpu_start, sample_cpu_usage()).parallelism;
     const RunTimes factor_times = median_min_max(factor_samples);
     direct.setup_ms = options.repeats > 0 ? factor_times.ms : factor_times.min_ms;
     const double direct_error = relative_error(x_direct, reference);
@@ -425,11 +436,9 @@ std::string timing_statistic(int repeats) {
     return "median of " + std::to_string(repeats) + " runs after one warm-up";
 }
 
-std::string solver_chart_caption(const SolverComparison& comparison, const std::string& gpu_renderer) {
-    const std::time_t now = std::time(nullptr);
-    char date[32];
-    std::strftime(date, sizeof date, "%Y-%m-%d", std::gmtime(&now));
-    std::string caption = std::string(date) + " | times: " + timing_statistic(comparison.repeats);
+std::string solver_chart_caption(const SolverComparison& comparison, const nlohmann::ordered_json& provenance) {
+    std::string caption = provenance_caption(provenance) + " | times: " + timing_statistic(comparison.repeats);
+    const std::string gpu_renderer = provenance.at("machine").at("opengl_renderer").get<std::string>();
     const bool gpu_ran = std::any_of(comparison.solvers.begin(), comparison.solvers.end(),
                                      [](const SolverCurve& s) { return s.name.rfind("gpu_", 0) == 0; });
     if (gpu_ran && gpu_renderer.find("llvmpipe") != std::string::npos)
@@ -439,8 +448,39 @@ std::string solver_chart_caption(const SolverComparison& comparison, const std::
     return caption;
 }
 
+nlohmann::ordered_json solver_comparison_definitions(const SolverComparisonOptions& options) {
+    return {
+        {"error", "relative L2 error of phi over every vertex and the three channels: ||phi - phi_ref||_2 / "
+                  "||phi_ref||_2 (unweighted sums)"},
+        {"reference", std::string("direct solve of each channel in double (") +
+                          (DirectSolver::backend() == "cholmod-supernodal" ? "CHOLMOD supernodal Cholesky"
+                                                                           : "Eigen SimplicialLDLT") +
+                          ") plus one step of iterative refinement"},
+        {"curve", "each iterative solver runs from a cold start (phi = 0; multires: its coarse-to-fine pass) with "
+                  "an increasing cap (0, 1, 2, then growing by a quarter), all three channels per run; a point is "
+                  "(time of that run, its error); a point slower than a later one is dropped"},
+        {"cap", "jacobi_cg, jacobi_cg_double, eigen_ic_cg, gpu_cg: CG iterations per channel; multires, cascadic_cg, "
+                "gpu_multires: level-0 CG iterations after the coarse levels; multigrid_cg: V-cycle-preconditioned CG "
+                "iterations; multigrid_cg_rgb, gpu_multigrid_cg: V-cycles (three channels at once)"},
+        {"stopping_rule", "a curve ends when its error falls below floor_error, when four caps in a row past cap 16 "
+                          "cut the error by less than 5%, at cap 200000, or after max_seconds of measuring"},
+        {"target_error", options.target_error},
+        {"floor_error", options.floor_error},
+        {"max_seconds", options.max_seconds},
+        {"time_to_1pct_ms", "the smallest cap reaching target_error (bisection between the measured caps), timed "
+                            "again; null when not reached"},
+        {"cap_to_1pct", "that cap, in the solver's cap unit"},
+        {"times", "milliseconds of wall clock for all three channels, solve only; statistic: " +
+                      timing_statistic(options.repeats)},
+        {"setup_ms", "per solver, milliseconds of per-mesh setup not in its curve (hierarchy, Galerkin operators, "
+                     "incomplete or direct factorisation, GPU uploads); setup + solve = setup_ms + a point's time"},
+        {"parallelism", "per solver, this process's CPU seconds per wall second over all of its measurements"},
+    };
+}
+
 void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const ComparedScene& scene,
-                             const SolverComparison& comparison, const SolverChartOptions& chart_options) {
+                             const SolverComparison& comparison, const nlohmann::ordered_json& provenance,
+                             const SolverChartOptions& chart_options) {
     using Json = nlohmann::ordered_json;
     Json solvers = Json::object();
     std::vector<ChartSeries> series;
@@ -460,6 +500,8 @@ void write_solver_comparison(const std::filesystem::path& dir, const std::string
                            {"time_to_1pct_ms_max", time_max},
                            {"cap_to_1pct", cap},
                            {"setup_ms", s.setup_ms},
+                           {"setup_plus_time_to_1pct_ms", s.time_to_target_ms ? Json(s.setup_ms + *s.time_to_target_ms) : Json(nullptr)},
+                           {"parallelism", s.parallelism},
                            {"curve", curve},
                            {"curve_ms_min", curve_min},
                            {"curve_ms_max", curve_max}};
@@ -486,6 +528,7 @@ void write_solver_comparison(const std::filesystem::path& dir, const std::string
         series.push_back(std::move(line));
     }
     Json json = {
+        {"provenance", provenance},
         {"mesh", scene.mesh},
         {"material", scene.material},
         {"mm_per_unit", scene.mm_per_unit},
@@ -509,7 +552,7 @@ void write_solver_comparison(const std::filesystem::path& dir, const std::string
     chart.y = {"relative L2 error of phi vs direct reference", AxisScale::Log, 0, 0};
     chart.target_line = 1e-2;
     chart.target_label = "1% error";
-    chart.caption = chart_options.caption;
+    chart.caption = solver_chart_caption(comparison, provenance);
     write_svg_chart(dir / (stem + ".svg"), series, chart);
 }
 

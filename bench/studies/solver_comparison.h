@@ -38,6 +38,8 @@
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -66,6 +68,7 @@ struct SolverCurve {
     std::optional<double> time_to_target_ms;          // nullopt when the target was not reached
     std::pair<double, double> time_to_target_range{};  // its (fastest, slowest) run
     double setup_ms = 0;                               // per-mesh setup, not in the curve's times
+    double parallelism = 0;                            // CPU seconds per wall second over its measurements
     std::optional<int> cap_to_target;              // the smallest cap reaching it (nullopt: not reached,
                                                    // or no cap, as for direct)
 };
@@ -108,27 +111,30 @@ struct ComparedScene {
     double mm_per_unit = 0;
 };
 
-// How the comparison's chart is drawn: solve time (default) or setup + solve on the x axis, "(quick
-// run)" in the title, and the caption line under it (date, statistic, device, ...).
+// How the comparison's chart is drawn: solve time (default) or setup + solve on the x axis, and "(quick
+// run)" in the title.
 struct SolverChartOptions {
     bool include_setup = false;
     bool quick = false;
-    std::string caption;
 };
 
-// Writes DIR/STEM.json, {"mesh", "material", "mm_per_unit", "tets", "vertices", "levels",
-// setup_times..., "statistic", "repeats", "solvers": {NAME: {"time_to_1pct_ms", "time_to_1pct_ms_min",
-// "time_to_1pct_ms_max", "cap_to_1pct", "setup_ms", "curve": [[ms, rel_error], ...], "curve_ms_min":
-// [...], "curve_ms_max": [...]}}} (ms: the statistic; _min, _max: the fastest and slowest run), and
-// DIR/STEM.svg and STEM.pdf (error against time, one line per solver, the direct solve pinned to the
-// bottom edge, the 1% target dashed), atomically.
-void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const ComparedScene& scene,
-                             const SolverComparison& comparison, const SolverChartOptions& chart = {});
+// What every number of the comparison means (the provenance block's "definitions").
+nlohmann::ordered_json solver_comparison_definitions(const SolverComparisonOptions& options);
 
-// The caption of a comparison's chart: the UTC date, the statistic and, when the GPU curves ran on a
-// software rasteriser, "GPU curves: software GPU (llvmpipe)" (gpu_renderer: the GL renderer string, or
-// empty).
-std::string solver_chart_caption(const SolverComparison& comparison, const std::string& gpu_renderer);
+// Writes DIR/STEM.json, {"provenance" (bench/studies/provenance.h), "mesh", "material", "mm_per_unit",
+// "tets", "vertices", "levels", setup_times..., "statistic", "repeats", "solvers": {NAME:
+// {"time_to_1pct_ms", "time_to_1pct_ms_min", "time_to_1pct_ms_max", "cap_to_1pct", "setup_ms",
+// "setup_plus_time_to_1pct_ms", "parallelism", "curve": [[ms, rel_error], ...], "curve_ms_min": [...],
+// "curve_ms_max": [...]}}} (ms: the statistic; _min, _max: the fastest and slowest run), and
+// DIR/STEM.svg and STEM.pdf (error against time, one line per solver, the direct solve pinned to the
+// bottom edge, the 1% target dashed, the caption from the provenance), atomically.
+void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const ComparedScene& scene,
+                             const SolverComparison& comparison, const nlohmann::ordered_json& provenance,
+                             const SolverChartOptions& chart = {});
+
+// The caption of a comparison's chart: provenance_caption (date, CPU, threads, commit), the statistic
+// and, when the GPU curves ran on a software rasteriser, "GPU curves: software GPU (llvmpipe)".
+std::string solver_chart_caption(const SolverComparison& comparison, const nlohmann::ordered_json& provenance);
 
 // For the GPU curves: a headless OpenGL context (OSMesa's llvmpipe unless WAXWORK_GL_DEVICE=egl finds a
 // GPU) set as options.gl. Returns null, with one warning line on stderr, when none can be created; the

@@ -24,7 +24,16 @@ using testing::scratch_dir;
 void expect_valid_curve(const nlohmann::json& solvers, const std::string& name) {
     ASSERT_TRUE(solvers.contains(name)) << name;
     const auto& s = solvers[name];
-    EXPECT_EQ(s.size(), 8u) << name;
+    EXPECT_EQ(s.size(), 10u) << name;
+    // Every solver ran on the one thread the comparison allows by default: its CPU time is its wall time.
+    ASSERT_TRUE(s["parallelism"].is_number()) << name;
+    EXPECT_GT(s["parallelism"].get<double>(), 0.5) << name;
+    EXPECT_LT(s["parallelism"].get<double>(), 1.15) << name;
+    if (s["time_to_1pct_ms"].is_number()) {
+        EXPECT_DOUBLE_EQ(s["setup_plus_time_to_1pct_ms"].get<double>(),
+                         s["setup_ms"].get<double>() + s["time_to_1pct_ms"].get<double>())
+            << name;
+    }
     // Setup apart from the solve: only the two Jacobi CGs have none.
     ASSERT_TRUE(s["setup_ms"].is_number()) << name;
     if (name == "jacobi_cg" || name == "jacobi_cg_double")
@@ -91,8 +100,8 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
     for (const auto& [key, value] : json.items()) keys.push_back(key);
     EXPECT_EQ(keys, (std::vector<std::string>{"hierarchy_ms", "hierarchy_rebuild_ms", "levels", "material", "mesh",
                                               "mm_per_unit", "multigrid_rgb_setup_ms", "multigrid_rgb_setup_rebuild_ms",
-                                              "multigrid_setup_ms", "multigrid_setup_rebuild_ms", "repeats", "solvers",
-                                              "statistic", "tets", "vertices"}));
+                                              "multigrid_setup_ms", "multigrid_setup_rebuild_ms", "provenance",
+                                              "repeats", "solvers", "statistic", "tets", "vertices"}));
     EXPECT_EQ(json["statistic"], "fastest of 3 runs (runs over 100 ms: one run) after one warm-up");
     EXPECT_EQ(json["repeats"], 0);
     EXPECT_EQ(json["material"], "marble");  // the cube stores no materials
@@ -119,6 +128,83 @@ TEST(BenchSolversCommand, WritesCurvesForEverySolver) {
     EXPECT_EQ(svg.find(">1e-16<"), std::string::npos);
     EXPECT_EQ(testing::read_text(out / "solvers.pdf").rfind("%PDF-", 0), 0u);
     EXPECT_EQ(std::distance(std::filesystem::directory_iterator(out), std::filesystem::directory_iterator{}), 3);
+}
+
+// The provenance block: what ran, where, on how many threads, from which build, on which input, and
+// what each number means; the run used one core (CPU time against wall time), and its recorded command
+// line alone runs it again.
+TEST(BenchSolversCommand, RecordsProvenanceAndRunsOnOneThread) {
+    const auto& [result, out] = cube_solvers_run();
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const auto json = nlohmann::json::parse(testing::read_text(out / "solvers.json"));
+    const auto& p = json["provenance"];
+    std::vector<std::string> keys;
+    for (const auto& [key, value] : p.items()) keys.push_back(key);
+    EXPECT_EQ(keys, (std::vector<std::string>{"build", "command", "definitions", "ended", "inputs", "machine", "started",
+                                              "warnings"}));
+    const auto& machine = p["machine"];
+    for (const char* key : {"cpu_model", "os"}) EXPECT_FALSE(machine[key].get<std::string>().empty()) << key;
+    EXPECT_GE(machine["hardware_threads"].get<int>(), 1);
+    EXPECT_GT(machine["memory_gib"].get<double>(), 0.0);
+    EXPECT_EQ(machine["threads_used"], 1);
+    for (const char* library : {"tbb", "openmp", "blas", "eigen", "llvmpipe"})
+        EXPECT_EQ(machine["threads_by_library"][library], 1) << library;
+    EXPECT_EQ(machine["load_average_start"].size(), 3u);
+    EXPECT_EQ(machine["load_average_end"].size(), 3u);
+    // One thread: the whole run's CPU time is at most its wall time (plus a little for the kernel).
+    EXPECT_GT(machine["parallelism"].get<double>(), 0.5);
+    EXPECT_LT(machine["parallelism"].get<double>(), 1.15);
+    EXPECT_GE(machine["other_load_cores"].get<double>(), 0.0);
+    const auto& build = p["build"];
+    const std::string commit = build["commit"];
+    EXPECT_TRUE(commit == "unknown" || (commit.size() == 40 && commit.find_first_not_of("0123456789abcdef") == std::string::npos))
+        << commit;
+    EXPECT_TRUE(build["dirty"].is_boolean());
+    EXPECT_NE(build["compiler"].get<std::string>().find("GNU"), std::string::npos);
+    EXPECT_NE(build["flags"].get<std::string>().find("-O"), std::string::npos);
+    for (const char* library : {"cgal", "eigen", "cholmod", "onetbb", "tetgen", "petsc"})
+        EXPECT_TRUE(build["libraries"].contains(library)) << library;
+    const auto& inputs = p["inputs"];
+    EXPECT_EQ(inputs["mesh_file"], (out.parent_path() / "cube.vtu").string());
+    EXPECT_EQ(inputs["mesh_sha256"].get<std::string>().size(), 64u);
+    EXPECT_EQ(inputs["tets"].get<size_t>(), 9u * 9u * 9u * 6u);
+    EXPECT_GT(inputs["mean_edge_mm"].get<double>(), 0.0);
+    EXPECT_GT(inputs["min_dihedral_deg"].get<double>(), 0.0);
+    EXPECT_EQ(inputs["material"], "marble");
+    EXPECT_EQ(inputs["lighting"]["lights"].size(), 1u);
+    EXPECT_EQ(inputs["meshing"]["mesher"], "none: read from the volume file");
+    for (const char* key : {"error", "reference", "curve", "cap", "stopping_rule", "times", "setup_ms", "parallelism"})
+        EXPECT_TRUE(p["definitions"][key].is_string()) << key;
+    EXPECT_TRUE(p["warnings"].is_array());
+    // The chart's caption carries the date, threads and commit.
+    const std::string svg = testing::read_text(out / "solvers.svg");
+    EXPECT_NE(svg.find("| 1 thread |"), std::string::npos);
+    EXPECT_NE(svg.find("commit " + commit.substr(0, 10)), std::string::npos);
+
+    // The recorded command, run as it stands, writes the same comparison again.
+    const std::string command = p["command"];
+    ASSERT_NE(command.find("bench solvers"), std::string::npos) << command;
+    std::filesystem::remove_all(out);
+    ASSERT_EQ(std::system((command + " > /dev/null 2>&1").c_str()), 0) << command;
+    const auto again = nlohmann::json::parse(testing::read_text(out / "solvers.json"));
+    EXPECT_EQ(again["provenance"]["inputs"]["mesh_sha256"], inputs["mesh_sha256"]);
+    EXPECT_EQ(again["tets"], json["tets"]);
+    EXPECT_EQ(again["solvers"].size(), json["solvers"].size());
+}
+
+// A mesh far coarser than the material's diffusion length is flagged in the output and the JSON.
+TEST(BenchSolversCommand, WarnsWhenTheMeshUnderResolvesTheLight) {
+    const auto dir = scratch_dir("bench_solvers_coarse");
+    const auto volume = dir / "cube.vtu";
+    write_volume(testing::make_cube_mesh(4, Eigen::Vector3d::Zero(), 1.0), volume);
+    // Skin's blue diffusion length is under a millimetre; the cube's edges at 100 mm per unit are 25 mm.
+    const auto result = run_waxwork("bench solvers --mesh " + volume.string() + " -o " + (dir / "out").string() +
+                                    " --material skin1 --scale 100 --floor 1e-2 --max-seconds 5");
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    EXPECT_NE(result.err.find("warning: the mesh under-resolves the light"), std::string::npos) << result.err;
+    const auto json = nlohmann::json::parse(testing::read_text(dir / "out" / "solvers.json"));
+    ASSERT_EQ(json["provenance"]["warnings"].size(), 1u);
+    EXPECT_NE(json["provenance"]["warnings"][0].get<std::string>().find("diffusion length"), std::string::npos);
 }
 
 // --backend gpu adds the GPU curves (llvmpipe here); a driver that rejects a shader leaves them out
@@ -179,7 +265,9 @@ TEST(BenchSolversCommand, GpuBackendAddsGpuCurvesOrWarns) {
     const auto dir = scratch_dir("bench_solvers_gpu");
     const auto volume = dir / "cube.vtu";
     write_volume(testing::make_cube_mesh(9, Eigen::Vector3d::Zero(), 1.0), volume);
-    const std::string args = "bench solvers --mesh " + volume.string() + " --backend gpu --floor 1e-3 --max-seconds 20 -o ";
+    // At 10 mm per unit the cube's 1.3 mm edges resolve marble's light: no warning but the GPU's.
+    const std::string args =
+        "bench solvers --mesh " + volume.string() + " --scale 10 --backend gpu --floor 1e-3 --max-seconds 20 -o ";
     const auto result = run_waxwork(args + (dir / "gpu").string());
     ASSERT_EQ(result.exit_code, 0) << result.err;
     EXPECT_TRUE(result.err.empty()) << result.err;
@@ -273,7 +361,8 @@ TEST(BenchSuiteCommand, OnlyRunsTheNamedParts) {
     EXPECT_EQ(index["parts"].size(), 1u);
     EXPECT_EQ(index["parts"]["stability"]["status"], "ok");
     const auto stability = nlohmann::json::parse(testing::read_text(dir / "stability.json"));
-    EXPECT_EQ(stability.size(), 7u);
+    EXPECT_EQ(stability["tables"].size(), 7u);
+    EXPECT_EQ(stability["provenance"]["machine"]["threads_used"].get<unsigned>(), index["parts"]["stability"]["threads"].get<unsigned>());
     EXPECT_NE(testing::read_text(dir / "stability.md").find("### slivers"), std::string::npos);
     const auto unknown = run_waxwork("bench --quick --only nonsense -o " + dir.string());
     EXPECT_NE(unknown.exit_code, 0);

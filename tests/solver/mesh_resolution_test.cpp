@@ -2,6 +2,7 @@
 #include "base/error.h"
 #include "solver/material.h"
 #include "solver/mesh_resolution.h"
+#include "tetops/box_mesh.h"
 #include "tetops/icosphere.h"
 
 #include <gtest/gtest.h>
@@ -39,6 +40,32 @@ TEST(MeshResolution, SizeFactorScalesBothEdgeLengths) {
     EXPECT_EQ(finer.grading, base.grading);
     EXPECT_THROW(default_mesh_sizing(ball, marble, 1.0, {.size_factor = 0.0}), InvalidArgumentError);
     EXPECT_THROW(default_mesh_sizing(ball, marble, 1.0, {.size_factor = NAN}), InvalidArgumentError);
+}
+
+// The warning follows the light term of the rule (l_d / 2, within kResolutionTolerance), not its
+// clamps: a mesh the D/150 cost floor allows is still flagged when its edges exceed the diffusion
+// length, and a mesh the D/25 shape cap would refine is not.
+TEST(MeshResolution, WarnsWhenSurfaceEdgesExceedTheDiffusionLength) {
+    const TetMesh cube = make_box_mesh({4, 4, 4}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones());  // edges 0.25
+    const TetMaterial skin = material_preset("skin1");
+    const double l_d = smallest_diffusion_length_mm(skin);
+    // Surface edges: the cube's face edges (0.25) and face diagonals, so their mean is above 0.25.
+    const ResolutionFit coarse = fit_to_resolution_rule(cube, {skin}, 100.0);
+    EXPECT_GT(coarse.surface_edge_mm, 25.0);
+    EXPECT_DOUBLE_EQ(coarse.diffusion_length_mm, l_d);
+    EXPECT_NE(under_resolution_warning(coarse).find("under-resolves the light"), std::string::npos);
+    // Scaled so the surface edge is just under and just over 1.5 x l_d / 2.
+    const double at_limit = kResolutionTolerance * 0.5 * l_d / (coarse.surface_edge_mm / 100.0);
+    EXPECT_EQ(under_resolution_warning(fit_to_resolution_rule(cube, {skin}, 0.99 * at_limit)), "");
+    EXPECT_NE(under_resolution_warning(fit_to_resolution_rule(cube, {skin}, 1.01 * at_limit)), "");
+    // The hardest of several materials decides.
+    std::vector<TetMaterial> mixed(cube.tet_count(), material_preset("marble"));
+    EXPECT_EQ(under_resolution_warning(fit_to_resolution_rule(cube, mixed, 1.01 * at_limit)), "");
+    mixed[7] = skin;
+    const ResolutionFit fit = fit_to_resolution_rule(cube, mixed, 1.01 * at_limit);
+    EXPECT_DOUBLE_EQ(fit.diffusion_length_mm, l_d);
+    EXPECT_NE(under_resolution_warning(fit).find("its most absorbing material"), std::string::npos);
+    EXPECT_THROW(fit_to_resolution_rule(TetMesh{}, {skin}, 1.0), InvalidArgumentError);
 }
 
 }  // namespace
