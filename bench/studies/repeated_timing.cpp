@@ -12,10 +12,12 @@ RunTimes median_min_max(std::vector<double> samples) {
     return {median, samples.front(), samples.back()};
 }
 
-double median_run_ms(int runs, const std::function<double()>& run) {
+RunTimes repeated_run_ms(int runs, const std::function<double()>& run) {
     std::vector<double> ms(static_cast<size_t>(std::max(runs, 1)));
     for (double& m : ms) m = run();
-    return median_min_max(std::move(ms)).ms;
+    return median_min_max(std::move(ms));
 }
+
+double median_run_ms(int runs, const std::function<double()>& run) { return repeated_run_ms(runs, run).ms; }
 
 }  // namespace waxwork

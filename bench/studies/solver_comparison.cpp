@@ -99,7 +99,9 @@ public:
     SolverCurve curve(const std::string& name, const CappedSolve& solve) {
         const CpuSample cpu_start = sample_cpu_usage();
         SolverCurve out = measure_curve(name, solve);
-        out.parallelism = cpu_usage_between(cpu_start, sample_cpu_usage()).parallelism;
+        const CpuUsage usage = cpu_usage_between(cpu_start, sample_cpu_usage());
+        out.parallelism = usage.parallelism;
+        out.other_load_cores = usage.other_load_cores;
         return out;
     }
 
@@ -407,7 +409,9 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
         factor_samples.push_back(factor_ms);
         return solve_ms;
     });
-    direct.parallelism = cpu_usage_between(direct_cpu_start, sample_cpu_usage()).parallelism;
+    const CpuUsage direct_usage = cpu_usage_between(direct_cpu_start, sample_cpu_usage());
+    direct.parallelism = direct_usage.parallelism;
+    direct.other_load_cores = direct_usage.other_load_cores;
     const RunTimes factor_times = median_min_max(factor_samples);
     direct.setup_ms = options.repeats > 0 ? factor_times.ms : factor_times.min_ms;
     const double direct_error = relative_error(x_direct, reference);
@@ -419,6 +423,20 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
     }
     result.solvers.push_back(std::move(direct));
     return result;
+}
+
+std::vector<std::string> busy_machine_warnings(const SolverComparison& comparison) {
+    std::vector<std::string> warnings;
+    for (const SolverCurve& s : comparison.solvers)
+        if (s.other_load_cores > kBusyMachineCores) {
+            char text[200];
+            std::snprintf(text, sizeof text,
+                          "the machine was busy during %s: other processes kept %.2f cores busy on average, so its "
+                          "times may be slow and noisy",
+                          s.name.c_str(), s.other_load_cores);
+            warnings.push_back(text);
+        }
+    return warnings;
 }
 
 std::vector<std::pair<std::string, double>> setup_times(const SolverComparison& comparison) {
@@ -475,6 +493,7 @@ nlohmann::ordered_json solver_comparison_definitions(const SolverComparisonOptio
         {"setup_ms", "per solver, milliseconds of per-mesh setup not in its curve (hierarchy, Galerkin operators, "
                      "incomplete or direct factorisation, GPU uploads); setup + solve = setup_ms + a point's time"},
         {"parallelism", "per solver, this process's CPU seconds per wall second over all of its measurements"},
+        {"other_load_cores", "per solver, the cores other processes kept busy on average during its measurements"},
     };
 }
 
@@ -502,6 +521,7 @@ void write_solver_comparison(const std::filesystem::path& dir, const std::string
                            {"setup_ms", s.setup_ms},
                            {"setup_plus_time_to_1pct_ms", s.time_to_target_ms ? Json(s.setup_ms + *s.time_to_target_ms) : Json(nullptr)},
                            {"parallelism", s.parallelism},
+                           {"other_load_cores", s.other_load_cores},
                            {"curve", curve},
                            {"curve_ms_min", curve_min},
                            {"curve_ms_max", curve_max}};

@@ -69,6 +69,7 @@ struct SolverCurve {
     std::pair<double, double> time_to_target_range{};  // its (fastest, slowest) run
     double setup_ms = 0;                               // per-mesh setup, not in the curve's times
     double parallelism = 0;                            // CPU seconds per wall second over its measurements
+    double other_load_cores = -1;                      // other processes' busy cores meanwhile (cpu_usage.h)
     std::optional<int> cap_to_target;              // the smallest cap reaching it (nullopt: not reached,
                                                    // or no cap, as for direct)
 };
@@ -87,6 +88,10 @@ struct SolverComparison {
     std::string gpu_fallback_reason;   // options.gl given but the GPU could not run (curves left out)
     int repeats = 0;                   // options.repeats, for timing_statistic
 };
+
+// One warning per solver during whose measurements other processes kept more than kBusyMachineCores
+// cores busy on average (provenance.h).
+std::vector<std::string> busy_machine_warnings(const SolverComparison& comparison);
 
 // The statistic a comparison's times are, in words, e.g. "median of 5 runs after one warm-up".
 std::string timing_statistic(int repeats);
@@ -124,7 +129,7 @@ nlohmann::ordered_json solver_comparison_definitions(const SolverComparisonOptio
 // Writes DIR/STEM.json, {"provenance" (bench/studies/provenance.h), "mesh", "material", "mm_per_unit",
 // "tets", "vertices", "levels", setup_times..., "statistic", "repeats", "solvers": {NAME:
 // {"time_to_1pct_ms", "time_to_1pct_ms_min", "time_to_1pct_ms_max", "cap_to_1pct", "setup_ms",
-// "setup_plus_time_to_1pct_ms", "parallelism", "curve": [[ms, rel_error], ...], "curve_ms_min": [...],
+// "setup_plus_time_to_1pct_ms", "parallelism", "other_load_cores", "curve": [[ms, rel_error], ...], "curve_ms_min": [...],
 // "curve_ms_max": [...]}}} (ms: the statistic; _min, _max: the fastest and slowest run), and
 // DIR/STEM.svg and STEM.pdf (error against time, one line per solver, the direct solve pinned to the
 // bottom edge, the 1% target dashed, the caption from the provenance), atomically.

@@ -52,26 +52,31 @@ TimingRow measure_timing_row(const std::filesystem::path& surface_path, const Ti
     AssemblyOptions assembly;
     assembly.mm_per_unit = options.mm_per_unit;
     std::vector<TetMaterial> materials(mesh.tet_count(), material);
-    const int runs = options.runs;
+    // Times a stage `options.runs` times, keeping its median, fastest and slowest run.
+    auto timed = [&](const char* stage, const std::function<double()>& run) {
+        const RunTimes times = repeated_run_ms(options.runs, run);
+        row.runs[stage] = times;
+        return times.ms;
+    };
 
     // Each stage runs `runs` times and its median is kept; what a run built is released before the
     // next run starts its clock, and the last run's result feeds the next stage.
     std::optional<TetConnectivity> connectivity;
-    row.connectivity_ms = median_run_ms(runs, [&] {
+    row.connectivity_ms = timed("connectivity", [&] {
         connectivity.reset();
         const auto start = Clock::now();
         connectivity.emplace(build_connectivity(mesh));
         return milliseconds_since(start);
     });
     std::optional<DiffusionMatrix> matrix;
-    row.matrix_ms = median_run_ms(runs, [&] {
+    row.matrix_ms = timed("matrix", [&] {
         matrix.reset();
         const auto start = Clock::now();
         matrix.emplace(assemble_diffusion_matrix(mesh, *connectivity, materials, assembly));
         return milliseconds_since(start);
     });
     std::optional<MultiresSolver> solver;
-    row.hierarchy_ms = median_run_ms(runs, [&] {
+    row.hierarchy_ms = timed("hierarchy", [&] {
         solver.reset();
         const auto start = Clock::now();
         solver.emplace(*matrix, mesh.positions);
@@ -92,7 +97,7 @@ TimingRow measure_timing_row(const std::filesystem::path& surface_path, const Ti
     solve_options.relative_tolerance = 0.01;
     std::vector<double> x(matrix->size());
     bool first_solve = true;
-    row.solve_ms = median_run_ms(runs, [&] {
+    row.solve_ms = timed("solve", [&] {
         const auto start = Clock::now();
         for (int c = 0; c < 3; ++c) {
             const MultiresSolveReport report = solver->solve(b[static_cast<size_t>(c)], c, x, solve_options);
@@ -117,7 +122,7 @@ TimingRow measure_timing_row(const std::filesystem::path& surface_path, const Ti
         PaintBrush brush;
         brush.material = material_preset("skin1");
         brush.sigma = 0.01 * (box[1] - box[0]).norm();
-        row.paint_ms = median_run_ms(runs, [&] {
+        row.paint_ms = timed("paint", [&] {
             const auto start = Clock::now();
             const PaintResult painted = paint_stroke(mesh, index, stroke, brush);
             const std::vector<int32_t> rows =
@@ -136,7 +141,7 @@ TimingRow measure_timing_row(const std::filesystem::path& surface_path, const Ti
         const auto box = bounding_box(mesh);
         const Eigen::Vector3d normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
         const PlaneCut plane(normal, normal.dot(0.5 * (box[0] + box[1])));
-        row.cut_ms = median_run_ms(runs, [&] {
+        row.cut_ms = timed("cut", [&] {
             TetMesh cut = mesh;
             const auto start = Clock::now();
             const CutResult removed = remove_cut_away_tets(cut, plane);
@@ -152,6 +157,29 @@ TimingRow measure_timing_row(const std::filesystem::path& surface_path, const Ti
     }
     return row;
 }
+
+namespace {
+
+// {stage: {"median", "min", "max"}} in ms.
+nlohmann::ordered_json runs_json(const std::map<std::string, RunTimes>& runs) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::object();
+    for (const auto& [stage, t] : runs) out[stage] = {{"median", t.ms}, {"min", t.min_ms}, {"max", t.max_ms}};
+    return out;
+}
+
+// "median (min-max)" of a stage, or the bare median when it ran once or is missing.
+std::string with_spread(const TimingRow& row, const char* stage, double median, const char* format) {
+    char text[96];
+    std::snprintf(text, sizeof text, format, median);
+    const auto it = row.runs.find(stage);
+    if (it == row.runs.end() || it->second.min_ms == it->second.max_ms) return text;
+    char spread[96];
+    std::snprintf(spread, sizeof spread, (std::string(" (") + format + "-" + format + ")").c_str(), it->second.min_ms,
+                  it->second.max_ms);
+    return text + std::string(spread);
+}
+
+}  // namespace
 
 nlohmann::ordered_json to_json(const std::vector<TimingRow>& rows) {
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
@@ -169,7 +197,8 @@ nlohmann::ordered_json to_json(const std::vector<TimingRow>& rows) {
                        {"Ts_ms", r.solve_ms},
                        {"Ts_level0_iterations", r.solve_level0_iterations},
                        {"cut_ms", r.cut_ms},
-                       {"paint_ms", r.paint_ms}});
+                       {"paint_ms", r.paint_ms},
+                       {"runs_ms", runs_json(r.runs)}});
     return out;
 }
 
@@ -180,9 +209,10 @@ std::string timing_table_markdown(const std::vector<TimingRow>& rows) {
     char line[256];
     for (const TimingRow& r : rows) {
         const std::string model = r.model + (r.mesher == "tetgen" ? "" : " (" + r.mesher + ")");
-        std::snprintf(line, sizeof line, "| %s | %zu | %d | %.0f | %.0f | %.0f | %.0f | %.1f |\n", model.c_str(), r.tets,
-                      r.levels, r.build_ms, r.matrix_ms, r.solve_ms, r.cut_ms, r.paint_ms);
-        md << line;
+        std::snprintf(line, sizeof line, "| %s | %zu | %d | %.0f | ", model.c_str(), r.tets, r.levels, r.build_ms);
+        md << line << with_spread(r, "matrix", r.matrix_ms, "%.0f") << " | " << with_spread(r, "solve", r.solve_ms, "%.0f")
+           << " | " << with_spread(r, "cut", r.cut_ms, "%.0f") << " | " << with_spread(r, "paint", r.paint_ms, "%.1f")
+           << " |\n";
     }
     for (const PaperTimingRow& p : kTransCutTable1) {
         std::snprintf(line, sizeof line, "| %s (paper, GTX 480) | %zu | %d | %.0f | %.0f | %.0f | < 3000 | real time |\n",

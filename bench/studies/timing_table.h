@@ -5,10 +5,13 @@
 // machine's CPU, and both are printed side by side.
 #pragma once
 
+#include "bench/studies/repeated_timing.h"
+
 #include <nlohmann/json.hpp>
 
 #include <array>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -44,6 +47,9 @@ struct TimingRow {
     std::array<int, 3> solve_level0_iterations{};  // T_s's level-0 CG iterations per channel, first run
     double cut_ms = 0;             // plane cut + 10 relaxation sweeps + connectivity, matrix and hierarchy
     double paint_ms = 0;           // 100-point stroke + matrix row updates + coarse level updates
+    // The fastest and slowest run of each timed stage: "connectivity", "matrix", "hierarchy", "solve",
+    // "paint", "cut" (the fields above are the medians).
+    std::map<std::string, RunTimes> runs;
 };
 
 struct TimingOptions {
@@ -62,7 +68,8 @@ struct TimingOptions {
 TimingRow measure_timing_row(const std::filesystem::path& surface, const TimingOptions& options);
 
 nlohmann::ordered_json to_json(const std::vector<TimingRow>& rows);
-// A markdown table: our rows, then the paper's rows marked "(GTX 480)".
+// A markdown table: our rows (medians; T_m, T_s, cut and paint with their fastest and slowest run in
+// brackets), then the paper's rows marked "(GTX 480)".
 std::string timing_table_markdown(const std::vector<TimingRow>& rows);
 
 }  // namespace waxwork

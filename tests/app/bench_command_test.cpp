@@ -24,7 +24,8 @@ using testing::scratch_dir;
 void expect_valid_curve(const nlohmann::json& solvers, const std::string& name) {
     ASSERT_TRUE(solvers.contains(name)) << name;
     const auto& s = solvers[name];
-    EXPECT_EQ(s.size(), 10u) << name;
+    EXPECT_EQ(s.size(), 11u) << name;
+    EXPECT_GE(s["other_load_cores"].get<double>(), 0.0) << name;
     // Every solver ran on the one thread the comparison allows by default: its CPU time is its wall time.
     ASSERT_TRUE(s["parallelism"].is_number()) << name;
     EXPECT_GT(s["parallelism"].get<double>(), 0.5) << name;

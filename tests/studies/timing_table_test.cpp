@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 namespace waxwork {
 namespace {
 
@@ -20,6 +22,27 @@ TEST(TimingTable, MeasuresEveryStageOnASmallMesh) {
     EXPECT_NE(md.find("| spot | "), std::string::npos);
     EXPECT_NE(md.find("Bunny (paper, GTX 480) | 511019 | 3 | 72 | 26 | 49"), std::string::npos);
     EXPECT_EQ(to_json({row})[0]["Tb_ms"], row.build_ms);
+    // Every stage's median lies within its fastest and slowest run, which the JSON and the table carry.
+    const std::pair<const char*, double> stages[] = {{"connectivity", row.connectivity_ms}, {"matrix", row.matrix_ms},
+                                                     {"hierarchy", row.hierarchy_ms},       {"solve", row.solve_ms},
+                                                     {"paint", row.paint_ms},               {"cut", row.cut_ms}};
+    const auto runs = to_json({row})[0]["runs_ms"];
+    ASSERT_EQ(runs.size(), 6u);
+    for (const auto& [stage, median] : stages) {
+        ASSERT_TRUE(row.runs.count(stage)) << stage;
+        const RunTimes& t = row.runs.at(stage);
+        EXPECT_EQ(t.ms, median) << stage;
+        EXPECT_LE(t.min_ms, t.ms) << stage;
+        EXPECT_GE(t.max_ms, t.ms) << stage;
+        EXPECT_EQ(runs[stage]["min"], t.min_ms) << stage;
+        EXPECT_EQ(runs[stage]["max"], t.max_ms) << stage;
+    }
+    char solve[64];
+    std::snprintf(solve, sizeof solve, "| %.0f (%.0f-%.0f) |", row.solve_ms, row.runs.at("solve").min_ms,
+                  row.runs.at("solve").max_ms);
+    if (row.runs.at("solve").min_ms != row.runs.at("solve").max_ms) {
+        EXPECT_NE(md.find(solve), std::string::npos) << md;
+    }
 }
 
 }  // namespace
