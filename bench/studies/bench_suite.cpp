@@ -259,6 +259,7 @@ void run_cut_modes_part(const BenchSuiteOptions& o, Json& index) {
 void run_accuracy_part(const BenchSuiteOptions& o, Json& index) {
     const StudySize size{.quick = o.quick};
     const std::vector<ConvergenceSeries> ball = study_ball_convergence(size);
+    const std::vector<ConvergenceSeries> ball_nested = study_ball_nested_convergence(size);
     SurfaceConvergenceOptions spot_options;
     spot_options.surface = o.asset_dir / "meshes/spot.obj";
     if (o.quick) {
@@ -267,7 +268,13 @@ void run_accuracy_part(const BenchSuiteOptions& o, Json& index) {
         spot_options.reference_size_factor = 0.6;
     }
     const ConvergenceSeries spot = study_surface_convergence(spot_options);
-    write_json(o.output_dir / "accuracy.json", Json{{"ball", to_json(ball)}, {"surface", to_json({spot})}});
+    write_json(o.output_dir / "accuracy.json",
+               Json{{"ball", to_json(ball)}, {"ball_nested", to_json(ball_nested)}, {"surface", to_json({spot})}});
+    std::vector<ConvergenceSeries> all = ball;
+    all.insert(all.end(), ball_nested.begin(), ball_nested.end());
+    all.push_back(spot);
+    write_text(o.output_dir / "accuracy.md", "### " + titled(o, "Observed orders of convergence") + "\n\n" +
+                                                 order_table_markdown(all));
 
     auto chart = [&](const std::vector<ConvergenceSeries>& series, const std::string& title,
                      const std::filesystem::path& path) {
@@ -289,6 +296,8 @@ void run_accuracy_part(const BenchSuiteOptions& o, Json& index) {
         write_svg_chart(path, lines, options);
     };
     chart(ball, "Ball (R = 10 mm) against the analytic solution", o.output_dir / "accuracy_ball.svg");
+    chart(ball_nested, "Ball (R = 10 mm), nested 1:8 refinement, against the analytic solution",
+          o.output_dir / "accuracy_ball_nested.svg");
     chart({spot}, "Spot against a mesh of half the default size", o.output_dir / "accuracy_spot.svg");
     index["accuracy"] = "accuracy.json";
 }
