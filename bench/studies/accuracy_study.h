@@ -20,18 +20,45 @@ struct ConvergencePoint {
     double solve_ms = 0;     // assembly + solve of channel 0..2
 };
 
+// The order of a series with how far to trust it.
+struct OrderFit {
+    double order = 0;                  // least-squares slope of log(error) on log(tet size)
+    double ci95_low = 0, ci95_high = 0;  // 95% confidence interval of the slope (unbounded below 3 points)
+    double size_range = 0;             // largest over smallest tet size
+    std::vector<double> local_orders;  // slope between consecutive points, coarse to fine
+    bool reliable = false;
+    std::string why_unreliable;        // the failed conditions in words; empty when reliable
+};
+
 struct ConvergenceSeries {
     std::string name;
     std::vector<ConvergencePoint> points;  // coarse to fine
-    // Least-squares slope of log(error) against log(tet size) (2 for linear elements in L2).
+    // The least-squares line through (log h, log error): order = slope (2 for linear elements in L2), its
+    // standard error from the residuals with n - 2 degrees of freedom and the 95% interval order +- t SE
+    // (Student's t at n - 2). Unreliable, with the reasons, when any of: fewer than 4 points, sizes
+    // spanning less than a factor of 4, an interval half-width above 0.5, or local orders spreading by
+    // more than 1.0 (max - min): an order from fewer or closer points, or from points off one line, is
+    // not yet the asymptotic one.
+    OrderFit fit_order() const;
+    // fit_order().order.
     double observed_order() const;
 };
 
 nlohmann::ordered_json to_json(const std::vector<ConvergenceSeries>& series);
 
+// A pipe table, one row per series: points, tet size range, order, 95% interval, reliable (or why not).
+std::string order_table_markdown(const std::vector<ConvergenceSeries>& series);
+
 // The ball of radius 10 mm (mu_a 0.01, mu_s' 1 per mm, eta 1.3) meshed from ~2K to ~128K tets
 // (quick: 2K to 16K): transcut/fem x uniform/directional.
 std::vector<ConvergenceSeries> study_ball_convergence(const StudySize& size);
+
+// The same ball and four series as a nested family: a coarse mesh refined `refinements` times by 1:8
+// subdivision (tetops/uniform_refinement.h) with the new boundary vertices projected onto the sphere, so
+// the tet size halves exactly per level and the surface converges with the volume. Coarse mesh: TetGen's
+// 320-tet mesh of the 320-triangle icosphere, to 164K tets after 3 refinements; quick: the 80 triangles
+// of the coarser icosphere joined to the centre, to 41K. Series "ball nested METHOD LIGHT".
+std::vector<ConvergenceSeries> study_ball_nested_convergence(const StudySize& size, int refinements = 3);
 
 struct SurfaceConvergenceOptions {
     std::filesystem::path surface;

@@ -2,8 +2,10 @@
 // into DIR, each part as JSON plus a chart (SVG) or a markdown table:
 //   solvers_*.json/.svg   error of phi against time for every solver path (paper Fig. 7), per mesh size
 //   coarse_start.json     the best level-0 start a coarse level can give the paper's multires scheme
-//   accuracy.json, accuracy_ball.svg, accuracy_spot.svg
-//                         error against tet size: the analytic ball, spot against a fine reference
+//   accuracy.json/.md, accuracy_ball.svg, accuracy_ball_nested.svg, accuracy_spot.svg
+//                         error against tet size: the analytic ball (independent meshes and a nested 1:8
+//                         family), spot against a fine reference; the table lists each fitted order
+//                         with its 95% interval and whether it is reliable
 //   cut_modes.json, cut_modes.svg, cut_quality.svg
 //                         cross-section distance and dihedral angles of remove+relax and exact cuts
 //   table1.json/.md       T_b, T_m, T_s, cut and paint per shipped model beside the paper's Table 1
