@@ -112,7 +112,7 @@ void run_solvers_command(const SolversCommandOptions& o) {
     SolverChartOptions chart;
     chart.include_setup = o.include_setup;
     if (context) provenance.set_gl_renderer(context->renderer());
-    for (const std::string& warning : busy_machine_warnings(comparison)) provenance.warn(warning);
+    if (const std::string busy = busy_machine_warning(comparison); !busy.empty()) provenance.warn(busy);
     nlohmann::ordered_json inputs = mesh_inputs(o.mesh, mesh, options.mm_per_unit);
     inputs["meshing"] = meshing;
     inputs["material"] = material_name;

@@ -425,18 +425,17 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
     return result;
 }
 
-std::vector<std::string> busy_machine_warnings(const SolverComparison& comparison) {
-    std::vector<std::string> warnings;
+std::string busy_machine_warning(const SolverComparison& comparison) {
+    std::string busy;
+    char entry[96];
     for (const SolverCurve& s : comparison.solvers)
         if (s.other_load_cores > kBusyMachineCores) {
-            char text[200];
-            std::snprintf(text, sizeof text,
-                          "the machine was busy during %s: other processes kept %.2f cores busy on average, so its "
-                          "times may be slow and noisy",
-                          s.name.c_str(), s.other_load_cores);
-            warnings.push_back(text);
+            std::snprintf(entry, sizeof entry, "%s%s (%.2f)", busy.empty() ? "" : ", ", s.name.c_str(), s.other_load_cores);
+            busy += entry;
         }
-    return warnings;
+    if (busy.empty()) return "";
+    return "the machine was busy during these solvers' measurements, so their times may be slow and noisy (cores "
+           "other processes kept busy on average): " + busy;
 }
 
 std::vector<std::pair<std::string, double>> setup_times(const SolverComparison& comparison) {

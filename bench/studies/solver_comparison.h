@@ -89,9 +89,9 @@ struct SolverComparison {
     int repeats = 0;                   // options.repeats, for timing_statistic
 };
 
-// One warning per solver during whose measurements other processes kept more than kBusyMachineCores
-// cores busy on average (provenance.h).
-std::vector<std::string> busy_machine_warnings(const SolverComparison& comparison);
+// One warning naming every solver during whose measurements other processes kept more than
+// kBusyMachineCores cores busy on average (provenance.h), or "" when none.
+std::string busy_machine_warning(const SolverComparison& comparison);
 
 // The statistic a comparison's times are, in words, e.g. "median of 5 runs after one warm-up".
 std::string timing_statistic(int repeats);

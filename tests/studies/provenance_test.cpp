@@ -92,8 +92,10 @@ TEST(Provenance, WarnsWhenTheMeshUnderResolvesTheLight) {
     const std::vector<TetMaterial> marble(cube.tet_count(), material_preset("marble"));
     provenance.warn_if_under_resolved(cube, marble, 0.1);  // 0.025 mm edges: fine
     const auto block = provenance.to_json({}, {});
-    ASSERT_EQ(block["warnings"].size(), 1u);
-    EXPECT_NE(block["warnings"][0].get<std::string>().find("under-resolves"), std::string::npos);
+    size_t resolution_warnings = 0;  // (a busy-machine warning can come too, when tests run side by side)
+    for (const auto& warning : block["warnings"])
+        resolution_warnings += warning.get<std::string>().find("under-resolves") != std::string::npos;
+    EXPECT_EQ(resolution_warnings, 1u);
 }
 
 }  // namespace
