@@ -326,7 +326,12 @@ void run_accuracy_part(const BenchSuiteOptions& o, Json& index, RunProvenance& p
     std::vector<ConvergenceSeries> all = ball;
     all.insert(all.end(), ball_nested.begin(), ball_nested.end());
     all.push_back(spot);
-    write_text(o.output_dir / "accuracy.md", "### " + titled(o, "Observed orders of convergence") + "\n\n" +
+    write_text(o.output_dir / "accuracy.md", "### " + titled(o, "Observed orders of convergence") +
+                                                 "\n\nLeast-squares slope of log(relative L2 error of phi) on log(mean "
+                                                 "tet size), with its 95% interval (Student's t at n - 2 degrees of "
+                                                 "freedom); reliable with at least 4 points over a size range of at least "
+                                                 "4, a half-width of at most 0.5 and local orders within 1.0 of each "
+                                                 "other.\n\n" +
                                                  order_table_markdown(all));
 
     auto chart = [&](const std::vector<ConvergenceSeries>& series, const std::string& title,

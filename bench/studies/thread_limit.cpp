@@ -2,7 +2,6 @@
 
 #include "base/error.h"
 
-#include <Eigen/Core>
 #include <dlfcn.h>
 #include <omp.h>
 
@@ -54,7 +53,6 @@ ThreadLimit::ThreadLimit(int threads) {
     // A num_threads clause overrides omp_set_num_threads; no active level at all does not.
     omp_set_max_active_levels(threads_ == 1 ? 0 : previous_omp_levels_);
     limit_blas_threads(threads_);
-    Eigen::setNbThreads(threads_);
     setenv("LP_NUM_THREADS", std::to_string(threads_).c_str(), 1);
 }
 
@@ -73,7 +71,7 @@ nlohmann::ordered_json ThreadLimit::libraries() const {
             {"cholmod_openmp_loops", threads_ == 1 ? "1" : "fixed by the SuiteSparse build (num_threads clauses)"},
             {"blas", reference_blas ? 1 : threads_},
             {"blas_library", blas.empty() ? "not loaded" : blas},
-            {"eigen", Eigen::nbThreads()},
+            {"eigen", 1},
             {"llvmpipe", threads_}};
 }
 

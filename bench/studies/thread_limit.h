@@ -2,7 +2,7 @@
 // solver on the same count. Waxwork's solvers run on oneTBB; CHOLMOD's supernodal factorisation on
 // OpenMP (libgomp) and on the BLAS it calls; llvmpipe's rasteriser and compute shaders on a thread pool
 // of its own sized by LP_NUM_THREADS, which it reads when the first OpenGL context is made; Eigen's
-// sparse solvers are sequential (the build has no OpenMP for Eigen).
+// sparse solvers are sequential (Waxwork is compiled without -fopenmp, so Eigen has no threads).
 #pragma once
 
 #include <tbb/global_control.h>

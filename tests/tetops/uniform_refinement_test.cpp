@@ -31,14 +31,22 @@ TetMesh coarse_ball(int surface_level, size_t target_tets) {
 
 double mean_edge_length(const TetMesh& mesh) { return measure_quality(mesh).mean_edge_length; }
 
-TEST(UniformRefinement, SplitsEveryTetIntoEightAtTheEdgeMidpoints) {
-    const TetMesh mesh = testing::make_box_mesh(3, Eigen::Vector3d(-1, 0, 2), Eigen::Vector3d(2, 1.5, 4));
-    const size_t edges = build_connectivity(mesh).edges.size();
-    const TetMesh fine = refine_uniformly(mesh);
+// What every refinement without projection gives: 8 tets per tet, a vertex per edge, the volume kept,
+// a valid mesh and half the mean edge length.
+void expect_plain_refinement(const TetMesh& mesh, const TetMesh& fine) {
     EXPECT_EQ(fine.tet_count(), 8 * mesh.tet_count());
-    EXPECT_EQ(fine.vertex_count(), mesh.vertex_count() + edges);
+    EXPECT_EQ(fine.vertex_count(), mesh.vertex_count() + build_connectivity(mesh).edges.size());
     EXPECT_NEAR(total_volume(fine) / total_volume(mesh), 1.0, 1e-12);
     EXPECT_TRUE(find_invariant_violations(fine).empty());
+    const double ratio = mean_edge_length(fine) / mean_edge_length(mesh);
+    EXPECT_GE(ratio, 0.45);
+    EXPECT_LE(ratio, 0.55);
+}
+
+TEST(UniformRefinement, SplitsEveryTetIntoEightAtTheEdgeMidpoints) {
+    const TetMesh mesh = testing::make_box_mesh(3, Eigen::Vector3d(-1, 0, 2), Eigen::Vector3d(2, 1.5, 4));
+    const TetMesh fine = refine_uniformly(mesh);
+    expect_plain_refinement(mesh, fine);
     for (size_t v = 0; v < mesh.vertex_count(); ++v) EXPECT_EQ(fine.positions[v], mesh.positions[v]);
     for (size_t t = 0; t < fine.tet_count(); ++t) ASSERT_GT(signed_volume(fine, t), 0) << t;
     // The children of one tet fill it exactly.
@@ -47,22 +55,12 @@ TEST(UniformRefinement, SplitsEveryTetIntoEightAtTheEdgeMidpoints) {
         for (size_t c = 0; c < 8; ++c) children += signed_volume(fine, 8 * t + c);
         EXPECT_NEAR(children, signed_volume(mesh, t), 1e-12 * signed_volume(mesh, t));
     }
-    const double ratio = mean_edge_length(fine) / mean_edge_length(mesh);
-    EXPECT_GE(ratio, 0.45);
-    EXPECT_LE(ratio, 0.55);
 }
 
 TEST(UniformRefinement, KeepsAnUnstructuredMeshValidAndItsVolumeWithoutProjection) {
     const TetMesh mesh = coarse_ball(1, 100);
-    const size_t edges = build_connectivity(mesh).edges.size();
     const TetMesh fine = refine_uniformly(mesh);
-    EXPECT_EQ(fine.tet_count(), 8 * mesh.tet_count());
-    EXPECT_EQ(fine.vertex_count(), mesh.vertex_count() + edges);
-    EXPECT_NEAR(total_volume(fine) / total_volume(mesh), 1.0, 1e-12);
-    EXPECT_TRUE(find_invariant_violations(fine).empty());
-    const double ratio = mean_edge_length(fine) / mean_edge_length(mesh);
-    EXPECT_GE(ratio, 0.45);
-    EXPECT_LE(ratio, 0.55);
+    expect_plain_refinement(mesh, fine);
 }
 
 TEST(UniformRefinement, ChildrenInheritMaterialOriginalIdAndPiece) {
