@@ -28,6 +28,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <exception>
 #include <iostream>
@@ -339,8 +340,14 @@ void run_accuracy_part(const BenchSuiteOptions& o, Json& index, RunProvenance& p
         std::vector<ChartSeries> lines;
         for (const ConvergenceSeries& s : series) {
             ChartSeries line;
-            char name[160];
-            std::snprintf(name, sizeof name, "%s (order %.2f)", s.name.c_str(), s.observed_order());
+            char name[224];
+            // The fitted order with its 95% interval, flagged where the fit is not to be trusted.
+            const OrderFit fit = s.fit_order();
+            if (std::isfinite(fit.ci95_low) && std::isfinite(fit.ci95_high))
+                std::snprintf(name, sizeof name, "%s (order %.2f, 95%% CI %.2f to %.2f%s)", s.name.c_str(), fit.order,
+                              fit.ci95_low, fit.ci95_high, fit.reliable ? "" : "; unreliable");
+            else
+                std::snprintf(name, sizeof name, "%s (order %.2f; unreliable)", s.name.c_str(), fit.order);
             line.name = name;
             for (const ConvergencePoint& p : s.points) line.points.emplace_back(p.tet_size_mm, p.relative_error);
             lines.push_back(std::move(line));
