@@ -1,4 +1,5 @@
-// 8-bit RGBA images and PNG files: what the headless renderer produces and the tests compare.
+// 8-bit RGBA images and PNG files (what the headless renderer produces and the tests compare), and
+// the high-dynamic-range Radiance .hdr files environment lights are read from.
 #pragma once
 
 #include <cstdint>
@@ -25,5 +26,16 @@ void write_png(const Image& image, const std::filesystem::path& path);
 // Reads any PNG (grey, grey-alpha, rgb, rgba, palette; 8 or 16 bits) as 8-bit RGBA. Throws
 // FileError("PATH: PROBLEM") for a missing, unreadable, truncated or corrupt file.
 Image read_png(const std::filesystem::path& path);
+
+// Linear RGB radiance from a Radiance RGBE (.hdr) file, row-major, top row first, 3 floats per pixel.
+struct HdrImage {
+    int width = 0;
+    int height = 0;
+    std::vector<float> rgb;
+};
+
+// Reads a Radiance .hdr file (flat or run-length encoded). Throws FileError("PATH: PROBLEM") for a
+// missing or empty file, another format, a corrupt or truncated one, or one of no pixels.
+HdrImage read_hdr(const std::filesystem::path& path);
 
 }  // namespace waxwork

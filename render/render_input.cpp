@@ -64,15 +64,17 @@ SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& sce
     // reach no surface from outside), each shadowed by the visibility its shadow rays found.
     input.lighting.ambient = lighting.ambient;
     input.lighting.shadows = lighting.shadows;
-    std::vector<size_t> kept;  // index into lighting.lights of each drawn light
-    for (size_t l = 0; l < lighting.lights.size(); ++l) {
-        const Light& light = lighting.lights[l];
+    // The sky's sun is one of them (direct_lights); the environment's own highlight is not drawn.
+    const std::vector<Light> lights = direct_lights(lighting);
+    std::vector<size_t> kept;  // index into lights of each drawn light
+    for (size_t l = 0; l < lights.size(); ++l) {
+        const Light& light = lights[l];
         if (input.lighting.lights.size() == static_cast<size_t>(kMaxRenderLights)) break;
         if (light.type == LightType::Point && point_inside_volume(mesh, light.vector)) continue;
         input.lighting.lights.push_back(light);
         kept.push_back(l);
     }
-    const size_t solved_lights = lighting.lights.size();
+    const size_t solved_lights = lights.size();
     const std::vector<float>& visibility = scene.shading_light.visibility;
     if (!kept.empty() && visibility.size() == n * solved_lights) {
         input.light_visibility.resize(n * kept.size());

@@ -49,8 +49,6 @@ const std::vector<Colour>& level_palette() {
     return palette;
 }
 
-double luminance(const std::array<double, 3>& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
-
 }  // namespace
 
 const std::vector<ViewMode>& all_view_modes() {

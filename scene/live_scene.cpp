@@ -55,11 +55,27 @@ void LiveScene::rebuild_surface(SceneUpdate& update) {
     shadow_bvh_ = build_shadow_bvh(surface_);
     shading_ = split_at_creases(surface_, options_.crease_angle_degrees);
     update.rebuilt_surface = true;
+    transfer_.reset();
     relight(update);
 }
 
+void LiveScene::refresh_transfer() {
+    if (!lighting_.environment) {
+        transfer_.reset();
+        return;
+    }
+    if (transfer_ && transfer_->settings().order == lighting_.environment->sh_order &&
+        transfer_->settings().shadows == lighting_.shadows)
+        return;
+    TransferSettings settings;
+    settings.order = lighting_.environment->sh_order;
+    settings.shadows = lighting_.shadows;
+    transfer_ = compute_environment_transfer(surface_, shadow_bvh_, settings);
+}
+
 void LiveScene::relight(SceneUpdate& update) {
-    surface_q_ = incident_light(surface_, shadow_bvh_, lighting_, &surface_visibility_);
+    refresh_transfer();
+    surface_q_ = incident_light(surface_, shadow_bvh_, lighting_, &surface_visibility_, transfer_ ? &*transfer_ : nullptr);
     light_shading();
     update.recomputed_light = true;
     refresh_right_hand_sides();
@@ -187,7 +203,8 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
             if (eta_changed && !change.piece_transforms) {
                 // Only those vertices' Fresnel transmittance changed: recompute q there (shadow rays
                 // included), not on the whole surface.
-                update_incident_light(surface_, shadow_bvh_, lighting_, changed, surface_q_);
+                if (transfer_) update_environment_transfer(surface_, shadow_bvh_, changed, *transfer_);
+                update_incident_light(surface_, shadow_bvh_, lighting_, changed, surface_q_, transfer_ ? &*transfer_ : nullptr);
                 light_shading();
                 update.recomputed_light = true;
             }

@@ -45,6 +45,7 @@
 #include "scene/live_solver.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/diffusion_solve.h"
+#include "solver/environment_transfer.h"
 #include "solver/lighting.h"
 #include "solver/ray_caster.h"
 #include "solver/shading_surface.h"
@@ -183,6 +184,9 @@ private:
     // q and visibility of the shading's copies from the surface's (after either changed), and the
     // solve's q from the copies' (source_light); the caller refreshes the right-hand sides.
     void light_shading();
+    // Computes transfer_ when the environment needs one it does not have (or of another order or
+    // shadow setting), drops it without an environment.
+    void refresh_transfer();
     void refresh_right_hand_sides();
     void mark_unconverged();
     // `time_budget` (optional) replaces the iteration budget.
@@ -196,6 +200,9 @@ private:
     DiffusionMatrix matrix_;
     BoundarySurface surface_;
     TriangleBvh shadow_bvh_;
+    // The environment's transfer per surface vertex (environment_transfer.h): computed when the
+    // surface is rebuilt, so that a change of the environment alone costs a dot product per vertex.
+    std::optional<EnvironmentTransfer> transfer_;
     std::vector<Rgb> surface_q_;                // per surface vertex
     std::vector<float> surface_visibility_;     // per surface vertex and light (incident_light)
     ShadingSurface shading_;                    // the surface split at creases (options_.crease_angle_degrees)

@@ -1,12 +1,14 @@
 #include "solver/lighting.h"
 
 #include "base/error.h"
+#include "solver/environment_transfer.h"
 #include "solver/material.h"
 #include "solver/radiance.h"
 
 #include <tbb/parallel_for.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 
 namespace waxwork {
@@ -54,6 +56,22 @@ void validate(const Lighting& lighting) {
     if (!valid_light_value(lighting.ambient)) {
         throw InvalidArgumentError("ambient light must be non-negative and at most 1e15");
     }
+    if (lighting.environment) validate(*lighting.environment);
+}
+
+std::vector<Light> direct_lights(const Lighting& lighting) {
+    std::vector<Light> lights = lighting.lights;
+    if (lighting.environment && lighting.environment->sky) {
+        const EnvironmentLight& environment = *lighting.environment;
+        Light sun;
+        sun.type = LightType::Directional;
+        sun.vector = -(Eigen::AngleAxisd(environment.rotation_degrees * std::numbers::pi / 180, Eigen::Vector3d::UnitY()) *
+                       sun_direction(*environment.sky));
+        sun.intensity = sun_irradiance(*environment.sky);
+        for (double& c : sun.intensity) c *= environment.intensity;
+        lights.push_back(sun);
+    }
+    return lights;
 }
 
 std::vector<Eigen::Vector3d> area_weighted_normals(const std::vector<Eigen::Vector3d>& positions,
@@ -161,12 +179,15 @@ std::vector<double> shadow_ray_offsets(const BoundarySurface& surface, const Lig
     return offset;
 }
 
-Rgb incident_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta,
-                      double shadow_offset, const TriangleBvh& bvh, const Lighting& lighting, float* visibility) {
+namespace {
+
+// ambient plus the direct lights (no environment) at one point.
+Rgb direct_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta, double shadow_offset,
+                    const TriangleBvh& bvh, const Lighting& lighting, std::span<const Light> lights, float* visibility) {
     Rgb sum = lighting.ambient;
     const Eigen::Vector3f origin = (position + shadow_offset * normal).cast<float>();
-    for (size_t l = 0; l < lighting.lights.size(); ++l) {
-        const Light& light = lighting.lights[l];
+    for (size_t l = 0; l < lights.size(); ++l) {
+        const Light& light = lights[l];
         if (visibility) visibility[l] = 1.0f;
         Eigen::Vector3d to_light;
         double scale = 1.0;
@@ -198,25 +219,71 @@ Rgb incident_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& no
     return sum;
 }
 
+void add(Rgb& sum, const Rgb& value) {
+    for (int c = 0; c < 3; ++c) sum[c] += value[c];
+}
+
+TransferSettings transfer_settings(const Lighting& lighting) {
+    TransferSettings settings;
+    settings.order = lighting.environment->sh_order;
+    settings.shadows = lighting.shadows;
+    return settings;
+}
+
+// The transfer incident_light uses: the caller's, checked, or one computed for the surface.
+const EnvironmentTransfer& environment_transfer(const BoundarySurface& surface, const TriangleBvh& bvh,
+                                                const Lighting& lighting, const EnvironmentTransfer* given,
+                                                std::optional<EnvironmentTransfer>& computed) {
+    if (given) {
+        if (given->size() != surface.positions.size() || given->settings().order != lighting.environment->sh_order)
+            throw InvalidArgumentError("incident_light: the environment transfer was not computed for this surface and order");
+        return *given;
+    }
+    computed = compute_environment_transfer(surface, bvh, transfer_settings(lighting));
+    return *computed;
+}
+
+}  // namespace
+
+Rgb incident_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta,
+                      double shadow_offset, const TriangleBvh& bvh, const Lighting& lighting, float* visibility) {
+    const std::vector<Light> lights = direct_lights(lighting);
+    Rgb sum = direct_light_at(position, normal, eta, shadow_offset, bvh, lighting, lights, visibility);
+    if (lighting.environment) {
+        EnvironmentTransfer transfer(transfer_settings(lighting), 1);
+        environment_transfer_at(position, normal, eta, shadow_offset, bvh, transfer.settings(), 0, transfer.at(0));
+        add(sum, transfer.apply(0, environment_sh(*lighting.environment)));
+    }
+    return sum;
+}
+
 std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
-                                std::vector<float>* visibility) {
+                                std::vector<float>* visibility, const EnvironmentTransfer* transfer) {
     check_lighting_inputs(surface, bvh, lighting);
     const size_t n = surface.positions.size();
-    const size_t lights = lighting.lights.size();
+    const std::vector<Light> lights = direct_lights(lighting);
     const std::vector<double> offset = shadow_ray_offsets(surface, lighting);
     std::vector<Rgb> q(n);
-    if (visibility) visibility->assign(n * lights, 1.0f);
+    if (visibility) visibility->assign(n * lights.size(), 1.0f);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
         for (size_t s = range.begin(); s != range.end(); ++s) {
-            float* v = visibility ? visibility->data() + s * lights : nullptr;
-            q[s] = incident_light_at(surface.positions[s], surface.normals[s], surface.eta[s], offset[s], bvh, lighting, v);
+            float* v = visibility ? visibility->data() + s * lights.size() : nullptr;
+            q[s] = direct_light_at(surface.positions[s], surface.normals[s], surface.eta[s], offset[s], bvh, lighting,
+                                   lights, v);
         }
     });
+    if (lighting.environment) {
+        std::optional<EnvironmentTransfer> computed;
+        const std::vector<Rgb> q_env = apply_environment_transfer(
+            environment_transfer(surface, bvh, lighting, transfer, computed), *lighting.environment);
+        for (size_t s = 0; s < n; ++s) add(q[s], q_env[s]);
+    }
     return q;
 }
 
 void update_incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
-                           std::span<const int32_t> surface_vertices, std::vector<Rgb>& q) {
+                           std::span<const int32_t> surface_vertices, std::vector<Rgb>& q,
+                           const EnvironmentTransfer* transfer) {
     check_lighting_inputs(surface, bvh, lighting);
     if (q.size() != surface.positions.size())
         throw InvalidArgumentError("update_incident_light: q has " + std::to_string(q.size()) + " values for " +
@@ -224,13 +291,28 @@ void update_incident_light(const BoundarySurface& surface, const TriangleBvh& bv
     for (const int32_t s : surface_vertices)
         if (s < 0 || static_cast<size_t>(s) >= q.size())
             throw InvalidArgumentError("update_incident_light: surface vertex " + std::to_string(s) + " out of range");
+    const std::vector<Light> lights = direct_lights(lighting);
     const std::vector<double> offset = shadow_ray_offsets(surface, lighting);
+    std::optional<EnvironmentTransfer> computed;
+    std::vector<Rgb> environment;
+    const EnvironmentTransfer* used = nullptr;
+    if (lighting.environment) {
+        if (transfer) {
+            used = &environment_transfer(surface, bvh, lighting, transfer, computed);
+        } else {
+            computed.emplace(transfer_settings(lighting), surface.positions.size());
+            update_environment_transfer(surface, bvh, surface_vertices, *computed);
+            used = &*computed;
+        }
+        environment = environment_sh(*lighting.environment);
+    }
     tbb::parallel_for(tbb::blocked_range<size_t>(0, surface_vertices.size(), 64),
                       [&](const tbb::blocked_range<size_t>& range) {
                           for (size_t i = range.begin(); i != range.end(); ++i) {
                               const size_t s = static_cast<size_t>(surface_vertices[i]);
-                              q[s] = incident_light_at(surface.positions[s], surface.normals[s], surface.eta[s], offset[s], bvh,
-                                                         lighting);
+                              q[s] = direct_light_at(surface.positions[s], surface.normals[s], surface.eta[s], offset[s],
+                                                     bvh, lighting, lights, nullptr);
+                              if (used) add(q[s], used->apply(s, environment));
                           }
                       });
 }

@@ -16,7 +16,9 @@
 // exactly on a vertex contributes nothing to that vertex (no direction; never NaN).
 #pragma once
 
+#include "solver/environment_light.h"
 #include "solver/ray_caster.h"
+#include "solver/rgb.h"
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
@@ -24,12 +26,11 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
 namespace waxwork {
-
-using Rgb = std::array<double, 3>;
 
 enum class LightType {
     Directional,  // parallel rays; `vector` is the direction in which the light travels
@@ -48,7 +49,17 @@ struct Lighting {
     std::vector<Light> lights;
     Rgb ambient = {0, 0, 0};
     bool shadows = true;
+    // Distant light from every direction (environment_light.h), integrated over each vertex's
+    // hemisphere with visibility: q gains q_env (environment_transfer.h).
+    std::optional<EnvironmentLight> environment;
 };
+
+// The lights evaluated with one shadow ray each: `lights`, then the sun of a built-in sky
+// environment (rotated and scaled with it). The per-light visibility incident_light reports follows
+// this order.
+std::vector<Light> direct_lights(const Lighting& lighting);
+
+class EnvironmentTransfer;
 
 // The largest light-vector component: beyond it the solver's sums of squares overflow (1e100 squared,
 // summed over a million vertices, is still finite; 1e308 is not), and so does the normalisation of
@@ -61,7 +72,8 @@ constexpr double kMaxLightValue = 1e100;
 constexpr double kMaxLightIntensity = 1e15;
 
 // Throws InvalidArgumentError naming the light for non-finite components or ones beyond
-// kMaxLightValue, a zero direction, or intensities / ambient negative or beyond kMaxLightIntensity.
+// kMaxLightValue, a zero direction, or intensities / ambient negative or beyond kMaxLightIntensity,
+// and for an invalid environment (environment_light.h: validate).
 void validate(const Lighting& lighting);
 
 // The boundary of a volume in world space, as the lighting and the renderer see it. Surface vertex s
@@ -92,18 +104,22 @@ BoundarySurface extract_boundary_surface(const TetMesh& mesh, const TetConnectiv
 TriangleBvh build_shadow_bvh(const BoundarySurface& surface);
 
 // q per surface vertex and channel. `bvh` must have been built from `surface` (only used with
-// lighting.shadows). Parallel over vertices (TBB).
+// lighting.shadows). Parallel over vertices (TBB). With an environment, q_env comes from `transfer`
+// when given (compute_environment_transfer of this surface, at the environment's order), else from
+// a transfer computed here.
 // `visibility`, when given, receives V_il from the shadow rays already cast for q, vertex-major
 // (visibility[s * lights + l]): 0 where light l is occluded at surface vertex s, else 1 (also where the
 // vertex faces away from the light, which the renderer's n.l test handles, so that interpolation
 // across a triangle does not darken the terminator). The renderer multiplies each light's specular
 // highlight by it, so highlights vanish in shadow as the diffuse light q does.
 std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
-                                std::vector<float>* visibility = nullptr);
+                                std::vector<float>* visibility = nullptr, const EnvironmentTransfer* transfer = nullptr);
 // Recomputes q (per surface vertex, as above) at `surface_vertices` only, e.g. after their eta
 // changed (painting): equal to the full computation at those vertices, other entries untouched.
+// With an environment, `transfer` as for incident_light (already updated at those vertices).
 void update_incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,
-                           std::span<const int32_t> surface_vertices, std::vector<Rgb>& q);
+                           std::span<const int32_t> surface_vertices, std::vector<Rgb>& q,
+                           const EnvironmentTransfer* transfer = nullptr);
 // Same, building the BVH when lighting.shadows is set.
 std::vector<Rgb> incident_light(const BoundarySurface& surface, const Lighting& lighting,
                                 std::vector<float>* visibility = nullptr);
@@ -117,8 +133,8 @@ std::vector<Rgb> incident_light(const TetMesh& mesh, const TetConnectivity& conn
 
 // q at one point of the surface with outward unit `normal` and relative index `eta`; the shadow ray
 // starts `shadow_offset` along the normal. `visibility`, when not null, receives V_il for each light
-// (lights.size() entries). incident_light is this at every surface vertex; `lighting` must be valid
-// (validate).
+// (direct_lights(lighting).size() entries). incident_light is this at every surface vertex (with the
+// environment's transfer computed here, for this one point); `lighting` must be valid (validate).
 Rgb incident_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta, double shadow_offset,
                       const TriangleBvh& bvh, const Lighting& lighting, float* visibility = nullptr);
 

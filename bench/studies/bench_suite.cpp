@@ -38,6 +38,13 @@
 namespace waxwork {
 namespace {
 
+// The lighting of the surface part: the default key light, no ambient.
+Lighting key_light_only() {
+    Lighting lighting;
+    lighting.lights = {default_key_light()};
+    return lighting;
+}
+
 using Json = nlohmann::ordered_json;
 
 void write_json(const std::filesystem::path& path, const Json& json) {
@@ -309,7 +316,7 @@ void run_accuracy_part(const BenchSuiteOptions& o, Json& index, RunProvenance& p
                      {"mm_per_unit", spot_options.mm_per_unit},
                      {"size_factors", spot_options.size_factors},
                      {"reference_size_factor", spot_options.reference_size_factor},
-                     {"lighting", lighting_to_json(Lighting{{default_key_light()}})}}}};
+                     {"lighting", lighting_to_json(key_light_only())}}}};
     const Json definitions = {
         {"ball_error", "relative L2 error of phi (channel 0, weighted by lumped vertex volume) against the analytic "
                        "series (60 Legendre terms for the directional light); solves to relative tolerance 1e-8"},
