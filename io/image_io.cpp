@@ -115,6 +115,14 @@ struct MemoryReader {
 }  // namespace
 
 HdrImage read_hdr(const std::filesystem::path& path) {
+    // Refuse devices and pipes (/dev/zero never ends) and files no environment map needs, before reading.
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) {
+        if (!std::filesystem::exists(path, ec)) throw FileError(path.string(), "no such file");
+        throw FileError(path.string(), "not a regular file");
+    }
+    if (std::filesystem::file_size(path, ec) > (size_t{1} << 30))
+        throw FileError(path.string(), "larger than 1 GiB; an environment map needs far less");
     const std::string bytes = read_bytes(path);
     if (bytes.empty()) throw FileError(path.string(), "empty file, not a Radiance .hdr image");
     if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max()))

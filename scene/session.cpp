@@ -12,6 +12,7 @@
 #include "io/volume_file.h"
 #include "render/camera.h"
 #include "render/render_input.h"
+#include "scene/environment_loading.h"
 #include "scene/json_fields.h"
 #include "scene/live_scene.h"
 #include "scene/scene_core.h"
@@ -72,8 +73,61 @@ Json light_to_json(const Light& light) {
     return j;
 }
 
-// "lights", "ambient", "shadows" of `in` into `lighting` (only the fields present).
-void read_lighting_fields(FieldReader& in, Lighting& lighting) {
+// {"file": PATH | "sky": {"sun_elevation", "sun_azimuth", "turbidity"}, "rotation", "intensity",
+// "background"}: the environment, its file read (relative paths from `base`, the session's folder).
+EnvironmentLight environment_from_json(const Json& json, const std::string& context, const fs::path& base) {
+    FieldReader in(json, context);
+    if (in.has("file") == in.has("sky"))
+        fail_json(context, "give exactly one of 'file' (an equirectangular .hdr image) and 'sky' (the built-in sky)");
+    EnvironmentSpec spec;
+    const std::string source = in.has("file") ? "file" : "sky";
+    if (in.has("file")) {
+        const Json& file = in.at("file");
+        if (!file.is_string() || file.get<std::string>().empty()) fail_json(in.field("file"), "expected a file path");
+        spec.file = (base / fs::path(file.get<std::string>())).string();
+    } else {
+        FieldReader sky(in.at("sky"), in.field("sky"));
+        SkySettings settings;
+        settings.sun_elevation_degrees = sky.number("sun_elevation");
+        settings.sun_azimuth_degrees = sky.number("sun_azimuth");
+        settings.turbidity = sky.number("turbidity", settings.turbidity);
+        sky.finish();
+        spec.sky = settings;
+    }
+    spec.rotation_degrees = in.number("rotation", 0.0);
+    spec.intensity = in.number("intensity", 1.0);
+    if (!(spec.intensity >= 0 && spec.intensity <= kMaxLightIntensity))
+        fail_json(in.field("intensity"), "must be non-negative and at most 1e15");
+    const bool background = in.boolean("background", true);
+    in.finish();
+    EnvironmentLight environment;
+    try {
+        environment = load_environment(spec);
+    } catch (const Error& e) {
+        fail_json(in.field(source), e.what());
+    }
+    environment.background = background;
+    return environment;
+}
+
+Json environment_to_json(const EnvironmentLight& environment) {
+    Json j = Json::object();
+    if (environment.sky) {
+        j["sky"] = {{"sun_elevation", environment.sky->sun_elevation_degrees},
+                    {"sun_azimuth", environment.sky->sun_azimuth_degrees},
+                    {"turbidity", environment.sky->turbidity}};
+    } else {
+        j["file"] = environment.file;
+    }
+    j["rotation"] = environment.rotation_degrees;
+    j["intensity"] = environment.intensity;
+    j["background"] = environment.background;
+    return j;
+}
+
+// "lights", "ambient", "shadows", "environment" of `in` into `lighting` (only the fields present;
+// "environment": null removes it). Environment files resolve against `base`.
+void read_lighting_fields(FieldReader& in, Lighting& lighting, const fs::path& base) {
     if (in.has("lights")) {
         const Json& lights = in.at("lights");
         if (!lights.is_array()) fail_json(in.field("lights"), "expected an array of lights");
@@ -83,6 +137,14 @@ void read_lighting_fields(FieldReader& in, Lighting& lighting) {
     }
     if (in.has("ambient")) lighting.ambient = rgb_from(in, "ambient");
     lighting.shadows = in.boolean("shadows", lighting.shadows);
+    if (in.has("environment")) {
+        const Json& environment = in.at("environment");
+        if (environment.is_null()) {
+            lighting.environment.reset();
+        } else {
+            lighting.environment = environment_from_json(environment, in.field("environment"), base);
+        }
+    }
 }
 
 void write_lighting_fields(const Lighting& lighting, Json& j) {
@@ -91,6 +153,7 @@ void write_lighting_fields(const Lighting& lighting, Json& j) {
     j["lights"] = lights;
     j["ambient"] = rgb_to_json(lighting.ambient);
     j["shadows"] = lighting.shadows;
+    j["environment"] = lighting.environment ? environment_to_json(*lighting.environment) : Json(nullptr);
 }
 
 }  // namespace
@@ -144,7 +207,8 @@ int count_from(FieldReader& in, const std::string& key) {
     return static_cast<int>(n);
 }
 
-SessionStep step_from_json(const Json& json, const std::string& context, const Session& session) {
+SessionStep step_from_json(const Json& json, const std::string& context, const Session& session,
+                           const fs::path& base_directory) {
     if (!json.is_object()) fail_json(context, "a step must be a JSON object");
     if (json.contains("op")) return edit_operation_from_json(json, context);
     FieldReader in(json, context);
@@ -163,7 +227,7 @@ SessionStep step_from_json(const Json& json, const std::string& context, const S
     } else if (in.has("light")) {
         LightStep l{session.lighting};
         FieldReader light(in.at("light"), in.field("light"));
-        read_lighting_fields(light, l.lighting);
+        read_lighting_fields(light, l.lighting, base_directory);
         light.finish();
         try {
             validate(l.lighting);
@@ -309,7 +373,12 @@ Session parse_session(const Json& json, const fs::path& base_directory, const st
         if (!(*session.scale >= kMinMmPerUnit && *session.scale <= kMaxMmPerUnit))
             fail_json(in.field("scale"), "must be a length in mm per model unit between 1e-6 and 1e6");
     }
-    read_lighting_fields(in, session.lighting);
+    read_lighting_fields(in, session.lighting, base_directory);
+    if (session.lighting.environment) {
+        // The environment lights the scene as --env does: the key light and ambient only when given.
+        if (!in.has("lights")) session.lighting.lights.clear();
+        if (!in.has("ambient")) session.lighting.ambient = {0, 0, 0};
+    }
     try {
         validate(session.lighting);
     } catch (const Error& e) {
@@ -340,7 +409,7 @@ Session parse_session(const Json& json, const fs::path& base_directory, const st
     const Json& steps = in.at("steps");
     if (!steps.is_array()) fail_json(in.field("steps"), "expected an array of steps");
     for (size_t i = 0; i < steps.size(); ++i)
-        session.steps.push_back(step_from_json(steps[i], name + ": step " + std::to_string(i), session));
+        session.steps.push_back(step_from_json(steps[i], name + ": step " + std::to_string(i), session, base_directory));
     in.finish();
     return session;
 }
@@ -384,6 +453,13 @@ void write_session(const fs::path& path, const Session& session) {
         relative.input.surface = relative_if_possible(fs::absolute(relative.input.surface), base);
     if (!relative.input.volume.empty())
         relative.input.volume = relative_if_possible(fs::absolute(relative.input.volume), base);
+    const auto relative_environment = [&](Lighting& lighting) {
+        if (lighting.environment && !lighting.environment->file.empty())
+            lighting.environment->file = relative_if_possible(fs::absolute(lighting.environment->file), base).string();
+    };
+    relative_environment(relative.lighting);
+    for (SessionStep& step : relative.steps)
+        if (auto* light = std::get_if<LightStep>(&step)) relative_environment(light->lighting);
     const std::string text = session_to_json(relative).dump(2) + "\n";
     write_file_atomically(path, [&](std::ostream& out) { out << text; });
 }

@@ -14,6 +14,10 @@
 //     "lights": [{"direction": [1,-1,-1], "intensity": [1,1,1]}, {"position": [0,2,0]}],
 //     "ambient": [0.02, 0.02, 0.02], "shadows": true,   optional: without "lights" (or "ambient"),
 //                                          render's key light (and ambient); "lights": [] is no light
+//     "environment": {"file": "studio.hdr" | "sky": {"sun_elevation": 35, "sun_azimuth": 60,
+//                     "turbidity": 3}, "rotation": 0, "intensity": 1, "background": true},
+//                                          optional (solver/environment_light.h); with it, no key light
+//                                          or ambient unless given; null in a light step removes it
 //     "camera": {"eye_direction": [0.75,0.5,-1], "up": [0,1,0], "fov_y_deg": 30, "margin": 1.1,
 //                "target_offset": [0,0,0]},    margin: framing distance factor (zoom); offset: pan
 //     "image": {"width": 640, "height": 480},
@@ -28,7 +32,8 @@
 //       {"render": "cut.png"},             a converged frame; {"render": "f.png", "frames": 3}: the frame
 //                                          a live editor shows 3 frames after the last change
 //       {"save": "cut.vtu"},               the volume (format from the extension)
-//       {"light": {"lights": [...], "ambient": [...], "shadows": true}},   new lighting
+//       {"light": {"lights": [...], "ambient": [...], "shadows": true, "environment": {...}}},
+//                                          new lighting (the fields given replace the current ones)
 //       {"camera": {...}},
 //       {"undo": 1}, {"redo": 2}
 //     ]
@@ -125,7 +130,7 @@ Session read_session(const std::filesystem::path& path);
 nlohmann::ordered_json session_to_json(const Session& session);
 
 // A lighting as the session file writes it: {"lights": [{"direction" | "position", "intensity"}, ...],
-// "ambient", "shadows"}.
+// "ambient", "shadows", "environment" (null when none)}.
 nlohmann::ordered_json lighting_to_json(const Lighting& lighting);
 // Writes atomically. Input paths are written relative to the file's directory when possible.
 void write_session(const std::filesystem::path& path, const Session& session);

@@ -18,6 +18,9 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr int kMaxEnvironmentSide = 65536;
+// 8192 x 4096, the largest HDRIs in common use; beyond it the map's memory (24 bytes a pixel) and its
+// projection time grow without changing the light of a diffuse transfer.
+constexpr size_t kMaxEnvironmentPixels = size_t{8192} * 4096;
 
 }  // namespace
 
@@ -26,6 +29,9 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<Rgb> radiance,
     if (width <= 0 || height <= 0 || width > kMaxEnvironmentSide || height > kMaxEnvironmentSide)
         throw InvalidArgumentError(name_ + ": environment image is " + std::to_string(width) + " x " +
                                    std::to_string(height) + " pixels; each side must be 1 to 65536");
+    if (static_cast<size_t>(width) * static_cast<size_t>(height) > kMaxEnvironmentPixels)
+        throw InvalidArgumentError(name_ + ": environment image is " + std::to_string(width) + " x " +
+                                   std::to_string(height) + " pixels; at most 8192 x 4096 (33.5M pixels) are taken");
     if (radiance_.size() != static_cast<size_t>(width) * static_cast<size_t>(height))
         throw InvalidArgumentError(name_ + ": " + std::to_string(radiance_.size()) + " pixels for a " +
                                    std::to_string(width) + " x " + std::to_string(height) + " image");

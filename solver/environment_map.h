@@ -24,7 +24,7 @@ class EnvironmentMap {
 public:
     EnvironmentMap() = default;
     // Throws InvalidArgumentError naming `name` (the file or the generator) for a zero or absurd
-    // size (beyond 65536 a side), a pixel count that disagrees with the size, a non-finite or
+    // size (beyond 65536 a side or 8192 x 4096 pixels), a pixel count that disagrees with the size, a non-finite or
     // negative value (with its pixel), or a value beyond kMaxLightIntensity.
     EnvironmentMap(int width, int height, std::vector<Rgb> radiance, std::string name);
 

@@ -131,7 +131,7 @@ ShadingLight shading_light(const BoundarySurface& surface, const ShadingSurface&
                            const Lighting& lighting, const std::vector<Rgb>& surface_q,
                            const std::vector<float>& surface_visibility) {
     validate(lighting);
-    const size_t n = surface.positions.size(), lights = lighting.lights.size();
+    const size_t n = surface.positions.size(), lights = direct_lights(lighting).size();
     if (surface_q.size() != n || shading.normals.size() != shading.size() || shading.size() < n)
         throw InvalidArgumentError("shading_light: " + std::to_string(surface_q.size()) + " light values and " +
                                    std::to_string(shading.size()) + " shading vertices for a surface of " +

@@ -1,6 +1,7 @@
 #include "app/options/scene_light_options.h"
 
 #include "base/error.h"
+#include "scene/environment_loading.h"
 #include "solver/conjugate_gradient.h"
 #include "solver/light_spec.h"
 #include "solver/material.h"
@@ -19,6 +20,10 @@ void add_scene_light_options(CLI::App& command, SceneLightOptions& options) {
                     "repeatable; intensity 1,1,1 by default")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    command.add_option("--env", options.environment,
+                       "Environment light: FILE.hdr[:ROT_DEG[:INTENSITY]] (equirectangular Radiance image, rotated "
+                       "about +y) or sky:SUN_ELEV_DEG,SUN_AZIM_DEG[,TURBIDITY][:ROT_DEG[:INTENSITY]] (a clear sky "
+                       "with its sun; azimuth from +z towards +x); replaces the default key light and ambient");
     command.add_option("--method", options.method, "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass)")
         ->check(CLI::IsMember({"transcut", "fem"}))
         ->capture_default_str();
@@ -33,8 +38,8 @@ void add_scene_light_options(CLI::App& command, SceneLightOptions& options) {
     command.add_option("--scale", options.scale,
                        "Millimetres per model unit (coefficients are per mm; default: the scale stored in the volume, "
                        "else the bounding-box diagonal about 75 mm)");
-    command.add_option("--ambient", options.ambient, "Ambient irradiance added to every boundary vertex")
-        ->capture_default_str();
+    command.add_option("--ambient", options.ambient,
+                       "Ambient irradiance added to every boundary vertex (default 0.02, 0 under --env)");
     command
         .add_option("--crease-angle", options.crease_angle,
                     "Shade and light the surface as folded where neighbouring triangles turn by more than "
@@ -47,15 +52,19 @@ void check_scene_light_options(const SceneLightOptions& o) {
     if (o.scale) validate_mm_per_unit(*o.scale, "--scale");
     if (!(o.tolerance >= kMinRelativeTolerance && o.tolerance < 1))
         fail("--tol must be a relative tolerance in [1e-15, 1)");
-    if (!(o.ambient >= 0 && o.ambient <= kMaxLightIntensity)) fail("--ambient must be non-negative and at most 1e15");
+    if (o.ambient && !(*o.ambient >= 0 && *o.ambient <= kMaxLightIntensity))
+        fail("--ambient must be non-negative and at most 1e15");
+    if (!o.environment.empty()) parse_environment_spec(o.environment);
     if (!is_crease_angle(o.crease_angle)) fail("--crease-angle must be between 0 and 180 degrees");
 }
 
 Lighting chosen_lighting(const SceneLightOptions& o) {
     Lighting lighting;
     for (const std::string& spec : o.lights) lighting.lights.push_back(parse_light_spec(spec));
-    if (lighting.lights.empty()) lighting.lights.push_back(default_key_light());
-    lighting.ambient = {o.ambient, o.ambient, o.ambient};
+    if (!o.environment.empty()) lighting.environment = load_environment(parse_environment_spec(o.environment));
+    if (lighting.lights.empty() && !lighting.environment) lighting.lights.push_back(default_key_light());
+    const double ambient = o.ambient.value_or(lighting.environment ? 0.0 : kDefaultAmbient);
+    lighting.ambient = {ambient, ambient, ambient};
     return lighting;
 }
 

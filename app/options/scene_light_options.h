@@ -1,7 +1,7 @@
 // The options that decide the light a volume shows, shared by the commands that solve it converged
 // (`render`, `export --radiance`), so both light a volume the same way from the same words:
 //   --material NAME | --mua R,G,B --musp R,G,B --eta N, --light SPEC..., --method transcut|fem,
-//   --tol T, --backend cpu|gpu, --scale S, --ambient A, --crease-angle DEG
+//   --env SPEC, --tol T, --backend cpu|gpu, --scale S, --ambient A, --crease-angle DEG
 #pragma once
 
 #include "app/options/material_options.h"
@@ -26,6 +26,7 @@ namespace waxwork {
 struct SceneLightOptions {
     MaterialOptions material;
     std::vector<std::string> lights;
+    std::string environment;  // --env: FILE.hdr[:ROT[:INTENSITY]] or sky:ELEV,AZIM[,TURBIDITY][:ROT[:INTENSITY]]
     std::string method = "transcut";
     // 1e-2: the resolution study (`waxwork bench --only resolution`; docs/accuracy.md) finds the image
     // at 1e-2 within 0.05% of the image at 1e-3 on spot at 3 and 30 mm per unit, while 1e-1 is visibly
@@ -33,7 +34,7 @@ struct SceneLightOptions {
     // closer than 1e-2.
     double tolerance = 1e-2;
     std::optional<double> scale;  // nullopt: the volume's stored scale, else chosen from its size
-    double ambient = kDefaultAmbient;
+    std::optional<double> ambient;  // nullopt: kDefaultAmbient, or 0 under an environment
     double crease_angle = kDefaultCreaseAngleDegrees;
     std::string backend = "cpu";
 };
@@ -46,7 +47,8 @@ void add_scene_light_options(CLI::App& command, SceneLightOptions& options);
 // unit error (a nanometre or a kilometre per model unit), not a scene.
 void check_scene_light_options(const SceneLightOptions& options);
 
-// The lights the options name (render's key light when none), with the ambient term.
+// The lights the options name (render's key light when there are none and no environment), the
+// environment (its .hdr file read here: FileError naming it when it cannot be), and the ambient term.
 Lighting chosen_lighting(const SceneLightOptions& options);
 
 // The solve's part of render_volume's settings: material, lighting, diffusion (at `scale`) and crease

@@ -113,6 +113,30 @@ TEST_F(Render, MarbleLitFromPlusXIsBrighterOnThePlusXSide) {
     }
 }
 
+// The sky's sun stands low in +x (azimuth 90 from +z): that side glows, the other is lit by the sky
+// and the ground alone, and no default key light or ambient is added.
+TEST_F(Render, SkyEnvironmentLightsTheSideOfItsSun) {
+    const fs::path image = dir_ / "sky.png", fields = dir_ / "sky.csv";
+    const auto r = run_waxwork("render " + volume_.string() + " -o " + image.string() +
+                               " --material marble --env sky:20,90 --scale 10 --width 80 --height 60 --fields " +
+                               fields.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["lights"], 0);
+    const Fields f = read_fields(fields);
+    const auto sunny = mean_lo_near(f, 0, true), shaded = mean_lo_near(f, 0, false);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_GT(sunny[c], 2 * shaded[c]) << "channel " << c;
+        EXPECT_GT(shaded[c], 0) << "the sky lights the side away from the sun";
+    }
+    // Rotating the environment by 180 degrees puts the sun on the other side.
+    const auto turned = run_waxwork("render " + volume_.string() + " -o " + image.string() +
+                                    " --material marble --env sky:20,90:180 --scale 10 --width 80 --height 60 --fields " +
+                                    fields.string());
+    ASSERT_EQ(turned.exit_code, 0) << turned.err;
+    const Fields g = read_fields(fields);
+    EXPECT_GT(mean_lo_near(g, 0, false)[0], 2 * mean_lo_near(g, 0, true)[0]);
+}
+
 TEST_F(Render, FemAgreesWithTransCut) {
     // Marble at 10 mm per unit: the diffusion length (3.9-8.5 mm) spans several edges (about 1.2 mm),
     // where the two discretisations must agree; on an under-resolved mesh they legitimately differ.
@@ -297,7 +321,11 @@ TEST_F(Render, BadInputIsAOneLineError) {
              {" --light point:1e308,0,0", "position has a non-finite component or one beyond 1e100"},
              {" --crease-angle 181", "--crease-angle must be between 0 and 180 degrees"},
              {" --crease-angle nan", "--crease-angle must be between 0 and 180 degrees"},
-             {" --exposure 1e308", "--exposure must be positive and at most 1e30"}}) {
+             {" --exposure 1e308", "--exposure must be positive and at most 1e30"},
+             {" --env sky:95,0", "bad environment spec 'sky:95,0': sky: sun elevation must be above 0"},
+             {" --env studio.hdr:0:-2", "the intensity must be a number between 0 and 1e15"},
+             {" --env " + (dir_ / "absent.hdr").string(), (dir_ / "absent.hdr").string() + ": no such file"},
+             {" --env " + volume_.string(), volume_.string() + ": not a Radiance .hdr image"}}) {
         const auto r = run_waxwork(base + args);
         EXPECT_NE(r.exit_code, 0) << args;
         EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
