@@ -206,6 +206,7 @@ private:
     void draw_side_panel();
     void draw_material_panel();
     void draw_light_panel();
+    void draw_environment_controls();
     void draw_solver_panel();
     // editor_solver_choice.cpp: the method and backend combos, and the GPU context they need.
     void draw_solver_choice();
@@ -324,6 +325,10 @@ private:
     int mods_ = 0;                                       // of the latest button event
     std::optional<Eigen::Vector3d> shown_preview_;       // the piece translation the view shows
     int selected_light_ = 0;
+    // The Lights panel's environment controls: the sky being edited and the .hdr path typed, kept
+    // while the environment is off so that switching back restores them.
+    SkySettings environment_sky_;
+    std::array<char, 1024> environment_file_{};
     int selected_preset_ = 0;
     std::optional<TetMaterial> custom_material_;  // the material panel's current material
     float brush_radius_ = 0.05f;                  // paint brush sigma, fraction of the scene radius

@@ -1,7 +1,10 @@
 // The Lights panel of EditorApp: add and remove directional and point lights, pick the one the Light
 // tool drags in the view, and set each light's colour and intensity separately (the solver takes
-// their product per channel, solver/lighting.h).
+// their product per channel, solver/lighting.h); choose, turn and scale the environment light.
 #include "editor/editor_app.h"
+
+#include "base/error.h"
+#include "scene/environment_loading.h"
 
 #include <imgui.h>
 
@@ -110,6 +113,81 @@ void EditorApp::draw_light_panel() {
         request_solve();
     }
     if (ImGui::Checkbox("shadows", &lighting_.shadows)) request_solve();
+    draw_environment_controls();
+}
+
+void EditorApp::draw_environment_controls() {
+    ImGui::Separator();
+    ImGui::TextUnformatted("Environment");
+    const bool sky = lighting_.environment && lighting_.environment->sky;
+    int kind = !lighting_.environment ? 0 : sky ? 1 : 2;
+    bool rebuild_sky = false;
+    if (ImGui::Combo("source", &kind, "none\0sky\0HDR file\0")) {
+        if (kind == 0) {
+            lighting_.environment.reset();
+            request_solve();
+        } else if (kind == 1) {
+            rebuild_sky = true;
+        }
+    }
+    if (kind == 1) {
+        float elevation = static_cast<float>(environment_sky_.sun_elevation_degrees);
+        float azimuth = static_cast<float>(environment_sky_.sun_azimuth_degrees);
+        float turbidity = static_cast<float>(environment_sky_.turbidity);
+        rebuild_sky |= ImGui::SliderFloat("sun elevation", &elevation, 1.0f, 90.0f, "%.1f deg");
+        rebuild_sky |= ImGui::SliderFloat("sun azimuth", &azimuth, -180.0f, 180.0f, "%.1f deg");
+        rebuild_sky |= ImGui::SliderFloat("turbidity", &turbidity, 2.0f, 10.0f, "%.1f");
+        if (rebuild_sky) {
+            environment_sky_ = {elevation, azimuth, turbidity};
+            // A new sky keeps the rotation, intensity and background of the environment it replaces.
+            EnvironmentLight next = sky_environment_light(environment_sky_);
+            if (lighting_.environment) {
+                next.rotation_degrees = lighting_.environment->rotation_degrees;
+                next.intensity = lighting_.environment->intensity;
+                next.background = lighting_.environment->background;
+            } else {
+                lighting_.lights.clear();  // the sun lights the scene in the key light's place
+                lighting_.ambient = {0, 0, 0};
+            }
+            lighting_.environment = std::move(next);
+            request_solve();
+        }
+    } else if (kind == 2) {
+        ImGui::InputText("file", environment_file_.data(), environment_file_.size());
+        ImGui::SameLine();
+        if (ImGui::Button("Load")) {
+            try {
+                EnvironmentSpec spec;
+                spec.file = environment_file_.data();
+                EnvironmentLight next = load_environment(spec);
+                if (lighting_.environment) {
+                    next.rotation_degrees = lighting_.environment->rotation_degrees;
+                    next.intensity = lighting_.environment->intensity;
+                    next.background = lighting_.environment->background;
+                }
+                lighting_.environment = std::move(next);
+                request_solve();
+            } catch (const Error& e) {
+                show_error(e.what());
+            }
+        }
+        if (lighting_.environment && !lighting_.environment->sky)
+            ImGui::TextDisabled("%s", lighting_.environment->map->name().c_str());
+    }
+    if (!lighting_.environment) return;
+    EnvironmentLight& environment = *lighting_.environment;
+    float rotation = static_cast<float>(environment.rotation_degrees);
+    if (ImGui::SliderFloat("rotation", &rotation, -180.0f, 180.0f, "%.1f deg")) {
+        // Relit by a dot product per vertex (environment_transfer.h): no rays are cast for a turn.
+        environment.rotation_degrees = rotation;
+        request_solve();
+    }
+    float intensity = static_cast<float>(environment.intensity);
+    if (ImGui::DragFloat("strength", &intensity, 0.01f * std::max(intensity, 0.1f), 0.0f, 1e6f, "%.3f",
+                         ImGuiSliderFlags_Logarithmic)) {
+        environment.intensity = std::max(0.0f, intensity);
+        request_solve();
+    }
 }
 
 }  // namespace waxwork

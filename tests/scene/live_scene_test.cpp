@@ -103,6 +103,41 @@ TEST(LiveScene, FollowsEveryKindOfChangeToTheFreshSolution) {
     }
 }
 
+// Under an environment the scene keeps one transfer per surface vertex: a turn of the environment
+// relights it without casting rays, a paint that changes eta at the surface updates the transfer of
+// those vertices only, and a cut rebuilds it; each time the solution is the fresh one.
+TEST(LiveScene, FollowsTheEnvironmentThroughEditsAndTurns) {
+    Document doc(testing::make_cube_mesh(5), material_preset("marble"));
+    Lighting lighting;
+    lighting.environment = sky_environment_light(SkySettings{30, 40, 3});
+    LiveScene scene(doc.mesh(), lighting, options());
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "sky");
+
+    PaintOp glassy = paint_at({1.0, 0.3, 0.5});
+    glassy.material.eta = 1.9;
+    SceneUpdate update = scene.apply_change(doc.mesh(), doc.apply(glassy));
+    EXPECT_TRUE(update.recomputed_light);
+    EXPECT_FALSE(update.rebuilt_surface);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "paint with another eta under the sky");
+
+    PlaneCutOp cut;
+    cut.plane = {Eigen::Vector3d(1, 0.3, 0.2), 0.6};
+    scene.apply_change(doc.mesh(), doc.apply(cut));
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "cut under the sky");
+
+    lighting.environment->rotation_degrees = 120;
+    lighting.environment->intensity = 1.5;
+    update = scene.set_lighting(lighting);
+    EXPECT_TRUE(update.recomputed_light);
+    EXPECT_FALSE(update.rebuilt_surface);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "turned sky");
+
+    lighting.environment.reset();
+    lighting.lights = key_lighting().lights;
+    scene.set_lighting(lighting);
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "sky removed");
+}
+
 // The crease angle decides which sides of a fold are shaded and lit as themselves: changing it
 // re-splits the shading and the solve's source (source_light) and leaves the matrix alone; the solve
 // goes on warm to the fresh solution at that angle, and the angle holds through later edits.
