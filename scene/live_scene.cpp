@@ -62,6 +62,7 @@ void LiveScene::rebuild_surface(SceneUpdate& update) {
 void LiveScene::refresh_transfer() {
     if (!lighting_.environment) {
         transfer_.reset();
+        copy_transfer_.reset();
         return;
     }
     if (transfer_ && transfer_->settings().order == lighting_.environment->sh_order &&
@@ -71,6 +72,7 @@ void LiveScene::refresh_transfer() {
     settings.order = lighting_.environment->sh_order;
     settings.shadows = lighting_.shadows;
     transfer_ = compute_environment_transfer(surface_, shadow_bvh_, settings);
+    copy_transfer_ = split_copy_transfer(surface_, shading_, shadow_bvh_, settings);
 }
 
 void LiveScene::relight(SceneUpdate& update) {
@@ -82,7 +84,8 @@ void LiveScene::relight(SceneUpdate& update) {
 }
 
 void LiveScene::light_shading() {
-    shading_light_ = shading_light(surface_, shading_, shadow_bvh_, lighting_, surface_q_, surface_visibility_);
+    shading_light_ = shading_light(surface_, shading_, shadow_bvh_, lighting_, surface_q_, surface_visibility_,
+                                   copy_transfer_ ? &*copy_transfer_ : nullptr);
     const std::vector<Rgb> surface_source_q = source_light(surface_, shading_, shading_light_.q);
     corners_ = corner_light(surface_, shading_, shading_light_.q, surface_source_q);
     q_ = to_volume_vertices(surface_, surface_source_q, matrix_.size());
@@ -96,6 +99,7 @@ SceneUpdate LiveScene::set_crease_angle(double degrees) {
     // Split first: a bad angle throws before anything changes.
     shading_ = split_at_creases(surface_, degrees);
     options_.crease_angle_degrees = degrees;
+    if (transfer_) copy_transfer_ = split_copy_transfer(surface_, shading_, shadow_bvh_, transfer_->settings());
     light_shading();
     update.recomputed_light = true;
     refresh_right_hand_sides();
@@ -203,7 +207,15 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
             if (eta_changed && !change.piece_transforms) {
                 // Only those vertices' Fresnel transmittance changed: recompute q there (shadow rays
                 // included), not on the whole surface.
-                if (transfer_) update_environment_transfer(surface_, shadow_bvh_, changed, *transfer_);
+                if (transfer_) {
+                    update_environment_transfer(surface_, shadow_bvh_, changed, *transfer_);
+                    // The split copies of those vertices integrate with the new eta too.
+                    std::vector<uint8_t> is_changed(surface_.positions.size(), 0);
+                    for (const int32_t v : changed) is_changed[v] = 1;
+                    if (std::any_of(shading_.split_copies.begin(), shading_.split_copies.end(),
+                                    [&](int32_t copy) { return is_changed[shading_.surface_vertex[copy]] != 0; }))
+                        copy_transfer_ = split_copy_transfer(surface_, shading_, shadow_bvh_, transfer_->settings());
+                }
                 update_incident_light(surface_, shadow_bvh_, lighting_, changed, surface_q_, transfer_ ? &*transfer_ : nullptr);
                 light_shading();
                 update.recomputed_light = true;

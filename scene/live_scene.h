@@ -203,6 +203,7 @@ private:
     // The environment's transfer per surface vertex (environment_transfer.h): computed when the
     // surface is rebuilt, so that a change of the environment alone costs a dot product per vertex.
     std::optional<EnvironmentTransfer> transfer_;
+    std::optional<EnvironmentTransfer> copy_transfer_;  // per split copy of shading_ (split_copy_transfer)
     std::vector<Rgb> surface_q_;                // per surface vertex
     std::vector<float> surface_visibility_;     // per surface vertex and light (incident_light)
     ShadingSurface shading_;                    // the surface split at creases (options_.crease_angle_degrees)

@@ -246,12 +246,21 @@ const EnvironmentTransfer& environment_transfer(const BoundarySurface& surface, 
 }  // namespace
 
 Rgb incident_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta,
-                      double shadow_offset, const TriangleBvh& bvh, const Lighting& lighting, float* visibility) {
+                      double shadow_offset, const TriangleBvh& bvh, const Lighting& lighting, float* visibility,
+                      std::span<const float> environment_transfer) {
     const std::vector<Light> lights = direct_lights(lighting);
     Rgb sum = direct_light_at(position, normal, eta, shadow_offset, bvh, lighting, lights, visibility);
     if (lighting.environment) {
         EnvironmentTransfer transfer(transfer_settings(lighting), 1);
-        environment_transfer_at(position, normal, eta, shadow_offset, bvh, transfer.settings(), 0, transfer.at(0));
+        if (environment_transfer.empty()) {
+            environment_transfer_at(position, normal, eta, shadow_offset, bvh, transfer.settings(), 0, transfer.at(0));
+        } else {
+            if (environment_transfer.size() != static_cast<size_t>(transfer.coefficients()))
+                throw InvalidArgumentError("incident_light_at: a transfer of " + std::to_string(environment_transfer.size()) +
+                                           " coefficients for an environment of order " +
+                                           std::to_string(lighting.environment->sh_order));
+            std::copy(environment_transfer.begin(), environment_transfer.end(), transfer.at(0).begin());
+        }
         add(sum, transfer.apply(0, environment_sh(*lighting.environment)));
     }
     return sum;

@@ -135,8 +135,11 @@ std::vector<Rgb> incident_light(const TetMesh& mesh, const TetConnectivity& conn
 // starts `shadow_offset` along the normal. `visibility`, when not null, receives V_il for each light
 // (direct_lights(lighting).size() entries). incident_light is this at every surface vertex (with the
 // environment's transfer computed here, for this one point); `lighting` must be valid (validate).
+// `environment_transfer`, when not empty, is the point's transfer vector (environment_transfer_at),
+// used instead of sampling one here.
 Rgb incident_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta, double shadow_offset,
-                      const TriangleBvh& bvh, const Lighting& lighting, float* visibility = nullptr);
+                      const TriangleBvh& bvh, const Lighting& lighting, float* visibility = nullptr,
+                      std::span<const float> environment_transfer = {});
 
 // The shadow-ray offset per surface vertex: kShadowOffset times its mean incident edge length (zero
 // without shadows), clear of the triangles the vertex lies on.

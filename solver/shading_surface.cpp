@@ -11,6 +11,7 @@
 #include <cmath>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -127,9 +128,24 @@ ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_an
     return shading;
 }
 
+EnvironmentTransfer split_copy_transfer(const BoundarySurface& surface, const ShadingSurface& shading,
+                                        const TriangleBvh& bvh, const TransferSettings& settings) {
+    EnvironmentTransfer transfer(settings, shading.split_copies.size());
+    Lighting lighting;
+    lighting.shadows = settings.shadows;
+    const std::vector<double> offset = shadow_ray_offsets(surface, lighting);
+    tbb::parallel_for(size_t{0}, shading.split_copies.size(), [&](size_t i) {
+        const int32_t copy = shading.split_copies[i];
+        const int32_t s = shading.surface_vertex[copy];
+        environment_transfer_at(surface.positions[s], shading.normals[copy], surface.eta[s], offset[s], bvh, settings,
+                                static_cast<uint32_t>(copy), transfer.at(i));
+    });
+    return transfer;
+}
+
 ShadingLight shading_light(const BoundarySurface& surface, const ShadingSurface& shading, const TriangleBvh& bvh,
                            const Lighting& lighting, const std::vector<Rgb>& surface_q,
-                           const std::vector<float>& surface_visibility) {
+                           const std::vector<float>& surface_visibility, const EnvironmentTransfer* copy_transfer) {
     validate(lighting);
     const size_t n = surface.positions.size(), lights = direct_lights(lighting).size();
     if (surface_q.size() != n || shading.normals.size() != shading.size() || shading.size() < n)
@@ -152,12 +168,24 @@ ShadingLight shading_light(const BoundarySurface& surface, const ShadingSurface&
     }
     if (shading.split_copies.empty()) return light;
     const std::vector<double> offset = shadow_ray_offsets(surface, lighting);
+    std::optional<EnvironmentTransfer> computed;
+    if (lighting.environment && !copy_transfer) {
+        TransferSettings settings;
+        settings.order = lighting.environment->sh_order;
+        settings.shadows = lighting.shadows;
+        computed = split_copy_transfer(surface, shading, bvh, settings);
+        copy_transfer = &*computed;
+    }
+    if (copy_transfer && copy_transfer->size() != shading.split_copies.size())
+        throw InvalidArgumentError("shading_light: a transfer of " + std::to_string(copy_transfer->size()) +
+                                   " vectors for " + std::to_string(shading.split_copies.size()) + " split copies");
     tbb::parallel_for(size_t{0}, shading.split_copies.size(), [&](size_t i) {
         const int32_t copy = shading.split_copies[i];
         const int32_t s = shading.surface_vertex[copy];
         float* visibility = light.visibility.empty() ? nullptr : light.visibility.data() + copy * lights;
         light.q[copy] = incident_light_at(surface.positions[s], shading.normals[copy], surface.eta[s], offset[s], bvh,
-                                          lighting, visibility);
+                                          lighting, visibility,
+                                          copy_transfer ? copy_transfer->at(i) : std::span<const float>());
     });
     return light;
 }

@@ -19,6 +19,7 @@
 #pragma once
 
 #include "solver/diffusion_matrix.h"
+#include "solver/environment_transfer.h"
 #include "solver/lighting.h"
 
 #include <Eigen/Core>
@@ -74,9 +75,18 @@ struct ShadingLight {
     std::vector<Rgb> q;             // per shading vertex
     std::vector<float> visibility;  // per shading vertex and light, vertex-major (empty when the input's is)
 };
+// With an environment, the copies' q_env comes from `copy_transfer` (split_copy_transfer's) when
+// given, else from one computed here.
 ShadingLight shading_light(const BoundarySurface& surface, const ShadingSurface& shading, const TriangleBvh& bvh,
                            const Lighting& lighting, const std::vector<Rgb>& surface_q,
-                           const std::vector<float>& surface_visibility);
+                           const std::vector<float>& surface_visibility,
+                           const EnvironmentTransfer* copy_transfer = nullptr);
+
+// The environment's transfer (environment_transfer.h) of each split copy with its own normal, in the
+// order of shading.split_copies; `settings` as the surface's transfer. Each copy's azimuth pattern is
+// seeded by its shading vertex index.
+EnvironmentTransfer split_copy_transfer(const BoundarySurface& surface, const ShadingSurface& shading,
+                                        const TriangleBvh& bvh, const TransferSettings& settings);
 
 // The light the diffusion solve takes per surface vertex: q_i of Eq. 12, whose source S_i q_i stands
 // for the integral of q over the vertex's boundary area (the lumped S_f / 3 of each of its triangles).
