@@ -50,12 +50,22 @@ void LiveScene::mark_unconverged() {
     solved_since_change_ = false;
 }
 
-void LiveScene::rebuild_surface(SceneUpdate& update) {
+void LiveScene::rebuild_surface(SceneUpdate& update, std::optional<std::span<const int32_t>> vertex_map) {
+    BoundarySurface old_surface = std::move(surface_);
     surface_ = extract_boundary_surface(*mesh_, *connectivity_, mesh_->materials);
     shadow_bvh_ = build_shadow_bvh(surface_);
     shading_ = split_at_creases(surface_, options_.crease_angle_degrees);
     update.rebuilt_surface = true;
-    transfer_.reset();
+    if (transfer_ && vertex_map && lighting_.environment && transfer_->settings().order == lighting_.environment->sh_order &&
+        transfer_->settings().shadows == lighting_.shadows) {
+        // Only the vertices that can see what changed are sampled again (carry_environment_transfer).
+        transfer_ = carry_environment_transfer(old_surface, *transfer_, surface_, shadow_bvh_, *vertex_map,
+                                               &update.resampled_transfer);
+        copy_transfer_ = split_copy_transfer(surface_, shading_, shadow_bvh_, transfer_->settings());
+    } else {
+        transfer_.reset();
+        if (lighting_.environment) update.resampled_transfer = surface_.positions.size();
+    }
     relight(update);
 }
 
@@ -120,6 +130,8 @@ void LiveScene::refresh_right_hand_sides() {
 
 void LiveScene::rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update,
                             std::span<const int32_t> new_of_old_vertex) {
+    const std::optional<std::span<const int32_t>> vertex_map =
+        new_of_old_vertex.empty() ? std::nullopt : std::optional(new_of_old_vertex);
     if (!connectivity) {
         connectivity = std::make_shared<const TetConnectivity>(build_connectivity(*mesh_));
         update.rebuilt_connectivity = true;
@@ -127,7 +139,7 @@ void LiveScene::rebuild_all(std::shared_ptr<const TetConnectivity> connectivity,
     connectivity_ = std::move(connectivity);
     matrix_ = assemble_diffusion_matrix(*mesh_, *connectivity_, mesh_->materials, assembly_options(options_));
     update.reassembled_matrix = true;
-    rebuild_surface(update);
+    rebuild_surface(update, vertex_map);
     // Also drops the smallest-eigenvalue hints of the old matrix: a stale hint could be too large and
     // make the error estimate optimistic.
     solver_->matrix_rebuilt(*mesh_, matrix_, new_of_old_vertex);
@@ -172,7 +184,7 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
         std::vector<int32_t> same_vertices(mesh.vertex_count());
         std::iota(same_vertices.begin(), same_vertices.end(), 0);
         solver_->matrix_rebuilt(mesh, matrix_, same_vertices);
-        rebuild_surface(update);
+        rebuild_surface(update, std::span<const int32_t>());
     } else {
         bool eta_changed = false;
         if (change.all_materials) {
@@ -224,7 +236,7 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
         if (change.piece_transforms) {
             // Rigid motions leave the matrix (built on rest positions) unchanged but move the pieces'
             // shadows onto each other.
-            rebuild_surface(update);
+            rebuild_surface(update, std::span<const int32_t>());
         } else if (eta_changed || update.recomputed_values) {
             refresh_right_hand_sides();  // the source operator (A, F_dr) follows the materials
         } else if (!update.updated_rows.empty()) {

@@ -100,6 +100,7 @@ struct SceneUpdate {
     bool recomputed_values = false;      // all values on the kept pattern
     std::vector<int32_t> updated_rows;   // rows rewritten by the incremental update (ascending)
     bool rebuilt_surface = false;        // boundary surface and shadow BVH
+    size_t resampled_transfer = 0;       // surface vertices whose environment transfer was sampled again
     bool recomputed_light = false;       // q and the right-hand sides
     bool warm_start = true;              // phi kept (possibly through a vertex map)
     double milliseconds = 0;
@@ -179,7 +180,9 @@ private:
     // new_of_old_vertex: where the previous mesh's vertices went (a cut's map), or empty when unknown.
     void rebuild_all(std::shared_ptr<const TetConnectivity> connectivity, SceneUpdate& update,
                      std::span<const int32_t> new_of_old_vertex = {});
-    void rebuild_surface(SceneUpdate& update);
+    // `vertex_map`: where the old volume vertices went (empty: the same numbering; nullopt: unknown),
+    // so that the environment's transfer is carried over where nothing it integrates changed.
+    void rebuild_surface(SceneUpdate& update, std::optional<std::span<const int32_t>> vertex_map = std::nullopt);
     void relight(SceneUpdate& update);
     // q and visibility of the shading's copies from the surface's (after either changed), and the
     // solve's q from the copies' (source_light); the caller refreshes the right-hand sides.

@@ -7,7 +7,10 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -29,16 +32,20 @@ double radical_inverse(uint32_t j) {
     return j * 0x1p-32;
 }
 
-// A per-vertex number in [0, 1) (the finaliser of MurmurHash3): turns each vertex's pattern by its own
-// angle, so neighbouring vertices sample different azimuths.
-double vertex_turn(uint32_t vertex) {
-    uint32_t h = vertex * 0x9e3779b9u + 0x7f4a7c15u;
-    h ^= h >> 16;
-    h *= 0x85ebca6bu;
-    h ^= h >> 13;
-    h *= 0xc2b2ae35u;
-    h ^= h >> 16;
-    return h * 0x1p-32;
+// A number in [0, 1) per point, from its position's bits (the 64-bit finaliser of MurmurHash3 over
+// the three coordinates): turns each vertex's pattern by its own angle, so neighbouring vertices
+// sample different azimuths, and a vertex an edit leaves in place keeps its angle.
+double vertex_turn(const Eigen::Vector3d& position) {
+    uint64_t h = 0x9e3779b97f4a7c15ull;
+    for (int a = 0; a < 3; ++a) {
+        h ^= std::bit_cast<uint64_t>(position[a]) + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+        h ^= h >> 33;
+        h *= 0xff51afd7ed558ccdull;
+        h ^= h >> 33;
+        h *= 0xc4ceb9fe1a85ec53ull;
+        h ^= h >> 33;
+    }
+    return static_cast<double>(h >> 11) * 0x1p-53;
 }
 
 double fraction(double x) { return x - std::floor(x); }
@@ -112,14 +119,13 @@ Rgb EnvironmentTransfer::apply(size_t point, std::span<const Rgb> environment) c
 }
 
 void environment_transfer_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta, double offset,
-                             const TriangleBvh& bvh, const TransferSettings& settings, uint32_t vertex,
-                             std::span<float> out) {
+                             const TriangleBvh& bvh, const TransferSettings& settings, std::span<float> out) {
     const int count = sh_coefficient_count(settings.order);
     std::fill(out.begin(), out.begin() + count, 0.0f);
     if (normal.squaredNorm() == 0) return;
     const TangentFrame frame(normal);
     const Eigen::Vector3f origin = (position + offset * normal).cast<float>();
-    const double turn = vertex_turn(vertex);
+    const double turn = vertex_turn(position);
     double basis[sh_coefficient_count(kMaxShOrder)];
     double sum[sh_coefficient_count(kMaxShOrder)] = {};
     for (int j = 0; j < settings.samples; ++j) {
@@ -158,7 +164,7 @@ void update_environment_transfer(const BoundarySurface& surface, const TriangleB
         for (size_t i = r.begin(); i != r.end(); ++i) {
             const auto s = static_cast<size_t>(surface_vertices[i]);
             environment_transfer_at(surface.positions[s], surface.normals[s], surface.eta[s], offset[s], bvh, settings,
-                                    static_cast<uint32_t>(s), transfer.at(s));
+                                    transfer.at(s));
         }
     });
 }
@@ -190,10 +196,95 @@ std::vector<int32_t> vertices_seeing_box(const BoundarySurface& surface, const E
     return seeing;
 }
 
+EnvironmentTransfer carry_environment_transfer(const BoundarySurface& old_surface, const EnvironmentTransfer& old_transfer,
+                                               const BoundarySurface& surface, const TriangleBvh& bvh,
+                                               std::span<const int32_t> new_of_old_vertex, size_t* recomputed) {
+    const TransferSettings& settings = old_transfer.settings();
+    if (old_transfer.size() != old_surface.positions.size())
+        throw InvalidArgumentError("carry_environment_transfer: " + std::to_string(old_transfer.size()) +
+                                   " vectors for " + std::to_string(old_surface.positions.size()) + " old surface vertices");
+    const auto new_volume_vertex = [&](int32_t old_vertex) -> int32_t {
+        if (new_of_old_vertex.empty()) return old_vertex;
+        return static_cast<size_t>(old_vertex) < new_of_old_vertex.size() ? new_of_old_vertex[old_vertex] : -1;
+    };
+    // The old surface vertex of each new volume vertex, if it had one.
+    int32_t largest = -1;
+    for (const int32_t v : surface.vertices) largest = std::max(largest, v);
+    std::vector<int32_t> old_of_new(static_cast<size_t>(largest + 1), -1);
+    for (size_t s = 0; s < old_surface.vertices.size(); ++s) {
+        const int32_t v = new_volume_vertex(old_surface.vertices[s]);
+        if (v >= 0 && v <= largest) old_of_new[v] = static_cast<int32_t>(s);
+    }
+    std::vector<int32_t> old_of_surface(surface.positions.size(), -1);
+    for (size_t s = 0; s < surface.vertices.size(); ++s) old_of_surface[s] = old_of_new[surface.vertices[s]];
+
+    // Triangles as sorted triples of new volume vertices; a triangle with a moved or removed corner is
+    // changed whatever its triple.
+    using Triple = std::array<int32_t, 3>;
+    const auto sorted = [](Triple t) {
+        std::sort(t.begin(), t.end());
+        return t;
+    };
+    std::vector<uint8_t> moved(surface.positions.size(), 0);
+    for (size_t s = 0; s < moved.size(); ++s)
+        moved[s] = old_of_surface[s] < 0 || old_surface.positions[old_of_surface[s]] != surface.positions[s];
+    std::vector<Triple> old_triangles, new_triangles;
+    Eigen::AlignedBox3d changed;
+    for (const auto& t : surface.triangles) {
+        if (moved[t[0]] || moved[t[1]] || moved[t[2]]) {
+            for (const int32_t c : t) changed.extend(surface.positions[c]);
+        } else {
+            new_triangles.push_back(sorted({surface.vertices[t[0]], surface.vertices[t[1]], surface.vertices[t[2]]}));
+        }
+    }
+    for (const auto& t : old_surface.triangles) {
+        Triple mapped;
+        for (int k = 0; k < 3; ++k) mapped[k] = new_volume_vertex(old_surface.vertices[t[k]]);
+        old_triangles.push_back(sorted(mapped));
+    }
+    std::sort(new_triangles.begin(), new_triangles.end());
+    std::vector<Triple> old_sorted = old_triangles;
+    std::sort(old_sorted.begin(), old_sorted.end());
+    // New, unmoved triangles that were not there before.
+    std::vector<Triple> added;
+    std::set_difference(new_triangles.begin(), new_triangles.end(), old_sorted.begin(), old_sorted.end(),
+                        std::back_inserter(added));
+    std::vector<int32_t> surface_of_volume(static_cast<size_t>(largest + 1), -1);
+    for (size_t s = 0; s < surface.vertices.size(); ++s) surface_of_volume[surface.vertices[s]] = static_cast<int32_t>(s);
+    for (const Triple& t : added)
+        for (const int32_t v : t) changed.extend(surface.positions[surface_of_volume[v]]);
+    // Old triangles that are gone or moved: everything not among the new, unmoved ones.
+    for (size_t i = 0; i < old_surface.triangles.size(); ++i) {
+        const Triple& t = old_triangles[i];
+        if (std::binary_search(new_triangles.begin(), new_triangles.end(), t)) continue;
+        for (const int32_t c : old_surface.triangles[i]) changed.extend(old_surface.positions[c]);
+    }
+
+    std::vector<uint8_t> sees(surface.positions.size(), 0);
+    for (const int32_t s : vertices_seeing_box(surface, changed)) sees[s] = 1;
+    const std::vector<double> old_offset = ray_offsets(old_surface, settings.shadows);
+    const std::vector<double> offset = ray_offsets(surface, settings.shadows);
+    EnvironmentTransfer transfer(settings, surface.positions.size());
+    std::vector<int32_t> again;
+    for (size_t s = 0; s < surface.positions.size(); ++s) {
+        const int32_t o = old_of_surface[s];
+        const bool same = o >= 0 && !moved[s] && !sees[s] && old_surface.normals[o] == surface.normals[s] &&
+                          old_surface.eta[o] == surface.eta[s] && old_offset[o] == offset[s];
+        if (same) {
+            const auto from = old_transfer.at(o);
+            std::copy(from.begin(), from.end(), transfer.at(s).begin());
+            continue;
+        }
+        again.push_back(static_cast<int32_t>(s));
+    }
+    update_environment_transfer(surface, bvh, again, transfer);
+    if (recomputed) *recomputed = again.size();
+    return transfer;
+}
+
 Rgb sampled_environment_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta,
                                  double offset, const TriangleBvh& bvh, bool shadows,
-                                 const EnvironmentLight& environment, const EnvironmentSampler& sampler, int samples,
-                                 uint32_t vertex) {
+                                 const EnvironmentLight& environment, const EnvironmentSampler& sampler, int samples) {
     Rgb q = {0, 0, 0};
     if (normal.squaredNorm() == 0 || samples < 1) return q;
     const TangentFrame frame(normal);
@@ -202,7 +293,7 @@ Rgb sampled_environment_light_at(const Eigen::Vector3d& position, const Eigen::V
     const Eigen::AngleAxisd rotate(radians, Eigen::Vector3d::UnitY()), unrotate(-radians, Eigen::Vector3d::UnitY());
     const int n_env = sampler.valid() ? samples / 2 : 0;
     const int n_cos = samples - n_env;
-    const double turn = vertex_turn(vertex);
+    const double turn = vertex_turn(position);
     const auto add = [&](const Eigen::Vector3d& w, double cos_theta, const Eigen::Vector3d& unrotated, double pdf_env) {
         if (!visible(origin, w, bvh, shadows)) return;
         const double weight = fresnel_transmittance(cos_theta, eta) * cos_theta / (n_cos * cos_theta / kPi + n_env * pdf_env);
@@ -238,7 +329,7 @@ std::vector<Rgb> sampled_environment_light(const BoundarySurface& surface, const
     tbb::parallel_for(tbb::blocked_range<size_t>(0, q.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t s = r.begin(); s != r.end(); ++s)
             q[s] = sampled_environment_light_at(surface.positions[s], surface.normals[s], surface.eta[s], offset[s], bvh,
-                                                shadows, environment, sampler, samples, static_cast<uint32_t>(s));
+                                                shadows, environment, sampler, samples);
     });
     return q;
 }

@@ -65,11 +65,11 @@ private:
 };
 
 // The transfer vector of one boundary point; `offset` lifts the ray origins off the surface along
-// the normal (shadow_ray_offsets). `vertex` seeds the per-vertex azimuth turn. A zero normal gives a
-// zero vector.
+// the normal (shadow_ray_offsets). The azimuth pattern is turned by an angle hashed from the
+// position's bits, so a vertex that an edit leaves in place keeps its pattern whatever its new index.
+// A zero normal gives a zero vector.
 void environment_transfer_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta, double offset,
-                             const TriangleBvh& bvh, const TransferSettings& settings, uint32_t vertex,
-                             std::span<float> out);
+                             const TriangleBvh& bvh, const TransferSettings& settings, std::span<float> out);
 
 // The transfer of every surface vertex (parallel with TBB). `bvh` is build_shadow_bvh(surface).
 EnvironmentTransfer compute_environment_transfer(const BoundarySurface& surface, const TriangleBvh& bvh,
@@ -88,12 +88,23 @@ std::vector<Rgb> apply_environment_transfer(const EnvironmentTransfer& transfer,
 // Vertices of zero normal are never listed.
 std::vector<int32_t> vertices_seeing_box(const BoundarySurface& surface, const Eigen::AlignedBox3d& changed);
 
+// The transfer of `surface` after an edit, from the transfer of the surface before it: a vertex keeps
+// its old vector when it was on the old surface at the same position, with the same normal, eta
+// and ray offset, and cannot see the changed triangles (vertices_seeing_box on the box of the old
+// triangles that are gone or moved and the new ones that were not there); every other vertex is
+// sampled again. `new_of_old_vertex` maps old volume vertices to new ones (-1: removed); empty: the
+// same numbering. The result equals compute_environment_transfer(surface, bvh, settings) bit for
+// bit. `recomputed`, when given, receives the number of vertices sampled again.
+EnvironmentTransfer carry_environment_transfer(const BoundarySurface& old_surface, const EnvironmentTransfer& old_transfer,
+                                               const BoundarySurface& surface, const TriangleBvh& bvh,
+                                               std::span<const int32_t> new_of_old_vertex,
+                                               size_t* recomputed = nullptr);
+
 // The sampled reference at one point, with `samples` directions (half by the cosine, half by the
 // environment's luminance); `sampler` is EnvironmentSampler(*environment.map).
 Rgb sampled_environment_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& normal, double eta,
                                  double offset, const TriangleBvh& bvh, bool shadows,
-                                 const EnvironmentLight& environment, const EnvironmentSampler& sampler, int samples,
-                                 uint32_t vertex);
+                                 const EnvironmentLight& environment, const EnvironmentSampler& sampler, int samples);
 // The sampled reference at every surface vertex.
 std::vector<Rgb> sampled_environment_light(const BoundarySurface& surface, const TriangleBvh& bvh, bool shadows,
                                            const EnvironmentLight& environment,

@@ -253,7 +253,7 @@ Rgb incident_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& no
     if (lighting.environment) {
         EnvironmentTransfer transfer(transfer_settings(lighting), 1);
         if (environment_transfer.empty()) {
-            environment_transfer_at(position, normal, eta, shadow_offset, bvh, transfer.settings(), 0, transfer.at(0));
+            environment_transfer_at(position, normal, eta, shadow_offset, bvh, transfer.settings(), transfer.at(0));
         } else {
             if (environment_transfer.size() != static_cast<size_t>(transfer.coefficients()))
                 throw InvalidArgumentError("incident_light_at: a transfer of " + std::to_string(environment_transfer.size()) +

@@ -138,7 +138,7 @@ EnvironmentTransfer split_copy_transfer(const BoundarySurface& surface, const Sh
         const int32_t copy = shading.split_copies[i];
         const int32_t s = shading.surface_vertex[copy];
         environment_transfer_at(surface.positions[s], shading.normals[copy], surface.eta[s], offset[s], bvh, settings,
-                                static_cast<uint32_t>(copy), transfer.at(i));
+                                transfer.at(i));
     });
     return transfer;
 }

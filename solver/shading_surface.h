@@ -83,8 +83,7 @@ ShadingLight shading_light(const BoundarySurface& surface, const ShadingSurface&
                            const EnvironmentTransfer* copy_transfer = nullptr);
 
 // The environment's transfer (environment_transfer.h) of each split copy with its own normal, in the
-// order of shading.split_copies; `settings` as the surface's transfer. Each copy's azimuth pattern is
-// seeded by its shading vertex index.
+// order of shading.split_copies; `settings` as the surface's transfer.
 EnvironmentTransfer split_copy_transfer(const BoundarySurface& surface, const ShadingSurface& shading,
                                         const TriangleBvh& bvh, const TransferSettings& settings);
 

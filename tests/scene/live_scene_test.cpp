@@ -122,7 +122,10 @@ TEST(LiveScene, FollowsTheEnvironmentThroughEditsAndTurns) {
 
     PlaneCutOp cut;
     cut.plane = {Eigen::Vector3d(1, 0.3, 0.2), 0.6};
-    scene.apply_change(doc.mesh(), doc.apply(cut));
+    update = scene.apply_change(doc.mesh(), doc.apply(cut));
+    // Only the vertices that can see the cut are sampled again.
+    EXPECT_GT(update.resampled_transfer, 0u);
+    EXPECT_LT(update.resampled_transfer, scene.solved_scene().surface.positions.size());
     expect_matches_fresh_solve(scene, doc.mesh(), lighting, "cut under the sky");
 
     lighting.environment->rotation_degrees = 120;

@@ -192,6 +192,7 @@ TEST(EnvironmentLight, UpdatingTheVerticesThatSeeAChangeEqualsRecomputingAll) {
     BoundarySurface surface = sphere_surface(2, 1.3);
     add_plate(surface, Eigen::Vector3d(1.5, 0, 0), 0.01);  // a tiny plate beside +x: the "before"
     const EnvironmentTransfer before = compute_environment_transfer(surface, build_shadow_bvh(surface), {});
+    const BoundarySurface before_surface = surface;
     const size_t n = surface.positions.size();
     Eigen::AlignedBox3d changed;
     for (size_t s = n - 4; s < n; ++s) changed.extend(surface.positions[s]);
@@ -213,6 +214,16 @@ TEST(EnvironmentLight, UpdatingTheVerticesThatSeeAChangeEqualsRecomputingAll) {
         differing += !std::equal(a.begin(), a.end(), b.begin());
     }
     EXPECT_EQ(differing, 0u);
+
+    // Carried over from the surface before the change: the same vectors, with fewer rays cast.
+    size_t recomputed = 0;
+    const EnvironmentTransfer carried = carry_environment_transfer(before_surface, before, surface, bvh, {}, &recomputed);
+    EXPECT_GT(recomputed, 4u);
+    EXPECT_LT(recomputed, n);
+    for (size_t s = 0; s < n; ++s) {
+        const std::span<const float> a = after.at(s), b = carried.at(s);
+        EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin())) << s;
+    }
 }
 
 TEST(EnvironmentLight, RotationMovesTheLitSide) {
