@@ -22,8 +22,12 @@
 
 namespace waxwork {
 
-// The spherical-harmonics order of the environment's projection and of every transfer vector.
-inline constexpr int kDefaultTransferOrder = 6;
+// The spherical-harmonics order of the environment's projection and of every transfer vector. 81
+// coefficients: on spot under a studio softbox 40 by 25 degrees wide the transfer is within 1.6% (L2)
+// of the sampled integral at order 8 and 2.4% at order 6, and a sky dome is at the 0.5% floor of the
+// 256-ray sampling from order 4 (`waxwork bench --only environment`); a relight still costs well under
+// a millisecond per 10K vertices.
+inline constexpr int kDefaultTransferOrder = 8;
 
 struct EnvironmentLight {
     std::shared_ptr<const EnvironmentMap> map;

@@ -4,6 +4,7 @@
 #include "bench/studies/accuracy_study.h"
 #include "bench/studies/coarse_start_bound.h"
 #include "bench/studies/cut_study.h"
+#include "bench/studies/environment_study.h"
 #include "bench/studies/provenance.h"
 #include "bench/studies/resolution_study.h"
 #include "bench/studies/solver_comparison.h"
@@ -374,6 +375,57 @@ void run_accuracy_part(const BenchSuiteOptions& o, Json& index, RunProvenance& p
     index["accuracy"] = "accuracy.json";
 }
 
+// The environment transfer against the sampled reference, per order, under the sky dome and a studio.
+void run_environment_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
+    const TetMesh mesh = spot_volume(o, o.quick ? 50'000 : 100'000);
+    const std::vector<TetMaterial> materials(mesh.tet_count(), material_preset("marble"));
+    const BoundarySurface surface = extract_boundary_surface(mesh, build_connectivity(mesh), materials);
+    const TriangleBvh bvh = build_shadow_bvh(surface);
+    const std::vector<int> orders = o.quick ? std::vector<int>{1, 2, 4, 6, 8} : std::vector<int>{1, 2, 3, 4, 6, 8, 10, 12};
+    const int reference_samples = o.quick ? 2048 : 8192;
+    std::vector<TransferAccuracy> studies;
+    studies.push_back(study_transfer_accuracy(surface, bvh, sky_environment_light(SkySettings{35, 60, 3}),
+                                              "sky dome (sun elevation 35, azimuth 60)", orders, reference_samples));
+    studies.push_back(study_transfer_accuracy(surface, bvh, studio_environment(kDefaultTransferOrder),
+                                              "studio (one 40 x 25 degree softbox)", orders, reference_samples));
+    Json results = Json::array();
+    for (const TransferAccuracy& study : studies) results.push_back(to_json(study));
+    const Json definitions = {
+        {"relative_l2", "L2 norm over surface vertices and channels of q_env(transfer) - q_env(reference), over the "
+                        "reference's norm"},
+        {"median_relative", "median over vertices lit above 1% of the brightest of |q_t - q_r| / q_r, green channel"},
+        {"reference", "multiple importance sampling of the cosine and the environment's luminance, shadows on"},
+        {"transfer_ms", "sampling every surface vertex's transfer (256 cosine-distributed rays each)"},
+        {"relight_ms", "rotating the environment's coefficients and one dot product per vertex"}};
+    write_json(o.output_dir / "environment.json",
+               with_provenance(provenance, mesh_inputs(o.asset_dir / "meshes/spot.obj", mesh, 1.0), definitions,
+                               {{"surface_vertices", surface.positions.size()}, {"studies", results}}));
+    std::vector<ChartSeries> by_order, by_time;
+    for (const TransferAccuracy& study : studies) {
+        ChartSeries order_line{study.environment, {}}, time_line{study.environment, {}};
+        for (const TransferAccuracyRow& r : study.rows) {
+            order_line.points.emplace_back(r.order, r.relative_l2);
+            time_line.points.emplace_back(r.transfer_ms, r.relative_l2);
+        }
+        by_order.push_back(order_line);
+        by_time.push_back(time_line);
+    }
+    ChartOptions order_chart;
+    order_chart.title = titled(o, "Environment transfer against the sampled integral (spot, " +
+                                      std::to_string(surface.positions.size()) + " surface vertices)");
+    order_chart.caption = provenance.caption();
+    order_chart.x = {"spherical harmonics order", AxisScale::Linear};
+    order_chart.y = {"relative L2 error of q_env", AxisScale::Log};
+    order_chart.target_line = 1e-2;
+    order_chart.target_label = "1%";
+    write_svg_chart(o.output_dir / "environment_order.svg", by_order, order_chart);
+    ChartOptions time_chart = order_chart;
+    time_chart.title = titled(o, "Environment transfer: error against the time to sample it");
+    time_chart.x = {"sampling every vertex's transfer (ms)", AxisScale::Log};
+    write_svg_chart(o.output_dir / "environment_time.svg", by_time, time_chart);
+    index["environment"] = "environment.json";
+}
+
 void run_table1_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
     std::vector<TimingRow> rows;
     TimingOptions options;
@@ -502,6 +554,7 @@ void run_bench_suite(const BenchSuiteOptions& o) {
     parts.emplace_back("coarse_start", [&](Json& i, RunProvenance& p) { run_coarse_start_part(o, i, p); });
     parts.emplace_back("accuracy", [&](Json& i, RunProvenance& p) { run_accuracy_part(o, i, p); });
     parts.emplace_back("cut_modes", [&](Json& i, RunProvenance& p) { run_cut_modes_part(o, i, p); });
+    parts.emplace_back("environment", [&](Json& i, RunProvenance& p) { run_environment_part(o, i, p); });
     parts.emplace_back("table1", [&](Json& i, RunProvenance& p) { run_table1_part(o, i, p); });
     parts.emplace_back("stability", [&](Json& i, RunProvenance& p) { run_stability_part(o, i, p); });
     parts.emplace_back("resolution", [&](Json& i, RunProvenance& p) { run_resolution_part(o, i, p); });

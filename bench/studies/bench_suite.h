@@ -32,7 +32,7 @@ struct BenchSuiteOptions {
     bool quick = false;
     std::filesystem::path asset_dir;                    // holds meshes/spot.obj, torus.obj, skull.obj
     std::function<void(const std::string&)> progress;   // one line per part started; may be empty
-    // Run only these parts (names as in bench.json: solvers_50k, solvers_500k, coarse_start, accuracy, cut_modes, table1,
+    // Run only these parts (names as in bench.json: solvers_50k, solvers_500k, coarse_start, accuracy, cut_modes, environment, table1,
     // stability, resolution); empty: all. An unknown name is an InvalidArgumentError.
     std::vector<std::string> only;
     // Timing statistic: 0 keeps each part's own (the solver comparison's fastest of 3 short runs, Table 1's

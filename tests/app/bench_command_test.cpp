@@ -420,6 +420,29 @@ void expect_consistent_coarse_start(const nlohmann::json& entry, const std::stri
     EXPECT_GT(mg_tight, mg_1pct);
 }
 
+// A higher order follows a small bright source better: under the studio softbox the error falls with
+// the order; the smooth sky dome is already near the sampling floor at order 4.
+TEST(BenchSuiteCommand, EnvironmentPartChartsTheTransferErrorAgainstOrderAndTime) {
+    const auto dir = scratch_dir("bench_suite_environment");
+    const auto result = run_waxwork("bench --quick --only environment -o " + dir.string());
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const auto json = nlohmann::json::parse(testing::read_text(dir / "environment.json"));
+    EXPECT_TRUE(json.contains("provenance"));
+    ASSERT_EQ(json["studies"].size(), 2u);
+    const auto& sky = json["studies"][0]["rows"];
+    const auto& studio = json["studies"][1]["rows"];
+    ASSERT_GE(studio.size(), 4u);
+    for (size_t i = 1; i < studio.size(); ++i)
+        EXPECT_LT(studio[i]["relative_l2"].get<double>(), studio[i - 1]["relative_l2"].get<double>()) << i;
+    EXPECT_LT(studio.back()["relative_l2"].get<double>(), 0.05);
+    for (const auto& row : sky) {
+        if (row["order"].get<int>() < 4) continue;
+        EXPECT_LT(row["relative_l2"].get<double>(), 0.02) << row.dump();
+    }
+    for (const char* chart : {"environment_order.svg", "environment_time.svg", "environment_order.pdf"})
+        EXPECT_TRUE(std::filesystem::exists(dir / chart)) << chart;
+}
+
 TEST(BenchSuiteCommand, CoarseStartPartBoundsThePapersSchemeOnTheSolverSystem) {
     const auto dir = scratch_dir("bench_suite_coarse_start");
     const auto result = run_waxwork("bench --quick --only coarse_start -o " + dir.string());
