@@ -118,15 +118,21 @@ void BM_EnvironmentCut(benchmark::State& state) {
     const PlaneCutOp cut = bench::middle_cut(source);
     const bool environment = state.range(0) != 0;
     double scene_ms = 0;
+    size_t resampled = 0, surface_vertices = 0;
     for (auto _ : state) {
         state.PauseTiming();
         Document doc(source, material_preset("marble"));
         LiveScene scene(doc.mesh(), environment ? sky(0) : bench::turning_light(0), bench::live_scene_options(doc.mesh()));
         const ChangeReport report = doc.apply(cut);
         state.ResumeTiming();
-        scene_ms = scene.apply_change(doc.mesh(), report).milliseconds;
+        const SceneUpdate update = scene.apply_change(doc.mesh(), report);
+        scene_ms = update.milliseconds;
+        resampled = update.resampled_transfer;
+        surface_vertices = scene.solved_scene(false).surface.positions.size();
     }
     state.counters["scene_ms"] = scene_ms;
+    state.counters["resampled"] = static_cast<double>(resampled);
+    state.counters["surface_vertices"] = static_cast<double>(surface_vertices);
     state.SetLabel(environment ? "sky" : "key light");
 }
 BENCHMARK(BM_EnvironmentCut)->Arg(0)->Arg(1)->Iterations(2)->Unit(benchmark::kMillisecond)->UseRealTime();

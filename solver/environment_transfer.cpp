@@ -182,17 +182,90 @@ std::vector<Rgb> apply_environment_transfer(const EnvironmentTransfer& transfer,
     return q;
 }
 
-std::vector<int32_t> vertices_seeing_box(const BoundarySurface& surface, const Eigen::AlignedBox3d& changed) {
-    std::vector<int32_t> seeing;
-    if (changed.isEmpty()) return seeing;
-    for (size_t s = 0; s < surface.positions.size(); ++s) {
-        const Eigen::Vector3d& n = surface.normals[s];
-        if (n.squaredNorm() == 0) continue;
-        // The box corner farthest along n decides: n . (corner - p) is linear over the box.
-        Eigen::Vector3d corner;
-        for (int a = 0; a < 3; ++a) corner[a] = n[a] >= 0 ? changed.max()[a] : changed.min()[a];
-        if (n.dot(corner - surface.positions[s]) > 0) seeing.push_back(static_cast<int32_t>(s));
+namespace {
+
+// The changed triangles grouped by median splits into boxes of at most kLeafTriangles, flattened
+// depth first: node i's first child is i + 1 and `skip` jumps past its subtree. Hand-written rather
+// than TriangleBvh, whose traversal answers ray queries, not "is any corner above this plane?".
+struct PlaneQueryTree {
+    static constexpr size_t kLeafTriangles = 8;
+    struct Node {
+        Eigen::AlignedBox3d box;
+        size_t begin = 0, end = 0;  // triangles [begin, end) in order (a leaf when end - begin <= kLeafTriangles)
+        size_t skip = 0;            // the node after this subtree
+    };
+    std::vector<WorldTriangle> triangles;
+    std::vector<Node> nodes;
+
+    explicit PlaneQueryTree(std::span<const WorldTriangle> changed) : triangles(changed.begin(), changed.end()) {
+        if (!triangles.empty()) build(0, triangles.size());
     }
+
+    void build(size_t begin, size_t end) {
+        const size_t index = nodes.size();
+        nodes.push_back({});
+        Eigen::AlignedBox3d box;
+        for (size_t t = begin; t < end; ++t)
+            for (const Eigen::Vector3d& p : triangles[t]) box.extend(p);
+        nodes[index].box = box;
+        nodes[index].begin = begin;
+        nodes[index].end = end;
+        if (end - begin > kLeafTriangles) {
+            int axis = 0;
+            box.sizes().maxCoeff(&axis);
+            const size_t middle = begin + (end - begin) / 2;
+            std::nth_element(triangles.begin() + static_cast<std::ptrdiff_t>(begin),
+                             triangles.begin() + static_cast<std::ptrdiff_t>(middle),
+                             triangles.begin() + static_cast<std::ptrdiff_t>(end),
+                             [axis](const WorldTriangle& a, const WorldTriangle& b) {
+                                 return a[0][axis] + a[1][axis] + a[2][axis] < b[0][axis] + b[1][axis] + b[2][axis];
+                             });
+            build(begin, middle);
+            build(middle, end);
+        }
+        nodes[index].skip = nodes.size();
+    }
+
+    // Whether a corner of some triangle lies strictly above the plane through p with normal n.
+    bool any_above(const Eigen::Vector3d& p, const Eigen::Vector3d& n) const {
+        for (size_t i = 0; i < nodes.size();) {
+            const Node& node = nodes[i];
+            // The box corner farthest along n decides: n . (corner - p) is linear over the box.
+            Eigen::Vector3d corner;
+            for (int a = 0; a < 3; ++a) corner[a] = n[a] >= 0 ? node.box.max()[a] : node.box.min()[a];
+            if (!(n.dot(corner - p) > 0)) {
+                i = node.skip;
+                continue;
+            }
+            if (node.end - node.begin <= kLeafTriangles) {
+                for (size_t t = node.begin; t < node.end; ++t)
+                    for (const Eigen::Vector3d& c : triangles[t])
+                        if (n.dot(c - p) > 0) return true;
+                i = node.skip;
+            } else {
+                ++i;
+            }
+        }
+        return false;
+    }
+};
+
+}  // namespace
+
+std::vector<int32_t> vertices_seeing_triangles(const BoundarySurface& surface, std::span<const WorldTriangle> changed) {
+    const PlaneQueryTree tree(changed);
+    std::vector<uint8_t> sees(surface.positions.size(), 0);
+    if (!tree.nodes.empty()) {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, sees.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t s = r.begin(); s != r.end(); ++s) {
+                const Eigen::Vector3d& n = surface.normals[s];
+                sees[s] = n.squaredNorm() > 0 && tree.any_above(surface.positions[s], n);
+            }
+        });
+    }
+    std::vector<int32_t> seeing;
+    for (size_t s = 0; s < sees.size(); ++s)
+        if (sees[s]) seeing.push_back(static_cast<int32_t>(s));
     return seeing;
 }
 
@@ -229,10 +302,13 @@ EnvironmentTransfer carry_environment_transfer(const BoundarySurface& old_surfac
     for (size_t s = 0; s < moved.size(); ++s)
         moved[s] = old_of_surface[s] < 0 || old_surface.positions[old_of_surface[s]] != surface.positions[s];
     std::vector<Triple> old_triangles, new_triangles;
-    Eigen::AlignedBox3d changed;
+    std::vector<WorldTriangle> changed;
+    const auto corners = [](const BoundarySurface& on, const std::array<int32_t, 3>& t) {
+        return WorldTriangle{on.positions[t[0]], on.positions[t[1]], on.positions[t[2]]};
+    };
     for (const auto& t : surface.triangles) {
         if (moved[t[0]] || moved[t[1]] || moved[t[2]]) {
-            for (const int32_t c : t) changed.extend(surface.positions[c]);
+            changed.push_back(corners(surface, t));
         } else {
             new_triangles.push_back(sorted({surface.vertices[t[0]], surface.vertices[t[1]], surface.vertices[t[2]]}));
         }
@@ -252,16 +328,17 @@ EnvironmentTransfer carry_environment_transfer(const BoundarySurface& old_surfac
     std::vector<int32_t> surface_of_volume(static_cast<size_t>(largest + 1), -1);
     for (size_t s = 0; s < surface.vertices.size(); ++s) surface_of_volume[surface.vertices[s]] = static_cast<int32_t>(s);
     for (const Triple& t : added)
-        for (const int32_t v : t) changed.extend(surface.positions[surface_of_volume[v]]);
+        changed.push_back({surface.positions[surface_of_volume[t[0]]], surface.positions[surface_of_volume[t[1]]],
+                           surface.positions[surface_of_volume[t[2]]]});
     // Old triangles that are gone or moved: everything not among the new, unmoved ones.
     for (size_t i = 0; i < old_surface.triangles.size(); ++i) {
         const Triple& t = old_triangles[i];
         if (std::binary_search(new_triangles.begin(), new_triangles.end(), t)) continue;
-        for (const int32_t c : old_surface.triangles[i]) changed.extend(old_surface.positions[c]);
+        changed.push_back(corners(old_surface, old_surface.triangles[i]));
     }
 
     std::vector<uint8_t> sees(surface.positions.size(), 0);
-    for (const int32_t s : vertices_seeing_box(surface, changed)) sees[s] = 1;
+    for (const int32_t s : vertices_seeing_triangles(surface, changed)) sees[s] = 1;
     const std::vector<double> old_offset = ray_offsets(old_surface, settings.shadows);
     const std::vector<double> offset = ray_offsets(surface, settings.shadows);
     EnvironmentTransfer transfer(settings, surface.positions.size());

@@ -21,6 +21,7 @@
 
 #include <Eigen/Geometry>
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -81,16 +82,21 @@ void update_environment_transfer(const BoundarySurface& surface, const TriangleB
 // q_env per surface vertex from a transfer and an environment.
 std::vector<Rgb> apply_environment_transfer(const EnvironmentTransfer& transfer, const EnvironmentLight& environment);
 
-// The surface vertices whose transfer can change when the triangles inside `changed` (world space,
-// old and new) change: those with a point of the box strictly above their tangent plane. A vertex's
-// transfer integrates rays over the open hemisphere above its tangent plane only, and only rays that
-// meet the box can meet a changed triangle, so every other vertex keeps its visibility exactly.
-// Vertices of zero normal are never listed.
-std::vector<int32_t> vertices_seeing_box(const BoundarySurface& surface, const Eigen::AlignedBox3d& changed);
+// A triangle in world space, as three corners.
+using WorldTriangle = std::array<Eigen::Vector3d, 3>;
+
+// The surface vertices whose transfer can change when the triangles `changed` (removed ones at their
+// old place, added ones at their new place) change: those with a corner of some changed triangle
+// strictly above their tangent plane. A vertex's transfer integrates rays over the open hemisphere
+// above its tangent plane only, a triangle meets that half-space only if one of its corners lies in
+// it, and only rays that meet a changed triangle can change their visibility, so every other vertex
+// keeps its transfer exactly. The changed triangles are grouped in a small box tree, so a vertex
+// skips every group lying wholly below its plane. Vertices of zero normal are never listed.
+std::vector<int32_t> vertices_seeing_triangles(const BoundarySurface& surface, std::span<const WorldTriangle> changed);
 
 // The transfer of `surface` after an edit, from the transfer of the surface before it: a vertex keeps
 // its old vector when it was on the old surface at the same position, with the same normal, eta
-// and ray offset, and cannot see the changed triangles (vertices_seeing_box on the box of the old
+// and ray offset, and cannot see the changed triangles (vertices_seeing_triangles on the old
 // triangles that are gone or moved and the new ones that were not there); every other vertex is
 // sampled again. `new_of_old_vertex` maps old volume vertices to new ones (-1: removed); empty: the
 // same numbering. The result equals compute_environment_transfer(surface, bvh, settings) bit for

@@ -195,16 +195,23 @@ TEST(EnvironmentLight, UpdatingTheVerticesThatSeeAChangeEqualsRecomputingAll) {
     const EnvironmentTransfer before = compute_environment_transfer(surface, build_shadow_bvh(surface), {});
     const BoundarySurface before_surface = surface;
     const size_t n = surface.positions.size();
-    Eigen::AlignedBox3d changed;
-    for (size_t s = n - 4; s < n; ++s) changed.extend(surface.positions[s]);
+    // The plate's four triangles, before and after.
+    std::vector<WorldTriangle> changed;
+    const auto plate_triangles = [&] {
+        for (size_t t = surface.triangles.size() - 4; t < surface.triangles.size(); ++t) {
+            const auto& c = surface.triangles[t];
+            changed.push_back({surface.positions[c[0]], surface.positions[c[1]], surface.positions[c[2]]});
+        }
+    };
+    plate_triangles();
     // Grow the plate to a side of 1.
     for (size_t s = n - 4; s < n; ++s) surface.positions[s] = Eigen::Vector3d(1.5, 0, 0) + (surface.positions[s] - Eigen::Vector3d(1.5, 0, 0)) * 50;
     surface.normals = area_weighted_normals(surface.positions, surface.triangles);
-    for (size_t s = n - 4; s < n; ++s) changed.extend(surface.positions[s]);
+    plate_triangles();
     const TriangleBvh bvh = build_shadow_bvh(surface);
     const EnvironmentTransfer after = compute_environment_transfer(surface, bvh, {});
 
-    std::vector<int32_t> update = vertices_seeing_box(surface, changed);
+    std::vector<int32_t> update = vertices_seeing_triangles(surface, changed);
     EXPECT_GT(update.size(), 4u);
     for (const int32_t s : update) EXPECT_GT(surface.positions[s].x(), -0.5) << "the far side cannot see the plate";
     EnvironmentTransfer updated = before;
