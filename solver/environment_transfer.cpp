@@ -2,6 +2,7 @@
 
 #include "base/error.h"
 #include "solver/material.h"
+#include "solver/sampling.h"
 #include "solver/spherical_harmonics.h"
 
 #include <tbb/blocked_range.h>
@@ -19,16 +20,6 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
-// The van der Corput radical inverse in base 2 of j, in [0, 1).
-double radical_inverse(uint32_t j) {
-    j = (j << 16) | (j >> 16);
-    j = ((j & 0x00ff00ffu) << 8) | ((j & 0xff00ff00u) >> 8);
-    j = ((j & 0x0f0f0f0fu) << 4) | ((j & 0xf0f0f0f0u) >> 4);
-    j = ((j & 0x33333333u) << 2) | ((j & 0xccccccccu) >> 2);
-    j = ((j & 0x55555555u) << 1) | ((j & 0xaaaaaaaau) >> 1);
-    return j * 0x1p-32;
-}
-
 // A per-vertex number in [0, 1) (the finaliser of MurmurHash3): turns each vertex's pattern by its own
 // angle, so neighbouring vertices sample different azimuths.
 double vertex_turn(uint32_t vertex) {
@@ -41,19 +32,10 @@ double vertex_turn(uint32_t vertex) {
     return h * 0x1p-32;
 }
 
-double fraction(double x) { return x - std::floor(x); }
-
-// An orthonormal tangent frame around unit n (Duff et al. 2017, "Building an Orthonormal Basis,
-// Revisited", Listing 3): continuous everywhere but at one pole, and no normalisation needed.
+// An orthonormal tangent frame around unit n (orthonormal_basis).
 struct TangentFrame {
     Eigen::Vector3d t, b, n;
-    explicit TangentFrame(const Eigen::Vector3d& normal) : n(normal) {
-        const double sign = std::copysign(1.0, n.z());
-        const double a = -1.0 / (sign + n.z());
-        const double c = n.x() * n.y() * a;
-        t = {1.0 + sign * n.x() * n.x() * a, sign * c, -sign * n.x()};
-        b = {c, sign + n.y() * n.y() * a, -n.y()};
-    }
+    explicit TangentFrame(const Eigen::Vector3d& normal) : n(normal) { orthonormal_basis(n, t, b); }
     // Cosine-distributed direction j of n (module comment): returns n . w through cos_theta.
     Eigen::Vector3d cosine_direction(int j, int n_samples, double turn, double& cos_theta) const {
         const double u1 = (j + 0.5) / n_samples;
