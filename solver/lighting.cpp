@@ -38,12 +38,8 @@ void validate_area_light(size_t index, const Light& light) {
     if (!within_light_range(light.axis) || light.axis.cwiseAbs().maxCoeff() == 0.0)
         fail("axis is the zero vector, has a non-finite component or one beyond 1e100");
     if (light.type == LightType::Rectangle) {
-        // Parallel when what is left of the unit tangent after removing its part along the unit axis
-        // is too short to give a direction.
-        const Eigen::Vector3d n = light.axis.stableNormalized();
-        const bool usable = within_light_range(light.tangent) && light.tangent.cwiseAbs().maxCoeff() > 0.0 &&
-                            n.cross(light.tangent.stableNormalized()).norm() > 1e-6;
-        if (!usable) fail("tangent is the zero vector, non-finite, or parallel to the axis");
+        if (!within_light_range(light.tangent) || !tangent_spans_plane(light.axis, light.tangent))
+            fail("tangent is the zero vector, non-finite, or parallel to the axis");
     }
 }
 
@@ -77,6 +73,13 @@ Eigen::Vector3d default_rect_tangent(const Eigen::Vector3d& axis) {
     const Eigen::Vector3d n = axis.stableNormalized();
     const Eigen::Vector3d along = std::abs(n.x()) > 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
     return (along - along.dot(n) * n).normalized();
+}
+
+bool tangent_spans_plane(const Eigen::Vector3d& axis, const Eigen::Vector3d& tangent) {
+    // Parallel when what is left of the unit tangent after removing its part along the unit axis is
+    // too short to give a direction.
+    return tangent.allFinite() && tangent.cwiseAbs().maxCoeff() > 0.0 &&
+           axis.stableNormalized().cross(tangent.stableNormalized()).norm() > 1e-6;
 }
 
 void validate(const Lighting& lighting) {

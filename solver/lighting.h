@@ -55,6 +55,9 @@ inline bool has_position(LightType type) { return type != LightType::Directional
 inline bool is_area_light(LightType type) {
     return type == LightType::Rectangle || type == LightType::Disk || type == LightType::Sphere;
 }
+// Point and sphere lights shine from around their centre in every direction: one centred inside a
+// closed object lights nothing (a sphere, at most where it pokes out of the surface).
+inline bool radiates_from_centre(LightType type) { return type == LightType::Point || type == LightType::Sphere; }
 
 // The intensity of an area light is its radiant intensity along its axis (for a sphere, in every
 // direction), so that as its size goes to zero it lights exactly as a point light of that intensity
@@ -83,6 +86,9 @@ struct Light {
 // (|axis.x| > 0.9 |axis|), where +x projects too short to be a stable direction. Unit length;
 // `axis` must be non-zero and finite.
 Eigen::Vector3d default_rect_tangent(const Eigen::Vector3d& axis);
+// Whether `tangent` gives a rectangle with normal `axis` a width direction: finite, non-zero and not
+// parallel to the (non-zero, finite) axis.
+bool tangent_spans_plane(const Eigen::Vector3d& axis, const Eigen::Vector3d& tangent);
 
 // The samples each area light is integrated with at each point (area_light.h).
 inline constexpr int kAreaLightSamples = 32;
