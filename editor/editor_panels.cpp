@@ -372,12 +372,12 @@ void EditorApp::draw_overlays() {
     };
     draw_tool_overlay();  // the stroke being drawn and the side a cut takes away
     if (!camera_ || !show_light_gizmos_) return;
-    // Light gizmos: point lights as suns at their position, directional ones as an arrow towards the
-    // target from where the light comes.
+    // Light gizmos: point and area lights as suns at their position (centre), directional ones as an
+    // arrow towards the target from where the light comes.
     for (int i = 0; i < static_cast<int>(lighting_.lights.size()); ++i) {
         const Light& light = lighting_.lights[i];
         const ImU32 colour = i == selected_light_ ? IM_COL32(255, 220, 120, 255) : IM_COL32(200, 200, 200, 180);
-        const Eigen::Vector3d from = light.type == LightType::Point
+        const Eigen::Vector3d from = has_position(light.type)
                                          ? light.vector
                                          : Eigen::Vector3d(camera_->target() - 1.3 * camera_->scene_radius() * light.vector.normalized());
         const Eigen::Vector3d p = camera_->project(from, view_w_, view_h_);

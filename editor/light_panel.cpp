@@ -1,6 +1,8 @@
 // The Lights panel of EditorApp: add and remove directional and point lights, pick the one the Light
 // tool drags in the view, and set each light's colour and intensity separately (the solver takes
-// their product per channel, solver/lighting.h); choose, turn and scale the environment light.
+// their product per channel, solver/lighting.h); choose, turn and scale the environment light. Area
+// lights (from sessions and the command line) show their shape read-only; their centre, colour and
+// intensity are edited as a point light's.
 #include "editor/editor_app.h"
 
 #include "base/error.h"
@@ -9,6 +11,7 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 
 namespace waxwork {
@@ -38,14 +41,26 @@ void EditorApp::draw_light_panel() {
         ImGui::PushID(i);
         bool changed = false;
         char title[48];
-        std::snprintf(title, sizeof title, "%s light %d", light.type == LightType::Directional ? "Directional" : "Point",
-                      i + 1);
+        std::snprintf(title, sizeof title, "%s light %d", light_type_name(light.type), i + 1);
+        title[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(title[0])));
         if (ImGui::RadioButton(title, selected_light_ == i)) selected_light_ = i;
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("The Light tool (L) drags the selected light in the view");
         ImGui::SameLine(ImGui::GetContentRegionAvail().x - 60 * ui_scale_);
         if (ImGui::SmallButton("remove")) remove = i;
         int type = light.type == LightType::Directional ? 0 : 1;
-        if (ImGui::Combo("type", &type, "directional\0point\0")) {
+        if (is_area_light(light.type)) {
+            // Area lights come from the command line and sessions; here their shape is shown, and
+            // their centre, colour and intensity edited.
+            if (light.type == LightType::Rectangle) {
+                ImGui::TextDisabled("%.3g x %.3g, normal %.2f %.2f %.2f", light.size.x(), light.size.y(), light.axis.x(),
+                                    light.axis.y(), light.axis.z());
+            } else if (light.type == LightType::Disk) {
+                ImGui::TextDisabled("radius %.3g, normal %.2f %.2f %.2f", light.size.x(), light.axis.x(), light.axis.y(),
+                                    light.axis.z());
+            } else {
+                ImGui::TextDisabled("radius %.3g", light.size.x());
+            }
+        } else if (ImGui::Combo("type", &type, "directional\0point\0")) {
             const bool to_point = type == 1;
             if (to_point != (light.type == LightType::Point)) {
                 // A point light placed where the directional light comes from, outside the object.
@@ -59,9 +74,12 @@ void EditorApp::draw_light_panel() {
         }
         float v[3] = {static_cast<float>(light.vector.x()), static_cast<float>(light.vector.y()),
                       static_cast<float>(light.vector.z())};
-        if (ImGui::DragFloat3(light.type == LightType::Directional ? "travels along" : "position", v, 0.01f)) {
+        const char* vector_label = light.type == LightType::Directional ? "travels along"
+                                   : light.type == LightType::Point     ? "position"
+                                                                        : "center";
+        if (ImGui::DragFloat3(vector_label, v, 0.01f)) {
             const Eigen::Vector3d next(v[0], v[1], v[2]);
-            if (next.allFinite() && (light.type == LightType::Point || next.norm() > 1e-6)) {
+            if (next.allFinite() && (has_position(light.type) || next.norm() > 1e-6)) {
                 light.vector = next;
                 changed = true;
             }

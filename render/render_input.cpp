@@ -60,8 +60,10 @@ SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& sce
         input.eta[d] = static_cast<float>(surface.eta[s]);
     }
     input.triangles = shading.triangles;
-    // Highlights: the same lights as the subsurface term, minus point lights inside the volume (they
-    // reach no surface from outside), each shadowed by the visibility its shadow rays found.
+    // Highlights: the same lights as the subsurface term, minus point lights and sphere lights centred
+    // inside the volume (they reach no surface from outside, or a sphere only where it pokes out, which
+    // a highlight from its centre would not show), each shadowed by the visibility its shadow rays found
+    // (for an area light, the visible fraction of its samples).
     input.lighting.ambient = lighting.ambient;
     input.lighting.shadows = lighting.shadows;
     // The sky's sun is one of them (direct_lights); the environment's own highlight is not drawn.
@@ -70,7 +72,7 @@ SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& sce
     for (size_t l = 0; l < lights.size(); ++l) {
         const Light& light = lights[l];
         if (input.lighting.lights.size() == static_cast<size_t>(kMaxRenderLights)) break;
-        if (light.type == LightType::Point && point_inside_volume(mesh, light.vector)) continue;
+        if (radiates_from_centre(light.type) && point_inside_volume(mesh, light.vector)) continue;
         input.lighting.lights.push_back(light);
         kept.push_back(l);
     }

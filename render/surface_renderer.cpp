@@ -265,7 +265,10 @@ constexpr double kFarPointLight = 1e15;
 // One light as the shader takes it, computed in double so that every light validate() accepts draws:
 // a direction is normalised here (its components may be 1e-30 or 1e50, beyond float's range or
 // precision once squared), and a point light beyond kFarPointLight becomes a direction with the
-// irradiance it gives at the centre.
+// irradiance it gives at the centre. An area light is drawn as the point light of its intensity at its
+// centre: the highlight of a small light, without the shape a large one would reflect or a rectangle's
+// or disk's fall-off with the emission angle (the subsurface term integrates the whole light); its
+// visibility, the visible fraction of its samples, still dims the highlight in partial shadow.
 struct ShaderLight {
     std::array<float, 4> vector;     // w = 0: unit direction of travel; w = 1: position
     std::array<float, 3> intensity;  // irradiance (w = 0) or radiant intensity (w = 1)
@@ -568,10 +571,11 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.Uniform4fv(location("clip_plane"), 1, plane.data());
         const auto light_count = static_cast<int>(input.lighting.lights.size());
         gl.Uniform1i(location("light_count"), light_count);
-        // The centre only matters to point lights (shader_light): no pass over the vertices without one.
+        // The centre only matters to lights with a position (shader_light): no pass over the vertices
+        // without one.
         Eigen::AlignedBox3d bounds;
         if (std::any_of(input.lighting.lights.begin(), input.lighting.lights.end(),
-                        [](const Light& light) { return light.type == LightType::Point; }))
+                        [](const Light& light) { return has_position(light.type); }))
             for (const Eigen::Vector3f& p : input.positions) bounds.extend(p.cast<double>());
         const Eigen::Vector3d centre = bounds.isEmpty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(bounds.center());
         for (int i = 0; i < light_count; ++i) {

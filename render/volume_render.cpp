@@ -64,7 +64,7 @@ VolumeRender render_volume(const TetMesh& mesh, const std::string& volume_name, 
     result.render_ms = milliseconds_since(render_start);
 
     for (const Light& light : settings.lighting.lights)
-        result.lights_inside += light.type == LightType::Point && point_inside_volume(mesh, light.vector);
+        result.lights_inside += radiates_from_centre(light.type) && point_inside_volume(mesh, light.vector);
     return result;
 }
 

@@ -37,7 +37,7 @@ struct VolumeRender {
     Image image;
     float exposure = 1;    // the one the image was drawn with
     double render_ms = 0;  // the renderer's input, the view and the drawing
-    size_t lights_inside = 0;  // point lights inside the volume (they light nothing)
+    size_t lights_inside = 0;  // point lights and sphere lights centred inside the volume (they light nothing)
 };
 
 // The light of a volume exactly as render_volume solves it, without drawing: the connectivity, the

@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <climits>
 #include <chrono>
 #include <cmath>
@@ -48,18 +49,63 @@ Rgb rgb_from(FieldReader& in, const std::string& key) {
     return {v.x(), v.y(), v.z()};
 }
 
+// The shape of an area light: {"center", "normal", "tangent" (optional), "size": [w, h]} for "rect",
+// {"center", "normal", "radius"} for "disk", {"center", "radius"} for "sphere".
+void area_light_from_json(const Json& json, const std::string& context, Light& light) {
+    FieldReader in(json, context);
+    light.vector = in.vector("center");
+    if (light.type != LightType::Sphere) {
+        light.axis = in.vector("normal");
+        if (light.axis.cwiseAbs().maxCoeff() == 0) fail_json(in.field("normal"), "must not be zero");
+    }
+    if (light.type == LightType::Rectangle) {
+        if (in.has("tangent")) {
+            light.tangent = in.vector("tangent");
+            if (!tangent_spans_plane(light.axis, light.tangent))
+                fail_json(in.field("tangent"), "must not be zero or parallel to the normal");
+        } else {
+            light.tangent = default_rect_tangent(light.axis);
+        }
+        const Json& size = in.at("size");
+        if (!size.is_array() || size.size() != 2 || !size[0].is_number() || !size[1].is_number())
+            fail_json(in.field("size"), "expected [width, height]");
+        light.size = {size[0].get<double>(), size[1].get<double>()};
+        if (!(light.size.allFinite() && light.size.minCoeff() > 0))
+            fail_json(in.field("size"), "width and height must be finite and positive");
+    } else {
+        light.size.setConstant(in.number("radius"));
+        if (!(light.size.x() > 0)) fail_json(in.field("radius"), "must be positive");
+    }
+    in.finish();
+}
+
+// {"direction": [x, y, z]} (directional), {"position": [x, y, z]} (point) or one of {"rect": SHAPE},
+// {"disk": SHAPE}, {"sphere": SHAPE} (area_light_from_json), with an optional "intensity".
 Light light_from_json(const Json& json, const std::string& context) {
     FieldReader in(json, context);
     Light light;
-    if (in.has("direction") == in.has("position"))
-        fail_json(context, "give exactly one of 'direction' (a directional light) and 'position' (a point light)");
+    static const std::array<std::pair<const char*, LightType>, 5> kinds = {{{"direction", LightType::Directional},
+                                                                            {"position", LightType::Point},
+                                                                            {"rect", LightType::Rectangle},
+                                                                            {"disk", LightType::Disk},
+                                                                            {"sphere", LightType::Sphere}}};
+    const auto given = std::count_if(kinds.begin(), kinds.end(), [&](const auto& kind) { return in.has(kind.first); });
+    if (given != 1)
+        fail_json(context, "give exactly one of 'direction' (a directional light), 'position' (a point light), "
+                           "'rect', 'disk' and 'sphere' (area lights)");
     if (in.has("direction")) {
         light.type = LightType::Directional;
         light.vector = in.vector("direction");
         if (light.vector.norm() == 0) fail_json(in.field("direction"), "must not be zero");
-    } else {
+    } else if (in.has("position")) {
         light.type = LightType::Point;
         light.vector = in.vector("position");
+    } else {
+        for (const auto& [key, type] : kinds) {
+            if (!in.has(key)) continue;
+            light.type = type;
+            area_light_from_json(in.at(key), in.field(key), light);
+        }
     }
     if (in.has("intensity")) light.intensity = rgb_from(in, "intensity");
     in.finish();
@@ -68,7 +114,22 @@ Light light_from_json(const Json& json, const std::string& context) {
 
 Json light_to_json(const Light& light) {
     Json j;
-    j[light.type == LightType::Directional ? "direction" : "position"] = vector_to_json(light.vector);
+    switch (light.type) {
+    case LightType::Directional: j["direction"] = vector_to_json(light.vector); break;
+    case LightType::Point: j["position"] = vector_to_json(light.vector); break;
+    case LightType::Rectangle:
+        j["rect"] = {{"center", vector_to_json(light.vector)},
+                     {"normal", vector_to_json(light.axis)},
+                     {"tangent", vector_to_json(light.tangent)},
+                     {"size", Json::array({light.size.x(), light.size.y()})}};
+        break;
+    case LightType::Disk:
+        j["disk"] = {{"center", vector_to_json(light.vector)}, {"normal", vector_to_json(light.axis)}, {"radius", light.size.x()}};
+        break;
+    case LightType::Sphere:
+        j["sphere"] = {{"center", vector_to_json(light.vector)}, {"radius", light.size.x()}};
+        break;
+    }
     j["intensity"] = rgb_to_json(light.intensity);
     return j;
 }

@@ -11,7 +11,11 @@
 //     "material": "marble" | {"mua": [..], "musp": [..], "eta": 1.3},   (tets without a stored material)
 //     "scale": 30,                         millimetres per model unit (optional: the input volume's
 //                                          stored scale, else chosen from the model's size)
-//     "lights": [{"direction": [1,-1,-1], "intensity": [1,1,1]}, {"position": [0,2,0]}],
+//     "lights": [{"direction": [1,-1,-1], "intensity": [1,1,1]}, {"position": [0,2,0]},
+//                {"rect": {"center": [0,2,0], "normal": [0,-1,0], "tangent": [1,0,0], "size": [1,0.5]}},
+//                {"disk": {"center": [..], "normal": [..], "radius": 0.3}},
+//                {"sphere": {"center": [..], "radius": 0.2}}],   area lights (solver/lighting.h): the
+//                                          tangent (the width's direction) is optional, default_rect_tangent
 //     "ambient": [0.02, 0.02, 0.02], "shadows": true,   optional: without "lights" (or "ambient"),
 //                                          render's key light (and ambient); "lights": [] is no light
 //     "environment": {"file": "studio.hdr" | "sky": {"sun_elevation": 35, "sun_azimuth": 60,
@@ -129,7 +133,8 @@ Session read_session(const std::filesystem::path& path);
 
 nlohmann::ordered_json session_to_json(const Session& session);
 
-// A lighting as the session file writes it: {"lights": [{"direction" | "position", "intensity"}, ...],
+// A lighting as the session file writes it: {"lights": [{"direction" | "position" | "rect" | "disk" |
+// "sphere", "intensity"}, ...],
 // "ambient", "shadows", "environment" (null when none)}.
 nlohmann::ordered_json lighting_to_json(const Lighting& lighting);
 // Writes atomically. Input paths are written relative to the file's directory when possible.

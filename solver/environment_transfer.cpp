@@ -2,13 +2,13 @@
 
 #include "base/error.h"
 #include "solver/material.h"
+#include "solver/sampling.h"
 #include "solver/spherical_harmonics.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <iterator>
 #include <limits>
@@ -22,45 +22,10 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
-// The van der Corput radical inverse in base 2 of j, in [0, 1).
-double radical_inverse(uint32_t j) {
-    j = (j << 16) | (j >> 16);
-    j = ((j & 0x00ff00ffu) << 8) | ((j & 0xff00ff00u) >> 8);
-    j = ((j & 0x0f0f0f0fu) << 4) | ((j & 0xf0f0f0f0u) >> 4);
-    j = ((j & 0x33333333u) << 2) | ((j & 0xccccccccu) >> 2);
-    j = ((j & 0x55555555u) << 1) | ((j & 0xaaaaaaaau) >> 1);
-    return j * 0x1p-32;
-}
-
-// A number in [0, 1) per point, from its position's bits (the 64-bit finaliser of MurmurHash3 over
-// the three coordinates): turns each vertex's pattern by its own angle, so neighbouring vertices
-// sample different azimuths, and a vertex an edit leaves in place keeps its angle.
-double vertex_turn(const Eigen::Vector3d& position) {
-    uint64_t h = 0x9e3779b97f4a7c15ull;
-    for (int a = 0; a < 3; ++a) {
-        h ^= std::bit_cast<uint64_t>(position[a]) + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
-        h ^= h >> 33;
-        h *= 0xff51afd7ed558ccdull;
-        h ^= h >> 33;
-        h *= 0xc4ceb9fe1a85ec53ull;
-        h ^= h >> 33;
-    }
-    return static_cast<double>(h >> 11) * 0x1p-53;
-}
-
-double fraction(double x) { return x - std::floor(x); }
-
-// An orthonormal tangent frame around unit n (Duff et al. 2017, "Building an Orthonormal Basis,
-// Revisited", Listing 3): continuous everywhere but at one pole, and no normalisation needed.
+// An orthonormal tangent frame around unit n (orthonormal_basis).
 struct TangentFrame {
     Eigen::Vector3d t, b, n;
-    explicit TangentFrame(const Eigen::Vector3d& normal) : n(normal) {
-        const double sign = std::copysign(1.0, n.z());
-        const double a = -1.0 / (sign + n.z());
-        const double c = n.x() * n.y() * a;
-        t = {1.0 + sign * n.x() * n.x() * a, sign * c, -sign * n.x()};
-        b = {c, sign + n.y() * n.y() * a, -n.y()};
-    }
+    explicit TangentFrame(const Eigen::Vector3d& normal) : n(normal) { orthonormal_basis(n, t, b); }
     // Cosine-distributed direction j of n (module comment): returns n . w through cos_theta.
     Eigen::Vector3d cosine_direction(int j, int n_samples, double turn, double& cos_theta) const {
         const double u1 = (j + 0.5) / n_samples;
@@ -125,7 +90,9 @@ void environment_transfer_at(const Eigen::Vector3d& position, const Eigen::Vecto
     if (normal.squaredNorm() == 0) return;
     const TangentFrame frame(normal);
     const Eigen::Vector3f origin = (position + offset * normal).cast<float>();
-    const double turn = vertex_turn(position);
+    // Turned by an angle from the position's bits, so neighbouring vertices sample different azimuths
+    // and a vertex an edit leaves in place keeps its pattern.
+    const double turn = position_shift(position).x();
     double basis[sh_coefficient_count(kMaxShOrder)];
     double sum[sh_coefficient_count(kMaxShOrder)] = {};
     for (int j = 0; j < settings.samples; ++j) {
@@ -370,7 +337,8 @@ Rgb sampled_environment_light_at(const Eigen::Vector3d& position, const Eigen::V
     const Eigen::AngleAxisd rotate(radians, Eigen::Vector3d::UnitY()), unrotate(-radians, Eigen::Vector3d::UnitY());
     const int n_env = sampler.valid() ? samples / 2 : 0;
     const int n_cos = samples - n_env;
-    const double turn = vertex_turn(position);
+    const Eigen::Vector2d shift = position_shift(position);
+    const double turn = shift.x();
     const auto add = [&](const Eigen::Vector3d& w, double cos_theta, const Eigen::Vector3d& unrotated, double pdf_env) {
         if (!visible(origin, w, bvh, shadows)) return;
         const double weight = fresnel_transmittance(cos_theta, eta) * cos_theta / (n_cos * cos_theta / kPi + n_env * pdf_env);
@@ -386,7 +354,7 @@ Rgb sampled_environment_light_at(const Eigen::Vector3d& position, const Eigen::V
     for (int j = 0; j < n_env; ++j) {
         double pdf = 0;
         const Eigen::Vector3d unrotated =
-            sampler.sample(fraction((j + 0.5) / n_env + turn), fraction(radical_inverse(static_cast<uint32_t>(j)) + turn * 0.618), pdf);
+            sampler.sample(fraction((j + 0.5) / n_env + shift.x()), fraction(radical_inverse(static_cast<uint32_t>(j)) + shift.y()), pdf);
         const Eigen::Vector3d w = rotate * unrotated;
         const double cos_theta = normal.dot(w);
         if (!(cos_theta > 0) || !(pdf > 0)) continue;

@@ -16,10 +16,14 @@ inline constexpr double kDefaultAmbient = 0.02;
 // The lighting of a scene that names none: default_key_light, kDefaultAmbient, shadows.
 Lighting default_lighting();
 
-// Parses "dir:X,Y,Z[:R,G,B]" (direction of travel) or "point:X,Y,Z[:R,G,B]" (position in model units);
-// the intensity defaults to 1,1,1. Throws InvalidArgumentError("bad light spec 'SPEC': WHY") for
+// Parses "dir:X,Y,Z[:R,G,B]" (direction of travel), "point:X,Y,Z[:R,G,B]" (position in model units)
+// or an area light (lighting.h): "rect:CX,CY,CZ:NX,NY,NZ:W,H[:R,G,B]" (centre, emitting normal, width
+// and height; the width runs along default_rect_tangent: world +x projected onto the rectangle, or +z
+// for a normal near the x axis), "disk:CX,CY,CZ:NX,NY,NZ:RADIUS[:R,G,B]" or
+// "sphere:CX,CY,CZ:RADIUS[:R,G,B]". The intensity defaults to 1,1,1 (for area lights, the radiant
+// intensity along the normal). Throws InvalidArgumentError("bad light spec 'SPEC': WHY") for
 // anything else: unknown kind, wrong component count, trailing text, non-finite numbers, a zero
-// direction or a negative intensity.
+// direction or normal, a size that is not positive, or a negative intensity.
 Light parse_light_spec(std::string_view spec);
 
 }  // namespace waxwork

@@ -1,6 +1,7 @@
 #include "solver/lighting.h"
 
 #include "base/error.h"
+#include "solver/area_light.h"
 #include "solver/environment_transfer.h"
 #include "solver/material.h"
 #include "solver/radiance.h"
@@ -16,8 +17,30 @@ namespace waxwork {
 namespace {
 
 std::string light_name(size_t index, const Light& light) {
-    return std::string("light ") + std::to_string(index) + " (" +
-           (light.type == LightType::Directional ? "directional" : "point") + ")";
+    return std::string("light ") + std::to_string(index) + " (" + light_type_name(light.type) + ")";
+}
+
+bool within_light_range(const Eigen::Vector3d& v) {
+    return v.allFinite() && v.cwiseAbs().maxCoeff() <= kMaxLightValue;
+}
+
+// The checks only area lights need: their shape.
+void validate_area_light(size_t index, const Light& light) {
+    const auto fail = [&](const std::string& why) { throw InvalidArgumentError(light_name(index, light) + ": " + why); };
+    const auto valid_length = [](double x) { return x > 0 && x <= kMaxLightValue; };
+    if (light.type == LightType::Rectangle) {
+        if (!valid_length(light.size.x()) || !valid_length(light.size.y()))
+            fail("width and height must be positive and at most 1e100");
+    } else if (!valid_length(light.size.x())) {
+        fail("radius must be positive and at most 1e100");
+    }
+    if (light.type == LightType::Sphere) return;
+    if (!within_light_range(light.axis) || light.axis.cwiseAbs().maxCoeff() == 0.0)
+        fail("axis is the zero vector, has a non-finite component or one beyond 1e100");
+    if (light.type == LightType::Rectangle) {
+        if (!within_light_range(light.tangent) || !tangent_spans_plane(light.axis, light.tangent))
+            fail("tangent is the zero vector, non-finite, or parallel to the axis");
+    }
 }
 
 // Non-negative and at most kMaxLightIntensity (so finite).
@@ -35,15 +58,41 @@ constexpr double kShadowOffset = 1e-2;
 
 }  // namespace
 
+const char* light_type_name(LightType type) {
+    switch (type) {
+    case LightType::Directional: return "directional";
+    case LightType::Point: return "point";
+    case LightType::Rectangle: return "rect";
+    case LightType::Disk: return "disk";
+    case LightType::Sphere: return "sphere";
+    }
+    return "unknown";
+}
+
+Eigen::Vector3d default_rect_tangent(const Eigen::Vector3d& axis) {
+    const Eigen::Vector3d n = axis.stableNormalized();
+    const Eigen::Vector3d along = std::abs(n.x()) > 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+    return (along - along.dot(n) * n).normalized();
+}
+
+bool tangent_spans_plane(const Eigen::Vector3d& axis, const Eigen::Vector3d& tangent) {
+    // Parallel when what is left of the unit tangent after removing its part along the unit axis is
+    // too short to give a direction.
+    return tangent.allFinite() && tangent.cwiseAbs().maxCoeff() > 0.0 &&
+           axis.stableNormalized().cross(tangent.stableNormalized()).norm() > 1e-6;
+}
+
 void validate(const Lighting& lighting) {
     for (size_t i = 0; i < lighting.lights.size(); ++i) {
         const Light& light = lighting.lights[i];
-        if (light.type != LightType::Directional && light.type != LightType::Point) {
+        if (light.type != LightType::Directional && light.type != LightType::Point && !is_area_light(light.type)) {
             throw InvalidArgumentError(light_name(i, light) + ": unknown light type");
         }
-        if (!light.vector.allFinite() || light.vector.cwiseAbs().maxCoeff() > kMaxLightValue) {
+        if (!within_light_range(light.vector)) {
             throw InvalidArgumentError(light_name(i, light) +
-                                       (light.type == LightType::Directional ? ": direction" : ": position") +
+                                       (light.type == LightType::Directional ? ": direction"
+                                        : light.type == LightType::Point     ? ": position"
+                                                                             : ": center") +
                                        " has a non-finite component or one beyond 1e100");
         }
         if (light.type == LightType::Directional && light.vector.squaredNorm() == 0.0) {
@@ -52,6 +101,7 @@ void validate(const Lighting& lighting) {
         if (!valid_light_value(light.intensity)) {
             throw InvalidArgumentError(light_name(i, light) + ": intensity must be non-negative and at most 1e15");
         }
+        if (is_area_light(light.type)) validate_area_light(i, light);
     }
     if (!valid_light_value(lighting.ambient)) {
         throw InvalidArgumentError("ambient light must be non-negative and at most 1e15");
@@ -189,6 +239,13 @@ Rgb direct_light_at(const Eigen::Vector3d& position, const Eigen::Vector3d& norm
     for (size_t l = 0; l < lights.size(); ++l) {
         const Light& light = lights[l];
         if (visibility) visibility[l] = 1.0f;
+        if (is_area_light(light.type)) {
+            const AreaLightEstimate area =
+                estimate_area_light(light, position, normal, eta, origin, lighting.shadows ? &bvh : nullptr);
+            if (visibility) visibility[l] = area.visibility;
+            for (int c = 0; c < 3; ++c) sum[c] += light.intensity[c] * area.factor;
+            continue;
+        }
         Eigen::Vector3d to_light;
         double scale = 1.0;
         double distance = std::numeric_limits<double>::infinity();

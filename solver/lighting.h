@@ -10,10 +10,16 @@
 // boundary vertex (no F_t, no visibility): it stands in for the light of the environment and keeps the
 // unlit side from going black.
 //
+// An area light l contributes the integral over the solid angle it subtends of
+// L_e(w) max(0, n_i . w) F_t(n_i . w, eta_i) V_i(w) dw, estimated with kAreaLightSamples shadow rays
+// (area_light.h); the point-light term above is its limit as the light shrinks.
+//
 // Lights inside the object: a point light inside a closed volume reaches no boundary vertex (every
 // shadow ray to it crosses the surface, and on a convex part n_i . w_il < 0), so it contributes zero
 // everywhere; with shadows off it lights the inner sides of faces that happen to face it. A point light
-// exactly on a vertex contributes nothing to that vertex (no direction; never NaN).
+// exactly on a vertex contributes nothing to that vertex (no direction; never NaN). Likewise a
+// vertex inside a sphere light, or behind the emitting side of a rectangle or disk, gets nothing
+// from it.
 #pragma once
 
 #include "solver/environment_light.h"
@@ -35,15 +41,57 @@ namespace waxwork {
 enum class LightType {
     Directional,  // parallel rays; `vector` is the direction in which the light travels
     Point,        // `vector` is the position (world space, model units); falloff 1/d^2
+    // Area lights (area_light.h): `vector` is the centre (world space, model units), and the light
+    // spreads over a shape, so shadows are soft.
+    Rectangle,  // a one-sided Lambertian rectangle: `axis`, `tangent`, `size` = (width, height)
+    Disk,       // a one-sided Lambertian disk: `axis`, radius `size.x()`
+    Sphere,     // a sphere emitting the same radiance everywhere: radius `size.x()`
 };
 
+// "directional", "point", "rect", "disk" or "sphere": the light's name in specs, sessions and errors.
+const char* light_type_name(LightType type);
+// Whether the light sits somewhere (point and area lights), as opposed to a direction.
+inline bool has_position(LightType type) { return type != LightType::Directional; }
+inline bool is_area_light(LightType type) {
+    return type == LightType::Rectangle || type == LightType::Disk || type == LightType::Sphere;
+}
+// Point and sphere lights shine from around their centre in every direction: one centred inside a
+// closed object lights nothing (a sphere, at most where it pokes out of the surface).
+inline bool radiates_from_centre(LightType type) { return type == LightType::Point || type == LightType::Sphere; }
+
+// The intensity of an area light is its radiant intensity along its axis (for a sphere, in every
+// direction), so that as its size goes to zero it lights exactly as a point light of that intensity
+// at its centre:
+//   rectangle, disk: I(theta) = intensity * cos(theta), theta from `axis` (a Lambertian emitter of
+//                    radiance intensity / area, towards +axis only; nothing behind it);
+//   sphere:          I = intensity in every direction (radiance intensity / (pi r^2) on its surface).
 struct Light {
     LightType type = LightType::Directional;
     Eigen::Vector3d vector = Eigen::Vector3d(0, 0, -1);
     // Directional: irradiance on a surface facing the light. Point: radiant intensity, so the
-    // irradiance at distance d facing the light is intensity / d^2 (d in model units).
+    // irradiance at distance d facing the light is intensity / d^2 (d in model units). Area lights:
+    // radiant intensity along the axis (above).
     Rgb intensity = {1, 1, 1};
+    // Rectangle and disk: the normal of the emitting side (need not be unit length; not zero).
+    Eigen::Vector3d axis = Eigen::Vector3d(0, 0, -1);
+    // Rectangle: the direction of its width side; only its part perpendicular to `axis` counts, so it
+    // must not be parallel to it (default_rect_tangent gives one).
+    Eigen::Vector3d tangent = Eigen::Vector3d(1, 0, 0);
+    // Rectangle: (width, height) in model units; disk and sphere: (radius, unused).
+    Eigen::Vector2d size = Eigen::Vector2d(1, 1);
 };
+
+// The width direction of a rectangle whose normal is `axis` when none is given: world +x projected
+// onto the rectangle's plane, or world +z when the axis is within 25.8 degrees of the x axis
+// (|axis.x| > 0.9 |axis|), where +x projects too short to be a stable direction. Unit length;
+// `axis` must be non-zero and finite.
+Eigen::Vector3d default_rect_tangent(const Eigen::Vector3d& axis);
+// Whether `tangent` gives a rectangle with normal `axis` a width direction: finite, non-zero and not
+// parallel to the (non-zero, finite) axis.
+bool tangent_spans_plane(const Eigen::Vector3d& axis, const Eigen::Vector3d& tangent);
+
+// The samples each area light is integrated with at each point (area_light.h).
+inline constexpr int kAreaLightSamples = 32;
 
 struct Lighting {
     std::vector<Light> lights;
@@ -72,8 +120,10 @@ constexpr double kMaxLightValue = 1e100;
 constexpr double kMaxLightIntensity = 1e15;
 
 // Throws InvalidArgumentError naming the light for non-finite components or ones beyond
-// kMaxLightValue, a zero direction, or intensities / ambient negative or beyond kMaxLightIntensity,
-// and for an invalid environment (environment_light.h: validate).
+// kMaxLightValue, a zero direction, or intensities / ambient negative or beyond kMaxLightIntensity;
+// for an area light whose size is not positive and finite (at most kMaxLightValue), whose axis is
+// zero, non-finite or beyond kMaxLightValue, or (rectangle) whose tangent is zero, non-finite or
+// parallel to its axis; and for an invalid environment (environment_light.h: validate).
 void validate(const Lighting& lighting);
 
 // The boundary of a volume in world space, as the lighting and the renderer see it. Surface vertex s
@@ -109,7 +159,8 @@ TriangleBvh build_shadow_bvh(const BoundarySurface& surface);
 // a transfer computed here.
 // `visibility`, when given, receives V_il from the shadow rays already cast for q, vertex-major
 // (visibility[s * lights + l]): 0 where light l is occluded at surface vertex s, else 1 (also where the
-// vertex faces away from the light, which the renderer's n.l test handles, so that interpolation
+// vertex faces away from the light; for an area light, the fraction of its samples in front of the
+// vertex that reach it, in [0, 1], and 1 when none is in front, which the renderer's n.l test handles, so that interpolation
 // across a triangle does not darken the terminator). The renderer multiplies each light's specular
 // highlight by it, so highlights vanish in shadow as the diffuse light q does.
 std::vector<Rgb> incident_light(const BoundarySurface& surface, const TriangleBvh& bvh, const Lighting& lighting,

@@ -104,7 +104,9 @@ void add_edit_command(CLI::App& app) {
         ->excludes(tets);
     add_surface_meshing_options(*cmd, options->meshing);
     add_material_options(*cmd, options->material);
-    cmd->add_option("--light", options->lights, "dir:X,Y,Z[:R,G,B] or point:X,Y,Z[:R,G,B], as for render")
+    cmd->add_option("--light", options->lights,
+                    "dir:X,Y,Z[:R,G,B], point:X,Y,Z[:R,G,B], rect:C:N:W,H[:R,G,B], disk:C:N:RADIUS[:R,G,B] or "
+                    "sphere:C:RADIUS[:R,G,B], as for render")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
     cmd->add_option("--scale", options->editor.scale,

@@ -156,8 +156,8 @@ void add_render_command(CLI::App& app) {
     cmd->footer(
         "Without --light a white key light shines from the upper front-left: dir:1,-1,-1 (y up, front +z).\n"
         "Without a material option the volume's stored per-tet materials are used, else marble.\n"
-        "Shadows are cast by the whole volume; a point light inside the object lights nothing (counted in\n"
-        "the summary's lights_inside). Exposure is automatic: the 95th percentile of the luminance of the\n"
+        "Shadows are cast by the whole volume; a point light, or a sphere light centred, inside the object\n"
+        "lights nothing (counted in the summary's lights_inside); area lights cast soft shadows. Exposure is automatic: the 95th percentile of the luminance of the\n"
         "subsurface radiance at camera-facing boundary vertices maps to 0.6 before ACES tone mapping;\n"
         "--exposure sets the multiplier instead. The summary (one JSON line) reports it.");
     cmd->callback([options] { run_render_command(*options); });

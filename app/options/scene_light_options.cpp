@@ -16,8 +16,11 @@ void add_scene_light_options(CLI::App& command, SceneLightOptions& options) {
     add_material_options(command, options.material);
     command
         .add_option("--light", options.lights,
-                    "dir:X,Y,Z[:R,G,B] (direction of travel) or point:X,Y,Z[:R,G,B] (position, model units); "
-                    "repeatable; intensity 1,1,1 by default")
+                    "dir:X,Y,Z[:R,G,B] (direction of travel), point:X,Y,Z[:R,G,B] (position, model units), or an "
+                    "area light with soft shadows: rect:CX,CY,CZ:NX,NY,NZ:W,H[:R,G,B] (centre, emitting normal, "
+                    "width along +x projected onto it, height), disk:CX,CY,CZ:NX,NY,NZ:RADIUS[:R,G,B] or "
+                    "sphere:CX,CY,CZ:RADIUS[:R,G,B] (intensity: radiant intensity along the normal, as a point "
+                    "light's); repeatable; intensity 1,1,1 by default")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
     command.add_option("--env", options.environment,

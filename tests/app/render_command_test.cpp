@@ -262,6 +262,34 @@ TEST_F(Render, PointLightInsideTheObjectLightsNothing) {
         for (int c = 0; c < 3; ++c) EXPECT_EQ(row.lo[c], 0);
 }
 
+// The cube spans [-1, 1]^3: a sphere light off its +x face lights that side; one centred inside lights
+// nothing, and is counted as a point light inside would be.
+TEST_F(Render, SphereLightLightsItsSideAndNothingFromInside) {
+    const fs::path fields = dir_ / "sphere.csv";
+    const auto r = run_waxwork("render " + volume_.string() + " --light sphere:2.5,0.2,0:0.5:8,8,8 --ambient 0 --scale 10 " +
+                               "--width 48 --height 36 -o " + (dir_ / "sphere.png").string() + " --fields " + fields.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["lights_inside"], 0);
+    EXPECT_TRUE(fs::exists(dir_ / "sphere.png"));
+    const Fields f = read_fields(fields);
+    EXPECT_TRUE(f.all_finite);
+    const auto lit = mean_lo_near(f, 0, true), dark = mean_lo_near(f, 0, false);
+    EXPECT_GT(lit[0], 10 * dark[0]);
+
+    const fs::path inside_fields = dir_ / "sphere_inside.csv";
+    const auto inside = run_waxwork("render " + volume_.string() + " --light sphere:0,0,0:0.3 --ambient 0 --width 32 " +
+                                    "--height 24 -o " + (dir_ / "sphere_inside.png").string() + " --fields " +
+                                    inside_fields.string());
+    ASSERT_EQ(inside.exit_code, 0) << inside.err;
+    EXPECT_EQ(nlohmann::json::parse(inside.out)["lights_inside"], 1);
+    for (const auto& row : read_fields(inside_fields).rows)
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(row.lo[c], 0);
+
+    const auto bad = run_waxwork("render " + volume_.string() + " --light sphere:3,0,0:0 -o " + (dir_ / "bad.png").string());
+    EXPECT_NE(bad.exit_code, 0);
+    EXPECT_NE(bad.err.find("bad light spec 'sphere:3,0,0:0': radius must be finite and positive"), std::string::npos) << bad.err;
+}
+
 // The cube's edges are creases: the summary counts the copies the image shades them with, and 180
 // degrees (one normal per vertex) makes none. The solve's light differs exactly along the edges, where
 // the split integrates each face's own light (source_light).
