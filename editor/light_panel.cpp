@@ -206,6 +206,8 @@ void EditorApp::draw_environment_controls() {
         environment.intensity = std::max(0.0f, intensity);
         request_solve();
     }
+    // Drawing only: the light is the same either way.
+    if (ImGui::Checkbox("draw as background", &environment.background)) request_solve();
 }
 
 }  // namespace waxwork

@@ -71,6 +71,7 @@ namespace waxwork {
     X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray)                  \
     X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)                          \
     X(PFNGLDRAWELEMENTSPROC, DrawElements)                                        \
+    X(PFNGLDRAWARRAYSPROC, DrawArrays)                                            \
     X(PFNGLGENTEXTURESPROC, GenTextures)                                          \
     X(PFNGLDELETETEXTURESPROC, DeleteTextures)                                    \
     X(PFNGLBINDTEXTUREPROC, BindTexture)                                          \

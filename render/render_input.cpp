@@ -66,7 +66,9 @@ SurfaceRenderInput make_render_input(const TetMesh& mesh, const SolvedScene& sce
     // (for an area light, the visible fraction of its samples).
     input.lighting.ambient = lighting.ambient;
     input.lighting.shadows = lighting.shadows;
-    // The sky's sun is one of them (direct_lights); the environment's own highlight is not drawn.
+    // The sky's sun is one of them (direct_lights); the environment itself is reflected by its
+    // prefiltered map and drawn behind the model when its `background` is set.
+    input.lighting.environment = lighting.environment;
     const std::vector<Light> lights = direct_lights(lighting);
     std::vector<size_t> kept;  // index into lights of each drawn light
     for (size_t l = 0; l < lights.size(); ++l) {

@@ -1,6 +1,8 @@
 #include "render/surface_renderer.h"
 
 #include "base/error.h"
+#include "render/environment_prefilter.h"
+#include "solver/environment_light.h"
 #include "solver/material.h"
 
 #include <Eigen/Geometry>
@@ -23,6 +25,10 @@ constexpr int kLutCosSamples = 128;
 constexpr int kLutEtaSamples = 41;
 constexpr float kLutEtaMin = 1.0f;  // the range validate_material accepts
 constexpr float kLutEtaMax = 3.0f;
+
+// The background's texture is the map reduced to at most this width: 2048 texels over 360 degrees
+// leave about 340 across a 60-degree view, sharp enough behind a model, and 24 MB of float texels.
+constexpr int kBackgroundWidth = 2048;
 
 constexpr const char* kVertexShader = R"glsl(
 #version 430 core
@@ -50,10 +56,45 @@ void main() {
 }
 )glsl";
 
-constexpr const char* kFragmentShader = R"glsl(
+// Shared by the surface's and the background's fragment shaders: exposure and tone mapping, the sRGB
+// encoding, and where a world direction falls in the environment's textures.
+constexpr const char* kCommonGlsl = R"glsl(
 #version 430 core
-const int kMaxLights = 8;
 const float kPi = 3.14159265358979;
+uniform float exposure;
+uniform int tone_map;                      // 0 ACES, 1 Reinhard, 2 clamp
+uniform vec2 environment_turn;             // cos and sin of the environment's rotation about +y
+uniform float environment_intensity;
+
+vec3 aces(vec3 x) {  // Narkowicz's fit of the ACES filmic curve
+    return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
+}
+
+vec3 srgb_encode(vec3 c) {
+    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+
+vec4 exposed_pixel(vec3 radiance) {
+    vec3 c = max(radiance * exposure, vec3(0.0));
+    if (tone_map == 0) c = aces(c);
+    else if (tone_map == 1) c = c / (1.0 + c);
+    else c = clamp(c, 0.0, 1.0);
+    return vec4(srgb_encode(c), 1.0);
+}
+
+// The texture coordinates of world direction w in the map (environment_map.h's convention), after
+// undoing the environment's rotation: R^-1 w.
+vec2 environment_uv(vec3 w) {
+    vec3 m = vec3(environment_turn.x * w.x - environment_turn.y * w.z, w.y,
+                  environment_turn.y * w.x + environment_turn.x * w.z);
+    float theta = acos(clamp(m.y / max(length(m), 1e-30), -1.0, 1.0));
+    float phi = atan(m.x, -m.z);
+    return vec2((phi + kPi) / (2.0 * kPi), theta / kPi);
+}
+)glsl";
+
+constexpr const char* kFragmentShader = R"glsl(
+const int kMaxLights = 8;
 in vec3 v_position;
 in vec3 v_normal;
 in vec3 v_factor;
@@ -74,8 +115,8 @@ uniform vec4 light_vector[kMaxLights];     // w = 0: direction of travel; w = 1:
 uniform vec3 light_intensity[kMaxLights];
 uniform float roughness;
 uniform float specular_scale;
-uniform float exposure;
-uniform int tone_map;                      // 0 ACES, 1 Reinhard, 2 clamp
+uniform int environment_enabled;
+uniform sampler2D environment_specular;    // the environment prefiltered for `roughness`
 
 float transmittance(float cos_theta, float eta) {
     vec2 t = vec2(clamp(cos_theta, 0.0, 1.0),
@@ -84,12 +125,15 @@ float transmittance(float cos_theta, float eta) {
     return texture(transmittance_lut, (t * (lut_size - 1.0) + 0.5) / lut_size).r;
 }
 
-vec3 aces(vec3 x) {  // Narkowicz's fit of the ACES filmic curve
-    return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
-}
-
-vec3 srgb_encode(vec3 c) {
-    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+// The integral of the BRDF against a white environment, split into a scale and a bias of the
+// normal-incidence reflectance F0 (the second sum of Karis 2013, Eq. 5), from Lazarov's analytic fit
+// ("Getting More Physical in Call of Duty: Black Ops II", 2013) instead of a second lookup table.
+vec2 environment_brdf(float roughness, float nv) {
+    const vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
+    const vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);
+    vec4 r = roughness * c0 + c1;
+    float a004 = min(r.x * r.x, exp2(-9.28 * nv)) * r.x + r.y;
+    return vec2(-1.04, 1.04) * a004 + r.zw;
 }
 
 void main() {
@@ -142,12 +186,38 @@ void main() {
         float F = 1.0 - transmittance(vh, v_eta);
         radiance += specular_scale * irradiance * nl * D * G * F / (4.0 * nl * nv);
     }
+    // The environment's reflection by the split sum (environment_prefilter.h), unshadowed.
+    if (environment_enabled != 0) {
+        vec3 prefiltered = texture(environment_specular, environment_uv(reflect(-v, n))).rgb;
+        float f0 = 1.0 - transmittance(1.0, v_eta);
+        vec2 ab = environment_brdf(roughness, nv);
+        radiance += specular_scale * environment_intensity * prefiltered * (f0 * ab.x + ab.y);
+    }
+    color = exposed_pixel(radiance);
+}
+)glsl";
 
-    vec3 c = max(radiance * exposure, vec3(0.0));
-    if (tone_map == 0) c = aces(c);
-    else if (tone_map == 1) c = c / (1.0 + c);
-    else c = clamp(c, 0.0, 1.0);
-    color = vec4(srgb_encode(c), 1.0);
+// The environment behind the model: one triangle covering the viewport, each pixel the radiance
+// arriving along its view ray, exposed and tone-mapped as the surface is.
+constexpr const char* kBackgroundVertexShader = R"glsl(
+#version 430 core
+void main() {
+    vec2 corner = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
+    gl_Position = vec4(corner * 2.0 - 1.0, 1.0, 1.0);
+}
+)glsl";
+
+constexpr const char* kBackgroundFragmentShader = R"glsl(
+uniform mat4 inverse_view_projection;
+uniform vec2 viewport_size;
+uniform sampler2D environment_background;
+out vec4 color;
+void main() {
+    vec2 ndc = gl_FragCoord.xy / viewport_size * 2.0 - 1.0;
+    vec4 near = inverse_view_projection * vec4(ndc, -1.0, 1.0);
+    vec4 far = inverse_view_projection * vec4(ndc, 1.0, 1.0);
+    vec3 w = far.xyz / far.w - near.xyz / near.w;
+    color = exposed_pixel(environment_intensity * texture(environment_background, environment_uv(w)).rgb);
 }
 )glsl";
 
@@ -178,9 +248,10 @@ vec3 srgb_encode(vec3 c) {
 void main() { color = vec4(srgb_encode(clamp(v_colour, 0.0, 1.0)), 1.0); }
 )glsl";
 
-GLuint compile_shader(const GlApi& gl, GLenum type, const char* source, const char* name) {
+GLuint compile_shader(const GlApi& gl, GLenum type, const std::string& source, const char* name) {
     const GLuint shader = gl.CreateShader(type);
-    gl.ShaderSource(shader, 1, &source, nullptr);
+    const char* text = source.c_str();
+    gl.ShaderSource(shader, 1, &text, nullptr);
     gl.CompileShader(shader);
     GLint ok = GL_FALSE;
     gl.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
@@ -192,8 +263,7 @@ GLuint compile_shader(const GlApi& gl, GLenum type, const char* source, const ch
     return shader;
 }
 
-GLuint link_program(const GlApi& gl, const char* vertex_source = kVertexShader,
-                    const char* fragment_source = kFragmentShader) {
+GLuint link_program(const GlApi& gl, const std::string& vertex_source, const std::string& fragment_source) {
     const GLuint vertex = compile_shader(gl, GL_VERTEX_SHADER, vertex_source, "vertex");
     GLuint fragment = 0;
     try {
@@ -225,6 +295,7 @@ struct FrameResources {
     GLuint renderbuffers[3] = {0, 0, 0};  // msaa colour, msaa depth, resolved colour
     GLuint vertex_array = 0;
     GLuint overlay_array = 0;
+    GLuint background_array = 0;  // empty: the background's triangle comes from gl_VertexID
     // positions, normals, factors, eta, indices, visibility, triangle colours, overlay positions,
     // overlay colours, overlay indices
     static constexpr int kBuffers = 10;
@@ -238,6 +309,7 @@ struct FrameResources {
         gl.DeleteRenderbuffers(3, renderbuffers);
         gl.DeleteVertexArrays(1, &vertex_array);
         gl.DeleteVertexArrays(1, &overlay_array);
+        gl.DeleteVertexArrays(1, &background_array);
         gl.DeleteBuffers(kBuffers, buffers);
     }
 };
@@ -314,6 +386,7 @@ void validate_input(const SurfaceRenderInput& input) {
     if (!(input.roughness > 0.0f && input.roughness <= 1.0f)) fail("roughness must be in (0, 1]");
     if (!std::isfinite(input.exposure) || input.exposure < 0) fail("exposure must be finite and non-negative");
     if (!std::isfinite(input.specular_scale) || input.specular_scale < 0) fail("specular_scale must be finite and non-negative");
+    if (input.lighting.environment) validate(*input.lighting.environment);
     if (input.lighting.lights.size() > static_cast<size_t>(kMaxRenderLights)) {
         fail(std::to_string(input.lighting.lights.size()) + " lights; at most " + std::to_string(kMaxRenderLights) + " are drawn");
     }
@@ -343,10 +416,12 @@ void validate_input(const SurfaceRenderInput& input) {
 }  // namespace
 
 SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {
-    program_ = link_program(gl_);
+    program_ = link_program(gl_, kVertexShader, std::string(kCommonGlsl) + kFragmentShader);
     try {
         overlay_program_ = link_program(gl_, kOverlayVertexShader, kOverlayFragmentShader);
+        background_program_ = link_program(gl_, kBackgroundVertexShader, std::string(kCommonGlsl) + kBackgroundFragmentShader);
     } catch (...) {
+        gl_.DeleteProgram(overlay_program_);
         gl_.DeleteProgram(program_);
         throw;
     }
@@ -373,6 +448,8 @@ SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {
 
 SurfaceRenderer::~SurfaceRenderer() {
     gl_.DeleteTextures(1, &transmittance_lut_);
+    gl_.DeleteTextures(2, environment_textures_);
+    gl_.DeleteProgram(background_program_);
     gl_.DeleteProgram(overlay_program_);
     gl_.DeleteProgram(program_);
 }
@@ -456,11 +533,49 @@ void draw_overlay(const GlApi& gl, GLuint program, const RenderOverlay& o, const
     gl.UseProgram(0);
 }
 
+// An equirectangular texture: linear filtering, wrapping across the seam in longitude, clamped at the
+// poles. Float texels: an HDR file's brightest pixels exceed half float's range.
+void upload_environment_texture(const GlApi& gl, GLuint texture, const EnvironmentTexture& t) {
+    gl.BindTexture(GL_TEXTURE_2D, texture);
+    gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, t.width, t.height, 0, GL_RGB, GL_FLOAT, t.texels.data());
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+}
+
+// The uniforms kCommonGlsl declares, for the program in use.
+void set_common_uniforms(const GlApi& gl, GLuint program, const SurfaceRenderInput& input) {
+    auto location = [&](const char* name) { return gl.GetUniformLocation(program, name); };
+    gl.Uniform1f(location("exposure"), input.exposure);
+    gl.Uniform1i(location("tone_map"), static_cast<int>(input.tone_map));
+    const auto& environment = input.lighting.environment;
+    const double radians = environment ? environment->rotation_degrees * std::numbers::pi / 180 : 0.0;
+    gl.Uniform2f(location("environment_turn"), static_cast<float>(std::cos(radians)), static_cast<float>(std::sin(radians)));
+    gl.Uniform1f(location("environment_intensity"), environment ? static_cast<float>(environment->intensity) : 0.0f);
+}
+
 }  // namespace
 
 struct SurfaceRenderer::Frame : FrameResources {
     using FrameResources::FrameResources;
 };
+
+void SurfaceRenderer::prepare_environment(const std::shared_ptr<const EnvironmentMap>& map, float roughness) {
+    if (environment_textures_[0] == 0) gl_.GenTextures(2, environment_textures_);
+    if (map != environment_map_) {
+        upload_environment_texture(gl_, environment_textures_[0], reduce_environment(*map, kBackgroundWidth));
+        environment_map_ = map;
+        environment_roughness_ = 0;  // the reflection is of the old map
+    }
+    if (roughness != environment_roughness_) {
+        upload_environment_texture(gl_, environment_textures_[1], prefilter_environment(*map, roughness));
+        environment_roughness_ = roughness;
+    }
+    check_gl_error(gl_, "surface renderer: uploading the environment");
+}
 
 void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const CameraFrame& frame, Frame& r) {
     validate_input(input);
@@ -494,6 +609,29 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
     gl.ClearColor(input.background[0] / 255.0f, input.background[1] / 255.0f, input.background[2] / 255.0f, 1.0f);
     gl.ClearDepth(1.0);
     gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+
+    // The environment appears in the physical image only, not in the inspection views.
+    const bool environment = input.lighting.environment && input.shading == SurfaceShading::Radiance;
+    if (environment) prepare_environment(input.lighting.environment->map, input.roughness);
+    if (environment && input.lighting.environment->background) {
+        gl.UseProgram(background_program_);
+        set_common_uniforms(gl, background_program_, input);
+        const Eigen::Matrix4f inverse = (frame.projection * frame.view).inverse().cast<float>();
+        gl.UniformMatrix4fv(gl.GetUniformLocation(background_program_, "inverse_view_projection"), 1, GL_FALSE,
+                            inverse.data());
+        gl.Uniform2f(gl.GetUniformLocation(background_program_, "viewport_size"), static_cast<float>(input.width),
+                     static_cast<float>(input.height));
+        gl.ActiveTexture(GL_TEXTURE0);
+        gl.BindTexture(GL_TEXTURE_2D, environment_textures_[0]);
+        gl.Uniform1i(gl.GetUniformLocation(background_program_, "environment_background"), 0);
+        gl.GenVertexArrays(1, &r.background_array);
+        gl.BindVertexArray(r.background_array);
+        gl.Disable(GL_DEPTH_TEST);  // behind everything, and the surface's depth test starts from the clear
+        gl.DrawArrays(GL_TRIANGLES, 0, 3);
+        gl.BindVertexArray(0);
+        gl.BindTexture(GL_TEXTURE_2D, 0);
+        gl.UseProgram(0);
+    }
 
     if (!input.triangles.empty()) {
         const size_t n = input.positions.size();
@@ -563,8 +701,8 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.Uniform2f(location("lut_size"), kLutCosSamples, kLutEtaSamples);
         gl.Uniform1f(location("roughness"), input.roughness);
         gl.Uniform1f(location("specular_scale"), input.specular_scale);
-        gl.Uniform1f(location("exposure"), input.exposure);
-        gl.Uniform1i(location("tone_map"), static_cast<int>(input.tone_map));
+        set_common_uniforms(gl, program_, input);
+        gl.Uniform1i(location("environment_enabled"), environment ? 1 : 0);
         gl.Uniform1i(location("shading"), static_cast<int>(input.shading));
         gl.Uniform1i(location("clip_enabled"), input.clip_plane ? 1 : 0);
         const Eigen::Vector4f plane = input.clip_plane.value_or(Eigen::Vector4f::Zero());
@@ -587,6 +725,11 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.ActiveTexture(GL_TEXTURE0);
         gl.BindTexture(GL_TEXTURE_2D, transmittance_lut_);
         gl.Uniform1i(location("transmittance_lut"), 0);
+        // Unit 1 always holds a texture: a sampler without one is undefined even where unused.
+        gl.ActiveTexture(GL_TEXTURE1);
+        gl.BindTexture(GL_TEXTURE_2D, environment ? environment_textures_[1] : transmittance_lut_);
+        gl.Uniform1i(location("environment_specular"), 1);
+        gl.ActiveTexture(GL_TEXTURE0);
 
         gl.Enable(GL_DEPTH_TEST);
         gl.DepthFunc(GL_LESS);
@@ -594,6 +737,9 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.Disable(GL_CULL_FACE);  // cut-open or non-closed surfaces show their inner side
         gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * input.triangles.size()), GL_UNSIGNED_INT, nullptr);
         gl.UseProgram(0);
+        gl.ActiveTexture(GL_TEXTURE1);
+        gl.BindTexture(GL_TEXTURE_2D, 0);
+        gl.ActiveTexture(GL_TEXTURE0);
         gl.BindTexture(GL_TEXTURE_2D, 0);
         gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
     }

@@ -1,6 +1,7 @@
 // Draws the boundary surface of a volume with its subsurface radiance: per-vertex exitant radiance
 // factor E (solver/radiance.h) times the view-dependent Fresnel transmittance F_t(theta_o) per
-// fragment, plus a Cook-Torrance highlight for each light, tone-mapped to sRGB. Cross-sections need no
+// fragment, plus a Cook-Torrance highlight for each light and the environment's reflection, over the
+// environment as background when there is one, tone-mapped to sRGB. Cross-sections need no
 // special case: after a cut they are boundary faces like any other.
 #pragma once
 
@@ -52,7 +53,9 @@ struct SurfaceRenderInput {
     std::vector<std::array<float, 3>> radiance_factor; // per vertex: E, rgb, HDR (L_o = F_t(theta_o) E)
     std::vector<float> eta;                            // per vertex; empty: uniform_eta everywhere
     float uniform_eta = 1.3f;
-    Lighting lighting;                                 // for the specular highlight (at most kMaxLights)
+    // For the specular highlights (at most kMaxRenderLights lights); its environment, if any, is also
+    // reflected (environment_prefilter.h) and, when its `background` is set, drawn behind the model.
+    Lighting lighting;
     float roughness = 0.35f;                           // GGX roughness of the surface, (0, 1]
     float specular_scale = 1.0f;                       // 0 turns the highlight off
     int width = 800;
@@ -105,11 +108,18 @@ private:
     struct Frame;
     // Draws into the multisampled target of `frame` and resolves it into its single-sampled one.
     void draw_resolved(const SurfaceRenderInput& input, const CameraFrame& camera, Frame& frame);
+    // Makes the environment textures hold `map`, and its reflection for `roughness`; keeps them while
+    // neither changes (the prefilter takes tens of milliseconds, a frame should not).
+    void prepare_environment(const std::shared_ptr<const EnvironmentMap>& map, float roughness);
 
     const GlApi& gl_;
     GLuint program_ = 0;
     GLuint overlay_program_ = 0;
+    GLuint background_program_ = 0;
     GLuint transmittance_lut_ = 0;
+    GLuint environment_textures_[2] = {0, 0};  // the background, the prefiltered reflection
+    std::shared_ptr<const EnvironmentMap> environment_map_;  // what environment_textures_ hold
+    float environment_roughness_ = 0;
 };
 
 // Reads the bound read framebuffer's lower-left width x height pixels as an Image (top row first).

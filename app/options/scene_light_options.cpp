@@ -27,6 +27,9 @@ void add_scene_light_options(CLI::App& command, SceneLightOptions& options) {
                        "Environment light: FILE.hdr[:ROT_DEG[:INTENSITY]] (equirectangular Radiance image, rotated "
                        "about +y) or sky:SUN_ELEV_DEG,SUN_AZIM_DEG[,TURBIDITY][:ROT_DEG[:INTENSITY]] (a clear sky "
                        "with its sun; azimuth from +z towards +x); replaces the default key light and ambient");
+    command.add_flag("--no-env-background", options.hide_environment,
+                     "Draw the background colour behind the model instead of the environment (it still lights and "
+                     "is reflected)");
     command.add_option("--method", options.method, "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass)")
         ->check(CLI::IsMember({"transcut", "fem"}))
         ->capture_default_str();
@@ -58,13 +61,17 @@ void check_scene_light_options(const SceneLightOptions& o) {
     if (o.ambient && !(*o.ambient >= 0 && *o.ambient <= kMaxLightIntensity))
         fail("--ambient must be non-negative and at most 1e15");
     if (!o.environment.empty()) parse_environment_spec(o.environment);
+    if (o.hide_environment && o.environment.empty()) fail("--no-env-background needs --env");
     if (!is_crease_angle(o.crease_angle)) fail("--crease-angle must be between 0 and 180 degrees");
 }
 
 Lighting chosen_lighting(const SceneLightOptions& o) {
     Lighting lighting;
     for (const std::string& spec : o.lights) lighting.lights.push_back(parse_light_spec(spec));
-    if (!o.environment.empty()) lighting.environment = load_environment(parse_environment_spec(o.environment));
+    if (!o.environment.empty()) {
+        lighting.environment = load_environment(parse_environment_spec(o.environment));
+        lighting.environment->background = !o.hide_environment;
+    }
     if (lighting.lights.empty() && !lighting.environment) lighting.lights.push_back(default_key_light());
     const double ambient = o.ambient.value_or(lighting.environment ? 0.0 : kDefaultAmbient);
     lighting.ambient = {ambient, ambient, ambient};

@@ -27,6 +27,7 @@ struct SceneLightOptions {
     MaterialOptions material;
     std::vector<std::string> lights;
     std::string environment;  // --env: FILE.hdr[:ROT[:INTENSITY]] or sky:ELEV,AZIM[,TURBIDITY][:ROT[:INTENSITY]]
+    bool hide_environment = false;  // --no-env-background: the environment lights but is not drawn
     std::string method = "transcut";
     // 1e-2: the resolution study (`waxwork bench --only resolution`; docs/accuracy.md) finds the image
     // at 1e-2 within 0.05% of the image at 1e-3 on spot at 3 and 30 mm per unit, while 1e-1 is visibly

@@ -1,5 +1,6 @@
 // `waxwork render` and `waxwork demo` end to end: the binary meshes, solves, renders and writes files.
 #include "io/image_io.h"
+#include "render/surface_renderer.h"
 #include "solver/shading_surface.h"
 #include "support/cli_run.h"
 #include "support/fields_table.h"
@@ -135,6 +136,22 @@ TEST_F(Render, SkyEnvironmentLightsTheSideOfItsSun) {
     ASSERT_EQ(turned.exit_code, 0) << turned.err;
     const Fields g = read_fields(fields);
     EXPECT_GT(mean_lo_near(g, 0, false)[0], 2 * mean_lo_near(g, 0, true)[0]);
+    // The sky is drawn behind the model, unless told not: seen level, the upper corners show the sky
+    // (blue, not the plain background).
+    const auto level = run_waxwork("render " + volume_.string() + " -o " + image.string() +
+                                   " --material marble --env sky:20,90 --view 1,0,0 --scale 10 --width 80 --height 60");
+    ASSERT_EQ(level.exit_code, 0) << level.err;
+    const Image with_sky = read_png(image);
+    const uint8_t* corner = with_sky.pixel(0, 0);
+    EXPECT_GT(corner[2], corner[0]) << "a clear sky is bluer than it is red";
+    const std::array<uint8_t, 3> plain = SurfaceRenderInput{}.background;
+    EXPECT_NE(std::vector<uint8_t>(corner, corner + 3), std::vector<uint8_t>(plain.begin(), plain.end()));
+    const auto hidden = run_waxwork("render " + volume_.string() + " -o " + image.string() +
+                                    " --material marble --env sky:20,90 --no-env-background --scale 10 --width 80 "
+                                    "--height 60");
+    ASSERT_EQ(hidden.exit_code, 0) << hidden.err;
+    const uint8_t* bare = read_png(image).pixel(0, 0);
+    EXPECT_EQ(std::vector<uint8_t>(bare, bare + 3), std::vector<uint8_t>(plain.begin(), plain.end()));
 }
 
 TEST_F(Render, FemAgreesWithTransCut) {
@@ -351,6 +368,7 @@ TEST_F(Render, BadInputIsAOneLineError) {
              {" --crease-angle nan", "--crease-angle must be between 0 and 180 degrees"},
              {" --exposure 1e308", "--exposure must be positive and at most 1e30"},
              {" --env sky:95,0", "bad environment spec 'sky:95,0': sky: sun elevation must be above 0"},
+             {" --no-env-background", "--no-env-background needs --env"},
              {" --env studio.hdr:0:-2", "the intensity must be a number between 0 and 1e15"},
              {" --env " + (dir_ / "absent.hdr").string(), (dir_ / "absent.hdr").string() + ": no such file"},
              {" --env " + volume_.string(), volume_.string() + ": not a Radiance .hdr image"}}) {

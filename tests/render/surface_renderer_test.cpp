@@ -1,7 +1,10 @@
 #include "base/error.h"
 #include "gl/gl_context.h"
 #include "io/image_io.h"
+#include "render/camera.h"
+#include "render/srgb.h"
 #include "render/surface_renderer.h"
+#include "solver/environment_light.h"
 #include "solver/lighting.h"
 
 #include <gtest/gtest.h>
@@ -248,6 +251,88 @@ TEST(ImageIo, CorruptOrMissingPngThrowsFileError) {
     inconsistent.rgba.pop_back();
     EXPECT_THROW(write_png(inconsistent, path), InvalidArgumentError);
     EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+
+// An environment of `width` x width / 2 pixels with radiance `radiance(direction)`.
+template <typename F>
+EnvironmentLight test_environment(int width, F radiance) {
+    std::vector<Rgb> pixels;
+    for (int y = 0; y < width / 2; ++y)
+        for (int x = 0; x < width; ++x)
+            pixels.push_back(radiance(EnvironmentMap::direction((x + 0.5) / width, (y + 0.5) / (width / 2))));
+    return environment_light(std::make_shared<const EnvironmentMap>(width, width / 2, std::move(pixels), "test map"), 2);
+}
+
+// Each background pixel is the environment's radiance along its view ray, rotated and scaled as the
+// lighting computes it (environment_radiance), so what is drawn is what lights the model.
+TEST(SurfaceRenderer, TheBackgroundIsTheRotatedEnvironmentAlongEachViewRay) {
+    SurfaceRenderInput input = make_sphere({0.2f, 0.2f, 0.2f}, 64, 48);
+    input.lighting.environment = test_environment(512, [](const Eigen::Vector3d& w) {
+        return Rgb{0.5 + 0.4 * w.x(), 0.5 + 0.4 * w.y(), 0.5 - 0.4 * w.z()};
+    });
+    input.lighting.environment->rotation_degrees = 70;
+    input.lighting.environment->intensity = 0.9;
+    input.tone_map = ToneMap::Clamp;
+    input.exposure = 1.0f;
+    input.camera.eye_direction = {0.3, 0.4, 1.0};
+    const Image image = render_surface(input);
+    Eigen::AlignedBox3d box;
+    for (const Eigen::Vector3f& p : input.positions) box.extend(p.cast<double>());
+    const CameraFrame frame = frame_camera(box, input.camera, static_cast<double>(input.width) / input.height);
+    const Eigen::Matrix4d inverse = (frame.projection * frame.view).inverse();
+    int checked = 0;
+    for (const auto& [x, y] : std::vector<std::pair<int, int>>{{0, 0}, {63, 0}, {0, 47}, {63, 47}, {32, 1}, {1, 24}, {62, 30}}) {
+        // Pixel centres in normalised device coordinates (OpenGL's rows run bottom up).
+        const double nx = (x + 0.5) / input.width * 2 - 1, ny = (input.height - 1 - y + 0.5) / input.height * 2 - 1;
+        const Eigen::Vector4d near = inverse * Eigen::Vector4d(nx, ny, -1, 1), far = inverse * Eigen::Vector4d(nx, ny, 1, 1);
+        const Eigen::Vector3d w = (far.head<3>() / far.w() - near.head<3>() / near.w()).normalized();
+        const std::array<uint8_t, 3> expected = srgb_bytes(environment_radiance(*input.lighting.environment, w));
+        const uint8_t* p = image.pixel(x, y);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(p[c], expected[c], 3) << "pixel " << x << "," << y << " channel " << c;
+        ++checked;
+    }
+    EXPECT_EQ(checked, 7);
+    // Without `background` the clear colour shows, and with another rotation the corner changes.
+    input.lighting.environment->background = false;
+    const Image plain = render_surface(input);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(plain.pixel(0, 0)[c], input.background[c]);
+    input.lighting.environment->background = true;
+    input.lighting.environment->rotation_degrees = 250;
+    const Image turned = render_surface(input);
+    int difference = 0;
+    for (int c = 0; c < 3; ++c) difference += std::abs(turned.pixel(0, 0)[c] - image.pixel(0, 0)[c]);
+    EXPECT_GT(difference, 20);
+}
+
+// A black body under a uniform white environment shows only the environment's reflection: about F0 L
+// where it faces the camera (F0 = ((eta - 1) / (eta + 1))^2), brighter towards the rim as the Fresnel
+// reflectance grows, and nothing with the highlights turned off or in the inspection views.
+TEST(SurfaceRenderer, TheEnvironmentsReflectionFollowsFresnel) {
+    SurfaceRenderInput input = make_sphere({0, 0, 0}, 96, 96);
+    input.lighting.lights.clear();
+    const double radiance = 10;
+    input.lighting.environment = test_environment(64, [&](const Eigen::Vector3d&) { return Rgb{radiance, radiance, radiance}; });
+    input.lighting.environment->background = false;
+    input.uniform_eta = 1.5f;
+    input.tone_map = ToneMap::Clamp;
+    input.exposure = 1.0f;
+    const Image image = render_surface(input);
+    const double f0 = 0.04;  // ((1.5 - 1) / (1.5 + 1))^2
+    const double centre = image.pixel(48, 48)[0];
+    EXPECT_GT(centre, srgb_byte(0.7 * f0 * radiance));
+    EXPECT_LT(centre, srgb_byte(1.5 * f0 * radiance));
+    // Along the row through the centre, the last pixel on the sphere before the background.
+    int rim = 48;
+    while (rim + 1 < input.width && image.pixel(rim + 1, 48)[0] != input.background[0]) ++rim;
+    ASSERT_GT(rim, 60);
+    EXPECT_GT(image.pixel(rim - 1, 48)[0], centre + 20);
+    input.specular_scale = 0;
+    EXPECT_EQ(render_surface(input).pixel(48, 48)[0], 0);
+    input.specular_scale = 1;
+    input.shading = SurfaceShading::VertexColour;
+    input.colours.assign(input.positions.size(), {0.0f, 0.0f, 0.0f});
+    EXPECT_EQ(render_surface(input).pixel(48, 48)[0], 0);
 }
 
 }  // namespace
