@@ -7,6 +7,7 @@
 #include "solver/warm_start.h"
 
 #include <algorithm>
+#include <limits>
 #include <chrono>
 #include <cmath>
 #include <numeric>
@@ -58,12 +59,17 @@ void LiveScene::rebuild_surface(SceneUpdate& update, std::optional<std::span<con
     update.rebuilt_surface = true;
     if (transfer_ && vertex_map && lighting_.environment && transfer_->settings().order == lighting_.environment->sh_order &&
         transfer_->settings().shadows == lighting_.shadows) {
-        // Only the vertices that can see what changed are sampled again (carry_environment_transfer).
+        // Only the vertices that can see what changed need sampling again, and those that stayed in
+        // place wait for the next frames (carry_environment_transfer, refine_transfer).
+        std::vector<int32_t> deferred;
         transfer_ = carry_environment_transfer(old_surface, *transfer_, surface_, shadow_bvh_, *vertex_map,
-                                               &update.resampled_transfer);
+                                               &update.resampled_transfer, deferred_transfer_, &deferred);
+        deferred_transfer_ = std::move(deferred);
+        update.deferred_transfer = deferred_transfer_.size();
         copy_transfer_ = split_copy_transfer(surface_, shading_, shadow_bvh_, transfer_->settings());
     } else {
         transfer_.reset();
+        deferred_transfer_.clear();
         if (lighting_.environment) update.resampled_transfer = surface_.positions.size();
     }
     relight(update);
@@ -73,16 +79,34 @@ void LiveScene::refresh_transfer() {
     if (!lighting_.environment) {
         transfer_.reset();
         copy_transfer_.reset();
+        deferred_transfer_.clear();
         return;
     }
     if (transfer_ && transfer_->settings().order == lighting_.environment->sh_order &&
         transfer_->settings().shadows == lighting_.shadows)
         return;
+    deferred_transfer_.clear();
     TransferSettings settings;
     settings.order = lighting_.environment->sh_order;
     settings.shadows = lighting_.shadows;
     transfer_ = compute_environment_transfer(surface_, shadow_bvh_, settings);
     copy_transfer_ = split_copy_transfer(surface_, shading_, shadow_bvh_, settings);
+}
+
+void LiveScene::refine_transfer(double milliseconds) {
+    if (deferred_transfer_.empty()) return;
+    const auto start = std::chrono::steady_clock::now();
+    size_t done = 0;
+    do {
+        const size_t count = std::min(kTransferRefineChunk, deferred_transfer_.size() - done);
+        update_environment_transfer(surface_, shadow_bvh_, std::span(deferred_transfer_).subspan(done, count), *transfer_);
+        done += count;
+    } while (done < deferred_transfer_.size() && milliseconds_since(start) < milliseconds);
+    update_incident_light(surface_, shadow_bvh_, lighting_, std::span(deferred_transfer_).first(done), surface_q_,
+                          &*transfer_);
+    deferred_transfer_.erase(deferred_transfer_.begin(), deferred_transfer_.begin() + static_cast<std::ptrdiff_t>(done));
+    light_shading();
+    refresh_right_hand_sides();
 }
 
 void LiveScene::relight(SceneUpdate& update) {
@@ -276,6 +300,7 @@ SceneUpdate LiveScene::set_lighting(const Lighting& lighting) {
 
 FrameReport LiveScene::iterate(int iteration_budget, const FrameBudget* time_budget) {
     const auto start = std::chrono::steady_clock::now();
+    refine_transfer(kTransferRefineMilliseconds);
     FrameReport report;
     const size_t n = matrix_.size();
     std::array<bool, 3> skip{};
@@ -294,7 +319,7 @@ FrameReport LiveScene::iterate(int iteration_budget, const FrameBudget* time_bud
         converged_[c] = channels[c].converged;
         report.estimated_relative_error[c] = error_[c];
     }
-    report.converged = converged_[0] && converged_[1] && converged_[2];
+    report.converged = converged_[0] && converged_[1] && converged_[2] && deferred_transfer_.empty();
     solved_since_change_ = true;
     report.milliseconds = milliseconds_since(start);
     return report;
@@ -332,6 +357,7 @@ FrameReport LiveScene::converge(int max_iterations) {
     const std::lock_guard lock(mutex_);
     // A channel that stopped inside its budget met its precision's floor (conjugate_gradient.h):
     // more iterations would not help, another precision might. A multigrid budget counts V-cycles.
+    refine_transfer(std::numeric_limits<double>::infinity());
     const int budget = options_.method == LiveMethod::MultigridCg ? std::max(1, max_iterations / 4) : max_iterations;
     const auto at_floor = [&](const FrameReport& report) {
         for (int c = 0; c < 3; ++c)
@@ -372,7 +398,12 @@ FrameReport LiveScene::converge(int max_iterations) {
 
 bool LiveScene::converged() const {
     const std::lock_guard lock(mutex_);
-    return converged_[0] && converged_[1] && converged_[2];
+    return converged_[0] && converged_[1] && converged_[2] && deferred_transfer_.empty();
+}
+
+size_t LiveScene::deferred_transfer() const {
+    const std::lock_guard lock(mutex_);
+    return deferred_transfer_.size();
 }
 
 std::optional<double> LiveScene::estimated_error() const {

@@ -101,10 +101,19 @@ struct SceneUpdate {
     std::vector<int32_t> updated_rows;   // rows rewritten by the incremental update (ascending)
     bool rebuilt_surface = false;        // boundary surface and shadow BVH
     size_t resampled_transfer = 0;       // surface vertices whose environment transfer was sampled again
+    // Surface vertices that can see what changed and keep their old transfer until the next frames
+    // sample it again (LiveScene::deferred_transfer).
+    size_t deferred_transfer = 0;
     bool recomputed_light = false;       // q and the right-hand sides
     bool warm_start = true;              // phi kept (possibly through a vertex map)
     double milliseconds = 0;
 };
+
+// How long a frame spends sampling deferred transfer vectors again before it iterates, and how many
+// vertices it samples at a time: with 256 rays per vertex a chunk is about 65K rays, some 10 ms on
+// one core, so a frame stays near 30 fps while a large cut's light settles within seconds.
+inline constexpr double kTransferRefineMilliseconds = 12;
+inline constexpr size_t kTransferRefineChunk = 256;
 
 class LiveScene {
 public:
@@ -138,7 +147,12 @@ public:
     // float's floor on this volume is reached in double on the CPU, which solves from then on
     // (LiveSolver::fall_back_to_cpu; gpu_fallback_reason() says why).
     FrameReport converge(int max_iterations = 10000);
+    // False while phi is outside the tolerance or some transfer vectors still wait to be sampled.
     bool converged() const;
+    // After an edit, the surface vertices whose environment transfer is carried over although they can
+    // see what changed: each step() samples some of them again (about kTransferRefineMilliseconds),
+    // converge() all, and the light they give follows; the result then equals a fresh scene's.
+    size_t deferred_transfer() const;
     // The estimated relative error of phi (max over channels) after the last step(), or nullopt when
     // nothing was solved since the last change.
     std::optional<double> estimated_error() const;
@@ -191,6 +205,9 @@ private:
     // shadow setting), drops it without an environment.
     void refresh_transfer();
     void refresh_right_hand_sides();
+    // Samples deferred transfer vectors again, chunk by chunk until `milliseconds` have passed (at
+    // least one chunk), and relights those vertices.
+    void refine_transfer(double milliseconds);
     void mark_unconverged();
     // `time_budget` (optional) replaces the iteration budget.
     FrameReport iterate(int iteration_budget, const FrameBudget* time_budget = nullptr);
@@ -207,6 +224,7 @@ private:
     // surface is rebuilt, so that a change of the environment alone costs a dot product per vertex.
     std::optional<EnvironmentTransfer> transfer_;
     std::optional<EnvironmentTransfer> copy_transfer_;  // per split copy of shading_ (split_copy_transfer)
+    std::vector<int32_t> deferred_transfer_;    // surface vertices whose transfer_ is stale (deferred_transfer())
     std::vector<Rgb> surface_q_;                // per surface vertex
     std::vector<float> surface_visibility_;     // per surface vertex and light (incident_light)
     ShadingSurface shading_;                    // the surface split at creases (options_.crease_angle_degrees)

@@ -238,7 +238,8 @@ std::vector<int32_t> vertices_seeing_triangles(const BoundarySurface& surface, s
 
 EnvironmentTransfer carry_environment_transfer(const BoundarySurface& old_surface, const EnvironmentTransfer& old_transfer,
                                                const BoundarySurface& surface, const TriangleBvh& bvh,
-                                               std::span<const int32_t> new_of_old_vertex, size_t* recomputed) {
+                                               std::span<const int32_t> new_of_old_vertex, size_t* recomputed,
+                                               std::span<const int32_t> old_deferred, std::vector<int32_t>* deferred) {
     const TransferSettings& settings = old_transfer.settings();
     if (old_transfer.size() != old_surface.positions.size())
         throw InvalidArgumentError("carry_environment_transfer: " + std::to_string(old_transfer.size()) +
@@ -308,15 +309,24 @@ EnvironmentTransfer carry_environment_transfer(const BoundarySurface& old_surfac
     for (const int32_t s : vertices_seeing_triangles(surface, changed)) sees[s] = 1;
     const std::vector<double> old_offset = ray_offsets(old_surface, settings.shadows);
     const std::vector<double> offset = ray_offsets(surface, settings.shadows);
+    std::vector<uint8_t> old_waiting(old_surface.positions.size(), 0);
+    for (const int32_t o : old_deferred) {
+        if (o < 0 || static_cast<size_t>(o) >= old_waiting.size())
+            throw InvalidArgumentError("carry_environment_transfer: deferred vertex " + std::to_string(o) + " out of range");
+        old_waiting[o] = 1;
+    }
+    if (deferred) deferred->clear();
     EnvironmentTransfer transfer(settings, surface.positions.size());
     std::vector<int32_t> again;
     for (size_t s = 0; s < surface.positions.size(); ++s) {
         const int32_t o = old_of_surface[s];
-        const bool same = o >= 0 && !moved[s] && !sees[s] && old_surface.normals[o] == surface.normals[s] &&
-                          old_surface.eta[o] == surface.eta[s] && old_offset[o] == offset[s];
-        if (same) {
+        const bool in_place = o >= 0 && !moved[s] && old_surface.normals[o] == surface.normals[s] &&
+                              old_surface.eta[o] == surface.eta[s] && old_offset[o] == offset[s];
+        const bool stale = in_place && (sees[s] || old_waiting[o]);
+        if (in_place && (!stale || deferred)) {
             const auto from = old_transfer.at(o);
             std::copy(from.begin(), from.end(), transfer.at(s).begin());
+            if (stale) deferred->push_back(static_cast<int32_t>(s));
             continue;
         }
         again.push_back(static_cast<int32_t>(s));

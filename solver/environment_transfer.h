@@ -101,10 +101,19 @@ std::vector<int32_t> vertices_seeing_triangles(const BoundarySurface& surface, s
 // sampled again. `new_of_old_vertex` maps old volume vertices to new ones (-1: removed); empty: the
 // same numbering. The result equals compute_environment_transfer(surface, bvh, settings) bit for
 // bit. `recomputed`, when given, receives the number of vertices sampled again.
+//
+// Deferring: when `deferred` is given, a vertex that stays in place but can see a change keeps its
+// old vector for now and is listed there instead of being sampled; the caller samples the list later
+// (update_environment_transfer), after which the result again equals a full computation. A large cut
+// changes what most of the surface sees, so this is what lets an editor show it at once and refine the
+// light over the next frames. `old_deferred` lists the old surface's vertices still waiting: they stay
+// listed (or, without `deferred`, are sampled now).
 EnvironmentTransfer carry_environment_transfer(const BoundarySurface& old_surface, const EnvironmentTransfer& old_transfer,
                                                const BoundarySurface& surface, const TriangleBvh& bvh,
                                                std::span<const int32_t> new_of_old_vertex,
-                                               size_t* recomputed = nullptr);
+                                               size_t* recomputed = nullptr,
+                                               std::span<const int32_t> old_deferred = {},
+                                               std::vector<int32_t>* deferred = nullptr);
 
 // The sampled reference at one point, with `samples` directions (half by the cosine, half by the
 // environment's luminance); `sampler` is EnvironmentSampler(*environment.map).

@@ -123,10 +123,36 @@ TEST(LiveScene, FollowsTheEnvironmentThroughEditsAndTurns) {
     PlaneCutOp cut;
     cut.plane = {Eigen::Vector3d(1, 0.3, 0.2), 0.6};
     update = scene.apply_change(doc.mesh(), doc.apply(cut));
-    // Only the vertices that can see the cut are sampled again.
+    // Only the vertices that can see the cut are sampled again (none of a convex body's old faces can).
     EXPECT_GT(update.resampled_transfer, 0u);
     EXPECT_LT(update.resampled_transfer, scene.solved_scene().surface.positions.size());
     expect_matches_fresh_solve(scene, doc.mesh(), lighting, "cut under the sky");
+
+    // A piece pulled away: the other piece's crack face now sees sky where it saw the piece. Those
+    // vertices stay in place, so they keep their old transfer and wait for the next steps; the scene is
+    // not converged until they are sampled.
+    FractureOp fracture;
+    fracture.seeds = {Eigen::Vector3d(0.3, 0.5, 0.5), Eigen::Vector3d(0.7, 0.5, 0.5)};
+    scene.apply_change(doc.mesh(), doc.apply(fracture));
+    scene.converge();
+    MovePieceOp pull;
+    pull.piece = 1;
+    pull.transform.translation = Eigen::Vector3d(0.4, 0.3, 0);
+    update = scene.apply_change(doc.mesh(), doc.apply(pull));
+    EXPECT_GT(update.deferred_transfer, 0u);
+    EXPECT_EQ(scene.deferred_transfer(), update.deferred_transfer);
+    EXPECT_LT(update.resampled_transfer + update.deferred_transfer, scene.solved_scene().surface.positions.size());
+    EXPECT_FALSE(scene.converged());
+    scene.step(1);
+    EXPECT_EQ(scene.deferred_transfer(), 0u) << "one step samples this small cube's deferred vertices";
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "piece pulled away under the sky");
+    // Moved back and again before any step: the vertices still waiting keep waiting, and the end is
+    // the same as a fresh scene's.
+    update = scene.apply_change(doc.mesh(), *doc.undo());
+    EXPECT_GT(scene.deferred_transfer(), 0u);
+    pull.transform.translation = Eigen::Vector3d(0.2, -0.3, 0.1);
+    scene.apply_change(doc.mesh(), doc.apply(pull));
+    expect_matches_fresh_solve(scene, doc.mesh(), lighting, "moved twice without a step between");
 
     lighting.environment->rotation_degrees = 120;
     lighting.environment->intensity = 1.5;

@@ -232,6 +232,34 @@ TEST(EnvironmentLight, UpdatingTheVerticesThatSeeAChangeEqualsRecomputingAll) {
         const std::span<const float> a = after.at(s), b = carried.at(s);
         EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin())) << s;
     }
+
+    // Deferred: only the moved plate corners are sampled now; the sphere's vertices that see the plate
+    // keep their old vectors and are listed, and sampling the list later gives the same vectors again.
+    size_t now = 0;
+    std::vector<int32_t> deferred;
+    EnvironmentTransfer deferring = carry_environment_transfer(before_surface, before, surface, bvh, {}, &now, {}, &deferred);
+    EXPECT_EQ(now, 4u);
+    EXPECT_EQ(now + deferred.size(), recomputed);
+    size_t stale = 0;
+    for (const int32_t s : deferred) {
+        const std::span<const float> a = after.at(s), b = std::as_const(deferring).at(s);
+        stale += !std::equal(a.begin(), a.end(), b.begin());
+    }
+    EXPECT_GT(stale, 0u) << "the plate shadows some of the listed vertices";
+    // A further carry with nothing changed keeps the list waiting, or samples it when not deferring.
+    std::vector<int32_t> still;
+    const EnvironmentTransfer again =
+        carry_environment_transfer(surface, deferring, surface, bvh, {}, &now, deferred, &still);
+    EXPECT_EQ(now, 0u);
+    EXPECT_EQ(still, deferred);
+    const EnvironmentTransfer sampled = carry_environment_transfer(surface, deferring, surface, bvh, {}, &now, deferred);
+    EXPECT_EQ(now, deferred.size());
+    update_environment_transfer(surface, bvh, deferred, deferring);
+    for (size_t s = 0; s < n; ++s) {
+        const std::span<const float> a = after.at(s), b = std::as_const(deferring).at(s), c = sampled.at(s);
+        EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin())) << s;
+        EXPECT_TRUE(std::equal(a.begin(), a.end(), c.begin())) << s;
+    }
 }
 
 TEST(EnvironmentLight, RotationMovesTheLitSide) {
