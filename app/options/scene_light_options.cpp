@@ -12,7 +12,7 @@
 
 namespace waxwork {
 
-void add_scene_light_options(CLI::App& command, SceneLightOptions& options) {
+void add_scene_light_options(CLI::App& command, SceneLightOptions& options, bool monte_carlo) {
     add_material_options(command, options.material);
     command
         .add_option("--light", options.lights,
@@ -27,9 +27,17 @@ void add_scene_light_options(CLI::App& command, SceneLightOptions& options) {
                        "Environment light: FILE.hdr[:ROT_DEG[:INTENSITY]] (equirectangular Radiance image, rotated "
                        "about +y) or sky:SUN_ELEV_DEG,SUN_AZIM_DEG[,TURBIDITY][:ROT_DEG[:INTENSITY]] (a clear sky "
                        "with its sun; azimuth from +z towards +x); replaces the default key light and ambient");
-    command.add_option("--method", options.method, "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass)")
-        ->check(CLI::IsMember({"transcut", "fem"}))
-        ->capture_default_str();
+    if (monte_carlo)
+        command
+            .add_option("--method", options.method,
+                        "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass), or mc: a Monte Carlo "
+                        "path tracer through the volume (the physical reference; see --mc-seconds)")
+            ->check(CLI::IsMember({"transcut", "fem", "mc"}))
+            ->capture_default_str();
+    else
+        command.add_option("--method", options.method, "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass)")
+            ->check(CLI::IsMember({"transcut", "fem"}))
+            ->capture_default_str();
     command.add_option("--tol", options.tolerance, "Relative tolerance of the diffusion solve")->capture_default_str();
     command
         .add_option("--backend", options.backend,
