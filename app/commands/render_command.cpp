@@ -2,7 +2,6 @@
 // `--method mc` traces the light with the Monte Carlo reference (solver/reference/monte_carlo.h) instead.
 #include "app/commands.h"
 #include "app/options/scene_light_options.h"
-#include "app/stderr_progress.h"
 #include "base/error.h"
 #include "io/file_extension.h"
 #include "io/volume_file.h"
@@ -19,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -109,6 +109,31 @@ std::string trace_status(const MonteCarloProgress& p) {
     return line;
 }
 
+// The trace reports after every round (several a second), so it keeps its own status line on stderr,
+// rewritten in place ("\r") at most once a second and blanked when the trace ends or fails, so that
+// stderr keeps its one-line error (StderrProgress shows a stage only once it has run for a second).
+class TraceStatusLine {
+public:
+    explicit TraceStatusLine(std::string prefix) : prefix_(std::move(prefix)) {}
+    ~TraceStatusLine() {
+        if (shown_ > 0) std::cerr << '\r' << std::string(shown_, ' ') << '\r' << std::flush;
+    }
+    void show(const MonteCarloProgress& p) {
+        if (p.seconds < next_) return;
+        next_ = p.seconds + 1;
+        std::string line = prefix_ + trace_status(p);
+        const size_t length = line.size();
+        if (length < shown_) line += std::string(shown_ - length, ' ');
+        std::cerr << '\r' << line << std::flush;
+        shown_ = std::max(shown_, length);
+    }
+
+private:
+    std::string prefix_;
+    double next_ = 1;  // seconds into the trace
+    size_t shown_ = 0;
+};
+
 struct TracedRender {
     VolumeRender render;
     MonteCarloFluence fluence;
@@ -123,12 +148,13 @@ TracedRender render_traced(const TetMesh& mesh, const RenderCommandOptions& o, c
     SolvedScene& scene = light.scene;
     const TriangleBvh bvh = settings.lighting.shadows ? build_shadow_bvh(scene.surface) : TriangleBvh();
     const std::vector<PhotonSource> sources = photon_sources(scene.surface, bvh, settings.lighting);
-    StderrProgress progress("waxwork: " + o.volume + ": ");
     TracedRender traced;
-    traced.fluence = trace_fluence(mesh, light.connectivity, light.materials, scene.surface, sources,
-                                   monte_carlo_options(o, settings.diffusion.mm_per_unit),
-                                   [&](const MonteCarloProgress& p) { progress.set_stage(trace_status(p)); }, &progress);
-    progress.finish();
+    {
+        TraceStatusLine status("waxwork: " + o.volume + ": ");
+        traced.fluence = trace_fluence(mesh, light.connectivity, light.materials, scene.surface, sources,
+                                       monte_carlo_options(o, settings.diffusion.mm_per_unit),
+                                       [&](const MonteCarloProgress& p) { status.show(p); });
+    }
     std::array<double, 3> mc_sum{}, diffusion_sum{};
     for (int32_t v : light.connectivity.boundary_vertices)
         for (int c = 0; c < 3; ++c) {

@@ -202,6 +202,23 @@ TEST_F(Render, MonteCarloWritesPhiWithStandardErrors) {
     for (size_t v = 0; v < f.rows.size(); ++v) EXPECT_EQ(g.rows[v].phi, f.rows[v].phi);
 }
 
+TEST_F(Render, MonteCarloStopsAtItsTimeBudgetShowingItsError) {
+    // An error target out of reach: the time budget stops the trace, and the status line (rewritten
+    // each second, blanked at the end) showed the current error meanwhile.
+    const auto r = run_waxwork("render " + volume_.string() + " -o " + (dir_ / "mct.png").string() +
+                               " --material marble --scale 2 --width 32 --height 24 --method mc --mc-error 0.0001 "
+                               "--mc-seconds 2.5 --seed 3");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto mc = nlohmann::json::parse(r.out)["monte_carlo"];
+    EXPECT_EQ(mc["stopped_by"], "seconds");
+    EXPECT_GE(mc["seconds"].get<double>(), 2.5);
+    EXPECT_EQ(mc["seed"], 3);
+    EXPECT_NE(r.err.find("monte carlo: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("relative error"), std::string::npos) << r.err;
+    ASSERT_FALSE(r.err.empty());
+    EXPECT_EQ(r.err.back(), '\r') << r.err;  // blanked: the next output starts on a clean line
+}
+
 TEST_F(Render, MonteCarloBadInputIsAOneLineError) {
     const std::string base = "render " + volume_.string() + " -o " + (dir_ / "mcbad.png").string() +
                              " --width 32 --height 24 ";
