@@ -79,7 +79,7 @@ struct MonteCarloOptions {
     double target_relative_error = 0;     // relative_error() of every channel at most this
     int min_batches = 16;                 // before the error target is trusted
     // Russian roulette (implicit capture): a photon below this fraction of its initial weight survives
-    // with probability kRouletteSurvival, its weight divided by it.
+    // with probability 0.1, its weight divided by it.
     double roulette_threshold = 1e-4;
     // A photon that takes more steps than this is dropped and counted (lost_photons).
     int64_t max_steps = 100'000'000;
