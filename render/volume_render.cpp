@@ -44,11 +44,11 @@ VolumeLight solve_volume_light(const TetMesh& mesh, const std::string& volume_na
     return solve_light(mesh, volume_name, settings, context ? &context->gl() : nullptr);
 }
 
-VolumeRender render_volume(const TetMesh& mesh, const std::string& volume_name, const VolumeRenderSettings& settings) {
-    check_not_empty(mesh, volume_name);
-    // One OpenGL context for the GPU solve and the renderer (the same device).
-    HeadlessGlContext context;
-    VolumeLight solved = solve_light(mesh, volume_name, settings, &context.gl());
+namespace {
+
+// Draws a solved light in `context`: the drawing half of render_volume.
+VolumeRender draw_volume_light(const TetMesh& mesh, VolumeLight solved, const VolumeRenderSettings& settings,
+                               HeadlessGlContext& context) {
     VolumeRender result;
     result.connectivity = std::move(solved.connectivity);
     result.materials = std::move(solved.materials);
@@ -66,6 +66,20 @@ VolumeRender render_volume(const TetMesh& mesh, const std::string& volume_name, 
     for (const Light& light : settings.lighting.lights)
         result.lights_inside += radiates_from_centre(light.type) && point_inside_volume(mesh, light.vector);
     return result;
+}
+
+}  // namespace
+
+VolumeRender render_volume(const TetMesh& mesh, const std::string& volume_name, const VolumeRenderSettings& settings) {
+    check_not_empty(mesh, volume_name);
+    // One OpenGL context for the GPU solve and the renderer (the same device).
+    HeadlessGlContext context;
+    return draw_volume_light(mesh, solve_light(mesh, volume_name, settings, &context.gl()), settings, context);
+}
+
+VolumeRender render_volume_light(const TetMesh& mesh, VolumeLight light, const VolumeRenderSettings& settings) {
+    HeadlessGlContext context;
+    return draw_volume_light(mesh, std::move(light), settings, context);
 }
 
 }  // namespace waxwork

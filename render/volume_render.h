@@ -54,4 +54,8 @@ VolumeLight solve_volume_light(const TetMesh& mesh, const std::string& volume_na
 // data (stored materials no solve can use) name `volume_name`.
 VolumeRender render_volume(const TetMesh& mesh, const std::string& volume_name, const VolumeRenderSettings& settings);
 
+// Draws a light solved by solve_volume_light, possibly changed since (a fluence from elsewhere, with
+// its radiance factors recomputed: `render --method mc`), as render_volume draws its own.
+VolumeRender render_volume_light(const TetMesh& mesh, VolumeLight light, const VolumeRenderSettings& settings);
+
 }  // namespace waxwork

@@ -1,4 +1,5 @@
 // `waxwork render VOLUME -o IMAGE.png`: a volume, its materials and lights -> diffusion -> a PNG.
+// `--method mc` traces the light with the Monte Carlo reference (solver/reference/monte_carlo.h) instead.
 #include "app/commands.h"
 #include "app/options/scene_light_options.h"
 #include "base/error.h"
@@ -10,12 +11,16 @@
 #include "scene/fields_csv.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
+#include "solver/radiance.h"
+#include "solver/reference/monte_carlo.h"
 #include "solver/solved_scene.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -36,7 +41,16 @@ struct RenderCommandOptions {
     std::string slice_normal;
     double slice_offset = 0;
     bool quality_interior = false;
+    // --method mc: the trace stops at the first of the time budget and the error target.
+    std::optional<double> mc_seconds;
+    std::optional<double> mc_error;
+    std::optional<double> mc_g;
+    std::optional<uint64_t> seed;
 };
+
+// Defaults of the trace: a minute at most, 1% relative standard error at the boundary.
+constexpr double kDefaultMcSeconds = 60;
+constexpr double kDefaultMcError = 0.01;
 
 // The view --show asks for, checked before any work.
 ViewOptions view_options(const RenderCommandOptions& o) {
@@ -63,6 +77,95 @@ void check_options(const RenderCommandOptions& o) {
         const Eigen::Vector3d v(o.view[0], o.view[1], o.view[2]);
         if (!v.allFinite() || v.norm() == 0) fail("--view must be a finite, non-zero direction");
     }
+    if (o.light.method != "mc") {
+        if (o.mc_seconds || o.mc_error || o.mc_g || o.seed)
+            fail("--mc-seconds, --mc-error, --mc-g and --seed apply only with --method mc");
+        return;
+    }
+    if (o.mc_seconds && !(*o.mc_seconds > 0 && std::isfinite(*o.mc_seconds)))
+        fail("--mc-seconds must be a positive, finite number of seconds");
+    if (o.mc_error && !(*o.mc_error > 0 && *o.mc_error < 1))
+        fail("--mc-error must be a relative standard error in (0, 1)");
+    if (o.mc_g && !(*o.mc_g > -1 && *o.mc_g < 1)) fail("--mc-g must be a Henyey-Greenstein anisotropy in (-1, 1)");
+}
+
+// The trace's options from the command's.
+MonteCarloOptions monte_carlo_options(const RenderCommandOptions& o, double mm_per_unit) {
+    MonteCarloOptions mc;
+    mc.mm_per_unit = mm_per_unit;
+    mc.anisotropy = o.mc_g.value_or(kDefaultMonteCarloAnisotropy);
+    mc.seed = o.seed.value_or(1);
+    mc.max_seconds = o.mc_seconds.value_or(kDefaultMcSeconds);
+    mc.target_relative_error = o.mc_error.value_or(kDefaultMcError);
+    return mc;
+}
+
+// The status line of a running trace.
+std::string trace_status(const MonteCarloProgress& p) {
+    char line[160];
+    std::snprintf(line, sizeof line, "monte carlo: %lld photons per channel, relative error %.2f%% %.2f%% %.2f%%, %.0f s",
+                  static_cast<long long>(p.photons), 100 * p.relative_error[0], 100 * p.relative_error[1],
+                  100 * p.relative_error[2], p.seconds);
+    return line;
+}
+
+// The trace reports after every round (several a second), so it keeps its own status line on stderr,
+// rewritten in place ("\r") at most once a second and blanked when the trace ends or fails, so that
+// stderr keeps its one-line error (StderrProgress shows a stage only once it has run for a second).
+class TraceStatusLine {
+public:
+    explicit TraceStatusLine(std::string prefix) : prefix_(std::move(prefix)) {}
+    ~TraceStatusLine() {
+        if (shown_ > 0) std::cerr << '\r' << std::string(shown_, ' ') << '\r' << std::flush;
+    }
+    void show(const MonteCarloProgress& p) {
+        if (p.seconds < next_) return;
+        next_ = p.seconds + 1;
+        std::string line = prefix_ + trace_status(p);
+        const size_t length = line.size();
+        if (length < shown_) line += std::string(shown_ - length, ' ');
+        std::cerr << '\r' << line << std::flush;
+        shown_ = std::max(shown_, length);
+    }
+
+private:
+    std::string prefix_;
+    double next_ = 1;  // seconds into the trace
+    size_t shown_ = 0;
+};
+
+struct TracedRender {
+    VolumeRender render;
+    MonteCarloFluence fluence;
+    std::array<double, 3> over_diffusion{};  // sum of phi over boundary vertices, MC over diffusion
+};
+
+// Solves the diffusion for the surface and its light (and as a comparison), traces the fluence, and
+// draws the image from the traced phi through the same radiance (Eq. 3) the diffusion image uses: an
+// interim picture until camera rays trace the exitant light themselves.
+TracedRender render_traced(const TetMesh& mesh, const RenderCommandOptions& o, const VolumeRenderSettings& settings) {
+    VolumeLight light = solve_volume_light(mesh, o.volume, settings);
+    SolvedScene& scene = light.scene;
+    const TriangleBvh bvh = settings.lighting.shadows ? build_shadow_bvh(scene.surface) : TriangleBvh();
+    const std::vector<PhotonSource> sources = photon_sources(scene.surface, bvh, settings.lighting);
+    TracedRender traced;
+    {
+        TraceStatusLine status("waxwork: " + o.volume + ": ");
+        traced.fluence = trace_fluence(mesh, light.connectivity, light.materials, scene.surface, sources,
+                                       monte_carlo_options(o, settings.diffusion.mm_per_unit),
+                                       [&](const MonteCarloProgress& p) { status.show(p); });
+    }
+    std::array<double, 3> mc_sum{}, diffusion_sum{};
+    for (int32_t v : light.connectivity.boundary_vertices)
+        for (int c = 0; c < 3; ++c) {
+            mc_sum[c] += traced.fluence.phi[v][c];
+            diffusion_sum[c] += scene.diffusion.phi[v][c];
+        }
+    for (int c = 0; c < 3; ++c) traced.over_diffusion[c] = diffusion_sum[c] > 0 ? mc_sum[c] / diffusion_sum[c] : 0.0;
+    scene.diffusion.phi = traced.fluence.phi;
+    scene.radiance_factor = shading_radiance_factors(scene.surface, scene.shading, scene.diffusion.phi, scene.shading_light.q);
+    traced.render = render_volume_light(mesh, std::move(light), settings);
+    return traced;
 }
 
 // The camera's up vector is +y; a view straight along y would leave it undefined, so use -z then.
@@ -91,13 +194,17 @@ void run_render_command(const RenderCommandOptions& o) {
     if (o.exposure) settings.image.exposure = static_cast<float>(*o.exposure);
     settings.view = view;
 
-    const VolumeRender render = render_volume(mesh, o.volume, settings);
+    const bool traced = o.light.method == "mc";
+    std::optional<TracedRender> trace;
+    if (traced) trace.emplace(render_traced(mesh, o, settings));
+    const VolumeRender render = traced ? std::move(trace->render) : render_volume(mesh, o.volume, settings);
     const SolvedScene& scene = render.scene;
     if (!scene.diffusion.gpu_fallback_reason.empty())
         std::cerr << "warning: solving on the CPU instead: " << scene.diffusion.gpu_fallback_reason << "\n";
     write_png(render.image, o.output);
     report_chosen_scale(o.volume, scale, mesh);
-    if (!o.fields.empty()) write_fields_csv(o.fields, mesh, render.connectivity, scene);
+    if (!o.fields.empty())
+        write_fields_csv(o.fields, mesh, render.connectivity, scene, traced ? &trace->fluence.phi_error : nullptr);
 
     const DiffusionSolution& s = scene.diffusion;
     nlohmann::ordered_json summary = {
@@ -122,6 +229,20 @@ void run_render_command(const RenderCommandOptions& o) {
         {"render_ms", render.render_ms},
         {"view", view_mode_name(view.mode)},
     };
+    if (traced) {
+        const MonteCarloFluence& mc = trace->fluence;
+        summary["monte_carlo"] = {
+            {"photons_per_channel", mc.photons},
+            {"batches", mc.batches},
+            {"seconds", mc.seconds},
+            {"relative_error", mc.relative_error},
+            {"stopped_by", mc.stop_reason},
+            {"seed", o.seed.value_or(1)},
+            {"anisotropy", o.mc_g.value_or(kDefaultMonteCarloAnisotropy)},
+            {"lost_photons", mc.lost_photons},
+            {"over_diffusion", trace->over_diffusion},
+        };
+    }
     if (view.mode != ViewMode::Radiance) summary["legend"] = render.view.legend.title;
     if (!o.fields.empty()) summary["fields"] = o.fields;
     std::cout << summary.dump() << "\n";
@@ -134,7 +255,15 @@ void add_render_command(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("render", "Solve the light diffusion in a volume and render a PNG");
     cmd->add_option("volume", options->volume, "Volume file (.vtu, .msh, .mesh, .node/.ele)")->required();
     cmd->add_option("-o,--output", options->output, "PNG image to write")->required();
-    add_scene_light_options(*cmd, options->light);
+    add_scene_light_options(*cmd, options->light, true);
+    cmd->add_option("--mc-seconds", options->mc_seconds,
+                    "--method mc: stop tracing after this many seconds (default 60)");
+    cmd->add_option("--mc-error", options->mc_error,
+                    "--method mc: stop once the relative standard error of phi at the boundary is at most this in "
+                    "every channel (default 0.01)");
+    cmd->add_option("--mc-g", options->mc_g,
+                    "--method mc: Henyey-Greenstein anisotropy g, mu_s = mu_s' / (1 - g) (default 0, isotropic)");
+    cmd->add_option("--seed", options->seed, "--method mc: random seed; the same seed gives the same result (default 1)");
     cmd->add_option("--width", options->width, "Image width in pixels")->capture_default_str();
     cmd->add_option("--height", options->height, "Image height in pixels")->capture_default_str();
     cmd->add_option("--fields", options->fields, "Also write q, phi and exitant radiance per vertex to this CSV");
@@ -159,7 +288,11 @@ void add_render_command(CLI::App& app) {
         "Shadows are cast by the whole volume; a point light, or a sphere light centred, inside the object\n"
         "lights nothing (counted in the summary's lights_inside); area lights cast soft shadows. Exposure is automatic: the 95th percentile of the luminance of the\n"
         "subsurface radiance at camera-facing boundary vertices maps to 0.6 before ACES tone mapping;\n"
-        "--exposure sets the multiplier instead. The summary (one JSON line) reports it.");
+        "--exposure sets the multiplier instead. The summary (one JSON line) reports it.\n"
+        "--method mc traces photons through the volume (per-tet coefficients, Fresnel at the boundary, the same\n"
+        "lights and shadows) until --mc-seconds or --mc-error, with a status line on stderr; --fields gains\n"
+        "phi_err_r,phi_err_g,phi_err_b (standard errors). The image is, for now, drawn from the traced phi with\n"
+        "the diffusion image's radiance; the summary's monte_carlo.over_diffusion compares the two fluences.");
     cmd->callback([options] { run_render_command(*options); });
 }
 

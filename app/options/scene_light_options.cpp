@@ -12,7 +12,7 @@
 
 namespace waxwork {
 
-void add_scene_light_options(CLI::App& command, SceneLightOptions& options) {
+void add_scene_light_options(CLI::App& command, SceneLightOptions& options, bool monte_carlo) {
     add_material_options(command, options.material);
     command
         .add_option("--light", options.lights,
@@ -30,9 +30,17 @@ void add_scene_light_options(CLI::App& command, SceneLightOptions& options) {
     command.add_flag("--no-env-background", options.hide_environment,
                      "Draw the background colour behind the model instead of the environment (it still lights and "
                      "is reflected)");
-    command.add_option("--method", options.method, "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass)")
-        ->check(CLI::IsMember({"transcut", "fem"}))
-        ->capture_default_str();
+    if (monte_carlo)
+        command
+            .add_option("--method", options.method,
+                        "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass), or mc: a Monte Carlo "
+                        "path tracer through the volume (the physical reference; see --mc-seconds)")
+            ->check(CLI::IsMember({"transcut", "fem", "mc"}))
+            ->capture_default_str();
+    else
+        command.add_option("--method", options.method, "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass)")
+            ->check(CLI::IsMember({"transcut", "fem"}))
+            ->capture_default_str();
     command.add_option("--tol", options.tolerance, "Relative tolerance of the diffusion solve")->capture_default_str();
     command
         .add_option("--backend", options.backend,

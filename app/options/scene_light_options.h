@@ -40,8 +40,9 @@ struct SceneLightOptions {
     std::string backend = "cpu";
 };
 
-// Registers the options on `command`.
-void add_scene_light_options(CLI::App& command, SceneLightOptions& options);
+// Registers the options on `command`. With `monte_carlo`, --method also takes mc (the command traces
+// the light instead of solving the diffusion; see render).
+void add_scene_light_options(CLI::App& command, SceneLightOptions& options, bool monte_carlo = false);
 
 // Throws InvalidArgumentError for a scale, tolerance, ambient or crease angle out of range. Physically
 // meaningless values are refused before any work: a scale beyond validate_mm_per_unit's bounds is a
@@ -53,7 +54,8 @@ void check_scene_light_options(const SceneLightOptions& options);
 Lighting chosen_lighting(const SceneLightOptions& options);
 
 // The solve's part of render_volume's settings: material, lighting, diffusion (at `scale`) and crease
-// angle; the image and view stay at their defaults.
+// angle; the image and view stay at their defaults. --method mc gives TransCut's settings: the
+// command solves the diffusion for the surface, its light and a comparison, then traces.
 VolumeRenderSettings scene_light_settings(const SceneLightOptions& options, const ModelScale& scale);
 
 // The scale a volume is lit at: --scale, else the file's stored scale, else one chosen from its size.

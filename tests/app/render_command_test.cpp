@@ -179,6 +179,84 @@ TEST_F(Render, FemAgreesWithTransCut) {
     }
 }
 
+TEST_F(Render, MonteCarloWritesPhiWithStandardErrors) {
+    // A 4 mm cube of marble (2 model units at 2 mm per unit) traced to 5% relative standard error at the
+    // boundary: the fields gain the standard errors, the seed makes the run repeatable, and the traced
+    // fluence is the diffusion's within what the two models legitimately differ by near a lit surface.
+    const std::string common = volume_.string() + " --material marble --light dir:-1,-0.5,-0.2 --scale 2 "
+                                                  "--width 64 --height 48 --method mc --mc-error 0.05 --mc-seconds 20";
+    const auto a = run_waxwork("render " + common + " -o " + (dir_ / "mc.png").string() + " --fields " +
+                               (dir_ / "mc.csv").string());
+    ASSERT_EQ(a.exit_code, 0) << a.err;
+    const auto summary = nlohmann::json::parse(a.out);
+    EXPECT_EQ(summary["method"], "mc");
+    const auto& mc = summary["monte_carlo"];
+    EXPECT_EQ(mc["stopped_by"], "error") << a.out;
+    EXPECT_EQ(mc["seed"], 1);
+    EXPECT_EQ(mc["lost_photons"], 0);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_LE(mc["relative_error"][c].get<double>(), 0.05);
+        EXPECT_NEAR(mc["over_diffusion"][c].get<double>(), 1.0, 0.3) << a.out;
+    }
+    const Fields f = read_fields(dir_ / "mc.csv");
+    EXPECT_EQ(f.header, std::string(kHeader) + ",phi_err_r,phi_err_g,phi_err_b");
+    EXPECT_TRUE(f.all_finite);
+    ASSERT_EQ(f.rows.size(), vertices_);
+    for (const auto& r : f.rows) {
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_GT(r.phi[c], 0);
+            EXPECT_GT(r.phi_err[c], 0);
+            EXPECT_LT(r.phi_err[c], r.phi[c]);
+        }
+    }
+    EXPECT_TRUE(fs::exists(dir_ / "mc.png"));
+    // The same seed, the same fluence; the trace is bit-identical on any thread count.
+    const auto b = run_waxwork("render " + common + " -o " + (dir_ / "mc2.png").string() + " --fields " +
+                               (dir_ / "mc2.csv").string());
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    const Fields g = read_fields(dir_ / "mc2.csv");
+    ASSERT_EQ(g.rows.size(), f.rows.size());
+    for (size_t v = 0; v < f.rows.size(); ++v) EXPECT_EQ(g.rows[v].phi, f.rows[v].phi);
+}
+
+TEST_F(Render, MonteCarloStopsAtItsTimeBudgetShowingItsError) {
+    // An error target out of reach: the time budget stops the trace, and the status line (rewritten
+    // each second, blanked at the end) showed the current error meanwhile.
+    const auto r = run_waxwork("render " + volume_.string() + " -o " + (dir_ / "mct.png").string() +
+                               " --material marble --scale 2 --width 32 --height 24 --method mc --mc-error 0.0001 "
+                               "--mc-seconds 2.5 --seed 3");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto mc = nlohmann::json::parse(r.out)["monte_carlo"];
+    EXPECT_EQ(mc["stopped_by"], "seconds");
+    EXPECT_GE(mc["seconds"].get<double>(), 2.5);
+    EXPECT_EQ(mc["seed"], 3);
+    EXPECT_NE(r.err.find("monte carlo: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("relative error"), std::string::npos) << r.err;
+    ASSERT_FALSE(r.err.empty());
+    EXPECT_EQ(r.err.back(), '\r') << r.err;  // blanked: the next output starts on a clean line
+}
+
+TEST_F(Render, MonteCarloBadInputIsAOneLineError) {
+    const std::string base = "render " + volume_.string() + " -o " + (dir_ / "mcbad.png").string() +
+                             " --width 32 --height 24 ";
+    for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+             {"--method mc --mc-seconds 0", "--mc-seconds must be a positive, finite number of seconds"},
+             {"--method mc --mc-seconds -1", "--mc-seconds must be a positive, finite number of seconds"},
+             {"--method mc --mc-seconds nan", "--mc-seconds must be a positive, finite number of seconds"},
+             {"--method mc --mc-error 0", "--mc-error must be a relative standard error in (0, 1)"},
+             {"--method mc --mc-error nan", "--mc-error must be a relative standard error in (0, 1)"},
+             {"--method mc --mc-error 1", "--mc-error must be a relative standard error in (0, 1)"},
+             {"--method mc --mc-g 1", "--mc-g must be a Henyey-Greenstein anisotropy in (-1, 1)"},
+             {"--seed 3", "apply only with --method mc"},
+             {"--method fem --mc-seconds 3", "apply only with --method mc"}}) {
+        const auto r = run_waxwork(base + args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_EQ(line_count(r.err), 1u) << args << ": " << r.err;
+        EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir_ / "mcbad.png"));
+}
+
 TEST_F(Render, GpuBackendAgreesWithTheCpuAndFallsBackWithAWarning) {
     const std::string common = volume_.string() + " --material marble --light dir:-1,-0.5,-0.2 --scale 10 "
                                                   "--width 64 --height 48";
