@@ -22,6 +22,10 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
+// cos(10 degrees): a deferred vertex's normal turned by at most this much since its vector was sampled,
+// so the lobe it integrates is nearly the same.
+constexpr double kDeferrableNormalCosine = 0.98480775301220802;
+
 // An orthonormal tangent frame around unit n (orthonormal_basis).
 struct TangentFrame {
     Eigen::Vector3d t, b, n;
@@ -322,11 +326,20 @@ EnvironmentTransfer carry_environment_transfer(const BoundarySurface& old_surfac
         const int32_t o = old_of_surface[s];
         const bool in_place = o >= 0 && !moved[s] && old_surface.normals[o] == surface.normals[s] &&
                               old_surface.eta[o] == surface.eta[s] && old_offset[o] == offset[s];
-        const bool stale = in_place && (sees[s] || old_waiting[o]);
-        if (in_place && (!stale || deferred)) {
+        if (in_place && !sees[s] && !old_waiting[o]) {
             const auto from = old_transfer.at(o);
             std::copy(from.begin(), from.end(), transfer.at(s).begin());
-            if (stale) deferred->push_back(static_cast<int32_t>(s));
+            continue;
+        }
+        // A vertex that was there before with the same eta and a normal turned by little (a cut's
+        // relaxation, a piece moved without much turning) can stand in with its old vector for a few
+        // frames; a new vertex or a turned one has nothing to stand in with.
+        const bool close = o >= 0 && old_surface.eta[o] == surface.eta[s] &&
+                           old_surface.normals[o].dot(surface.normals[s]) >= kDeferrableNormalCosine;
+        if (deferred && close) {
+            const auto from = old_transfer.at(o);
+            std::copy(from.begin(), from.end(), transfer.at(s).begin());
+            deferred->push_back(static_cast<int32_t>(s));
             continue;
         }
         again.push_back(static_cast<int32_t>(s));

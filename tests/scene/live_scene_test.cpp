@@ -150,8 +150,12 @@ TEST(LiveScene, FollowsTheEnvironmentThroughEditsAndTurns) {
     // the same as a fresh scene's.
     update = scene.apply_change(doc.mesh(), *doc.undo());
     EXPECT_GT(scene.deferred_transfer(), 0u);
+    // Turned by 35 degrees: the piece's normals turned too far for its old vectors to stand in, so it
+    // is sampled at once.
+    pull.transform.rotation = Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     pull.transform.translation = Eigen::Vector3d(0.2, -0.3, 0.1);
-    scene.apply_change(doc.mesh(), doc.apply(pull));
+    update = scene.apply_change(doc.mesh(), doc.apply(pull));
+    EXPECT_GT(update.resampled_transfer, 0u);
     expect_matches_fresh_solve(scene, doc.mesh(), lighting, "moved twice without a step between");
 
     lighting.environment->rotation_degrees = 120;

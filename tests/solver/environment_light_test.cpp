@@ -233,8 +233,9 @@ TEST(EnvironmentLight, UpdatingTheVerticesThatSeeAChangeEqualsRecomputingAll) {
         EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin())) << s;
     }
 
-    // Deferred: only the moved plate corners are sampled now; the sphere's vertices that see the plate
-    // keep their old vectors and are listed, and sampling the list later gives the same vectors again.
+    // Deferred: the sphere's vertices that see the plate keep their old vectors and are listed, and
+    // sampling the list later gives the same vectors again. The plate's corners, whose normals vanish
+    // (its two sides cancel), have no direction to stand in with and are sampled at once.
     size_t now = 0;
     std::vector<int32_t> deferred;
     EnvironmentTransfer deferring = carry_environment_transfer(before_surface, before, surface, bvh, {}, &now, {}, &deferred);
