@@ -11,10 +11,11 @@
 // one-ring's covariance, which in 3D mixes negative cotangent weights (obtuse dihedral angles) into
 // the covariance and can make the fitted rotation meaningless. Per tet, E = 0 exactly when every tet
 // moves rigidly, which is what "a tet keeps its shape" means for the tests and the guard. The cost is
-// one 3x3 SVD per tet (about 5.5 per vertex) per iteration, run in parallel.
+// one 3x3 polar decomposition per tet (about 4 tets per vertex) per iteration, run in parallel.
 //
 // Local/global iterations (paper Sec. 3): with the positions fixed, each R_t is the rotation nearest
-// F_t (polar part, by SVD with the reflection fixed, Eq. 6 and the remark after it); with the
+// F_t (Eq. 6 and the remark after it: the SVD's U V^T with the reflection fixed; computed as the
+// polar factor by Newton's iteration where det F_t > 0, by Jacobi SVD elsewhere); with the
 // rotations fixed, the positions solve K x = sum_t vol_t R_t B_t^T, K fixed for a fixed set of
 // constrained vertices (Eq. 9: constrained vertices move to the right-hand side). K is factored once
 // per constraint set (sparse Cholesky: CHOLMOD supernodal when the build found it, Eigen's
