@@ -86,6 +86,22 @@ BENCHMARK(BM_ArapDragFrame)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+// The guard every drag frame runs after its iterations (guard_step over the body's tets), when the
+// whole step passes: one minimum-dihedral and volume check of every tet.
+void BM_ArapGuardStep(benchmark::State& state) {
+    const DragSetup& s = drag_setup(static_cast<size_t>(state.range(0)));
+    ArapDeformer deformer(s.mesh, s.region.body_tets);
+    deformer.set_constrained(s.region.constrained());
+    deformer.solve(drag_targets(s.region, s.mesh.positions, 1.0 / 30), 2);
+    for (auto _ : state) {
+        const GuardedStep step = guard_step(s.mesh, s.region.body_tets, s.mesh.positions, deformer.positions());
+        benchmark::DoNotOptimize(step.min_dihedral_deg);
+        state.counters["halvings"] = step.halvings;
+    }
+    add_size_counters(state, s);
+}
+BENCHMARK(BM_ArapGuardStep)->Arg(100'000)->Iterations(10)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 // The drag in 10 frames of k iterations each; counters: the final energy's excess over converged (the
 // same final targets after 200 more iterations from the k = 8 drag), in percent.
 void BM_ArapIterationsPerFrame(benchmark::State& state) {
