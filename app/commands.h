@@ -16,6 +16,7 @@ void add_demo_command(CLI::App& app);
 void add_cut_command(CLI::App& app);
 void add_fracture_command(CLI::App& app);
 void add_paint_command(CLI::App& app);
+void add_deform_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_edit_command(CLI::App& app);
@@ -28,6 +29,7 @@ inline void register_commands(CLI::App& app) {
     add_cut_command(app);
     add_fracture_command(app);
     add_paint_command(app);
+    add_deform_command(app);
     add_run_command(app);
     add_demo_command(app);
     add_bench_command(app);

@@ -10,8 +10,8 @@
 // through a Document, as the editor and sessions do, then writes the volume and prints a one-line JSON
 // summary on stdout.
 #include "app/options/material_options.h"
+#include "app/options/number_options.h"
 #include "base/error.h"
-#include "base/number_list.h"
 #include "base/timing.h"
 #include "io/volume_file.h"
 #include "scene/document.h"
@@ -40,25 +40,6 @@ namespace waxwork {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// Comma-separated finite numbers, exactly `count` of them, blanks allowed around each; `what` names
-// the option in errors. A value beyond double's normal range (overflow, or underflow to a subnormal)
-// is refused as not a finite number: it is a typing error, not a plane or a position.
-std::vector<double> parse_numbers(const std::string& text, size_t count, const std::string& what) {
-    std::vector<double> values;
-    const bool numbers = parse_number_list(text, values, NumberSpacing::Blanks) &&
-                         std::all_of(values.begin(), values.end(), [](double v) {
-                             return v == 0 || std::isnormal(v);
-                         });
-    if (!numbers)
-        throw InvalidArgumentError(what + ": \"" + text + "\" is not " +
-                                   (count == 1 ? std::string("a finite number")
-                                               : std::to_string(count) + " comma-separated finite numbers"));
-    if (values.size() != count)
-        throw InvalidArgumentError(what + ": expected " + std::to_string(count) + " comma-separated numbers, got " +
-                                   std::to_string(values.size()) + " in \"" + text + "\"");
-    return values;
-}
 
 // The volume a command edits, in the Document the editor and sessions edit through (scene/document.h),
 // so the three cannot apply an operation differently. Nothing is undone on the command line: with no

@@ -1,0 +1,144 @@
+// As-rigid-as-possible deformation (tetops/arap_deformation.h) on spot at 100K and 500K tets: the
+// factorisation when the handle changes, one drag frame's local/global iterations, and how many
+// iterations per frame keep the energy within 1% of converged while dragging.
+// Targets: factorisation <= 1 s at 100K; a frame's iterations within a 30 fps budget at 100K (with
+// the lighting), >= 10 fps at 500K.
+#include "tetops/arap_deformation.h"
+#include "tetops/connectivity.h"
+#include "bench_main.h"
+#include "bench_meshes.h"
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <map>
+
+namespace waxwork {
+namespace {
+
+// The drag every benchmark runs: the handle at spot's highest vertex (radius 15% of the bounding-box
+// diagonal), a pin at its lowest (20%), moved by 10% of the diagonal sideways and up.
+struct DragSetup {
+    const TetMesh& mesh;
+    TetConnectivity connectivity;
+    DragRegion region;
+};
+
+const DragSetup& drag_setup(size_t target_tets) {
+    static std::map<size_t, std::unique_ptr<DragSetup>> cache;
+    std::unique_ptr<DragSetup>& slot = cache[target_tets];
+    if (!slot) {
+        const TetMesh& mesh = bench::spot_volume(target_tets);
+        slot = std::make_unique<DragSetup>(DragSetup{mesh, build_connectivity(mesh), {}});
+        const auto box = bounding_box(mesh);
+        const double diagonal = (box[1] - box[0]).norm();
+        auto by_y = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.y() < b.y(); };
+        const Eigen::Vector3d top = *std::max_element(mesh.positions.begin(), mesh.positions.end(), by_y);
+        const Eigen::Vector3d bottom = *std::min_element(mesh.positions.begin(), mesh.positions.end(), by_y);
+        const PinSphere pin{bottom, 0.2 * diagonal};
+        slot->region = select_drag_region(mesh, slot->connectivity, top, 0.15 * diagonal,
+                                          0.1 * diagonal * Eigen::Vector3d(1, 0.5, 0.5).normalized(), std::span(&pin, 1));
+    }
+    return *slot;
+}
+
+void add_size_counters(benchmark::State& state, const DragSetup& s) {
+    state.counters["tets"] = static_cast<double>(s.mesh.tet_count());
+    state.counters["vertices"] = static_cast<double>(s.mesh.vertex_count());
+    state.counters["constrained"] = static_cast<double>(s.region.handle.size() + s.region.pinned.size());
+}
+
+// What a change of handle costs: the per-tet operators and the Cholesky factorisation.
+void BM_ArapFactorize(benchmark::State& state) {
+    const DragSetup& s = drag_setup(static_cast<size_t>(state.range(0)));
+    for (auto _ : state) {
+        ArapDeformer deformer(s.mesh, s.region.body_tets);
+        deformer.set_constrained(s.region.constrained());
+        benchmark::DoNotOptimize(deformer.positions().data());
+    }
+    add_size_counters(state, s);
+}
+BENCHMARK(BM_ArapFactorize)->Arg(100'000)->Arg(500'000)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// One drag frame: range(1) local/global iterations warm-started from the previous frame, the handle
+// advancing by 1/30 of the move per frame (back and forth).
+void BM_ArapDragFrame(benchmark::State& state) {
+    const DragSetup& s = drag_setup(static_cast<size_t>(state.range(0)));
+    const int iterations = static_cast<int>(state.range(1));
+    ArapDeformer deformer(s.mesh, s.region.body_tets);
+    deformer.set_constrained(s.region.constrained());
+    int frame = 0;
+    for (auto _ : state) {
+        const int phase = frame++ % 60;
+        const double t = (phase < 30 ? phase + 1 : 60 - phase) / 30.0;
+        const std::vector<Eigen::Vector3d> targets = drag_targets(s.region, s.mesh.positions, t);
+        benchmark::DoNotOptimize(deformer.solve(targets, iterations).energy);
+    }
+    add_size_counters(state, s);
+    state.counters["iterations"] = iterations;
+}
+BENCHMARK(BM_ArapDragFrame)
+    ->Args({100'000, 1})
+    ->Args({100'000, 4})
+    ->Args({500'000, 1})
+    ->Args({500'000, 4})
+    ->Iterations(10)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The guard every drag frame runs after its iterations (guard_step over the body's tets), when the
+// whole step passes: one minimum-dihedral and volume check of every tet.
+void BM_ArapGuardStep(benchmark::State& state) {
+    const DragSetup& s = drag_setup(static_cast<size_t>(state.range(0)));
+    ArapDeformer deformer(s.mesh, s.region.body_tets);
+    deformer.set_constrained(s.region.constrained());
+    deformer.solve(drag_targets(s.region, s.mesh.positions, 1.0 / 30), 2);
+    for (auto _ : state) {
+        const GuardedStep step = guard_step(s.mesh, s.region.body_tets, s.mesh.positions, deformer.positions());
+        benchmark::DoNotOptimize(step.min_dihedral_deg);
+        state.counters["halvings"] = step.halvings;
+    }
+    add_size_counters(state, s);
+}
+BENCHMARK(BM_ArapGuardStep)->Arg(100'000)->Iterations(10)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The drag in 10 frames of k iterations each; counters: the final energy's excess over converged (the
+// same final targets after 200 more iterations from the k = 8 drag), in percent.
+void BM_ArapIterationsPerFrame(benchmark::State& state) {
+    const DragSetup& s = drag_setup(static_cast<size_t>(state.range(0)));
+    const int frames = 10;
+    static std::map<size_t, double> converged;
+    const std::vector<Eigen::Vector3d> final_targets = drag_targets(s.region, s.mesh.positions, 1.0);
+    if (!converged.count(s.mesh.tet_count())) {
+        ArapDeformer reference(s.mesh, s.region.body_tets);
+        reference.set_constrained(s.region.constrained());
+        for (int f = 1; f <= frames; ++f) reference.solve(drag_targets(s.region, s.mesh.positions, f / double(frames)), 8);
+        converged[s.mesh.tet_count()] = reference.solve(final_targets, 200).energy;
+    }
+    const int k = static_cast<int>(state.range(1));
+    double energy = 0;
+    for (auto _ : state) {
+        ArapDeformer deformer(s.mesh, s.region.body_tets);
+        deformer.set_constrained(s.region.constrained());
+        for (int f = 1; f <= frames; ++f)
+            energy = deformer.solve(drag_targets(s.region, s.mesh.positions, f / double(frames)), k).energy;
+    }
+    add_size_counters(state, s);
+    state.counters["iterations_per_frame"] = k;
+    state.counters["energy"] = energy;
+    state.counters["converged_energy"] = converged[s.mesh.tet_count()];
+    state.counters["excess_percent"] = 100 * (energy / converged[s.mesh.tet_count()] - 1);
+}
+BENCHMARK(BM_ArapIterationsPerFrame)
+    ->Args({100'000, 1})
+    ->Args({100'000, 2})
+    ->Args({100'000, 4})
+    ->Args({100'000, 8})
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+}  // namespace waxwork
+
+WAXWORK_BENCHMARK_MAIN()
