@@ -100,7 +100,7 @@ struct SceneUpdate {
     bool recomputed_values = false;      // all values on the kept pattern
     std::vector<int32_t> updated_rows;   // rows rewritten by the incremental update (ascending)
     bool rebuilt_surface = false;        // boundary surface and shadow BVH
-    size_t resampled_transfer = 0;       // surface vertices whose environment transfer was sampled again
+    size_t resampled_transfer = 0;       // surface vertices whose environment transfer was sampled at once
     // Surface vertices that can see what changed and keep their old transfer until the next frames
     // sample it again (LiveScene::deferred_transfer).
     size_t deferred_transfer = 0;

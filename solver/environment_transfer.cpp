@@ -344,7 +344,22 @@ EnvironmentTransfer carry_environment_transfer(const BoundarySurface& old_surfac
         }
         again.push_back(static_cast<int32_t>(s));
     }
-    update_environment_transfer(surface, bvh, again, transfer);
+    if (deferred) {
+        // Sampled now with few rays to stand in for a few frames, and first in line for the full
+        // sampling: new vertices are where the user looks (a cut's face).
+        TransferSettings interim = settings;
+        interim.samples = std::min(settings.samples, kInterimTransferSamples);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, again.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                const auto s = static_cast<size_t>(again[i]);
+                environment_transfer_at(surface.positions[s], surface.normals[s], surface.eta[s], offset[s], bvh,
+                                        interim, transfer.at(s));
+            }
+        });
+        deferred->insert(deferred->begin(), again.begin(), again.end());
+    } else {
+        update_environment_transfer(surface, bvh, again, transfer);
+    }
     if (recomputed) *recomputed = again.size();
     return transfer;
 }

@@ -104,12 +104,14 @@ std::vector<int32_t> vertices_seeing_triangles(const BoundarySurface& surface, s
 //
 // Deferring: when `deferred` is given, a vertex that was on the old surface with the same eta and a
 // normal turned by at most 10 degrees (it stayed in place but can see a change, or a cut's relaxation
-// moved it a little) keeps its old vector for now and is listed there instead of being sampled; only
-// new and turned vertices are sampled at once. The caller samples the list later
+// moved it a little) keeps its old vector for now and is listed there instead of being sampled; new
+// and turned vertices are sampled at once with kInterimTransferSamples rays and listed first. The
+// caller samples the list later
 // (update_environment_transfer), after which the result again equals a full computation. A large cut
 // changes what most of the surface sees, so this is what lets an editor show it at once and refine the
 // light over the next frames. `old_deferred` lists the old surface's vertices still waiting: they stay
 // listed (or, without `deferred`, are sampled now).
+inline constexpr int kInterimTransferSamples = 32;
 EnvironmentTransfer carry_environment_transfer(const BoundarySurface& old_surface, const EnvironmentTransfer& old_transfer,
                                                const BoundarySurface& surface, const TriangleBvh& bvh,
                                                std::span<const int32_t> new_of_old_vertex,
