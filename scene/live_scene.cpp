@@ -65,11 +65,18 @@ void LiveScene::rebuild_surface(SceneUpdate& update, std::optional<std::span<con
         transfer_ = carry_environment_transfer(old_surface, *transfer_, surface_, shadow_bvh_, *vertex_map,
                                                &update.resampled_transfer, deferred_transfer_, &deferred);
         deferred_transfer_ = std::move(deferred);
-        update.deferred_transfer = deferred_transfer_.size();
-        copy_transfer_ = split_copy_transfer(surface_, shading_, shadow_bvh_, transfer_->settings());
+        // The split copies (a cut's new rim has thousands) stand in with a few rays and are sampled
+        // fully after the vertices.
+        copy_transfer_.emplace(transfer_->settings(), shading_.split_copies.size());
+        deferred_copies_.resize(shading_.split_copies.size());
+        std::iota(deferred_copies_.begin(), deferred_copies_.end(), 0);
+        update_split_copy_transfer(surface_, shading_, shadow_bvh_, deferred_copies_, *copy_transfer_,
+                                   kInterimTransferSamples);
+        update.deferred_transfer = deferred_transfer_.size() + deferred_copies_.size();
     } else {
         transfer_.reset();
         deferred_transfer_.clear();
+        deferred_copies_.clear();
         if (lighting_.environment) update.resampled_transfer = surface_.positions.size();
     }
     relight(update);
@@ -80,12 +87,14 @@ void LiveScene::refresh_transfer() {
         transfer_.reset();
         copy_transfer_.reset();
         deferred_transfer_.clear();
+        deferred_copies_.clear();
         return;
     }
     if (transfer_ && transfer_->settings().order == lighting_.environment->sh_order &&
         transfer_->settings().shadows == lighting_.shadows)
         return;
     deferred_transfer_.clear();
+    deferred_copies_.clear();
     TransferSettings settings;
     settings.order = lighting_.environment->sh_order;
     settings.shadows = lighting_.shadows;
@@ -94,17 +103,30 @@ void LiveScene::refresh_transfer() {
 }
 
 void LiveScene::refine_transfer(double milliseconds) {
-    if (deferred_transfer_.empty()) return;
+    if (deferred_transfer_.empty() && deferred_copies_.empty()) return;
     const auto start = std::chrono::steady_clock::now();
+    // The surface's vertices first (most of the light), then the split copies.
     size_t done = 0;
-    do {
+    while (done < deferred_transfer_.size()) {
         const size_t count = std::min(kTransferRefineChunk, deferred_transfer_.size() - done);
         update_environment_transfer(surface_, shadow_bvh_, std::span(deferred_transfer_).subspan(done, count), *transfer_);
         done += count;
-    } while (done < deferred_transfer_.size() && milliseconds_since(start) < milliseconds);
-    update_incident_light(surface_, shadow_bvh_, lighting_, std::span(deferred_transfer_).first(done), surface_q_,
-                          &*transfer_);
-    deferred_transfer_.erase(deferred_transfer_.begin(), deferred_transfer_.begin() + static_cast<std::ptrdiff_t>(done));
+        if (milliseconds_since(start) >= milliseconds) break;
+    }
+    if (done > 0) {
+        update_incident_light(surface_, shadow_bvh_, lighting_, std::span(deferred_transfer_).first(done), surface_q_,
+                              &*transfer_);
+        deferred_transfer_.erase(deferred_transfer_.begin(), deferred_transfer_.begin() + static_cast<std::ptrdiff_t>(done));
+    }
+    size_t copies_done = 0;
+    while (deferred_transfer_.empty() && copies_done < deferred_copies_.size() &&
+           ((copies_done == 0 && done == 0) || milliseconds_since(start) < milliseconds)) {
+        const size_t count = std::min(kTransferRefineChunk, deferred_copies_.size() - copies_done);
+        update_split_copy_transfer(surface_, shading_, shadow_bvh_, std::span(deferred_copies_).subspan(copies_done, count),
+                                   *copy_transfer_);
+        copies_done += count;
+    }
+    deferred_copies_.erase(deferred_copies_.begin(), deferred_copies_.begin() + static_cast<std::ptrdiff_t>(copies_done));
     light_shading();
     refresh_right_hand_sides();
 }
@@ -134,6 +156,7 @@ SceneUpdate LiveScene::set_crease_angle(double degrees) {
     shading_ = split_at_creases(surface_, degrees);
     options_.crease_angle_degrees = degrees;
     if (transfer_) copy_transfer_ = split_copy_transfer(surface_, shading_, shadow_bvh_, transfer_->settings());
+    deferred_copies_.clear();
     light_shading();
     update.recomputed_light = true;
     refresh_right_hand_sides();
@@ -248,9 +271,10 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
                     // The split copies of those vertices integrate with the new eta too.
                     std::vector<uint8_t> is_changed(surface_.positions.size(), 0);
                     for (const int32_t v : changed) is_changed[v] = 1;
-                    if (std::any_of(shading_.split_copies.begin(), shading_.split_copies.end(),
-                                    [&](int32_t copy) { return is_changed[shading_.surface_vertex[copy]] != 0; }))
-                        copy_transfer_ = split_copy_transfer(surface_, shading_, shadow_bvh_, transfer_->settings());
+                    std::vector<int32_t> copies;
+                    for (size_t i = 0; i < shading_.split_copies.size(); ++i)
+                        if (is_changed[shading_.surface_vertex[shading_.split_copies[i]]]) copies.push_back(static_cast<int32_t>(i));
+                    update_split_copy_transfer(surface_, shading_, shadow_bvh_, copies, *copy_transfer_);
                 }
                 update_incident_light(surface_, shadow_bvh_, lighting_, changed, surface_q_, transfer_ ? &*transfer_ : nullptr);
                 light_shading();
@@ -319,7 +343,8 @@ FrameReport LiveScene::iterate(int iteration_budget, const FrameBudget* time_bud
         converged_[c] = channels[c].converged;
         report.estimated_relative_error[c] = error_[c];
     }
-    report.converged = converged_[0] && converged_[1] && converged_[2] && deferred_transfer_.empty();
+    report.converged = converged_[0] && converged_[1] && converged_[2] && deferred_transfer_.empty() &&
+                       deferred_copies_.empty();
     solved_since_change_ = true;
     report.milliseconds = milliseconds_since(start);
     return report;
@@ -398,12 +423,12 @@ FrameReport LiveScene::converge(int max_iterations) {
 
 bool LiveScene::converged() const {
     const std::lock_guard lock(mutex_);
-    return converged_[0] && converged_[1] && converged_[2] && deferred_transfer_.empty();
+    return converged_[0] && converged_[1] && converged_[2] && deferred_transfer_.empty() && deferred_copies_.empty();
 }
 
 size_t LiveScene::deferred_transfer() const {
     const std::lock_guard lock(mutex_);
-    return deferred_transfer_.size();
+    return deferred_transfer_.size() + deferred_copies_.size();
 }
 
 std::optional<double> LiveScene::estimated_error() const {

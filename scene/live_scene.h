@@ -149,9 +149,10 @@ public:
     FrameReport converge(int max_iterations = 10000);
     // False while phi is outside the tolerance or some transfer vectors still wait to be sampled.
     bool converged() const;
-    // After an edit, the surface vertices whose environment transfer is carried over although they can
-    // see what changed: each step() samples some of them again (about kTransferRefineMilliseconds),
-    // converge() all, and the light they give follows; the result then equals a fresh scene's.
+    // After an edit, the surface vertices and split copies whose environment transfer stands in for
+    // the full sampling (carried over although they can see what changed, or sampled with few rays):
+    // each step() samples some of them again (about kTransferRefineMilliseconds), converge() all, and
+    // the light they give follows; the result then equals a fresh scene's.
     size_t deferred_transfer() const;
     // The estimated relative error of phi (max over channels) after the last step(), or nullopt when
     // nothing was solved since the last change.
@@ -225,6 +226,8 @@ private:
     std::optional<EnvironmentTransfer> transfer_;
     std::optional<EnvironmentTransfer> copy_transfer_;  // per split copy of shading_ (split_copy_transfer)
     std::vector<int32_t> deferred_transfer_;    // surface vertices whose transfer_ is stale (deferred_transfer())
+    std::vector<int32_t> deferred_copies_;      // split copies (into shading_.split_copies) whose copy_transfer_ is
+                                                // coarse
     std::vector<Rgb> surface_q_;                // per surface vertex
     std::vector<float> surface_visibility_;     // per surface vertex and light (incident_light)
     ShadingSurface shading_;                    // the surface split at creases (options_.crease_angle_degrees)

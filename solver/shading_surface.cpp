@@ -128,18 +128,34 @@ ShadingSurface split_at_creases(const BoundarySurface& surface, double crease_an
     return shading;
 }
 
-EnvironmentTransfer split_copy_transfer(const BoundarySurface& surface, const ShadingSurface& shading,
-                                        const TriangleBvh& bvh, const TransferSettings& settings) {
-    EnvironmentTransfer transfer(settings, shading.split_copies.size());
+void update_split_copy_transfer(const BoundarySurface& surface, const ShadingSurface& shading, const TriangleBvh& bvh,
+                                std::span<const int32_t> copies, EnvironmentTransfer& transfer, int samples) {
+    if (transfer.size() != shading.split_copies.size())
+        throw InvalidArgumentError("split copy transfer: " + std::to_string(transfer.size()) + " vectors for " +
+                                   std::to_string(shading.split_copies.size()) + " split copies");
+    for (const int32_t i : copies)
+        if (i < 0 || static_cast<size_t>(i) >= shading.split_copies.size())
+            throw InvalidArgumentError("split copy transfer: copy " + std::to_string(i) + " out of range");
+    TransferSettings settings = transfer.settings();
+    if (samples > 0) settings.samples = samples;
     Lighting lighting;
     lighting.shadows = settings.shadows;
     const std::vector<double> offset = shadow_ray_offsets(surface, lighting);
-    tbb::parallel_for(size_t{0}, shading.split_copies.size(), [&](size_t i) {
+    tbb::parallel_for(size_t{0}, copies.size(), [&](size_t k) {
+        const auto i = static_cast<size_t>(copies[k]);
         const int32_t copy = shading.split_copies[i];
         const int32_t s = shading.surface_vertex[copy];
         environment_transfer_at(surface.positions[s], shading.normals[copy], surface.eta[s], offset[s], bvh, settings,
                                 transfer.at(i));
     });
+}
+
+EnvironmentTransfer split_copy_transfer(const BoundarySurface& surface, const ShadingSurface& shading,
+                                        const TriangleBvh& bvh, const TransferSettings& settings) {
+    EnvironmentTransfer transfer(settings, shading.split_copies.size());
+    std::vector<int32_t> all(shading.split_copies.size());
+    std::iota(all.begin(), all.end(), 0);
+    update_split_copy_transfer(surface, shading, bvh, all, transfer);
     return transfer;
 }
 

@@ -27,6 +27,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace waxwork {
@@ -81,6 +82,13 @@ ShadingLight shading_light(const BoundarySurface& surface, const ShadingSurface&
                            const Lighting& lighting, const std::vector<Rgb>& surface_q,
                            const std::vector<float>& surface_visibility,
                            const EnvironmentTransfer* copy_transfer = nullptr);
+
+// Samples again the transfer of the split copies `copies` (indices into shading.split_copies) with
+// `samples` rays, or with the transfer's own count when 0 (fewer rays stand in until a later call
+// samples them fully, as the live scene does after an edit). InvalidArgumentError for an index out of
+// range or a transfer of another size.
+void update_split_copy_transfer(const BoundarySurface& surface, const ShadingSurface& shading, const TriangleBvh& bvh,
+                                std::span<const int32_t> copies, EnvironmentTransfer& transfer, int samples = 0);
 
 // The environment's transfer (environment_transfer.h) of each split copy with its own normal, in the
 // order of shading.split_copies; `settings` as the surface's transfer.
