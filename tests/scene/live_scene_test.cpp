@@ -141,10 +141,14 @@ TEST(LiveScene, FollowsTheEnvironmentThroughEditsAndTurns) {
     update = scene.apply_change(doc.mesh(), doc.apply(pull));
     EXPECT_GT(update.deferred_transfer, 0u);
     EXPECT_EQ(scene.deferred_transfer(), update.deferred_transfer);
-    EXPECT_LT(update.resampled_transfer + update.deferred_transfer, scene.solved_scene().surface.positions.size());
+    EXPECT_LT(update.resampled_transfer, scene.solved_scene().surface.positions.size());
     EXPECT_FALSE(scene.converged());
-    scene.step(1);
-    EXPECT_EQ(scene.deferred_transfer(), 0u) << "one step samples this small cube's deferred vertices";
+    for (int step = 0; step < 20 && scene.deferred_transfer() > 0; ++step) {
+        const size_t waiting = scene.deferred_transfer();
+        scene.step(1);
+        EXPECT_LT(scene.deferred_transfer(), waiting) << "every step samples some";
+    }
+    EXPECT_EQ(scene.deferred_transfer(), 0u);
     expect_matches_fresh_solve(scene, doc.mesh(), lighting, "piece pulled away under the sky");
     // Moved back and again before any step: the vertices still waiting keep waiting, and the end is
     // the same as a fresh scene's.
