@@ -79,11 +79,58 @@ RelaxationOptions relaxation_options(const RelaxSettings& r) {
 
 }  // namespace
 
+struct Document::DeformCache {
+    std::shared_ptr<const TetConnectivity> connectivity;  // of the current topology
+    // The last deform's handle and what was built for it, valid while the positions equal `rest`.
+    Eigen::Vector3d grab = Eigen::Vector3d::Zero();
+    double radius = 0;
+    std::vector<PinSphere> pins;
+    std::vector<Eigen::Vector3d> rest;
+    DragRegion region;
+    std::optional<ArapDeformer> deformer;
+    bool previewing = false;  // a drag is shown: the mesh holds preview positions, `rest` the ones before
+};
+
 Document::Document(TetMesh mesh, const TetMaterial& default_material, size_t undo_budget_bytes)
     : mesh_(std::move(mesh)), budget_(undo_budget_bytes) {
     validate(mesh_);
     if (!mesh_.has_materials()) mesh_.materials.assign(mesh_.tet_count(), default_material);
     min_dihedral_deg_ = min_dihedral_of(mesh_);
+}
+
+Document::~Document() = default;
+Document::Document(Document&&) noexcept = default;
+Document& Document::operator=(Document&&) noexcept = default;
+
+Document::DeformCache& Document::deform_setup(const DeformOp& op) {
+    if (!deform_cache_) deform_cache_ = std::make_unique<DeformCache>();
+    DeformCache& c = *deform_cache_;
+    if (!c.connectivity) c.connectivity = std::make_shared<const TetConnectivity>(build_connectivity(mesh_));
+    DragRegion region;
+    try {
+        region = select_drag_region(mesh_, *c.connectivity, op.grab, op.radius, op.motion, op.pins);
+    } catch (const InvalidArgumentError& error) {
+        throw InvalidArgumentError(std::string("deform: ") + error.what());
+    }
+    // A new body or rest shape changes the gradient operators and K: build them again. The same ones
+    // with another handle or pins only refactor (ArapDeformer::set_constrained decides).
+    if (!c.deformer || region.body_tets != c.region.body_tets || c.rest != mesh_.positions) {
+        c.deformer.reset();
+        c.deformer.emplace(mesh_, region.body_tets);
+        c.rest = mesh_.positions;
+    }
+    c.region = std::move(region);
+    c.grab = op.grab;
+    c.radius = op.radius;
+    c.pins = op.pins;
+    return c;
+}
+
+bool Document::previewing() const { return deform_cache_ && deform_cache_->previewing; }
+
+void Document::require_no_preview(const char* what) const {
+    if (previewing())
+        throw InvalidArgumentError(std::string(what) + ": a deform drag is in progress (commit or cancel it first)");
 }
 
 ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
@@ -95,6 +142,18 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
     entry.op = op;
     entry.old_min_dihedral_deg = min_dihedral_deg_;
     std::ostringstream details;
+    // Relax and deform: the vertices whose position changed, their old positions for undo.
+    const auto record_moved_vertices = [&](const std::vector<Eigen::Vector3d>& before,
+                                           const std::vector<Eigen::Vector3d>& after) {
+        for (size_t v = 0; v < before.size(); ++v) {
+            if (before[v] != after[v]) {
+                entry.moved_vertices.push_back(static_cast<int32_t>(v));
+                entry.old_positions.push_back(before[v]);
+            }
+        }
+        report.positions = !entry.moved_vertices.empty();
+        report.moved_vertices = entry.moved_vertices;
+    };
 
     // Cut: remove the tets on the cut-away side, then relax the cut vertices onto the surface
     // (TransCut Sec. 5), or split the crossed tets exactly along it. Works on a copy that becomes the mesh only when everything succeeded; the
@@ -168,17 +227,26 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
             mesh_.positions = before;
             throw;
         }
-        for (size_t v = 0; v < before.size(); ++v) {
-            if (before[v] != mesh_.positions[v]) {
-                entry.moved_vertices.push_back(static_cast<int32_t>(v));
-                entry.old_positions.push_back(before[v]);
-            }
-        }
+        record_moved_vertices(before, mesh_.positions);
         min_dihedral_deg_ = relaxed.min_dihedral_deg;
-        report.positions = !entry.moved_vertices.empty();
         report.connectivity = std::make_shared<const TetConnectivity>(connectivity);
         details << entry.moved_vertices.size() << " vertices moved in " << relaxed.iterations << " sweeps";
         report.result = relaxed;
+    } else if (const auto* o = std::get_if<DeformOp>(&op)) {
+        DeformCache& c = deform_setup(*o);
+        GuardOptions guard;
+        guard.min_dihedral_guard_deg = o->guard_deg;
+        c.deformer->reset();  // from the rest shape, as a fresh deformer: the result depends on `op` only
+        const DragReport drag = run_drag(*c.deformer, mesh_, c.region, mesh_.positions, o->steps, o->iterations, guard);
+        record_moved_vertices(mesh_.positions, c.deformer->positions());
+        mesh_.positions = c.deformer->positions();
+        min_dihedral_deg_ = min_dihedral_of(mesh_);
+        report.connectivity = c.connectivity;
+        details << entry.moved_vertices.size() << " vertices moved in " << drag.steps << " steps of "
+                << drag.iterations_per_step << " iterations";
+        if (drag.shortened_steps > 0)
+            details << "; the angle guard shortened " << drag.shortened_steps << (drag.shortened_steps == 1 ? " step" : " steps");
+        report.result = drag;
     } else if (const auto* o = std::get_if<PaintOp>(&op)) {
         PaintBrush brush;
         brush.material = o->material;
@@ -235,6 +303,7 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
     }
 
     if (report.topology || report.positions || report.piece_transforms) paint_index_.reset();
+    if (report.topology) deform_cache_.reset();
     report.tets_after = mesh_.tet_count();
     report.vertices_after = mesh_.vertex_count();
     report.min_dihedral_deg = min_dihedral_deg_;
@@ -268,6 +337,7 @@ void Document::push_undo(UndoEntry entry, ChangeReport& report) {
 }
 
 ChangeReport Document::apply(const EditOperation& op) {
+    require_no_preview(operation_name(op).c_str());
     UndoEntry entry;
     ChangeReport report = run(op, entry);
     redo_.clear();
@@ -277,6 +347,7 @@ ChangeReport Document::apply(const EditOperation& op) {
 }
 
 std::optional<ChangeReport> Document::undo() {
+    require_no_preview("undo");
     if (undo_.empty()) return std::nullopt;
     const auto start = std::chrono::steady_clock::now();
     UndoEntry entry = std::move(undo_.back());
@@ -297,12 +368,14 @@ std::optional<ChangeReport> Document::undo() {
         for (size_t i = 0; i < entry.moved_vertices.size(); ++i)
             mesh_.positions[entry.moved_vertices[i]] = entry.old_positions[i];
         report.positions = true;
+        report.moved_vertices = std::move(entry.moved_vertices);
     } else {
         for (size_t i = 0; i < entry.material_tets.size(); ++i)
             mesh_.materials[entry.material_tets[i]] = entry.old_materials[i];
         report.changed_material_tets = entry.material_tets;
     }
     if (report.topology || report.positions || report.piece_transforms) paint_index_.reset();
+    if (report.topology) deform_cache_.reset();
     min_dihedral_deg_ = entry.old_min_dihedral_deg;
     report.min_dihedral_deg = min_dihedral_deg_;
     report.tets_after = mesh_.tet_count();
@@ -314,6 +387,7 @@ std::optional<ChangeReport> Document::undo() {
 }
 
 std::optional<ChangeReport> Document::redo() {
+    require_no_preview("redo");
     if (redo_.empty()) return std::nullopt;
     UndoEntry entry;
     ChangeReport report = run(redo_.back(), entry);
@@ -321,6 +395,114 @@ std::optional<ChangeReport> Document::redo() {
     history_.push_back(redo_.back());
     redo_.pop_back();
     push_undo(std::move(entry), report);
+    return report;
+}
+
+namespace {
+
+// The vertices whose position differs between `shown` and `now`, ascending.
+std::vector<int32_t> changed_positions(const std::vector<Eigen::Vector3d>& shown, const std::vector<Eigen::Vector3d>& now) {
+    std::vector<int32_t> moved;
+    for (size_t v = 0; v < now.size(); ++v)
+        if (shown[v] != now[v]) moved.push_back(static_cast<int32_t>(v));
+    return moved;
+}
+
+}  // namespace
+
+ChangeReport Document::preview_deform(const DeformOp& op, int iterations) {
+    const auto start = std::chrono::steady_clock::now();
+    if (iterations < 1 || iterations > kMaxDeformIterations)
+        throw InvalidArgumentError("deform preview: iterations must be between 1 and " +
+                                   std::to_string(kMaxDeformIterations));
+    if (!previewing()) {
+        DeformCache& c = deform_setup(op);
+        c.deformer->reset();
+        c.deformer->set_constrained(c.region.constrained());
+        c.previewing = true;
+    } else {
+        const DeformCache& c = *deform_cache_;
+        if (op.grab != c.grab || op.radius != c.radius || op.pins != c.pins)
+            throw InvalidArgumentError("deform preview: a drag keeps its grab point, radius and pins");
+        validate_handle_motion(op.motion);
+    }
+    DeformCache& c = *deform_cache_;
+    c.region.motion_rest = op.motion.in_rest_frame(mesh_.piece_transforms[c.region.piece]);
+    GuardOptions guard;
+    guard.min_dihedral_guard_deg = op.guard_deg;
+    const std::vector<Eigen::Vector3d> targets = drag_targets(c.region, c.rest, 1.0);
+    const std::vector<Eigen::Vector3d> before = c.deformer->positions();
+    DragReport drag;
+    drag.steps = 1;
+    drag.iterations_per_step = iterations;
+    drag.body_tets = c.region.body_tets.size();
+    drag.handle_vertices = c.region.handle.size();
+    drag.pinned_vertices = c.region.pinned.size();
+    drag.energy = c.deformer->solve(targets, iterations).energy;
+    GuardedStep step = guard_step(mesh_, c.region.body_tets, before, c.deformer->positions(), guard);
+    drag.last_step_fraction = step.fraction;
+    drag.min_dihedral_deg = step.min_dihedral_deg;
+    drag.inverted_tets = step.inverted_tets;
+    if (step.shortened()) {
+        drag.shortened_steps = 1;
+        c.deformer->set_positions(std::move(step.positions));
+        drag.energy = c.deformer->energy();
+    }
+    ChangeReport report;
+    report.name = "deform preview";
+    report.tets_before = report.tets_after = mesh_.tet_count();
+    report.vertices_before = report.vertices_after = mesh_.vertex_count();
+    for (const int32_t v : c.deformer->body_vertices()) {
+        if (mesh_.positions[v] == c.deformer->positions()[v]) continue;
+        report.moved_vertices.push_back(v);
+        mesh_.positions[v] = c.deformer->positions()[v];
+    }
+    report.positions = !report.moved_vertices.empty();
+    if (report.positions) paint_index_.reset();
+    report.connectivity = c.connectivity;
+    report.min_dihedral_deg = min_dihedral_deg_;
+    report.undoable = false;
+    report.result = drag;
+    report.milliseconds = milliseconds_since(start);
+    return report;
+}
+
+ChangeReport Document::commit_deform(const DeformOp& op) {
+    if (!previewing()) throw InvalidArgumentError("deform: no drag in progress to commit");
+    DeformCache& c = *deform_cache_;
+    std::vector<Eigen::Vector3d> shown = c.rest;
+    std::swap(shown, mesh_.positions);  // the positions before the drag are what `op` applies to
+    c.previewing = false;
+    ChangeReport report;
+    try {
+        report = apply(op);
+    } catch (...) {
+        // The drag goes on as it was shown: the caller may cancel it.
+        mesh_.positions = std::move(shown);
+        c.previewing = true;
+        throw;
+    }
+    report.moved_vertices = changed_positions(shown, mesh_.positions);
+    report.positions = !report.moved_vertices.empty();
+    return report;
+}
+
+std::optional<ChangeReport> Document::cancel_deform() {
+    if (!previewing()) return std::nullopt;
+    const auto start = std::chrono::steady_clock::now();
+    DeformCache& c = *deform_cache_;
+    ChangeReport report;
+    report.name = "cancel deform";
+    report.tets_before = report.tets_after = mesh_.tet_count();
+    report.vertices_before = report.vertices_after = mesh_.vertex_count();
+    report.moved_vertices = changed_positions(mesh_.positions, c.rest);
+    report.positions = !report.moved_vertices.empty();
+    mesh_.positions = c.rest;
+    c.previewing = false;
+    if (report.positions) paint_index_.reset();
+    report.connectivity = c.connectivity;
+    report.min_dihedral_deg = min_dihedral_deg_;
+    report.milliseconds = milliseconds_since(start);
     return report;
 }
 

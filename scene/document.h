@@ -5,7 +5,7 @@
 // Undo data, per kind, the smallest that restores the mesh bit for bit (TetMesh::operator==):
 //   paint, set_material   the changed tets and their old materials
 //   move_piece            the piece's old transform
-//   relax                 the moved vertices and their old positions
+//   relax, deform         the moved vertices and their old positions
 //   cut, fracture, weld   a snapshot of the mesh before (every array changes: tets are removed or
 //                         split, vertices renumbered or duplicated)
 // Redo re-runs the operation: every operation is deterministic, so the result is identical, and the
@@ -23,6 +23,7 @@
 #pragma once
 
 #include "scene/edit_operation.h"
+#include "tetops/arap_deformation.h"
 #include "tetops/connectivity.h"
 #include "tetops/cut.h"
 #include "tetops/exact_cut.h"
@@ -53,12 +54,13 @@ struct RelaxedCutResult {
 
 // What an operation's tetops algorithm reported, for callers that summarise it (the command line's
 // JSON): RelaxedCutResult (plane and stroke cuts), ExactCutResult (exact cuts), RelaxationReport
-// (relax), FractureResult, WeldResult, FragmentRemoval (remove_fragments), PaintResult; monostate for
+// (relax), FractureResult, WeldResult, FragmentRemoval (remove_fragments), PaintResult, DragReport
+// (deform); monostate for
 // move_piece, set_material and undo. Only the counts: the per-vertex and per-tet arrays are left empty
 // (the ones the scene needs are ChangeReport's own old_to_new_vertex, vertex_origins and
 // changed_material_tets), so a report stays small.
 using OperationResult = std::variant<std::monostate, RelaxedCutResult, ExactCutResult, RelaxationReport,
-                                     FractureResult, WeldResult, FragmentRemoval, PaintResult>;
+                                     FractureResult, WeldResult, FragmentRemoval, PaintResult, DragReport>;
 
 // What an applied (or undone, or redone) operation changed. The live scene reacts to the flags.
 struct ChangeReport {
@@ -72,6 +74,7 @@ struct ChangeReport {
 
     bool topology = false;         // tets/vertices added, removed or renumbered
     bool positions = false;        // rest positions moved (topology unchanged)
+    std::vector<int32_t> moved_vertices;  // positions: exactly these vertices moved (ascending)
     bool piece_transforms = false; // one or more piece transforms changed
     bool all_materials = false;    // potentially every tet's material changed
     std::vector<int32_t> changed_material_tets;  // else: exactly these tets' materials changed (ascending)
@@ -105,6 +108,9 @@ public:
     // `default_material` is given to every tet when `mesh` stores no materials. Validates the mesh.
     explicit Document(TetMesh mesh, const TetMaterial& default_material,
                       size_t undo_budget_bytes = kDefaultUndoBudgetBytes);
+    ~Document();
+    Document(Document&&) noexcept;
+    Document& operator=(Document&&) noexcept;
 
     const TetMesh& mesh() const { return mesh_; }
     double min_dihedral_deg() const { return min_dihedral_deg_; }
@@ -129,6 +135,26 @@ public:
     // undone; evicted undo entries still count): the session record (session.h write_session).
     const std::vector<EditOperation>& history() const { return history_; }
 
+    // --- Drag previews: the editor's Grab, Bend and Twist while the mouse moves. ---
+    // A deform op's factorisation depends only on the grabbed body, its handle and pins and the rest
+    // shape, so a drag factors once: the document keeps it while the positions stay those it was made
+    // for (apply() of a deform reuses it too, with an identical result).
+    //
+    // preview_deform moves the vertices towards `op`'s full motion with `iterations` local/global
+    // iterations warm-started from the previous preview of the same drag (guarded as apply() guards),
+    // so a frame costs a few triangular solves. It makes no undo entry and no history; the first preview
+    // remembers the positions before the drag. Later previews must keep the op's grab, radius and pins
+    // (the drag's handle): InvalidArgumentError otherwise. The report is a positions change whose
+    // moved_vertices are those that moved since the previous preview.
+    ChangeReport preview_deform(const DeformOp& op, int iterations);
+    bool previewing() const;
+    // Ends the drag with `op` as the edit: the positions before the drag come back and `op` is applied
+    // from them as apply() applies it (deterministic, so a session replays it bit for bit). The report's
+    // moved_vertices are those whose position differs from the last preview's.
+    ChangeReport commit_deform(const DeformOp& op);
+    // Ends the drag without an edit: the positions before it come back (nullopt: no drag).
+    std::optional<ChangeReport> cancel_deform();
+
 private:
     // Exactly one kind of undo data is filled (see the top of this header).
     struct UndoEntry {
@@ -148,6 +174,11 @@ private:
         size_t bytes = 0;
     };
     ChangeReport run(const EditOperation& op, UndoEntry& entry);
+    // The drag region and ARAP factorisation for `op` on the current positions (reused when they,
+    // the body, the handle and the pins are those of the previous deform).
+    struct DeformCache;
+    DeformCache& deform_setup(const DeformOp& op);
+    void require_no_preview(const char* what) const;
     // fracture, move_piece, weld (tetops/fracture.h).
     void run_piece_operation(const EditOperation& op, UndoEntry& entry, ChangeReport& report,
                              std::ostringstream& details);
@@ -157,6 +188,9 @@ private:
     // Tet centroids for painting, built on the first stroke and kept until the geometry changes
     // (a kd-tree build costs more than a stroke at 500K tets). shared_ptr: PaintIndex stays opaque here.
     std::shared_ptr<PaintIndex> paint_index_;
+    // The last deform's connectivity, region and factorisation (the mesh's connectivity is dropped
+    // when the topology changes; the rest is checked against the positions on use).
+    std::unique_ptr<DeformCache> deform_cache_;
     double min_dihedral_deg_ = 0;
     size_t budget_;
     size_t undo_bytes_ = 0;

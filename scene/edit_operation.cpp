@@ -19,7 +19,8 @@ using Json = nlohmann::ordered_json;
 
 // Listed in errors about a missing or unknown "op".
 constexpr const char* kOperationNames =
-    "plane_cut, stroke_cut, relax, fracture, move_piece, weld, remove_fragments, paint, set_material";
+    "plane_cut, stroke_cut, relax, fracture, move_piece, weld, remove_fragments, paint, set_material, deform";
+
 
 Json relax_to_json(const RelaxSettings& r) {
     return Json{{"iterations", r.iterations}, {"step", r.step}, {"guard_deg", r.guard_deg}};
@@ -90,6 +91,55 @@ Eigen::Matrix3d rotation_from_json(const Json& json, const std::string& context)
     return r;
 }
 
+Json axis_to_json(const HandleMotion& m, const char* angle_name) {
+    return Json{{"axis_point", vector_to_json(m.axis_point)}, {"axis", vector_to_json(m.axis_direction)}, {angle_name, m.angle}};
+}
+
+HandleMotion axis_motion_from_json(FieldReader& in, const char* name, const char* angle_name) {
+    FieldReader axis(in.at(name), in.field(name));
+    const Eigen::Vector3d point = axis.vector("axis_point");
+    const Eigen::Vector3d direction = axis.vector("axis");
+    if (direction.norm() == 0) fail_json(axis.field("axis"), "must not be zero");
+    const double angle = axis.number(angle_name);
+    axis.finish();
+    return std::string(name) == "bend" ? HandleMotion::bend(point, direction, angle)
+                                       : HandleMotion::twist(point, direction, angle);
+}
+
+DeformOp deform_from_fields(FieldReader& in) {
+    DeformOp op;
+    op.grab = in.vector("grab");
+    op.radius = in.number("radius");
+    if (!(op.radius > 0)) fail_json(in.field("radius"), "must be a positive number (world units)");
+    const int motions = int(in.has("move")) + int(in.has("bend")) + int(in.has("twist"));
+    if (motions != 1) fail_json(in.context(), "give exactly one of 'move', 'bend' and 'twist'");
+    if (in.has("move")) op.motion = HandleMotion::translation(in.vector("move"));
+    if (in.has("bend")) op.motion = axis_motion_from_json(in, "bend", "angle");
+    if (in.has("twist")) op.motion = axis_motion_from_json(in, "twist", "angle_per_length");
+    if (in.has("pins")) {
+        const Json& pins = in.at("pins");
+        if (!pins.is_array()) fail_json(in.field("pins"), "expected an array of {\"center\": [x, y, z], \"radius\": r}");
+        for (size_t i = 0; i < pins.size(); ++i) {
+            FieldReader pin(pins[i], in.field("pins") + "[" + std::to_string(i) + "]");
+            PinSphere sphere{pin.vector("center"), pin.number("radius")};
+            if (!(sphere.radius > 0)) fail_json(pin.field("radius"), "must be a positive number (world units)");
+            pin.finish();
+            op.pins.push_back(sphere);
+        }
+    }
+    const int64_t iterations = in.integer("iterations", op.iterations);
+    if (iterations < 1 || iterations > kMaxDeformIterations)
+        fail_json(in.field("iterations"), "must be between 1 and " + std::to_string(kMaxDeformIterations));
+    op.iterations = static_cast<int>(iterations);
+    const int64_t steps = in.integer("steps", op.steps);
+    if (steps < 1 || steps > kMaxDeformSteps)
+        fail_json(in.field("steps"), "must be between 1 and " + std::to_string(kMaxDeformSteps));
+    op.steps = static_cast<int>(steps);
+    op.guard_deg = in.number("guard_deg", op.guard_deg);
+    if (op.guard_deg < 0 || op.guard_deg >= 60) fail_json(in.field("guard_deg"), "must be in [0, 60) degrees");
+    return op;
+}
+
 struct ToJson {
     Json operator()(const PlaneCutOp& op) const {
         Json j{{"op", "plane_cut"}, {"normal", vector_to_json(op.plane.normal)}, {"offset", op.plane.offset}};
@@ -150,6 +200,23 @@ struct ToJson {
     Json operator()(const SetMaterialOp& op) const {
         Json j{{"op", "set_material"}, {"material", material_to_json(op.material)}};
         if (op.piece) j["piece"] = *op.piece;
+        return j;
+    }
+    Json operator()(const DeformOp& op) const {
+        Json j{{"op", "deform"}, {"grab", vector_to_json(op.grab)}, {"radius", op.radius}};
+        switch (op.motion.kind) {
+        case HandleMotion::Kind::Translate: j["move"] = vector_to_json(op.motion.move); break;
+        case HandleMotion::Kind::Bend: j["bend"] = axis_to_json(op.motion, "angle"); break;
+        case HandleMotion::Kind::Twist: j["twist"] = axis_to_json(op.motion, "angle_per_length"); break;
+        }
+        if (!op.pins.empty()) {
+            Json pins = Json::array();
+            for (const PinSphere& pin : op.pins) pins.push_back(Json{{"center", vector_to_json(pin.center)}, {"radius", pin.radius}});
+            j["pins"] = pins;
+        }
+        j["iterations"] = op.iterations;
+        j["steps"] = op.steps;
+        j["guard_deg"] = op.guard_deg;
         return j;
     }
 };
@@ -307,6 +374,8 @@ EditOperation edit_operation_from_json(const Json& json, const std::string& cont
             op.piece = static_cast<int>(piece);
         }
         result = op;
+    } else if (name == "deform") {
+        result = deform_from_fields(in);
     } else {
         fail_json(context, "unknown op '" + name + "' (" + kOperationNames + ")");
     }

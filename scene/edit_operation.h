@@ -18,9 +18,13 @@
 //   {"op": "remove_fragments", "max_volume_fraction": 0.001}
 //   {"op": "paint", "points": [[...], ...], "material": ..., "sigma": 0.05, "cutoff_weight": 0.001}
 //   {"op": "set_material", "material": ..., "piece": 2}          (no "piece": the whole volume)
+//   {"op": "deform", "grab": [...], "radius": r, "move": [...] | "bend": {"axis_point": [...], "axis": [...],
+//    "angle": radians} | "twist": {"axis_point": [...], "axis": [...], "angle_per_length": radians},
+//    "pins": [{"center": [...], "radius": r}, ...], "iterations": 10, "steps": 10, "guard_deg": 0.5}
 // with "relax": {"iterations": 10, "step": 0.1, "guard_deg": 0.5}.
 #pragma once
 
+#include "tetops/arap_deformation.h"
 #include "tetops/fragments.h"
 #include "tetops/tet_mesh.h"
 
@@ -127,8 +131,26 @@ struct SetMaterialOp {
     friend bool operator==(const SetMaterialOp&, const SetMaterialOp&) = default;
 };
 
+// Bounds on a deform's work (a hostile session must not run for hours).
+inline constexpr int kMaxDeformIterations = 1000;
+inline constexpr int kMaxDeformSteps = 1000;
+
+// Drags one body as rigidly as possible (tetops/arap_deformation.h): the handle of falloff radius
+// `radius` at `grab` follows `motion` (Grab, Bend or Twist; world space) while the pins hold, in
+// `steps` guarded steps of `iterations` local/global iterations each, as the editor's drag frames run it.
+struct DeformOp {
+    Eigen::Vector3d grab = Eigen::Vector3d::Zero();
+    double radius = 0;
+    HandleMotion motion;
+    std::vector<PinSphere> pins;
+    int iterations = 10;
+    int steps = 10;
+    double guard_deg = 0.5;  // no tet ends under this minimum dihedral angle (or under its own, if lower)
+    friend bool operator==(const DeformOp&, const DeformOp&) = default;
+};
+
 using EditOperation = std::variant<PlaneCutOp, StrokeCutOp, RelaxOp, FractureOp, MovePieceOp, WeldOp,
-                                   RemoveFragmentsOp, PaintOp, SetMaterialOp>;
+                                   RemoveFragmentsOp, PaintOp, SetMaterialOp, DeformOp>;
 
 // The "op" name of an operation ("plane_cut", "paint", ...).
 std::string operation_name(const EditOperation& op);

@@ -225,12 +225,22 @@ SceneUpdate LiveScene::apply_change(const TetMesh& mesh, const ChangeReport& cha
         // neighbours' values instead of zero (solver/warm_start.h).
         if (update.warm_start) extend_to_unknown_vertices(matrix_, carried.known, phi_);
     } else if (change.positions) {
-        // Same tets, moved vertices: new geometry on the same connectivity.
-        matrix_ = assemble_diffusion_matrix(mesh, *connectivity_, mesh.materials, assembly_options(options_));
-        update.reassembled_matrix = true;
-        std::vector<int32_t> same_vertices(mesh.vertex_count());
-        std::iota(same_vertices.begin(), same_vertices.end(), 0);
-        solver_->matrix_rebuilt(mesh, matrix_, same_vertices);
+        // Same tets, moved vertices (a deformation, a relaxation): the geometry of the tets around the
+        // moved vertices changes, so exactly their rows are rewritten on the kept pattern, and the
+        // solver's hierarchy keeps its graph and updates its values (as for painted materials).
+        if (change.moved_vertices.empty()) {
+            matrix_ = assemble_diffusion_matrix(mesh, *connectivity_, mesh.materials, assembly_options(options_));
+            update.reassembled_matrix = true;
+            std::vector<int32_t> same_vertices(mesh.vertex_count());
+            std::iota(same_vertices.begin(), same_vertices.end(), 0);
+            solver_->matrix_rebuilt(mesh, matrix_, same_vertices);
+        } else {
+            update.updated_rows = update_diffusion_geometry(matrix_, mesh, *connectivity_, change.moved_vertices);
+            solver_->rows_changed(update.updated_rows);
+        }
+        // The surface keeps its numbering (the empty vertex map): the environment transfer keeps the
+        // vectors of vertices that barely turned for the next frames and samples the rest now
+        // (carry_environment_transfer).
         rebuild_surface(update, std::span<const int32_t>());
     } else {
         bool eta_changed = false;

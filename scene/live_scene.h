@@ -11,7 +11,8 @@
 //   all materials            recompute matrix values on the kept pattern and geometry; warm start
 //   piece transforms         boundary surface, shadow BVH and q (pieces shadow each other); the matrix
 //                            is invariant under rigid motion; warm start
-//   positions (relaxation)   matrix geometry and values, lighting; warm start
+//   positions (relaxation,   the rows of the moved vertices' tets (geometry and values, same pattern;
+//   deformation)             the solver's hierarchy keeps its graph), surface and lighting; warm start
 //   topology (cut, fracture, connectivity (reused from the report when the edit built it), matrix,
 //   weld, their undo)        lighting; warm start through the edit's vertex map and vertex origins
 //                            (ChangeReport), else cold

@@ -54,6 +54,24 @@ std::optional<ChangeReport> SceneCore::redo() {
     return report;
 }
 
+ChangeReport SceneCore::preview_deform(const DeformOp& op, int iterations) {
+    ChangeReport report = document_.preview_deform(op, iterations);
+    live_->apply_change(document_.mesh(), report);
+    return report;
+}
+
+ChangeReport SceneCore::commit_deform(const DeformOp& op) {
+    ChangeReport report = document_.commit_deform(op);
+    live_->apply_change(document_.mesh(), report);
+    return report;
+}
+
+std::optional<ChangeReport> SceneCore::cancel_deform() {
+    std::optional<ChangeReport> report = document_.cancel_deform();
+    if (report) live_->apply_change(document_.mesh(), *report);
+    return report;
+}
+
 void SceneCore::set_solver_options(const LiveSceneOptions& options) {
     const Lighting lighting = live_->lighting();
     live_.reset();  // it borrows the document's mesh: release before building the next one

@@ -98,6 +98,11 @@ public:
     ChangeReport apply(const EditOperation& op);
     std::optional<ChangeReport> undo();  // nullopt: nothing to undo (nothing changed)
     std::optional<ChangeReport> redo();
+    // Document::preview_deform / commit_deform / cancel_deform (a Grab, Bend or Twist drag), each
+    // followed by the live scene's update of the moved vertices.
+    ChangeReport preview_deform(const DeformOp& op, int iterations);
+    ChangeReport commit_deform(const DeformOp& op);
+    std::optional<ChangeReport> cancel_deform();
 
     // A new live scene for `options` (method, backend, scale, tolerance, crease angle), lit as the
     // current one and solved again from scratch. The head follows these three setters.

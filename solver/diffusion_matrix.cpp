@@ -160,6 +160,27 @@ void assemble_row_impl(DiffusionMatrix& m, const TetConnectivity& conn, int32_t 
     source[d] += source_diag;
 }
 
+// A tet's K_ab / kappa and volume in millimetres.
+DiffusionMatrix::TetGeometry tet_geometry_mm(const TetMesh& mesh, const Tet& tet, const AssemblyOptions& options) {
+    // Relative to the first vertex before scaling: keeps the rounding of large coordinates out.
+    const double scale = options.mm_per_unit;
+    const Eigen::Vector3d o = mesh.positions[tet[0]];
+    const Eigen::Vector3d p1 = (mesh.positions[tet[1]] - o) * scale;
+    const Eigen::Vector3d p2 = (mesh.positions[tet[2]] - o) * scale;
+    const Eigen::Vector3d p3 = (mesh.positions[tet[3]] - o) * scale;
+    return {tet_edge_stiffness<double>(Eigen::Vector3d::Zero(), p1, p2, p3, options.stiffness_form),
+            p1.dot(p2.cross(p3)) / 6.0};
+}
+
+double boundary_face_area_mm(const TetMesh& mesh, const std::array<int32_t, 3>& v, double scale) {
+    return 0.5 * scale * scale *
+           (mesh.positions[v[1]] - mesh.positions[v[0]]).cross(mesh.positions[v[2]] - mesh.positions[v[0]]).norm();
+}
+
+[[noreturn]] void throw_inverted_tet(int64_t tet) {
+    throw InvalidMeshError("diffusion matrix: tet " + std::to_string(tet) + " has non-positive volume (inverted or degenerate)");
+}
+
 void assemble_row(DiffusionMatrix& m, const TetConnectivity& conn, int32_t i) {
     if (m.options.discretization == Discretization::Fem)
         assemble_row_impl<true>(m, conn, i);
@@ -289,29 +310,14 @@ DiffusionMatrix assemble_diffusion_matrix(const TetMesh& mesh, const TetConnecti
     const double scale = options.mm_per_unit;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tet_count, 1024), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t t = r.begin(); t != r.end(); ++t) {
-            const Tet& tet = mesh.tets[t];
-            // Relative to the first vertex before scaling: keeps the rounding of large coordinates out.
-            const Eigen::Vector3d o = mesh.positions[tet[0]];
-            const Eigen::Vector3d p1 = (mesh.positions[tet[1]] - o) * scale;
-            const Eigen::Vector3d p2 = (mesh.positions[tet[2]] - o) * scale;
-            const Eigen::Vector3d p3 = (mesh.positions[tet[3]] - o) * scale;
-            const double volume = p1.dot(p2.cross(p3)) / 6.0;
-            if (!(volume > 0)) bad_tet = static_cast<int64_t>(t);
-            m.tet_geometry[t] = {tet_edge_stiffness<double>(Eigen::Vector3d::Zero(), p1, p2, p3, options.stiffness_form),
-                                 volume};
+            m.tet_geometry[t] = tet_geometry_mm(mesh, mesh.tets[t], options);
+            if (!(m.tet_geometry[t].volume > 0)) bad_tet = static_cast<int64_t>(t);
         }
     });
-    if (bad_tet >= 0)
-        throw InvalidMeshError("diffusion matrix: tet " + std::to_string(bad_tet.load()) +
-                               " has non-positive volume (inverted or degenerate)");
+    if (bad_tet >= 0) throw_inverted_tet(bad_tet);
     const auto& faces = conn.boundary_faces;
     m.boundary_face_area.resize(faces.size());
-    for (size_t f = 0; f < faces.size(); ++f) {
-        const auto& v = faces[f].vertices;
-        m.boundary_face_area[f] =
-            0.5 * scale * scale *
-            (mesh.positions[v[1]] - mesh.positions[v[0]]).cross(mesh.positions[v[2]] - mesh.positions[v[0]]).norm();
-    }
+    for (size_t f = 0; f < faces.size(); ++f) m.boundary_face_area[f] = boundary_face_area_mm(mesh, faces[f].vertices, scale);
 
     assemble_diffusion_values(m, conn, materials);
     return m;
@@ -363,6 +369,58 @@ std::vector<int32_t> update_diffusion_matrix(DiffusionMatrix& m, const TetMesh& 
     }
     std::sort(rows.begin(), rows.end());
     rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, rows.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k != r.end(); ++k) assemble_row(m, conn, rows[k]);
+    });
+    return rows;
+}
+
+std::vector<int32_t> update_diffusion_geometry(DiffusionMatrix& m, const TetMesh& mesh, const TetConnectivity& conn,
+                                               std::span<const int32_t> moved_vertices) {
+    const size_t n = m.size();
+    if (mesh.vertex_count() != n || mesh.tet_count() != m.tet_geometry.size() ||
+        conn.vertex_tets.row_count() != n || conn.boundary_faces.size() != m.boundary_face_area.size())
+        throw InvalidArgumentError("diffusion matrix geometry update: the mesh (" + std::to_string(mesh.vertex_count()) +
+                                   " vertices, " + std::to_string(mesh.tet_count()) + " tets) is not the one the matrix (" +
+                                   std::to_string(n) + " vertices, " + std::to_string(m.tet_geometry.size()) +
+                                   " tets) was assembled on");
+    for (const int32_t v : moved_vertices)
+        if (v < 0 || static_cast<size_t>(v) >= n)
+            throw InvalidArgumentError("diffusion matrix geometry update: vertex index " + std::to_string(v) + " out of range");
+    // Marks rather than sorted lists: a drag moves most of a body, and sorting its tets' incidences
+    // costs more than the rows' assembly.
+    std::vector<uint8_t> tet_moved(m.tet_geometry.size(), 0), face_moved(m.boundary_face_area.size(), 0);
+    for (const int32_t v : moved_vertices) {
+        for (const int32_t t : conn.vertex_tets.row(v)) tet_moved[t] = 1;
+        for (int32_t k = m.vertex_face_offsets[v]; k < m.vertex_face_offsets[v + 1]; ++k) face_moved[m.vertex_faces[k]] = 1;
+    }
+    const auto marked = [](const std::vector<uint8_t>& flags) {
+        std::vector<int32_t> list;
+        for (size_t i = 0; i < flags.size(); ++i)
+            if (flags[i]) list.push_back(static_cast<int32_t>(i));
+        return list;
+    };
+    const std::vector<int32_t> tets = marked(tet_moved), faces = marked(face_moved);
+    // New geometry first, so an inverted tet throws before the matrix changes.
+    std::vector<DiffusionMatrix::TetGeometry> geometry(tets.size());
+    std::atomic<int64_t> bad_tet{-1};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, tets.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t k = r.begin(); k != r.end(); ++k) {
+            geometry[k] = tet_geometry_mm(mesh, mesh.tets[tets[k]], m.options);
+            if (!(geometry[k].volume > 0)) bad_tet = tets[k];
+        }
+    });
+    if (bad_tet >= 0) throw_inverted_tet(bad_tet);
+    // The moved geometry enters exactly the rows of those tets' vertices (a boundary face lies in its
+    // tet, so its vertices are among them).
+    std::vector<uint8_t> row_changed(n, 0);
+    for (size_t k = 0; k < tets.size(); ++k) {
+        m.tet_geometry[tets[k]] = geometry[k];
+        for (const int32_t v : mesh.tets[tets[k]]) row_changed[v] = 1;
+    }
+    for (const int32_t f : faces)
+        m.boundary_face_area[f] = boundary_face_area_mm(mesh, conn.boundary_faces[f].vertices, m.options.mm_per_unit);
+    const std::vector<int32_t> rows = marked(row_changed);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rows.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t k = r.begin(); k != r.end(); ++k) assemble_row(m, conn, rows[k]);
     });

@@ -149,6 +149,15 @@ std::vector<int32_t> update_diffusion_matrix(DiffusionMatrix& matrix, const TetM
                                              const std::vector<TetMaterial>& materials,
                                              std::span<const int32_t> changed_tets);
 
+// After vertices move with topology and materials unchanged (a deformation, a relaxation), recomputes
+// the geometry of the tets and boundary faces around `moved_vertices` and rewrites exactly the rows of
+// those tets' vertices, keeping the pattern. Returns the rewritten rows, ascending. The result equals
+// a full reassembly on the new positions. Throws InvalidMeshError, leaving the matrix unchanged, when a
+// tet around a moved vertex has non-positive volume.
+std::vector<int32_t> update_diffusion_geometry(DiffusionMatrix& matrix, const TetMesh& mesh,
+                                               const TetConnectivity& connectivity,
+                                               std::span<const int32_t> moved_vertices);
+
 // b = source * q for one channel (q per vertex; only boundary rows are non-zero).
 void diffusion_right_hand_side(const DiffusionMatrix& matrix, const std::vector<std::array<double, 3>>& q,
                                int channel, std::span<double> b);

@@ -2,6 +2,7 @@
 
 #include "base/error.h"
 #include "base/parallel_rows.h"
+#include "base/timing.h"
 #include "tetops/quality.h"
 
 #include <Eigen/Geometry>
@@ -15,8 +16,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <sstream>
 
@@ -101,7 +102,7 @@ ArapDeformer::ArapDeformer(const TetMesh& mesh, std::vector<int32_t> body_tets)
 
     // B_t = S D_m^{-1}, with S mapping corner positions to the edge matrix [x1-x0, x2-x0, x3-x0].
     gradients_.resize(tets_.size());
-    volumes_.resize(tets_.size());
+    weights_.resize(tets_.size());
     std::atomic<bool> degenerate = false;
     for_rows(tets_.size(), kTetGrain, [&](size_t t) {
         const Tet& tet = tets_[t];
@@ -117,7 +118,8 @@ ArapDeformer::ArapDeformer(const TetMesh& mesh, std::vector<int32_t> body_tets)
         b.row(0) = -g.colwise().sum();
         b.bottomRows<3>() = g;
         gradients_[t] = b;
-        volumes_[t] = volume;
+        const double angle = min_dihedral_angle_deg(rest_[tet[0]], rest_[tet[1]], rest_[tet[2]], rest_[tet[3]]);
+        weights_[t] = volume * std::max(1.0, kStiffSliverAngleDeg / angle);
     });
     if (degenerate) throw InvalidArgumentError("ARAP deformation: a tet of the body has non-positive volume");
 
@@ -176,7 +178,7 @@ void ArapDeformer::set_constrained(std::vector<int32_t> constrained) {
     std::vector<Eigen::Triplet<double>> ff, fc;
     ff.reserve(tets_.size() * 10);
     for (size_t t = 0; t < tets_.size(); ++t) {
-        const Eigen::Matrix4d k = volumes_[t] * gradients_[t] * gradients_[t].transpose();
+        const Eigen::Matrix4d k = weights_[t] * gradients_[t] * gradients_[t].transpose();
         for (int a = 0; a < 4; ++a) {
             const int32_t row = free_index_[local_index_[tets_[t][a]]];
             if (row < 0) continue;
@@ -211,7 +213,7 @@ void ArapDeformer::local_step() {
         for (int k = 0; k < 4; ++k) x.col(k) = positions_[tet[k]];
         const Eigen::Matrix3d f = x * gradients_[t];
         rotations_[t] = nearest_rotation(f);
-        return volumes_[t] * (f - rotations_[t]).squaredNorm();
+        return weights_[t] * (f - rotations_[t]).squaredNorm();
     });
     rotations_current_ = true;
 }
@@ -226,7 +228,7 @@ void ArapDeformer::global_step(std::span<const Eigen::Vector3d> targets) {
         for (int32_t i = vertex_tets_.offsets[v]; i < vertex_tets_.offsets[v + 1]; ++i) {
             const int32_t code = vertex_tets_.indices[i];
             const int32_t t = code / 4, corner = code % 4;
-            sum += volumes_[t] * gradients_[t].row(corner) * rotations_[t].transpose();
+            sum += weights_[t] * gradients_[t].row(corner) * rotations_[t].transpose();
         }
         rhs.row(static_cast<Eigen::Index>(f)) = sum;
     });
@@ -279,7 +281,7 @@ double ArapDeformer::energy() const {
         Eigen::Matrix<double, 3, 4> x;
         for (int k = 0; k < 4; ++k) x.col(k) = positions_[tets_[t][k]];
         const Eigen::Matrix3d f = x * gradients_[t];
-        return volumes_[t] * (f - nearest_rotation(f)).squaredNorm();
+        return weights_[t] * (f - nearest_rotation(f)).squaredNorm();
     });
 }
 
@@ -319,10 +321,59 @@ std::vector<int32_t> DragRegion::constrained() const {
     return all;
 }
 
+HandleMotion HandleMotion::translation(const Eigen::Vector3d& move) {
+    HandleMotion m;
+    m.move = move;
+    return m;
+}
+
+HandleMotion HandleMotion::bend(const Eigen::Vector3d& axis_point, const Eigen::Vector3d& axis_direction, double angle_rad) {
+    HandleMotion m;
+    m.kind = Kind::Bend;
+    m.axis_point = axis_point;
+    m.axis_direction = axis_direction;
+    m.angle = angle_rad;
+    return m;
+}
+
+HandleMotion HandleMotion::twist(const Eigen::Vector3d& axis_point, const Eigen::Vector3d& axis_direction,
+                                 double angle_per_length) {
+    HandleMotion m = bend(axis_point, axis_direction, angle_per_length);
+    m.kind = Kind::Twist;
+    return m;
+}
+
+HandleMotion HandleMotion::in_rest_frame(const RigidTransform& piece) const {
+    HandleMotion m = *this;
+    const Eigen::Matrix3d to_rest = piece.rotation.transpose();
+    m.move = to_rest * move;
+    m.axis_point = to_rest * (axis_point - piece.translation);
+    m.axis_direction = to_rest * axis_direction;
+    return m;
+}
+
+Eigen::Vector3d HandleMotion::apply(const Eigen::Vector3d& point, double f) const {
+    if (kind == Kind::Translate) return point + f * move;
+    const Eigen::Vector3d axis = axis_direction.normalized();
+    const Eigen::Vector3d r = point - axis_point;
+    const double turn = kind == Kind::Bend ? f * angle : f * angle * r.dot(axis);
+    return axis_point + Eigen::AngleAxisd(turn, axis) * r;
+}
+
+void validate_handle_motion(const HandleMotion& motion) {
+    if (!motion.move.allFinite()) throw InvalidArgumentError("the move is not finite");
+    if (motion.kind == HandleMotion::Kind::Translate) return;
+    if (!motion.axis_point.allFinite() || !motion.axis_direction.allFinite() || motion.axis_direction.norm() == 0)
+        throw InvalidArgumentError("the rotation axis needs a finite point and a finite, non-zero direction");
+    if (!std::isfinite(motion.angle))
+        throw InvalidArgumentError(motion.kind == HandleMotion::Kind::Bend ? "the bend angle is not finite"
+                                                                           : "the twist rate is not finite");
+}
+
 DragRegion select_drag_region(const TetMesh& mesh, const TetConnectivity& connectivity, const Eigen::Vector3d& grab,
-                              double radius, const Eigen::Vector3d& move, std::span<const PinSphere> pins) {
+                              double radius, const HandleMotion& motion, std::span<const PinSphere> pins) {
     if (!grab.allFinite()) throw InvalidArgumentError("the grab point is not finite");
-    if (!move.allFinite()) throw InvalidArgumentError("the move is not finite");
+    validate_handle_motion(motion);
     if (!(radius > 0) || !std::isfinite(radius))
         throw InvalidArgumentError("the handle radius must be a positive number");
     for (const PinSphere& pin : pins)
@@ -382,33 +433,30 @@ DragRegion select_drag_region(const TetMesh& mesh, const TetConnectivity& connec
     if (region.handle.size() + region.pinned.size() >= body_vertices)
         throw InvalidArgumentError("the handle and the pins hold every vertex of the body (" +
                                    std::to_string(body_vertices) + "); nothing is left to deform");
-    region.move_rest = mesh.piece_transforms[region.piece].rotation.transpose() * move;
+    region.motion_rest = motion.in_rest_frame(mesh.piece_transforms[region.piece]);
     return region;
+}
+
+double handle_fraction(const DragRegion& region, size_t i, double t) {
+    return region.motion_rest.kind == HandleMotion::Kind::Translate ? t * region.handle_weights[i] : t;
 }
 
 std::vector<Eigen::Vector3d> drag_targets(const DragRegion& region, std::span<const Eigen::Vector3d> rest, double t) {
     std::vector<Eigen::Vector3d> targets;
     targets.reserve(region.handle.size() + region.pinned.size());
     for (size_t i = 0; i < region.handle.size(); ++i)
-        targets.push_back(rest[region.handle[i]] + t * region.handle_weights[i] * region.move_rest);
+        targets.push_back(region.motion_rest.apply(rest[region.handle[i]], handle_fraction(region, i, t)));
     for (int32_t v : region.pinned) targets.push_back(rest[v]);
     return targets;
 }
 
 namespace {
 
-std::vector<Eigen::Vector3d> rotate_about_axis(std::span<const Eigen::Vector3d> points, const Eigen::Vector3d& axis_point,
-                                               const Eigen::Vector3d& axis_direction,
-                                               const std::function<double(double)>& angle_at) {
-    if (!axis_point.allFinite() || !axis_direction.allFinite() || axis_direction.norm() == 0)
-        throw InvalidArgumentError("the rotation axis needs a finite point and a finite, non-zero direction");
-    const Eigen::Vector3d axis = axis_direction.normalized();
+std::vector<Eigen::Vector3d> moved_points(std::span<const Eigen::Vector3d> points, const HandleMotion& motion) {
+    validate_handle_motion(motion);
     std::vector<Eigen::Vector3d> out;
     out.reserve(points.size());
-    for (const Eigen::Vector3d& p : points) {
-        const Eigen::Vector3d r = p - axis_point;
-        out.push_back(axis_point + Eigen::AngleAxisd(angle_at(r.dot(axis)), axis) * r);
-    }
+    for (const Eigen::Vector3d& p : points) out.push_back(motion.apply(p, 1));
     return out;
 }
 
@@ -416,14 +464,12 @@ std::vector<Eigen::Vector3d> rotate_about_axis(std::span<const Eigen::Vector3d> 
 
 std::vector<Eigen::Vector3d> bend_about_axis(std::span<const Eigen::Vector3d> points, const Eigen::Vector3d& axis_point,
                                              const Eigen::Vector3d& axis_direction, double angle_rad) {
-    if (!std::isfinite(angle_rad)) throw InvalidArgumentError("the bend angle is not finite");
-    return rotate_about_axis(points, axis_point, axis_direction, [&](double) { return angle_rad; });
+    return moved_points(points, HandleMotion::bend(axis_point, axis_direction, angle_rad));
 }
 
 std::vector<Eigen::Vector3d> twist_about_axis(std::span<const Eigen::Vector3d> points, const Eigen::Vector3d& axis_point,
                                               const Eigen::Vector3d& axis_direction, double angle_per_length) {
-    if (!std::isfinite(angle_per_length)) throw InvalidArgumentError("the twist rate is not finite");
-    return rotate_about_axis(points, axis_point, axis_direction, [&](double s) { return angle_per_length * s; });
+    return moved_points(points, HandleMotion::twist(axis_point, axis_direction, angle_per_length));
 }
 
 GuardedStep guard_step(const TetMesh& mesh, std::span<const int32_t> tets,
@@ -483,10 +529,15 @@ DragReport run_drag(ArapDeformer& deformer, const TetMesh& mesh, const DragRegio
                     std::span<const Eigen::Vector3d> rest, int steps, int iterations, const GuardOptions& guard) {
     if (steps < 1) throw InvalidArgumentError("the drag needs at least one step");
     if (iterations < 1) throw InvalidArgumentError("the drag needs at least one iteration per step");
-    deformer.set_constrained(region.constrained());
     DragReport report;
+    const auto factor_start = std::chrono::steady_clock::now();
+    deformer.set_constrained(region.constrained());
+    report.factorization_ms = milliseconds_since(factor_start);
     report.steps = steps;
     report.iterations_per_step = iterations;
+    report.body_tets = region.body_tets.size();
+    report.handle_vertices = region.handle.size();
+    report.pinned_vertices = region.pinned.size();
     std::vector<Eigen::Vector3d> targets;
     for (int s = 1; s <= steps; ++s) {
         targets = drag_targets(region, rest, static_cast<double>(s) / steps);

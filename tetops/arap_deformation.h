@@ -13,6 +13,15 @@
 // moves rigidly, which is what "a tet keeps its shape" means for the tests and the guard. The cost is
 // one 3x3 polar decomposition per tet (about 4 tets per vertex) per iteration, run in parallel.
 //
+// Slivers. The energy integrates over volume, so a sliver (tiny volume) costs almost nothing to
+// distort and the global step leaves the strain there: in a volume that cuts and relaxation have left
+// with tets near the 0.5 degree guard, those tets are the ones a step would push under it, and the guard
+// then shortens every step of the drag. Each tet's term is weighted by w_t = vol_t max(1, 10 deg /
+// theta_t), theta_t its minimum dihedral angle at rest: well-shaped tets keep the paper's weights,
+// slivers become stiffer in proportion to how thin they are (docs/deformation.md measures the
+// difference). E below is this weighted sum.
+inline constexpr double kStiffSliverAngleDeg = 10;
+
 // Local/global iterations (paper Sec. 3): with the positions fixed, each R_t is the rotation nearest
 // F_t (Eq. 6 and the remark after it: the SVD's U V^T with the reflection fixed; computed as the
 // polar factor by Newton's iteration where det F_t > 0, by Jacobi SVD elsewhere); with the
@@ -93,7 +102,7 @@ private:
     std::vector<int32_t> body_tets_;
     std::vector<int32_t> body_vertices_;
     std::vector<Eigen::Matrix<double, 4, 3>> gradients_;  // B_t: F_t = [x0 x1 x2 x3] B_t
-    std::vector<double> volumes_;
+    std::vector<double> weights_;           // w_t: the volume, larger for slivers (see the top)
     std::vector<Eigen::Matrix3d> rotations_;
     bool rotations_current_ = false;        // rotations_ fit positions_ (saves a local step per frame)
     double energy_ = 0;                     // E for positions_ when rotations_current_
@@ -124,7 +133,36 @@ double handle_falloff(double distance, double radius);
 struct PinSphere {
     Eigen::Vector3d center = Eigen::Vector3d::Zero();
     double radius = 0;
+    friend bool operator==(const PinSphere&, const PinSphere&) = default;
 };
+
+// How the handle moves: Grab translates it, Bend turns it about an axis, Twist turns it about an axis by
+// an angle that grows along the axis. For a translation a handle vertex with falloff weight w moves by
+// w move, so the handle's rim blends into the body. Turns hold the handle rigid instead: a rim turned by
+// w angle would lag its centre by the lever arm times the angle's difference, shearing the handle
+// itself far more than the body around it (a 45 degree bend two handle-widths from the axis inverts
+// tets in the handle); Twist's angle already grows smoothly along the axis.
+struct HandleMotion {
+    enum class Kind { Translate, Bend, Twist };
+    Kind kind = Kind::Translate;
+    Eigen::Vector3d move = Eigen::Vector3d::Zero();                 // Translate
+    Eigen::Vector3d axis_point = Eigen::Vector3d::Zero();           // Bend, Twist
+    Eigen::Vector3d axis_direction = Eigen::Vector3d::UnitZ();      // Bend, Twist; need not be unit
+    double angle = 0;  // Bend: radians; Twist: radians per unit length along the axis
+
+    static HandleMotion translation(const Eigen::Vector3d& move);
+    static HandleMotion bend(const Eigen::Vector3d& axis_point, const Eigen::Vector3d& axis_direction, double angle_rad);
+    static HandleMotion twist(const Eigen::Vector3d& axis_point, const Eigen::Vector3d& axis_direction,
+                              double angle_per_length);
+    // The same motion seen in a piece's rest frame (world = rotation * rest + translation).
+    HandleMotion in_rest_frame(const RigidTransform& piece) const;
+    // Where a point goes under the fraction `f` of the motion.
+    Eigen::Vector3d apply(const Eigen::Vector3d& point, double f) const;
+    friend bool operator==(const HandleMotion&, const HandleMotion&) = default;
+};
+
+// InvalidArgumentError when the motion is not finite or a Bend or Twist axis has zero direction.
+void validate_handle_motion(const HandleMotion& motion);
 
 // What a drag holds, in the rest frame of the body's piece. Positions of one piece are rest-frame
 // coordinates; grab, move and pins are in world space and mapped through the piece's transform.
@@ -134,20 +172,25 @@ struct DragRegion {
     std::vector<int32_t> handle;           // weight >= kHandleMinWeight, not pinned
     std::vector<double> handle_weights;    // per handle vertex
     std::vector<int32_t> pinned;           // body vertices inside a pin sphere
-    Eigen::Vector3d move_rest = Eigen::Vector3d::Zero();  // the world move in the piece's rest frame
+    HandleMotion motion_rest;              // the world motion in the piece's rest frame
     // handle then pinned: the order ArapDeformer::set_constrained and drag_targets use.
     std::vector<int32_t> constrained() const;
 };
 
-// Selects the body, handle and pins for a drag of `move` (world) at `grab` (world) with falloff
+// Selects the body, handle and pins for a drag of `motion` (world) at `grab` (world) with falloff
 // radius `radius`. Throws InvalidArgumentError (naming the problem, for the caller to prefix with
-// its options) when radius <= 0 or anything is not finite, no vertex has weight >= kHandleMinWeight,
+// its options) when radius <= 0 or anything is not finite, a Bend or Twist axis has zero direction,
+// no vertex has weight >= kHandleMinWeight,
 // every handle vertex is pinned, or handle and pins together hold every vertex of the body.
 DragRegion select_drag_region(const TetMesh& mesh, const TetConnectivity& connectivity, const Eigen::Vector3d& grab,
-                              double radius, const Eigen::Vector3d& move, std::span<const PinSphere> pins);
+                              double radius, const HandleMotion& motion, std::span<const PinSphere> pins);
 
-// Targets for region.constrained() after the fraction `t` in [0, 1] of the move: handle vertices at
-// rest + t * w * move, pinned at rest.
+// The fraction of motion_rest that handle vertex i (of region.handle) follows after the fraction `t`
+// of the drag: t w_i for a translation, t for a turn (see HandleMotion).
+double handle_fraction(const DragRegion& region, size_t i, double t);
+
+// Targets for region.constrained() after the fraction `t` in [0, 1] of the motion: handle vertices
+// at handle_fraction of motion_rest (rest + t w move for a translation), pinned at rest.
 std::vector<Eigen::Vector3d> drag_targets(const DragRegion& region, std::span<const Eigen::Vector3d> rest, double t);
 
 // Targets for the Bend and Twist tools: `points` rotated about the axis through `axis_point` along
@@ -190,6 +233,8 @@ GuardedStep guard_step(const TetMesh& mesh, std::span<const int32_t> tets,
 struct DragReport {
     int steps = 0;
     int iterations_per_step = 0;
+    size_t body_tets = 0, handle_vertices = 0, pinned_vertices = 0;  // the region's sizes
+    double factorization_ms = 0;  // factoring K for the region's constraints (0 when the factor was kept)
     double energy = 0;            // ARAP energy of the final positions
     int shortened_steps = 0;      // steps the guard shortened
     double last_step_fraction = 1;

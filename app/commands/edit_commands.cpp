@@ -14,6 +14,7 @@
 #include "base/error.h"
 #include "base/timing.h"
 #include "io/volume_file.h"
+#include "app/commands/edited_volume.h"
 #include "scene/document.h"
 #include "scene/edit_operation.h"
 #include "solver/material.h"
@@ -40,43 +41,6 @@ namespace waxwork {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// The volume a command edits, in the Document the editor and sessions edit through (scene/document.h),
-// so the three cannot apply an operation differently. Nothing is undone on the command line: with no
-// undo budget the document keeps no snapshot of the volume before an edit.
-class EditedVolume {
-public:
-    // Reads `input`. The document gives every tet `base` when the file stores no materials; they are
-    // written out only with `write_base`: a painted volume needs them, a cut or a fracture adds no
-    // materials the input did not have.
-    EditedVolume(const std::string& input, const TetMaterial& base, bool write_base)
-        : EditedVolume(input, read_volume_file(input), base, write_base) {}
-
-    const TetMesh& mesh() const { return document_.mesh(); }
-
-    // Errors name the volume (what it does not allow: a cut that leaves nothing, more pieces than tets).
-    ChangeReport apply(const EditOperation& op) {
-        return naming_context(input_, [&] { return document_.apply(op); });
-    }
-
-    // Keeps what the input stored beside the mesh (its scale).
-    void write(const std::string& output) const {
-        if (keep_materials_) return write_volume(document_.mesh(), output, metadata_);
-        TetMesh mesh = document_.mesh();
-        mesh.materials.clear();
-        write_volume(mesh, output, metadata_);
-    }
-
-private:
-    EditedVolume(const std::string& input, VolumeFile file, const TetMaterial& base, bool write_base)
-        : input_(input), keep_materials_(write_base || file.mesh.has_materials()), metadata_(file.metadata),
-          document_(std::move(file.mesh), base, /*undo_budget_bytes=*/0) {}
-
-    std::string input_;
-    bool keep_materials_;
-    VolumeMetadata metadata_;
-    Document document_;
-};
 
 struct CutCommandOptions {
     std::string input;

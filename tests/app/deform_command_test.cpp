@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -74,6 +75,34 @@ TEST(DeformCommand, AbsurdMoveIsShortenedAndInvertsNothing) {
     for (size_t t = 0; t < out.tet_count(); ++t) ASSERT_GT(signed_volume(out, t), 0) << t;
 }
 
+// Bend turns the grabbed end about the elbow axis, Twist about the bar's own axis; both keep every tet.
+TEST(DeformCommand, BendsAndTwistsAboutTheGivenAxis) {
+    const auto dir = scratch_dir("deform_command_bend");
+    const TetMesh bar = painted_bar();
+    write_volume(bar, dir / "in.vtu");
+    const int32_t end = box_vertex_index({16, 4, 4}, 16, 2, 2);  // (4, 0.5, 0.5), the handle's centre
+    for (const std::string motion : {"--bend 2,0.5,0.5:0,0,1:45", "--twist 0,0.5,0.5:1,0,0:10"}) {
+        const auto r = run_waxwork("deform " + (dir / "in.vtu").string() + " -o " + (dir / "out.vtu").string() +
+                                   " --grab 4,0.5,0.5 --radius 1 " + motion + " --pin 0,0.5,0.5:0.6 --steps 4");
+        ASSERT_EQ(r.exit_code, 0) << motion << ": " << r.err;
+        const nlohmann::json summary = nlohmann::json::parse(r.out);
+        EXPECT_EQ(summary["tool"], motion.substr(2, 4) == "bend" ? "bend" : "twist") << motion;
+        EXPECT_EQ(summary["inverted_tets"], 0) << motion;
+        EXPECT_EQ(summary["step_shortened"], false) << motion;
+        const TetMesh out = read_volume(dir / "out.vtu");
+        EXPECT_EQ(out.materials, bar.materials);
+        if (motion.substr(2, 4) == "bend") {
+            // The handle's centre (weight 1) turned 45 degrees about z through (2, 0.5): to (2 + sqrt 2, 0.5 + sqrt 2).
+            EXPECT_LT((out.positions[end] - Eigen::Vector3d(2 + std::sqrt(2.0), 0.5 + std::sqrt(2.0), 0.5)).norm(), 1e-9);
+        } else {
+            // On the axis: a twist leaves it in place, while the corners of the end turn.
+            EXPECT_LT((out.positions[end] - bar.positions[end]).norm(), 1e-9);
+            const int32_t corner = box_vertex_index({16, 4, 4}, 16, 1, 1);
+            EXPECT_GT((out.positions[corner] - bar.positions[corner]).norm(), 0.05);
+        }
+    }
+}
+
 TEST(DeformCommand, BadInputIsAOneLineErrorNamingTheOption) {
     const auto dir = scratch_dir("deform_command_errors");
     write_volume(painted_bar(), dir / "in.vtu");
@@ -87,6 +116,10 @@ TEST(DeformCommand, BadInputIsAOneLineErrorNamingTheOption) {
         {"--grab 4,0.5,0.5 --radius 1 --move 0,1,0 --pin 2,0.5,0.5:100", "every vertex of the handle is pinned"},
         {"--grab 4,0.5,0.5 --radius 1 --move 0,1,0 --pin 2,0.5,0.5", "--pin"},
         {"--grab 4,0.5,0.5 --radius 1 --move 0,1,0 --iterations 0", "--iterations"},
+        {"--grab 4,0.5,0.5 --radius 1", "exactly one of --move, --bend and --twist"},
+        {"--grab 4,0.5,0.5 --radius 1 --move 0,1,0 --bend 2,0.5,0.5:0,0,1:30", "exactly one of"},
+        {"--grab 4,0.5,0.5 --radius 1 --bend 2,0.5,0.5:0,0,0:30", "--bend: the axis direction must not be zero"},
+        {"--grab 4,0.5,0.5 --radius 1 --twist 2,0.5,0.5:1,0,0", "--twist"},
     };
     for (const auto& [args, expected] : cases) {
         const auto r = run_waxwork(base + args);

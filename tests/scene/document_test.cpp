@@ -47,7 +47,18 @@ std::vector<EditOperation> material_and_geometry_ops() {
     MovePieceOp move;
     move.transform.rotation = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()).toRotationMatrix();
     move.transform.translation = Eigen::Vector3d(0.3, 0, 0);
-    return {plane_cut(0.55), exact, stroke, relax, paint_at({0.3, 0.3, 0.3}),
+    // Drags of the side x = 0, pinned near the middle (first: a document given every kind in turn
+    // deforms the whole cube before the cuts take parts of it away).
+    DeformOp grab;
+    grab.grab = Eigen::Vector3d(0, 0.5, 0.5);
+    grab.radius = 0.4;
+    grab.motion = HandleMotion::translation(Eigen::Vector3d(-0.15, 0.1, 0.05));
+    grab.pins = {PinSphere{Eigen::Vector3d(0.3, 0.5, 0.5), 0.15}};
+    grab.iterations = 4;
+    grab.steps = 2;
+    DeformOp twist = grab;
+    twist.motion = HandleMotion::twist(Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(1, 0, 0), 0.6);
+    return {grab, twist, plane_cut(0.55), exact, stroke, relax, paint_at({0.3, 0.3, 0.3}),
             SetMaterialOp{material_preset("skin1"), std::nullopt}, SetMaterialOp{material_preset("marble"), 0},
             scattered, seeded, move};
 }
@@ -89,6 +100,47 @@ TEST(Document, UndoRestoresTheMeshBitForBitForEveryKind) {
         EXPECT_TRUE(doc.mesh() == after) << report.name;
         EXPECT_EQ(doc.history().size(), 2u);
     }
+}
+
+TEST(Document, DeformReportsTheMovedVerticesAndKeepsEverythingButPositions) {
+    Document doc(test_cube(), material_preset("marble"));
+    doc.apply(paint_at({0.1, 0.5, 0.5}));
+    const TetMesh before = doc.mesh();
+    const double min_angle_before = doc.min_dihedral_deg();
+    DeformOp bend;
+    bend.grab = Eigen::Vector3d(0, 0.5, 0.5);
+    bend.radius = 0.5;
+    bend.motion = HandleMotion::bend(Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(0, 0, 1), 0.4);
+    bend.pins = {PinSphere{Eigen::Vector3d(1, 0.5, 0.5), 0.3}};
+    const ChangeReport report = doc.apply(bend);
+    EXPECT_TRUE(report.positions);
+    EXPECT_FALSE(report.topology);
+    ASSERT_FALSE(report.moved_vertices.empty());
+    EXPECT_TRUE(std::is_sorted(report.moved_vertices.begin(), report.moved_vertices.end()));
+    size_t moved = 0;
+    for (size_t v = 0; v < before.vertex_count(); ++v) moved += doc.mesh().positions[v] != before.positions[v] ? 1 : 0;
+    EXPECT_EQ(report.moved_vertices.size(), moved);
+    EXPECT_EQ(doc.mesh().tets, before.tets);
+    EXPECT_EQ(doc.mesh().materials, before.materials);  // painted materials move with their tets
+    const DragReport& drag = std::get<DragReport>(report.result);
+    EXPECT_EQ(drag.inverted_tets, 0u);
+    EXPECT_GE(report.min_dihedral_deg, std::min(0.5, min_angle_before) - 1e-9);
+    EXPECT_GT(drag.handle_vertices, 0u);
+    EXPECT_GT(drag.pinned_vertices, 0u);
+    const std::optional<ChangeReport> undone = doc.undo();
+    ASSERT_TRUE(undone);
+    EXPECT_EQ(undone->moved_vertices, report.moved_vertices);
+    EXPECT_TRUE(doc.mesh() == before);
+    // A grab that reaches no vertex is refused, names the operation and changes nothing.
+    DeformOp nowhere = bend;
+    nowhere.grab = Eigen::Vector3d(5, 5, 5);
+    try {
+        doc.apply(nowhere);
+        ADD_FAILURE() << "no error";
+    } catch (const InvalidArgumentError& e) {
+        EXPECT_NE(std::string(e.what()).find("deform: no vertex lies within the handle"), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(doc.mesh() == before);
 }
 
 TEST(Document, SaveAndReloadAfterEveryKindOfOperationIsIdentical) {

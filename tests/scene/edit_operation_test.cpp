@@ -39,8 +39,21 @@ std::vector<EditOperation> one_of_each() {
     paint.sigma = 0.07;
     SetMaterialOp all{material_preset("skin1"), std::nullopt};
     SetMaterialOp one{material_preset("marble"), 3};
+    DeformOp grab;
+    grab.grab = Eigen::Vector3d(1, 0.5, 1.0 / 3.0);
+    grab.radius = 0.4;
+    grab.motion = HandleMotion::translation(Eigen::Vector3d(0.1, -0.2, 1e-17));
+    grab.pins = {PinSphere{Eigen::Vector3d(0, 0.5, 0.5), 0.3}, PinSphere{Eigen::Vector3d(0, 0, 0), 0.1}};
+    DeformOp bend = grab;
+    bend.motion = HandleMotion::bend(Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(0, 0, 2), 0.7853981633974483);
+    bend.pins.clear();
+    bend.iterations = 3;
+    bend.steps = 1;
+    bend.guard_deg = 0;
+    DeformOp twist = grab;
+    twist.motion = HandleMotion::twist(Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(1, 0, 0), -1.0 / 3.0);
     return {plane,        stroke,      relax_plane, relax_stroke, scattered, seeded,
-            move,         WeldOp{1e-5}, RemoveFragmentsOp{0.0025}, paint, all,   one};
+            move,         WeldOp{1e-5}, RemoveFragmentsOp{0.0025}, paint, all,   one, grab, bend, twist};
 }
 
 TEST(EditOperation, EveryKindRoundTripsThroughJsonText) {
@@ -112,6 +125,28 @@ TEST(EditOperation, ErrorsNameTheContextAndTheField) {
     EXPECT_NE(error_of(R"({"op":"relax","relax":{}})").find("exactly one of"), std::string::npos);
     EXPECT_NE(error_of(R"({"op":"fracture","pieces":3,"collapse":0})").find("field 'collapse': expected true or false"),
               std::string::npos);
+}
+
+TEST(EditOperation, DeformErrorsNameTheField) {
+    const std::string grab = R"("op":"deform","grab":[1,0.5,0.5],"radius":0.4,)";
+    EXPECT_NE(error_of("{" + grab + R"("move":[0,1,0],"bend":{"axis_point":[0,0,0],"axis":[0,0,1],"angle":1}})")
+                  .find("exactly one of 'move', 'bend' and 'twist'"),
+              std::string::npos);
+    EXPECT_NE(error_of("{" + grab.substr(0, grab.size() - 1) + "}").find("exactly one of"), std::string::npos);
+    EXPECT_NE(error_of(R"({"op":"deform","grab":[1,0.5,0.5],"radius":0,"move":[0,1,0]})").find("field 'radius'"),
+              std::string::npos);
+    EXPECT_NE(error_of("{" + grab + R"("bend":{"axis_point":[0,0,0],"axis":[0,0,0],"angle":1}})")
+                  .find("field 'bend': field 'axis': must not be zero"),
+              std::string::npos);
+    EXPECT_NE(error_of("{" + grab + R"("twist":{"axis_point":[0,0,0],"axis":[0,0,1]}})")
+                  .find("missing field 'angle_per_length'"),
+              std::string::npos);
+    EXPECT_NE(error_of("{" + grab + R"("move":[0,1,0],"pins":[{"center":[0,0,0],"radius":-1}]})")
+                  .find("field 'pins'[0]: field 'radius'"),
+              std::string::npos);
+    EXPECT_NE(error_of("{" + grab + R"("move":[0,1,0],"steps":100000})").find("field 'steps': must be between 1 and 1000"),
+              std::string::npos);
+    EXPECT_NE(error_of("{" + grab + R"("move":[0,1,0],"iterations":0})").find("field 'iterations'"), std::string::npos);
 }
 
 }  // namespace

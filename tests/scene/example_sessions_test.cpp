@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <functional>
 
@@ -189,6 +191,31 @@ TEST(ExampleSessions, FracturedPiecesPullApart) {
     EXPECT_GE(object_column_runs(apart), 2);
     EXPECT_EQ(r.result.mesh.piece_transforms.size(), 3u);
     EXPECT_TRUE(read_volume(r.out / "fractured.vtu") == r.result.mesh);
+}
+
+// A slab carved out of spot, its head bent out of the slab's plane: the head swings out (the slab was
+// 0.22 thick in x, the bent head reaches far beyond it), the pinned rear stays, and the back light
+// through the turned head is seen differently.
+TEST(ExampleSessions, BentSlabSwingsItsHeadAndTheLightFollows) {
+    const Replay r = replay("bend");
+    const Image slab = read_png(r.out / "bend_0_slab.png");
+    const Image bent = read_png(r.out / "bend_1_bent.png");
+    expect_visible(slab, "slab");
+    expect_visible(bent, "bent");
+    EXPECT_TRUE(read_volume(r.out / "bent.vtu") == r.result.mesh);
+    double head_x = 0, rear_x = 0;
+    for (const Eigen::Vector3d& p : r.result.mesh.positions) {
+        if (p.z() < -0.4 && p.y() > 0.3) head_x = std::max(head_x, std::abs(p.x()));
+        if (p.z() > 0.6) rear_x = std::max(rear_x, std::abs(p.x()));
+    }
+    EXPECT_GT(head_x, 0.25);
+    EXPECT_LT(rear_x, 0.13);
+    ASSERT_EQ(slab.width, bent.width);
+    double difference = 0;
+    for (int y = 0; y < slab.height; ++y)
+        for (int x = 0; x < slab.width; ++x)
+            difference += std::abs(luminance(slab.pixel(x, y)) - luminance(bent.pixel(x, y)));
+    EXPECT_GT(difference / (slab.width * slab.height), 2.0);
 }
 
 }  // namespace

@@ -292,6 +292,13 @@ TEST(Session, RecordedHistoryReplaysToTheSameVolumeBitForBit) {
     PlaneCutOp cut;
     cut.plane = {Eigen::Vector3d(1, 0.1, -0.2), 0.6};
     doc.apply(paint);
+    DeformOp pull;  // positions move: the replay must reproduce them bit for bit too
+    pull.grab = Eigen::Vector3d(1, 0.5, 0.5);
+    pull.radius = 0.4;
+    pull.motion = HandleMotion::translation(Eigen::Vector3d(0.1, 0.05, 0));
+    pull.pins = {PinSphere{Eigen::Vector3d(0, 0.5, 0.5), 0.3}};
+    pull.steps = 2;
+    doc.apply(pull);
     doc.apply(cut);
     doc.apply(SetMaterialOp{material_preset("skin1"), 0});
     doc.undo();  // not part of the record
@@ -308,7 +315,7 @@ TEST(Session, RecordedHistoryReplaysToTheSameVolumeBitForBit) {
 
     write_session(dir / "recorded.json", record_session(setup, doc, {SaveStep{"replayed.vtu"}}));
     const Session replay = read_session(dir / "recorded.json");
-    EXPECT_EQ(replay.steps.size(), 5u);
+    EXPECT_EQ(replay.steps.size(), 6u);
     const SessionResult result = run_session(replay, dir / "out");
     EXPECT_TRUE(result.mesh == doc.mesh());
     EXPECT_TRUE(read_volume(dir / "out" / "replayed.vtu") == doc.mesh());

@@ -177,6 +177,56 @@ TEST(DiffusionMatrix, IncrementalUpdateEqualsFullReassemblyAndTouchesOnlyItsRows
     }
 }
 
+// Moved vertices (a deformation): the geometry update rewrites exactly the rows of the tets around
+// them, bit for bit as a full reassembly on the new positions, boundary faces included, and refuses an
+// inverted tet before changing anything.
+TEST(DiffusionMatrix, GeometryUpdateEqualsFullReassemblyAndTouchesOnlyItsRows) {
+    for (auto disc : {Discretization::TransCut, Discretization::Fem}) {
+        Fixture f;
+        DiffusionMatrix m = assemble_diffusion_matrix(f.mesh, f.conn, f.materials, {disc});
+        const std::vector<int32_t> moved = {0, 9, static_cast<int32_t>(f.mesh.vertex_count() / 2)};
+        for (int32_t v : moved) f.mesh.positions[v] += Eigen::Vector3d(0.013, -0.007, 0.011) * (1 + v % 3);
+        std::vector<uint8_t> expected_rows(m.size(), 0);
+        for (int32_t v : moved)
+            for (int32_t t : f.conn.vertex_tets.row(v))
+                for (int32_t w : f.mesh.tets[t]) expected_rows[w] = 1;
+        const double poison = -12345.0;
+        for (size_t i = 0; i < m.size(); ++i)
+            if (!expected_rows[i])
+                for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) {
+                    for (auto& v : m.values) v[k] = poison;
+                    m.source[k] = poison;
+                }
+        const auto rows = update_diffusion_geometry(m, f.mesh, f.conn, moved);
+        EXPECT_EQ(rows.size(), static_cast<size_t>(std::count(expected_rows.begin(), expected_rows.end(), 1)));
+        for (int32_t r : rows) EXPECT_TRUE(expected_rows[r]);
+        const DiffusionMatrix full = assemble_diffusion_matrix(f.mesh, f.conn, f.materials, {disc});
+        for (size_t t = 0; t < full.tet_geometry.size(); ++t) {
+            EXPECT_EQ(m.tet_geometry[t].volume, full.tet_geometry[t].volume) << t;
+            EXPECT_EQ(m.tet_geometry[t].edge_stiffness, full.tet_geometry[t].edge_stiffness) << t;
+        }
+        EXPECT_EQ(m.boundary_face_area, full.boundary_face_area);
+        for (size_t i = 0; i < m.size(); ++i)
+            for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) {
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_EQ(m.values[c][k], expected_rows[i] ? full.values[c][k] : poison) << "row " << i;
+                EXPECT_EQ(m.source[k], expected_rows[i] ? full.source[k] : poison) << "row " << i;
+            }
+    }
+    // A move that inverts a tet is refused and the matrix is left as it was.
+    Fixture f;
+    DiffusionMatrix m = assemble_diffusion_matrix(f.mesh, f.conn, f.materials);
+    const DiffusionMatrix before = m;
+    const int32_t v = f.mesh.tets[0][0];
+    f.mesh.positions[v] = f.mesh.positions[f.mesh.tets[0][1]];
+    const std::vector<int32_t> moved = {v};
+    EXPECT_THROW(update_diffusion_geometry(m, f.mesh, f.conn, moved), InvalidMeshError);
+    EXPECT_EQ(m.values, before.values);
+    EXPECT_EQ(m.boundary_face_area, before.boundary_face_area);
+    const std::vector<int32_t> out_of_range = {static_cast<int32_t>(f.mesh.vertex_count())};
+    EXPECT_THROW(update_diffusion_geometry(m, f.mesh, f.conn, out_of_range), InvalidArgumentError);
+}
+
 TEST(DiffusionMatrix, UnreferencedVertexGetsIdentityRow) {
     TetMesh mesh = make_cube_mesh(2);
     mesh.positions.emplace_back(10, 10, 10);

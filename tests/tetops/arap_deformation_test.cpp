@@ -177,7 +177,7 @@ TEST(ArapDeformation, GuardShortensAnAbsurdDragAndNothingInverts) {
     const TetConnectivity connectivity = build_connectivity(bar);
     const PinSphere pin{Eigen::Vector3d(0, 0.5, 0.5), 1.0};
     const DragRegion region = select_drag_region(bar, connectivity, Eigen::Vector3d(4, 0.5, 0.5), 1.0,
-                                                 Eigen::Vector3d(-60, 40, 0), std::span(&pin, 1));
+                                                 HandleMotion::translation(Eigen::Vector3d(-60, 40, 0)), std::span(&pin, 1));
     ArapDeformer deformer(bar, region.body_tets);
     const DragReport report = run_drag(deformer, bar, region, bar.positions, 1, 3);
     EXPECT_GE(report.shortened_steps, 1);
@@ -216,7 +216,7 @@ TEST(ArapDeformation, SelectsHandlePinsAndTheGrabbedBodyOnly) {
     const PinSphere pin{Eigen::Vector3d(0, 0.5, 0.5), 0.8};
     // The grab's falloff reaches the second bar (at y >= 3) too, but its handle vertex is farther.
     const DragRegion region = select_drag_region(two, connectivity, Eigen::Vector3d(4, 1.2, 0.5), 3.0,
-                                                 Eigen::Vector3d(0, 0, 1), std::span(&pin, 1));
+                                                 HandleMotion::translation(Eigen::Vector3d(0, 0, 1)), std::span(&pin, 1));
     EXPECT_EQ(region.body_tets.size(), a.tet_count());
     for (int32_t v : region.handle) {
         EXPECT_LT(v, offset);
@@ -244,25 +244,25 @@ TEST(ArapDeformation, MovesInTheRestFrameOfTheGrabbedPiece) {
     const TetConnectivity connectivity = build_connectivity(bar);
     // The rest-frame end x = 4 is at world (10 - 0.5, 4, 0.5); a world move along +x is rest-frame -y.
     const DragRegion region = select_drag_region(bar, connectivity, Eigen::Vector3d(9.5, 4, 0.5), 0.6,
-                                                 Eigen::Vector3d(0.2, 0, 0), {});
+                                                 HandleMotion::translation(Eigen::Vector3d(0.2, 0, 0)), {});
     ASSERT_FALSE(region.handle.empty());
     for (int32_t v : region.handle) EXPECT_GE(bar.positions[v].x(), 3.6);
-    EXPECT_LT((region.move_rest - Eigen::Vector3d(0, -0.2, 0)).norm(), 1e-12);
+    EXPECT_LT((region.motion_rest.move - Eigen::Vector3d(0, -0.2, 0)).norm(), 1e-12);
 }
 
 TEST(ArapDeformation, RejectsBadRegions) {
     const TetMesh bar = make_bar();
     const TetConnectivity connectivity = build_connectivity(bar);
     const Eigen::Vector3d grab(4, 0.5, 0.5), move(0, 1, 0);
-    EXPECT_THROW(select_drag_region(bar, connectivity, grab, 0.0, move, {}), InvalidArgumentError);
-    EXPECT_THROW(select_drag_region(bar, connectivity, grab, std::nan(""), move, {}), InvalidArgumentError);
-    EXPECT_THROW(select_drag_region(bar, connectivity, Eigen::Vector3d(40, 0, 0), 1.0, move, {}), InvalidArgumentError);
-    EXPECT_THROW(select_drag_region(bar, connectivity, grab, 1.0, Eigen::Vector3d(0, std::nan(""), 0), {}),
+    EXPECT_THROW(select_drag_region(bar, connectivity, grab, 0.0, HandleMotion::translation(move), {}), InvalidArgumentError);
+    EXPECT_THROW(select_drag_region(bar, connectivity, grab, std::nan(""), HandleMotion::translation(move), {}), InvalidArgumentError);
+    EXPECT_THROW(select_drag_region(bar, connectivity, Eigen::Vector3d(40, 0, 0), 1.0, HandleMotion::translation(move), {}), InvalidArgumentError);
+    EXPECT_THROW(select_drag_region(bar, connectivity, grab, 1.0, HandleMotion::translation(Eigen::Vector3d(0, std::nan(""), 0)), {}),
                  InvalidArgumentError);
     const PinSphere everything{Eigen::Vector3d(2, 0.5, 0.5), 100};
-    EXPECT_THROW(select_drag_region(bar, connectivity, grab, 1.0, move, std::span(&everything, 1)), InvalidArgumentError);
+    EXPECT_THROW(select_drag_region(bar, connectivity, grab, 1.0, HandleMotion::translation(move), std::span(&everything, 1)), InvalidArgumentError);
     const PinSphere free_end{Eigen::Vector3d(0, 0.5, 0.5), 0.3};
-    EXPECT_THROW(select_drag_region(bar, connectivity, grab, 100, move, std::span(&free_end, 1)), InvalidArgumentError);
+    EXPECT_THROW(select_drag_region(bar, connectivity, grab, 100, HandleMotion::translation(move), std::span(&free_end, 1)), InvalidArgumentError);
     ArapDeformer deformer(bar, all_tets(bar));
     EXPECT_THROW(deformer.set_constrained({}), InvalidArgumentError);
     EXPECT_THROW(deformer.set_constrained(all_tets(bar)), InvalidArgumentError);  // 1536 > vertex count
@@ -282,6 +282,38 @@ TEST(ArapDeformation, BendAndTwistRotateAboutTheAxis) {
     EXPECT_THROW(bend_about_axis(points, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 1), InvalidArgumentError);
 }
 
+// The Bend and Twist tools: the handle turns rigidly about the axis and its vertices end exactly
+// there, the pinned end stays, and nothing inverts.
+TEST(ArapDeformation, BendAndTwistToolsTurnTheHandleAboutTheAxis) {
+    const TetMesh bar = make_bar();
+    const TetConnectivity connectivity = build_connectivity(bar);
+    const PinSphere pin{Eigen::Vector3d(0, 0.5, 0.5), 0.6};
+    const std::vector<HandleMotion> motions = {
+        HandleMotion::bend(Eigen::Vector3d(2, 0.5, 0.5), Eigen::Vector3d(0, 0, 1), std::numbers::pi / 4),
+        HandleMotion::twist(Eigen::Vector3d(0, 0.5, 0.5), Eigen::Vector3d(1, 0, 0), std::numbers::pi / 16)};
+    for (const HandleMotion& motion : motions) {
+        const DragRegion region =
+            select_drag_region(bar, connectivity, Eigen::Vector3d(4, 0.5, 0.5), 1.0, motion, std::span(&pin, 1));
+        ArapDeformer deformer(bar, region.body_tets);
+        const DragReport report = run_drag(deformer, bar, region, bar.positions, 6, 10);
+        EXPECT_EQ(report.shortened_steps, 0);
+        EXPECT_EQ(report.inverted_tets, 0u);
+        EXPECT_EQ(report.handle_vertices, region.handle.size());
+        for (size_t i = 0; i < region.handle.size(); ++i) {
+            const int32_t v = region.handle[i];
+            EXPECT_EQ(handle_fraction(region, i, 1.0), 1.0);
+            const Eigen::Vector3d expected = motion.apply(bar.positions[v], 1.0);
+            EXPECT_LT((deformer.positions()[v] - expected).norm(), 1e-9) << v;
+        }
+        for (int32_t v : region.pinned) EXPECT_EQ(deformer.positions()[v], bar.positions[v]);
+        // The end turned: by 45 degrees about the elbow at x = 2 (bend), by about pi/4 about x (twist).
+        const int32_t corner = box_vertex_index({16, 4, 4}, 16, 0, 0);
+        EXPECT_GT((deformer.positions()[corner] - bar.positions[corner]).norm(), 0.3);
+        const TetMesh result = with_positions(bar, deformer.positions());
+        EXPECT_GE(mesh_min_dihedral_deg(result), 0.5);
+    }
+}
+
 TEST(ArapDeformation, WorksAfterAnExactCut) {
     TetMesh bar = make_bar();
     cut_exact(bar, PlaneCut(Eigen::Vector3d(1, 0.3, 0.2), 3.1));
@@ -289,7 +321,7 @@ TEST(ArapDeformation, WorksAfterAnExactCut) {
     const TetConnectivity connectivity = build_connectivity(bar);
     const PinSphere pin{Eigen::Vector3d(0, 0.5, 0.5), 0.6};
     const DragRegion region = select_drag_region(bar, connectivity, Eigen::Vector3d(2.8, 0.5, 0.5), 0.8,
-                                                 Eigen::Vector3d(0, 0.6, 0.3), std::span(&pin, 1));
+                                                 HandleMotion::translation(Eigen::Vector3d(0, 0.6, 0.3)), std::span(&pin, 1));
     ArapDeformer deformer(bar, region.body_tets);
     const DragReport report = run_drag(deformer, bar, region, bar.positions, 3, 8);
     const TetMesh result = with_positions(bar, deformer.positions());
@@ -316,7 +348,7 @@ TEST(ArapDeformation, PaintedMaterialsStayWithTheirTetsAndSaveAndReloadIdentical
     const TetConnectivity connectivity = build_connectivity(bar);
     const PinSphere pin{Eigen::Vector3d(0, 0.5, 0.5), 0.6};
     const DragRegion region = select_drag_region(bar, connectivity, Eigen::Vector3d(4, 0.5, 0.5), 1.0,
-                                                 Eigen::Vector3d(0, 0, 0.8), std::span(&pin, 1));
+                                                 HandleMotion::translation(Eigen::Vector3d(0, 0, 0.8)), std::span(&pin, 1));
     ArapDeformer deformer(bar, region.body_tets);
     run_drag(deformer, bar, region, bar.positions, 2, 8);
     bar.positions = deformer.positions();
