@@ -386,9 +386,12 @@ void EditorApp::on_key(int key, int mods) {
         return;
     }
     switch (key) {
-    case GLFW_KEY_ESCAPE:
+    case GLFW_KEY_ESCAPE: {
+        const bool deforming = tools_.active() && is_deform_tool(tools_.tool());
         if (!tools_.cancel(viewport_context())) select_tool(Tool::Orbit);
+        else if (deforming) queue_cancel_deform();
         break;
+    }
     case GLFW_KEY_C: select_tool(Tool::Cut); break;
     case GLFW_KEY_X: select_tool(Tool::ExactCut); break;
     case GLFW_KEY_R: select_tool(Tool::Relax); break;
@@ -397,6 +400,10 @@ void EditorApp::on_key(int key, int mods) {
     case GLFW_KEY_M: select_tool(Tool::MovePiece); break;
     case GLFW_KEY_P: select_tool(Tool::Paint); break;
     case GLFW_KEY_L: select_tool(Tool::Light); break;
+    case GLFW_KEY_G: select_tool(Tool::Grab); break;
+    case GLFW_KEY_B: select_tool(Tool::Bend); break;
+    case GLFW_KEY_T: select_tool(Tool::Twist); break;
+    case GLFW_KEY_N: select_tool(Tool::Pin); break;
     case GLFW_KEY_HOME: camera_.reset(); break;
     case GLFW_KEY_TAB: options_.hide_ui = !options_.hide_ui; break;
     default: break;

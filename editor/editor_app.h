@@ -205,6 +205,7 @@ private:
     void draw_tool_palette();
     void draw_side_panel();
     void draw_material_panel();
+    void draw_deform_panel();
     void draw_light_panel();
     void draw_environment_controls();
     void draw_solver_panel();
@@ -254,6 +255,10 @@ private:
     void pointer_event(PointerAction action, PointerButton button, int mods, double scroll = 0);
     bool ui_has_pointer() const;
     void apply_tool_outcome(const ToolOutcome& outcome);
+    // Grab, Bend and Twist: a preview replaces the one still queued (the worker shows the latest), a
+    // finished drag commits, a cancelled one restores the volume as it was before the drag.
+    void queue_deform(const ToolOutcome& outcome);
+    void queue_cancel_deform();
     void draw_tool_overlay();
     void update_piece_preview();
     SurfaceRenderInput with_piece_preview(const SurfaceRenderInput& input) const;
@@ -332,6 +337,11 @@ private:
     int selected_preset_ = 0;
     std::optional<TetMaterial> custom_material_;  // the material panel's current material
     float brush_radius_ = 0.05f;                  // paint brush sigma, fraction of the scene radius
+    // Grab, Bend, Twist and Pin: the handle's falloff radius (fraction of the scene radius), the
+    // ARAP iterations each preview frame runs, and the pins placed (world space).
+    float deform_radius_ = 0.25f;
+    int deform_preview_iterations_ = 2;
+    std::vector<PinSphere> pins_;
     bool show_light_gizmos_ = true;
 
     // Viewport rectangle in framebuffer pixels (origin top-left) and the scale from window to

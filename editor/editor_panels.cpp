@@ -203,6 +203,7 @@ void EditorApp::draw_side_panel() {
     ImGui::SetNextWindowSize(ImVec2(width, io.DisplaySize.y - top - ImGui::GetFrameHeight() * 1.2f));
     ImGui::Begin("Scene", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
     if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) draw_material_panel();
+    if (ImGui::CollapsingHeader("Deform")) draw_deform_panel();
     if (ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) draw_light_panel();
     if (ImGui::CollapsingHeader("Solver", ImGuiTreeNodeFlags_DefaultOpen)) draw_solver_panel();
     if (ImGui::CollapsingHeader("View")) draw_view_panel();
@@ -252,6 +253,19 @@ void EditorApp::draw_material_panel() {
     if (ImGui::Button("Apply to the whole object") && has_scene) set_whole_material(m, names[selected_preset_]);
     ImGui::TextDisabled("Object: %s; Paint (P) brushes it in locally", scene_->material_name.c_str());
     ImGui::SliderFloat("brush radius", &brush_radius_, 0.005f, 0.3f, "%.3f x size");
+}
+
+void EditorApp::draw_deform_panel() {
+    ImGui::TextDisabled("As rigid as possible (Sorkine and Alexa 2007)");
+    ImGui::TextDisabled("G grab, B bend, T twist about the pins, N pin");
+    ImGui::SliderFloat("handle radius", &deform_radius_, 0.02f, 1.0f, "%.2f x size");
+    ImGui::SliderInt("iterations per frame", &deform_preview_iterations_, 1, 8);
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("ARAP iterations while dragging; the release commits %d steps of %d from the rest shape",
+                          ViewportTools::kCommitSteps, ViewportTools::kCommitIterations);
+    ImGui::Text("%zu pins", pins_.size());
+    ImGui::SameLine();
+    if (ImGui::SmallButton("clear pins")) pins_.clear();
 }
 
 void EditorApp::draw_solver_panel() {

@@ -10,7 +10,9 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <sstream>
 
 namespace waxwork {
 
@@ -23,6 +25,8 @@ ViewportContext EditorApp::viewport_context() {
     context.piece_transforms = &scene_->piece_transforms;
     context.lights = &lighting_.lights;
     context.selected_light = selected_light_;
+    context.deform_radius = camera_ ? deform_radius_ * camera_->scene_radius() : 0.0;
+    context.pins = &pins_;
     return context;
 }
 
@@ -79,7 +83,10 @@ void EditorApp::pointer_event(PointerAction action, PointerButton button, int mo
 
 void EditorApp::apply_tool_outcome(const ToolOutcome& outcome) {
     if (outcome.light_changed) request_solve();
+    if (!outcome.message.empty()) status_ = outcome.message;
     if (!camera_ || !scene_->core) return;
+    if (outcome.pin) pins_.push_back(*outcome.pin);
+    queue_deform(outcome);
     try {
         if (outcome.cut) {
             last_cut_ = outcome.cut->stroke;
@@ -116,8 +123,44 @@ void EditorApp::apply_tool_outcome(const ToolOutcome& outcome) {
 
 void EditorApp::select_tool(Tool tool) {
     // Relax is an action on the last cut, not a mode.
-    if (tool == Tool::Relax) relax_last_cut();
-    else tools_.set_tool(tool, viewport_context());
+    if (tool == Tool::Relax) return relax_last_cut();
+    const bool deforming = tools_.active() && is_deform_tool(tools_.tool());
+    tools_.set_tool(tool, viewport_context());
+    if (deforming) queue_cancel_deform();
+}
+
+void EditorApp::queue_deform(const ToolOutcome& outcome) {
+    if (outcome.deform_cancelled) return queue_cancel_deform();
+    if (!outcome.deform) return;
+    const DeformOp op = *outcome.deform;
+    if (outcome.deform_finished) {
+        queue_job("deform", [op](SceneCore& core) {
+            const ChangeReport report = core.commit_deform(op);
+            std::ostringstream line;
+            line << "deform: " << report.details << " (" << std::lround(report.milliseconds) << " ms)";
+            return line.str();
+        });
+        return;
+    }
+    // Only the latest preview matters: it replaces one still waiting for the worker.
+    static constexpr const char* kPreviewLabel = "deform preview";
+    if (!pending_jobs_.empty() && pending_jobs_.back().first == kPreviewLabel) pending_jobs_.pop_back();
+    const int iterations = deform_preview_iterations_;
+    queue_job(kPreviewLabel, [op, iterations](SceneCore& core) {
+        const ChangeReport report = core.preview_deform(op, iterations);
+        const DragReport& drag = std::get<DragReport>(report.result);
+        std::ostringstream line;
+        line << "deforming: " << report.moved_vertices.size() << " vertices moved ("
+             << std::lround(report.milliseconds) << " ms)";
+        if (drag.shortened_steps > 0) line << "; held back by the angle guard";
+        return line.str();
+    });
+}
+
+void EditorApp::queue_cancel_deform() {
+    queue_job("cancel deform", [](SceneCore& core) {
+        return core.cancel_deform() ? std::string("deform cancelled") : std::string();
+    });
 }
 
 void EditorApp::select_brush_material(const std::string& name) {
@@ -178,13 +221,23 @@ SurfaceRenderInput EditorApp::with_piece_preview(const SurfaceRenderInput& input
 }
 
 void EditorApp::draw_tool_overlay() {
-    const ToolOverlay overlay = tools_.overlay();
-    if (overlay.stroke.size() < 2) return;
     ImDrawList* draw = ImGui::GetForegroundDrawList();
     const double s = framebuffer_scale_;
     auto to_screen = [&](double x, double y) {
         return ImVec2(static_cast<float>((x + view_x_) / s), static_cast<float>((y + view_y_) / s));
     };
+    // The pins, as circles of their radius, while a tool that uses them is selected.
+    if (camera_ && (is_deform_tool(tools_.tool()) || tools_.tool() == Tool::Pin)) {
+        for (const PinSphere& pin : pins_) {
+            const Eigen::Vector3d c = camera_->project(pin.center, view_w_, view_h_);
+            const Eigen::Vector3d r = camera_->project(pin.center + pin.radius * camera_->right_axis(), view_w_, view_h_);
+            const float radius = static_cast<float>((r.head<2>() - c.head<2>()).norm() / s);
+            if (std::isfinite(radius))
+                draw->AddCircle(to_screen(c.x(), c.y()), radius, IM_COL32(90, 220, 140, 220), 0, 1.5f * ui_scale_);
+        }
+    }
+    const ToolOverlay overlay = tools_.overlay();
+    if (overlay.stroke.size() < 2) return;
     const ImU32 colour = tools_.tool() == Tool::Paint ? IM_COL32(120, 200, 255, 230) : IM_COL32(255, 190, 90, 230);
     const auto& p = overlay.stroke;
     for (size_t i = 1; i < p.size(); ++i)

@@ -17,9 +17,15 @@ const std::vector<ToolInfo>& tool_infos() {
         {Tool::MovePiece, "Move piece", "M", "move_piece"},
         {Tool::Paint, "Paint", "P", "paint"},
         {Tool::Light, "Light", "L", "light"},
+        {Tool::Grab, "Grab", "G", "grab"},
+        {Tool::Bend, "Bend", "B", "bend"},
+        {Tool::Twist, "Twist", "T", "twist"},
+        {Tool::Pin, "Pin", "N", "pin"},
     };
     return tools;
 }
+
+bool is_deform_tool(Tool tool) { return tool == Tool::Grab || tool == Tool::Bend || tool == Tool::Twist; }
 
 const char* tool_hint(Tool tool) {
     switch (tool) {
@@ -31,13 +37,18 @@ const char* tool_hint(Tool tool) {
     case Tool::MovePiece: return "Drag a piece to move it (after Fracture); Esc while dragging puts it back.";
     case Tool::Paint: return "Paint the selected material into the volume under the stroke.";
     case Tool::Light: return "Drag: turn the selected directional light like a trackball, or move the point light.";
+    case Tool::Grab: return "Drag the surface: the body follows as rigidly as it can; pins (N) hold it elsewhere.";
+    case Tool::Bend: return "Drag around the pins: the grabbed end turns about the view axis through their centre.";
+    case Tool::Twist: return "Drag sideways: the grabbed end turns about the line from the pins' centre to it.";
+    case Tool::Pin: return "Click or drag on the surface to pin the volume there (Deform panel: clear pins).";
     }
     return "";
 }
 
 const std::vector<std::string>& control_lines() {
     static const std::vector<std::string> lines = {
-        "Left drag: the current tool (C cut, X exact cut, F fracture, M move piece, P paint, L light)",
+        "Left drag: the current tool (C cut, X exact cut, F fracture, M move piece, P paint, L light,",
+        "           G grab, B bend, T twist, N pin)",
         "Right drag or Alt+left drag: orbit",
         "Middle drag or Shift+right drag: pan",
         "Wheel: zoom          Home: reset the view",
@@ -104,6 +115,8 @@ bool ViewportTools::cancel(const ViewportContext& context) {
     stroke_.clear();
     preview_.reset();
     light_index_ = -1;
+    deform_.reset();
+    last_pin_.reset();
     return true;
 }
 
@@ -167,6 +180,14 @@ void ViewportTools::begin(const PointerEvent& event, const ViewportContext& cont
             preview_ = PiecePreview{hit->piece, (*transforms)[hit->piece], Eigen::Vector3d::Zero()};
             break;
         }
+        case Tool::Grab:
+        case Tool::Bend:
+        case Tool::Twist: begin_deform(event, context, out); break;
+        case Tool::Pin:
+            drag_ = Drag::Pin;
+            last_pin_.reset();
+            place_pin(event, context, out);
+            break;
         case Tool::Light:
             if (!context.lights || context.selected_light < 0 ||
                 context.selected_light >= static_cast<int>(context.lights->size()))
@@ -210,6 +231,14 @@ void ViewportTools::drag_to(const PointerEvent& event, const ViewportContext& co
         preview_->translation = point_under_cursor(camera, event.position, context.width, context.height, grab_point_) -
                                 grab_point_;
         break;
+    case Drag::Deform:
+        // A press and release on one pixel is a click, not a drag (the round trip through the
+        // camera's projection would still make a tiny motion of it).
+        deform_moved_ = deform_moved_ || (event.position - start_).norm() >= 1;
+        deform_to(event, context);
+        out.deform = deform_;
+        break;
+    case Drag::Pin: place_pin(event, context, out); break;
     case Drag::Light: {
         Light* light = dragged_light(context);
         if (!light) break;
@@ -246,6 +275,15 @@ void ViewportTools::finish(const PointerEvent& event, const ViewportContext& con
         op.transform.translation += preview_->translation;
         out.move = op;
     }
+    if (drag_ == Drag::Deform) {
+        if (deform_moved_) {
+            out.deform = deform_;
+            out.deform_finished = true;
+        } else {
+            out.deform.reset();
+            out.deform_cancelled = true;
+        }
+    }
     // After a move the preview stays until the editor shows the moved piece (clear_preview), so the
     // piece does not jump back for the frames the document takes to apply it.
     const bool keep_preview = out.move.has_value();
@@ -253,7 +291,79 @@ void ViewportTools::finish(const PointerEvent& event, const ViewportContext& con
     drag_button_ = PointerButton::None;
     stroke_.clear();
     light_index_ = -1;
+    deform_.reset();
+    last_pin_.reset();
     if (!keep_preview) preview_.reset();
+}
+
+void ViewportTools::begin_deform(const PointerEvent& event, const ViewportContext& context, ToolOutcome& out) {
+    const std::optional<PieceHit> hit = context.pick_piece ? context.pick_piece(event.position) : std::nullopt;
+    if (!hit) return;
+    if (!(context.deform_radius > 0)) {
+        out.message = "Grab, Bend and Twist need a positive radius";
+        return;
+    }
+    const std::vector<PinSphere> pins = context.pins ? *context.pins : std::vector<PinSphere>{};
+    if (tool_ != Tool::Grab) {
+        if (pins.empty()) {
+            out.message = "Bend and Twist turn about the pins: place pins first (Pin tool, N)";
+            return;
+        }
+        pivot_ = Eigen::Vector3d::Zero();
+        for (const PinSphere& pin : pins) pivot_ += pin.center;
+        pivot_ /= static_cast<double>(pins.size());
+        if ((hit->point - pivot_).norm() <= 1e-9 * context.deform_radius) {
+            out.message = "Grab farther from the pins: Bend and Twist turn about their centre";
+            return;
+        }
+    }
+    DeformOp op;
+    op.grab = hit->point;
+    op.radius = context.deform_radius;
+    op.pins = pins;
+    op.steps = kCommitSteps;
+    op.iterations = kCommitIterations;
+    deform_ = op;
+    deform_moved_ = false;
+    grab_point_ = hit->point;
+    drag_ = Drag::Deform;
+}
+
+void ViewportTools::deform_to(const PointerEvent& event, const ViewportContext& context) {
+    const OrbitCamera& camera = *context.camera;
+    const Eigen::Vector3d cursor = point_under_cursor(camera, event.position, context.width, context.height, grab_point_);
+    switch (tool_) {
+    case Tool::Bend: {
+        // About the view axis through the pins' centre, by the angle the cursor swept around it (the
+        // axis points at the eye, so a counter-clockwise sweep on screen turns the body the same way).
+        const Eigen::Vector3d axis = camera.eye_direction();
+        Eigen::Vector3d a = grab_point_ - pivot_, b = cursor - pivot_;
+        a -= a.dot(axis) * axis;
+        b -= b.dot(axis) * axis;
+        const double angle = std::atan2(axis.dot(a.cross(b)), a.dot(b));
+        deform_->motion = HandleMotion::bend(pivot_, axis, std::isfinite(angle) ? angle : 0.0);
+        break;
+    }
+    case Tool::Twist: {
+        // About the line from the pins' centre to the grab point; the turn grows along it from zero at
+        // the pins to the dragged angle at the grab point.
+        const Eigen::Vector3d axis = grab_point_ - pivot_;
+        const double angle = (event.position.x() - start_.x()) * kTwistRadiansPerPixel;
+        deform_->motion = HandleMotion::twist(pivot_, axis, angle / axis.norm());
+        break;
+    }
+    default: deform_->motion = HandleMotion::translation(cursor - grab_point_); break;
+    }
+}
+
+void ViewportTools::place_pin(const PointerEvent& event, const ViewportContext& context, ToolOutcome& out) {
+    const std::optional<PieceHit> hit = context.pick_piece ? context.pick_piece(event.position) : std::nullopt;
+    const double radius = kPinRadiusFraction * context.deform_radius;
+    if (!hit || !(radius > 0)) return;
+    // A drag lays pins half a radius apart along the surface.
+    if (last_pin_ && (hit->point - *last_pin_).norm() < 0.5 * radius) return;
+    last_pin_ = hit->point;
+    out.pin = PinSphere{hit->point, radius};
 }
 
 ToolOverlay ViewportTools::overlay() const {

@@ -4,7 +4,8 @@
 //
 //   left drag            the current tool (Orbit orbits; Cut, Exact cut, Fracture and Paint draw a
 //                        stroke; Move piece drags the piece under the cursor; Light drags the selected
-//                        light: a directional one turns like a trackball, a point light follows the cursor)
+//                        light: a directional one turns like a trackball, a point light follows the cursor;
+//                        Grab, Bend and Twist deform the body under the cursor, Pin places pins)
 //   right drag, Alt+left orbit          middle drag, Shift+right  pan          wheel  zoom
 //   Esc                  cancels the stroke or drag in progress (the editor selects Orbit otherwise)
 //   Home                 resets the view (the editor rebuilds the camera)
@@ -24,7 +25,10 @@
 
 namespace waxwork {
 
-enum class Tool { Orbit, Cut, ExactCut, Relax, Fracture, MovePiece, Paint, Light };
+enum class Tool { Orbit, Cut, ExactCut, Relax, Fracture, MovePiece, Paint, Light, Grab, Bend, Twist, Pin };
+
+// Grab, Bend and Twist: the tools that deform the volume while dragging.
+bool is_deform_tool(Tool tool);
 
 struct ToolInfo {
     Tool tool;
@@ -70,6 +74,10 @@ struct ViewportContext {
     const std::vector<RigidTransform>* piece_transforms = nullptr;
     std::vector<Light>* lights = nullptr;  // the Light tool changes lights[selected_light] in place
     int selected_light = 0;
+    // Grab, Bend, Twist and Pin: the handle's falloff radius (world units; a pin's radius is half of
+    // it) and the pins placed so far (Bend and Twist turn about their centre).
+    double deform_radius = 0;
+    const std::vector<PinSphere>* pins = nullptr;
 };
 
 // A piece shown moved while it is dragged (the document moves it when the drag ends).
@@ -86,7 +94,16 @@ struct ToolOutcome {
     std::optional<ScreenStroke> paint;      // a finished Paint stroke (the editor casts it at the surface)
     std::optional<ScreenStroke> fracture;   // a finished Fracture stroke
     std::optional<MovePieceOp> move;        // a finished piece drag
-    bool handled() const { return camera_changed || light_changed || cut || paint || fracture || move; }
+    // Grab, Bend and Twist: the drag's deformation so far (shown as a preview), and whether the drag
+    // ended (commit it) or ended without a motion (drop the preview).
+    std::optional<DeformOp> deform;
+    bool deform_finished = false;
+    bool deform_cancelled = false;
+    std::optional<PinSphere> pin;           // Pin: a pin placed on the surface
+    std::string message;                    // why a press did nothing, for the status line
+    bool handled() const {
+        return camera_changed || light_changed || cut || paint || fracture || move || deform || deform_cancelled || pin;
+    }
 };
 
 // What to draw over the viewport while a stroke is drawn: its polyline and short ticks on the side
@@ -103,7 +120,11 @@ public:
     static constexpr float kStrokeSpacing = 3.0f;    // pixels between kept stroke points
     static constexpr double kTickSpacing = 24.0;     // pixels between cut-side ticks
     static constexpr double kTickLength = 9.0;
-
+    static constexpr double kTwistRadiansPerPixel = 0.01;  // horizontal drag: the turn at the handle
+    static constexpr double kPinRadiusFraction = 0.5;      // of the deform radius
+    // The committed deform: steps and iterations from the rest shape (Document::commit_deform).
+    static constexpr int kCommitSteps = 2;
+    static constexpr int kCommitIterations = 8;
     Tool tool() const { return tool_; }
     // Cancels a drag in progress (as Esc does) and switches.
     void set_tool(Tool tool, const ViewportContext& context);
@@ -123,12 +144,15 @@ public:
     }
 
 private:
-    enum class Drag { None, Orbit, Pan, Stroke, Piece, Light };
+    enum class Drag { None, Orbit, Pan, Stroke, Piece, Light, Deform, Pin };
 
     void begin(const PointerEvent& event, const ViewportContext& context, ToolOutcome& out);
     void drag_to(const PointerEvent& event, const ViewportContext& context, ToolOutcome& out);
     void finish(const PointerEvent& event, const ViewportContext& context, ToolOutcome& out);
     Light* dragged_light(const ViewportContext& context) const;
+    void begin_deform(const PointerEvent& event, const ViewportContext& context, ToolOutcome& out);
+    void deform_to(const PointerEvent& event, const ViewportContext& context);
+    void place_pin(const PointerEvent& event, const ViewportContext& context, ToolOutcome& out);
 
     Tool tool_ = Tool::Orbit;
     Drag drag_ = Drag::None;
@@ -141,6 +165,10 @@ private:
     Eigen::Vector3d grab_point_ = Eigen::Vector3d::Zero();  // piece or light point under the cursor at the press
     int light_index_ = -1;
     Light light_at_press_;
+    std::optional<DeformOp> deform_;                   // the deform drag in progress
+    bool deform_moved_ = false;                        // ... and the cursor has left the press pixel
+    Eigen::Vector3d pivot_ = Eigen::Vector3d::Zero();  // Bend, Twist: the pins' centre
+    std::optional<Eigen::Vector3d> last_pin_;          // Pin drag: where the last pin went
 };
 
 // The point on the plane through `anchor` facing the camera that the cursor at `pixel` is over: what

@@ -249,6 +249,111 @@ TEST(ViewportTools, PieceDragOnNothingOrCancelledMovesNothing) {
     EXPECT_FALSE(tools.pointer(event(PointerAction::Release, 260, 150, PointerButton::Left), context).move);
 }
 
+// Grab: every move previews the translation that keeps the grabbed point under the cursor; the
+// release commits it with the pins and radius of the press.
+TEST(ViewportTools, GrabPreviewsEveryMoveAndCommitsOnRelease) {
+    OrbitCamera camera = test_camera();
+    ViewportContext context = context_for(camera);
+    const Eigen::Vector3d grabbed(0.2, 0.1, 0.4);
+    context.pick_piece = [&](const Eigen::Vector2d&) { return std::optional<PieceHit>(PieceHit{0, grabbed}); };
+    const std::vector<PinSphere> pins = {PinSphere{Eigen::Vector3d(-0.5, 0, 0), 0.1}};
+    context.pins = &pins;
+    context.deform_radius = 0.3;
+    ViewportTools tools;
+    tools.set_tool(Tool::Grab, context);
+    const Eigen::Vector3d at = camera.project(grabbed, kWidth, kHeight);
+    EXPECT_FALSE(tools.pointer(event(PointerAction::Press, at.x(), at.y(), PointerButton::Left), context).deform);
+    const ToolOutcome during = tools.pointer(event(PointerAction::Move, at.x() + 30, at.y() + 10), context);
+    ASSERT_TRUE(during.deform);
+    EXPECT_FALSE(during.deform_finished);
+    EXPECT_EQ(during.deform->grab, grabbed);
+    EXPECT_EQ(during.deform->radius, 0.3);
+    EXPECT_EQ(during.deform->pins, pins);
+    EXPECT_EQ(during.deform->motion.kind, HandleMotion::Kind::Translate);
+    const Eigen::Vector3d seen = camera.project(grabbed + during.deform->motion.move, kWidth, kHeight);
+    EXPECT_NEAR(seen.x(), at.x() + 30, 1e-6);
+    EXPECT_NEAR(seen.y(), at.y() + 10, 1e-6);
+    const ToolOutcome out = tools.pointer(event(PointerAction::Release, at.x() + 30, at.y() + 10, PointerButton::Left), context);
+    ASSERT_TRUE(out.deform);
+    EXPECT_TRUE(out.deform_finished);
+    EXPECT_TRUE(*out.deform == *during.deform);
+    EXPECT_FALSE(tools.active());
+    // A click without a motion ends the preview instead of committing an empty edit.
+    tools.pointer(event(PointerAction::Press, at.x(), at.y(), PointerButton::Left), context);
+    const ToolOutcome click = tools.pointer(event(PointerAction::Release, at.x(), at.y(), PointerButton::Left), context);
+    EXPECT_FALSE(click.deform);
+    EXPECT_TRUE(click.deform_cancelled);
+}
+
+// Bend turns about the view axis through the pins' centre by the angle swept around it; Twist turns
+// about the line from the pins' centre to the grab point, the turn at the grab point growing with the
+// horizontal drag. Without pins both refuse with a message.
+TEST(ViewportTools, BendAndTwistTurnAboutThePins) {
+    OrbitCamera camera = test_camera();
+    ViewportContext context = context_for(camera);
+    const Eigen::Vector3d grabbed(0.5, 0, 0);
+    context.pick_piece = [&](const Eigen::Vector2d&) { return std::optional<PieceHit>(PieceHit{0, grabbed}); };
+    context.deform_radius = 0.3;
+    std::vector<PinSphere> pins;
+    context.pins = &pins;
+    ViewportTools tools;
+    tools.set_tool(Tool::Bend, context);
+    const Eigen::Vector3d at = camera.project(grabbed, kWidth, kHeight);
+    const ToolOutcome refused = tools.pointer(event(PointerAction::Press, at.x(), at.y(), PointerButton::Left), context);
+    EXPECT_NE(refused.message.find("place pins first"), std::string::npos);
+    EXPECT_FALSE(tools.active());
+    EXPECT_FALSE(tools.pointer(event(PointerAction::Release, at.x(), at.y() - 40, PointerButton::Left), context).deform);
+
+    pins = {PinSphere{Eigen::Vector3d(-0.5, 0.1, 0), 0.1}, PinSphere{Eigen::Vector3d(-0.5, -0.1, 0), 0.1}};
+    const Eigen::Vector3d pivot(-0.5, 0, 0);
+    // The cursor goes a quarter turn counter-clockwise on screen around the pivot (up is -y on screen).
+    const Eigen::Vector3d p = camera.project(pivot, kWidth, kHeight);
+    const double r = at.x() - p.x();
+    const ToolOutcome bent = drag(tools, context, {at.head<2>(), Eigen::Vector2d(p.x(), p.y() - r)});
+    ASSERT_TRUE(bent.deform);
+    EXPECT_TRUE(bent.deform_finished);
+    EXPECT_EQ(bent.deform->motion.kind, HandleMotion::Kind::Bend);
+    EXPECT_LT((bent.deform->motion.axis_point - pivot).norm(), 1e-12);
+    EXPECT_NEAR(bent.deform->motion.angle, std::numbers::pi / 2, 1e-6);
+    // The grab point goes to the cursor: (0.5, 0) about (-0.5, 0) by a quarter turn is (-0.5, 1).
+    EXPECT_LT((bent.deform->motion.apply(grabbed, 1) - Eigen::Vector3d(-0.5, 1, 0)).norm(), 1e-6);
+
+    tools.set_tool(Tool::Twist, context);
+    const ToolOutcome twisted = drag(tools, context, {at.head<2>(), at.head<2>() + Eigen::Vector2d(50, 7)});
+    ASSERT_TRUE(twisted.deform);
+    EXPECT_EQ(twisted.deform->motion.kind, HandleMotion::Kind::Twist);
+    // The turn at the grab point (distance 1 from the pivot along the axis) is 50 px of drag.
+    EXPECT_NEAR(twisted.deform->motion.angle * (grabbed - pivot).norm(), 50 * ViewportTools::kTwistRadiansPerPixel, 1e-12);
+    EXPECT_LT((twisted.deform->motion.apply(grabbed, 1) - grabbed).norm(), 1e-12);  // on the axis
+}
+
+TEST(ViewportTools, PinPlacesPinsAlongADragHalfARadiusApart) {
+    OrbitCamera camera = test_camera();
+    ViewportContext context = context_for(camera);
+    context.deform_radius = 0.4;
+    context.pick_piece = [&](const Eigen::Vector2d& pixel) {
+        return std::optional<PieceHit>(PieceHit{0, Eigen::Vector3d(pixel.x() / 100, 0, 0)});
+    };
+    ViewportTools tools;
+    tools.set_tool(Tool::Pin, context);
+    std::vector<PinSphere> placed;
+    const ToolOutcome first = tools.pointer(event(PointerAction::Press, 0, 150, PointerButton::Left), context);
+    ASSERT_TRUE(first.pin);
+    EXPECT_EQ(first.pin->radius, 0.2);
+    placed.push_back(*first.pin);
+    for (int x = 1; x <= 40; ++x)
+        if (const auto out = tools.pointer(event(PointerAction::Move, x, 150), context); out.pin) placed.push_back(*out.pin);
+    tools.pointer(event(PointerAction::Release, 40, 150, PointerButton::Left), context);
+    // Points 0 .. 0.4 apart by 0.01: a pin at the first point at least 0.1 (half the pin radius) from
+    // the previous one.
+    ASSERT_GE(placed.size(), 4u);
+    for (size_t i = 1; i < placed.size(); ++i) {
+        const double gap = (placed[i].center - placed[i - 1].center).norm();
+        EXPECT_GE(gap, 0.1 - 1e-12);
+        EXPECT_LT(gap, 0.11 + 1e-12);
+    }
+}
+
 TEST(ViewportTools, LightDragTurnsADirectionalLightLikeATrackball) {
     OrbitCamera camera = test_camera();
     ViewportContext context = context_for(camera);
