@@ -323,6 +323,50 @@ TEST_F(EditorWindow, PieceDragAfterFractureMovesThatPiece) {
     EXPECT_EQ(moved_pieces, 1);
 }
 
+// A pin on the left of the front face, then a grab on the right dragged 40 px up: the grabbed
+// region follows the cursor while the pinned one stays, the tets are the same, the release is one
+// edit, and the recorded session replays it to the identical volume.
+TEST_F(EditorWindow, GrabDragDeformsAroundThePinsAndTheSessionReplaysIt) {
+    const fs::path dir = scratch_dir("editor_grab");
+    const auto r = run_script(dir, R"([
+        {"frame": 2, "event": "save_volume", "file": "before.vtu"},
+        {"event": "tool", "tool": "pin"},
+        {"event": "press", "x": 125, "y": 150},
+        {"event": "release", "x": 125, "y": 150},
+        {"event": "tool", "tool": "grab"},
+        {"event": "drag", "from": [275, 150], "to": [275, 110], "steps": 8},
+        {"event": "idle"},
+        {"event": "save_session", "file": "session.json"},
+        {"event": "save_volume", "file": "after.vtu"},
+        {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const TetMesh before = read_volume(dir / "before.vtu"), after = read_volume(dir / "after.vtu");
+    ASSERT_EQ(after.tets, before.tets);
+    const double up = 40 * units_per_pixel_at_front_face();
+    const Eigen::Vector3d grabbed(85 * units_per_pixel_at_front_face(), 0, 1), pinned(-grabbed.x(), 0, 1);
+    double handle_rise = 0;
+    size_t near_pin = 0, moved_near_pin = 0;
+    for (size_t v = 0; v < before.vertex_count(); ++v) {
+        const Eigen::Vector3d& p = before.positions[v];
+        if ((p - grabbed).norm() < 0.1) handle_rise = std::max(handle_rise, after.positions[v].y() - p.y());
+        if ((p - pinned).norm() < 0.15) {
+            ++near_pin;
+            moved_near_pin += after.positions[v] != p ? 1 : 0;
+        }
+    }
+    EXPECT_NEAR(handle_rise, up, 0.25 * up);
+    EXPECT_GT(near_pin, 0u);
+    EXPECT_EQ(moved_near_pin, 0u);
+    nlohmann::json session = nlohmann::json::parse(testing::read_text(dir / "session.json"));
+    ASSERT_EQ(session["steps"].size(), 1u);
+    EXPECT_EQ(session["steps"][0]["op"], "deform");
+    session["steps"].push_back({{"save", "replay.vtu"}});
+    std::ofstream(dir / "replay.json") << session.dump(2);
+    const auto run = run_waxwork("run " + (dir / "replay.json").string() + " -o " + (dir / "run").string());
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_TRUE(read_volume(dir / "run" / "replay.vtu") == after);
+}
+
 TEST_F(EditorWindow, DraggedPieceIsShownMovedBeforeTheDocumentMovesIt) {
     // The screenshot of a drag still in progress (pressed, moved, not released) shows the piece where
     // the finished drag puts it: the same silhouette as after the release, out beyond the cube.
