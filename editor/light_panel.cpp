@@ -1,8 +1,7 @@
-// The Lights panel of EditorApp: add and remove directional and point lights, pick the one the Light
-// tool drags in the view, and set each light's colour and intensity separately (the solver takes
-// their product per channel, solver/lighting.h); choose, turn and scale the environment light. Area
-// lights (from sessions and the command line) show their shape read-only; their centre, colour and
-// intensity are edited as a point light's.
+// The Lights panel of EditorApp: add and remove directional, point and area lights, pick the one the
+// Light tool drags in the view, and set each light's colour and intensity separately (the solver
+// takes their product per channel, solver/lighting.h); an area light's size and the way it faces too;
+// choose, turn and scale the environment light.
 #include "editor/editor_app.h"
 
 #include "base/error.h"
@@ -13,6 +12,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <utility>
 
 namespace waxwork {
 
@@ -32,6 +32,64 @@ Light new_point_light(const std::optional<OrbitCamera>& camera) {
     return light;
 }
 
+// A new area light where a new point light goes, facing the view's target, about the object's size
+// (soft shadows need a source that is not small against the distance); the same intensity along its
+// axis as the point light's, so it lights the object about as brightly.
+Light new_area_light(const std::optional<OrbitCamera>& camera, LightType type) {
+    Light light = new_point_light(camera);
+    light.type = type;
+    const Eigen::Vector3d centre = camera ? camera->target() : Eigen::Vector3d::Zero();
+    light.axis = (centre - light.vector).normalized();
+    light.tangent = default_rect_tangent(light.axis);
+    const double size = camera ? camera->scene_radius() : 1.0;
+    light.size = type == LightType::Rectangle ? Eigen::Vector2d(size, size) : Eigen::Vector2d(0.5 * size, 0);
+    return light;
+}
+
+// The area light's shape: size (model units) and, for the one-sided shapes, the side it faces. Returns
+// whether anything changed.
+bool edit_area_shape(Light& light, const std::optional<OrbitCamera>& camera) {
+    bool changed = false;
+    constexpr float kMinSize = 1e-4f;
+    if (light.type == LightType::Rectangle) {
+        float size[2] = {static_cast<float>(light.size.x()), static_cast<float>(light.size.y())};
+        if (ImGui::DragFloat2("width, height", size, 0.005f, kMinSize, 1e4f, "%.3f")) {
+            light.size = Eigen::Vector2d(std::max(size[0], kMinSize), std::max(size[1], kMinSize));
+            changed = true;
+        }
+    } else {
+        float radius = static_cast<float>(light.size.x());
+        if (ImGui::DragFloat("radius", &radius, 0.005f, kMinSize, 1e4f, "%.3f")) {
+            light.size.x() = std::max(radius, kMinSize);
+            changed = true;
+        }
+    }
+    if (light.type == LightType::Sphere) return changed;
+    float axis[3] = {static_cast<float>(light.axis.x()), static_cast<float>(light.axis.y()),
+                     static_cast<float>(light.axis.z())};
+    if (ImGui::DragFloat3("faces", axis, 0.01f)) {
+        const Eigen::Vector3d next(axis[0], axis[1], axis[2]);
+        if (next.allFinite() && next.norm() > 1e-6) {
+            light.axis = next;
+            changed = true;
+        }
+    }
+    ImGui::SameLine();
+    if (camera && ImGui::SmallButton("aim")) {
+        const Eigen::Vector3d to_target = camera->target() - light.vector;
+        if (to_target.norm() > 1e-9) {
+            light.axis = to_target.normalized();
+            changed = true;
+        }
+    }
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Face the view's target");
+    // Only the width direction's part across the axis counts: keep one that is not along it.
+    if (changed && light.type == LightType::Rectangle &&
+        light.tangent.cross(light.axis).norm() < 1e-3 * light.tangent.norm() * light.axis.norm())
+        light.tangent = default_rect_tangent(light.axis);
+    return changed;
+}
+
 }  // namespace
 
 void EditorApp::draw_light_panel() {
@@ -49,17 +107,7 @@ void EditorApp::draw_light_panel() {
         if (ImGui::SmallButton("remove")) remove = i;
         int type = light.type == LightType::Directional ? 0 : 1;
         if (is_area_light(light.type)) {
-            // Area lights come from the command line and sessions; here their shape is shown, and
-            // their centre, colour and intensity edited.
-            if (light.type == LightType::Rectangle) {
-                ImGui::TextDisabled("%.3g x %.3g, normal %.2f %.2f %.2f", light.size.x(), light.size.y(), light.axis.x(),
-                                    light.axis.y(), light.axis.z());
-            } else if (light.type == LightType::Disk) {
-                ImGui::TextDisabled("radius %.3g, normal %.2f %.2f %.2f", light.size.x(), light.axis.x(), light.axis.y(),
-                                    light.axis.z());
-            } else {
-                ImGui::TextDisabled("radius %.3g", light.size.x());
-            }
+            changed |= edit_area_shape(light, camera_);
         } else if (ImGui::Combo("type", &type, "directional\0point\0")) {
             const bool to_point = type == 1;
             if (to_point != (light.type == LightType::Point)) {
@@ -122,6 +170,16 @@ void EditorApp::draw_light_panel() {
         lighting_.lights.push_back(new_point_light(camera_));
         selected_light_ = static_cast<int>(lighting_.lights.size()) - 1;
         request_solve();
+    }
+    // Area lights: soft shadows (solver/area_light.h).
+    for (const auto& [type, label] : {std::pair{LightType::Rectangle, "Add rectangle"}, std::pair{LightType::Disk, "Add disk"},
+                                      std::pair{LightType::Sphere, "Add sphere"}}) {
+        if (type != LightType::Rectangle) ImGui::SameLine();
+        if (ImGui::Button(label)) {
+            lighting_.lights.push_back(new_area_light(camera_, type));
+            selected_light_ = static_cast<int>(lighting_.lights.size()) - 1;
+            request_solve();
+        }
     }
     if (!room) ImGui::EndDisabled();
     ImGui::TextDisabled("Light tool (L): drag in the view to turn or move the selected light");
