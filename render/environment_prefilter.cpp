@@ -82,19 +82,30 @@ std::array<double, 3> bilinear(const EnvironmentTexture& t, const Eigen::Vector3
 
 }  // namespace
 
-EnvironmentTexture reduce_environment(const EnvironmentMap& map, int max_width) {
+EnvironmentTexture reduce_environment(const EnvironmentTexture& texture, int max_width) {
     if (max_width < 1) throw InvalidArgumentError("reduce_environment: the width must be at least 1");
-    EnvironmentTexture t = texture_of(map);
+    if (texture.width <= max_width) return texture;
+    EnvironmentTexture t = halve(texture);
     while (t.width > max_width) t = halve(t);
     return t;
 }
 
+EnvironmentTexture reduce_environment(const EnvironmentMap& map, int max_width) {
+    return reduce_environment(texture_of(map), max_width);
+}
+
 EnvironmentTexture prefilter_environment(const EnvironmentMap& map, float roughness, int width, int samples) {
+    return prefilter_environment(reduce_environment(map, kPrefilterSourceWidth), roughness, width, samples);
+}
+
+EnvironmentTexture prefilter_environment(const EnvironmentTexture& source, float roughness, int width, int samples) {
     if (!(roughness > 0.0f && roughness <= 1.0f))
         throw InvalidArgumentError("prefilter_environment: roughness must be in (0, 1]");
     if (width < 2 || samples < 1)
         throw InvalidArgumentError("prefilter_environment: the width must be at least 2 and the samples at least 1");
-    std::vector<EnvironmentTexture> pyramid{reduce_environment(map, kPrefilterSourceWidth)};
+    if (source.width < 1 || source.height < 1 || source.texels.size() != static_cast<size_t>(source.width) * source.height)
+        throw InvalidArgumentError("prefilter_environment: the source texture is empty or its size is inconsistent");
+    std::vector<EnvironmentTexture> pyramid{reduce_environment(source, kPrefilterSourceWidth)};
     while (pyramid.back().width > 1 || pyramid.back().height > 1) pyramid.push_back(halve(pyramid.back()));
     const auto top = static_cast<double>(pyramid.size() - 1);
     const double texel_solid_angle = 4 * kPi / (static_cast<double>(pyramid[0].width) * pyramid[0].height);

@@ -34,6 +34,9 @@ struct EnvironmentTexture {
 // The map box-filtered by halving until it is at most `max_width` wide (each texel the mean of the
 // pixels it covers); the map itself when already that narrow. InvalidArgumentError for max_width < 1.
 EnvironmentTexture reduce_environment(const EnvironmentMap& map, int max_width);
+// The same from a texture already reduced (halving is deterministic, so reducing a reduction gives
+// what reducing the map further would).
+EnvironmentTexture reduce_environment(const EnvironmentTexture& texture, int max_width);
 
 // L_pre above for GGX roughness `roughness` (alpha = roughness^2, as the renderer's highlight), on a
 // `width` by width / 2 texture with `samples` lobe directions per texel. InvalidArgumentError for a
@@ -42,5 +45,10 @@ inline constexpr int kPrefilterWidth = 256;
 inline constexpr int kPrefilterSamples = 64;
 EnvironmentTexture prefilter_environment(const EnvironmentMap& map, float roughness, int width = kPrefilterWidth,
                                          int samples = kPrefilterSamples);
+// The same from a reduction of the map (reduce_environment, at least 512 wide or the map's own
+// width): the renderer prefilters the background texture it has just reduced instead of reducing the
+// full map a second time. Equal to the map's prefilter bit for bit.
+EnvironmentTexture prefilter_environment(const EnvironmentTexture& source, float roughness,
+                                         int width = kPrefilterWidth, int samples = kPrefilterSamples);
 
 }  // namespace waxwork

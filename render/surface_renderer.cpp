@@ -566,9 +566,12 @@ struct SurfaceRenderer::Frame : FrameResources {
 void SurfaceRenderer::prepare_environment(const std::shared_ptr<const EnvironmentMap>& map, float roughness) {
     if (environment_textures_[0] == 0) gl_.GenTextures(2, environment_textures_);
     if (map != environment_map_) {
-        upload_environment_texture(gl_, environment_textures_[0], reduce_environment(*map, kBackgroundWidth));
+        // One reduction of the full map serves both textures.
+        const EnvironmentTexture background = reduce_environment(*map, kBackgroundWidth);
+        upload_environment_texture(gl_, environment_textures_[0], background);
+        upload_environment_texture(gl_, environment_textures_[1], prefilter_environment(background, roughness));
         environment_map_ = map;
-        environment_roughness_ = 0;  // the reflection is of the old map
+        environment_roughness_ = roughness;
     }
     if (roughness != environment_roughness_) {
         upload_environment_texture(gl_, environment_textures_[1], prefilter_environment(*map, roughness));

@@ -81,6 +81,22 @@ TEST(EnvironmentPrefilter, ReducingKeepsTheMeanWithinTheWidth) {
         }
 }
 
+// The renderer prefilters its background texture instead of the map: the same texels, because a
+// reduction of a reduction is the reduction.
+TEST(EnvironmentPrefilter, PrefilteringAReductionEqualsPrefilteringTheMap) {
+    const EnvironmentMap map = map_of(1536, [](const Eigen::Vector3d& w) {
+        return Rgb{0.2 + std::max(0.0, w.y()), 0.5 + 0.3 * w.x(), 1.0 + 0.5 * std::sin(3 * w.z())};
+    });
+    const EnvironmentTexture background = reduce_environment(map, 1024);
+    ASSERT_EQ(background.width, 768);
+    for (const float roughness : {0.2f, 0.7f}) {
+        const EnvironmentTexture direct = prefilter_environment(map, roughness, 64, 16);
+        const EnvironmentTexture shared = prefilter_environment(background, roughness, 64, 16);
+        EXPECT_EQ(shared.texels, direct.texels) << "roughness " << roughness;
+    }
+    EXPECT_EQ(reduce_environment(background, 384).texels, reduce_environment(map, 384).texels);
+}
+
 TEST(EnvironmentPrefilter, RejectsBadArguments) {
     const EnvironmentMap map = map_of(8, [](const Eigen::Vector3d&) { return Rgb{1, 1, 1}; });
     EXPECT_THROW(prefilter_environment(map, 0.0f), InvalidArgumentError);
