@@ -204,6 +204,24 @@ double units_per_pixel_at_front_face() {
     return 2 * (distance - 1) * std::tan(half_fov) / 300;
 }
 
+// DIR/session.json, saved by a script, records one edit, `op`; `waxwork run` replays it to `edited`.
+// Returns the session.
+nlohmann::json expect_session_replays_one_step(const fs::path& dir, const std::string& op, const TetMesh& edited) {
+    nlohmann::json session = nlohmann::json::parse(testing::read_text(dir / "session.json"));
+    EXPECT_EQ(session["steps"].size(), 1u);
+    if (session["steps"].size() != 1) return session;
+    EXPECT_EQ(session["steps"][0]["op"], op);
+    nlohmann::json replay = session;
+    replay["steps"].push_back({{"save", "replay.vtu"}});
+    std::ofstream(dir / "replay.json") << replay.dump(2);
+    const auto run = run_waxwork("run " + (dir / "replay.json").string() + " -o " + (dir / "run").string());
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    if (run.exit_code == 0) {
+        EXPECT_TRUE(read_volume(dir / "run" / "replay.vtu") == edited);
+    }
+    return session;
+}
+
 testing::CommandResult run_script(const fs::path& dir, const std::string& script, const std::string& extra = "") {
     const fs::path path = dir / "input.json";
     std::ofstream(path) << script;
@@ -241,16 +259,9 @@ TEST_F(EditorWindow, CutStrokeCutsTheSideDrawnAndTheSessionReplaysIt) {
 
     // The recorded session holds the current view and the stroke; `waxwork run` replays it to the
     // identical volume.
-    nlohmann::json session = nlohmann::json::parse(testing::read_text(dir / "session.json"));
-    ASSERT_EQ(session["steps"].size(), 1u);
-    EXPECT_EQ(session["steps"][0]["op"], "stroke_cut");
+    const nlohmann::json session = expect_session_replays_one_step(dir, "stroke_cut", after);
     EXPECT_NEAR(session["camera"]["eye_direction"][2].get<double>(), 1.0, 1e-9);
     EXPECT_EQ(session["image"]["width"], 400);
-    session["steps"].push_back({{"save", "replay.vtu"}});
-    std::ofstream(dir / "replay.json") << session.dump(2);
-    const auto run = run_waxwork("run " + (dir / "replay.json").string() + " -o " + (dir / "run").string());
-    ASSERT_EQ(run.exit_code, 0) << run.err;
-    EXPECT_TRUE(read_volume(dir / "run" / "replay.vtu") == after);
 }
 
 TEST_F(EditorWindow, PaintStrokeChangesTheMaterialWhereDrawn) {
@@ -357,14 +368,7 @@ TEST_F(EditorWindow, GrabDragDeformsAroundThePinsAndTheSessionReplaysIt) {
     EXPECT_NEAR(handle_rise, up, 0.25 * up);
     EXPECT_GT(near_pin, 0u);
     EXPECT_EQ(moved_near_pin, 0u);
-    nlohmann::json session = nlohmann::json::parse(testing::read_text(dir / "session.json"));
-    ASSERT_EQ(session["steps"].size(), 1u);
-    EXPECT_EQ(session["steps"][0]["op"], "deform");
-    session["steps"].push_back({{"save", "replay.vtu"}});
-    std::ofstream(dir / "replay.json") << session.dump(2);
-    const auto run = run_waxwork("run " + (dir / "replay.json").string() + " -o " + (dir / "run").string());
-    ASSERT_EQ(run.exit_code, 0) << run.err;
-    EXPECT_TRUE(read_volume(dir / "run" / "replay.vtu") == after);
+    expect_session_replays_one_step(dir, "deform", after);
 }
 
 TEST_F(EditorWindow, DraggedPieceIsShownMovedBeforeTheDocumentMovesIt) {

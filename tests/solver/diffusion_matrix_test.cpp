@@ -138,6 +138,17 @@ TEST(DiffusionMatrix, FemAndTransCutShareTheStiffness) {
     }
 }
 
+// Overwrites every row not marked in `keep`, so a test sees whether an update touched it.
+constexpr double kPoison = -12345.0;
+void poison_rows_except(DiffusionMatrix& m, const std::vector<uint8_t>& keep) {
+    for (size_t i = 0; i < m.size(); ++i)
+        if (!keep[i])
+            for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) {
+                for (auto& v : m.values) v[k] = kPoison;
+                m.source[k] = kPoison;
+            }
+}
+
 TEST(DiffusionMatrix, IncrementalUpdateEqualsFullReassemblyAndTouchesOnlyItsRows) {
     for (auto disc : {Discretization::TransCut, Discretization::Fem}) {
         Fixture f;
@@ -150,14 +161,7 @@ TEST(DiffusionMatrix, IncrementalUpdateEqualsFullReassemblyAndTouchesOnlyItsRows
         std::vector<uint8_t> expected_rows(m.size(), 0);
         for (int32_t t : changed)
             for (int32_t v : f.mesh.tets[t]) expected_rows[v] = 1;
-        // Poison every row that must not be touched.
-        const double poison = -12345.0;
-        for (size_t i = 0; i < m.size(); ++i)
-            if (!expected_rows[i])
-                for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) {
-                    for (auto& v : m.values) v[k] = poison;
-                    m.source[k] = poison;
-                }
+        poison_rows_except(m, expected_rows);
         const auto rows = update_diffusion_matrix(m, f.mesh, f.conn, f.materials, changed);
         for (int32_t r : rows) EXPECT_TRUE(expected_rows[r]);
         EXPECT_EQ(rows.size(), static_cast<size_t>(std::count(expected_rows.begin(), expected_rows.end(), 1)));
@@ -168,7 +172,7 @@ TEST(DiffusionMatrix, IncrementalUpdateEqualsFullReassemblyAndTouchesOnlyItsRows
                     if (expected_rows[i])
                         EXPECT_NEAR(m.values[c][k], full.values[c][k], 1e-15 * std::abs(full.values[c][full.diagonal[i]]));
                     else
-                        EXPECT_EQ(m.values[c][k], poison) << "untouched row " << i << " was rewritten";
+                        EXPECT_EQ(m.values[c][k], kPoison) << "untouched row " << i << " was rewritten";
                 }
                 if (expected_rows[i]) {
                     EXPECT_NEAR(m.source[k], full.source[k], 1e-15);
@@ -190,13 +194,7 @@ TEST(DiffusionMatrix, GeometryUpdateEqualsFullReassemblyAndTouchesOnlyItsRows) {
         for (int32_t v : moved)
             for (int32_t t : f.conn.vertex_tets.row(v))
                 for (int32_t w : f.mesh.tets[t]) expected_rows[w] = 1;
-        const double poison = -12345.0;
-        for (size_t i = 0; i < m.size(); ++i)
-            if (!expected_rows[i])
-                for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) {
-                    for (auto& v : m.values) v[k] = poison;
-                    m.source[k] = poison;
-                }
+        poison_rows_except(m, expected_rows);
         const auto rows = update_diffusion_geometry(m, f.mesh, f.conn, moved);
         EXPECT_EQ(rows.size(), static_cast<size_t>(std::count(expected_rows.begin(), expected_rows.end(), 1)));
         for (int32_t r : rows) EXPECT_TRUE(expected_rows[r]);
@@ -209,8 +207,8 @@ TEST(DiffusionMatrix, GeometryUpdateEqualsFullReassemblyAndTouchesOnlyItsRows) {
         for (size_t i = 0; i < m.size(); ++i)
             for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) {
                 for (int c = 0; c < 3; ++c)
-                    EXPECT_EQ(m.values[c][k], expected_rows[i] ? full.values[c][k] : poison) << "row " << i;
-                EXPECT_EQ(m.source[k], expected_rows[i] ? full.source[k] : poison) << "row " << i;
+                    EXPECT_EQ(m.values[c][k], expected_rows[i] ? full.values[c][k] : kPoison) << "row " << i;
+                EXPECT_EQ(m.source[k], expected_rows[i] ? full.source[k] : kPoison) << "row " << i;
             }
     }
     // A move that inverts a tet is refused and the matrix is left as it was.
