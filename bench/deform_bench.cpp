@@ -10,6 +10,7 @@
 #include "tetops/connectivity.h"
 #include "bench_main.h"
 #include "bench_meshes.h"
+#include "live_scene_setup.h"
 
 #include <benchmark/benchmark.h>
 
@@ -137,22 +138,19 @@ void BM_ArapIterationsPerFrame(benchmark::State& state) {
 }
 // A whole editor drag frame, as the Grab tool runs it: Document::preview_deform with range(1)
 // iterations warm-started from the previous frame, the live scene's update (the moved rows of the
-// matrix on the kept pattern, the surface, shadows and q) and one warm solver frame of 10 Jacobi-CG
-// iterations per channel; the handle advances by 1/30 of the move per frame. Counters: each part's
-// milliseconds per frame.
+// matrix on the kept pattern, the surface, shadows and q) and one warm solver frame of
+// kFrameIterations Jacobi-CG iterations per channel; the handle advances by 1/30 of the move per
+// frame. Counters: each part's milliseconds per frame.
 void BM_DeformDragFrameWithLight(benchmark::State& state) {
     const DragSetup& s = drag_setup(static_cast<size_t>(state.range(0)));
     const int iterations = static_cast<int>(state.range(1));
     Document document(s.mesh, material_preset("marble"));
-    Lighting lighting;
-    lighting.lights = {Light{LightType::Directional, Eigen::Vector3d(1, -0.8, -0.5).normalized(), {1, 1, 1}}};
-    LiveSceneOptions options;
-    const auto box = bounding_box(s.mesh);
-    options.mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();
-    LiveScene scene(document.mesh(), lighting, options);
+    const Lighting lighting = bench::turning_light(0);
+    LiveScene scene(document.mesh(), lighting, bench::live_scene_options(s.mesh));
     scene.converge();
     DeformOp op;
     // The region drag_setup selected, as an operation: same grab, radius and pin.
+    const auto box = bounding_box(s.mesh);
     const double diagonal = (box[1] - box[0]).norm();
     auto by_y = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.y() < b.y(); };
     op.grab = *std::max_element(s.mesh.positions.begin(), s.mesh.positions.end(), by_y);
@@ -168,7 +166,7 @@ void BM_DeformDragFrameWithLight(benchmark::State& state) {
     // The press: region, operators and factorisation (BM_ArapFactorize), not part of a drag frame.
     advance();
     scene.apply_change(document.mesh(), document.preview_deform(op, iterations));
-    scene.step(FrameBudget::iterations(10));
+    scene.step(bench::kFrameIterations);
     const int first_timed = frame;
     for (auto _ : state) {
         advance();
@@ -177,7 +175,7 @@ void BM_DeformDragFrameWithLight(benchmark::State& state) {
         const auto moved = Clock::now();
         scene.apply_change(document.mesh(), report);
         const auto updated = Clock::now();
-        scene.step(FrameBudget::iterations(10));
+        scene.step(bench::kFrameIterations);
         const auto solved = Clock::now();
         arap_ms += std::chrono::duration<double, std::milli>(moved - start).count();
         scene_ms += std::chrono::duration<double, std::milli>(updated - moved).count();

@@ -22,10 +22,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr size_t kFrameTets = 100'000;
-constexpr size_t kEditTets = 500'000;
+using bench::kEditTets;
+using bench::kFrameIterations;
+using bench::kFrameTets;
 constexpr int kFrames = 60;
-constexpr int kFrameIterations = 8;  // as live_scene_bench's relighting frames
 
 Lighting sky(double rotation_degrees) {
     Lighting lighting;

@@ -28,11 +28,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr size_t kFrameTets = 100'000;
-constexpr size_t kEditTets = 500'000;
+using bench::kEditTets;
+using bench::kFrameIterations;
+using bench::kFrameTets;
 constexpr int kFrames = 90;
-// CG iterations per channel and frame: what fits a 30 fps frame at 100K tets with the lighting update.
-constexpr int kFrameIterations = 8;
 
 // CPU time of the whole process (all TBB threads), in ms: on a shared machine wall time includes
 // waiting for a core; this does not.
