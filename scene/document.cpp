@@ -133,7 +133,7 @@ void Document::require_no_preview(const char* what) const {
         throw InvalidArgumentError(std::string(what) + ": a deform drag is in progress (commit or cancel it first)");
 }
 
-ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
+ChangeReport Document::run(const EditOperation& op, UndoEntry& entry, Progress* progress) {
     const auto start = std::chrono::steady_clock::now();
     ChangeReport report;
     report.name = operation_name(op);
@@ -237,7 +237,8 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry) {
         GuardOptions guard;
         guard.min_dihedral_guard_deg = o->guard_deg;
         c.deformer->reset();  // from the rest shape, as a fresh deformer: the result depends on `op` only
-        const DragReport drag = run_drag(*c.deformer, mesh_, c.region, mesh_.positions, o->steps, o->iterations, guard);
+        const DragReport drag =
+            run_drag(*c.deformer, mesh_, c.region, mesh_.positions, o->steps, o->iterations, guard, progress);
         record_moved_vertices(mesh_.positions, c.deformer->positions());
         mesh_.positions = c.deformer->positions();
         min_dihedral_deg_ = min_dihedral_of(mesh_);
@@ -336,10 +337,10 @@ void Document::push_undo(UndoEntry entry, ChangeReport& report) {
     undo_.push_back(std::move(entry));
 }
 
-ChangeReport Document::apply(const EditOperation& op) {
+ChangeReport Document::apply(const EditOperation& op, Progress* progress) {
     require_no_preview(operation_name(op).c_str());
     UndoEntry entry;
-    ChangeReport report = run(op, entry);
+    ChangeReport report = run(op, entry, progress);
     redo_.clear();
     history_.push_back(op);
     push_undo(std::move(entry), report);

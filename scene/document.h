@@ -46,6 +46,8 @@
 
 namespace waxwork {
 
+class Progress;
+
 // A cut with relaxation: the tets it removed, then the relaxation of the cut vertices.
 struct RelaxedCutResult {
     CutResult removal;
@@ -115,9 +117,10 @@ public:
     const TetMesh& mesh() const { return mesh_; }
     double min_dihedral_deg() const { return min_dihedral_deg_; }
 
-    // Runs the operation. On an exception (bad parameters, an algorithm failure) the mesh is left as
-    // it was and nothing is recorded. Clears the redo stack.
-    ChangeReport apply(const EditOperation& op);
+    // Runs the operation. On an exception (bad parameters, an algorithm failure, a cancel through
+    // `progress`) the mesh is left as it was and nothing is recorded. Clears the redo stack. `progress`
+    // (optional) follows the operations that can take seconds (deform).
+    ChangeReport apply(const EditOperation& op, Progress* progress = nullptr);
 
     bool can_undo() const { return !undo_.empty(); }
     bool can_redo() const { return !redo_.empty(); }
@@ -173,7 +176,7 @@ private:
         double old_min_dihedral_deg = 0;
         size_t bytes = 0;
     };
-    ChangeReport run(const EditOperation& op, UndoEntry& entry);
+    ChangeReport run(const EditOperation& op, UndoEntry& entry, Progress* progress = nullptr);
     // The drag region and ARAP factorisation for `op` on the current positions (reused when they,
     // the body, the handle and the pins are those of the previous deform).
     struct DeformCache;

@@ -2,6 +2,7 @@
 
 #include "base/error.h"
 #include "base/parallel_rows.h"
+#include "base/progress.h"
 #include "base/timing.h"
 #include "tetops/quality.h"
 
@@ -526,9 +527,11 @@ GuardedStep guard_step(const TetMesh& mesh, std::span<const int32_t> tets,
 }
 
 DragReport run_drag(ArapDeformer& deformer, const TetMesh& mesh, const DragRegion& region,
-                    std::span<const Eigen::Vector3d> rest, int steps, int iterations, const GuardOptions& guard) {
+                    std::span<const Eigen::Vector3d> rest, int steps, int iterations, const GuardOptions& guard,
+                    Progress* progress) {
     if (steps < 1) throw InvalidArgumentError("the drag needs at least one step");
     if (iterations < 1) throw InvalidArgumentError("the drag needs at least one iteration per step");
+    report_stage(progress, "deforming (ARAP, " + std::to_string(steps) + " steps)");
     DragReport report;
     const auto factor_start = std::chrono::steady_clock::now();
     deformer.set_constrained(region.constrained());
@@ -540,6 +543,8 @@ DragReport run_drag(ArapDeformer& deformer, const TetMesh& mesh, const DragRegio
     report.pinned_vertices = region.pinned.size();
     std::vector<Eigen::Vector3d> targets;
     for (int s = 1; s <= steps; ++s) {
+        check_cancelled(progress);
+        if (progress) progress->set_fraction(static_cast<float>(s - 1) / static_cast<float>(steps));
         targets = drag_targets(region, rest, static_cast<double>(s) / steps);
         const std::vector<Eigen::Vector3d> before = deformer.positions();
         report.energy = deformer.solve(targets, iterations).energy;

@@ -44,6 +44,8 @@ inline constexpr double kStiffSliverAngleDeg = 10;
 
 namespace waxwork {
 
+class Progress;
+
 // The energy after an ARAP solve, and what ran.
 struct ArapSolveReport {
     int iterations = 0;
@@ -229,7 +231,9 @@ GuardedStep guard_step(const TetMesh& mesh, std::span<const int32_t> tets,
 // and then guarded (guard_step over the body's tets); a shortened step's positions become the warm
 // start of the next, so the handle lags behind its target rather than breaking a tet. `rest` holds
 // the positions the targets are measured from (drag_targets). Throws InvalidArgumentError for
-// steps < 1 or iterations < 1.
+// steps < 1 or iterations < 1. `progress`, when given, names the stage, gets the fraction of steps
+// done, and stops the drag between steps with CancelledError (the deformer then holds a partial drag;
+// reset it).
 struct DragReport {
     int steps = 0;
     int iterations_per_step = 0;
@@ -243,6 +247,7 @@ struct DragReport {
     size_t inverted_tets = 0;     // of the body's tets at the end (0 unless the input had some)
 };
 DragReport run_drag(ArapDeformer& deformer, const TetMesh& mesh, const DragRegion& region,
-                    std::span<const Eigen::Vector3d> rest, int steps, int iterations, const GuardOptions& guard = {});
+                    std::span<const Eigen::Vector3d> rest, int steps, int iterations, const GuardOptions& guard = {},
+                    Progress* progress = nullptr);
 
 }  // namespace waxwork

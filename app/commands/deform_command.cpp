@@ -8,6 +8,7 @@
 // materials, ids and pieces unchanged (only positions move) and a one-line JSON summary is printed.
 #include "app/commands/edited_volume.h"
 #include "app/options/number_options.h"
+#include "app/stderr_progress.h"
 #include "base/error.h"
 #include "base/timing.h"
 #include "scene/edit_operation.h"
@@ -113,10 +114,13 @@ void run_deform_command(const DeformCommandOptions& o) {
     const DeformOp op = deform_operation(o);
     EditedVolume volume(o.input, TetMaterial{}, /*write_base=*/false);
     const double volume_before = total_volume(volume.mesh());
+    StderrProgress progress("waxwork: " + o.input + ": ");
     const auto start = Clock::now();
-    const ChangeReport report = volume.apply(op);
+    const ChangeReport report = volume.apply(op, &progress);
     const double elapsed = milliseconds_since(start);
+    progress.set_stage("writing " + o.output);
     volume.write(o.output);
+    progress.finish();
 
     const DragReport& drag = std::get<DragReport>(report.result);
     const TetMesh& mesh = volume.mesh();

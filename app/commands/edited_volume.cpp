@@ -13,8 +13,8 @@ EditedVolume::EditedVolume(const std::string& input, VolumeFile file, const TetM
     : input_(input), keep_materials_(write_base || file.mesh.has_materials()), metadata_(file.metadata),
       document_(std::move(file.mesh), base, /*undo_budget_bytes=*/0) {}
 
-ChangeReport EditedVolume::apply(const EditOperation& op) {
-    return naming_context(input_, [&] { return document_.apply(op); });
+ChangeReport EditedVolume::apply(const EditOperation& op, Progress* progress) {
+    return naming_context(input_, [&] { return document_.apply(op, progress); });
 }
 
 void EditedVolume::write(const std::string& output) const {

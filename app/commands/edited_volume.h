@@ -21,7 +21,8 @@ public:
     const TetMesh& mesh() const { return document_.mesh(); }
 
     // Errors name the volume (what it does not allow: a cut that leaves nothing, more pieces than tets).
-    ChangeReport apply(const EditOperation& op);
+    // `progress` as for Document::apply.
+    ChangeReport apply(const EditOperation& op, Progress* progress = nullptr);
 
     // Atomically; keeps what the input stored beside the mesh (its scale).
     void write(const std::string& output) const;

@@ -1,4 +1,5 @@
 #include "base/error.h"
+#include "base/progress.h"
 #include "io/volume_file.h"
 #include "scene/document.h"
 #include "solver/material.h"
@@ -141,6 +142,13 @@ TEST(Document, DeformReportsTheMovedVerticesAndKeepsEverythingButPositions) {
         EXPECT_NE(std::string(e.what()).find("deform: no vertex lies within the handle"), std::string::npos) << e.what();
     }
     EXPECT_TRUE(doc.mesh() == before);
+    // A deform cancelled through its progress changes nothing either, and the next one works.
+    Progress cancelled;
+    cancelled.request_cancel();
+    EXPECT_THROW(doc.apply(bend, &cancelled), CancelledError);
+    EXPECT_TRUE(doc.mesh() == before);
+    EXPECT_EQ(doc.history().size(), 1u);
+    EXPECT_TRUE(doc.apply(bend).positions);
 }
 
 TEST(Document, SaveAndReloadAfterEveryKindOfOperationIsIdentical) {

@@ -2,6 +2,7 @@
 // a bent bar keeps its volume and inverts nothing, the guard shortens steps that would break a tet,
 // and deformation works on cut, painted and multi-body volumes.
 #include "base/error.h"
+#include "base/progress.h"
 #include "io/volume_file.h"
 #include "support/scratch_dir.h"
 #include "tetops/arap_deformation.h"
@@ -312,6 +313,23 @@ TEST(ArapDeformation, BendAndTwistToolsTurnTheHandleAboutTheAxis) {
         const TetMesh result = with_positions(bar, deformer.positions());
         EXPECT_GE(mesh_min_dihedral_deg(result), 0.5);
     }
+}
+
+// A drag reports its steps and stops between them when asked to.
+TEST(ArapDeformation, DragReportsProgressAndStopsWhenCancelled) {
+    const TetMesh bar = make_bar();
+    const TetConnectivity connectivity = build_connectivity(bar);
+    const PinSphere pin{Eigen::Vector3d(0, 0.5, 0.5), 0.6};
+    const DragRegion region = select_drag_region(bar, connectivity, Eigen::Vector3d(4, 0.5, 0.5), 1.0,
+                                                 HandleMotion::translation(Eigen::Vector3d(0, 0.5, 0)), std::span(&pin, 1));
+    Progress progress;
+    ArapDeformer deformer(bar, region.body_tets);
+    run_drag(deformer, bar, region, bar.positions, 4, 2, {}, &progress);
+    EXPECT_NE(progress.stage().find("deforming"), std::string::npos);
+    EXPECT_FLOAT_EQ(progress.fraction(), 0.75f);  // set as the last of the four steps starts
+    progress.request_cancel();
+    deformer.reset();
+    EXPECT_THROW(run_drag(deformer, bar, region, bar.positions, 4, 2, {}, &progress), CancelledError);
 }
 
 TEST(ArapDeformation, WorksAfterAnExactCut) {
