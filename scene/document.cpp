@@ -89,6 +89,8 @@ struct Document::DeformCache {
     DragRegion region;
     std::optional<ArapDeformer> deformer;
     bool previewing = false;  // a drag is shown: the mesh holds preview positions, `rest` the ones before
+    std::vector<double> guard_floors;  // while previewing: per body tet, guard_floors at `rest`
+    double guard_deg = 0;              // ... for this guard
 };
 
 Document::Document(TetMesh mesh, const TetMaterial& default_material, size_t undo_budget_bytes)
@@ -420,11 +422,15 @@ ChangeReport Document::preview_deform(const DeformOp& op, int iterations) {
         DeformCache& c = deform_setup(op);
         c.deformer->reset();
         c.deformer->set_constrained(c.region.constrained());
+        GuardOptions guard;
+        guard.min_dihedral_guard_deg = op.guard_deg;
+        c.guard_floors = guard_floors(c.region.body_tets, mesh_.tets, c.rest, guard);
+        c.guard_deg = op.guard_deg;
         c.previewing = true;
     } else {
         const DeformCache& c = *deform_cache_;
-        if (op.grab != c.grab || op.radius != c.radius || op.pins != c.pins)
-            throw InvalidArgumentError("deform preview: a drag keeps its grab point, radius and pins");
+        if (op.grab != c.grab || op.radius != c.radius || op.pins != c.pins || op.guard_deg != c.guard_deg)
+            throw InvalidArgumentError("deform preview: a drag keeps its grab point, radius, pins and guard");
         validate_handle_motion(op.motion);
     }
     DeformCache& c = *deform_cache_;
@@ -440,7 +446,7 @@ ChangeReport Document::preview_deform(const DeformOp& op, int iterations) {
     drag.handle_vertices = c.region.handle.size();
     drag.pinned_vertices = c.region.pinned.size();
     drag.energy = c.deformer->solve(targets, iterations).energy;
-    GuardedStep step = guard_step(mesh_, c.region.body_tets, before, c.deformer->positions(), guard);
+    GuardedStep step = guard_step(mesh_, c.region.body_tets, before, c.deformer->positions(), guard, c.guard_floors);
     drag.last_step_fraction = step.fraction;
     drag.min_dihedral_deg = step.min_dihedral_deg;
     drag.inverted_tets = step.inverted_tets;

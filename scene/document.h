@@ -146,8 +146,9 @@ public:
     // preview_deform moves the vertices towards `op`'s full motion with `iterations` local/global
     // iterations warm-started from the previous preview of the same drag (guarded as apply() guards),
     // so a frame costs a few triangular solves. It makes no undo entry and no history; the first preview
-    // remembers the positions before the drag. Later previews must keep the op's grab, radius and pins
-    // (the drag's handle): InvalidArgumentError otherwise. The report is a positions change whose
+    // remembers the positions before the drag, and its tets may not end under min(guard, their angle
+    // then). Later previews must keep the op's grab, radius, pins and guard (the drag's handle):
+    // InvalidArgumentError otherwise. The report is a positions change whose
     // moved_vertices are those that moved since the previous preview.
     ChangeReport preview_deform(const DeformOp& op, int iterations);
     bool previewing() const;

@@ -54,7 +54,11 @@ void LiveScene::mark_unconverged() {
 void LiveScene::rebuild_surface(SceneUpdate& update, std::optional<std::span<const int32_t>> vertex_map) {
     BoundarySurface old_surface = std::move(surface_);
     surface_ = extract_boundary_surface(*mesh_, *connectivity_, mesh_->materials);
-    shadow_bvh_ = build_shadow_bvh(surface_);
+    // Moved vertices (a deformation, a piece moved) keep the triangles: the tree is refitted.
+    if (!shadow_bvh_.empty() && surface_.triangles == old_surface.triangles)
+        refit_shadow_bvh(shadow_bvh_, surface_);
+    else
+        shadow_bvh_ = build_shadow_bvh(surface_);
     shading_ = split_at_creases(surface_, options_.crease_angle_degrees);
     update.rebuilt_surface = true;
     if (transfer_ && vertex_map && lighting_.environment && transfer_->settings().order == lighting_.environment->sh_order &&

@@ -186,10 +186,23 @@ BoundarySurface extract_boundary_surface(const TetMesh& mesh, const TetConnectiv
     return surface;
 }
 
-TriangleBvh build_shadow_bvh(const BoundarySurface& surface) {
+namespace {
+
+std::vector<Eigen::Vector3f> float_points(const BoundarySurface& surface) {
     std::vector<Eigen::Vector3f> points(surface.positions.size());
     for (size_t i = 0; i < points.size(); ++i) points[i] = surface.positions[i].cast<float>();
-    return TriangleBvh(points, surface.triangles);
+    return points;
+}
+
+}  // namespace
+
+TriangleBvh build_shadow_bvh(const BoundarySurface& surface) { return TriangleBvh(float_points(surface), surface.triangles); }
+
+void refit_shadow_bvh(TriangleBvh& bvh, const BoundarySurface& surface) {
+    if (bvh.triangle_count() != surface.triangles.size())
+        throw InvalidArgumentError("refit_shadow_bvh: the tree has " + std::to_string(bvh.triangle_count()) +
+                                   " triangles, the surface " + std::to_string(surface.triangles.size()));
+    bvh.refit(float_points(surface));
 }
 
 namespace {

@@ -152,6 +152,9 @@ BoundarySurface extract_boundary_surface(const TetMesh& mesh, const TetConnectiv
 // The triangles of `surface` in float, for shadow rays; build once per geometry change and pass it to
 // incident_light while only the lights change.
 TriangleBvh build_shadow_bvh(const BoundarySurface& surface);
+// The same tree for the same triangles at the surface's new positions (TriangleBvh::refit): what a
+// deformation needs. `bvh` must have been built from a surface with these triangles, in this order.
+void refit_shadow_bvh(TriangleBvh& bvh, const BoundarySurface& surface);
 
 // q per surface vertex and channel. `bvh` must have been built from `surface` (only used with
 // lighting.shadows). Parallel over vertices (TBB). With an environment, q_env comes from `transfer`

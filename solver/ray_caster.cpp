@@ -201,12 +201,48 @@ TriangleBvh::TriangleBvh(std::span<const Eigen::Vector3f> points,
     nodes_.resize(builder.next_node.load());
     nodes_.shrink_to_fit();
 
+    leaf_triangles_.resize(triangles.size());
+    for (size_t i = 0; i < triangles.size(); ++i) leaf_triangles_[i] = triangles[builder.order[i]];
     triangles_.resize(triangles.size());
     tbb::parallel_for(size_t{0}, triangles.size(), [&](size_t i) {
-        const auto& tri = triangles[builder.order[i]];
+        const auto& tri = leaf_triangles_[i];
         const Eigen::Vector3f& v0 = points[tri[0]];
         triangles_[i] = {v0, points[tri[1]] - v0, points[tri[2]] - v0};
     });
+}
+
+void TriangleBvh::refit(std::span<const Eigen::Vector3f> points) {
+    for (const Eigen::Vector3f& p : points)
+        if (!p.allFinite()) throw InvalidArgumentError("TriangleBvh::refit: non-finite point coordinate");
+    const auto point_count = static_cast<int64_t>(points.size());
+    for (const auto& tri : leaf_triangles_)
+        for (const int32_t v : tri)
+            if (v >= point_count)
+                throw InvalidArgumentError("TriangleBvh::refit: a triangle has vertex index " + std::to_string(v) +
+                                           " outside the " + std::to_string(point_count) + " points");
+    tbb::parallel_for(size_t{0}, leaf_triangles_.size(), [&](size_t i) {
+        const auto& tri = leaf_triangles_[i];
+        const Eigen::Vector3f& v0 = points[tri[0]];
+        triangles_[i] = {v0, points[tri[1]] - v0, points[tri[2]] - v0};
+    });
+    // Children are allocated after their parent (BvhBuilder::next_node), so a backward sweep sees
+    // both children of a node before the node.
+    for (size_t k = nodes_.size(); k-- > 0;) {
+        Node& node = nodes_[k];
+        Box box;
+        if (node.count > 0) {
+            for (int32_t i = node.index; i < node.index + node.count; ++i)
+                for (const int32_t v : leaf_triangles_[i]) box.grow(points[v]);
+        } else {
+            for (const Node* child : {&nodes_[node.index], &nodes_[node.index + 1]})
+                box.grow(Box{Eigen::Vector3f(child->lo[0], child->lo[1], child->lo[2]),
+                             Eigen::Vector3f(child->hi[0], child->hi[1], child->hi[2])});
+        }
+        for (int a = 0; a < 3; ++a) {
+            node.lo[a] = box.lo[a];
+            node.hi[a] = box.hi[a];
+        }
+    }
 }
 
 bool TriangleBvh::occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float t_min,

@@ -39,6 +39,13 @@ public:
     bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float t_min,
                   float t_max) const;
 
+    // The same triangles at moved `points` (a deformation): the tree keeps its structure and takes the
+    // new triangles and bounds, which is several times cheaper than building it again and answers
+    // occluded() exactly as a new tree would (bounds stay exact; only traversal cost can grow as the
+    // shape moves away from the one the tree was built for). InvalidArgumentError for a point set the
+    // triangles do not fit or a non-finite point.
+    void refit(std::span<const Eigen::Vector3f> points);
+
     size_t triangle_count() const { return triangles_.size(); }
     size_t node_count() const { return nodes_.size(); }
     bool empty() const { return triangles_.empty(); }
@@ -60,6 +67,7 @@ private:
 
     std::vector<Node> nodes_;
     std::vector<PackedTriangle> triangles_;
+    std::vector<std::array<int32_t, 3>> leaf_triangles_;  // the input triangles in leaf order, for refit
 
     friend struct BvhBuilder;
 };

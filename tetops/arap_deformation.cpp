@@ -473,9 +473,21 @@ std::vector<Eigen::Vector3d> twist_about_axis(std::span<const Eigen::Vector3d> p
     return moved_points(points, HandleMotion::twist(axis_point, axis_direction, angle_per_length));
 }
 
+std::vector<double> guard_floors(std::span<const int32_t> tets, const std::vector<Tet>& mesh_tets,
+                                 std::span<const Eigen::Vector3d> positions, const GuardOptions& options) {
+    std::vector<double> floor_deg(tets.size());
+    for_rows(tets.size(), kTetGrain, [&](size_t i) {
+        const Tet& tet = mesh_tets[tets[i]];
+        const double before = min_dihedral_angle_deg(positions[tet[0]], positions[tet[1]], positions[tet[2]],
+                                                     positions[tet[3]]);
+        floor_deg[i] = std::min(options.min_dihedral_guard_deg, before) - 1e-9;
+    });
+    return floor_deg;
+}
+
 GuardedStep guard_step(const TetMesh& mesh, std::span<const int32_t> tets,
                        std::span<const Eigen::Vector3d> old_positions, std::span<const Eigen::Vector3d> new_positions,
-                       const GuardOptions& options) {
+                       const GuardOptions& options, std::span<const double> given_floor_deg) {
     if (old_positions.size() != mesh.vertex_count() || new_positions.size() != mesh.vertex_count())
         throw InvalidArgumentError("guard_step: one old and one new position per vertex are needed");
     if (!(options.min_dihedral_guard_deg >= 0) || options.max_halvings < 0)
@@ -483,15 +495,13 @@ GuardedStep guard_step(const TetMesh& mesh, std::span<const int32_t> tets,
     for (int32_t t : tets)
         if (t < 0 || static_cast<size_t>(t) >= mesh.tet_count())
             throw InvalidArgumentError("guard_step: tet index " + std::to_string(t) + " out of range");
+    if (!given_floor_deg.empty() && given_floor_deg.size() != tets.size())
+        throw InvalidArgumentError("guard_step: one floor per checked tet is needed");
     // Per tet, the least angle it may end with: the guard, or its own angle when it was already below.
-    std::vector<double> floor_deg(tets.size());
-    for_rows(tets.size(), kTetGrain, [&](size_t i) {
-        const Tet& tet = mesh.tets[tets[i]];
-        const double before = min_dihedral_angle_deg(old_positions[tet[0]], old_positions[tet[1]],
-                                                     old_positions[tet[2]], old_positions[tet[3]]);
-        // 1e-9 degrees of slack: a rigid motion changes the angles by rounding only.
-        floor_deg[i] = std::min(options.min_dihedral_guard_deg, before) - 1e-9;
-    });
+    std::vector<double> computed_floor_deg;
+    if (given_floor_deg.empty()) computed_floor_deg = guard_floors(tets, mesh.tets, old_positions, options);
+    const std::span<const double> floor_deg = given_floor_deg.empty() ? std::span<const double>(computed_floor_deg)
+                                                                      : given_floor_deg;
     auto at = [&](int32_t v, double f) { return Eigen::Vector3d(old_positions[v] + f * (new_positions[v] - old_positions[v])); };
     std::vector<double> angle(tets.size());
     std::vector<uint8_t> inverted(tets.size()), failing(tets.size());

@@ -222,9 +222,16 @@ struct GuardedStep {
 // whose vertices may move): halves the step until no tet is inverted and no tet's minimum dihedral
 // angle is under the guard, or under its value at `old_positions` when it was already below (a tet
 // already under the guard may not get worse). Both arrays hold one position per mesh vertex.
+// `floor_deg`, when not empty, gives per tet of `tets` the least angle it may end with instead (from
+// guard_floors): a drag previewed frame by frame holds its tets to the angles they had before the
+// drag, computed once, rather than measuring the previous frame's angles every frame.
 GuardedStep guard_step(const TetMesh& mesh, std::span<const int32_t> tets,
                        std::span<const Eigen::Vector3d> old_positions, std::span<const Eigen::Vector3d> new_positions,
-                       const GuardOptions& options = {});
+                       const GuardOptions& options = {}, std::span<const double> floor_deg = {});
+// Per tet of `tets`, the least angle guard_step lets it end with from `positions`: the guard, or its
+// angle there when that is lower (less 1e-9 degrees: a rigid motion changes the angles by rounding).
+std::vector<double> guard_floors(std::span<const int32_t> tets, const std::vector<Tet>& mesh_tets,
+                                 std::span<const Eigen::Vector3d> positions, const GuardOptions& options);
 
 // A whole drag from the deformer's current positions, as the editor's frames run it: the move in
 // `steps` equal increments, each `iterations` local/global steps warm-started from the previous one

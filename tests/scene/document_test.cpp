@@ -151,6 +151,60 @@ TEST(Document, DeformReportsTheMovedVerticesAndKeepsEverythingButPositions) {
     EXPECT_TRUE(doc.apply(bend).positions);
 }
 
+// A drag previewed frame by frame: no history until it ends; other edits wait; the commit equals
+// applying the final operation to the document as it was before the drag, bit for bit (what a session
+// replays); a cancel restores the volume.
+TEST(Document, DeformPreviewsCommitWhatAReplayMakesAndCancelRestores) {
+    Document doc(test_cube(), material_preset("marble"));
+    const TetMesh before = doc.mesh();
+    DeformOp op;
+    op.grab = Eigen::Vector3d(1, 0.5, 0.5);
+    op.radius = 0.4;
+    op.pins = {PinSphere{Eigen::Vector3d(0, 0.5, 0.5), 0.3}};
+    op.steps = 2;
+    op.iterations = 6;
+    for (int frame = 1; frame <= 3; ++frame) {
+        op.motion = HandleMotion::translation(Eigen::Vector3d(0, 0.05 * frame, 0));
+        const ChangeReport preview = doc.preview_deform(op, 2);
+        EXPECT_TRUE(preview.positions) << frame;
+        EXPECT_FALSE(preview.moved_vertices.empty()) << frame;
+        EXPECT_TRUE(doc.previewing());
+    }
+    EXPECT_TRUE(doc.history().empty());
+    EXPECT_FALSE(doc.can_undo());
+    EXPECT_THROW(doc.apply(paint_at({0.5, 0.5, 0.5})), InvalidArgumentError);
+    EXPECT_THROW(doc.undo(), InvalidArgumentError);
+    DeformOp elsewhere = op;
+    elsewhere.grab = Eigen::Vector3d(1, 0.4, 0.5);
+    EXPECT_THROW(doc.preview_deform(elsewhere, 2), InvalidArgumentError);
+    const TetMesh shown = doc.mesh();
+
+    const ChangeReport committed = doc.commit_deform(op);
+    EXPECT_FALSE(doc.previewing());
+    ASSERT_EQ(doc.history().size(), 1u);
+    EXPECT_TRUE(doc.history().front() == EditOperation(op));
+    Document replay(test_cube(), material_preset("marble"));
+    replay.apply(op);
+    EXPECT_TRUE(doc.mesh() == replay.mesh());
+    // The report names every vertex whose position differs from the last preview's.
+    size_t differs = 0;
+    for (size_t v = 0; v < shown.vertex_count(); ++v) differs += shown.positions[v] != doc.mesh().positions[v] ? 1 : 0;
+    EXPECT_EQ(committed.moved_vertices.size(), differs);
+    ASSERT_TRUE(doc.undo());
+    EXPECT_TRUE(doc.mesh() == before);
+
+    op.motion = HandleMotion::translation(Eigen::Vector3d(0, -0.1, 0));
+    doc.preview_deform(op, 3);
+    EXPECT_FALSE(doc.mesh() == before);
+    const std::optional<ChangeReport> cancelled = doc.cancel_deform();
+    ASSERT_TRUE(cancelled);
+    EXPECT_FALSE(cancelled->moved_vertices.empty());
+    EXPECT_TRUE(doc.mesh() == before);
+    EXPECT_FALSE(doc.previewing());
+    EXPECT_FALSE(doc.cancel_deform());
+    EXPECT_THROW(doc.commit_deform(op), InvalidArgumentError);
+}
+
 TEST(Document, SaveAndReloadAfterEveryKindOfOperationIsIdentical) {
     const auto path = testing::scratch_dir("document_reload") / "reload.vtu";
     std::vector<EditOperation> ops = material_and_geometry_ops();

@@ -270,6 +270,47 @@ TEST(RayCaster, BvhAnyHitAgreesWithBruteForce) {
     EXPECT_GT(misses, 500);
 }
 
+// A tree refitted to moved points (the triangles turned and stretched about the centre) answers every
+// ray as a tree built on the moved points does, and refuses a point set that does not fit.
+TEST(RayCaster, RefittedBvhAnswersAsAFreshTreeOnMovedPoints) {
+    std::mt19937 rng(777);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    std::vector<Eigen::Vector3f> points;
+    std::vector<std::array<int32_t, 3>> triangles;
+    for (int t = 0; t < 2000; ++t) {
+        const Eigen::Vector3f c(unit(rng), unit(rng), unit(rng));
+        for (int k = 0; k < 3; ++k) points.push_back(c + 0.05f * Eigen::Vector3f(gauss(rng), gauss(rng), gauss(rng)));
+        const auto base = static_cast<int32_t>(points.size() - 3);
+        triangles.push_back({base, base + 1, base + 2});
+    }
+    TriangleBvh refitted(points, triangles);
+    std::vector<Eigen::Vector3f> moved = points;
+    for (Eigen::Vector3f& p : moved) {
+        const float angle = 1.5f * p.y();  // a twist about y, and a stretch along x
+        const float x = p.x() - 0.5f, z = p.z() - 0.5f;
+        p = Eigen::Vector3f(0.5f + 1.7f * (std::cos(angle) * x - std::sin(angle) * z), p.y(),
+                            0.5f + std::sin(angle) * x + std::cos(angle) * z);
+    }
+    refitted.refit(moved);
+    const TriangleBvh fresh(moved, triangles);
+    int hits = 0;
+    for (int r = 0; r < 4000; ++r) {
+        const Eigen::Vector3f origin(2 * unit(rng) - 0.5f, 2 * unit(rng) - 0.5f, 2 * unit(rng) - 0.5f);
+        const Eigen::Vector3f direction(gauss(rng), gauss(rng), gauss(rng));
+        const float t_max = r % 2 == 0 ? std::numeric_limits<float>::infinity() : unit(rng);
+        const bool expected = fresh.occluded(origin, direction, 0.0f, t_max);
+        ASSERT_EQ(refitted.occluded(origin, direction, 0.0f, t_max), expected) << "ray " << r;
+        hits += expected ? 1 : 0;
+    }
+    EXPECT_GT(hits, 400);
+    EXPECT_LT(hits, 3600);
+    moved.pop_back();
+    EXPECT_THROW(refitted.refit(moved), InvalidArgumentError);
+    moved.push_back(Eigen::Vector3f(std::numeric_limits<float>::quiet_NaN(), 0, 0));
+    EXPECT_THROW(refitted.refit(moved), InvalidArgumentError);
+}
+
 TEST(RayCaster, EmptyAndInvalidInput) {
     const TriangleBvh empty;
     EXPECT_FALSE(empty.occluded({0, 0, 0}, {0, 0, 1}, 0, 1));
