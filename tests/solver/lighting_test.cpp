@@ -230,6 +230,19 @@ TEST(Lighting, InvalidLightsThrow) {
     EXPECT_THROW(incident_light(mesh, connectivity, {}, lighting), InvalidArgumentError);
 }
 
+// `count` triangles around random centres in the unit cube, corners `size` x a normal deviate away.
+void add_random_triangles(std::mt19937& rng, int count, float size, std::vector<Eigen::Vector3f>& points,
+                          std::vector<std::array<int32_t, 3>>& triangles) {
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    for (int t = 0; t < count; ++t) {
+        const Eigen::Vector3f c(unit(rng), unit(rng), unit(rng));
+        for (int k = 0; k < 3; ++k) points.push_back(c + size * Eigen::Vector3f(gauss(rng), gauss(rng), gauss(rng)));
+        const auto base = static_cast<int32_t>(points.size() - 3);
+        triangles.push_back({base, base + 1, base + 2});
+    }
+}
+
 TEST(RayCaster, BvhAnyHitAgreesWithBruteForce) {
     std::mt19937 rng(12345);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
@@ -238,13 +251,8 @@ TEST(RayCaster, BvhAnyHitAgreesWithBruteForce) {
     // boxes spanning everything occur.
     std::vector<Eigen::Vector3f> points;
     std::vector<std::array<int32_t, 3>> triangles;
-    for (int t = 0; t < 3000; ++t) {
-        const Eigen::Vector3f c(unit(rng), unit(rng), unit(rng));
-        const float size = t < 20 ? 0.5f : 0.04f;
-        for (int k = 0; k < 3; ++k) points.push_back(c + size * Eigen::Vector3f(gauss(rng), gauss(rng), gauss(rng)));
-        const auto base = static_cast<int32_t>(points.size() - 3);
-        triangles.push_back({base, base + 1, base + 2});
-    }
+    add_random_triangles(rng, 20, 0.5f, points, triangles);
+    add_random_triangles(rng, 2980, 0.04f, points, triangles);
     const TriangleBvh bvh(points, triangles);
     EXPECT_EQ(bvh.triangle_count(), triangles.size());
     EXPECT_GT(bvh.node_count(), 1u);
@@ -278,12 +286,7 @@ TEST(RayCaster, RefittedBvhAnswersAsAFreshTreeOnMovedPoints) {
     std::normal_distribution<float> gauss(0.0f, 1.0f);
     std::vector<Eigen::Vector3f> points;
     std::vector<std::array<int32_t, 3>> triangles;
-    for (int t = 0; t < 2000; ++t) {
-        const Eigen::Vector3f c(unit(rng), unit(rng), unit(rng));
-        for (int k = 0; k < 3; ++k) points.push_back(c + 0.05f * Eigen::Vector3f(gauss(rng), gauss(rng), gauss(rng)));
-        const auto base = static_cast<int32_t>(points.size() - 3);
-        triangles.push_back({base, base + 1, base + 2});
-    }
+    add_random_triangles(rng, 2000, 0.05f, points, triangles);
     TriangleBvh refitted(points, triangles);
     std::vector<Eigen::Vector3f> moved = points;
     for (Eigen::Vector3f& p : moved) {
