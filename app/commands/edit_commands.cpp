@@ -278,6 +278,14 @@ void add_cut_command(CLI::App& app) {
     cmd->callback([options] { run_cut_command(*options); });
 }
 
+// --NAME sets `target`, --no-NAME clears it (the last given wins), each with its own help line: CLI11's
+// "--x,!--no-x" prints one line ending in "{false}", which reads as if the flag were off by default.
+void add_on_off_flags(CLI::App* cmd, const std::string& name, bool& target, const std::string& on_help,
+                      const std::string& off_help) {
+    cmd->add_flag_callback("--" + name, [&target] { target = true; }, on_help);
+    cmd->add_flag_callback("--no-" + name, [&target] { target = false; }, off_help);
+}
+
 void add_fracture_command(CLI::App& app) {
     auto options = std::make_shared<FractureCommandOptions>();
     CLI::App* cmd = app.add_subcommand("fracture", "Break a volume into pieces along Voronoi cells");
@@ -285,13 +293,13 @@ void add_fracture_command(CLI::App& app) {
     cmd->add_option("-o,--output", options->output, "Volume file to write (.vtu keeps the pieces)")->required();
     cmd->add_option("--pieces", options->pieces, "Number of Voronoi seeds (pieces)")->required();
     cmd->add_option("--seed", options->seed, "Random seed for the seed points")->capture_default_str();
-    cmd->add_flag("--exact,!--no-exact", options->exact,
-                  "Split tets along the cell walls (flat cracks; default) or keep whole tets (cracks on tet faces)");
+    add_on_off_flags(cmd, "exact", options->exact, "Split tets along the cell walls: flat cracks (default)",
+                     "Keep whole tets: cracks run along tet faces");
     cmd->add_option("--min-piece-tets", options->min_piece_tets, "Smaller pieces join their largest neighbour")
         ->capture_default_str();
-    cmd->add_flag("--collapse,!--no-collapse", options->collapse,
-                  "Exact mode: collapse the vertices that walls of earlier cells left inside later ones (default), "
-                  "or keep every split (to compare)");
+    add_on_off_flags(cmd, "collapse", options->collapse,
+                     "Exact mode: collapse the vertices that walls of earlier cells left inside later ones (default)",
+                     "Exact mode: keep every split (to compare)");
     cmd->footer("Seeds are scattered uniformly in the volume; each cell's part of each piece becomes a piece (a cell\n"
                 "cut in two by a concave volume gives two), with the crack vertices duplicated so pieces move apart.");
     cmd->callback([options] { run_fracture_command(*options); });

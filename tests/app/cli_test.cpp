@@ -22,10 +22,13 @@ namespace fs = std::filesystem;
 const std::string kShared = WAXWORK_SHARED_DIR;
 
 TEST(Cli, HelpOnEveryCommand) {
-    for (const std::string command : {"", "mesh", "info"}) {
+    for (const std::string command : {"", "mesh", "info", "render", "cut", "fracture", "paint", "deform", "export",
+                                      "run", "edit", "bench", "demo"}) {
         const auto r = run_waxwork(command + " --help");
         EXPECT_EQ(r.exit_code, 0) << command;
         EXPECT_NE(r.out.find("Usage"), std::string::npos) << command;
+        // CLI11's rendering of a negated flag ("--x,--no-x{false}") reads as if the flag were off.
+        EXPECT_EQ(r.out.find("{false}"), std::string::npos) << command << ":\n" << r.out;
     }
 }
 
