@@ -113,7 +113,9 @@ bool SceneCore::export_surface(const std::filesystem::path& path, ShellGrouping 
 }
 
 void SceneCore::save_session(const std::filesystem::path& path, const Session& head) const {
-    write_session(path, record_session(head, document_));
+    // It replays to something: the image as the view shows it and the volume, named after the file.
+    const std::string stem = path.stem().string();
+    write_session(path, record_session(head, document_, {RenderStep{stem + ".png", std::nullopt}, SaveStep{stem + ".vtu"}}));
 }
 
 SceneTickResult SceneCore::tick(const SceneTickRequest& request, const std::function<void(const std::string&)>& stage) {

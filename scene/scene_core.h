@@ -127,7 +127,8 @@ public:
     // `waxwork export --radiance` bakes it). Returns whether colours were written.
     bool export_surface(const std::filesystem::path& path, ShellGrouping grouping);
     // The session that replays this document: `head` (usually setup() with what the front end changed
-    // since: its view, lights, frame budget) and the document's history as steps.
+    // since: its view, lights, frame budget), the document's history as steps, then a converged render
+    // and a save named after the file (NAME.json renders NAME.png and saves NAME.vtu).
     void save_session(const std::filesystem::path& path, const Session& head) const;
 
 private:

@@ -525,6 +525,12 @@ void write_session(const fs::path& path, const Session& session) {
     write_file_atomically(path, [&](std::ostream& out) { out << text; });
 }
 
+bool writes_outputs(const Session& session) {
+    return std::any_of(session.steps.begin(), session.steps.end(), [](const SessionStep& step) {
+        return std::holds_alternative<RenderStep>(step) || std::holds_alternative<SaveStep>(step);
+    });
+}
+
 Session record_session(const Session& setup, const Document& document, const std::vector<SessionStep>& extra_steps) {
     Session session = setup;
     session.steps.clear();

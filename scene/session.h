@@ -140,6 +140,9 @@ nlohmann::ordered_json lighting_to_json(const Lighting& lighting);
 // Writes atomically. Input paths are written relative to the file's directory when possible.
 void write_session(const std::filesystem::path& path, const Session& session);
 
+// Whether the session writes anything besides metrics.json (a render or a save step).
+bool writes_outputs(const Session& session);
+
 // The recording of an editing session: `setup`'s input, material, lights and camera, and as steps the
 // document's history (the operations that made its current mesh), followed by `extra_steps`
 // (e.g. a final render or save). Replaying it gives the document's mesh bit for bit.

@@ -21,6 +21,9 @@ struct RunCommandOptions {
 
 void run_run_command(const RunCommandOptions& o) {
     const Session session = read_session(o.session);
+    if (!writes_outputs(session))
+        std::cerr << "waxwork: " << o.session << ": warning: no render or save step, so only metrics.json is written "
+                  << "(add {\"render\": \"a.png\"} or {\"save\": \"a.vtu\"})\n";
     SessionRunOptions run;
     run.backend = parse_live_backend(o.solver.backend);
     run.method = parse_live_method(o.solver.method);

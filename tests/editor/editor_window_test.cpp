@@ -204,20 +204,21 @@ double units_per_pixel_at_front_face() {
     return 2 * (distance - 1) * std::tan(half_fov) / 300;
 }
 
-// DIR/session.json, saved by a script, records one edit, `op`; `waxwork run` replays it to `edited`.
-// Returns the session.
+// DIR/session.json, saved by a script, records one edit, `op`, then a render and a save named after
+// it; `waxwork run` replays it to `edited` and the image. Returns the session.
 nlohmann::json expect_session_replays_one_step(const fs::path& dir, const std::string& op, const TetMesh& edited) {
     nlohmann::json session = nlohmann::json::parse(testing::read_text(dir / "session.json"));
-    EXPECT_EQ(session["steps"].size(), 1u);
-    if (session["steps"].size() != 1) return session;
+    EXPECT_EQ(session["steps"].size(), 3u);
+    if (session["steps"].size() != 3) return session;
     EXPECT_EQ(session["steps"][0]["op"], op);
-    nlohmann::json replay = session;
-    replay["steps"].push_back({{"save", "replay.vtu"}});
-    std::ofstream(dir / "replay.json") << replay.dump(2);
-    const auto run = run_waxwork("run " + (dir / "replay.json").string() + " -o " + (dir / "run").string());
+    EXPECT_EQ(session["steps"][1]["render"], "session.png");
+    EXPECT_EQ(session["steps"][2]["save"], "session.vtu");
+    const auto run = run_waxwork("run " + (dir / "session.json").string() + " -o " + (dir / "run").string());
     EXPECT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_EQ(run.err.find("warning"), std::string::npos) << run.err;
     if (run.exit_code == 0) {
-        EXPECT_TRUE(read_volume(dir / "run" / "replay.vtu") == edited);
+        EXPECT_TRUE(read_volume(dir / "run" / "session.vtu") == edited);
+        EXPECT_TRUE(fs::exists(dir / "run" / "session.png"));
     }
     return session;
 }

@@ -118,6 +118,19 @@ TEST(SessionBackend, RunReportsTheInputAsLoaded) {
     EXPECT_NE(run.out.substr(0, run.out.find('\n')).find("(1296 tets)"), std::string::npos) << run.out;
     EXPECT_EQ(read_metrics(dir / "out" / "metrics.json").at("input_tets"), 1296);
     EXPECT_LT(read_volume(dir / "out" / "cut.vtu").tet_count(), 1296u);
+    EXPECT_EQ(run.err.find("warning"), std::string::npos) << run.err;
+}
+
+// A session that renders and saves nothing still runs, and says that only metrics.json comes of it.
+TEST(SessionBackend, RunWarnsWhenTheSessionWritesNothing) {
+    const fs::path dir = testing::scratch_dir("no_outputs");
+    write_volume(testing::make_cube_mesh(4), dir / "cube.vtu");
+    std::ofstream(dir / "s.json") << R"({"input": {"volume": "cube.vtu"},
+        "steps": [{"op": "plane_cut", "normal": [1, 0, 0], "offset": 0.5}]})";
+    const auto run = run_waxwork("run " + (dir / "s.json").string() + " -o " + (dir / "out").string());
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_NE(run.err.find("s.json: warning: no render or save step"), std::string::npos) << run.err;
+    EXPECT_TRUE(fs::exists(dir / "out" / "metrics.json"));
 }
 
 }  // namespace
