@@ -58,12 +58,13 @@ Image tone_mapped_image(const RadianceImage& image, float exposure, std::array<u
     return out;
 }
 
-ImageDifference compare_radiance_images(const RadianceImage& image, const RadianceImage& reference, float exposure) {
+ImageDifference compare_radiance_images(const RadianceImage& image, float image_exposure,
+                                        const RadianceImage& reference, float reference_exposure) {
     check_sizes(image);
     check_sizes(reference);
     if (image.width != reference.width || image.height != reference.height)
         throw InvalidArgumentError("radiance image: the images to compare differ in size");
-    double difference2 = 0, reference2 = 0, squared_error = 0;
+    double difference2 = 0, reference2 = 0, image2 = 0, cross = 0, squared_error = 0;
     ImageDifference result;
     for (size_t p = 0; p < image.radiance.size(); ++p) {
         if (image.coverage[p] < 1 || reference.coverage[p] < 1) continue;
@@ -72,11 +73,19 @@ ImageDifference compare_radiance_images(const RadianceImage& image, const Radian
             const double a = image.radiance[p][c], b = reference.radiance[p][c];
             difference2 += (a - b) * (a - b);
             reference2 += b * b;
-            const double e = displayed(a, exposure) - displayed(b, exposure);
+            image2 += a * a;
+            cross += a * b;
+            const double e = displayed(a, image_exposure) - displayed(b, reference_exposure);
             squared_error += e * e;
         }
     }
-    result.relative_l2 = reference2 > 0 ? std::sqrt(difference2 / reference2) : 0.0;
+    if (reference2 > 0) {
+        result.relative_l2 = std::sqrt(difference2 / reference2);
+        result.scale = image2 > 0 ? cross / image2 : 0.0;
+        // |s I - R|^2 at the least-squares s = <I, R> / |I|^2 is |R|^2 - <I, R>^2 / |I|^2.
+        const double residual = image2 > 0 ? std::max(0.0, reference2 - cross * cross / image2) : reference2;
+        result.scaled_relative_l2 = std::sqrt(residual / reference2);
+    }
     const double mse = result.pixels > 0 ? squared_error / (3.0 * result.pixels) : 0.0;
     result.psnr_db = mse > 0 ? 10 * std::log10(1.0 / mse) : std::numeric_limits<double>::infinity();
     return result;

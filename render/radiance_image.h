@@ -20,14 +20,22 @@ float radiance_image_exposure(const RadianceImage& image);
 // whose arrays do not match its size.
 Image tone_mapped_image(const RadianceImage& image, float exposure, std::array<uint8_t, 3> background = {38, 40, 46});
 
-// How far `image` is from `reference` over the pixels both cover fully: the relative L2 error
-// sqrt(sum |I - R|^2 / sum |R|^2) over the three channels in linear radiance, and the PSNR (dB) of
-// the two tone-mapped with the reference's exposure, over the same pixels (peak 1 in [0, 1] sRGB).
+// How far `image` is from `reference` over the pixels both cover fully, over the three channels:
+//   relative_l2        sqrt(sum |I - R|^2 / sum |R|^2) in linear radiance;
+//   scaled_relative_l2 the same after scaling I by the one factor that fits R best (least squares):
+//                      the error of the light's distribution, whatever the overall brightness (which
+//                      the automatic exposure hides from the viewer);
+//   scale              R over I in that fit;
+//   psnr_db            the PSNR of the two as they are shown, each tone-mapped with its own exposure
+//                      (peak 1 in [0, 1] sRGB).
 struct ImageDifference {
     double relative_l2 = 0;
+    double scaled_relative_l2 = 0;
+    double scale = 1;
     double psnr_db = 0;
     int64_t pixels = 0;
 };
-ImageDifference compare_radiance_images(const RadianceImage& image, const RadianceImage& reference, float exposure);
+ImageDifference compare_radiance_images(const RadianceImage& image, float image_exposure,
+                                        const RadianceImage& reference, float reference_exposure);
 
 }  // namespace waxwork
