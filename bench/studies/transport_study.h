@@ -50,6 +50,10 @@ struct TransportCase {
 // each material, under a white directional light from the upper front left without ambient light.
 std::vector<TransportCase> run_transport_study(const TransportStudyOptions& options);
 
+// The part of the error after the best brightness factor that the Monte Carlo noise does not explain:
+// sqrt(max(0, scaled_relative_l2^2 - mc_noise^2)) (independent errors add in quadrature).
+double model_error(const TransportCase& result);
+
 nlohmann::ordered_json to_json(const TransportCase& result);
 // A pipe table, one row per case, with the statistic's definitions in its heading.
 std::string transport_table_markdown(const std::vector<TransportCase>& cases);

@@ -32,6 +32,7 @@ TEST(TransportStudy, EveryCaseReportsAnImageComparison) {
         EXPECT_GT(c.difference.pixels, 0) << c.shape;
         EXPECT_TRUE(std::isfinite(c.difference.relative_l2)) << c.shape;
         EXPECT_GE(c.difference.relative_l2, c.difference.scaled_relative_l2) << c.shape;
+        EXPECT_LE(model_error(c), c.difference.scaled_relative_l2) << c.shape;
         EXPECT_GT(c.difference.scale, 0) << c.shape;
         EXPECT_GT(c.mc_paths, 0) << c.shape;
         EXPECT_FALSE(c.convergence.empty()) << c.shape;
