@@ -11,6 +11,8 @@
 #include "solver/reference/monte_carlo_image.h"
 #include "tetops/box_mesh.h"
 
+#include "monte_carlo_volume.h"
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -22,25 +24,8 @@
 namespace waxwork {
 namespace {
 
-TetMaterial uniform_material(double mua, double musp, double eta) {
-    return TetMaterial{{mua, mua, mua}, {musp, musp, musp}, eta};
-}
-
-struct Volume {
-    TetMesh mesh;
-    TetConnectivity connectivity;
-    std::vector<TetMaterial> materials;
-    BoundarySurface surface;
-    TriangleBvh bvh;
-    FirstHitGrid grid;
-    Volume(TetMesh m, const TetMaterial& material) : mesh(std::move(m)) {
-        connectivity = build_connectivity(mesh);
-        materials.assign(mesh.tet_count(), material);
-        surface = extract_boundary_surface(mesh, connectivity, materials);
-        bvh = build_shadow_bvh(surface);
-        grid = surface_hit_grid(surface);
-    }
-};
+using test::uniform_material;
+using Volume = test::MonteCarloVolume;
 
 // A camera at `distance` from `target` along unit `from`, with a narrow field of view (half-width
 // tan = `spread`), so every pixel looks at target along very nearly -from.
@@ -105,6 +90,24 @@ private:
     std::vector<double> h_;
 };
 
+// A semi-infinite medium of mu_t = 1 / mm: a box of 2000 x 2000 x 1000 mean free paths whose top is
+// z = 0, and collimated light straight down transmitting q = 1 through the top.
+Volume semi_infinite(double albedo, double eta) {
+    const double half = 1000, depth = 1000;
+    return Volume(make_box_mesh({4, 4, 1}, Eigen::Vector3d(-half, -half, -depth), Eigen::Vector3d(half, half, 0)),
+                  uniform_material(1 - albedo, albedo, eta));
+}
+
+PhotonSource normal_light_on_top(const Volume& volume) {
+    PhotonSource source;
+    source.entry = PhotonEntry::Collimated;
+    source.vector = Eigen::Vector3d(0, 0, -1);
+    source.q.assign(volume.surface.positions.size(), {0, 0, 0});
+    for (size_t s = 0; s < volume.surface.positions.size(); ++s)
+        if (volume.surface.positions[s].z() == 0) source.q[s] = {1, 1, 1};
+    return source;
+}
+
 TEST(MonteCarloImage, HFunctionMatchesTheTabulatedValues) {
     EXPECT_NEAR(HFunction(0.5).evaluate(1.0), 1.25126, 1e-4);
     EXPECT_NEAR(HFunction(0.9).evaluate(1.0), 1.85010, 1e-4);
@@ -114,23 +117,15 @@ TEST(MonteCarloImage, HFunctionMatchesTheTabulatedValues) {
 // normally incident collimated light of irradiance E, seen at mu = cos(theta) from the normal:
 //     L(mu) = a E H(mu) H(1) / (4 pi (mu + 1))
 // (Chandrasekhar 1960, Eq. IV.44 with mu_0 = 1 and the incident flux pi F = E): every order of
-// scattering, the single scattering a E / (4 pi (mu + 1)) included. The medium is a box of
-// 2000 x 2000 x 1000 mean free paths lit on its top (q = 1: eta 1 transmits all), seen at its centre
-// through a narrow camera.
+// scattering, the single scattering a E / (4 pi (mu + 1)) included. The medium is
+// semi_infinite lit on its top (q = 1: eta 1 transmits all), seen at its centre through a narrow camera.
 TEST(MonteCarloImage, SemiInfiniteRadianceMatchesChandrasekhar) {
-    const double half = 1000, depth = 1000;
     struct Case {
         double albedo, mu;
     };
     for (const Case& k : {Case{0.5, 1.0}, Case{0.9, 1.0}, Case{0.9, 0.5}}) {
-        Volume volume(make_box_mesh({4, 4, 1}, Eigen::Vector3d(-half, -half, -depth), Eigen::Vector3d(half, half, 0)),
-                      uniform_material(1 - k.albedo, k.albedo, 1.0));
-        PhotonSource source;
-        source.entry = PhotonEntry::Collimated;
-        source.vector = Eigen::Vector3d(0, 0, -1);
-        source.q.assign(volume.surface.positions.size(), {0, 0, 0});
-        for (size_t s = 0; s < volume.surface.positions.size(); ++s)
-            if (volume.surface.positions[s].z() == 0) source.q[s] = {1, 1, 1};
+        const Volume volume = semi_infinite(k.albedo, 1.0);
+        const PhotonSource source = normal_light_on_top(volume);
         const Eigen::Vector3d from(std::sqrt(1 - k.mu * k.mu), 0, k.mu);
         const PixelCamera camera = narrow_camera(Eigen::Vector3d::Zero(), from, 10, 0.01, 4);
         const MonteCarloImage mc = trace_camera_image(volume.mesh, volume.connectivity, volume.materials,
@@ -163,15 +158,9 @@ TEST(MonteCarloImage, SemiInfiniteRadianceMatchesChandrasekhar) {
 // Gauss-Legendre in mu), is the power per area the photon tracer sees leave (its diffuse reflectance
 // times q = 1). This checks the refraction, the Fresnel factors and the eta^2 of both ends.
 TEST(MonteCarloImage, IntegratedRadianceIsThePhotonTracersExitance) {
-    const double half = 1000, depth = 1000, albedo = 0.9, eta = 1.4;
-    Volume volume(make_box_mesh({4, 4, 1}, Eigen::Vector3d(-half, -half, -depth), Eigen::Vector3d(half, half, 0)),
-                  uniform_material(1 - albedo, albedo, eta));
-    PhotonSource source;
-    source.entry = PhotonEntry::Collimated;
-    source.vector = Eigen::Vector3d(0, 0, -1);
-    source.q.assign(volume.surface.positions.size(), {0, 0, 0});
-    for (size_t s = 0; s < volume.surface.positions.size(); ++s)
-        if (volume.surface.positions[s].z() == 0) source.q[s] = {1, 1, 1};
+    const double albedo = 0.9, eta = 1.4;
+    const Volume volume = semi_infinite(albedo, eta);
+    const PhotonSource source = normal_light_on_top(volume);
     MonteCarloOptions photons;
     photons.max_photons = 16000;
     photons.batch_photons = 1000;
