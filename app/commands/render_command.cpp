@@ -5,6 +5,8 @@
 #include "base/error.h"
 #include "io/file_extension.h"
 #include "io/volume_file.h"
+#include "render/camera.h"
+#include "render/radiance_image.h"
 #include "render/render_input.h"
 #include "render/view_modes.h"
 #include "render/volume_render.h"
@@ -12,7 +14,9 @@
 #include "solver/lighting.h"
 #include "solver/material.h"
 #include "solver/radiance.h"
+#include "solver/reference/camera_rays.h"
 #include "solver/reference/monte_carlo.h"
+#include "solver/reference/monte_carlo_image.h"
 #include "solver/solved_scene.h"
 
 #include <CLI/CLI.hpp>
@@ -45,12 +49,16 @@ struct RenderCommandOptions {
     std::optional<double> mc_seconds;
     std::optional<double> mc_error;
     std::optional<double> mc_g;
+    std::optional<int64_t> mc_photons;
     std::optional<uint64_t> seed;
 };
 
-// Defaults of the trace: a minute at most, 1% relative standard error at the boundary.
+// Defaults of the trace: a minute at most, 1% relative standard error (of phi at the boundary, of the
+// image's radiance over the object).
 constexpr double kDefaultMcSeconds = 60;
 constexpr double kDefaultMcError = 0.01;
+// The share of the time budget the fluence trace (the --fields columns) gets; the image the rest.
+constexpr double kFluenceTimeShare = 0.25;
 
 // The view --show asks for, checked before any work.
 ViewOptions view_options(const RenderCommandOptions& o) {
@@ -78,8 +86,8 @@ void check_options(const RenderCommandOptions& o) {
         if (!v.allFinite() || v.norm() == 0) fail("--view must be a finite, non-zero direction");
     }
     if (o.light.method != "mc") {
-        if (o.mc_seconds || o.mc_error || o.mc_g || o.seed)
-            fail("--mc-seconds, --mc-error, --mc-g and --seed apply only with --method mc");
+        if (o.mc_seconds || o.mc_error || o.mc_g || o.mc_photons || o.seed)
+            fail("--mc-seconds, --mc-error, --mc-g, --mc-photons and --seed apply only with --method mc");
         return;
     }
     if (o.mc_seconds && !(*o.mc_seconds > 0 && std::isfinite(*o.mc_seconds)))
@@ -87,6 +95,7 @@ void check_options(const RenderCommandOptions& o) {
     if (o.mc_error && !(*o.mc_error > 0 && *o.mc_error < 1))
         fail("--mc-error must be a relative standard error in (0, 1)");
     if (o.mc_g && !(*o.mc_g > -1 && *o.mc_g < 1)) fail("--mc-g must be a Henyey-Greenstein anisotropy in (-1, 1)");
+    if (o.mc_photons && !(*o.mc_photons > 0)) fail("--mc-photons must be a positive number of paths");
 }
 
 // The trace's options from the command's.
@@ -97,14 +106,15 @@ MonteCarloOptions monte_carlo_options(const RenderCommandOptions& o, double mm_p
     mc.seed = o.seed.value_or(1);
     mc.max_seconds = o.mc_seconds.value_or(kDefaultMcSeconds);
     mc.target_relative_error = o.mc_error.value_or(kDefaultMcError);
+    mc.max_photons = o.mc_photons.value_or(0);
     return mc;
 }
 
 // The status line of a running trace.
-std::string trace_status(const MonteCarloProgress& p) {
+std::string trace_status(const MonteCarloProgress& p, const char* what) {
     char line[160];
-    std::snprintf(line, sizeof line, "monte carlo: %lld photons per channel, relative error %.2f%% %.2f%% %.2f%%, %.0f s",
-                  static_cast<long long>(p.photons), 100 * p.relative_error[0], 100 * p.relative_error[1],
+    std::snprintf(line, sizeof line, "monte carlo: %lld %s per channel, relative error %.2f%% %.2f%% %.2f%%, %.0f s",
+                  static_cast<long long>(p.photons), what, 100 * p.relative_error[0], 100 * p.relative_error[1],
                   100 * p.relative_error[2], p.seconds);
     return line;
 }
@@ -114,14 +124,14 @@ std::string trace_status(const MonteCarloProgress& p) {
 // stderr keeps its one-line error (StderrProgress shows a stage only once it has run for a second).
 class TraceStatusLine {
 public:
-    explicit TraceStatusLine(std::string prefix) : prefix_(std::move(prefix)) {}
+    TraceStatusLine(std::string prefix, const char* what) : prefix_(std::move(prefix)), what_(what) {}
     ~TraceStatusLine() {
         if (shown_ > 0) std::cerr << '\r' << std::string(shown_, ' ') << '\r' << std::flush;
     }
     void show(const MonteCarloProgress& p) {
         if (p.seconds < next_) return;
         next_ = p.seconds + 1;
-        std::string line = prefix_ + trace_status(p);
+        std::string line = prefix_ + trace_status(p, what_);
         const size_t length = line.size();
         if (length < shown_) line += std::string(shown_ - length, ' ');
         std::cerr << '\r' << line << std::flush;
@@ -130,6 +140,7 @@ public:
 
 private:
     std::string prefix_;
+    const char* what_;
     double next_ = 1;  // seconds into the trace
     size_t shown_ = 0;
 };
@@ -137,23 +148,62 @@ private:
 struct TracedRender {
     VolumeRender render;
     MonteCarloFluence fluence;
+    MonteCarloImage image;
     std::array<double, 3> over_diffusion{};  // sum of phi over boundary vertices, MC over diffusion
+    // Sums of radiance over the pixels both cover: the camera-ray image over the image drawn from the
+    // traced phi through Eq. 3, and over the diffusion's own (live) image.
+    std::array<double, 3> image_over_eq3{}, image_over_diffusion{};
 };
 
-// Solves the diffusion for the surface and its light (and as a comparison), traces the fluence, and
-// draws the image from the traced phi through the same radiance (Eq. 3) the diffusion image uses: an
-// interim picture until camera rays trace the exitant light themselves.
+// The pixel rays of the image `settings` frame, as the renderer frames the surface.
+PixelCamera render_pixel_camera(const BoundarySurface& surface, const ImageSettings& image) {
+    Eigen::AlignedBox3d box;
+    for (const Eigen::Vector3d& p : surface.positions) box.extend(p);
+    const CameraFrame frame = frame_camera(box, image.camera, static_cast<double>(image.width) / image.height);
+    return pixel_camera(frame.eye, frame.view, frame.projection, image.width, image.height);
+}
+
+// Sums of a's over b's radiance per channel, over the pixels both cover fully.
+std::array<double, 3> radiance_ratio(const RadianceImage& a, const RadianceImage& b) {
+    std::array<double, 3> sum_a{}, sum_b{}, ratio{};
+    for (size_t p = 0; p < a.radiance.size(); ++p) {
+        if (a.coverage[p] < 1 || b.coverage[p] < 1) continue;
+        for (int c = 0; c < 3; ++c) {
+            sum_a[c] += a.radiance[p][c];
+            sum_b[c] += b.radiance[p][c];
+        }
+    }
+    for (int c = 0; c < 3; ++c) ratio[c] = sum_b[c] > 0 ? sum_a[c] / sum_b[c] : 0.0;
+    return ratio;
+}
+
+// Solves the diffusion for the surface and its light (and as a comparison), traces the fluence (the
+// --fields columns) and then the image with camera rays (monte_carlo_image.h), which is what is drawn
+// (for the radiance view; the other views draw the traced phi).
 TracedRender render_traced(const TetMesh& mesh, const RenderCommandOptions& o, const VolumeRenderSettings& settings) {
     VolumeLight light = solve_volume_light(mesh, o.volume, settings);
     SolvedScene& scene = light.scene;
-    const TriangleBvh bvh = settings.lighting.shadows ? build_shadow_bvh(scene.surface) : TriangleBvh();
+    const TriangleBvh bvh = build_shadow_bvh(scene.surface);
     const std::vector<PhotonSource> sources = photon_sources(scene.surface, bvh, settings.lighting);
+    const PixelCamera camera = render_pixel_camera(scene.surface, settings.image);
+    const FirstHitGrid grid = surface_hit_grid(scene.surface);
+    const RadianceImage diffusion_image =
+        surface_radiance_image(scene.surface, scene.shading, scene.radiance_factor, grid, camera);
+    const MonteCarloOptions options = monte_carlo_options(o, settings.diffusion.mm_per_unit);
     TracedRender traced;
     {
-        TraceStatusLine status("waxwork: " + o.volume + ": ");
-        traced.fluence = trace_fluence(mesh, light.connectivity, light.materials, scene.surface, sources,
-                                       monte_carlo_options(o, settings.diffusion.mm_per_unit),
+        MonteCarloOptions fluence_options = options;
+        fluence_options.max_seconds = kFluenceTimeShare * options.max_seconds;
+        TraceStatusLine status("waxwork: " + o.volume + ": ", "photons");
+        traced.fluence = trace_fluence(mesh, light.connectivity, light.materials, scene.surface, sources, fluence_options,
                                        [&](const MonteCarloProgress& p) { status.show(p); });
+    }
+    {
+        MonteCarloOptions image_options = options;
+        image_options.max_seconds = std::max(1e-3, options.max_seconds - traced.fluence.seconds);
+        TraceStatusLine status("waxwork: " + o.volume + ": image: ", "paths");
+        traced.image = trace_camera_image(mesh, light.connectivity, light.materials, scene.surface, grid, sources, camera,
+                                          image_options, [&](const MonteCarloProgress& p) { status.show(p); });
     }
     std::array<double, 3> mc_sum{}, diffusion_sum{};
     for (int32_t v : light.connectivity.boundary_vertices)
@@ -164,7 +214,15 @@ TracedRender render_traced(const TetMesh& mesh, const RenderCommandOptions& o, c
     for (int c = 0; c < 3; ++c) traced.over_diffusion[c] = diffusion_sum[c] > 0 ? mc_sum[c] / diffusion_sum[c] : 0.0;
     scene.diffusion.phi = traced.fluence.phi;
     scene.radiance_factor = shading_radiance_factors(scene.surface, scene.shading, scene.diffusion.phi, scene.shading_light.q);
+    const RadianceImage eq3_image = surface_radiance_image(scene.surface, scene.shading, scene.radiance_factor, grid, camera);
+    traced.image_over_eq3 = radiance_ratio(traced.image.image, eq3_image);
+    traced.image_over_diffusion = radiance_ratio(traced.image.image, diffusion_image);
     traced.render = render_volume_light(mesh, std::move(light), settings);
+    if (settings.view.mode == ViewMode::Radiance) {
+        const float exposure = settings.image.exposure ? *settings.image.exposure : radiance_image_exposure(traced.image.image);
+        traced.render.image = tone_mapped_image(traced.image.image, exposure);
+        traced.render.exposure = exposure;
+    }
     return traced;
 }
 
@@ -242,6 +300,17 @@ void run_render_command(const RenderCommandOptions& o) {
             {"lost_photons", mc.lost_photons},
             {"over_diffusion", trace->over_diffusion},
         };
+        const MonteCarloImage& image = trace->image;
+        summary["monte_carlo_image"] = {
+            {"samples_per_pixel", image.passes},
+            {"paths_per_channel", image.paths},
+            {"seconds", image.seconds},
+            {"relative_error", image.relative_error},
+            {"stopped_by", image.stop_reason},
+            {"lost_paths", image.lost_paths},
+            {"over_eq3", trace->image_over_eq3},
+            {"over_diffusion", trace->image_over_diffusion},
+        };
     }
     if (view.mode != ViewMode::Radiance) summary["legend"] = render.view.legend.title;
     if (!o.fields.empty()) summary["fields"] = o.fields;
@@ -263,6 +332,8 @@ void add_render_command(CLI::App& app) {
                     "every channel (default 0.01)");
     cmd->add_option("--mc-g", options->mc_g,
                     "--method mc: Henyey-Greenstein anisotropy g, mu_s = mu_s' / (1 - g) (default 0, isotropic)");
+    cmd->add_option("--mc-photons", options->mc_photons,
+                    "--method mc: stop each trace after this many photons (camera paths for the image) per channel");
     cmd->add_option("--seed", options->seed, "--method mc: random seed; the same seed gives the same result (default 1)");
     cmd->add_option("--width", options->width, "Image width in pixels")->capture_default_str();
     cmd->add_option("--height", options->height, "Image height in pixels")->capture_default_str();
@@ -290,9 +361,10 @@ void add_render_command(CLI::App& app) {
         "subsurface radiance at camera-facing boundary vertices maps to 0.6 before ACES tone mapping;\n"
         "--exposure sets the multiplier instead. The summary (one JSON line) reports it.\n"
         "--method mc traces photons through the volume (per-tet coefficients, Fresnel at the boundary, the same\n"
-        "lights and shadows) until --mc-seconds or --mc-error, with a status line on stderr; --fields gains\n"
-        "phi_err_r,phi_err_g,phi_err_b (standard errors). The image is, for now, drawn from the traced phi with\n"
-        "the diffusion image's radiance; the summary's monte_carlo.over_diffusion compares the two fluences.");
+        "lights and shadows) for the fluence (--fields gains phi_err_r,phi_err_g,phi_err_b, standard errors), then\n"
+        "camera rays for the image (exitant radiance with single scattering, no highlight), until --mc-seconds\n"
+        "(a quarter for the fluence), --mc-error or --mc-photons, with a status line on stderr. The summary's\n"
+        "monte_carlo.over_diffusion compares the fluences, monte_carlo_image.over_diffusion the images.");
     cmd->callback([options] { run_render_command(*options); });
 }
 

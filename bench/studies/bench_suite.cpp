@@ -5,6 +5,7 @@
 #include "bench/studies/coarse_start_bound.h"
 #include "bench/studies/cut_study.h"
 #include "bench/studies/environment_study.h"
+#include "bench/studies/transport_study.h"
 #include "bench/studies/provenance.h"
 #include "bench/studies/resolution_study.h"
 #include "bench/studies/solver_comparison.h"
@@ -426,6 +427,82 @@ void run_environment_part(const BenchSuiteOptions& o, Json& index, RunProvenance
     index["environment"] = "environment.json";
 }
 
+// TransCut's live image against the Monte Carlo image: where the diffusion approximation can be trusted.
+void run_transport_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
+    TransportStudyOptions study;
+    if (o.quick) {
+        study.plate_thicknesses = {1, 4, 16};
+        study.mc_seconds = 1;
+    }
+    if (o.progress) study.progress = [&](const std::string& line) { o.progress("  " + line); };
+    const std::vector<TransportCase> cases = run_transport_study(study);
+    Json rows = Json::array();
+    for (const TransportCase& c : cases) rows.push_back(to_json(c));
+    const Json inputs = {{"materials", study.materials},
+                         {"cube_scales_mm_per_unit", study.cube_scales},
+                         {"plate_thicknesses_mfp", study.plate_thicknesses},
+                         {"cut_scale_mm_per_unit", study.cut_scale},
+                         {"image", {study.width, study.height}},
+                         {"cube_cells", study.cube_cells},
+                         {"mc_seconds_per_case", study.mc_seconds},
+                         {"seed", study.seed},
+                         {"light", "directional 1,-1,-1, white, no ambient"}};
+    const Json definitions = {
+        {"relative_l2", "sqrt(sum |live - MC|^2 / sum |MC|^2) over the pixels both cover, linear radiance, all channels"},
+        {"scaled_relative_l2", "relative_l2 after scaling the live image by the least-squares factor mc_over_live"},
+        {"psnr_db", "PSNR of the two images as shown, each tone-mapped at its own automatic exposure"},
+        {"mc_noise", "the Monte Carlo image's relative standard error (from its passes)"},
+        {"size_mfp", "cube side or plate thickness over the transport mean free path 1/(mu_a + mu_s'), green"},
+        {"live_ms", "the diffusion solve: assembly and iterations (CPU, tolerance 1e-3)"}};
+    write_json(o.output_dir / "diffusion_vs_transport.json",
+               with_provenance(provenance, inputs, definitions, {{"cases", rows}}));
+    write_text(o.output_dir / "diffusion_vs_transport.md",
+               "### " + titled(o, "Diffusion (live image) against transport (Monte Carlo image)") + "\n\n" +
+                   transport_table_markdown(cases));
+
+    std::vector<ChartSeries> by_thickness, by_albedo, by_time;
+    for (const std::string& material : study.materials) {
+        for (const std::string& side : {std::string("plate, lit side"), std::string("plate, far side")}) {
+            ChartSeries line{material + ", " + side.substr(7), {}};
+            for (const TransportCase& c : cases)
+                if (c.material == material && c.shape == side) line.points.emplace_back(c.size_mfp, c.difference.scaled_relative_l2);
+            by_thickness.push_back(line);
+        }
+    }
+    for (double scale : study.cube_scales) {
+        char name[64];
+        std::snprintf(name, sizeof name, "cube, %g mm per unit", scale);
+        ChartSeries line{name, {}};
+        for (const TransportCase& c : cases)
+            if (c.shape == "cube" && c.mm_per_unit == scale) line.points.emplace_back(1 - c.albedo, c.difference.scaled_relative_l2);
+        std::sort(line.points.begin(), line.points.end());
+        by_albedo.push_back(line);
+    }
+    for (const TransportCase& c : cases) {
+        if (c.shape != "cube" || c.mm_per_unit != 30) continue;
+        ChartSeries trace{c.material + ": Monte Carlo standard error", c.convergence};
+        trace.markers = false;
+        by_time.push_back(trace);
+        by_time.push_back(ChartSeries{c.material + ": live image against MC", {{c.live_ms / 1000, c.difference.scaled_relative_l2}}});
+    }
+    ChartOptions thickness_chart;
+    thickness_chart.title = titled(o, "Live image against Monte Carlo: plates");
+    thickness_chart.caption = provenance.caption();
+    thickness_chart.x = {"plate thickness (transport mean free paths)", AxisScale::Log};
+    thickness_chart.y = {"relative L2 error after the best brightness factor", AxisScale::Log};
+    write_svg_chart(o.output_dir / "diffusion_vs_transport_thickness.svg", by_thickness, thickness_chart);
+    ChartOptions albedo_chart = thickness_chart;
+    albedo_chart.title = titled(o, "Live image against Monte Carlo: cubes of side 1 unit");
+    albedo_chart.x = {"1 - reduced albedo (green)", AxisScale::Log};
+    write_svg_chart(o.output_dir / "diffusion_vs_transport_albedo.svg", by_albedo, albedo_chart);
+    ChartOptions time_chart = thickness_chart;
+    time_chart.title = titled(o, "Monte Carlo convergence next to the live solve (cubes, 30 mm per unit)");
+    time_chart.x = {"seconds", AxisScale::Log};
+    time_chart.y = {"relative error", AxisScale::Log};
+    write_svg_chart(o.output_dir / "diffusion_vs_transport_time.svg", by_time, time_chart);
+    index["diffusion_vs_transport"] = "diffusion_vs_transport.json";
+}
+
 void run_table1_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
     std::vector<TimingRow> rows;
     TimingOptions options;
@@ -558,6 +635,7 @@ void run_bench_suite(const BenchSuiteOptions& o) {
     parts.emplace_back("table1", [&](Json& i, RunProvenance& p) { run_table1_part(o, i, p); });
     parts.emplace_back("stability", [&](Json& i, RunProvenance& p) { run_stability_part(o, i, p); });
     parts.emplace_back("resolution", [&](Json& i, RunProvenance& p) { run_resolution_part(o, i, p); });
+    parts.emplace_back("diffusion_vs_transport", [&](Json& i, RunProvenance& p) { run_transport_part(o, i, p); });
 
     for (const std::string& wanted : o.only)
         if (std::none_of(parts.begin(), parts.end(), [&](const auto& part) { return part.first == wanted; }))

@@ -1,5 +1,7 @@
 #include "solver/reference/monte_carlo.h"
 
+#include "solver/reference/monte_carlo_medium.h"
+
 #include "base/error.h"
 #include "solver/material.h"
 #include "solver/sampling.h"
@@ -21,119 +23,6 @@ namespace {
 constexpr int kRoundBatches = 8;
 // A photon below roulette_threshold of its initial weight survives with this probability.
 constexpr double kRouletteSurvival = 0.1;
-
-uint64_t splitmix64(uint64_t& state) {
-    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
-// xoshiro256** (Blackman and Vigna 2018), one stream per batch, seeded through splitmix64 from
-// (seed, batch) so that batches are independent of each other and of the schedule.
-class Random {
-public:
-    Random(uint64_t seed, uint64_t batch) {
-        uint64_t state = seed ^ (0xd1b54a32d192ed03ull * (batch + 1));
-        for (auto& word : s_) word = splitmix64(state);
-    }
-    uint64_t next() {
-        const uint64_t result = rotl(s_[1] * 5, 7) * 9;
-        const uint64_t t = s_[1] << 17;
-        s_[2] ^= s_[0];
-        s_[3] ^= s_[1];
-        s_[1] ^= s_[2];
-        s_[0] ^= s_[3];
-        s_[2] ^= t;
-        s_[3] = rotl(s_[3], 45);
-        return result;
-    }
-    // In [0, 1).
-    double uniform() { return (next() >> 11) * 0x1p-53; }
-    // In (0, 1]: safe under log.
-    double open_uniform() { return ((next() >> 11) + 1) * 0x1p-53; }
-
-private:
-    static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-    std::array<uint64_t, 4> s_{};
-};
-
-// Unit direction from the Henyey-Greenstein phase function with anisotropy g about `d`.
-Eigen::Vector3d sample_hg(const Eigen::Vector3d& d, double g, Random& random) {
-    const double xi = random.uniform();
-    double cos_theta;
-    if (std::abs(g) < 1e-6) {
-        cos_theta = 2 * xi - 1;
-    } else {
-        const double f = (1 - g * g) / (1 - g + 2 * g * xi);
-        cos_theta = std::clamp((1 + g * g - f * f) / (2 * g), -1.0, 1.0);
-    }
-    const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
-    const double phi = 2 * std::numbers::pi * random.uniform();
-    Eigen::Vector3d t, b;
-    orthonormal_basis(d, t, b);
-    return (sin_theta * std::cos(phi) * t + sin_theta * std::sin(phi) * b + cos_theta * d).normalized();
-}
-
-// Snell refraction of `d` (unit, travelling into the surface: d . n < 0) from index 1 into relative
-// index eta through a surface with outward unit normal n.
-Eigen::Vector3d refract_in(const Eigen::Vector3d& d, const Eigen::Vector3d& n, double eta) {
-    const double cos_i = -d.dot(n);
-    const double inv = 1.0 / eta;
-    const double sin_t2 = inv * inv * std::max(0.0, 1 - cos_i * cos_i);
-    const double cos_t = std::sqrt(std::max(0.0, 1 - sin_t2));
-    return (inv * d + (inv * cos_i - cos_t) * n).normalized();
-}
-
-// What the walk needs of the volume, in millimetres and in each piece's rest frame (rigid motions
-// keep lengths, so paths inside a piece are traced where its tets are stored).
-struct Medium {
-    struct TetPlanes {
-        std::array<Eigen::Vector3d, 4> normal;  // outward unit normal of face k (opposite vertex k)
-        std::array<double, 4> offset;           // normal . x on the face
-    };
-    std::vector<TetPlanes> planes;
-    std::vector<double> volume;                  // mm^3
-    std::vector<std::array<double, 3>> mua, mus;
-    std::vector<double> eta;
-    std::vector<std::array<int32_t, 4>> boundary_face;  // per tet and local face: boundary face or -1
-};
-
-Medium build_medium(const TetMesh& mesh, const TetConnectivity& connectivity, const std::vector<TetMaterial>& materials,
-                    double scale, double g) {
-    Medium m;
-    const size_t n = mesh.tet_count();
-    m.planes.resize(n);
-    m.volume.resize(n);
-    m.mua.resize(n);
-    m.mus.resize(n);
-    m.eta.resize(n);
-    m.boundary_face.assign(n, {-1, -1, -1, -1});
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t t = r.begin(); t != r.end(); ++t) {
-            const Tet& tet = mesh.tets[t];
-            std::array<Eigen::Vector3d, 4> p;
-            for (int k = 0; k < 4; ++k) p[k] = mesh.positions[tet[k]] * scale;
-            for (int k = 0; k < 4; ++k) {
-                const auto& f = kTetFaces[k];
-                const Eigen::Vector3d normal = (p[f[1]] - p[f[0]]).cross(p[f[2]] - p[f[0]]).normalized();
-                m.planes[t].normal[k] = normal;
-                m.planes[t].offset[k] = normal.dot(p[f[0]]);
-            }
-            m.volume[t] = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
-            for (int c = 0; c < 3; ++c) {
-                m.mua[t][c] = materials[t].mua[c];
-                m.mus[t][c] = materials[t].musp[c] / (1 - g);
-            }
-            m.eta[t] = materials[t].eta;
-        }
-    });
-    for (size_t f = 0; f < connectivity.boundary_faces.size(); ++f) {
-        const BoundaryFace& face = connectivity.boundary_faces[f];
-        m.boundary_face[face.tet][face.local_face] = static_cast<int32_t>(f);
-    }
-    return m;
-}
 
 // Where photons enter: per channel, a table over (source, boundary face) of the power that enters
 // there, area (mm^2) times the face's mean q.
@@ -183,11 +72,11 @@ struct Tracer {
     const BoundarySurface& surface;
     const std::vector<PhotonSource>& sources;
     const MonteCarloOptions& options;
-    const Medium& medium;
+    const MonteCarloMedium& medium;
     const EntryTable& table;
 
     void trace_batch(uint64_t batch, BatchTally& tally) const {
-        Random random(options.seed, batch);
+        MonteCarloRandom random(options.seed, batch);
         tally.track.assign(3 * mesh.tet_count(), 0.0);
         tally.escaped.assign(3 * connectivity.boundary_faces.size(), 0.0);
         tally.injected = tally.absorbed = tally.escaped_total = {};
@@ -198,7 +87,7 @@ struct Tracer {
         }
     }
 
-    void trace_photon(int c, Random& random, BatchTally& tally) const {
+    void trace_photon(int c, MonteCarloRandom& random, BatchTally& tally) const {
         // Entry: a (source, face) by its power, a point uniform on the face, weight q(x) / mean q.
         const auto& cdf = table.cumulative[c];
         const double pick = random.uniform() * table.power[c];
@@ -253,19 +142,10 @@ struct Tracer {
                 ++tally.lost;
                 return;
             }
-            const Medium::TetPlanes& planes = medium.planes[tet];
-            double exit = std::numeric_limits<double>::infinity();
-            int exit_face = -1;
-            for (int k = 0; k < 4; ++k) {
-                if (k == skip) continue;
-                const double denom = planes.normal[k].dot(d);
-                if (!(denom > 0)) continue;
-                const double dist = std::max(0.0, (planes.offset[k] - planes.normal[k].dot(x)) / denom);
-                if (dist < exit) {
-                    exit = dist;
-                    exit_face = k;
-                }
-            }
+            const MonteCarloMedium::TetPlanes& planes = medium.planes[tet];
+            const TetExit leave = tet_exit(planes, x, d, skip);
+            const int exit_face = leave.face;
+            const double exit = leave.distance;
             if (exit_face < 0) {  // only from a degenerate direction: drop rather than loop
                 ++tally.lost;
                 return;
@@ -282,7 +162,7 @@ struct Tracer {
             weight *= kept;
             x += segment * d;
             if (scatters) {
-                d = sample_hg(d, g, random);
+                d = sample_henyey_greenstein(d, g, random);
                 skip = -1;
                 tau = -std::log(random.open_uniform());
                 if (weight < options.roulette_threshold * initial_weight) {
@@ -294,8 +174,7 @@ struct Tracer {
             tau -= mus * segment;
             const int32_t next = connectivity.tet_neighbors[tet][exit_face];
             if (next >= 0) {
-                const auto& back = connectivity.tet_neighbors[next];
-                skip = static_cast<int>(std::find(back.begin(), back.end(), tet) - back.begin());
+                skip = shared_face(connectivity, next, tet);
                 tet = next;
                 continue;
             }
@@ -362,11 +241,9 @@ void validate(const MonteCarloOptions& o) {
     if (o.max_steps <= 0) fail("the step limit must be positive");
 }
 
-MonteCarloFluence trace_fluence(const TetMesh& mesh, const TetConnectivity& connectivity,
-                                const std::vector<TetMaterial>& materials, const BoundarySurface& surface,
-                                const std::vector<PhotonSource>& sources, const MonteCarloOptions& options,
-                                const std::function<void(const MonteCarloProgress&)>& progress,
-                                const Progress* cancel) {
+void validate_trace_input(const TetMesh& mesh, const TetConnectivity& connectivity,
+                          const std::vector<TetMaterial>& materials, const BoundarySurface& surface,
+                          const std::vector<PhotonSource>& sources, const MonteCarloOptions& options) {
     validate(options);
     if (materials.size() != mesh.tet_count())
         throw InvalidArgumentError("monte carlo: " + std::to_string(materials.size()) + " materials for " +
@@ -380,10 +257,18 @@ MonteCarloFluence trace_fluence(const TetMesh& mesh, const TetConnectivity& conn
         const std::string problem = material_problem(materials[t]);
         if (!problem.empty()) throw InvalidArgumentError("monte carlo: tet " + std::to_string(t) + ": " + problem);
     }
+}
+
+MonteCarloFluence trace_fluence(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                const std::vector<TetMaterial>& materials, const BoundarySurface& surface,
+                                const std::vector<PhotonSource>& sources, const MonteCarloOptions& options,
+                                const std::function<void(const MonteCarloProgress&)>& progress,
+                                const Progress* cancel) {
+    validate_trace_input(mesh, connectivity, materials, surface, sources, options);
 
     const auto start = std::chrono::steady_clock::now();
     const double scale = options.mm_per_unit;
-    const Medium medium = build_medium(mesh, connectivity, materials, scale, options.anisotropy);
+    const MonteCarloMedium medium = build_monte_carlo_medium(mesh, connectivity, materials, scale, options.anisotropy);
     std::vector<double> face_area(surface.triangles.size());
     for (size_t f = 0; f < face_area.size(); ++f) {
         const auto& v = connectivity.boundary_faces[f].vertices;

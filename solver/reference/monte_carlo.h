@@ -120,6 +120,13 @@ struct MonteCarloFluence {
 // negative or non-finite limits, or no limit at all.
 void validate(const MonteCarloOptions& options);
 
+// validate(options), and throws InvalidArgumentError (starting "monte carlo: ") for materials not one
+// per tet or unusable, a surface that does not match the connectivity, or a source without one q per
+// surface vertex. What trace_fluence and trace_camera_image check first.
+void validate_trace_input(const TetMesh& mesh, const TetConnectivity& connectivity,
+                          const std::vector<TetMaterial>& materials, const BoundarySurface& surface,
+                          const std::vector<PhotonSource>& sources, const MonteCarloOptions& options);
+
 // Traces the light of `sources` through the volume. `surface` is extract_boundary_surface of this mesh
 // (its triangle t is connectivity.boundary_faces[t]); materials one per tet (validated). Deterministic
 // for a seed: batch b uses its own random stream derived from (seed, b), and rounds are reduced in batch

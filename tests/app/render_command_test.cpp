@@ -184,7 +184,7 @@ TEST_F(Render, MonteCarloWritesPhiWithStandardErrors) {
     // boundary: the fields gain the standard errors, the seed makes the run repeatable, and the traced
     // fluence is the diffusion's within what the two models legitimately differ by near a lit surface.
     const std::string common = volume_.string() + " --material marble --light dir:-1,-0.5,-0.2 --scale 2 "
-                                                  "--width 64 --height 48 --method mc --mc-error 0.05 --mc-seconds 20";
+                                                  "--width 64 --height 48 --method mc --mc-error 0.05 --mc-seconds 8";
     const auto a = run_waxwork("render " + common + " -o " + (dir_ / "mc.png").string() + " --fields " +
                                (dir_ / "mc.csv").string());
     ASSERT_EQ(a.exit_code, 0) << a.err;
@@ -219,6 +219,37 @@ TEST_F(Render, MonteCarloWritesPhiWithStandardErrors) {
     for (size_t v = 0; v < f.rows.size(); ++v) EXPECT_EQ(g.rows[v].phi, f.rows[v].phi);
 }
 
+TEST_F(Render, MonteCarloImageFromCameraRaysIsTheSameForASeed) {
+    // The written image is traced with camera rays to a path budget: the same seed gives the same PNG,
+    // another seed a different one; the summary compares it with the Eq. 3 images.
+    const std::string common = volume_.string() + " --material marble --light dir:-1,-0.5,-0.2 --scale 2 "
+                                                  "--width 48 --height 36 --method mc --mc-photons 6000";
+    const auto a = run_waxwork("render " + common + " -o " + (dir_ / "mci.png").string());
+    const auto b = run_waxwork("render " + common + " -o " + (dir_ / "mci2.png").string());
+    const auto c = run_waxwork("render " + common + " --seed 2 -o " + (dir_ / "mci3.png").string());
+    ASSERT_EQ(a.exit_code, 0) << a.err;
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    ASSERT_EQ(c.exit_code, 0) << c.err;
+    const auto image = nlohmann::json::parse(a.out)["monte_carlo_image"];
+    EXPECT_EQ(image["stopped_by"], "photons") << a.out;
+    EXPECT_GE(image["paths_per_channel"].get<int64_t>(), 6000);
+    EXPECT_EQ(image["lost_paths"], 0);
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_GT(image["relative_error"][k].get<double>(), 0);
+        EXPECT_GT(image["over_eq3"][k].get<double>(), 0);
+        EXPECT_GT(image["over_diffusion"][k].get<double>(), 0);
+    }
+    const Image first = read_png(dir_ / "mci.png");
+    EXPECT_EQ(first, read_png(dir_ / "mci2.png"));
+    EXPECT_NE(first, read_png(dir_ / "mci3.png"));
+    // The object is drawn over the background: some pixels differ from the corner's.
+    const uint8_t* corner = first.pixel(0, 0);
+    int object = 0;
+    for (int y = 0; y < first.height; ++y)
+        for (int x = 0; x < first.width; ++x) object += first.pixel(x, y)[1] != corner[1];
+    EXPECT_GT(object, first.width * first.height / 10);
+}
+
 TEST_F(Render, MonteCarloStopsAtItsTimeBudgetShowingItsError) {
     // An error target out of reach: the time budget stops the trace, and the status line (rewritten
     // each second, blanked at the end) showed the current error meanwhile.
@@ -228,7 +259,11 @@ TEST_F(Render, MonteCarloStopsAtItsTimeBudgetShowingItsError) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto mc = nlohmann::json::parse(r.out)["monte_carlo"];
     EXPECT_EQ(mc["stopped_by"], "seconds");
-    EXPECT_GE(mc["seconds"].get<double>(), 2.5);
+    // A quarter of the budget for the fluence, the rest for the image.
+    EXPECT_GE(mc["seconds"].get<double>(), 0.25 * 2.5);
+    const auto image = nlohmann::json::parse(r.out)["monte_carlo_image"];
+    EXPECT_EQ(image["stopped_by"], "seconds");
+    EXPECT_GE(mc["seconds"].get<double>() + image["seconds"].get<double>(), 2.5);
     EXPECT_EQ(mc["seed"], 3);
     EXPECT_NE(r.err.find("monte carlo: "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("relative error"), std::string::npos) << r.err;
@@ -247,6 +282,8 @@ TEST_F(Render, MonteCarloBadInputIsAOneLineError) {
              {"--method mc --mc-error nan", "--mc-error must be a relative standard error in (0, 1)"},
              {"--method mc --mc-error 1", "--mc-error must be a relative standard error in (0, 1)"},
              {"--method mc --mc-g 1", "--mc-g must be a Henyey-Greenstein anisotropy in (-1, 1)"},
+             {"--method mc --mc-photons 0", "--mc-photons must be a positive number of paths"},
+             {"--mc-photons 1000", "apply only with --method mc"},
              {"--seed 3", "apply only with --method mc"},
              {"--method fem --mc-seconds 3", "apply only with --method mc"}}) {
         const auto r = run_waxwork(base + args);

@@ -9,6 +9,8 @@
 #include "solver_test_meshes.h"
 #include "tetops/box_mesh.h"
 
+#include "monte_carlo_volume.h"
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -19,21 +21,8 @@
 namespace waxwork {
 namespace {
 
-TetMaterial uniform_material(double mua, double musp, double eta) {
-    return TetMaterial{{mua, mua, mua}, {musp, musp, musp}, eta};
-}
-
-struct Volume {
-    TetMesh mesh;
-    TetConnectivity connectivity;
-    std::vector<TetMaterial> materials;
-    BoundarySurface surface;
-    Volume(TetMesh m, const TetMaterial& material) : mesh(std::move(m)) {
-        connectivity = build_connectivity(mesh);
-        materials.assign(mesh.tet_count(), material);
-        surface = extract_boundary_surface(mesh, connectivity, materials);
-    }
-};
+using test::uniform_material;
+using Volume = test::MonteCarloVolume;
 
 // A directional light straight down, without shadows (a convex box shadows nothing).
 std::vector<PhotonSource> light_from_above(const Volume& volume) {
