@@ -484,6 +484,7 @@ void EditorApp::start_tick() {
             s.tets = r->tets;
             s.vertices = r->vertices;
             s.min_dihedral_deg = r->min_dihedral;
+            if (r->trust_warning) s.trust_warning = *r->trust_warning;
             s.solver_backend = r->backend;
             s.solver_description = r->solver_description;
             s.gpu_fallback_reason = r->gpu_fallback_reason;

@@ -122,6 +122,7 @@ struct EditorScene {
     double tick_ms_sum = 0;
     int ticks = 0;
     double min_dihedral_deg = 0;
+    std::string trust_warning;  // SceneTickResult::trust_warning, kept until the next one
     // Of the loaded volume, for the size in mm beside the scale and the mesh's fit to the rule at it.
     Eigen::Vector3d extent = Eigen::Vector3d::Zero();  // bounding box, model units
     double surface_edge = 0;                           // mean_surface_edge_length, model units

@@ -302,6 +302,11 @@ void EditorApp::draw_solver_panel() {
             ImGui::Text("est. error   %.1e (tolerance %.0e)", *s.estimated_error, live_options_.relative_tolerance);
         ImGui::Text("solver tick  %.1f ms", s.tick_ms);
         ImGui::Text("%zu tets, %zu vertices, min dihedral %.1f deg", s.tets, s.vertices, s.min_dihedral_deg);
+        if (!s.trust_warning.empty()) {
+            ImGui::PushTextWrapPos(0.0f);
+            ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s", s.trust_warning.c_str());
+            ImGui::PopTextWrapPos();
+        }
         ImGui::Text("%zu edits in the history", s.history_size);
     }
     const ImGuiIO& io = ImGui::GetIO();
@@ -385,6 +390,10 @@ void EditorApp::draw_overlays() {
         return ImVec2(static_cast<float>((x + view_x_) / s), static_cast<float>((y + view_y_) / s));
     };
     draw_tool_overlay();  // the stroke being drawn and the side a cut takes away
+    // On the view itself, so that whoever judges the image sees it; the Solver panel says why.
+    if (!scene_->trust_warning.empty() && !options_.hide_ui)
+        draw->AddText(to_screen(8.0f, static_cast<float>(view_h_) - 24.0f * static_cast<float>(ui_scale_)),
+                      IM_COL32(255, 205, 80, 255), "diffusion may be off here: low-albedo material (Solver panel)");
     if (!camera_ || !show_light_gizmos_) return;
     // Light gizmos: point and area lights as suns at their position (centre), directional ones as an
     // arrow towards the target from where the light comes.

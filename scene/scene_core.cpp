@@ -6,6 +6,7 @@
 #include "io/volume_file.h"
 #include "scene/surface_export.h"
 #include "solver/solved_scene.h"
+#include "solver/transport_validity.h"
 #include "tetops/model_scale.h"
 
 #include <array>
@@ -188,6 +189,7 @@ SceneTickResult SceneCore::tick(const SceneTickRequest& request, const std::func
     r.tets = mesh.tet_count();
     r.vertices = mesh.vertex_count();
     r.min_dihedral = document_.min_dihedral_deg();
+    if (request.first || r.geometry_changed) r.trust_warning = diffusion_trust_warning(mesh.materials);
     r.backend = live_->backend();
     r.solver_description = live_->solver_description();
     r.gpu_fallback_reason = live_->gpu_fallback_reason();

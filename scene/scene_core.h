@@ -71,6 +71,9 @@ struct SceneTickResult {
     bool can_undo = false, can_redo = false;
     size_t history = 0, tets = 0, vertices = 0;
     double min_dihedral = 0;
+    // With the geometry (a job ran, or the first tick): diffusion_trust_warning of the materials, empty
+    // when they are all in the regime where the live image can be trusted.
+    std::optional<std::string> trust_warning;
     LiveBackend backend = LiveBackend::Cpu;  // after the step (Cpu after a fallback)
     std::string solver_description, gpu_fallback_reason, method_fallback_reason;
     double milliseconds = 0;  // the whole tick
