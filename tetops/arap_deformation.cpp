@@ -426,7 +426,6 @@ DragRegion select_drag_region(const TetMesh& mesh, const TetConnectivity& connec
             region.pinned.push_back(static_cast<int32_t>(v));
         } else if (w >= kHandleMinWeight) {
             region.handle.push_back(static_cast<int32_t>(v));
-            region.handle_weights.push_back(w);
             ++unpinned_handle;
         }
     }
@@ -438,15 +437,10 @@ DragRegion select_drag_region(const TetMesh& mesh, const TetConnectivity& connec
     return region;
 }
 
-double handle_fraction(const DragRegion& region, size_t i, double t) {
-    return region.motion_rest.kind == HandleMotion::Kind::Translate ? t * region.handle_weights[i] : t;
-}
-
 std::vector<Eigen::Vector3d> drag_targets(const DragRegion& region, std::span<const Eigen::Vector3d> rest, double t) {
     std::vector<Eigen::Vector3d> targets;
     targets.reserve(region.handle.size() + region.pinned.size());
-    for (size_t i = 0; i < region.handle.size(); ++i)
-        targets.push_back(region.motion_rest.apply(rest[region.handle[i]], handle_fraction(region, i, t)));
+    for (const int32_t v : region.handle) targets.push_back(region.motion_rest.apply(rest[v], t));
     for (int32_t v : region.pinned) targets.push_back(rest[v]);
     return targets;
 }

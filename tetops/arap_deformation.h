@@ -121,13 +121,13 @@ private:
 // vertex `seed`. Vertices of other bodies (other pieces, detached parts) stay where they are.
 std::vector<int32_t> vertex_connected_tets(const TetMesh& mesh, const TetConnectivity& connectivity, int32_t seed);
 
-// The soft handle: smooth falloff w(d) = (1 - (d/R)^2)^2 for distance d < R from the grab point, 0
-// beyond (C1 at R, 1 at the centre). A vertex with w >= kHandleMinWeight is constrained to
-// rest + w * move; vertices with smaller weight are left free, so ARAP, not the falloff, shapes the
-// region between the handle and the rest of the body. Holding the low-weight ring at
-// rest + w * move would pin it almost in place and fight the drag; dropping the weights altogether
-// would tear a sharp step at the handle's rim. With 0.5, the handle is the ball of radius
-// R sqrt(1 - sqrt(0.5)) ~ 0.54 R and its vertices move by half to all of the move.
+// The handle: the falloff w(d) = (1 - (d/R)^2)^2 for distance d < R from the grab point, 0 beyond (C1
+// at R, 1 at the centre), selects it: the vertices with w >= kHandleMinWeight, the ball of radius
+// R sqrt(1 - sqrt(0.5)) ~ 0.54 R. The handle moves as one rigid grip (HandleMotion) and ARAP shapes
+// everything between it and the pins. Moving each handle vertex by w of the motion instead (the rim
+// by half, the centre by all of it) shears the handle itself: a torus lifted by about the handle's
+// width then had tets pushed under the angle guard at any number of iterations, and five times the
+// energy of the rigid grip (docs/deformation.md).
 inline constexpr double kHandleMinWeight = 0.5;
 double handle_falloff(double distance, double radius);
 
@@ -139,11 +139,7 @@ struct PinSphere {
 };
 
 // How the handle moves: Grab translates it, Bend turns it about an axis, Twist turns it about an axis by
-// an angle that grows along the axis. For a translation a handle vertex with falloff weight w moves by
-// w move, so the handle's rim blends into the body. Turns hold the handle rigid instead: a rim turned by
-// w angle would lag its centre by the lever arm times the angle's difference, shearing the handle
-// itself far more than the body around it (a 45 degree bend two handle-widths from the axis inverts
-// tets in the handle); Twist's angle already grows smoothly along the axis.
+// an angle that grows along the axis. The whole handle follows the motion (see kHandleMinWeight).
 struct HandleMotion {
     enum class Kind { Translate, Bend, Twist };
     Kind kind = Kind::Translate;
@@ -172,7 +168,6 @@ struct DragRegion {
     int32_t piece = 0;
     std::vector<int32_t> body_tets;        // vertex_connected_tets of the handle vertex nearest the grab
     std::vector<int32_t> handle;           // weight >= kHandleMinWeight, not pinned
-    std::vector<double> handle_weights;    // per handle vertex
     std::vector<int32_t> pinned;           // body vertices inside a pin sphere
     HandleMotion motion_rest;              // the world motion in the piece's rest frame
     // handle then pinned: the order ArapDeformer::set_constrained and drag_targets use.
@@ -187,12 +182,8 @@ struct DragRegion {
 DragRegion select_drag_region(const TetMesh& mesh, const TetConnectivity& connectivity, const Eigen::Vector3d& grab,
                               double radius, const HandleMotion& motion, std::span<const PinSphere> pins);
 
-// The fraction of motion_rest that handle vertex i (of region.handle) follows after the fraction `t`
-// of the drag: t w_i for a translation, t for a turn (see HandleMotion).
-double handle_fraction(const DragRegion& region, size_t i, double t);
-
 // Targets for region.constrained() after the fraction `t` in [0, 1] of the motion: handle vertices
-// at handle_fraction of motion_rest (rest + t w move for a translation), pinned at rest.
+// moved by the fraction t of motion_rest (rest + t move for a translation), pinned at rest.
 std::vector<Eigen::Vector3d> drag_targets(const DragRegion& region, std::span<const Eigen::Vector3d> rest, double t);
 
 // Targets for the Bend and Twist tools: `points` rotated about the axis through `axis_point` along

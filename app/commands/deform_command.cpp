@@ -172,7 +172,7 @@ void add_deform_command(CLI::App& app) {
     cmd->add_option("--steps", options->steps, "The move is applied in this many equal steps (drag frames)")
         ->capture_default_str();
     cmd->footer("Handle weight w = (1 - (d/R)^2)^2 for d < R from the grab point; vertices with w >= 0.5 (d <= 0.54 R)\n"
-                "form the handle: --move moves each by w x the move, --bend and --twist turn it as one rigid grip.\n"
+                "form the handle, which moves (--move) or turns (--bend, --twist) as one rigid grip.\n"
                 "The rest of the grabbed body follows as rigidly as possible (per-tet rotations, Sorkine and\n"
                 "Alexa 2007); other bodies and pieces stay. A step that would invert a tet or leave one under\n"
                 "0.5 degrees is shortened (halved until it passes): then \"step_shortened\" is true.");

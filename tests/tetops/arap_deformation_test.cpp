@@ -232,10 +232,8 @@ TEST(ArapDeformation, SelectsHandlePinsAndTheGrabbedBodyOnly) {
     EXPECT_LT(report.handle_error, 1e-12);
     for (size_t v = offset; v < two.vertex_count(); ++v) EXPECT_EQ(deformer.positions()[v], two.positions[v]);
     for (int32_t v : region.pinned) EXPECT_EQ(deformer.positions()[v], two.positions[v]);
-    for (size_t i = 0; i < region.handle.size(); ++i) {
-        const int32_t v = region.handle[i];
-        EXPECT_NEAR((deformer.positions()[v] - two.positions[v]).z(), region.handle_weights[i], 1e-12);
-    }
+    for (const int32_t v : region.handle)  // the whole handle moves as one grip
+        EXPECT_LT((deformer.positions()[v] - two.positions[v] - Eigen::Vector3d(0, 0, 1)).norm(), 1e-12);
 }
 
 TEST(ArapDeformation, MovesInTheRestFrameOfTheGrabbedPiece) {
@@ -300,12 +298,8 @@ TEST(ArapDeformation, BendAndTwistToolsTurnTheHandleAboutTheAxis) {
         EXPECT_EQ(report.shortened_steps, 0);
         EXPECT_EQ(report.inverted_tets, 0u);
         EXPECT_EQ(report.handle_vertices, region.handle.size());
-        for (size_t i = 0; i < region.handle.size(); ++i) {
-            const int32_t v = region.handle[i];
-            EXPECT_EQ(handle_fraction(region, i, 1.0), 1.0);
-            const Eigen::Vector3d expected = motion.apply(bar.positions[v], 1.0);
-            EXPECT_LT((deformer.positions()[v] - expected).norm(), 1e-9) << v;
-        }
+        for (const int32_t v : region.handle)
+            EXPECT_LT((deformer.positions()[v] - motion.apply(bar.positions[v], 1.0)).norm(), 1e-9) << v;
         for (int32_t v : region.pinned) EXPECT_EQ(deformer.positions()[v], bar.positions[v]);
         // The end turned: by 45 degrees about the elbow at x = 2 (bend), by about pi/4 about x (twist).
         const int32_t corner = box_vertex_index({16, 4, 4}, 16, 0, 0);
