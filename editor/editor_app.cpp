@@ -65,6 +65,7 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
     gl_ = load_gl_api(gl_proc_address);
     renderer_ = std::make_unique<SurfaceRenderer>(gl_);
     view_cache_ = std::make_unique<ViewCache>(gl_);
+    reference_ = std::make_unique<ReferenceView>(gl_);
 
     lighting_ = default_lighting();
     if (!options.lights.empty()) lighting_.lights = options.lights;
@@ -273,6 +274,8 @@ EditorApp::LoadedModel EditorApp::measure_loaded_model(const SessionVolume& inpu
 void EditorApp::install_core(std::shared_ptr<SceneCore> core, const fs::path& path, const std::string& material_name,
                              const std::vector<EditOperation>& replay, const LoadedModel& model) {
     pending_jobs_.clear();
+    reference_snapshot_.reset();
+    reference_->clear();
     scene_ = std::make_unique<Scene>();
     scene_->core = core;
     scene_->tets = core->document().mesh().tet_count();
@@ -330,6 +333,57 @@ void EditorApp::export_surface(const fs::path& path) {
         const bool coloured = core.export_surface(path, ShellGrouping::Separate);
         return "Exported the surface" + std::string(coloured ? " with its light" : "") + " to " + path.string();
     });
+}
+
+void EditorApp::render_reference() {
+    if (!scene_->core || !camera_) {
+        set_error("open a file first");
+        return;
+    }
+    if (reference_->busy() || reference_snapshot_) {
+        status_ = "A reference is being traced already (Cancel it in the Reference window)";
+        return;
+    }
+    // The view as it is now, at the size the Reference window asks for.
+    const std::array<int, 2> size = reference_->image_size(view_w_, view_h_);
+    const CameraFrame frame = camera_->frame(static_cast<double>(view_w_) / std::max(view_h_, 1));
+    reference_camera_ = pixel_camera(frame.eye, frame.view, frame.projection, size[0], size[1]);
+    auto snapshot = std::make_shared<ReferenceSnapshot>();
+    reference_snapshot_ = snapshot;
+    reference_->show();
+    queue_job("reference", [snapshot](SceneCore& core) {
+        snapshot->taken = true;
+        snapshot->scene = std::make_shared<const ReferenceScene>(snapshot_reference_scene(core));
+        return std::string("Tracing the reference of the view");
+    });
+}
+
+void EditorApp::render_reference_with(std::optional<double> seconds, std::optional<double> noise_percent,
+                                      std::optional<int> size_divisor) {
+    ReferenceView::Settings& settings = reference_->settings();
+    if (seconds) settings.seconds = static_cast<float>(*seconds);
+    if (noise_percent) settings.target_error_percent = static_cast<float>(*noise_percent);
+    if (size_divisor) {
+        const auto& divisors = ReferenceView::kSizeDivisors;
+        const auto it = std::find(divisors.begin(), divisors.end(), *size_divisor);
+        if (it != divisors.end()) settings.size = static_cast<int>(it - divisors.begin());
+    }
+    render_reference();
+}
+
+bool EditorApp::cancel_reference() {
+    if (!reference_->busy()) return false;
+    reference_->cancel();
+    return true;
+}
+
+void EditorApp::save_reference(const fs::path& path) {
+    try {
+        reference_->save(path);
+        status_ = "Saved the reference comparison to " + path.string();
+    } catch (const std::exception& e) {
+        set_error(e.what());
+    }
 }
 
 void EditorApp::save_session(const fs::path& path) {
@@ -422,7 +476,8 @@ void EditorApp::set_crease_angle(double degrees) {
 }
 
 bool EditorApp::idle() const {
-    if (load_task_.busy() || tick_task_.busy() || !pending_jobs_.empty() || lighting_dirty_ || crease_angle_dirty_)
+    if (load_task_.busy() || tick_task_.busy() || !pending_jobs_.empty() || lighting_dirty_ || crease_angle_dirty_ ||
+        reference_->busy() || reference_snapshot_)
         return false;
     return !scene_->core || (scene_->converged && scene_->render_input && scene_->exposure_locked && !view_dirty_);
 }
@@ -458,9 +513,12 @@ void EditorApp::start_tick() {
     tick_task_.start(label, [this, target, core, request](TaskProgress& progress) {
         auto r = std::make_shared<SceneTickResult>(
             core->tick(*request, [&progress](const std::string& stage) { progress.set_stage(stage); }));
-        return BackgroundTask::Apply([this, target, r] {
+        return BackgroundTask::Apply([this, target, r, request] {
             if (scene_.get() != target) return;  // another file was opened meanwhile
             Scene& s = *scene_;
+            if (r->history != s.history_size || r->can_undo != s.can_undo || r->can_redo != s.can_redo ||
+                request->lighting || request->crease_angle)
+                ++s.light_version;
             for (const std::string& m : r->messages) status_ = m;
             for (const std::string& e : r->errors) set_error(e);
             if (r->input) {
@@ -490,6 +548,10 @@ void EditorApp::start_tick() {
             s.gpu_fallback_reason = r->gpu_fallback_reason;
             s.method_fallback_reason = r->method_fallback_reason;
             s.tick_ms = r->milliseconds;
+            if (reference_->busy()) {
+                s.tick_ms_sum_while_tracing += r->milliseconds;
+                ++s.ticks_while_tracing;
+            }
             if (!s.converged || r->frame.total_iterations() > 0) {
                 s.tick_ms_sum += r->milliseconds;
                 ++s.ticks;
@@ -511,6 +573,15 @@ void EditorApp::poll_tasks() {
         scene_->converged = true;  // do not retry a failing step every frame
         scene_->exposure_locked = true;
     }
+    // The snapshot a tick took for Render reference: the trace starts from it, tagged with the light
+    // it shows.
+    if (reference_snapshot_ && !tick_task_.busy() && reference_snapshot_->taken) {
+        // A snapshot that threw was reported by its tick; there is nothing to trace then.
+        if (reference_snapshot_->scene)
+            reference_->start(std::move(reference_snapshot_->scene), reference_camera_, scene_->light_version);
+        reference_snapshot_.reset();
+    }
+    if (const std::optional<std::string> ended = reference_->poll()) status_ = *ended;
     // Keep one tick running while there is anything to do.
     if (scene_->core && !tick_task_.busy() && !load_task_.busy() &&
         (!pending_jobs_.empty() || lighting_dirty_ || crease_angle_dirty_ || !scene_->converged ||
@@ -701,13 +772,21 @@ EditorRunStats run_editor(const EditorOptions& options) {
         const auto script_running = [&] { return player && !player->done(); };
         stats.gl_version = reinterpret_cast<const char*>(app.gl().GetString(GL_VERSION));
         stats.gl_renderer = reinterpret_cast<const char*>(app.gl().GetString(GL_RENDERER));
-        double frame_ms_sum = 0, view_ms_sum = 0;
+        double frame_ms_sum = 0, view_ms_sum = 0, tracing_frame_ms_sum = 0;
         while (!glfwWindowShouldClose(window)) {
             if (screenshot || !app.idle() || app.animating() || script_running()) glfwPollEvents();
             else glfwWaitEventsTimeout(0.5);  // nothing moves: sleep until input arrives
             const auto start = std::chrono::steady_clock::now();
             if (player) player->advance(*script_target);
+            const bool tracing = app.reference().busy();
             app.frame();
+            if (tracing) {
+                app.gl().Finish();  // the frame's GPU work counts too
+                const double ms = milliseconds_since(start);
+                ++stats.frames_while_tracing;
+                tracing_frame_ms_sum += ms;
+                stats.max_frame_ms_while_tracing = std::max(stats.max_frame_ms_while_tracing, ms);
+            }
             if (screenshot) {
                 if (!app.last_error().empty()) throw Error(app.last_error());
             // A refused surface's dialog waits for a repair the script may still choose.
@@ -731,12 +810,14 @@ EditorRunStats run_editor(const EditorOptions& options) {
         }
         stats.mean_frame_ms = stats.frames ? frame_ms_sum / stats.frames : 0;
         stats.mean_view_ms = stats.frames ? view_ms_sum / stats.frames : 0;
+        if (stats.frames_while_tracing) stats.mean_frame_ms_while_tracing = tracing_frame_ms_sum / stats.frames_while_tracing;
         const EditorScene& scene = app.scene();
         stats.tets = scene.tets;
         stats.vertices = scene.vertices;
         stats.mm_per_unit = app.mm_per_unit();
         stats.ticks = scene.ticks;
         stats.tick_ms = scene.ticks ? scene.tick_ms_sum / scene.ticks : 0;
+        stats.tick_ms_while_tracing = scene.ticks_while_tracing ? scene.tick_ms_sum_while_tracing / scene.ticks_while_tracing : 0;
         stats.solver_backend = live_backend_name(scene.solver_backend);
         stats.gpu_fallback_reason = scene.gpu_fallback_reason;
         stats.method_fallback_reason = scene.method_fallback_reason;

@@ -15,6 +15,7 @@
 #include "editor/file_dialog.h"
 #include "editor/input_script.h"
 #include "editor/orbit_camera.h"
+#include "editor/reference_view.h"
 #include "editor/repair_choices.h"
 #include "editor/view_cache.h"
 #include "editor/viewport_tools.h"
@@ -86,6 +87,12 @@ struct EditorRunStats {
     std::string gpu_fallback_reason;  // why the GPU backend was given up, if it was
     std::string method_fallback_reason;  // why the chosen method ran as Jacobi CG, if it did
     bool view_reads_device_radiance = false;  // the 3D view drew E from the GPU solver's buffer
+    // Frames drawn while a reference was being traced (View > Render reference): their UI and view
+    // work (not the screenshot mode's waits between frames), mean and longest.
+    int frames_while_tracing = 0;
+    double mean_frame_ms_while_tracing = 0;
+    double max_frame_ms_while_tracing = 0;
+    double tick_ms_while_tracing = 0;  // the worker's mean tick meanwhile
 };
 EditorRunStats run_editor(const EditorOptions& options);
 
@@ -121,8 +128,13 @@ struct EditorScene {
     double tick_ms = 0;
     double tick_ms_sum = 0;
     int ticks = 0;
+    double tick_ms_sum_while_tracing = 0;  // the ticks that ran while a reference was being traced
+    int ticks_while_tracing = 0;
     double min_dihedral_deg = 0;
     std::string trust_warning;  // SceneTickResult::trust_warning, kept until the next one
+    // Moves whenever the light shown may differ from before: an edit, undo or redo, new lights or
+    // crease angle. A reference tagged with an older one shows an earlier state.
+    long long light_version = 0;
     // Of the loaded volume, for the size in mm beside the scale and the mesh's fit to the rule at it.
     Eigen::Vector3d extent = Eigen::Vector3d::Zero();  // bounding box, model units
     double surface_edge = 0;                           // mean_surface_edge_length, model units
@@ -197,6 +209,18 @@ public:
     // File > Export: the boundary surface (.ply, .obj, .stl), with the current light's radiance baked
     // into vertex colours where the format stores them (SceneCore::export_surface), in the background.
     void export_surface(const std::filesystem::path& path);
+    // View > Render reference: converges the live light, copies the scene and traces the current view
+    // with Monte Carlo in the background (ReferenceView), leaving the editor usable meanwhile.
+    void render_reference();
+    // The same with the Reference window's settings changed first where given (input scripts): the
+    // time limit, the noise target in percent and the size as 1/divisor of the view (4, 2 or 1).
+    void render_reference_with(std::optional<double> seconds, std::optional<double> noise_percent,
+                               std::optional<int> size_divisor);
+    // The Reference window's Cancel; false when no reference is being traced.
+    bool cancel_reference();
+    // The Reference window's Save: its comparison as PNG, its numbers beside it as JSON.
+    void save_reference(const std::filesystem::path& path);
+    const ReferenceView& reference() const { return *reference_; }
 
 private:
     using Scene = EditorScene;
@@ -225,7 +249,7 @@ private:
     void apply_theme(float scale);
 
     // What a Save dialog writes when confirmed.
-    enum class SaveKind { Volume, Session, Surface };
+    enum class SaveKind { Volume, Session, Surface, Reference };
     void open_dialog(FileDialog::Mode mode, SaveKind kind = SaveKind::Volume);
     void relax_last_cut();
     // What loading found out about the model, measured off the UI thread.
@@ -317,6 +341,15 @@ private:
     std::optional<Refusal> refusal_;
     bool close_error_popup_ = false;  // a repair was chosen by a script: the dialog goes
     BackgroundTask tick_task_;
+    // Render reference: the trace and its window; the snapshot job's result until the trace starts,
+    // and the camera it traces through.
+    std::unique_ptr<ReferenceView> reference_;
+    struct ReferenceSnapshot {
+        bool taken = false;  // the job ran (it may have thrown, leaving `scene` empty)
+        std::shared_ptr<const ReferenceScene> scene;
+    };
+    std::shared_ptr<ReferenceSnapshot> reference_snapshot_;
+    PixelCamera reference_camera_;
     std::deque<std::pair<std::string, SceneJob>> pending_jobs_;  // for the next tick, in order
     bool lighting_dirty_ = false;                                // send lighting_ with the next tick
     bool crease_angle_dirty_ = false;                            // send live_options_'s crease angle too

@@ -78,6 +78,9 @@ void EditorApp::open_dialog(FileDialog::Mode mode, SaveKind kind) {
     } else if (kind == SaveKind::Surface) {
         file_dialog_.open(mode, "Export surface", directory, {".ply", ".obj", ".stl"},
                           (stem.empty() ? "surface" : stem) + ".ply");
+    } else if (kind == SaveKind::Reference) {
+        file_dialog_.open(mode, "Save reference comparison", directory, {".png"},
+                          (stem.empty() ? "reference" : stem) + "_reference.png");
     } else {
         file_dialog_.open(mode, "Save volume", directory, {".vtu", ".msh", ".mesh", ".node"},
                           (stem.empty() ? "volume" : stem) + ".vtu");
@@ -90,6 +93,7 @@ void EditorApp::file_dialog_result() {
         if (file_dialog_.mode() == FileDialog::Mode::Open) open_file(*chosen);
         else if (saving_ == SaveKind::Session) save_session(*chosen);
         else if (saving_ == SaveKind::Surface) export_surface(*chosen);
+        else if (saving_ == SaveKind::Reference) save_reference(*chosen);
         else save_volume(*chosen);
     }
 }
@@ -99,6 +103,11 @@ void EditorApp::draw_ui() {
     draw_tool_palette();
     draw_side_panel();
     draw_status_bar();
+    switch (reference_->draw(scene_->light_version, ui_scale_)) {
+    case ReferenceView::Request::Render: render_reference(); break;
+    case ReferenceView::Request::Save: open_dialog(FileDialog::Mode::Save, SaveKind::Reference); break;
+    case ReferenceView::Request::None: break;
+    }
     if (show_error_popup_) {
         ImGui::OpenPopup("Error");
         show_error_popup_ = false;
@@ -162,6 +171,8 @@ void EditorApp::draw_menu_bar() {
         if (ImGui::MenuItem("Reset camera", "Home")) camera_.reset();
         if (ImGui::MenuItem("Hide panels", "Tab", options_.hide_ui)) options_.hide_ui = !options_.hide_ui;
         draw_view_mode_menu();
+        ImGui::Separator();
+        if (ImGui::MenuItem("Render reference", nullptr, false, scene_->core && !reference_->busy())) render_reference();
         ImGui::EndMenu();
     }
     if (ImGui::BeginMenu("Help")) {

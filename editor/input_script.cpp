@@ -177,10 +177,31 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
     } else if (kind == "idle") {
         e.action = ScriptAction::WaitIdle;
         events.push_back(e);
-    } else if (kind == "save_session" || kind == "save_volume" || kind == "export_surface" || kind == "open") {
+    } else if (kind == "render_reference") {
+        e.action = ScriptAction::RenderReference;
+        if (in.has("seconds")) {
+            e.seconds = in.number("seconds");
+            if (!(*e.seconds > 0 && *e.seconds <= 3600)) fail_json(in.field("seconds"), "must be above 0 and at most 3600");
+        }
+        if (in.has("noise")) {
+            e.noise_percent = in.number("noise");
+            if (!(*e.noise_percent >= 0 && *e.noise_percent < 100)) fail_json(in.field("noise"), "must be a percentage in [0, 100)");
+        }
+        if (in.has("size")) {
+            const int64_t divisor = in.integer("size");
+            if (divisor != 1 && divisor != 2 && divisor != 4) fail_json(in.field("size"), "must be 4, 2 or 1 (1/size of the view across)");
+            e.size_divisor = static_cast<int>(divisor);
+        }
+        events.push_back(e);
+    } else if (kind == "cancel_reference") {
+        e.action = ScriptAction::CancelReference;
+        events.push_back(e);
+    } else if (kind == "save_session" || kind == "save_volume" || kind == "export_surface" || kind == "open" ||
+               kind == "save_reference") {
         e.action = kind == "save_session"     ? ScriptAction::SaveSession
                    : kind == "save_volume"    ? ScriptAction::SaveVolume
                    : kind == "export_surface" ? ScriptAction::ExportSurface
+                   : kind == "save_reference" ? ScriptAction::SaveReference
                                               : ScriptAction::Open;
         const Json& f = in.at("file");
         if (!f.is_string() || f.get<std::string>().empty()) fail_json(in.field("file"), "expected a file path");
@@ -200,7 +221,8 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
     } else {
         fail_json(entry, "unknown event \"" + kind +
                              "\" (expected press, move, release, drag, scroll, key, tool, material, crease_angle, "
-                             "idle, save_session, save_volume, export_surface, open, cancel_task, repair)");
+                             "idle, save_session, save_volume, export_surface, open, cancel_task, repair, render_reference, "
+                             "cancel_reference, save_reference)");
     }
     in.finish();
 }
@@ -249,6 +271,9 @@ void InputScriptPlayer::advance(ScriptTarget& target) {
         case ScriptAction::Open: target.open_file(e.file); break;
         case ScriptAction::CancelTask: target.cancel_task(); break;
         case ScriptAction::Repair: target.choose_repair(e.repair); break;
+        case ScriptAction::RenderReference: target.render_reference(e.seconds, e.noise_percent, e.size_divisor); break;
+        case ScriptAction::CancelReference: target.cancel_reference(); break;
+        case ScriptAction::SaveReference: target.save_reference(e.file); break;
         }
         last_fired_ = frame_;
         ++next_;

@@ -20,9 +20,14 @@
 //     {"event": "export_surface", "file": "v.ply"},           as File > Export surface
 //     {"event": "open", "file": "other.obj"},                 as File > Open (loads in the background)
 //     {"event": "cancel_task"},                               the status bar's Cancel of that load
-//     {"event": "repair", "repair": "wrap"}                   a refused surface's repair button: "wrap",
+//     {"event": "repair", "repair": "wrap"},                  a refused surface's repair button: "wrap",
 //                                                             "fill_holes", "autorefine" or
 //                                                             "fill_holes_autorefine" (repair_choices.h)
+//     {"event": "render_reference", "seconds": 5, "noise": 5, "size": 4},
+//                                 View > Render reference: at most `seconds`, until `noise` percent,
+//                                 1/size of the view across (4, 2 or 1); all optional
+//     {"event": "cancel_reference"},                          the Reference window's Cancel
+//     {"event": "save_reference", "file": "r.png"}            its Save (the numbers go to r.json)
 //   ]
 //
 // Positions are window coordinates (GLFW's: screen units, origin top-left; with --hide-ui the view
@@ -45,7 +50,7 @@ namespace waxwork {
 
 enum class ScriptAction {
     Move, Press, Release, Scroll, Key, SelectTool, SelectMaterial, SetCreaseAngle, WaitIdle, SaveSession, SaveVolume,
-    ExportSurface, Open, CancelTask, Repair
+    ExportSurface, Open, CancelTask, Repair, RenderReference, CancelReference, SaveReference
 };
 
 struct ScriptEvent {
@@ -61,6 +66,8 @@ struct ScriptEvent {
     double degrees = 0;          // SetCreaseAngle: in [0, 180]
     std::filesystem::path file;  // SaveSession, SaveVolume, ExportSurface, Open (absolute after parsing)
     std::string repair;          // Repair: a RepairChoice id
+    std::optional<double> seconds, noise_percent;  // RenderReference: the Reference window's settings
+    std::optional<int> size_divisor;               // (nullopt: as the window has them)
     std::string context;         // "SCRIPT: entry N (kind)" for messages
 };
 
@@ -99,6 +106,11 @@ public:
     virtual void open_file(const std::filesystem::path& file) = 0;  // as File > Open
     virtual void cancel_task() = 0;                                 // the status bar's Cancel
     virtual void choose_repair(const std::string& id) = 0;          // a refused surface's repair button
+    // View > Render reference with these settings (nullopt: the Reference window's), its Cancel and Save.
+    virtual void render_reference(std::optional<double> seconds, std::optional<double> noise_percent,
+                                  std::optional<int> size_divisor) = 0;
+    virtual void cancel_reference() = 0;
+    virtual void save_reference(const std::filesystem::path& file) = 0;
 };
 
 // Replays a script, a frame at a time.

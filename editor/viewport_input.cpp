@@ -288,6 +288,12 @@ public:
     void open_file(const std::filesystem::path& file) override { app_.open_file(file); }
     void cancel_task() override { app_.cancel_loading(); }
     void choose_repair(const std::string& id) override { app_.choose_repair(id); }
+    void render_reference(std::optional<double> seconds, std::optional<double> noise_percent,
+                          std::optional<int> size_divisor) override {
+        app_.render_reference_with(seconds, noise_percent, size_divisor);
+    }
+    void cancel_reference() override { app_.cancel_reference(); }
+    void save_reference(const std::filesystem::path& file) override { app_.save_reference(file); }
 
 private:
     GLFWwindow* window_;

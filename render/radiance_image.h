@@ -4,6 +4,7 @@
 #pragma once
 
 #include "io/image_io.h"
+#include "render/srgb.h"
 #include "solver/reference/camera_rays.h"
 
 #include <array>
@@ -18,7 +19,7 @@ float radiance_image_exposure(const RadianceImage& image);
 // ACES (Narkowicz's fit) of the exposed radiance, sRGB-encoded, over `background` by coverage (the
 // renderer's multisample resolve blends encoded colours too). Throws InvalidArgumentError for an image
 // whose arrays do not match its size.
-Image tone_mapped_image(const RadianceImage& image, float exposure, std::array<uint8_t, 3> background = {38, 40, 46});
+Image tone_mapped_image(const RadianceImage& image, float exposure, std::array<uint8_t, 3> background = kViewBackground);
 
 // How far `image` is from `reference` over the pixels both cover fully, over the three channels:
 //   relative_l2        sqrt(sum |I - R|^2 / sum |R|^2) in linear radiance;

@@ -16,4 +16,8 @@ double srgb_encode(double linear);
 uint8_t srgb_byte(double linear);
 std::array<uint8_t, 3> srgb_bytes(const std::array<double, 3>& linear);
 
+// What every view draws behind the model (8-bit sRGB): the renderer's clear colour and the CPU
+// images' background, so that pictures put side by side match.
+inline constexpr std::array<uint8_t, 3> kViewBackground{38, 40, 46};
+
 }  // namespace waxwork

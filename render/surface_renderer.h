@@ -9,6 +9,7 @@
 #include "gl/gpu_compute.h"
 #include "io/image_io.h"
 #include "render/camera.h"
+#include "render/srgb.h"
 #include "solver/lighting.h"
 
 #include <Eigen/Core>
@@ -64,7 +65,7 @@ struct SurfaceRenderInput {
     CameraSettings camera;
     float exposure = 1.0f;
     ToneMap tone_map = ToneMap::Aces;
-    std::array<uint8_t, 3> background = {38, 40, 46}; // sRGB
+    std::array<uint8_t, 3> background = kViewBackground; // sRGB
     // Per vertex and light (lighting.lights.size() per vertex, vertex-major), multiplies that light's
     // highlight: the shadow rays' visibility (SolvedScene::light_visibility). Empty: all visible.
     std::vector<float> light_visibility;

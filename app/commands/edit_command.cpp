@@ -74,6 +74,10 @@ void run_edit_command(const EditCommandOptions& o) {
             {"gpu_fallback_reason", stats.gpu_fallback_reason},
             {"method_fallback_reason", stats.method_fallback_reason},
             {"view_reads_device_radiance", stats.view_reads_device_radiance},
+            {"frames_while_tracing", stats.frames_while_tracing},
+            {"frame_ms_while_tracing", stats.mean_frame_ms_while_tracing},
+            {"max_frame_ms_while_tracing", stats.max_frame_ms_while_tracing},
+            {"tick_ms_while_tracing", stats.tick_ms_while_tracing},
         };
         std::cout << summary.dump() << "\n";
     }

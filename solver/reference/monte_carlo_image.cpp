@@ -272,6 +272,9 @@ MonteCarloImage trace_camera_image(const TetMesh& mesh, const TetConnectivity& c
     while (true) {
         check_cancelled(cancel);
         tbb::parallel_for(0, height, [&](int row) {
+            // A round over a large image can take many seconds: a cancelled one skips its remaining
+            // rows (its partial sums are thrown away with the CancelledError below).
+            if (cancel && cancel->cancel_requested()) return;
             for (int column = 0; column < width; ++column) {
                 const size_t p = static_cast<size_t>(row) * width + column;
                 for (int k = 0; k < kRoundPasses; ++k) {
@@ -286,6 +289,7 @@ MonteCarloImage trace_camera_image(const TetMesh& mesh, const TetConnectivity& c
                 }
             }
         });
+        check_cancelled(cancel);
         passes += kRoundPasses;
         finish(passes);
         if (progress) progress({result.paths, passes, result.seconds, result.relative_error});

@@ -50,7 +50,7 @@ struct MonteCarloImage {
 // paths per channel that enter the volume, min_batches the passes before the error target is trusted
 // (batch_photons is not used: a pass is one jittered sample per pixel). Each pixel and pass draws from
 // its own random stream derived from (seed, pass, pixel), so the image is bit-identical on any thread
-// count. Parallel over rows (TBB); progress after each round of passes, cancel checked between rounds
+// count. Parallel over rows (TBB); progress after each round of passes, cancel checked before every row
 // (CancelledError). `grid` is surface_hit_grid(surface). Throws as trace_fluence.
 MonteCarloImage trace_camera_image(const TetMesh& mesh, const TetConnectivity& connectivity,
                                    const std::vector<TetMaterial>& materials, const BoundarySurface& surface,

@@ -507,6 +507,56 @@ TEST(EditorWithoutDisplay, BadOptionsAreRefusedBeforeOpeningAWindow) {
     EXPECT_EQ(testing::line_count(r.err), 1u) << r.err;
 }
 
+// View > Render reference traces the view in the background while the window keeps drawing; Save
+// writes live, reference and difference side by side with the numbers beside them.
+TEST_F(EditorWindow, RenderReferenceTracesTheViewBesideTheLiveImage) {
+    const fs::path dir = scratch_dir("editor_reference");
+    const auto r = run_script(dir, R"([
+        {"frame": 1, "event": "render_reference", "seconds": 3, "noise": 1, "size": 4},
+        {"event": "idle"},
+        {"event": "save_reference", "file": "reference.png"},
+        {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json summary = summary_of(r);
+    EXPECT_GT(summary["frames_while_tracing"].get<int>(), 10) << r.out;  // the window drew meanwhile
+    const Image strip = read_png(dir / "reference.png");
+    nlohmann::json numbers;
+    std::ifstream(dir / "reference.json") >> numbers;
+    // A quarter of the 400 x 300 view across, three images and two gaps.
+    const int w = numbers["width"], h = numbers["height"];
+    EXPECT_GT(w, 40);
+    EXPECT_EQ(strip.width, 3 * w + 2 * 8);
+    EXPECT_EQ(strip.height, h);
+    EXPECT_EQ(numbers["stop_reason"], "seconds");  // 1 % noise is out of reach in 3 s
+    EXPECT_GT(numbers["passes"].get<int>(), 0);
+    EXPECT_GT(numbers["pixels_compared"].get<int>(), w * h / 10);
+    EXPECT_GT(numbers["traced_over_live"].get<double>(), 0);
+    // The cube is lit in the middle of the live and the traced image, and the difference map colours it.
+    const int cx = w / 2, cy = h / 2;
+    const auto brightness = [&](int x0) { return mean_brightness(strip, x0 + cx - 2, cy - 2, x0 + cx + 2, cy + 2); };
+    const double background = 38 + 40 + 46;
+    EXPECT_GT(brightness(0), background + 30);
+    EXPECT_GT(brightness(w + 8), background + 30);
+    EXPECT_NE(brightness(2 * (w + 8)), background);
+}
+
+// Cancel in the Reference window stops a long trace (without it the script's wait for idle would
+// last the trace's hour, past the test's time-out) and leaves nothing to save.
+TEST_F(EditorWindow, CancelledReferenceStopsAndLeavesNothingToSave) {
+    const fs::path dir = scratch_dir("editor_reference_cancel");
+    const auto cancelled = run_script(dir, R"([
+        {"frame": 1, "event": "render_reference", "seconds": 3600, "noise": 0.1},
+        {"frame": 10, "event": "cancel_reference"},
+        {"event": "idle"}])");
+    ASSERT_EQ(cancelled.exit_code, 0) << cancelled.err;
+    EXPECT_GT(summary_of(cancelled)["frames_while_tracing"].get<int>(), 0) << cancelled.out;  // it did start
+    // Saving with no reference is an error (screenshot mode exits with it) and writes nothing.
+    const auto saved = run_script(dir, R"([{"event": "save_reference", "file": "reference.png"}])");
+    EXPECT_NE(saved.exit_code, 0);
+    EXPECT_NE(saved.err.find("no reference rendered yet"), std::string::npos) << saved.err;
+    EXPECT_FALSE(fs::exists(dir / "reference.png"));
+}
+
 TEST_F(EditorWindow, FileExportWritesTheCutSurfaceWithItsLight) {
     const fs::path dir = scratch_dir("editor_export");
     const auto r = run_script(dir, R"([

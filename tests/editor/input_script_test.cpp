@@ -135,6 +135,12 @@ TEST(InputScript, BadScriptsGetOneLineErrorsNamingTheFileAndEntry) {
         {R"([{"event": "crease_angle", "degrees": 181}])", "s.json: entry 0 (crease_angle): field 'degrees': must be between 0 and 180"},
         {R"([{"event": "crease_angle", "degrees": -1}])", "field 'degrees': must be between 0 and 180"},
         {R"([{"event": "crease_angle"}])", "missing field 'degrees'"},
+        {R"([{"event": "render_reference", "seconds": 0}])", "s.json: entry 0 (render_reference): field 'seconds'"},
+        {R"([{"event": "render_reference", "seconds": 1e9}])", "field 'seconds'"},
+        {R"([{"event": "render_reference", "noise": 100}])", "field 'noise': must be a percentage"},
+        {R"([{"event": "render_reference", "size": 3}])", "field 'size': must be 4, 2 or 1"},
+        {R"([{"event": "render_reference", "samples": 3}])", "unknown field 'samples'"},
+        {R"([{"event": "save_reference"}])", "missing field 'file'"},
     };
     for (const auto& [text, expected] : cases) {
         const std::string message = parse_error(text);
@@ -177,6 +183,12 @@ public:
     void open_file(const std::filesystem::path& f) override { add("open " + f.filename().string()); }
     void cancel_task() override { add("cancel"); }
     void choose_repair(const std::string& id) override { add("repair " + id); }
+    void render_reference(std::optional<double> seconds, std::optional<double> noise, std::optional<int> size) override {
+        add("reference " + (seconds ? std::to_string(int(*seconds)) : "-") + " " + (noise ? std::to_string(int(*noise)) : "-") +
+            " " + (size ? std::to_string(*size) : "-"));
+    }
+    void cancel_reference() override { add("cancel reference"); }
+    void save_reference(const std::filesystem::path& f) override { add("save reference " + f.filename().string()); }
 
 private:
     void add(const std::string& s) { log.push_back(std::to_string(frame) + ": " + s); }
@@ -212,6 +224,16 @@ TEST(InputScriptPlayer, PlaysOpenCancelAndRepair) {
     target.is_ready = true;
     for (target.frame = 0; target.frame < 4; ++target.frame) player.advance(target);
     EXPECT_EQ(target.log, (std::vector<std::string>{"0: open big.obj", "1: cancel", "2: repair autorefine"}));
+}
+
+TEST(InputScriptPlayer, PlaysTheReferenceEventsWithTheSettingsGiven) {
+    InputScriptPlayer player(parse(R"([{"event": "render_reference", "seconds": 3, "noise": 7, "size": 2},
+        {"event": "render_reference"}, {"event": "cancel_reference"}, {"event": "save_reference", "file": "r.png"}])"));
+    FakeTarget target;
+    target.is_ready = true;
+    for (target.frame = 0; target.frame < 5; ++target.frame) player.advance(target);
+    EXPECT_EQ(target.log, (std::vector<std::string>{"0: reference 3 7 2", "1: reference - - -", "2: cancel reference",
+                                                    "3: save reference r.png"}));
 }
 
 TEST(InputScript, ExampleScriptsParse) {
