@@ -9,10 +9,16 @@
 
 namespace waxwork {
 
-double exitant_radiance_factor(double phi, double q, double eta, bool clamp_negative) {
+ExitantRadianceWeights exitant_radiance_weights(double eta) {
     const double fdr = diffuse_fresnel_reflectance(eta);
     const double a = (1.0 + fdr) / (1.0 - fdr);
-    const double e = ((1.0 + 1.0 / a) * phi - 4.0 * q / (1.0 + fdr)) / (4.0 * std::numbers::pi);  // Eq. 3
+    const double outside = 1.0 / (4.0 * std::numbers::pi * eta * eta);  // Eq. 3's 1 / (4 pi), then 1 / eta^2
+    return {(1.0 + 1.0 / a) * outside, 4.0 / (1.0 + fdr) * outside};
+}
+
+double exitant_radiance_factor(double phi, double q, double eta, bool clamp_negative) {
+    const ExitantRadianceWeights w = exitant_radiance_weights(eta);
+    const double e = w.phi_weight * phi - w.q_weight * q;
     return clamp_negative ? std::max(e, 0.0) : e;
 }
 

@@ -1,10 +1,8 @@
 #include "solver/gpu/gpu_radiance.h"
 
 #include "base/error.h"
-#include "solver/material.h"
 
 #include <cmath>
-#include <numbers>
 #include <string>
 
 namespace waxwork {
@@ -38,11 +36,9 @@ GpuRadiance::GpuRadiance(GpuKernels& kernels, const RadianceRows& rows, size_t p
         if (!(row_eta[r] >= 1.0) || !std::isfinite(row_eta[r]))
             throw InvalidArgumentError("GPU radiance: row " + std::to_string(r) + " has eta " +
                                        number_text(row_eta[r]));
-        // exitant_radiance_factor's coefficients (Eq. 3), linear in phi and q.
-        const double fdr = diffuse_fresnel_reflectance(row_eta[r]);
-        const double big_a = (1.0 + fdr) / (1.0 - fdr);
-        a[r] = static_cast<float>((1.0 + 1.0 / big_a) / (4.0 * std::numbers::pi));
-        c[r] = static_cast<float>(4.0 / (1.0 + fdr) / (4.0 * std::numbers::pi));
+        const ExitantRadianceWeights w = exitant_radiance_weights(row_eta[r]);
+        a[r] = static_cast<float>(w.phi_weight);
+        c[r] = static_cast<float>(w.q_weight);
     }
     row_vertex_ = GpuBuffer::from<int32_t>(kernels.gl(), row_vertex);
     phi_weight_ = GpuBuffer::from<float>(kernels.gl(), a);

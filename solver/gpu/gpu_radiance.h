@@ -1,7 +1,7 @@
 // The view-independent exitant radiance factor of solver/radiance.h (Li et al. 2013, Eq. 3 without
 // F_t) computed on the device from the resident fluence, so a renderer on the same context can read E
 // without a round trip through the CPU:
-//     E = max( (1 + 1/A) / (4 pi) phi - 4 / ((1 + F_dr) 4 pi) q, 0 )
+//     E = max( phi_weight phi - q_weight q, 0 )   (exitant_radiance_weights of the row's eta)
 // at chosen rows, each reading phi at one volume vertex: the renderer's shading vertices
 // (shading_surface.h), several of which read the same vertex where the surface is split at a crease,
 // each with its own q. The two weights depend only on the row's eta, so they are uploaded once per

@@ -9,10 +9,10 @@
 namespace waxwork {
 namespace {
 
-TEST(Radiance, FactorFollowsEq3) {
+TEST(Radiance, FactorFollowsEq3WithTheBoundarysOneOverEtaSquared) {
     const double eta = 1.3, fdr = diffuse_fresnel_reflectance(eta), a = boundary_reflection_parameter(eta);
     const double phi = 5.0, q = 0.7;
-    const double expected = ((1 + 1 / a) * phi - 4 * q / (1 + fdr)) / (4 * std::numbers::pi);
+    const double expected = ((1 + 1 / a) * phi - 4 * q / (1 + fdr)) / (4 * std::numbers::pi) / (eta * eta);
     EXPECT_NEAR(exitant_radiance_factor(phi, q, eta), expected, 1e-15);
     EXPECT_NEAR(exitant_radiance(phi, q, eta, 0.6), fresnel_transmittance(0.6, eta) * expected, 1e-15);
     EXPECT_EQ(exitant_radiance(phi, q, eta, 0.0), 0.0);  // grazing: no transmission
