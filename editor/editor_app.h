@@ -87,8 +87,12 @@ struct EditorRunStats {
     std::string gpu_fallback_reason;  // why the GPU backend was given up, if it was
     std::string method_fallback_reason;  // why the chosen method ran as Jacobi CG, if it did
     bool view_reads_device_radiance = false;  // the 3D view drew E from the GPU solver's buffer
-    // Frames drawn while a reference was being traced (View > Render reference): their UI and view
-    // work (not the screenshot mode's waits between frames), mean and longest.
+    // Frames drawn while an input script ran, and while a reference was being traced (View > Render
+    // reference): their UI and view work (not the screenshot mode's waits between frames), mean and
+    // longest.
+    int script_frames = 0;
+    double mean_script_frame_ms = 0;
+    double max_script_frame_ms = 0;
     int frames_while_tracing = 0;
     double mean_frame_ms_while_tracing = 0;
     double max_frame_ms_while_tracing = 0;

@@ -103,7 +103,10 @@ void EditorApp::draw_ui() {
     draw_tool_palette();
     draw_side_panel();
     draw_status_bar();
-    switch (reference_->draw(scene_->light_version, ui_scale_)) {
+    // The Reference window opens over the lower part of the view, clear of the tool palette.
+    const float reference_x = (kToolPaletteWidth + 12) * ui_scale_;
+    const float reference_y = ImGui::GetIO().DisplaySize.y - (360 + 48) * ui_scale_;
+    switch (reference_->draw(scene_->light_version, ui_scale_, reference_x, std::max(reference_y, 40.0f))) {
     case ReferenceView::Request::Render: render_reference(); break;
     case ReferenceView::Request::Save: open_dialog(FileDialog::Mode::Save, SaveKind::Reference); break;
     case ReferenceView::Request::None: break;

@@ -1,5 +1,6 @@
 #include "editor/reference_view.h"
 
+#include "base/thread_priority.h"
 #include "render/difference_map.h"
 
 #include <imgui.h>
@@ -43,6 +44,8 @@ void ReferenceView::start(std::shared_ptr<const ReferenceScene> scene, const Pix
     open_ = true;
     const long long generation = generation_;
     task_.start("Reference", [scene = std::move(scene), camera, options, scene_version, generation, this](TaskProgress& progress) {
+        // The trace's own thread (on two cores, the only one tracing) gives way to the window's.
+        lower_this_thread_priority();
         auto traced = std::make_shared<ReferenceComparison>(render_reference(*scene, camera, options, &progress));
         // Runs on the UI thread (BackgroundTask::poll), the only place the view's state changes.
         return BackgroundTask::Apply([this, traced, scene_version, generation] {
@@ -108,9 +111,10 @@ void ReferenceView::upload() {
     gl_.BindTexture(GL_TEXTURE_2D, 0);
 }
 
-ReferenceView::Request ReferenceView::draw(long long scene_version, float ui_scale) {
+ReferenceView::Request ReferenceView::draw(long long scene_version, float ui_scale, float x, float y) {
     if (!open_) return Request::None;
-    ImGui::SetNextWindowSize(ImVec2(900 * ui_scale, 440 * ui_scale), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(760 * ui_scale, 360 * ui_scale), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("Reference", &open_)) {
         ImGui::End();
         return Request::None;
@@ -153,10 +157,13 @@ ReferenceView::Request ReferenceView::draw(long long scene_version, float ui_sca
     if (result_version_ != scene_version)
         ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "The scene has changed since: this is the reference of an earlier state.");
     ImGui::Checkbox("Each at its own exposure (compare the light's shape, not its brightness)", &own_exposure_);
+    // Three images across, as large as the window allows with the titles, legend and numbers visible.
     const float gap = 8 * ui_scale;
-    const float avail = ImGui::GetContentRegionAvail().x;
-    const float w = std::max(32.0f, (avail - 2 * gap) / 3);
-    const float h = w * static_cast<float>(r.live_image.height) / static_cast<float>(std::max(1, r.live_image.width));
+    const ImVec2 avail = ImGui::GetContentRegionAvail();
+    const float aspect = static_cast<float>(r.live_image.width) / static_cast<float>(std::max(1, r.live_image.height));
+    const float text_below = 4 * ImGui::GetFrameHeightWithSpacing();
+    const float w = std::max(32.0f, std::min((avail.x - 2 * gap) / 3, (avail.y - text_below) * aspect));
+    const float h = w / aspect;
     const char* titles[] = {"Live (diffusion, Eq. 3)", "Reference (Monte Carlo)", "Difference"};
     const GLuint shown[] = {textures_[0], own_exposure_ ? textures_[2] : textures_[1], own_exposure_ ? textures_[4] : textures_[3]};
     for (int i = 0; i < 3; ++i) {

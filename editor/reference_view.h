@@ -51,7 +51,8 @@ public:
     enum class Request { None, Render, Save };
     // The Reference window (when shown): the settings, Render, the progress with Cancel, the three
     // images and their numbers, Save. `scene_version` as for start.
-    Request draw(long long scene_version, float ui_scale);
+    // `x`, `y`: where the window first opens (window coordinates; the user may move it).
+    Request draw(long long scene_version, float ui_scale, float x, float y);
     // Asks the window to show (View > Render reference opens it even before the first result).
     void show() { open_ = true; }
     // Another document was opened: cancels the trace and forgets the result (a trace that ends later
