@@ -447,7 +447,7 @@ void EditorApp::on_key(int key, int mods) {
         break;
     }
     case GLFW_KEY_C: select_tool(Tool::Cut); break;
-    case GLFW_KEY_X: select_tool(Tool::ExactCut); break;
+    case GLFW_KEY_X: select_tool(Tool::RemoveCut); break;
     case GLFW_KEY_R: select_tool(Tool::Relax); break;
     case GLFW_KEY_F: select_tool(Tool::Fracture); break;
     case GLFW_KEY_D: remove_fragments(); break;

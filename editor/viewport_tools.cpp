@@ -11,7 +11,7 @@ const std::vector<ToolInfo>& tool_infos() {
     static const std::vector<ToolInfo> tools = {
         {Tool::Orbit, "Orbit", "Esc", "orbit"},
         {Tool::Cut, "Cut", "C", "cut"},
-        {Tool::ExactCut, "Exact cut", "X", "exact_cut"},
+        {Tool::RemoveCut, "Remove cut", "X", "remove_cut"},
         {Tool::Relax, "Relax", "R", "relax"},
         {Tool::Fracture, "Fracture", "F", "fracture"},
         {Tool::MovePiece, "Move piece", "M", "move_piece"},
@@ -30,8 +30,12 @@ bool is_deform_tool(Tool tool) { return tool == Tool::Grab || tool == Tool::Bend
 const char* tool_hint(Tool tool) {
     switch (tool) {
     case Tool::Orbit: return "Drag: orbit. Right drag: orbit, middle drag: pan, wheel: zoom.";
-    case Tool::Cut: return "Draw a stroke across the object: the ticked (left) side is cut away; Shift: the right.";
-    case Tool::ExactCut: return "Draw a stroke: cut exactly along it (tets split at the surface); Shift: keep the left.";
+    case Tool::Cut:
+        return "Draw a stroke across the object: it cuts exactly along it (tets split at the surface) and the "
+               "ticked (left) side goes; Shift: the right.";
+    case Tool::RemoveCut:
+        return "The paper's cut, for comparison: the tets on the ticked side go whole and the jagged "
+               "cross-section is relaxed (R relaxes more); Shift: the right side.";
     case Tool::Relax: return "Relax the cross-sections of the last cut.";
     case Tool::Fracture: return "Draw a stroke: the object breaks into pieces along it; a click: random pieces.";
     case Tool::MovePiece: return "Drag a piece to move it (after Fracture); Esc while dragging puts it back.";
@@ -164,7 +168,7 @@ void ViewportTools::begin(const PointerEvent& event, const ViewportContext& cont
         case Tool::Orbit:
         case Tool::Relax: drag_ = Drag::Orbit; break;
         case Tool::Cut:
-        case Tool::ExactCut:
+        case Tool::RemoveCut:
         case Tool::Fracture:
         case Tool::Paint:
             drag_ = Drag::Stroke;
@@ -260,8 +264,8 @@ void ViewportTools::finish(const PointerEvent& event, const ViewportContext& con
     const OrbitCamera& camera = *context.camera;
     if (drag_ == Drag::Stroke) {
         const ScreenStroke stroke = simplify_stroke(stroke_, kStrokeSpacing);
-        if (tool_ == Tool::Cut || tool_ == Tool::ExactCut) {
-            out.cut = stroke_cut_op(camera, stroke, context.width, context.height, tool_ == Tool::ExactCut,
+        if (tool_ == Tool::Cut || tool_ == Tool::RemoveCut) {
+            out.cut = stroke_cut_op(camera, stroke, context.width, context.height, tool_ == Tool::Cut,
                                     event.modifiers.shift);
         } else if (tool_ == Tool::Paint) {
             if (!stroke.empty()) out.paint = stroke;
@@ -370,7 +374,7 @@ ToolOverlay ViewportTools::overlay() const {
     ToolOverlay overlay;
     if (drag_ != Drag::Stroke) return overlay;
     overlay.stroke = stroke_;
-    if (tool_ != Tool::Cut && tool_ != Tool::ExactCut) return overlay;
+    if (tool_ != Tool::Cut && tool_ != Tool::RemoveCut) return overlay;
     // Ticks every kTickSpacing pixels of arc length, on the side that goes: the left of the stroke as
     // drawn (y down, so the left of direction (dx, dy) is (dy, -dx)), the right with Shift.
     double next_tick = 0.5 * kTickSpacing, travelled = 0;

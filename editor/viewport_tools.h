@@ -25,7 +25,7 @@
 
 namespace waxwork {
 
-enum class Tool { Orbit, Cut, ExactCut, Relax, Fracture, MovePiece, Paint, Light, Grab, Bend, Twist, Pin };
+enum class Tool { Orbit, Cut, RemoveCut, Relax, Fracture, MovePiece, Paint, Light, Grab, Bend, Twist, Pin };
 
 // Grab, Bend and Twist: the tools that deform the volume while dragging.
 bool is_deform_tool(Tool tool);
@@ -34,7 +34,7 @@ struct ToolInfo {
     Tool tool;
     const char* name;
     const char* shortcut;  // shown in the menus; empty: none
-    const char* id;        // the name input scripts use ("exact_cut")
+    const char* id;        // the name input scripts use ("remove_cut")
 };
 const std::vector<ToolInfo>& tool_infos();
 // One line on what a left drag does with the tool and the camera controls (tooltips, the overlay).

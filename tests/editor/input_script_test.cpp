@@ -27,7 +27,7 @@ std::string parse_error(const std::string& text) {
 
 TEST(InputScript, ParsesEveryEventKind) {
     const InputScript s = parse(R"([
-        {"event": "tool", "tool": "exact_cut"},
+        {"event": "tool", "tool": "remove_cut"},
         {"frame": 3, "event": "press", "x": 10, "y": 20.5, "button": "right", "mods": ["shift", "alt"]},
         {"event": "move", "x": 15, "y": 25},
         {"event": "release", "x": 16, "y": 26, "button": "right"},
@@ -40,7 +40,7 @@ TEST(InputScript, ParsesEveryEventKind) {
         {"event": "export_surface", "file": "out/v.ply"}])");
     ASSERT_EQ(s.events.size(), 11u);
     EXPECT_EQ(s.events[0].action, ScriptAction::SelectTool);
-    EXPECT_EQ(s.events[0].tool, Tool::ExactCut);
+    EXPECT_EQ(s.events[0].tool, Tool::RemoveCut);
     EXPECT_FALSE(s.events[0].frame);
     EXPECT_EQ(s.events[1].action, ScriptAction::Press);
     EXPECT_EQ(s.events[1].frame, 3);
@@ -123,7 +123,7 @@ TEST(InputScript, BadScriptsGetOneLineErrorsNamingTheFileAndEntry) {
         {R"([{"event": "press", "x": 1, "y": 1, "colour": 3}])", "unknown field 'colour'"},
         {R"([{"event": "move", "x": 1, "y": 1, "frame": -1}])", "field 'frame'"},
         {R"([{"event": "key", "key": "F13"}])", "s.json: entry 0 (key): field 'key'"},
-        {R"([{"event": "tool", "tool": "chisel"}])", "expected one of orbit, cut, exact_cut"},
+        {R"([{"event": "tool", "tool": "chisel"}])", "expected one of orbit, cut, remove_cut"},
         {R"([{"event": "material", "material": "cheese"}])", "s.json: entry 0 (material): field 'material': expected a measured preset: apple"},
         {R"([{"event": "material", "material": 3}])", "field 'material'"},
         {R"([{"event": "drag", "from": [0, 0]}])", "missing field 'to'"},

@@ -46,11 +46,11 @@ ViewportContext context_for(OrbitCamera& camera) {
     return context;
 }
 
-TEST(ViewportTools, CutDragYieldsAStrokeCutThroughTheDraggedPoints) {
+TEST(ViewportTools, RemoveCutDragYieldsAStrokeCutThroughTheDraggedPoints) {
     OrbitCamera camera = test_camera();
     ViewportContext context = context_for(camera);
     ViewportTools tools;
-    tools.set_tool(Tool::Cut, context);
+    tools.set_tool(Tool::RemoveCut, context);
     const std::vector<Eigen::Vector2d> points = {{100, 50}, {150, 120}, {220, 180}, {300, 250}};
     tools.pointer(event(PointerAction::Press, 100, 50, PointerButton::Left), context);
     for (size_t i = 1; i < points.size(); ++i) {
@@ -76,11 +76,11 @@ TEST(ViewportTools, CutDragYieldsAStrokeCutThroughTheDraggedPoints) {
     EXPECT_TRUE(tools.overlay().stroke.empty());
 }
 
-TEST(ViewportTools, ExactCutAndShiftFlipTheSide) {
+TEST(ViewportTools, TheCutToolCutsExactlyAndShiftFlipsTheSide) {
     OrbitCamera camera = test_camera();
     ViewportContext context = context_for(camera);
     ViewportTools tools;
-    tools.set_tool(Tool::ExactCut, context);
+    tools.set_tool(Tool::Cut, context);
     const ToolOutcome out = drag(tools, context, {{200, 20}, {200, 150}, {200, 280}}, PointerButton::Left, {true, false, false});
     ASSERT_TRUE(out.cut);
     EXPECT_TRUE(out.cut->exact);
