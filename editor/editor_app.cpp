@@ -78,6 +78,9 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
     }
     const std::vector<std::string> presets = material_preset_names();
     selected_preset_ = static_cast<int>(std::find(presets.begin(), presets.end(), "marble") - presets.begin());
+    // A brush that shows on the default marble: ketchup's red absorbs most of blue and green.
+    brush_preset_ = static_cast<int>(std::find(presets.begin(), presets.end(), "ketchup") - presets.begin());
+    brush_material_ = material_preset("ketchup");
 
     // Our callbacks go in first: ImGui's GLFW backend (install_callbacks = true) chains to them.
     glfwSetWindowUserPointer(window_, this);

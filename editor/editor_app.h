@@ -234,6 +234,7 @@ private:
     void draw_tool_palette();
     void draw_side_panel();
     void draw_material_panel();
+    void draw_brush_panel();
     void draw_deform_panel();
     void draw_light_panel();
     void draw_environment_controls();
@@ -289,6 +290,8 @@ private:
     void queue_deform(const ToolOutcome& outcome);
     void queue_cancel_deform();
     void draw_tool_overlay();
+    // The Paint tool's rings on the surface under the cursor (stroke_tools.h brush_cursor).
+    void draw_brush_cursor();
     void update_piece_preview();
     SurfaceRenderInput with_piece_preview(const SurfaceRenderInput& input) const;
     void layout_viewport(int fb_w, int fb_h);
@@ -374,7 +377,12 @@ private:
     std::array<char, 1024> environment_file_{};
     int selected_preset_ = 0;
     std::optional<TetMaterial> custom_material_;  // the material panel's current material
-    float brush_radius_ = 0.05f;                  // paint brush sigma, fraction of the scene radius
+    // The paint brush, apart from the object's material: its preset, material and sigma (a fraction
+    // of the scene radius). The Brush panel opens when the Paint tool is chosen.
+    int brush_preset_ = 0;
+    TetMaterial brush_material_;
+    float brush_radius_ = 0.05f;
+    bool open_brush_panel_ = false;
     // Grab, Bend, Twist and Pin: the handle's falloff radius (fraction of the scene radius), the
     // ARAP iterations each preview frame runs, and the pins placed (world space).
     float deform_radius_ = 0.25f;

@@ -217,6 +217,9 @@ void EditorApp::draw_side_panel() {
     ImGui::SetNextWindowSize(ImVec2(width, io.DisplaySize.y - top - ImGui::GetFrameHeight() * 1.2f));
     ImGui::Begin("Scene", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
     if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) draw_material_panel();
+    if (open_brush_panel_) ImGui::SetNextItemOpen(true);
+    open_brush_panel_ = false;
+    if (ImGui::CollapsingHeader("Brush")) draw_brush_panel();
     if (ImGui::CollapsingHeader("Deform")) draw_deform_panel();
     if (ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) draw_light_panel();
     if (ImGui::CollapsingHeader("Solver", ImGuiTreeNodeFlags_DefaultOpen)) draw_solver_panel();
@@ -224,30 +227,32 @@ void EditorApp::draw_side_panel() {
     ImGui::End();
 }
 
-void EditorApp::draw_material_panel() {
+namespace {
+
+// A preset list (click to take a preset) above the coefficients it filled in, which stay editable:
+// the Material and the Brush panels each have one, for their own material.
+void material_editor(const char* id, int& preset, TetMaterial& m) {
     const std::vector<std::string> names = material_preset_names();
-    selected_preset_ = std::clamp(selected_preset_, 0, static_cast<int>(names.size()) - 1);
-    ImGui::TextDisabled("Jensen et al. 2001, per mm; swatch: diffuse reflectance");
+    preset = std::clamp(preset, 0, static_cast<int>(names.size()) - 1);
+    ImGui::PushID(id);
     const float swatch_size = ImGui::GetFrameHeight();
     ImGui::BeginChild("presets", ImVec2(0, 5.3f * ImGui::GetFrameHeightWithSpacing()), true);
     for (int i = 0; i < static_cast<int>(names.size()); ++i) {
-        const TetMaterial m = material_preset(names[i]);
+        const TetMaterial p = material_preset(names[i]);
         ImGui::PushID(i);
-        ImGui::ColorButton("##swatch", swatch(m), ImGuiColorEditFlags_NoTooltip, ImVec2(swatch_size, swatch_size * 0.8f));
+        ImGui::ColorButton("##swatch", swatch(p), ImGuiColorEditFlags_NoTooltip, ImVec2(swatch_size, swatch_size * 0.8f));
         ImGui::SameLine();
-        if (ImGui::Selectable(names[i].c_str(), selected_preset_ == i)) {
-            selected_preset_ = i;
-            custom_material_ = m;
+        if (ImGui::Selectable(names[i].c_str(), preset == i)) {
+            preset = i;
+            m = p;
         }
         if (ImGui::IsItemHovered()) {
-            ImGui::SetTooltip("mu_a  %.4f %.4f %.4f /mm\nmu_s' %.2f %.2f %.2f /mm\neta %.2f", m.mua[0], m.mua[1], m.mua[2],
-                              m.musp[0], m.musp[1], m.musp[2], m.eta);
+            ImGui::SetTooltip("mu_a  %.4f %.4f %.4f /mm\nmu_s' %.2f %.2f %.2f /mm\neta %.2f", p.mua[0], p.mua[1], p.mua[2],
+                              p.musp[0], p.musp[1], p.musp[2], p.eta);
         }
         ImGui::PopID();
     }
     ImGui::EndChild();
-    if (!custom_material_) custom_material_ = material_preset(names[selected_preset_]);
-    TetMaterial& m = *custom_material_;
     float mua[3] = {static_cast<float>(m.mua[0]), static_cast<float>(m.mua[1]), static_cast<float>(m.mua[2])};
     float musp[3] = {static_cast<float>(m.musp[0]), static_cast<float>(m.musp[1]), static_cast<float>(m.musp[2])};
     float eta = static_cast<float>(m.eta);
@@ -262,11 +267,30 @@ void EditorApp::draw_material_panel() {
         m.eta = std::clamp(static_cast<double>(eta), 1.0, 3.0);
     }
     ImGui::ColorButton("##custom", swatch(m), ImGuiColorEditFlags_NoTooltip, ImVec2(swatch_size * 2, swatch_size));
+    ImGui::PopID();
+}
+
+}  // namespace
+
+void EditorApp::draw_material_panel() {
+    const std::vector<std::string> names = material_preset_names();
+    ImGui::TextDisabled("Jensen et al. 2001, per mm; swatch: diffuse reflectance");
+    if (!custom_material_) custom_material_ = material_preset(names[std::clamp(selected_preset_, 0, static_cast<int>(names.size()) - 1)]);
+    TetMaterial& m = *custom_material_;
+    material_editor("object", selected_preset_, m);
     ImGui::SameLine();
     const bool has_scene = scene_->core != nullptr;
     if (ImGui::Button("Apply to the whole object") && has_scene) set_whole_material(m, names[selected_preset_]);
-    ImGui::TextDisabled("Object: %s; Paint (P) brushes it in locally", scene_->material_name.c_str());
+    ImGui::TextDisabled("Object: %s", scene_->material_name.c_str());
+}
+
+void EditorApp::draw_brush_panel() {
+    ImGui::TextDisabled("Paint (P) brushes this material into the volume");
+    material_editor("brush", brush_preset_, brush_material_);
+    ImGui::SameLine();
+    ImGui::TextUnformatted(material_preset_names()[brush_preset_].c_str());
     ImGui::SliderFloat("brush radius", &brush_radius_, 0.005f, 0.3f, "%.3f x size");
+    ImGui::TextDisabled("Rings on the surface: half strength, a tenth");
 }
 
 void EditorApp::draw_deform_panel() {

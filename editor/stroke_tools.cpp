@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace waxwork {
 
@@ -61,6 +62,40 @@ std::vector<Eigen::Vector3d> stroke_on_surface(const OrbitCamera& camera, const 
         if (const auto hit = first_hit(bvh, ray, reach)) points.push_back(*hit);
     }
     return points;
+}
+
+std::optional<BrushCursor> brush_cursor(const OrbitCamera& camera, const TriangleBvh& bvh, const Eigen::Vector2d& pixel,
+                                        double viewport_width, double viewport_height, double sigma) {
+    const double reach = camera.distance() + 4 * camera.scene_radius();
+    const auto hit_at = [&](const Eigen::Vector2d& p) {
+        return first_hit(bvh, camera.unproject(p, viewport_width, viewport_height), reach);
+    };
+    const std::optional<Eigen::Vector3d> center = hit_at(pixel);
+    if (!center) return std::nullopt;
+    BrushCursor cursor;
+    cursor.center = *center;
+    // Three pixels aside: far enough that float hits give a stable plane, near enough to stay on the
+    // facet under the cursor at the brush sizes one paints with.
+    constexpr double kNormalOffsetPixels = 3;
+    const auto right = hit_at(pixel + Eigen::Vector2d(kNormalOffsetPixels, 0));
+    const auto down = hit_at(pixel + Eigen::Vector2d(0, kNormalOffsetPixels));
+    const Eigen::Vector3d towards_eye = (camera.eye() - *center).normalized();
+    Eigen::Vector3d normal = towards_eye;
+    if (right && down) {
+        const Eigen::Vector3d n = (*right - *center).cross(*down - *center);
+        if (n.norm() > 0) normal = n.dot(towards_eye) >= 0 ? n.normalized() : Eigen::Vector3d(-n.normalized());
+    }
+    cursor.normal = normal;
+    const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+    // exp(-r^2 / (2 sigma^2)) = w at r = sigma sqrt(-2 ln w).
+    const double half = sigma * std::sqrt(2 * std::log(2.0)), tenth = sigma * std::sqrt(2 * std::log(10.0));
+    for (int i = 0; i < kBrushCursorSegments; ++i) {
+        const double angle = 2 * std::numbers::pi * i / kBrushCursorSegments;
+        const Eigen::Vector3d direction = std::cos(angle) * u + std::sin(angle) * v;
+        cursor.half_strength.push_back(camera.project(*center + half * direction, viewport_width, viewport_height).head<2>());
+        cursor.tenth_strength.push_back(camera.project(*center + tenth * direction, viewport_width, viewport_height).head<2>());
+    }
+    return cursor;
 }
 
 std::optional<StrokeCutOp> stroke_cut_op(const OrbitCamera& camera, const ScreenStroke& stroke,

@@ -36,6 +36,20 @@ std::vector<Eigen::Vector3d> stroke_on_surface(const OrbitCamera& camera, const 
                                                const ScreenStroke& stroke, double viewport_width,
                                                double viewport_height);
 
+// The paint brush's footprint under the cursor, for drawing it: where the view ray through `pixel`
+// meets the surface (cross-sections included: they are surface too), the surface's normal there
+// (from the hits of two rays a few pixels aside; facing the camera where those miss), and two rings
+// in that tangent plane, in viewport pixels: where the Gaussian brush (tetops/paint.h) blends at half
+// strength and at a tenth. nullopt when the ray misses the object.
+struct BrushCursor {
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+    std::vector<Eigen::Vector2d> half_strength, tenth_strength;  // closed outlines (first point not repeated)
+};
+inline constexpr int kBrushCursorSegments = 48;
+std::optional<BrushCursor> brush_cursor(const OrbitCamera& camera, const TriangleBvh& bvh, const Eigen::Vector2d& pixel,
+                                        double viewport_width, double viewport_height, double sigma);
+
 // The cut a stroke draws: swept from the camera's eye along its view rays; the left side of the
 // stroke as drawn is cut away, the right with `flip` (Shift in the editor). nullopt for a stroke of
 // fewer than two distinct points.

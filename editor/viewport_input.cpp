@@ -95,8 +95,7 @@ void EditorApp::apply_tool_outcome(const ToolOutcome& outcome) {
         if (outcome.paint) {
             if (!scene_->surface_bvh) return;
             const auto op = paint_op(*camera_, *scene_->surface_bvh, *outcome.paint, view_w_, view_h_,
-                                     custom_material_.value_or(material_preset("marble")),
-                                     brush_radius_ * camera_->scene_radius());
+                                     brush_material_, brush_radius_ * camera_->scene_radius());
             if (op) queue_edit(*op);
             else status_ = "Paint: the stroke missed the object";
         }
@@ -127,6 +126,7 @@ void EditorApp::select_tool(Tool tool) {
     const bool deforming = tools_.active() && is_deform_tool(tools_.tool());
     tools_.set_tool(tool, viewport_context());
     if (deforming) queue_cancel_deform();
+    if (tool == Tool::Paint) open_brush_panel_ = true;
 }
 
 void EditorApp::queue_deform(const ToolOutcome& outcome) {
@@ -167,8 +167,8 @@ void EditorApp::select_brush_material(const std::string& name) {
     const std::vector<std::string> names = material_preset_names();
     const auto it = std::find(names.begin(), names.end(), name);
     if (it == names.end()) throw InvalidArgumentError("no material preset named '" + name + "'");
-    selected_preset_ = static_cast<int>(it - names.begin());
-    custom_material_ = material_preset(name);
+    brush_preset_ = static_cast<int>(it - names.begin());
+    brush_material_ = material_preset(name);
 }
 
 std::optional<PieceHit> EditorApp::piece_under(const Eigen::Vector2d& pixel) const {
@@ -236,6 +236,7 @@ void EditorApp::draw_tool_overlay() {
                 draw->AddCircle(to_screen(c.x(), c.y()), radius, IM_COL32(90, 220, 140, 220), 0, 1.5f * ui_scale_);
         }
     }
+    draw_brush_cursor();
     const ToolOverlay overlay = tools_.overlay();
     if (overlay.stroke.size() < 2) return;
     const ImU32 colour = tools_.tool() == Tool::Paint ? IM_COL32(120, 200, 255, 230) : IM_COL32(255, 190, 90, 230);
@@ -245,6 +246,38 @@ void EditorApp::draw_tool_overlay() {
     for (const auto& tick : overlay.cut_side_ticks)
         draw->AddLine(to_screen(tick[0].x(), tick[0].y()), to_screen(tick[1].x(), tick[1].y()),
                       IM_COL32(255, 110, 80, 230), 1.5f * ui_scale_);
+}
+
+namespace {
+
+// The brush rings' colour: the stroke overlay's paint blue, opaque (and a fainter copy for the outer ring).
+constexpr ImU32 kBrushRingColour = IM_COL32(80, 200, 255, 255);
+constexpr ImU32 kFaintBrushRingColour = IM_COL32(80, 200, 255, 150);
+
+}  // namespace
+
+void EditorApp::draw_brush_cursor() {
+    if (tools_.tool() != Tool::Paint || !camera_ || !scene_->surface_bvh || ui_has_pointer()) return;
+    const Eigen::Vector2d pixel = cursor_ * framebuffer_scale_ - Eigen::Vector2d(view_x_, view_y_);
+    if (pixel.x() < 0 || pixel.y() < 0 || pixel.x() >= view_w_ || pixel.y() >= view_h_) return;
+    const std::optional<BrushCursor> brush = brush_cursor(*camera_, *scene_->surface_bvh, pixel, view_w_, view_h_,
+                                                          brush_radius_ * camera_->scene_radius());
+    if (!brush) return;
+    ImDrawList* draw = ImGui::GetForegroundDrawList();
+    const double s = framebuffer_scale_;
+    const auto outline = [&](const std::vector<Eigen::Vector2d>& ring, ImU32 colour, float thickness) {
+        std::vector<ImVec2> points;
+        for (const Eigen::Vector2d& p : ring)
+            points.emplace_back(static_cast<float>((p.x() + view_x_) / s), static_cast<float>((p.y() + view_y_) / s));
+        draw->AddPolyline(points.data(), static_cast<int>(points.size()), colour, ImDrawFlags_Closed, thickness);
+    };
+    // Dark under light, so the rings read on a bright surface and on a dark one alike.
+    outline(brush->tenth_strength, IM_COL32(0, 0, 0, 110), 2.5f * ui_scale_);
+    outline(brush->tenth_strength, kFaintBrushRingColour, 1.0f * ui_scale_);
+    outline(brush->half_strength, IM_COL32(0, 0, 0, 160), 3.5f * ui_scale_);
+    outline(brush->half_strength, kBrushRingColour, 1.8f * ui_scale_);
+    const ImVec2 centre(static_cast<float>(cursor_.x()), static_cast<float>(cursor_.y()));
+    draw->AddCircleFilled(centre, 2.0f * ui_scale_, kBrushRingColour);
 }
 
 namespace {

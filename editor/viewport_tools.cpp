@@ -39,7 +39,7 @@ const char* tool_hint(Tool tool) {
     case Tool::Relax: return "Relax the cross-sections of the last cut.";
     case Tool::Fracture: return "Draw a stroke: the object breaks into pieces along it; a click: random pieces.";
     case Tool::MovePiece: return "Drag a piece to move it (after Fracture); Esc while dragging puts it back.";
-    case Tool::Paint: return "Paint the selected material into the volume under the stroke.";
+    case Tool::Paint: return "Paint the Brush panel's material into the volume under the stroke; the rings show its reach.";
     case Tool::Light: return "Drag: turn the selected directional light like a trackball, or move the point light.";
     case Tool::Grab: return "Drag the surface: the body follows as rigidly as it can; pins (N) hold it elsewhere.";
     case Tool::Bend: return "Drag around the pins: the grabbed end turns about the view axis through their centre.";

@@ -507,6 +507,33 @@ TEST(EditorWithoutDisplay, BadOptionsAreRefusedBeforeOpeningAWindow) {
     EXPECT_EQ(testing::line_count(r.err), 1u) << r.err;
 }
 
+// The Paint tool draws its rings on the surface under the cursor, and only the Paint tool: the same
+// cursor position with the Orbit tool shows none of the rings' blue.
+TEST_F(EditorWindow, PaintToolDrawsTheBrushRingsUnderTheCursor) {
+    const fs::path dir = scratch_dir("editor_brush_cursor");
+    const auto blue_pixels = [&](const std::string& tool) {
+        std::ofstream(dir / "input.json") << R"([{"event": "tool", "tool": ")" + tool + R"("},
+            {"frame": 2, "event": "move", "x": 346, "y": 210}, {"event": "idle"}])";
+        const fs::path png = dir / (tool + ".png");
+        const auto r = run_under_xvfb("edit " + kAssets + "/meshes/cube.obj --max-tets 6000 --view 0,0,1 --width 900 "
+                                      "--height 420 --input " + (dir / "input.json").string() + " --frames 2 --screenshot " +
+                                      png.string());
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        if (r.exit_code != 0) return -1;
+        const Image image = read_png(png);
+        int count = 0;
+        for (int y = 130; y < 290; ++y)
+            for (int x = 266; x < 426; ++x) {
+                const uint8_t* p = image.pixel(x, y);
+                count += p[2] > 200 && p[1] > 150 && p[0] < 140;  // the rings' blue, not the grey marble
+            }
+        return count;
+    };
+    const int painting = blue_pixels("paint"), orbiting = blue_pixels("orbit");
+    EXPECT_GT(painting, 100) << "no brush rings drawn";
+    EXPECT_EQ(orbiting, 0);
+}
+
 // View > Render reference traces the view in the background while the window keeps drawing; Save
 // writes live, reference and difference side by side with the numbers beside them.
 TEST_F(EditorWindow, RenderReferenceTracesTheViewBesideTheLiveImage) {

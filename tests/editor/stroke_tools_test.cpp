@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace waxwork {
 namespace {
 
@@ -86,6 +88,52 @@ TEST(StrokeTools, PaintStrokeLandsOnTheVisibleSurface) {
     for (const Eigen::Vector3d& p : on_surface) EXPECT_NEAR(p.z(), 0.25, 1e-5);
     EXPECT_NEAR(on_surface[0].x(), 0, 1e-5);
     EXPECT_NEAR(on_surface[0].y(), 0, 1e-5);
+}
+
+// The brush cursor lies on the surface under the cursor: on a square facing the camera its rings are
+// circles around the cursor of the radii where the Gaussian falls to 1/2 and 1/10; on a tilted square
+// they are ellipses squeezed along the tilt, with the square's normal; off the object there is none.
+TEST(StrokeTools, BrushCursorRingsLieOnTheSurfaceUnderTheCursor) {
+    const std::vector<std::array<int32_t, 3>> triangles = {{0, 1, 2}, {0, 2, 3}};
+    const OrbitCamera camera = front_camera();
+    const double sigma = 0.1;
+    {
+        const std::vector<Eigen::Vector3f> facing = {{-1, -1, 0.25f}, {1, -1, 0.25f}, {1, 1, 0.25f}, {-1, 1, 0.25f}};
+        const TriangleBvh bvh(facing, triangles);
+        const auto cursor = brush_cursor(camera, bvh, Eigen::Vector2d(100, 100), 200, 200, sigma);
+        ASSERT_TRUE(cursor.has_value());
+        EXPECT_NEAR(cursor->center.z(), 0.25, 1e-5);
+        EXPECT_NEAR(cursor->normal.z(), 1.0, 1e-6);
+        ASSERT_EQ(cursor->half_strength.size(), static_cast<size_t>(kBrushCursorSegments));
+        // The rings' world radii, through the projection of a point that far from the centre.
+        const auto pixels_for = [&](double world) {
+            return (camera.project(cursor->center + Eigen::Vector3d(world, 0, 0), 200, 200) -
+                    camera.project(cursor->center, 200, 200)).head<2>().norm();
+        };
+        const double half = pixels_for(sigma * std::sqrt(2 * std::log(2.0)));
+        const double tenth = pixels_for(sigma * std::sqrt(2 * std::log(10.0)));
+        for (int i = 0; i < kBrushCursorSegments; ++i) {
+            EXPECT_NEAR((cursor->half_strength[i] - Eigen::Vector2d(100, 100)).norm(), half, 0.02 * half) << i;
+            EXPECT_NEAR((cursor->tenth_strength[i] - Eigen::Vector2d(100, 100)).norm(), tenth, 0.02 * tenth) << i;
+        }
+        EXPECT_FALSE(brush_cursor(camera, bvh, Eigen::Vector2d(1, 1), 200, 200, sigma).has_value());  // misses
+    }
+    {
+        // Tilted 60 degrees about the x axis: seen along z the ring is half as tall as it is wide.
+        const float c = 0.5f, s = std::sqrt(3.0f) / 2;
+        const std::vector<Eigen::Vector3f> tilted = {{-1, -c, -s}, {1, -c, -s}, {1, c, s}, {-1, c, s}};
+        const TriangleBvh bvh(tilted, triangles);
+        const auto cursor = brush_cursor(camera, bvh, Eigen::Vector2d(100, 100), 200, 200, sigma);
+        ASSERT_TRUE(cursor.has_value());
+        EXPECT_NEAR(std::abs(cursor->normal.dot(Eigen::Vector3d(0, -s, c).normalized())), 1.0, 1e-4);
+        EXPECT_GT(cursor->normal.z(), 0);  // towards the camera
+        double width = 0, height = 0;
+        for (const Eigen::Vector2d& p : cursor->tenth_strength) {
+            width = std::max(width, std::abs(p.x() - 100));
+            height = std::max(height, std::abs(p.y() - 100));
+        }
+        EXPECT_NEAR(height / width, 0.5, 0.05);
+    }
 }
 
 TEST(StrokeTools, CutStrokeBecomesAStrokeCutOpFromTheEye) {
