@@ -279,6 +279,7 @@ void EditorApp::install_core(std::shared_ptr<SceneCore> core, const fs::path& pa
     pending_jobs_.clear();
     reference_snapshot_.reset();
     reference_->clear();
+    snapshots_.clear();
     scene_ = std::make_unique<Scene>();
     scene_->core = core;
     scene_->tets = core->document().mesh().tet_count();
@@ -338,6 +339,27 @@ void EditorApp::export_surface(const fs::path& path) {
     });
 }
 
+CameraSettings EditorApp::recorded_camera() const {
+    if (!camera_) return options_.camera;
+    const double aspect = static_cast<double>(view_w_) / std::max(view_h_, 1);
+    Eigen::AlignedBox3d box;
+    if (scene_->render_input)
+        for (const Eigen::Vector3f& p : scene_->render_input->positions) box.extend(p.cast<double>());
+    return camera_->settings(aspect, box);
+}
+
+double EditorApp::shown_exposure() const { return scene_->automatic_exposure * std::exp2(exposure_stops_); }
+
+void EditorApp::snapshot() {
+    if (!scene_->core || !camera_) {
+        set_error("open a file first");
+        return;
+    }
+    snapshots_.push_back({scene_->history_size, recorded_camera(), lighting_, shown_exposure()});
+    status_ = "Snapshot " + std::to_string(snapshots_.size()) +
+              " recorded: a session saved now renders this view at this point of the edits";
+}
+
 void EditorApp::render_reference() {
     if (!scene_->core || !camera_) {
         set_error("open a file first");
@@ -393,13 +415,14 @@ void EditorApp::save_session(const fs::path& path) {
     // The view and lights as they are now, not as the session started.
     Session current;
     current.lighting = lighting_;
-    current.camera = camera_ ? camera_->settings(static_cast<double>(view_w_) / view_h_) : options_.camera;
+    current.camera = recorded_camera();
     current.width = view_w_;
     current.height = view_h_;
     current.frame_iterations = frame_iterations_;  // the budget as the panel has it now
     if (frame_budget_in_ms_) current.frame_ms = frame_ms_;
     current.crease_angle_degrees = live_options_.crease_angle_degrees;
-    queue_job("save session", [path, current](SceneCore& core) {
+    const double exposure = shown_exposure();
+    queue_job("save session", [path, current, snapshots = snapshots_, exposure](SceneCore& core) {
         Session setup = core.setup();
         setup.frame_iterations = current.frame_iterations;
         setup.frame_ms = current.frame_ms;
@@ -408,8 +431,9 @@ void EditorApp::save_session(const fs::path& path) {
         setup.camera = current.camera;
         setup.width = current.width;
         setup.height = current.height;
-        core.save_session(path, setup);
-        return "Saved the session (" + std::to_string(core.document().history().size()) + " edits) to " + path.string();
+        core.save_session(path, setup, snapshots, exposure);
+        return "Saved the session (" + std::to_string(core.document().history().size()) + " edits, " +
+               std::to_string(snapshots.size()) + " snapshots) to " + path.string();
     });
 }
 
@@ -522,6 +546,8 @@ void EditorApp::start_tick() {
             if (r->history != s.history_size || r->can_undo != s.can_undo || r->can_redo != s.can_redo ||
                 request->lighting || request->crease_angle)
                 ++s.light_version;
+            // A snapshot of a state an undo went back past shows what no longer exists.
+            std::erase_if(snapshots_, [&](const SessionSnapshot& shot) { return shot.history > r->history; });
             for (const std::string& m : r->messages) status_ = m;
             for (const std::string& e : r->errors) set_error(e);
             if (r->input) {

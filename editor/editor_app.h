@@ -210,6 +210,14 @@ public:
     // InvalidArgumentError outside [0, 180].
     void set_crease_angle(double degrees);
     void save_session(const std::filesystem::path& path);
+    // File > Snapshot: the view and lights as they are now, at this point of the edit history, become a
+    // render step in the sessions saved from now on (dropped when an undo goes back past it).
+    void snapshot();
+    size_t snapshot_count() const { return snapshots_.size(); }
+    // The view as a session records it: the camera relative to the shown model's box now (a cut model
+    // frames differently from the loaded one) and the exposure it is drawn with.
+    CameraSettings recorded_camera() const;
+    double shown_exposure() const;
     // File > Export: the boundary surface (.ply, .obj, .stl), with the current light's radiance baked
     // into vertex colours where the format stores them (SceneCore::export_surface), in the background.
     void export_surface(const std::filesystem::path& path);
@@ -356,6 +364,7 @@ private:
         std::shared_ptr<const ReferenceScene> scene;
     };
     std::shared_ptr<ReferenceSnapshot> reference_snapshot_;
+    std::vector<SessionSnapshot> snapshots_;  // File > Snapshot, in the order taken
     PixelCamera reference_camera_;
     std::deque<std::pair<std::string, SceneJob>> pending_jobs_;  // for the next tick, in order
     bool lighting_dirty_ = false;                                // send lighting_ with the next tick

@@ -147,6 +147,9 @@ void EditorApp::draw_menu_bar() {
         if (ImGui::MenuItem("Open...", "Ctrl+O")) open_dialog(FileDialog::Mode::Open);
         if (ImGui::MenuItem("Save volume...", "Ctrl+S", false, scene_->core != nullptr)) open_dialog(FileDialog::Mode::Save);
         if (ImGui::MenuItem("Save session...", nullptr, false, scene_->core != nullptr)) open_dialog(FileDialog::Mode::Save, SaveKind::Session);
+        if (ImGui::MenuItem("Snapshot", nullptr, false, scene_->core != nullptr)) snapshot();
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("Record this view at this point of the edits: saved sessions render it when replayed");
         if (ImGui::MenuItem("Export surface...", nullptr, false, scene_->core != nullptr))
             open_dialog(FileDialog::Mode::Save, SaveKind::Surface);
         ImGui::Separator();

@@ -196,6 +196,9 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
     } else if (kind == "cancel_reference") {
         e.action = ScriptAction::CancelReference;
         events.push_back(e);
+    } else if (kind == "snapshot") {
+        e.action = ScriptAction::Snapshot;
+        events.push_back(e);
     } else if (kind == "save_session" || kind == "save_volume" || kind == "export_surface" || kind == "open" ||
                kind == "save_reference") {
         e.action = kind == "save_session"     ? ScriptAction::SaveSession
@@ -222,7 +225,7 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
         fail_json(entry, "unknown event \"" + kind +
                              "\" (expected press, move, release, drag, scroll, key, tool, material, crease_angle, "
                              "idle, save_session, save_volume, export_surface, open, cancel_task, repair, render_reference, "
-                             "cancel_reference, save_reference)");
+                             "cancel_reference, save_reference, snapshot)");
     }
     in.finish();
 }
@@ -274,6 +277,7 @@ void InputScriptPlayer::advance(ScriptTarget& target) {
         case ScriptAction::RenderReference: target.render_reference(e.seconds, e.noise_percent, e.size_divisor); break;
         case ScriptAction::CancelReference: target.cancel_reference(); break;
         case ScriptAction::SaveReference: target.save_reference(e.file); break;
+        case ScriptAction::Snapshot: target.snapshot(); break;
         }
         last_fired_ = frame_;
         ++next_;

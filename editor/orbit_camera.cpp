@@ -36,6 +36,14 @@ CameraSettings OrbitCamera::settings(double aspect) const {
     return s;
 }
 
+CameraSettings OrbitCamera::settings(double aspect, const Eigen::AlignedBox3d& box) const {
+    if (box.isEmpty()) return settings(aspect);
+    CameraSettings s = settings(aspect);
+    s.margin = distance_ / framing_distance(bounding_radius(box), fov_y_degrees_, aspect, 1.0);
+    s.target_offset = target_ - box.center();
+    return s;
+}
+
 Eigen::Vector3d OrbitCamera::right_axis() const { return (-eye_direction_).cross(up_).normalized(); }
 
 Eigen::Vector3d OrbitCamera::up_axis() const { return right_axis().cross(-eye_direction_); }

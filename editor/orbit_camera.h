@@ -28,6 +28,9 @@ public:
     // The settings that give this view through frame_camera (`waxwork render`, sessions) for a
     // viewport of this aspect: the zoom as the margin, the pan as the target offset.
     CameraSettings settings(double aspect) const;
+    // The same for a model whose bounding box is now `box` (cut, deformed or moved since the camera
+    // was made): frame_camera(box, settings(aspect, box), aspect) gives this view again.
+    CameraSettings settings(double aspect, const Eigen::AlignedBox3d& box) const;
 
     // Turns the eye around the target: `yaw` radians about the up vector, then `pitch` radians about
     // the image's right axis (positive: the eye moves up). The pitch stops kMinPoleAngle short of the

@@ -327,6 +327,7 @@ public:
     }
     void cancel_reference() override { app_.cancel_reference(); }
     void save_reference(const std::filesystem::path& file) override { app_.save_reference(file); }
+    void snapshot() override { app_.snapshot(); }
 
 private:
     GLFWwindow* window_;

@@ -113,10 +113,22 @@ bool SceneCore::export_surface(const std::filesystem::path& path, ShellGrouping 
     return colours;
 }
 
-void SceneCore::save_session(const std::filesystem::path& path, const Session& head) const {
+void SceneCore::save_session(const std::filesystem::path& path, const Session& head,
+                             const std::vector<SessionSnapshot>& snapshots, std::optional<double> exposure) const {
     // It replays to something: the image as the view shows it and the volume, named after the file.
     const std::string stem = path.stem().string();
-    write_session(path, record_session(head, document_, {RenderStep{stem + ".png", std::nullopt}, SaveStep{stem + ".vtu"}}));
+    std::vector<AnchoredSteps> anchored;
+    for (size_t k = 0; k < snapshots.size(); ++k) {
+        const SessionSnapshot& s = snapshots[k];
+        anchored.push_back({s.history, {CameraStep{s.camera}, LightStep{s.lighting},
+                                        RenderStep{stem + "_snapshot_" + std::to_string(k + 1) + ".png", std::nullopt,
+                                                   s.exposure}}});
+    }
+    std::vector<SessionStep> tail;
+    if (!snapshots.empty()) tail = {CameraStep{head.camera}, LightStep{head.lighting}};
+    tail.push_back(RenderStep{stem + ".png", std::nullopt, exposure});
+    tail.push_back(SaveStep{stem + ".vtu"});
+    write_session(path, record_session(head, document_, tail, anchored));
 }
 
 SceneTickResult SceneCore::tick(const SceneTickRequest& request, const std::function<void(const std::string&)>& stage) {

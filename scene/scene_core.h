@@ -38,6 +38,15 @@ namespace waxwork {
 
 class SceneCore;
 
+// A picture asked for at one point of the editing (the editor's Snapshot): after the first `history`
+// operations of the document's history, seen with `camera` under `lighting`.
+struct SessionSnapshot {
+    size_t history = 0;
+    CameraSettings camera;
+    Lighting lighting;
+    std::optional<double> exposure;  // the one the view was shown with (nullopt: automatic)
+};
+
 // One queued piece of work for the next tick; returns a status line. Throws to report a failure
 // (the document is then unchanged, Document::apply's guarantee).
 using SceneJob = std::function<std::string(SceneCore&)>;
@@ -131,8 +140,12 @@ public:
     bool export_surface(const std::filesystem::path& path, ShellGrouping grouping);
     // The session that replays this document: `head` (usually setup() with what the front end changed
     // since: its view, lights, frame budget), the document's history as steps, then a converged render
-    // and a save named after the file (NAME.json renders NAME.png and saves NAME.vtu).
-    void save_session(const std::filesystem::path& path, const Session& head) const;
+    // and a save named after the file (NAME.json renders NAME.png and saves NAME.vtu). Each snapshot
+    // becomes, at its point of the history, its camera, its lights and a render NAME_snapshot_K.png (K
+    // from 1); the final render then returns to head's camera and lights, at `exposure` when given.
+    void save_session(const std::filesystem::path& path, const Session& head,
+                      const std::vector<SessionSnapshot>& snapshots = {},
+                      std::optional<double> exposure = std::nullopt) const;
 
 private:
     // Declared in this order: the live scene borrows the document's mesh, so it is destroyed first.

@@ -279,6 +279,11 @@ SessionStep step_from_json(const Json& json, const std::string& context, const S
         r.file = output_name(in, "render");
         if (lower_extension(r.file) != ".png") fail_json(in.field("render"), "'" + r.file + "' must be a .png");
         if (in.has("frames")) r.frames = count_from(in, "frames");
+        if (in.has("exposure")) {
+            r.exposure = in.number("exposure");
+            // The renderer multiplies radiance by it in float: beyond 1e30 it overflows.
+            if (!(*r.exposure > 0 && *r.exposure <= 1e30)) fail_json(in.field("exposure"), "must be a positive number");
+        }
         step = r;
     } else if (in.has("save")) {
         step = SaveStep{output_name(in, "save")};
@@ -320,6 +325,7 @@ Json step_to_json(const SessionStep& step, const Session& session) {
     if (const auto* r = std::get_if<RenderStep>(&step)) {
         Json j{{"render", r->file}};
         if (r->frames) j["frames"] = *r->frames;
+        if (r->exposure) j["exposure"] = *r->exposure;
         return j;
     }
     if (const auto* s = std::get_if<SaveStep>(&step)) return Json{{"save", s->file}};
@@ -531,10 +537,20 @@ bool writes_outputs(const Session& session) {
     });
 }
 
-Session record_session(const Session& setup, const Document& document, const std::vector<SessionStep>& extra_steps) {
+Session record_session(const Session& setup, const Document& document, const std::vector<SessionStep>& extra_steps,
+                       const std::vector<AnchoredSteps>& anchored) {
     Session session = setup;
     session.steps.clear();
-    for (const EditOperation& op : document.history()) session.steps.emplace_back(op);
+    const auto& history = document.history();
+    const auto insert_anchored = [&](size_t before) {
+        for (const AnchoredSteps& a : anchored)
+            if (a.before == before) session.steps.insert(session.steps.end(), a.steps.begin(), a.steps.end());
+    };
+    for (size_t i = 0; i < history.size(); ++i) {
+        insert_anchored(i);
+        session.steps.emplace_back(history[i]);
+    }
+    insert_anchored(history.size());
     session.steps.insert(session.steps.end(), extra_steps.begin(), extra_steps.end());
     return session;
 }
@@ -660,8 +676,10 @@ Json replay_session(const Session& session, const fs::path& output_directory, co
                 context->make_current();  // the solver may have used its own context meanwhile
                 if (!renderer) renderer = std::make_unique<SurfaceRenderer>(context->gl());
                 const SolvedScene solved = core.live().solved_scene();
+                ImageSettings step_image = image;
+                if (r->exposure) step_image.exposure = static_cast<float>(*r->exposure);
                 const Image picture = render_scene(
-                    *renderer, make_render_input(core.document().mesh(), solved, core.live().lighting(), image));
+                    *renderer, make_render_input(core.document().mesh(), solved, core.live().lighting(), step_image));
                 const fs::path path = contained_output_path(output_directory, r->file);
                 write_png(picture, path);
                 result.written.push_back(path);

@@ -84,7 +84,8 @@ struct SessionInput {
 
 struct RenderStep {
     std::string file;
-    std::optional<int> frames;  // nullopt: converged
+    std::optional<int> frames;       // nullopt: converged
+    std::optional<double> exposure;  // nullopt: the image's automatic exposure (render_input.h)
 };
 struct SaveStep {
     std::string file;
@@ -143,11 +144,20 @@ void write_session(const std::filesystem::path& path, const Session& session);
 // Whether the session writes anything besides metrics.json (a render or a save step).
 bool writes_outputs(const Session& session);
 
+// Steps that belong between two operations of a recorded history: before the operation at index
+// `before` (the history's size: after the last).
+struct AnchoredSteps {
+    size_t before = 0;
+    std::vector<SessionStep> steps;
+};
+
 // The recording of an editing session: `setup`'s input, material, lights and camera, and as steps the
-// document's history (the operations that made its current mesh), followed by `extra_steps`
-// (e.g. a final render or save). Replaying it gives the document's mesh bit for bit.
+// document's history (the operations that made its current mesh) with `anchored` steps in their places
+// (in order; those anchored past the history's end are dropped), followed by `extra_steps` (e.g. a
+// final render or save). Replaying it gives the document's mesh bit for bit.
 Session record_session(const Session& setup, const Document& document,
-                       const std::vector<SessionStep>& extra_steps = {});
+                       const std::vector<SessionStep>& extra_steps = {},
+                       const std::vector<AnchoredSteps>& anchored = {});
 
 // The volume a session starts from and its scale (the session's, else the one the volume stores, else
 // the model's default).

@@ -265,6 +265,44 @@ TEST_F(EditorWindow, CutStrokeCutsTheSideDrawnAndTheSessionReplaysIt) {
     EXPECT_EQ(session["image"]["width"], 400);
 }
 
+// File > Snapshot records the view at that point of the edits; the saved session replays to the
+// images the editor showed: the snapshot's after the cut (a second editor run stopped there), the
+// final one after the paint stroke and the turn of the view.
+TEST_F(EditorWindow, SnapshotsReplayToTheImagesTheEditorShowed) {
+    const fs::path dir = scratch_dir("editor_snapshot");
+    const std::string until_snapshot = R"([
+        {"event": "tool", "tool": "cut"},
+        {"frame": 2, "event": "drag", "from": [150, 20], "to": [260, 280], "steps": 10},
+        {"event": "idle"},
+        {"event": "drag", "from": [200, 150], "to": [150, 140], "steps": 5, "button": "right"},
+        {"event": "idle"})";
+    const auto shown = run_script(dir, until_snapshot + "]");
+    ASSERT_EQ(shown.exit_code, 0) << shown.err;
+    fs::rename(dir / "shot.png", dir / "at_snapshot.png");
+    const auto edited = run_script(dir, until_snapshot + R"(,
+        {"event": "snapshot"},
+        {"event": "tool", "tool": "paint"},
+        {"event": "drag", "from": [170, 150], "to": [230, 160], "steps": 6},
+        {"event": "idle"},
+        {"event": "drag", "from": [200, 150], "to": [240, 170], "steps": 5, "button": "right"},
+        {"event": "idle"},
+        {"event": "save_session", "file": "session.json"},
+        {"event": "idle"}])");
+    ASSERT_EQ(edited.exit_code, 0) << edited.err;
+    const auto run = run_waxwork("run " + (dir / "session.json").string() + " -o " + (dir / "run").string());
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const auto expect_same = [&](const fs::path& editor_image, const fs::path& replayed) {
+        const Image a = read_png(editor_image), b = read_png(replayed);
+        ASSERT_EQ(a.width, b.width) << replayed;
+        ASSERT_EQ(a.height, b.height) << replayed;
+        // Both converge phi to the editor's tolerance along different iteration paths (see above).
+        EXPECT_LE(max_channel_difference(a, b), 2) << replayed;
+    };
+    expect_same(dir / "at_snapshot.png", dir / "run" / "session_snapshot_1.png");
+    expect_same(dir / "shot.png", dir / "run" / "session.png");
+    EXPECT_GT(max_channel_difference(read_png(dir / "run" / "session_snapshot_1.png"), read_png(dir / "run" / "session.png")), 20);
+}
+
 TEST_F(EditorWindow, PaintStrokeChangesTheMaterialWhereDrawn) {
     const fs::path dir = scratch_dir("editor_paint_stroke");
     // The object is skin; the brush paints ketchup (chosen as in the material panel) along the upper

@@ -189,6 +189,7 @@ public:
     }
     void cancel_reference() override { add("cancel reference"); }
     void save_reference(const std::filesystem::path& f) override { add("save reference " + f.filename().string()); }
+    void snapshot() override { add("snapshot"); }
 
 private:
     void add(const std::string& s) { log.push_back(std::to_string(frame) + ": " + s); }
@@ -226,14 +227,14 @@ TEST(InputScriptPlayer, PlaysOpenCancelAndRepair) {
     EXPECT_EQ(target.log, (std::vector<std::string>{"0: open big.obj", "1: cancel", "2: repair autorefine"}));
 }
 
-TEST(InputScriptPlayer, PlaysTheReferenceEventsWithTheSettingsGiven) {
+TEST(InputScriptPlayer, PlaysTheReferenceEventsWithTheirSettingsAndSnapshot) {
     InputScriptPlayer player(parse(R"([{"event": "render_reference", "seconds": 3, "noise": 7, "size": 2},
-        {"event": "render_reference"}, {"event": "cancel_reference"}, {"event": "save_reference", "file": "r.png"}])"));
+        {"event": "render_reference"}, {"event": "cancel_reference"}, {"event": "save_reference", "file": "r.png"}, {"event": "snapshot"}])"));
     FakeTarget target;
     target.is_ready = true;
-    for (target.frame = 0; target.frame < 5; ++target.frame) player.advance(target);
+    for (target.frame = 0; target.frame < 6; ++target.frame) player.advance(target);
     EXPECT_EQ(target.log, (std::vector<std::string>{"0: reference 3 7 2", "1: reference - - -", "2: cancel reference",
-                                                    "3: save reference r.png"}));
+                                                    "3: save reference r.png", "4: snapshot"}));
 }
 
 TEST(InputScript, ExampleScriptsParse) {

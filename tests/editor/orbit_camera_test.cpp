@@ -128,6 +128,15 @@ TEST(OrbitCamera, SettingsReproduceThePannedZoomedView) {
         EXPECT_LT((rebuilt.eye() - camera.eye()).norm(), 1e-9);
         EXPECT_LT((rebuilt.target() - camera.target()).norm(), 1e-9);
     }
+    // For a model whose box changed since (a cut took half): the same eye, target and field of view
+    // (the depth range follows the new box, which changes no pixel).
+    const Eigen::AlignedBox3d half(test_box().min(), Eigen::Vector3d(test_box().center().x(), test_box().max().y(),
+                                                                       test_box().max().z()));
+    const CameraFrame expected = camera.frame(1.5);
+    const CameraFrame reframed = frame_camera(half, camera.settings(1.5, half), 1.5);
+    EXPECT_LT((reframed.view - expected.view).cwiseAbs().maxCoeff(), 1e-9);
+    EXPECT_NEAR(reframed.projection(0, 0), expected.projection(0, 0), 1e-12);
+    EXPECT_NEAR(reframed.projection(1, 1), expected.projection(1, 1), 1e-12);
     // Unpanned and unzoomed: the default settings come back.
     const OrbitCamera fresh(test_box(), CameraSettings{}, 1.5);
     EXPECT_NEAR(fresh.settings(1.5).margin, CameraSettings{}.margin, 1e-12);
