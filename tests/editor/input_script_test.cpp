@@ -189,6 +189,15 @@ public:
     }
     void cancel_reference() override { add("cancel reference"); }
     void save_reference(const std::filesystem::path& f) override { add("save reference " + f.filename().string()); }
+    void quit() override { add("quit"); }
+    void close_window() override { add("close window"); }
+    void answer_dialog(const std::string& button, const std::filesystem::path& f) override {
+        add("dialog " + button + (f.empty() ? "" : " " + f.filename().string()));
+    }
+    void open_example(const std::string& name) override { add("example " + name); }
+    void recover(bool accept) override { add(accept ? "recover" : "discard recovery"); }
+    void autosave() override { add("autosave"); }
+    void kill() override { add("kill"); }
 
 private:
     void add(const std::string& s) { log.push_back(std::to_string(frame) + ": " + s); }
