@@ -116,6 +116,7 @@ void EditorApp::answer_unsaved_dialog(const std::string& button, const fs::path&
 void EditorApp::autosave() {
     if (!scene_->core) return;
     unsaved_since_autosave_.reset();
+    recovery_written_ = true;
     const RecoveryFiles files = own_recovery_;
     const Session current = view_session();
     const fs::path source = current_file_.empty() ? fs::path() : fs::absolute(current_file_);
@@ -173,6 +174,11 @@ void EditorApp::document_frame() {
             after_save_.reset();
             do_action(action);
         }
+    }
+    // Saved since the last copy: the copy is older than the save, nothing is left to recover.
+    if (recovery_written_ && !modified_ && pending_jobs_.empty() && !tick_task_.busy()) {
+        remove_own_recovery();
+        recovery_written_ = false;
     }
     if (modified_ && unsaved_since_autosave_ && scene_->core &&
         std::chrono::steady_clock::now() - *unsaved_since_autosave_ >=

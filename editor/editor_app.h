@@ -462,6 +462,7 @@ private:
     std::filesystem::path state_dir_;
     RecentFiles recent_;
     RecoveryFiles own_recovery_;
+    bool recovery_written_ = false;  // own_recovery_ may hold a copy (removed once saved)
     std::vector<RecoveryFiles> abandoned_;  // offered for recovery
     bool open_recovery_popup_ = false;
     std::optional<RecoveryFiles> recovering_;  // being opened: removed once its volume is open

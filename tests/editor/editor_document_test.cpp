@@ -98,30 +98,41 @@ TEST_F(EditorDocument, DiscardQuitsWithoutSavingAndAnUnmodifiedDocumentQuitsAtOn
     EXPECT_NE(unasked.err.find("no unsaved-changes dialog"), std::string::npos) << unasked.err;
 }
 
-// A run killed after its autosave leaves its recovery copy; the next run offers it and Recover opens
-// the edited volume exactly as it was.
+// A run killed after its autosave leaves its recovery copy (the cut volume, and a session that
+// replays to it); the next run offers it and Recover opens the edited volume exactly as it was.
 TEST_F(EditorDocument, AutosavedVolumeIsRecoveredAfterAKill) {
     const fs::path dir = scratch_dir("editor_recovery");
     const auto killed = edit_with_state(dir, kCube, "[" + kCut + R"(
         {"event": "autosave"},
         {"event": "idle"},
-        {"event": "save_volume", "file": "expected.vtu"},
-        {"event": "idle"},
-        {"event": "kill"}])");
+        {"event": "kill"},
+        {"event": "save_volume", "file": "not_reached.vtu"}])");
     EXPECT_NE(killed.exit_code, 0) << "the run should have been killed";
-    ASSERT_TRUE(fs::exists(dir / "expected.vtu")) << killed.err;
+    EXPECT_FALSE(fs::exists(dir / "not_reached.vtu"));
     const std::vector<RecoveryFiles> left = abandoned_recovery_files(dir / "state");
-    ASSERT_EQ(left.size(), 1u);
-    EXPECT_TRUE(fs::exists(left.front().session()));
+    ASSERT_EQ(left.size(), 1u) << killed.err;
     EXPECT_EQ(recovered_source(left.front()), kAssets + "/meshes/cube.obj");
-    const TetMesh expected = read_volume(dir / "expected.vtu");
+    const TetMesh expected = read_volume(left.front().volume());
+    const auto whole = run_waxwork("mesh " + kAssets + "/meshes/cube.obj --max-tets 6000 -o " + (dir / "whole.vtu").string());
+    ASSERT_EQ(whole.exit_code, 0) << whole.err;
+    EXPECT_LT(expected.tet_count(), 0.7 * read_volume(dir / "whole.vtu").tet_count()) << "the copy should hold the cut";
+    const auto replay = run_waxwork("run " + left.front().session().string() + " -o " + (dir / "replay").string());
+    ASSERT_EQ(replay.exit_code, 0) << replay.err;
+    EXPECT_TRUE(read_volume(dir / "replay" / "session.vtu") == expected);
 
     const auto recovered = edit_with_state(dir, "", R"([{"event": "recover"}, {"event": "idle"},
         {"event": "save_volume", "file": "recovered.vtu"}, {"event": "idle"}])");
     ASSERT_EQ(recovered.exit_code, 0) << recovered.err;
     EXPECT_TRUE(read_volume(dir / "recovered.vtu") == expected);
     EXPECT_EQ(summary_of(recovered)["tets"], expected.tet_count());
-    EXPECT_EQ(recovery_folders(dir / "state"), 0u) << "recovered, then a clean exit: nothing left to offer";
+    EXPECT_EQ(recovery_folders(dir / "state"), 0u) << "recovered, then saved and a clean exit: nothing left to offer";
+
+    // A copy that a save made stale is removed even when the run dies afterwards.
+    const auto saved = edit_with_state(dir, kCube, "[" + kCut + R"(
+        {"event": "autosave"}, {"event": "idle"},
+        {"event": "save_volume", "file": "saved.vtu"}, {"event": "idle"}, {"event": "kill"}])");
+    ASSERT_TRUE(fs::exists(dir / "saved.vtu")) << saved.err;
+    EXPECT_EQ(recovery_folders(dir / "state"), 0u);
 
     // Nothing left: Recover is an error.
     const auto nothing = edit_with_state(dir, "", R"([{"event": "recover"}, {"event": "idle"}])");

@@ -141,6 +141,11 @@ TEST(InputScript, BadScriptsGetOneLineErrorsNamingTheFileAndEntry) {
         {R"([{"event": "render_reference", "size": 3}])", "field 'size': must be 4, 2 or 1"},
         {R"([{"event": "render_reference", "samples": 3}])", "unknown field 'samples'"},
         {R"([{"event": "save_reference"}])", "missing field 'file'"},
+        {R"([{"event": "dialog", "button": "maybe"}])", "s.json: entry 0 (dialog): field 'button': expected \"save\""},
+        {R"([{"event": "dialog"}])", "missing field 'button'"},
+        {R"([{"event": "dialog", "button": "save", "file": ""}])", "field 'file'"},
+        {R"([{"event": "open_example"}])", "s.json: entry 0 (open_example): missing field 'name'"},
+        {R"([{"event": "quit", "now": true}])", "unknown field 'now'"},
     };
     for (const auto& [text, expected] : cases) {
         const std::string message = parse_error(text);
@@ -233,6 +238,19 @@ TEST(InputScriptPlayer, PlaysOpenCancelAndRepair) {
     target.is_ready = true;
     for (target.frame = 0; target.frame < 4; ++target.frame) player.advance(target);
     EXPECT_EQ(target.log, (std::vector<std::string>{"0: open big.obj", "1: cancel", "2: repair autorefine"}));
+}
+
+TEST(InputScriptPlayer, PlaysTheDocumentEvents) {
+    InputScriptPlayer player(parse(R"([{"event": "quit"}, {"event": "dialog", "button": "cancel"},
+        {"event": "close_window"}, {"event": "dialog", "button": "save", "file": "s.json"},
+        {"event": "open_example", "name": "spot"}, {"event": "recover"}, {"event": "discard_recovery"},
+        {"event": "autosave"}, {"event": "kill"}])"));
+    FakeTarget target;
+    target.is_ready = true;
+    for (target.frame = 0; target.frame < 10; ++target.frame) player.advance(target);
+    EXPECT_EQ(target.log, (std::vector<std::string>{"0: quit", "1: dialog cancel", "2: close window", "3: dialog save s.json",
+                                                    "4: example spot", "5: recover", "6: discard recovery",
+                                                    "7: autosave", "8: kill"}));
 }
 
 TEST(InputScriptPlayer, PlaysTheReferenceEventsWithTheSettingsGiven) {
