@@ -860,6 +860,7 @@ EditorRunStats run_editor(const EditorOptions& options) {
         stats.method_fallback_reason = scene.method_fallback_reason;
         stats.view_reads_device_radiance = scene.render_input && scene.render_input->device_radiance;
         stats.modified = app.modified();
+        stats.title = app.title();
     }
     glfwDestroyWindow(window);
     return stats;

@@ -103,6 +103,7 @@ struct EditorRunStats {
     double max_frame_ms_while_tracing = 0;
     double tick_ms_while_tracing = 0;  // the worker's mean tick meanwhile
     bool modified = false;             // edits not saved when the window closed
+    std::string title;                 // the window's title then
 };
 EditorRunStats run_editor(const EditorOptions& options);
 
@@ -235,6 +236,7 @@ public:
     // Document safety (document_safety.cpp). Edits since the last save of the volume or session
     // (undoing back to it still counts as modified); the title shows them with " *".
     bool modified() const { return modified_; }
+    const std::string& title() const { return shown_title_; }
     // Ctrl+Q, File > Quit and the window's close button: asks Save / Discard / Cancel first when
     // modified, else closes the window.
     void request_quit();

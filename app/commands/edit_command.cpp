@@ -83,7 +83,7 @@ void run_edit_command(const EditCommandOptions& o) {
             {"frame_ms_while_tracing", stats.mean_frame_ms_while_tracing},
             {"max_frame_ms_while_tracing", stats.max_frame_ms_while_tracing},
             {"tick_ms_while_tracing", stats.tick_ms_while_tracing},
-            {"modified", stats.modified},
+            {"modified", stats.modified}, {"title", stats.title},
         };
         std::cout << summary.dump() << "\n";
     }

@@ -62,6 +62,7 @@ TEST_F(EditorDocument, QuitWithUnsavedEditsAsksAndSaveKeepsThem) {
     EXPECT_FALSE(fs::exists(dir / "after_quit.vtu")) << "the window should have closed after saving";
     EXPECT_FALSE(fs::exists(dir / "shot.png"));
     EXPECT_EQ(summary_of(r)["modified"], false);
+    EXPECT_EQ(summary_of(r)["title"], "Waxwork - cube.obj");
     // The saved session replays to the cut volume.
     const auto run = run_waxwork("run " + (dir / "saved.json").string() + " -o " + (dir / "run").string());
     ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -87,6 +88,7 @@ TEST_F(EditorDocument, DiscardQuitsWithoutSavingAndAnUnmodifiedDocumentQuitsAtOn
         {"event": "idle"}])");
     ASSERT_EQ(discarded.exit_code, 0) << discarded.err;
     EXPECT_EQ(summary_of(discarded)["modified"], true);
+    EXPECT_EQ(summary_of(discarded)["title"], "Waxwork - cube.obj *");
     EXPECT_FALSE(fs::exists(dir / "after_quit.vtu"));
     const auto unmodified = edit_with_state(dir, kCube, R"([{"frame": 1, "event": "quit"},
         {"event": "save_volume", "file": "after_quit.vtu"}, {"event": "idle"}])");
