@@ -108,7 +108,10 @@ void EditorApp::answer_unsaved_dialog(const std::string& button, const fs::path&
     errors_before_ = errors_;
     after_save_ = action;
     const fs::path target = file.empty() ? save_target_ : file;
-    if (target.empty()) open_dialog(FileDialog::Mode::Save, SaveKind::Session);
+    if (target.empty()) {
+        options_.hide_ui = false;  // the Save dialog is one of the panels
+        open_dialog(FileDialog::Mode::Save, SaveKind::Session);
+    }
     else if (lower_extension(target) == ".json") save_session(target);
     else save_volume(target);
 }
