@@ -142,6 +142,21 @@ TEST_F(EditorDocument, AutosavedVolumeIsRecoveredAfterAKill) {
     EXPECT_NE(nothing.err.find("no recovery files"), std::string::npos) << nothing.err;
 }
 
+// The copy is written on its own once edits have stayed unsaved for --autosave seconds, and not
+// without edits. Each scripted frame lasts at least 20 ms, so frame 200 comes 4 s or more after the
+// start: well past the 1 s interval.
+TEST_F(EditorDocument, AutosaveCopiesUnsavedEditsAfterTheInterval) {
+    const fs::path dir = scratch_dir("editor_autosave_interval");
+    const std::string options = "--hide-ui --width 400 --height 300 --autosave 1";
+    const auto edited = edit_with_state(dir, kCube, "[" + kCut + R"( {"frame": 200, "event": "kill"}])", options);
+    EXPECT_NE(edited.exit_code, 0);
+    EXPECT_EQ(abandoned_recovery_files(dir / "state").size(), 1u) << edited.err;
+    fs::remove_all(dir / "state");
+    const auto untouched = edit_with_state(dir, kCube, R"([{"frame": 200, "event": "kill"}])", options);
+    EXPECT_NE(untouched.exit_code, 0);
+    EXPECT_EQ(recovery_folders(dir / "state"), 0u) << untouched.err;
+}
+
 // With no file the start screen shows; its example opens meshed, at the scale the model's size
 // suggests and seen from its front (spot.obj faces -z), and joins the recent files.
 TEST_F(EditorDocument, StartScreenExampleOpensAndMeshesTheModel) {
