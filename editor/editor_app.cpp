@@ -96,6 +96,11 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
         app_of(w)->on_mouse_button(button, action, mods);
     });
     glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double dy) { app_of(w)->on_scroll(dy); });
+    // The close button asks first, as Ctrl+Q does: the window closes once request_quit agrees.
+    glfwSetWindowCloseCallback(window_, [](GLFWwindow* w) {
+        glfwSetWindowShouldClose(w, GLFW_FALSE);
+        app_of(w)->request_quit();
+    });
 
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
@@ -108,6 +113,12 @@ EditorApp::EditorApp(GLFWwindow* window, const EditorOptions& options)
     ImGui_ImplGlfw_InitForOpenGL(window_, true);
     if (!ImGui_ImplOpenGL3_Init("#version 430 core")) throw Error("editor: ImGui's OpenGL 3 backend failed to start");
 
+    state_dir_ = state_directory();
+    recent_ = read_recent_files(state_dir_ / "recent.json");
+    own_recovery_ = own_recovery_files(state_dir_);
+    abandoned_ = abandoned_recovery_files(state_dir_);
+    open_recovery_popup_ = !abandoned_.empty();
+
     if (!options.session.empty()) open_session(options.session);
     else if (!options.file.empty()) open_file(options.file);
     else status_ = "Open a surface (OBJ, OFF, PLY, STL) or a volume (VTU, MSH, MESH) with Ctrl+O or drop it here";
@@ -118,6 +129,7 @@ EditorApp::~EditorApp() {
     tick_task_.cancel();
     load_task_.wait();
     tick_task_.wait();
+    remove_own_recovery();  // a clean exit: nothing to recover
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();
@@ -132,6 +144,7 @@ void EditorApp::set_error(const std::string& message) {
 
 void EditorApp::show_error(const std::string& message) {
     status_ = "Error: " + message;
+    ++errors_;
     error_message_ = message;
     show_error_popup_ = true;
     close_error_popup_ = false;
@@ -217,7 +230,8 @@ void EditorApp::open_file(const fs::path& path, std::optional<double> scale, std
     setup.tolerance = live_options_.relative_tolerance;
     setup.crease_angle_degrees = live_options_.crease_angle_degrees;
     setup.lighting = lighting_;
-    setup.camera = options_.camera;
+    setup.camera = next_camera_.value_or(options_.camera);
+    next_camera_.reset();
     setup.frame_iterations = frame_iterations_;
     if (frame_budget_in_ms_) setup.frame_ms = frame_ms_;
     const std::string material_name = options_.material ? "custom" : "marble (or stored)";
@@ -300,8 +314,8 @@ void EditorApp::install_core(std::shared_ptr<SceneCore> core, const fs::path& pa
     for (const EditOperation& op : replay) queue_edit(op);
     status_ = "Loaded " + path.filename().string() + ": " + std::to_string(scene_->tets) + " tets, " +
               std::to_string(scene_->vertices) + " vertices; " + model.scale_note;
-    glfwSetWindowTitle(window_, ("Waxwork - " + path.filename().string()).c_str());
     lighting_dirty_ = false;
+    document_opened(path);
     crease_angle_dirty_ = false;
 }
 
@@ -314,6 +328,7 @@ void EditorApp::queue_job(std::string label, SceneJob job) {
 }
 
 void EditorApp::queue_edit(const EditOperation& op) {
+    if (scene_->core) mark_modified();
     queue_job(operation_name(op), [op](SceneCore& core) {
         const ChangeReport report = core.apply(op);
         std::ostringstream line;
@@ -324,6 +339,8 @@ void EditorApp::queue_edit(const EditOperation& op) {
 }
 
 void EditorApp::save_volume(const fs::path& path) {
+    if (!scene_->core) return set_error("open a file first");
+    mark_saved(path);
     queue_job("save", [path](SceneCore& core) {
         core.save_volume(path);
         return "Saved " + path.string();
@@ -332,6 +349,7 @@ void EditorApp::save_volume(const fs::path& path) {
 }
 
 void EditorApp::export_surface(const fs::path& path) {
+    if (scene_->core) remember_output(path, false);
     queue_job("export", [path](SceneCore& core) {
         // Pieces apart: what Blender's and a slicer's users expect of a fractured model.
         const bool coloured = core.export_surface(path, ShellGrouping::Separate);
@@ -405,13 +423,14 @@ bool EditorApp::cancel_reference() {
 void EditorApp::save_reference(const fs::path& path) {
     try {
         reference_->save(path);
+        remember_output(path, false);
         status_ = "Saved the reference comparison to " + path.string();
     } catch (const std::exception& e) {
         set_error(e.what());
     }
 }
 
-void EditorApp::save_session(const fs::path& path) {
+Session EditorApp::view_session() const {
     // The view and lights as they are now, not as the session started.
     Session current;
     current.lighting = lighting_;
@@ -421,6 +440,13 @@ void EditorApp::save_session(const fs::path& path) {
     current.frame_iterations = frame_iterations_;  // the budget as the panel has it now
     if (frame_budget_in_ms_) current.frame_ms = frame_ms_;
     current.crease_angle_degrees = live_options_.crease_angle_degrees;
+    return current;
+}
+
+void EditorApp::save_session(const fs::path& path) {
+    if (!scene_->core) return set_error("open a file first");
+    const Session current = view_session();
+    mark_saved(path);
     const double exposure = shown_exposure();
     queue_job("save session", [path, current, snapshots = snapshots_, exposure](SceneCore& core) {
         Session setup = core.setup();
@@ -447,7 +473,7 @@ void EditorApp::rebuild_live_scene() {
 }
 
 void EditorApp::on_drop(const std::vector<fs::path>& paths) {
-    if (!paths.empty()) open_file(paths.front());
+    if (!paths.empty()) request_open(paths.front());
 }
 
 void EditorApp::on_key(int key, int mods) {
@@ -461,7 +487,7 @@ void EditorApp::on_key(int key, int mods) {
         case GLFW_KEY_S: open_dialog(FileDialog::Mode::Save); break;
         case GLFW_KEY_Z: shift ? redo() : undo(); break;
         case GLFW_KEY_Y: redo(); break;
-        case GLFW_KEY_Q: glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
+        case GLFW_KEY_Q: request_quit(); break;
         default: break;
         }
         return;
@@ -634,7 +660,9 @@ void EditorApp::frame() {
     ImGui::NewFrame();
     layout_viewport(fb_w, fb_h);
     poll_tasks();  // after the layout: a solve started now exposes for the current viewport
+    document_frame();
     if (!options_.hide_ui) draw_ui();
+    draw_document_dialogs();  // with the panels hidden too: a quit must still ask
     file_dialog_result();
     handle_viewport_input();
     if (!options_.hide_ui) draw_overlays();
@@ -712,6 +740,7 @@ void EditorApp::remove_fragments() {
 }
 
 void EditorApp::queue_history_step(bool redo) {
+    if (scene_->core) mark_modified();
     queue_job(redo ? "redo" : "undo", [redo](SceneCore& core) {
         const auto report = redo ? core.redo() : core.undo();
         if (!report) return std::string(redo ? "Nothing to redo" : "Nothing to undo");
@@ -859,6 +888,8 @@ EditorRunStats run_editor(const EditorOptions& options) {
         stats.gpu_fallback_reason = scene.gpu_fallback_reason;
         stats.method_fallback_reason = scene.method_fallback_reason;
         stats.view_reads_device_radiance = scene.render_input && scene.render_input->device_radiance;
+        stats.modified = app.modified();
+        stats.title = app.title();
     }
     glfwDestroyWindow(window);
     return stats;

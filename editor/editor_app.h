@@ -24,11 +24,14 @@
 #include "render/view_modes.h"
 #include "scene/document.h"
 #include "scene/live_scene.h"
+#include "scene/recent_files.h"
+#include "scene/recovery_files.h"
 #include "scene/scene_core.h"
 #include "scene/session.h"
 #include "solver/light_spec.h"
 #include "solver/ray_caster.h"
 
+#include <chrono>
 #include <deque>
 #include <filesystem>
 #include <functional>
@@ -69,6 +72,8 @@ struct EditorOptions {
     LiveBackend solver_backend = LiveBackend::Cpu;    // panel switches both
     std::optional<double> frame_ms;      // a time budget per solver step instead of iterations (--frame-ms);
                                          // also wins over an opened session's
+    double autosave_seconds = 60;        // unsaved edits are copied to the recovery folder this often
+                                         // (scene/recovery_files.h; --autosave)
 };
 
 // Opens the window and runs until it is closed (or, with a screenshot, until it is saved). Throws
@@ -97,6 +102,8 @@ struct EditorRunStats {
     double mean_frame_ms_while_tracing = 0;
     double max_frame_ms_while_tracing = 0;
     double tick_ms_while_tracing = 0;  // the worker's mean tick meanwhile
+    bool modified = false;             // edits not saved when the window closed
+    std::string title;                 // the window's title then
 };
 EditorRunStats run_editor(const EditorOptions& options);
 
@@ -234,6 +241,32 @@ public:
     void save_reference(const std::filesystem::path& path);
     const ReferenceView& reference() const { return *reference_; }
 
+    // Document safety (document_safety.cpp). Edits since the last save of the volume or session
+    // (undoing back to it still counts as modified); the title shows them with " *".
+    bool modified() const { return modified_; }
+    const std::string& title() const { return shown_title_; }
+    // Ctrl+Q, File > Quit and the window's close button: asks Save / Discard / Cancel first when
+    // modified, else closes the window.
+    void request_quit();
+    // Opens `path` (File > Open, Open Recent, a drop, the start screen), asking first when modified.
+    // `camera`: the first view instead of the command line's (the examples' front views).
+    void request_open(const std::filesystem::path& path, std::optional<CameraSettings> camera = std::nullopt);
+    // A button of the unsaved-changes dialog: "save", "discard" or "cancel". Save writes the session
+    // or volume the document came from or was last saved as (`file` instead when given; a Save
+    // dialog when there is neither), then carries on. An error when no dialog is asking.
+    void answer_unsaved_dialog(const std::string& button, const std::filesystem::path& file = {});
+    // The recovery offer of a run that did not exit cleanly: opens its volume, or removes its files.
+    // Errors when nothing is offered.
+    void recover();
+    void discard_recovery();
+    // Writes the recovery copy now (it is written every EditorOptions::autosave_seconds of unsaved
+    // edits).
+    void autosave();
+    // The start screen (start_screen.cpp): shown while no document is open or loading. Opens the
+    // bundled example `name` (example_models()) as a click on it does.
+    bool start_screen_shown() const { return !scene_->core && !load_task_.busy(); }
+    void open_example(const std::string& name);
+
 private:
     using Scene = EditorScene;
     // editor_panels.cpp: the ImGui parts.
@@ -311,6 +344,24 @@ private:
     void set_error(const std::string& message);
     void show_error(const std::string& message);  // as set_error, not counted as the run's error
     void load_failed(const std::exception& error);
+    // document_safety.cpp
+    struct DocumentAction {  // what the unsaved-changes dialog holds back
+        bool quit = false;
+        std::filesystem::path open;
+        std::optional<CameraSettings> camera;
+    };
+    void ask_or_do(DocumentAction action);
+    void do_action(const DocumentAction& action);
+    void mark_modified();
+    void mark_saved(const std::filesystem::path& path);
+    void remember_output(const std::filesystem::path& path, bool recent);
+    void document_opened(const std::filesystem::path& path);  // unmodified, recent, recovery done
+    void document_frame();          // title, autosave, carrying on after the dialog's Save
+    void draw_document_dialogs();   // the unsaved-changes and recovery dialogs
+    void draw_open_recent_menu();
+    void remove_own_recovery();
+    Session view_session() const;   // the view, lights and budget as they are now (saved sessions keep them)
+    void draw_start_screen();       // start_screen.cpp
 
     static constexpr float kToolPaletteWidth = 132;  // logical pixels (times the UI scale)
     static constexpr float kSidePanelWidth = 340;
@@ -416,6 +467,26 @@ private:
     ViewOptions view_options_ = options_.view;
     bool view_dirty_ = false;  // the choice changed: the next tick rebuilds the image input
     std::shared_ptr<const ViewGeometry> view_geometry_;  // of the installed image input (the legend)
+
+    // Document safety: the modified state, the dialog's held-back action, the recovery folders and
+    // the recent files.
+    bool modified_ = false;
+    std::optional<std::chrono::steady_clock::time_point> unsaved_since_autosave_;
+    std::filesystem::path save_target_;  // the session or volume the dialog's Save writes ("" : ask)
+    std::optional<DocumentAction> unsaved_dialog_;   // asking Save / Discard / Cancel
+    bool open_unsaved_popup_ = false;
+    std::optional<DocumentAction> after_save_;        // carried on once the save finished
+    int saves_ = 0, saves_before_ = 0;                // saves queued, and before the dialog's Save
+    int errors_ = 0, errors_before_ = 0;              // errors shown, and before the dialog's Save
+    std::filesystem::path state_dir_;
+    RecentFiles recent_;
+    RecoveryFiles own_recovery_;
+    bool recovery_written_ = false;  // own_recovery_ may hold a copy (removed once saved)
+    std::vector<RecoveryFiles> abandoned_;  // offered for recovery
+    bool open_recovery_popup_ = false;
+    std::optional<RecoveryFiles> recovering_;  // being opened: removed once its volume is open
+    std::optional<CameraSettings> next_camera_;  // the next open's first view (request_open)
+    std::string shown_title_;
 };
 
 }  // namespace waxwork

@@ -68,7 +68,11 @@ void EditorApp::apply_theme(float scale) {
 }
 
 void EditorApp::open_dialog(FileDialog::Mode mode, SaveKind kind) {
-    const fs::path directory = current_file_.empty() ? fs::current_path() : current_file_.parent_path();
+    // Saving starts in the folder the user last saved into, else the working directory: not the
+    // input's folder, which may be the repository's assets/meshes.
+    const fs::path directory = mode == FileDialog::Mode::Save ? (recent_.output_folder.empty() ? fs::current_path() : recent_.output_folder)
+                               : current_file_.empty() ? fs::current_path()
+                                                       : current_file_.parent_path();
     saving_ = kind;
     const std::string stem = current_file_.empty() ? "" : current_file_.stem().string();
     if (mode == FileDialog::Mode::Open) {
@@ -90,7 +94,7 @@ void EditorApp::open_dialog(FileDialog::Mode mode, SaveKind kind) {
 void EditorApp::file_dialog_result() {
     if (options_.hide_ui) return;
     if (const auto chosen = file_dialog_.draw(ui_scale_)) {
-        if (file_dialog_.mode() == FileDialog::Mode::Open) open_file(*chosen);
+        if (file_dialog_.mode() == FileDialog::Mode::Open) request_open(*chosen);
         else if (saving_ == SaveKind::Session) save_session(*chosen);
         else if (saving_ == SaveKind::Surface) export_surface(*chosen);
         else if (saving_ == SaveKind::Reference) save_reference(*chosen);
@@ -103,6 +107,7 @@ void EditorApp::draw_ui() {
     draw_tool_palette();
     draw_side_panel();
     draw_status_bar();
+    if (start_screen_shown()) draw_start_screen();
     // The Reference window opens over the lower part of the view, clear of the tool palette.
     const float reference_x = (kToolPaletteWidth + 12) * ui_scale_;
     const float reference_y = ImGui::GetIO().DisplaySize.y - (360 + 48) * ui_scale_;
@@ -145,6 +150,7 @@ void EditorApp::draw_menu_bar() {
     if (!ImGui::BeginMainMenuBar()) return;
     if (ImGui::BeginMenu("File")) {
         if (ImGui::MenuItem("Open...", "Ctrl+O")) open_dialog(FileDialog::Mode::Open);
+        draw_open_recent_menu();
         if (ImGui::MenuItem("Save volume...", "Ctrl+S", false, scene_->core != nullptr)) open_dialog(FileDialog::Mode::Save);
         if (ImGui::MenuItem("Save session...", nullptr, false, scene_->core != nullptr)) open_dialog(FileDialog::Mode::Save, SaveKind::Session);
         if (ImGui::MenuItem("Snapshot", nullptr, false, scene_->core != nullptr)) snapshot();
@@ -153,7 +159,7 @@ void EditorApp::draw_menu_bar() {
         if (ImGui::MenuItem("Export surface...", nullptr, false, scene_->core != nullptr))
             open_dialog(FileDialog::Mode::Save, SaveKind::Surface);
         ImGui::Separator();
-        if (ImGui::MenuItem("Quit", "Ctrl+Q")) glfwSetWindowShouldClose(window_, GLFW_TRUE);
+        if (ImGui::MenuItem("Quit", "Ctrl+Q")) request_quit();
         ImGui::EndMenu();
     }
     if (ImGui::BeginMenu("Edit")) {

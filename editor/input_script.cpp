@@ -210,6 +210,33 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
         if (!f.is_string() || f.get<std::string>().empty()) fail_json(in.field("file"), "expected a file path");
         e.file = fs::absolute(base / fs::path(f.get<std::string>()));
         events.push_back(e);
+    } else if (kind == "quit" || kind == "close_window" || kind == "recover" || kind == "discard_recovery" ||
+               kind == "autosave" || kind == "kill") {
+        e.action = kind == "quit"               ? ScriptAction::Quit
+                   : kind == "close_window"     ? ScriptAction::CloseWindow
+                   : kind == "recover"          ? ScriptAction::Recover
+                   : kind == "discard_recovery" ? ScriptAction::DiscardRecovery
+                   : kind == "autosave"         ? ScriptAction::Autosave
+                                                : ScriptAction::Kill;
+        events.push_back(e);
+    } else if (kind == "dialog") {
+        e.action = ScriptAction::Dialog;
+        const Json& b = in.at("button");
+        if (!b.is_string() || (b != "save" && b != "discard" && b != "cancel"))
+            fail_json(in.field("button"), "expected \"save\", \"discard\" or \"cancel\"");
+        e.name = b.get<std::string>();
+        if (in.has("file")) {
+            const Json& f = in.at("file");
+            if (!f.is_string() || f.get<std::string>().empty()) fail_json(in.field("file"), "expected a file path");
+            e.file = fs::absolute(base / fs::path(f.get<std::string>()));
+        }
+        events.push_back(e);
+    } else if (kind == "open_example") {
+        e.action = ScriptAction::OpenExample;
+        const Json& n = in.at("name");
+        if (!n.is_string() || n.get<std::string>().empty()) fail_json(in.field("name"), "expected an example's name, e.g. \"spot\"");
+        e.name = n.get<std::string>();
+        events.push_back(e);
     } else if (kind == "cancel_task") {
         e.action = ScriptAction::CancelTask;
         events.push_back(e);
@@ -225,7 +252,8 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
         fail_json(entry, "unknown event \"" + kind +
                              "\" (expected press, move, release, drag, scroll, key, tool, material, crease_angle, "
                              "idle, save_session, save_volume, export_surface, open, cancel_task, repair, render_reference, "
-                             "cancel_reference, save_reference, snapshot)");
+                             "cancel_reference, save_reference, quit, close_window, dialog, open_example, recover, "
+                             "discard_recovery, autosave, kill, snapshot)");
     }
     in.finish();
 }
@@ -278,6 +306,14 @@ void InputScriptPlayer::advance(ScriptTarget& target) {
         case ScriptAction::CancelReference: target.cancel_reference(); break;
         case ScriptAction::SaveReference: target.save_reference(e.file); break;
         case ScriptAction::Snapshot: target.snapshot(); break;
+        case ScriptAction::Quit: target.quit(); break;
+        case ScriptAction::CloseWindow: target.close_window(); break;
+        case ScriptAction::Dialog: target.answer_dialog(e.name, e.file); break;
+        case ScriptAction::OpenExample: target.open_example(e.name); break;
+        case ScriptAction::Recover: target.recover(true); break;
+        case ScriptAction::DiscardRecovery: target.recover(false); break;
+        case ScriptAction::Autosave: target.autosave(); break;
+        case ScriptAction::Kill: target.kill(); break;
         }
         last_fired_ = frame_;
         ++next_;

@@ -28,12 +28,26 @@
 //                                 1/size of the view across (4, 2 or 1); all optional
 //     {"event": "cancel_reference"},                          the Reference window's Cancel
 //     {"event": "save_reference", "file": "r.png"},           its Save (the numbers go to r.json)
+//     {"event": "quit"},                                      File > Quit (asks first when modified,
+//                                                             as Ctrl+Q: {"event": "key", "key": "Q",
+//                                                             "mods": ["ctrl"]})
+//     {"event": "close_window"},                              the window's close button (likewise)
+//     {"event": "dialog", "button": "save", "file": "s.json"},
+//                                 a button of the unsaved-changes dialog: "save", "discard" or
+//                                 "cancel"; Save writes `file` when given (a .json: the session, else
+//                                 the volume), else what the document was opened from or saved as
+//     {"event": "open_example", "name": "spot"},              a start screen example (as a click)
+//     {"event": "recover"},                                   the recovery offer's Recover / Discard
+//     {"event": "discard_recovery"},
+//     {"event": "autosave"},                                  write the recovery copy now
+//     {"event": "kill"},                                      die at once as a crash would (SIGKILL):
+//                                                             the recovery copy stays behind
 //     {"event": "snapshot"}                                   File > Snapshot
 //   ]
 //
 // Positions are window coordinates (GLFW's: screen units, origin top-left; with --hide-ui the view
 // fills the window). "frame" is the earliest frame an event fires, counted from the first frame that
-// shows the loaded object; events fire in order, each at the earliest one frame after the previous
+// shows the loaded object (or the start screen, when the editor opened with no file); events fire in order, each at the earliest one frame after the previous
 // (several per frame would pile a whole drag into one frame). Output files are relative to the
 // script's directory. Errors name the file and the entry ("s.json: entry 3 (press): field 'x': ...").
 #pragma once
@@ -51,7 +65,8 @@ namespace waxwork {
 
 enum class ScriptAction {
     Move, Press, Release, Scroll, Key, SelectTool, SelectMaterial, SetCreaseAngle, WaitIdle, SaveSession, SaveVolume,
-    ExportSurface, Open, CancelTask, Repair, RenderReference, CancelReference, SaveReference, Snapshot
+    ExportSurface, Open, CancelTask, Repair, RenderReference, CancelReference, SaveReference, Quit, CloseWindow,
+    Dialog, OpenExample, Recover, DiscardRecovery, Autosave, Kill, Snapshot
 };
 
 struct ScriptEvent {
@@ -67,6 +82,8 @@ struct ScriptEvent {
     double degrees = 0;          // SetCreaseAngle: in [0, 180]
     std::filesystem::path file;  // SaveSession, SaveVolume, ExportSurface, Open (absolute after parsing)
     std::string repair;          // Repair: a RepairChoice id
+    std::string name;            // Dialog: "save", "discard" or "cancel"; OpenExample: the example
+                                 // (Dialog's optional file is `file`, empty when not given)
     std::optional<double> seconds, noise_percent;  // RenderReference: the Reference window's settings
     std::optional<int> size_divisor;               // (nullopt: as the window has them)
     std::string context;         // "SCRIPT: entry N (kind)" for messages
@@ -113,6 +130,14 @@ public:
     virtual void cancel_reference() = 0;
     virtual void save_reference(const std::filesystem::path& file) = 0;
     virtual void snapshot() = 0;  // File > Snapshot
+    // Document safety and the start screen (editor_app.h).
+    virtual void quit() = 0;          // File > Quit
+    virtual void close_window() = 0;  // the window's close button
+    virtual void answer_dialog(const std::string& button, const std::filesystem::path& file) = 0;
+    virtual void open_example(const std::string& name) = 0;
+    virtual void recover(bool accept) = 0;  // Recover (true) or Discard
+    virtual void autosave() = 0;
+    virtual void kill() = 0;
 };
 
 // Replays a script, a frame at a time.

@@ -10,6 +10,7 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <csignal>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -134,6 +135,7 @@ void EditorApp::queue_deform(const ToolOutcome& outcome) {
     if (!outcome.deform) return;
     const DeformOp op = *outcome.deform;
     if (outcome.deform_finished) {
+        mark_modified();
         queue_job("deform", [op](SceneCore& core) {
             const ChangeReport report = core.commit_deform(op);
             std::ostringstream line;
@@ -287,7 +289,7 @@ namespace {
 class WindowScriptTarget final : public ScriptTarget {
 public:
     WindowScriptTarget(GLFWwindow* window, EditorApp& app) : window_(window), app_(app) {}
-    bool ready() const override { return app_.viewport_ready(); }
+    bool ready() const override { return app_.viewport_ready() || app_.start_screen_shown(); }
     bool idle() const override { return app_.idle(); }
     void cursor(double x, double y) override {
         const GLFWcursorposfun f = glfwSetCursorPosCallback(window_, nullptr);
@@ -318,7 +320,7 @@ public:
     void save_session(const std::filesystem::path& file) override { app_.save_session(file); }
     void save_volume(const std::filesystem::path& file) override { app_.save_volume(file); }
     void export_surface(const std::filesystem::path& file) override { app_.export_surface(file); }
-    void open_file(const std::filesystem::path& file) override { app_.open_file(file); }
+    void open_file(const std::filesystem::path& file) override { app_.request_open(file); }
     void cancel_task() override { app_.cancel_loading(); }
     void choose_repair(const std::string& id) override { app_.choose_repair(id); }
     void render_reference(std::optional<double> seconds, std::optional<double> noise_percent,
@@ -328,6 +330,21 @@ public:
     void cancel_reference() override { app_.cancel_reference(); }
     void save_reference(const std::filesystem::path& file) override { app_.save_reference(file); }
     void snapshot() override { app_.snapshot(); }
+    void quit() override { app_.request_quit(); }
+    void close_window() override {
+        const GLFWwindowclosefun f = glfwSetWindowCloseCallback(window_, nullptr);
+        glfwSetWindowCloseCallback(window_, f);
+        // What GLFW does for the close button: flag the window, then tell the callback.
+        glfwSetWindowShouldClose(window_, GLFW_TRUE);
+        if (f) f(window_);
+    }
+    void answer_dialog(const std::string& button, const std::filesystem::path& file) override {
+        app_.answer_unsaved_dialog(button, file);
+    }
+    void open_example(const std::string& name) override { app_.open_example(name); }
+    void recover(bool accept) override { accept ? app_.recover() : app_.discard_recovery(); }
+    void autosave() override { app_.autosave(); }
+    void kill() override { std::raise(SIGKILL); }
 
 private:
     GLFWwindow* window_;

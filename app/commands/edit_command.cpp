@@ -39,6 +39,8 @@ void run_edit_command(const EditCommandOptions& o) {
     if (options.frames < 1 || options.frames > 100000)
         throw InvalidArgumentError("--frames must be between 1 and 100000");
     if (options.scale) validate_mm_per_unit(*options.scale, "--scale");
+    if (!(options.autosave_seconds >= 1 && options.autosave_seconds <= 86400))
+        throw InvalidArgumentError("--autosave must be between 1 and 86400 seconds");
     if (!is_crease_angle(options.crease_angle_degrees))
         throw InvalidArgumentError("--crease-angle must be between 0 and 180 degrees");
     options.view.mode = parse_view_mode(o.show);
@@ -81,6 +83,7 @@ void run_edit_command(const EditCommandOptions& o) {
             {"frame_ms_while_tracing", stats.mean_frame_ms_while_tracing},
             {"max_frame_ms_while_tracing", stats.max_frame_ms_while_tracing},
             {"tick_ms_while_tracing", stats.tick_ms_while_tracing},
+            {"modified", stats.modified}, {"title", stats.title},
         };
         std::cout << summary.dump() << "\n";
     }
@@ -103,6 +106,10 @@ void add_edit_command(CLI::App& app) {
                     "Replay this JSON list of timed mouse and key events into the window (editor/input_script.h)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--frames", options->editor.frames, "Frames drawn before the screenshot")->capture_default_str();
+    cmd->add_option("--autosave", options->editor.autosave_seconds,
+                    "Seconds between recovery copies of unsaved edits (in $WAXWORK_STATE_DIR, else "
+                    "$XDG_STATE_HOME/waxwork, else ~/.local/state/waxwork)")
+        ->capture_default_str();
     cmd->add_flag("--hide-ui", options->editor.hide_ui, "Show the 3D view alone (Tab toggles it)");
     cmd->add_option("--width", options->editor.width, "Window width")->capture_default_str();
     cmd->add_option("--height", options->editor.height, "Window height")->capture_default_str();

@@ -141,6 +141,11 @@ TEST(InputScript, BadScriptsGetOneLineErrorsNamingTheFileAndEntry) {
         {R"([{"event": "render_reference", "size": 3}])", "field 'size': must be 4, 2 or 1"},
         {R"([{"event": "render_reference", "samples": 3}])", "unknown field 'samples'"},
         {R"([{"event": "save_reference"}])", "missing field 'file'"},
+        {R"([{"event": "dialog", "button": "maybe"}])", "s.json: entry 0 (dialog): field 'button': expected \"save\""},
+        {R"([{"event": "dialog"}])", "missing field 'button'"},
+        {R"([{"event": "dialog", "button": "save", "file": ""}])", "field 'file'"},
+        {R"([{"event": "open_example"}])", "s.json: entry 0 (open_example): missing field 'name'"},
+        {R"([{"event": "quit", "now": true}])", "unknown field 'now'"},
     };
     for (const auto& [text, expected] : cases) {
         const std::string message = parse_error(text);
@@ -190,6 +195,15 @@ public:
     void cancel_reference() override { add("cancel reference"); }
     void save_reference(const std::filesystem::path& f) override { add("save reference " + f.filename().string()); }
     void snapshot() override { add("snapshot"); }
+    void quit() override { add("quit"); }
+    void close_window() override { add("close window"); }
+    void answer_dialog(const std::string& button, const std::filesystem::path& f) override {
+        add("dialog " + button + (f.empty() ? "" : " " + f.filename().string()));
+    }
+    void open_example(const std::string& name) override { add("example " + name); }
+    void recover(bool accept) override { add(accept ? "recover" : "discard recovery"); }
+    void autosave() override { add("autosave"); }
+    void kill() override { add("kill"); }
 
 private:
     void add(const std::string& s) { log.push_back(std::to_string(frame) + ": " + s); }
@@ -225,6 +239,19 @@ TEST(InputScriptPlayer, PlaysOpenCancelAndRepair) {
     target.is_ready = true;
     for (target.frame = 0; target.frame < 4; ++target.frame) player.advance(target);
     EXPECT_EQ(target.log, (std::vector<std::string>{"0: open big.obj", "1: cancel", "2: repair autorefine"}));
+}
+
+TEST(InputScriptPlayer, PlaysTheDocumentEvents) {
+    InputScriptPlayer player(parse(R"([{"event": "quit"}, {"event": "dialog", "button": "cancel"},
+        {"event": "close_window"}, {"event": "dialog", "button": "save", "file": "s.json"},
+        {"event": "open_example", "name": "spot"}, {"event": "recover"}, {"event": "discard_recovery"},
+        {"event": "autosave"}, {"event": "kill"}])"));
+    FakeTarget target;
+    target.is_ready = true;
+    for (target.frame = 0; target.frame < 10; ++target.frame) player.advance(target);
+    EXPECT_EQ(target.log, (std::vector<std::string>{"0: quit", "1: dialog cancel", "2: close window", "3: dialog save s.json",
+                                                    "4: example spot", "5: recover", "6: discard recovery",
+                                                    "7: autosave", "8: kill"}));
 }
 
 TEST(InputScriptPlayer, PlaysTheReferenceEventsWithTheirSettingsAndSnapshot) {

@@ -56,9 +56,15 @@ inline size_t line_count(const std::string& s) { return static_cast<size_t>(std:
 inline bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
 
 // Runs waxwork under its own virtual display (-a: a free server number, so tests may run in
-// parallel); `environment` (e.g. "VAR=1 ") is put before the launcher.
+// parallel); `environment` (e.g. "VAR=1 ") is put before the launcher. The editor's state (recent
+// files, recovery copies) goes to a folder of this test process unless `environment` sets
+// WAXWORK_STATE_DIR: never the user's, and no test sees another's recovery offer.
 inline CommandResult run_under_xvfb(const std::string& arguments, const std::string& environment = "") {
-    return run_waxwork(arguments, environment + "xvfb-run -a -s '-screen 0 1280x1024x24' ");
+    std::string state;
+    if (environment.find("WAXWORK_STATE_DIR=") == std::string::npos)
+        state = "WAXWORK_STATE_DIR=" + (std::filesystem::temp_directory_path() /
+                                        ("waxwork_test_" + std::to_string(::getpid())) / "editor_state").string() + " ";
+    return run_waxwork(arguments, state + environment + "xvfb-run -a -s '-screen 0 1280x1024x24' ");
 }
 
 }  // namespace waxwork::testing
