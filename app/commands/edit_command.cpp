@@ -2,6 +2,7 @@
 // --frames frames once loading and solving have finished, saves the window (UI included unless
 // --hide-ui) as a PNG and exits: for the docs and the tests, under xvfb-run on a server.
 #include "app/commands.h"
+#include "app/options/help_sections.h"
 #include "app/options/live_solver_options.h"
 #include "app/options/material_options.h"
 #include "app/options/surface_meshing_options.h"
@@ -147,6 +148,14 @@ void add_edit_command(CLI::App& app) {
         "pans, the wheel zooms, Home resets the view, Esc cancels a stroke or drag.\n"
         "With --hide-ui the first frame shows exactly what `waxwork render` writes for the same volume,\n"
         "materials, lights, --view and window size.");
+    organise_help(*cmd, "waxwork edit assets/meshes/spot.obj --material skin1",
+                  {{"Custom material (per mm, instead of --material)", {"--mua", "--musp", "--eta"}},
+                   {"Meshing a surface (docs/meshing.md)", {"--max-tets", "--edge", "--mesher", "--min-dihedral", "--radius-edge"}},
+                   {"Repairing a broken surface", {"--fill-holes", "--autorefine", "--repair", "--wrap-alpha", "--wrap-offset"}},
+                   {"Views and shading", {"--view", "--show", "--slice-normal", "--slice-offset", "--quality-interior",
+                                          "--crease-angle"}},
+                   {"Live solver (docs/solvers.md)", {"--backend", "--method", "--frame-ms"}},
+                   {"Scripts and screenshots (docs/editor.md)", {"--screenshot", "--input", "--frames", "--hide-ui"}}});
     cmd->callback([options] { run_edit_command(*options); });
 }
 

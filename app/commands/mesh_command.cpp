@@ -1,6 +1,7 @@
 // `waxwork mesh INPUT -o OUTPUT`: surface file -> validated surface -> tetrahedral volume file.
 #include "app/commands.h"
 #include "app/stderr_progress.h"
+#include "app/options/help_sections.h"
 #include "app/options/material_options.h"
 #include "app/options/surface_meshing_options.h"
 #include "base/error.h"
@@ -108,6 +109,10 @@ void add_mesh_command(CLI::App& app) {
     cmd->footer(
         "Without --edge or --max-tets the size follows the material (default marble): tets near the surface\n"
         "resolve the diffusion length 1/sigma_tr and grow inward (see solver/mesh_resolution.h).");
+    organise_help(*cmd, "waxwork mesh assets/meshes/spot.obj -o spot.vtu --max-tets 100000",
+                  {{"Meshing details (docs/meshing.md)", {"--edge", "--mesher", "--min-dihedral", "--radius-edge"}},
+                   {"Repairing a broken surface", {"--fill-holes", "--autorefine", "--repair", "--wrap-alpha", "--wrap-offset"}},
+                   {"Custom material (per mm, instead of --material)", {"--mua", "--musp", "--eta"}}});
     cmd->callback([options] { run_mesh_command(*options); });
 }
 

@@ -1,6 +1,7 @@
 // `waxwork render VOLUME -o IMAGE.png`: a volume, its materials and lights -> diffusion -> a PNG.
 // `--method mc` traces the light with the Monte Carlo reference (solver/reference/monte_carlo.h) instead.
 #include "app/commands.h"
+#include "app/options/help_sections.h"
 #include "app/options/scene_light_options.h"
 #include "base/error.h"
 #include "io/file_extension.h"
@@ -365,6 +366,13 @@ void add_render_command(CLI::App& app) {
         "camera rays for the image (exitant radiance with single scattering, no highlight), until --mc-seconds\n"
         "(a quarter for the fluence), --mc-error or --mc-photons, with a status line on stderr. The summary's\n"
         "monte_carlo.over_diffusion compares the fluences, monte_carlo_image.over_diffusion the images.");
+    organise_help(*cmd, "waxwork render spot.vtu -o spot.png --material skin1 --light dir:1,-1,-1 --view 0.7,0.5,1",
+                  {{"Custom material (per mm, instead of --material)", {"--mua", "--musp", "--eta"}},
+                   {"Light and shading details", {"--no-env-background", "--ambient", "--crease-angle"}},
+                   {"Inspection views and data", {"--slice-normal", "--slice-offset", "--quality-interior", "--fields"}},
+                   {"Solver (docs/solvers.md)", {"--method", "--tol", "--backend"}},
+                   {"Monte Carlo reference (--method mc; docs/monte_carlo.md)",
+                    {"--mc-seconds", "--mc-error", "--mc-g", "--mc-photons", "--seed"}}});
     cmd->callback([options] { run_render_command(*options); });
 }
 

@@ -1,6 +1,7 @@
 // `waxwork run SESSION.json -o OUTDIR`: replays a scripted editing session headless (session.h) and
 // prints one line per step; OUTDIR/metrics.json holds the same numbers.
 #include "app/commands.h"
+#include "app/options/help_sections.h"
 #include "app/options/live_solver_options.h"
 #include "scene/session.h"
 
@@ -56,6 +57,7 @@ void add_run_command(CLI::App& app) {
     add_live_solver_options(*cmd, options->solver, "in the renderer's OSMesa context");
     cmd->footer("Steps: edit operations ({\"op\": \"plane_cut\", ...}), {\"render\": \"a.png\"}, {\"save\": \"a.vtu\"},\n"
                 "{\"light\": {...}}, {\"camera\": {...}}, {\"undo\": 1}, {\"redo\": 1}. See assets/sessions/.");
+    organise_help(*cmd, "waxwork run assets/sessions/carve.json -o carve", {});
     cmd->callback([options] { run_run_command(*options); });
 }
 

@@ -32,6 +32,27 @@ TEST(Cli, HelpOnEveryCommand) {
     }
 }
 
+// The first screen of the main commands' help is for users: what the command does, an example and the
+// options most uses need; the solver's and the mesher's details come after them, in their sections.
+TEST(Cli, HelpStartsWithAnExampleAndTheCommonOptions) {
+    const std::vector<std::pair<std::string, std::vector<std::string>>> details = {
+        {"edit", {"--frame-ms", "--method", "--mesher", "--wrap-alpha", "--slice-offset", "--mua"}},
+        {"render", {"--tol", "--mc-seconds", "--backend", "--slice-offset", "--mua"}},
+        {"mesh", {"--mesher", "--wrap-alpha", "--mua"}}};
+    for (const auto& [command, later] : details) {
+        const auto r = run_waxwork(command + " --help");
+        ASSERT_EQ(r.exit_code, 0) << command;
+        const size_t example = r.out.find("Example:\n  waxwork " + command + " ");
+        const size_t usage = r.out.find("Usage:");
+        EXPECT_LT(example, usage) << command << ":\n" << r.out;
+        const size_t first_section = r.out.find(":\n", r.out.find("Options:") + 9);  // the first titled section
+        ASSERT_NE(first_section, std::string::npos) << command;
+        for (const std::string& option : later)
+            EXPECT_GT(r.out.find("  " + option), first_section) << command << ": " << option << " on the first screen";
+        EXPECT_LT(r.out.find("  --material"), first_section) << command;
+    }
+}
+
 TEST(Cli, UnknownCommandAndOptionAreOneLineErrors) {
     for (const std::string args : {"carve", "info --bogus x.vtu", "mesh", "mesh in.obj"}) {
         const auto r = run_waxwork(args);
