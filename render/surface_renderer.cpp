@@ -62,7 +62,7 @@ constexpr const char* kCommonGlsl = R"glsl(
 #version 430 core
 const float kPi = 3.14159265358979;
 uniform float exposure;
-uniform int tone_map;                      // 0 ACES, 1 Reinhard, 2 clamp
+uniform int tone_map;                      // 0 ACES, 1 Reinhard, 2 clamp, 3 none (linear output)
 uniform vec2 environment_turn;             // cos and sin of the environment's rotation about +y
 uniform float environment_intensity;
 
@@ -76,6 +76,7 @@ vec3 srgb_encode(vec3 c) {
 
 vec4 exposed_pixel(vec3 radiance) {
     vec3 c = max(radiance * exposure, vec3(0.0));
+    if (tone_map == 3) return vec4(c, 1.0);
     if (tone_map == 0) c = aces(c);
     else if (tone_map == 1) c = c / (1.0 + c);
     else c = clamp(c, 0.0, 1.0);
@@ -547,10 +548,10 @@ void upload_environment_texture(const GlApi& gl, GLuint texture, const Environme
 }
 
 // The uniforms kCommonGlsl declares, for the program in use.
-void set_common_uniforms(const GlApi& gl, GLuint program, const SurfaceRenderInput& input) {
+void set_common_uniforms(const GlApi& gl, GLuint program, const SurfaceRenderInput& input, bool linear) {
     auto location = [&](const char* name) { return gl.GetUniformLocation(program, name); };
     gl.Uniform1f(location("exposure"), input.exposure);
-    gl.Uniform1i(location("tone_map"), static_cast<int>(input.tone_map));
+    gl.Uniform1i(location("tone_map"), linear ? 3 : static_cast<int>(input.tone_map));
     const auto& environment = input.lighting.environment;
     const double radians = environment ? environment->rotation_degrees * std::numbers::pi / 180 : 0.0;
     gl.Uniform2f(location("environment_turn"), static_cast<float>(std::cos(radians)), static_cast<float>(std::sin(radians)));
@@ -580,7 +581,7 @@ void SurfaceRenderer::prepare_environment(const std::shared_ptr<const Environmen
     check_gl_error(gl_, "surface renderer: uploading the environment");
 }
 
-void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const CameraFrame& frame, Frame& r) {
+void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const CameraFrame& frame, Frame& r, bool linear) {
     validate_input(input);
     const GlApi& gl = gl_;
     GLint max_size = 0, max_samples = 0;
@@ -595,11 +596,12 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
     gl.GenFramebuffers(2, r.framebuffers);
     gl.GenRenderbuffers(3, r.renderbuffers);
     gl.BindRenderbuffer(GL_RENDERBUFFER, r.renderbuffers[0]);
-    gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, input.width, input.height);
+    const GLenum colour_format = linear ? GL_RGBA32F : GL_RGBA8;
+    gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, colour_format, input.width, input.height);
     gl.BindRenderbuffer(GL_RENDERBUFFER, r.renderbuffers[1]);
     gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT24, input.width, input.height);
     gl.BindRenderbuffer(GL_RENDERBUFFER, r.renderbuffers[2]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, input.width, input.height);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, colour_format, input.width, input.height);
     gl.BindFramebuffer(GL_FRAMEBUFFER, r.framebuffers[1]);
     gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, r.renderbuffers[2]);
     check_framebuffer(gl, "resolve", input.width, input.height, 1);
@@ -609,7 +611,16 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
     check_framebuffer(gl, "multisampled", input.width, input.height, samples);
 
     gl.Viewport(0, 0, input.width, input.height);
-    gl.ClearColor(input.background[0] / 255.0f, input.background[1] / 255.0f, input.background[2] / 255.0f, 1.0f);
+    if (input.transparent_background) {
+        gl.ClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+    } else if (linear) {
+        // The background colour is sRGB-encoded; the linear image holds it decoded.
+        gl.ClearColor(static_cast<float>(srgb_decode(input.background[0] / 255.0)),
+                      static_cast<float>(srgb_decode(input.background[1] / 255.0)),
+                      static_cast<float>(srgb_decode(input.background[2] / 255.0)), 1.0f);
+    } else {
+        gl.ClearColor(input.background[0] / 255.0f, input.background[1] / 255.0f, input.background[2] / 255.0f, 1.0f);
+    }
     gl.ClearDepth(1.0);
     gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 
@@ -618,7 +629,7 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
     if (environment) prepare_environment(input.lighting.environment->map, input.roughness);
     if (environment && input.lighting.environment->background) {
         gl.UseProgram(background_program_);
-        set_common_uniforms(gl, background_program_, input);
+        set_common_uniforms(gl, background_program_, input, linear);
         const Eigen::Matrix4f inverse = (frame.projection * frame.view).inverse().cast<float>();
         gl.UniformMatrix4fv(gl.GetUniformLocation(background_program_, "inverse_view_projection"), 1, GL_FALSE,
                             inverse.data());
@@ -704,7 +715,7 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.Uniform2f(location("lut_size"), kLutCosSamples, kLutEtaSamples);
         gl.Uniform1f(location("roughness"), input.roughness);
         gl.Uniform1f(location("specular_scale"), input.specular_scale);
-        set_common_uniforms(gl, program_, input);
+        set_common_uniforms(gl, program_, input, linear);
         gl.Uniform1i(location("environment_enabled"), environment ? 1 : 0);
         gl.Uniform1i(location("shading"), static_cast<int>(input.shading));
         gl.Uniform1i(location("clip_enabled"), input.clip_plane ? 1 : 0);
@@ -770,18 +781,67 @@ void SurfaceRenderer::draw(const SurfaceRenderInput& input, const CameraFrame& c
     check_gl_error(gl_, "surface renderer: drawing into the target framebuffer");
 }
 
-Image SurfaceRenderer::render(const SurfaceRenderInput& input) {
-    validate_input(input);
+namespace {
+
+// The frame render() and render_linear() draw: framed on the input's bounding box.
+CameraFrame input_frame(const SurfaceRenderInput& input) {
     Eigen::AlignedBox3d box;
     for (const Eigen::Vector3f& p : input.positions) box.extend(p.cast<double>());
-    const CameraFrame frame = box.isEmpty() ? CameraFrame{} :
-        frame_camera(box, input.camera, static_cast<double>(input.width) / input.height);
+    return box.isEmpty() ? CameraFrame{} : frame_camera(box, input.camera, static_cast<double>(input.width) / input.height);
+}
+
+// The resolve averages premultiplied samples (the clear is transparent black, the surface opaque):
+// divide the colour by the coverage for straight alpha.
+void unpremultiply(Image& image) {
+    for (size_t p = 0; p < image.rgba.size(); p += 4) {
+        const unsigned a = image.rgba[p + 3];
+        if (a == 0 || a == 255) continue;
+        for (int c = 0; c < 3; ++c)
+            image.rgba[p + c] = static_cast<uint8_t>(std::min(255u, (image.rgba[p + c] * 255u + a / 2) / a));
+    }
+}
+
+}  // namespace
+
+Image SurfaceRenderer::render(const SurfaceRenderInput& input) {
+    validate_input(input);
+    const CameraFrame frame = input_frame(input);
     const GlApi& gl = gl_;
     Frame r(gl);
     draw_resolved(input, frame, r);
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[1]);
     Image image = read_framebuffer(gl, input.width, input.height);
     check_gl_error(gl, "surface renderer: drawing");
+    if (input.transparent_background) unpremultiply(image);
+    return image;
+}
+
+LinearImage SurfaceRenderer::render_linear(const SurfaceRenderInput& input) {
+    validate_input(input);
+    const CameraFrame frame = input_frame(input);
+    const GlApi& gl = gl_;
+    Frame r(gl);
+    draw_resolved(input, frame, r, true);
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[1]);
+    LinearImage image;
+    image.width = input.width;
+    image.height = input.height;
+    image.rgba.resize(4 * static_cast<size_t>(input.width) * static_cast<size_t>(input.height));
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    gl.ReadPixels(0, 0, input.width, input.height, GL_RGBA, GL_FLOAT, image.rgba.data());
+    check_gl_error(gl, "surface renderer: drawing the linear image");
+    // Bottom row first from OpenGL, top row first in LinearImage; straight alpha as render() gives.
+    const size_t row = 4 * static_cast<size_t>(input.width);
+    for (int y = 0; y < input.height / 2; ++y)
+        std::swap_ranges(image.rgba.begin() + static_cast<std::ptrdiff_t>(y * row),
+                         image.rgba.begin() + static_cast<std::ptrdiff_t>((y + 1) * row),
+                         image.rgba.begin() + static_cast<std::ptrdiff_t>((input.height - 1 - y) * row));
+    if (input.transparent_background)
+        for (size_t p = 0; p < image.rgba.size(); p += 4) {
+            const float a = image.rgba[p + 3];
+            if (a > 0 && a < 1)
+                for (int c = 0; c < 3; ++c) image.rgba[p + c] /= a;
+        }
     return image;
 }
 
