@@ -386,6 +386,29 @@ void EditorApp::save_reference(const fs::path& path) {
     }
 }
 
+void EditorApp::save_image(const fs::path& path) {
+    if (!is_image_extension(path)) {
+        set_error("save image: " + path.string() + ": the image must be .png, .jpg or .jpeg");
+        return;
+    }
+    image_to_save_ = path;
+}
+
+void EditorApp::write_saved_image() {
+    const fs::path path = *image_to_save_;
+    image_to_save_.reset();
+    if (!scene_->render_input) {
+        set_error("save image: nothing is shown yet");
+        return;
+    }
+    try {
+        write_image(read_viewport(), path);
+        status_ = "Saved the view to " + path.string();
+    } catch (const std::exception& e) {
+        set_error(e.what());
+    }
+}
+
 void EditorApp::save_session(const fs::path& path) {
     // The view and lights as they are now, not as the session started.
     Session current;
@@ -616,6 +639,7 @@ void EditorApp::frame() {
     gl_.ClearColor(0.09f, 0.09f, 0.11f, 1.0f);
     gl_.Clear(GL_COLOR_BUFFER_BIT);
     draw_viewport(fb_h);
+    if (image_to_save_) write_saved_image();  // the view alone, before the panels are drawn over it
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 }
 

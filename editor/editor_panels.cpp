@@ -78,6 +78,8 @@ void EditorApp::open_dialog(FileDialog::Mode mode, SaveKind kind) {
     } else if (kind == SaveKind::Surface) {
         file_dialog_.open(mode, "Export surface", directory, {".ply", ".obj", ".stl"},
                           (stem.empty() ? "surface" : stem) + ".ply");
+    } else if (kind == SaveKind::Image) {
+        file_dialog_.open(mode, "Save image", directory, {".png", ".jpg", ".jpeg"}, (stem.empty() ? "view" : stem) + ".png");
     } else if (kind == SaveKind::Reference) {
         file_dialog_.open(mode, "Save reference comparison", directory, {".png"},
                           (stem.empty() ? "reference" : stem) + "_reference.png");
@@ -94,6 +96,7 @@ void EditorApp::file_dialog_result() {
         else if (saving_ == SaveKind::Session) save_session(*chosen);
         else if (saving_ == SaveKind::Surface) export_surface(*chosen);
         else if (saving_ == SaveKind::Reference) save_reference(*chosen);
+        else if (saving_ == SaveKind::Image) save_image(*chosen);
         else save_volume(*chosen);
     }
 }
@@ -149,6 +152,8 @@ void EditorApp::draw_menu_bar() {
         if (ImGui::MenuItem("Save session...", nullptr, false, scene_->core != nullptr)) open_dialog(FileDialog::Mode::Save, SaveKind::Session);
         if (ImGui::MenuItem("Export surface...", nullptr, false, scene_->core != nullptr))
             open_dialog(FileDialog::Mode::Save, SaveKind::Surface);
+        if (ImGui::MenuItem("Save image...", nullptr, false, scene_->render_input.has_value()))
+            open_dialog(FileDialog::Mode::Save, SaveKind::Image);
         ImGui::Separator();
         if (ImGui::MenuItem("Quit", "Ctrl+Q")) glfwSetWindowShouldClose(window_, GLFW_TRUE);
         ImGui::EndMenu();

@@ -197,11 +197,12 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
         e.action = ScriptAction::CancelReference;
         events.push_back(e);
     } else if (kind == "save_session" || kind == "save_volume" || kind == "export_surface" || kind == "open" ||
-               kind == "save_reference") {
+               kind == "save_reference" || kind == "save_image") {
         e.action = kind == "save_session"     ? ScriptAction::SaveSession
                    : kind == "save_volume"    ? ScriptAction::SaveVolume
                    : kind == "export_surface" ? ScriptAction::ExportSurface
                    : kind == "save_reference" ? ScriptAction::SaveReference
+                   : kind == "save_image"     ? ScriptAction::SaveImage
                                               : ScriptAction::Open;
         const Json& f = in.at("file");
         if (!f.is_string() || f.get<std::string>().empty()) fail_json(in.field("file"), "expected a file path");
@@ -222,7 +223,7 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
         fail_json(entry, "unknown event \"" + kind +
                              "\" (expected press, move, release, drag, scroll, key, tool, material, crease_angle, "
                              "idle, save_session, save_volume, export_surface, open, cancel_task, repair, render_reference, "
-                             "cancel_reference, save_reference)");
+                             "cancel_reference, save_reference, save_image)");
     }
     in.finish();
 }
@@ -274,6 +275,7 @@ void InputScriptPlayer::advance(ScriptTarget& target) {
         case ScriptAction::RenderReference: target.render_reference(e.seconds, e.noise_percent, e.size_divisor); break;
         case ScriptAction::CancelReference: target.cancel_reference(); break;
         case ScriptAction::SaveReference: target.save_reference(e.file); break;
+        case ScriptAction::SaveImage: target.save_image(e.file); break;
         }
         last_fired_ = frame_;
         ++next_;

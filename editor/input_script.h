@@ -27,7 +27,8 @@
 //                                 View > Render reference: at most `seconds`, until `noise` percent,
 //                                 1/size of the view across (4, 2 or 1); all optional
 //     {"event": "cancel_reference"},                          the Reference window's Cancel
-//     {"event": "save_reference", "file": "r.png"}            its Save (the numbers go to r.json)
+//     {"event": "save_reference", "file": "r.png"},           its Save (the numbers go to r.json)
+//     {"event": "save_image", "file": "view.png"}             as File > Save image (.png, .jpg, .jpeg)
 //   ]
 //
 // Positions are window coordinates (GLFW's: screen units, origin top-left; with --hide-ui the view
@@ -50,7 +51,7 @@ namespace waxwork {
 
 enum class ScriptAction {
     Move, Press, Release, Scroll, Key, SelectTool, SelectMaterial, SetCreaseAngle, WaitIdle, SaveSession, SaveVolume,
-    ExportSurface, Open, CancelTask, Repair, RenderReference, CancelReference, SaveReference
+    ExportSurface, Open, CancelTask, Repair, RenderReference, CancelReference, SaveReference, SaveImage
 };
 
 struct ScriptEvent {
@@ -111,6 +112,7 @@ public:
                                   std::optional<int> size_divisor) = 0;
     virtual void cancel_reference() = 0;
     virtual void save_reference(const std::filesystem::path& file) = 0;
+    virtual void save_image(const std::filesystem::path& file) = 0;  // File > Save image
 };
 
 // Replays a script, a frame at a time.

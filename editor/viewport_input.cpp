@@ -294,6 +294,7 @@ public:
     }
     void cancel_reference() override { app_.cancel_reference(); }
     void save_reference(const std::filesystem::path& file) override { app_.save_reference(file); }
+    void save_image(const std::filesystem::path& file) override { app_.save_image(file); }
 
 private:
     GLFWwindow* window_;

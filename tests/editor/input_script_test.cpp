@@ -141,6 +141,7 @@ TEST(InputScript, BadScriptsGetOneLineErrorsNamingTheFileAndEntry) {
         {R"([{"event": "render_reference", "size": 3}])", "field 'size': must be 4, 2 or 1"},
         {R"([{"event": "render_reference", "samples": 3}])", "unknown field 'samples'"},
         {R"([{"event": "save_reference"}])", "missing field 'file'"},
+        {R"([{"event": "save_image"}])", "missing field 'file'"},
     };
     for (const auto& [text, expected] : cases) {
         const std::string message = parse_error(text);
@@ -189,6 +190,7 @@ public:
     }
     void cancel_reference() override { add("cancel reference"); }
     void save_reference(const std::filesystem::path& f) override { add("save reference " + f.filename().string()); }
+    void save_image(const std::filesystem::path& f) override { add("save image " + f.filename().string()); }
 
 private:
     void add(const std::string& s) { log.push_back(std::to_string(frame) + ": " + s); }
@@ -234,6 +236,14 @@ TEST(InputScriptPlayer, PlaysTheReferenceEventsWithTheSettingsGiven) {
     for (target.frame = 0; target.frame < 5; ++target.frame) player.advance(target);
     EXPECT_EQ(target.log, (std::vector<std::string>{"0: reference 3 7 2", "1: reference - - -", "2: cancel reference",
                                                     "3: save reference r.png"}));
+}
+
+TEST(InputScriptPlayer, PlaysSaveImage) {
+    InputScriptPlayer player(parse(R"([{"event": "save_image", "file": "out/view.jpg"}])"));
+    FakeTarget target;
+    target.is_ready = true;
+    for (target.frame = 0; target.frame < 2; ++target.frame) player.advance(target);
+    EXPECT_EQ(target.log, (std::vector<std::string>{"0: save image view.jpg"}));
 }
 
 TEST(InputScript, ExampleScriptsParse) {
