@@ -677,6 +677,7 @@ void EditorApp::draw_viewport(int fb_h) {
     input.height = view_h_;
     input.samples = msaa_samples_;
     input.exposure = scene_->automatic_exposure * std::exp2(exposure_stops_);
+    input.ground = ground_plane_;
     const CameraFrame frame = camera_->frame(static_cast<double>(view_w_) / view_h_);
     const ViewKey key{frame.view, frame.projection, view_w_, view_h_, input.samples, input.exposure, scene_version_};
     const int y = fb_h - view_y_ - view_h_;

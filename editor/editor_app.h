@@ -385,6 +385,7 @@ private:
     int deform_preview_iterations_ = 2;
     std::vector<PinSphere> pins_;
     bool show_light_gizmos_ = true;
+    bool ground_plane_ = false;  // the View panel's: the model on a ground with its shadows
 
     // Viewport rectangle in framebuffer pixels (origin top-left) and the scale from window to
     // framebuffer coordinates (HiDPI).

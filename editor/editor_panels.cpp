@@ -362,6 +362,7 @@ void EditorApp::draw_view_panel() {
     int msaa = msaa_samples_ >= 4 ? 2 : msaa_samples_ >= 2 ? 1 : 0;
     if (ImGui::Combo("antialiasing", &msaa, "off\0" "2x MSAA\0" "4x MSAA\0")) msaa_samples_ = msaa == 2 ? 4 : msaa == 1 ? 2 : 1;
     ImGui::Checkbox("show light gizmos", &show_light_gizmos_);
+    if (ImGui::Checkbox("ground plane", &ground_plane_)) view_cache_->invalidate();
     if (ImGui::Button("Reset camera (Home)")) camera_.reset();
     if (camera_) {
         const Eigen::Vector3d d = camera_->eye_direction();

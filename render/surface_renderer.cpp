@@ -2,6 +2,7 @@
 
 #include "base/error.h"
 #include "render/environment_prefilter.h"
+#include "render/ground_plane.h"
 #include "solver/environment_light.h"
 #include "solver/material.h"
 
@@ -222,6 +223,40 @@ void main() {
 }
 )glsl";
 
+// The ground plane (ground_plane.h): a square from gl_VertexID, its irradiance from a texture, a
+// diffuse grey exposed and tone-mapped as the surface is, faded towards its edge.
+constexpr const char* kGroundVertexShader = R"glsl(
+#version 430 core
+uniform mat4 view_projection;
+uniform vec4 ground;  // centre x, centre z, half side, height
+out vec3 v_position;
+void main() {
+    vec2 corner = vec2(gl_VertexID & 1, gl_VertexID >> 1) * 2.0 - 1.0;
+    v_position = vec3(ground.x + corner.x * ground.z, ground.w, ground.y + corner.y * ground.z);
+    gl_Position = view_projection * vec4(v_position, 1.0);
+}
+)glsl";
+
+constexpr const char* kGroundFragmentShader = R"glsl(
+in vec3 v_position;
+out vec4 color;
+uniform vec4 ground;
+uniform float texture_extent;
+uniform float albedo;
+uniform sampler2D ground_irradiance;
+uniform int fade;           // 0 none, 1 into `background`, 2 into transparency
+uniform vec3 background;    // as the clear colour holds it
+void main() {
+    vec2 offset = v_position.xz - ground.xy;
+    vec3 irradiance = texture(ground_irradiance, offset / (2.0 * texture_extent) + 0.5).rgb;
+    vec4 c = exposed_pixel(albedo / kPi * irradiance);
+    float a = 1.0 - smoothstep(0.3, 0.95, length(offset) / ground.z);
+    if (fade == 1) color = vec4(mix(background, c.rgb, a), 1.0);
+    else if (fade == 2) color = vec4(c.rgb * a, a);  // premultiplied, as the resolve of the clear
+    else color = c;
+}
+)glsl";
+
 // The overlay: unlit, coloured lines, triangles and points.
 constexpr const char* kOverlayVertexShader = R"glsl(
 #version 430 core
@@ -421,7 +456,9 @@ SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {
     try {
         overlay_program_ = link_program(gl_, kOverlayVertexShader, kOverlayFragmentShader);
         background_program_ = link_program(gl_, kBackgroundVertexShader, std::string(kCommonGlsl) + kBackgroundFragmentShader);
+        ground_program_ = link_program(gl_, kGroundVertexShader, std::string(kCommonGlsl) + kGroundFragmentShader);
     } catch (...) {
+        gl_.DeleteProgram(background_program_);
         gl_.DeleteProgram(overlay_program_);
         gl_.DeleteProgram(program_);
         throw;
@@ -449,6 +486,8 @@ SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {
 
 SurfaceRenderer::~SurfaceRenderer() {
     gl_.DeleteTextures(1, &transmittance_lut_);
+    gl_.DeleteTextures(1, &ground_texture_);
+    gl_.DeleteProgram(ground_program_);
     gl_.DeleteTextures(2, environment_textures_);
     gl_.DeleteProgram(background_program_);
     gl_.DeleteProgram(overlay_program_);
@@ -647,6 +686,9 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.UseProgram(0);
     }
 
+    if (input.ground && input.shading == SurfaceShading::Radiance && !input.triangles.empty())
+        draw_ground(input, frame, r, linear, environment && input.lighting.environment->background);
+
     if (!input.triangles.empty()) {
         const size_t n = input.positions.size();
         std::vector<float> eta = input.eta.empty() ? std::vector<float>(n, input.uniform_eta) : input.eta;
@@ -763,6 +805,69 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[0]);
     gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, r.framebuffers[1]);
     gl.BlitFramebuffer(0, 0, input.width, input.height, 0, 0, input.width, input.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+}
+
+void SurfaceRenderer::draw_ground(const SurfaceRenderInput& input, const CameraFrame& frame, Frame& r, bool linear,
+                                  bool over_environment) {
+    const GlApi& gl = gl_;
+    std::vector<double> lights = {static_cast<double>(input.lighting.shadows), input.lighting.ambient[0],
+                                  input.lighting.ambient[1], input.lighting.ambient[2]};
+    for (const Light& light : input.lighting.lights) {
+        lights.insert(lights.end(), {static_cast<double>(light.type), light.vector.x(), light.vector.y(), light.vector.z()});
+        lights.insert(lights.end(), light.intensity.begin(), light.intensity.end());
+    }
+    if (const auto& environment = input.lighting.environment)
+        lights.insert(lights.end(), {static_cast<double>(reinterpret_cast<uintptr_t>(environment->map.get())),
+                                     environment->rotation_degrees, environment->intensity});
+    if (ground_texture_ == 0) gl.GenTextures(1, &ground_texture_);
+    gl.ActiveTexture(GL_TEXTURE0);
+    gl.BindTexture(GL_TEXTURE_2D, ground_texture_);
+    if (input.positions != ground_positions_ || lights != ground_lights_ ||
+        ground_plane_.irradiance.empty()) {
+        ground_plane_ = ground_plane(input);
+        ground_positions_ = input.positions;
+        ground_lights_ = std::move(lights);
+        gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, ground_plane_.resolution, ground_plane_.resolution, 0, GL_RGB,
+                      GL_FLOAT, ground_plane_.irradiance.data());
+    }
+    const GroundPlane& plane = ground_plane_;
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+
+    gl.UseProgram(ground_program_);
+    set_common_uniforms(gl, ground_program_, input, linear);
+    auto location = [&](const char* name) { return gl.GetUniformLocation(ground_program_, name); };
+    const Eigen::Matrix4f view_projection = to_float(frame.projection * frame.view);
+    gl.UniformMatrix4fv(location("view_projection"), 1, GL_FALSE, view_projection.data());
+    // Just below the lowest point: the model's face resting on the ground must win the depth test.
+    const float below = 1e-4f * plane.extent;
+    const std::array<float, 4> ground{plane.centre.x(), plane.centre.y(), plane.extent, plane.height - below};
+    gl.Uniform4fv(location("ground"), 1, ground.data());
+    gl.Uniform1f(location("texture_extent"), plane.texture_extent);
+    gl.Uniform1f(location("albedo"), kGroundPlaneAlbedo);
+    gl.Uniform1i(location("ground_irradiance"), 0);
+    gl.Uniform1i(location("fade"), over_environment ? 0 : input.transparent_background ? 2 : 1);
+    std::array<float, 3> background{};
+    for (int c = 0; c < 3; ++c)
+        background[c] = linear ? static_cast<float>(srgb_decode(input.background[c] / 255.0)) : input.background[c] / 255.0f;
+    gl.Uniform3fv(location("background"), 1, background.data());
+    if (r.background_array == 0) gl.GenVertexArrays(1, &r.background_array);
+    gl.BindVertexArray(r.background_array);  // empty: the corners come from gl_VertexID
+    // The plane reaches beyond the far plane, which encloses only the model's bounding sphere: clamped
+    // depth (at 1, the clear's, hence LEQUAL) keeps its far part instead of cutting a false horizon.
+    gl.Enable(GL_DEPTH_TEST);
+    gl.DepthFunc(GL_LEQUAL);
+    gl.Enable(GL_DEPTH_CLAMP);
+    gl.DrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    gl.Disable(GL_DEPTH_CLAMP);
+    gl.DepthFunc(GL_LESS);
+    gl.BindVertexArray(0);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+    gl.UseProgram(0);
+    check_gl_error(gl, "surface renderer: drawing the ground");
 }
 
 void SurfaceRenderer::draw(const SurfaceRenderInput& input, const CameraFrame& camera, GLuint target_framebuffer, int x,

@@ -59,6 +59,7 @@ VolumeRender draw_volume_light(const TetMesh& mesh, VolumeLight solved, const Vo
     result.view = build_view_geometry(mesh, result.connectivity, result.materials, result.scene, settings.view);
     apply_view(result.view, input);
     apply_background(settings.background, input);
+    input.ground = settings.ground;
     SurfaceRenderer renderer(context.gl());
     result.image = render_scene(renderer, input);
     if (settings.linear) result.linear = renderer.render_linear(input);

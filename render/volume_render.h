@@ -29,7 +29,8 @@ struct VolumeRenderSettings {
     ImageSettings image;
     ViewOptions view;
     ImageBackground background;
-    bool linear = false;  // also draw VolumeRender::linear (SurfaceRenderer::render_linear)
+    bool linear = false;
+    bool ground = false;  // a ground plane with the model's shadows (SurfaceRenderInput::ground)  // also draw VolumeRender::linear (SurfaceRenderer::render_linear)
 };
 
 struct VolumeRender {

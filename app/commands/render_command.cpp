@@ -49,6 +49,7 @@ struct RenderCommandOptions {
     bool quality_interior = false;
     std::string background;  // image_background.h's words; "" automatic
     std::string linear;      // also the linear radiance, a 16-bit PNG
+    bool ground = false;
     // --method mc: the trace stops at the first of the time budget and the error target.
     std::optional<double> mc_seconds;
     std::optional<double> mc_error;
@@ -98,10 +99,11 @@ void check_options(const RenderCommandOptions& o) {
         const Eigen::Vector3d v(o.view[0], o.view[1], o.view[2]);
         if (!v.allFinite() || v.norm() == 0) fail("--view must be a finite, non-zero direction");
     }
-    if (o.light.method == "mc" && (!o.linear.empty() || background == BackgroundKind::Transparent ||
+    if (o.ground && o.show != "radiance") fail("--ground applies only to --show radiance");
+    if (o.light.method == "mc" && (o.ground || !o.linear.empty() || background == BackgroundKind::Transparent ||
                                    background == BackgroundKind::Environment))
-        fail("--method mc draws over a colour: --linear and --background transparent or environment need the "
-             "diffusion's image");
+        fail("--method mc draws over a colour: --ground, --linear and --background transparent or environment need "
+             "the diffusion's image");
     if (o.light.method != "mc") {
         if (o.mc_seconds || o.mc_error || o.mc_g || o.mc_photons || o.seed)
             fail("--mc-seconds, --mc-error, --mc-g, --mc-photons and --seed apply only with --method mc");
@@ -272,6 +274,7 @@ void run_render_command(const RenderCommandOptions& o) {
     settings.view = view;
     settings.background = parse_background(o.background);
     settings.linear = !o.linear.empty();
+    settings.ground = o.ground;
 
     const bool traced = o.light.method == "mc";
     std::optional<TracedRender> trace;
@@ -369,6 +372,8 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--background", options->background,
                     "Behind the model: R,G,B (0-255) or #RRGGBB, transparent (.png: the coverage as alpha), or "
                     "environment (needs --env) (default: the environment when --env is drawn, else grey)");
+    cmd->add_flag("--ground", options->ground,
+                  "Put the model on a ground plane lit by the same lights, with its shadows and a soft contact shadow");
     cmd->add_option("--linear", options->linear,
                     "Also write the exposed linear radiance, before tone mapping, as a 16-bit PNG (linear, not sRGB)");
     cmd->add_option("--show", options->show,

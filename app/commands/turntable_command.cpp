@@ -48,6 +48,7 @@ struct TurntableOptions {
     std::optional<int> width, height;
     std::optional<double> exposure;
     std::string background;
+    bool ground = false;
 };
 
 // More frames than this is a mistake (an hour of 60 fps video per turn), not a turntable.
@@ -178,6 +179,7 @@ void run_turntable_command(const TurntableOptions& o) {
         image.exposure = exposure;
         SurfaceRenderInput input = make_render_input(t.mesh, t.scene, t.lighting, image);
         apply_background(background, input);
+        input.ground = o.ground;
         exposure = input.exposure;
         write_png(render_scene(renderer, input), contained_output_path(dir, frame_name(i)));
     }
@@ -220,6 +222,7 @@ void add_turntable_command(CLI::App& app) {
     cmd->add_option("--exposure", options->exposure, "Fixed exposure (default: the first frame's automatic one, kept for all)");
     cmd->add_option("--background", options->background,
                     "Behind the model: R,G,B (0-255) or #RRGGBB, transparent, or environment (as render's)");
+    cmd->add_flag("--ground", options->ground, "Put the model on a ground plane with its shadows (as render's)");
     add_scene_light_options(*cmd, options->light);
     cmd->footer(
         "The camera starts where render's does (or the session's camera) and turns counter-clockwise seen from\n"

@@ -491,6 +491,7 @@ TEST_F(Render, BadInputIsAOneLineError) {
              {" --background 1,2", "background '1,2': expected"},
              {" --background environment", "--background environment needs --env"},
              {" --linear x.jpg", "--linear x.jpg: the linear image is a 16-bit .png"},
+             {" --ground --show materials", "--ground applies only to --show radiance"},
              {" --env studio.hdr:0:-2", "the intensity must be a number between 0 and 1e15"},
              {" --env " + (dir_ / "absent.hdr").string(), (dir_ / "absent.hdr").string() + ": no such file"},
              {" --env " + volume_.string(), volume_.string() + ": not a Radiance .hdr image"}}) {
