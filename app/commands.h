@@ -11,6 +11,7 @@ namespace waxwork {
 void add_mesh_command(CLI::App& app);
 void add_info_command(CLI::App& app);
 void add_render_command(CLI::App& app);
+void add_turntable_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 void add_demo_command(CLI::App& app);
 void add_cut_command(CLI::App& app);
@@ -25,6 +26,7 @@ inline void register_commands(CLI::App& app) {
     add_mesh_command(app);
     add_info_command(app);
     add_render_command(app);
+    add_turntable_command(app);
     add_export_command(app);
     add_cut_command(app);
     add_fracture_command(app);

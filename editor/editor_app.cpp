@@ -430,6 +430,29 @@ void EditorApp::save_reference(const fs::path& path) {
     }
 }
 
+void EditorApp::save_image(const fs::path& path) {
+    if (!is_image_extension(path)) {
+        set_error("save image: " + path.string() + ": the image must be .png, .jpg or .jpeg");
+        return;
+    }
+    image_to_save_ = path;
+}
+
+void EditorApp::write_saved_image() {
+    const fs::path path = *image_to_save_;
+    image_to_save_.reset();
+    if (!scene_->render_input) {
+        set_error("save image: nothing is shown yet");
+        return;
+    }
+    try {
+        write_image(read_viewport(), path);
+        status_ = "Saved the view to " + path.string();
+    } catch (const std::exception& e) {
+        set_error(e.what());
+    }
+}
+
 Session EditorApp::view_session() const {
     // The view and lights as they are now, not as the session started.
     Session current;
@@ -673,6 +696,7 @@ void EditorApp::frame() {
     gl_.ClearColor(0.09f, 0.09f, 0.11f, 1.0f);
     gl_.Clear(GL_COLOR_BUFFER_BIT);
     draw_viewport(fb_h);
+    if (image_to_save_) write_saved_image();  // the view alone, before the panels are drawn over it
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 }
 
@@ -710,6 +734,7 @@ void EditorApp::draw_viewport(int fb_h) {
     input.height = view_h_;
     input.samples = msaa_samples_;
     input.exposure = scene_->automatic_exposure * std::exp2(exposure_stops_);
+    input.ground = ground_plane_;
     const CameraFrame frame = camera_->frame(static_cast<double>(view_w_) / view_h_);
     const ViewKey key{frame.view, frame.projection, view_w_, view_h_, input.samples, input.exposure, scene_version_};
     const int y = fb_h - view_y_ - view_h_;

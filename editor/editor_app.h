@@ -239,6 +239,9 @@ public:
     bool cancel_reference();
     // The Reference window's Save: its comparison as PNG, its numbers beside it as JSON.
     void save_reference(const std::filesystem::path& path);
+    // File > Save image: the 3D view as shown (its exposure and tone mapping, no panels: read_viewport)
+    // as .png or .jpg/.jpeg, written once the current frame's view is drawn.
+    void save_image(const std::filesystem::path& path);
     const ReferenceView& reference() const { return *reference_; }
 
     // Document safety (document_safety.cpp). Edits since the last save of the volume or session
@@ -295,8 +298,9 @@ private:
     void apply_theme(float scale);
 
     // What a Save dialog writes when confirmed.
-    enum class SaveKind { Volume, Session, Surface, Reference };
+    enum class SaveKind { Volume, Session, Surface, Reference, Image };
     void open_dialog(FileDialog::Mode mode, SaveKind kind = SaveKind::Volume);
+    void write_saved_image();  // save_image's file, from the view just drawn
     void relax_last_cut();
     // What loading found out about the model, measured off the UI thread.
     struct LoadedModel {
@@ -449,6 +453,7 @@ private:
     int deform_preview_iterations_ = 2;
     std::vector<PinSphere> pins_;
     bool show_light_gizmos_ = true;
+    bool ground_plane_ = false;  // the View panel's: the model on a ground with its shadows
 
     // Viewport rectangle in framebuffer pixels (origin top-left) and the scale from window to
     // framebuffer coordinates (HiDPI).
@@ -457,6 +462,7 @@ private:
 
     FileDialog file_dialog_;
     SaveKind saving_ = SaveKind::Volume;
+    std::optional<std::filesystem::path> image_to_save_;  // save_image's file, written after the view is drawn
     std::string status_;
     std::string last_error_;
     std::string error_message_;

@@ -82,6 +82,8 @@ void EditorApp::open_dialog(FileDialog::Mode mode, SaveKind kind) {
     } else if (kind == SaveKind::Surface) {
         file_dialog_.open(mode, "Export surface", directory, {".ply", ".obj", ".stl"},
                           (stem.empty() ? "surface" : stem) + ".ply");
+    } else if (kind == SaveKind::Image) {
+        file_dialog_.open(mode, "Save image", directory, {".png", ".jpg", ".jpeg"}, (stem.empty() ? "view" : stem) + ".png");
     } else if (kind == SaveKind::Reference) {
         file_dialog_.open(mode, "Save reference comparison", directory, {".png"},
                           (stem.empty() ? "reference" : stem) + "_reference.png");
@@ -98,6 +100,7 @@ void EditorApp::file_dialog_result() {
         else if (saving_ == SaveKind::Session) save_session(*chosen);
         else if (saving_ == SaveKind::Surface) export_surface(*chosen);
         else if (saving_ == SaveKind::Reference) save_reference(*chosen);
+        else if (saving_ == SaveKind::Image) save_image(*chosen);
         else save_volume(*chosen);
     }
 }
@@ -158,6 +161,8 @@ void EditorApp::draw_menu_bar() {
             ImGui::SetTooltip("Record this view at this point of the edits: saved sessions render it when replayed");
         if (ImGui::MenuItem("Export surface...", nullptr, false, scene_->core != nullptr))
             open_dialog(FileDialog::Mode::Save, SaveKind::Surface);
+        if (ImGui::MenuItem("Save image...", nullptr, false, scene_->render_input.has_value()))
+            open_dialog(FileDialog::Mode::Save, SaveKind::Image);
         ImGui::Separator();
         if (ImGui::MenuItem("Quit", "Ctrl+Q")) request_quit();
         ImGui::EndMenu();
@@ -390,6 +395,7 @@ void EditorApp::draw_view_panel() {
     int msaa = msaa_samples_ >= 4 ? 2 : msaa_samples_ >= 2 ? 1 : 0;
     if (ImGui::Combo("antialiasing", &msaa, "off\0" "2x MSAA\0" "4x MSAA\0")) msaa_samples_ = msaa == 2 ? 4 : msaa == 1 ? 2 : 1;
     ImGui::Checkbox("show light gizmos", &show_light_gizmos_);
+    if (ImGui::Checkbox("ground plane", &ground_plane_)) view_cache_->invalidate();
     if (ImGui::Button("Reset camera (Home)")) camera_.reset();
     if (camera_) {
         const Eigen::Vector3d d = camera_->eye_direction();

@@ -200,11 +200,12 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
         e.action = ScriptAction::Snapshot;
         events.push_back(e);
     } else if (kind == "save_session" || kind == "save_volume" || kind == "export_surface" || kind == "open" ||
-               kind == "save_reference") {
+               kind == "save_reference" || kind == "save_image") {
         e.action = kind == "save_session"     ? ScriptAction::SaveSession
                    : kind == "save_volume"    ? ScriptAction::SaveVolume
                    : kind == "export_surface" ? ScriptAction::ExportSurface
                    : kind == "save_reference" ? ScriptAction::SaveReference
+                   : kind == "save_image"     ? ScriptAction::SaveImage
                                               : ScriptAction::Open;
         const Json& f = in.at("file");
         if (!f.is_string() || f.get<std::string>().empty()) fail_json(in.field("file"), "expected a file path");
@@ -253,7 +254,7 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
                              "\" (expected press, move, release, drag, scroll, key, tool, material, crease_angle, "
                              "idle, save_session, save_volume, export_surface, open, cancel_task, repair, render_reference, "
                              "cancel_reference, save_reference, quit, close_window, dialog, open_example, recover, "
-                             "discard_recovery, autosave, kill, snapshot)");
+                             "discard_recovery, autosave, kill, snapshot, save_image)");
     }
     in.finish();
 }
@@ -314,6 +315,7 @@ void InputScriptPlayer::advance(ScriptTarget& target) {
         case ScriptAction::DiscardRecovery: target.recover(false); break;
         case ScriptAction::Autosave: target.autosave(); break;
         case ScriptAction::Kill: target.kill(); break;
+        case ScriptAction::SaveImage: target.save_image(e.file); break;
         }
         last_fired_ = frame_;
         ++next_;

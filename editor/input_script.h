@@ -42,7 +42,8 @@
 //     {"event": "autosave"},                                  write the recovery copy now
 //     {"event": "kill"},                                      die at once as a crash would (SIGKILL):
 //                                                             the recovery copy stays behind
-//     {"event": "snapshot"}                                   File > Snapshot
+//     {"event": "snapshot"},                                  File > Snapshot
+//     {"event": "save_image", "file": "view.png"}             as File > Save image (.png, .jpg, .jpeg)
 //   ]
 //
 // Positions are window coordinates (GLFW's: screen units, origin top-left; with --hide-ui the view
@@ -66,7 +67,7 @@ namespace waxwork {
 enum class ScriptAction {
     Move, Press, Release, Scroll, Key, SelectTool, SelectMaterial, SetCreaseAngle, WaitIdle, SaveSession, SaveVolume,
     ExportSurface, Open, CancelTask, Repair, RenderReference, CancelReference, SaveReference, Quit, CloseWindow,
-    Dialog, OpenExample, Recover, DiscardRecovery, Autosave, Kill, Snapshot
+    Dialog, OpenExample, Recover, DiscardRecovery, Autosave, Kill, Snapshot, SaveImage
 };
 
 struct ScriptEvent {
@@ -138,6 +139,7 @@ public:
     virtual void recover(bool accept) = 0;  // Recover (true) or Discard
     virtual void autosave() = 0;
     virtual void kill() = 0;
+    virtual void save_image(const std::filesystem::path& file) = 0;  // File > Save image
 };
 
 // Replays a script, a frame at a time.

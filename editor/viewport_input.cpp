@@ -345,6 +345,7 @@ public:
     void recover(bool accept) override { accept ? app_.recover() : app_.discard_recovery(); }
     void autosave() override { app_.autosave(); }
     void kill() override { std::raise(SIGKILL); }
+    void save_image(const std::filesystem::path& file) override { app_.save_image(file); }
 
 private:
     GLFWwindow* window_;

@@ -10,6 +10,10 @@ namespace waxwork {
 // Linear [0, 1] -> encoded [0, 1]: 12.92 c below 0.0031308, else 1.055 c^(1/2.4) - 0.055.
 double srgb_encode(double linear);
 
+// Encoded [0, 1] -> linear [0, 1], the inverse of srgb_encode: c / 12.92 up to 0.04045, else
+// ((c + 0.055) / 1.055)^2.4.
+double srgb_decode(double encoded);
+
 // A linear value to its 8-bit sRGB code: clamped to [0, 1] (as the shaders clamp before encoding),
 // encoded, then rounded to the nearest of 0..255 as OpenGL converts a float to an 8-bit normalised
 // colour. NaN gives 0.

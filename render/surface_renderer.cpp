@@ -2,6 +2,7 @@
 
 #include "base/error.h"
 #include "render/environment_prefilter.h"
+#include "render/ground_plane.h"
 #include "solver/environment_light.h"
 #include "solver/material.h"
 
@@ -62,7 +63,7 @@ constexpr const char* kCommonGlsl = R"glsl(
 #version 430 core
 const float kPi = 3.14159265358979;
 uniform float exposure;
-uniform int tone_map;                      // 0 ACES, 1 Reinhard, 2 clamp
+uniform int tone_map;                      // 0 ACES, 1 Reinhard, 2 clamp, 3 none (linear output)
 uniform vec2 environment_turn;             // cos and sin of the environment's rotation about +y
 uniform float environment_intensity;
 
@@ -76,6 +77,7 @@ vec3 srgb_encode(vec3 c) {
 
 vec4 exposed_pixel(vec3 radiance) {
     vec3 c = max(radiance * exposure, vec3(0.0));
+    if (tone_map == 3) return vec4(c, 1.0);
     if (tone_map == 0) c = aces(c);
     else if (tone_map == 1) c = c / (1.0 + c);
     else c = clamp(c, 0.0, 1.0);
@@ -218,6 +220,40 @@ void main() {
     vec4 far = inverse_view_projection * vec4(ndc, 1.0, 1.0);
     vec3 w = far.xyz / far.w - near.xyz / near.w;
     color = exposed_pixel(environment_intensity * texture(environment_background, environment_uv(w)).rgb);
+}
+)glsl";
+
+// The ground plane (ground_plane.h): a square from gl_VertexID, its irradiance from a texture, a
+// diffuse grey exposed and tone-mapped as the surface is, faded towards its edge.
+constexpr const char* kGroundVertexShader = R"glsl(
+#version 430 core
+uniform mat4 view_projection;
+uniform vec4 ground;  // centre x, centre z, half side, height
+out vec3 v_position;
+void main() {
+    vec2 corner = vec2(gl_VertexID & 1, gl_VertexID >> 1) * 2.0 - 1.0;
+    v_position = vec3(ground.x + corner.x * ground.z, ground.w, ground.y + corner.y * ground.z);
+    gl_Position = view_projection * vec4(v_position, 1.0);
+}
+)glsl";
+
+constexpr const char* kGroundFragmentShader = R"glsl(
+in vec3 v_position;
+out vec4 color;
+uniform vec4 ground;
+uniform float texture_extent;
+uniform float albedo;
+uniform sampler2D ground_irradiance;
+uniform int fade;           // 0 none, 1 into `background`, 2 into transparency
+uniform vec3 background;    // as the clear colour holds it
+void main() {
+    vec2 offset = v_position.xz - ground.xy;
+    vec3 irradiance = texture(ground_irradiance, offset / (2.0 * texture_extent) + 0.5).rgb;
+    vec4 c = exposed_pixel(albedo / kPi * irradiance);
+    float a = 1.0 - smoothstep(0.3, 0.95, length(offset) / ground.z);
+    if (fade == 1) color = vec4(mix(background, c.rgb, a), 1.0);
+    else if (fade == 2) color = vec4(c.rgb * a, a);  // premultiplied, as the resolve of the clear
+    else color = c;
 }
 )glsl";
 
@@ -420,7 +456,9 @@ SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {
     try {
         overlay_program_ = link_program(gl_, kOverlayVertexShader, kOverlayFragmentShader);
         background_program_ = link_program(gl_, kBackgroundVertexShader, std::string(kCommonGlsl) + kBackgroundFragmentShader);
+        ground_program_ = link_program(gl_, kGroundVertexShader, std::string(kCommonGlsl) + kGroundFragmentShader);
     } catch (...) {
+        gl_.DeleteProgram(background_program_);
         gl_.DeleteProgram(overlay_program_);
         gl_.DeleteProgram(program_);
         throw;
@@ -448,6 +486,8 @@ SurfaceRenderer::SurfaceRenderer(const GlApi& gl) : gl_(gl) {
 
 SurfaceRenderer::~SurfaceRenderer() {
     gl_.DeleteTextures(1, &transmittance_lut_);
+    gl_.DeleteTextures(1, &ground_texture_);
+    gl_.DeleteProgram(ground_program_);
     gl_.DeleteTextures(2, environment_textures_);
     gl_.DeleteProgram(background_program_);
     gl_.DeleteProgram(overlay_program_);
@@ -547,10 +587,10 @@ void upload_environment_texture(const GlApi& gl, GLuint texture, const Environme
 }
 
 // The uniforms kCommonGlsl declares, for the program in use.
-void set_common_uniforms(const GlApi& gl, GLuint program, const SurfaceRenderInput& input) {
+void set_common_uniforms(const GlApi& gl, GLuint program, const SurfaceRenderInput& input, bool linear) {
     auto location = [&](const char* name) { return gl.GetUniformLocation(program, name); };
     gl.Uniform1f(location("exposure"), input.exposure);
-    gl.Uniform1i(location("tone_map"), static_cast<int>(input.tone_map));
+    gl.Uniform1i(location("tone_map"), linear ? 3 : static_cast<int>(input.tone_map));
     const auto& environment = input.lighting.environment;
     const double radians = environment ? environment->rotation_degrees * std::numbers::pi / 180 : 0.0;
     gl.Uniform2f(location("environment_turn"), static_cast<float>(std::cos(radians)), static_cast<float>(std::sin(radians)));
@@ -580,7 +620,7 @@ void SurfaceRenderer::prepare_environment(const std::shared_ptr<const Environmen
     check_gl_error(gl_, "surface renderer: uploading the environment");
 }
 
-void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const CameraFrame& frame, Frame& r) {
+void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const CameraFrame& frame, Frame& r, bool linear) {
     validate_input(input);
     const GlApi& gl = gl_;
     GLint max_size = 0, max_samples = 0;
@@ -595,11 +635,12 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
     gl.GenFramebuffers(2, r.framebuffers);
     gl.GenRenderbuffers(3, r.renderbuffers);
     gl.BindRenderbuffer(GL_RENDERBUFFER, r.renderbuffers[0]);
-    gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, input.width, input.height);
+    const GLenum colour_format = linear ? GL_RGBA32F : GL_RGBA8;
+    gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, colour_format, input.width, input.height);
     gl.BindRenderbuffer(GL_RENDERBUFFER, r.renderbuffers[1]);
     gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT24, input.width, input.height);
     gl.BindRenderbuffer(GL_RENDERBUFFER, r.renderbuffers[2]);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, input.width, input.height);
+    gl.RenderbufferStorage(GL_RENDERBUFFER, colour_format, input.width, input.height);
     gl.BindFramebuffer(GL_FRAMEBUFFER, r.framebuffers[1]);
     gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, r.renderbuffers[2]);
     check_framebuffer(gl, "resolve", input.width, input.height, 1);
@@ -609,7 +650,16 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
     check_framebuffer(gl, "multisampled", input.width, input.height, samples);
 
     gl.Viewport(0, 0, input.width, input.height);
-    gl.ClearColor(input.background[0] / 255.0f, input.background[1] / 255.0f, input.background[2] / 255.0f, 1.0f);
+    if (input.transparent_background) {
+        gl.ClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+    } else if (linear) {
+        // The background colour is sRGB-encoded; the linear image holds it decoded.
+        gl.ClearColor(static_cast<float>(srgb_decode(input.background[0] / 255.0)),
+                      static_cast<float>(srgb_decode(input.background[1] / 255.0)),
+                      static_cast<float>(srgb_decode(input.background[2] / 255.0)), 1.0f);
+    } else {
+        gl.ClearColor(input.background[0] / 255.0f, input.background[1] / 255.0f, input.background[2] / 255.0f, 1.0f);
+    }
     gl.ClearDepth(1.0);
     gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 
@@ -618,7 +668,7 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
     if (environment) prepare_environment(input.lighting.environment->map, input.roughness);
     if (environment && input.lighting.environment->background) {
         gl.UseProgram(background_program_);
-        set_common_uniforms(gl, background_program_, input);
+        set_common_uniforms(gl, background_program_, input, linear);
         const Eigen::Matrix4f inverse = (frame.projection * frame.view).inverse().cast<float>();
         gl.UniformMatrix4fv(gl.GetUniformLocation(background_program_, "inverse_view_projection"), 1, GL_FALSE,
                             inverse.data());
@@ -635,6 +685,9 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.BindTexture(GL_TEXTURE_2D, 0);
         gl.UseProgram(0);
     }
+
+    if (input.ground && input.shading == SurfaceShading::Radiance && !input.triangles.empty())
+        draw_ground(input, frame, r, linear, environment && input.lighting.environment->background);
 
     if (!input.triangles.empty()) {
         const size_t n = input.positions.size();
@@ -704,7 +757,7 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
         gl.Uniform2f(location("lut_size"), kLutCosSamples, kLutEtaSamples);
         gl.Uniform1f(location("roughness"), input.roughness);
         gl.Uniform1f(location("specular_scale"), input.specular_scale);
-        set_common_uniforms(gl, program_, input);
+        set_common_uniforms(gl, program_, input, linear);
         gl.Uniform1i(location("environment_enabled"), environment ? 1 : 0);
         gl.Uniform1i(location("shading"), static_cast<int>(input.shading));
         gl.Uniform1i(location("clip_enabled"), input.clip_plane ? 1 : 0);
@@ -754,6 +807,69 @@ void SurfaceRenderer::draw_resolved(const SurfaceRenderInput& input, const Camer
     gl.BlitFramebuffer(0, 0, input.width, input.height, 0, 0, input.width, input.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
 }
 
+void SurfaceRenderer::draw_ground(const SurfaceRenderInput& input, const CameraFrame& frame, Frame& r, bool linear,
+                                  bool over_environment) {
+    const GlApi& gl = gl_;
+    std::vector<double> lights = {static_cast<double>(input.lighting.shadows), input.lighting.ambient[0],
+                                  input.lighting.ambient[1], input.lighting.ambient[2]};
+    for (const Light& light : input.lighting.lights) {
+        lights.insert(lights.end(), {static_cast<double>(light.type), light.vector.x(), light.vector.y(), light.vector.z()});
+        lights.insert(lights.end(), light.intensity.begin(), light.intensity.end());
+    }
+    if (const auto& environment = input.lighting.environment)
+        lights.insert(lights.end(), {static_cast<double>(reinterpret_cast<uintptr_t>(environment->map.get())),
+                                     environment->rotation_degrees, environment->intensity});
+    if (ground_texture_ == 0) gl.GenTextures(1, &ground_texture_);
+    gl.ActiveTexture(GL_TEXTURE0);
+    gl.BindTexture(GL_TEXTURE_2D, ground_texture_);
+    if (input.positions != ground_positions_ || lights != ground_lights_ ||
+        ground_plane_.irradiance.empty()) {
+        ground_plane_ = ground_plane(input);
+        ground_positions_ = input.positions;
+        ground_lights_ = std::move(lights);
+        gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, ground_plane_.resolution, ground_plane_.resolution, 0, GL_RGB,
+                      GL_FLOAT, ground_plane_.irradiance.data());
+    }
+    const GroundPlane& plane = ground_plane_;
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+
+    gl.UseProgram(ground_program_);
+    set_common_uniforms(gl, ground_program_, input, linear);
+    auto location = [&](const char* name) { return gl.GetUniformLocation(ground_program_, name); };
+    const Eigen::Matrix4f view_projection = to_float(frame.projection * frame.view);
+    gl.UniformMatrix4fv(location("view_projection"), 1, GL_FALSE, view_projection.data());
+    // Just below the lowest point: the model's face resting on the ground must win the depth test.
+    const float below = 1e-4f * plane.extent;
+    const std::array<float, 4> ground{plane.centre.x(), plane.centre.y(), plane.extent, plane.height - below};
+    gl.Uniform4fv(location("ground"), 1, ground.data());
+    gl.Uniform1f(location("texture_extent"), plane.texture_extent);
+    gl.Uniform1f(location("albedo"), kGroundPlaneAlbedo);
+    gl.Uniform1i(location("ground_irradiance"), 0);
+    gl.Uniform1i(location("fade"), over_environment ? 0 : input.transparent_background ? 2 : 1);
+    std::array<float, 3> background{};
+    for (int c = 0; c < 3; ++c)
+        background[c] = linear ? static_cast<float>(srgb_decode(input.background[c] / 255.0)) : input.background[c] / 255.0f;
+    gl.Uniform3fv(location("background"), 1, background.data());
+    if (r.background_array == 0) gl.GenVertexArrays(1, &r.background_array);
+    gl.BindVertexArray(r.background_array);  // empty: the corners come from gl_VertexID
+    // The plane reaches beyond the far plane, which encloses only the model's bounding sphere: clamped
+    // depth (at 1, the clear's, hence LEQUAL) keeps its far part instead of cutting a false horizon.
+    gl.Enable(GL_DEPTH_TEST);
+    gl.DepthFunc(GL_LEQUAL);
+    gl.Enable(GL_DEPTH_CLAMP);
+    gl.DrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    gl.Disable(GL_DEPTH_CLAMP);
+    gl.DepthFunc(GL_LESS);
+    gl.BindVertexArray(0);
+    gl.BindTexture(GL_TEXTURE_2D, 0);
+    gl.UseProgram(0);
+    check_gl_error(gl, "surface renderer: drawing the ground");
+}
+
 void SurfaceRenderer::draw(const SurfaceRenderInput& input, const CameraFrame& camera, GLuint target_framebuffer, int x,
                            int y) {
     {
@@ -770,18 +886,67 @@ void SurfaceRenderer::draw(const SurfaceRenderInput& input, const CameraFrame& c
     check_gl_error(gl_, "surface renderer: drawing into the target framebuffer");
 }
 
-Image SurfaceRenderer::render(const SurfaceRenderInput& input) {
-    validate_input(input);
+namespace {
+
+// The frame render() and render_linear() draw: framed on the input's bounding box.
+CameraFrame input_frame(const SurfaceRenderInput& input) {
     Eigen::AlignedBox3d box;
     for (const Eigen::Vector3f& p : input.positions) box.extend(p.cast<double>());
-    const CameraFrame frame = box.isEmpty() ? CameraFrame{} :
-        frame_camera(box, input.camera, static_cast<double>(input.width) / input.height);
+    return box.isEmpty() ? CameraFrame{} : frame_camera(box, input.camera, static_cast<double>(input.width) / input.height);
+}
+
+// The resolve averages premultiplied samples (the clear is transparent black, the surface opaque):
+// divide the colour by the coverage for straight alpha.
+void unpremultiply(Image& image) {
+    for (size_t p = 0; p < image.rgba.size(); p += 4) {
+        const unsigned a = image.rgba[p + 3];
+        if (a == 0 || a == 255) continue;
+        for (int c = 0; c < 3; ++c)
+            image.rgba[p + c] = static_cast<uint8_t>(std::min(255u, (image.rgba[p + c] * 255u + a / 2) / a));
+    }
+}
+
+}  // namespace
+
+Image SurfaceRenderer::render(const SurfaceRenderInput& input) {
+    validate_input(input);
+    const CameraFrame frame = input_frame(input);
     const GlApi& gl = gl_;
     Frame r(gl);
     draw_resolved(input, frame, r);
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[1]);
     Image image = read_framebuffer(gl, input.width, input.height);
     check_gl_error(gl, "surface renderer: drawing");
+    if (input.transparent_background) unpremultiply(image);
+    return image;
+}
+
+LinearImage SurfaceRenderer::render_linear(const SurfaceRenderInput& input) {
+    validate_input(input);
+    const CameraFrame frame = input_frame(input);
+    const GlApi& gl = gl_;
+    Frame r(gl);
+    draw_resolved(input, frame, r, true);
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, r.framebuffers[1]);
+    LinearImage image;
+    image.width = input.width;
+    image.height = input.height;
+    image.rgba.resize(4 * static_cast<size_t>(input.width) * static_cast<size_t>(input.height));
+    gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
+    gl.ReadPixels(0, 0, input.width, input.height, GL_RGBA, GL_FLOAT, image.rgba.data());
+    check_gl_error(gl, "surface renderer: drawing the linear image");
+    // Bottom row first from OpenGL, top row first in LinearImage; straight alpha as render() gives.
+    const size_t row = 4 * static_cast<size_t>(input.width);
+    for (int y = 0; y < input.height / 2; ++y)
+        std::swap_ranges(image.rgba.begin() + static_cast<std::ptrdiff_t>(y * row),
+                         image.rgba.begin() + static_cast<std::ptrdiff_t>((y + 1) * row),
+                         image.rgba.begin() + static_cast<std::ptrdiff_t>((input.height - 1 - y) * row));
+    if (input.transparent_background)
+        for (size_t p = 0; p < image.rgba.size(); p += 4) {
+            const float a = image.rgba[p + 3];
+            if (a > 0 && a < 1)
+                for (int c = 0; c < 3; ++c) image.rgba[p + c] /= a;
+        }
     return image;
 }
 

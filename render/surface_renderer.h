@@ -9,6 +9,7 @@
 #include "gl/gpu_compute.h"
 #include "io/image_io.h"
 #include "render/camera.h"
+#include "render/ground_plane.h"
 #include "render/srgb.h"
 #include "solver/lighting.h"
 
@@ -66,6 +67,14 @@ struct SurfaceRenderInput {
     float exposure = 1.0f;
     ToneMap tone_map = ToneMap::Aces;
     std::array<uint8_t, 3> background = kViewBackground; // sRGB
+    // Clear to transparent instead of `background`: render() then returns the object's coverage (the
+    // multisample resolve's average) as alpha, with the colours un-premultiplied (straight alpha, as
+    // PNG stores it). An environment drawn behind the model covers every pixel.
+    bool transparent_background = false;
+    // A ground plane under the model with its shadows and a soft contact shadow (ground_plane.h), for
+    // the radiance shading. It fades into the background towards its edge (into transparency with
+    // transparent_background; not at all in front of an environment, which it then hides below).
+    bool ground = false;
     // Per vertex and light (lighting.lights.size() per vertex, vertex-major), multiplies that light's
     // highlight: the shadow rays' visibility (SolvedScene::light_visibility). Empty: all visible.
     std::vector<float> light_visibility;
@@ -100,6 +109,11 @@ public:
     // sizes beyond the driver's limits, too many lights) and waxwork::Error for driver failures.
     Image render(const SurfaceRenderInput& input);
 
+    // The same picture before tone mapping: each pixel the exposed linear radiance (radiance times
+    // input.exposure, the value ACES receives), straight alpha as render() gives it. For the radiance
+    // shading; the overlay, if any, is drawn in its linear colours. Throws as render().
+    LinearImage render_linear(const SurfaceRenderInput& input);
+
     // Draws `input` seen from `frame` (input.camera is ignored) and copies the resolved image into
     // `target_framebuffer` (0: the window's) with its lower-left corner at (x, y): exactly the pixels
     // render() returns for the same frame. The editor's viewport. Leaves `target_framebuffer` bound.
@@ -108,15 +122,26 @@ public:
 private:
     struct Frame;
     // Draws into the multisampled target of `frame` and resolves it into its single-sampled one.
-    void draw_resolved(const SurfaceRenderInput& input, const CameraFrame& camera, Frame& frame);
+    // `linear`: float colour buffers and no tone mapping (render_linear).
+    void draw_resolved(const SurfaceRenderInput& input, const CameraFrame& camera, Frame& frame, bool linear = false);
     // Makes the environment textures hold `map`, and its reflection for `roughness`; keeps them while
     // neither changes (the prefilter takes tens of milliseconds, a frame should not).
+    // The ground plane (input.ground) into the bound multisampled target, before the surface.
+    void draw_ground(const SurfaceRenderInput& input, const CameraFrame& camera, Frame& frame, bool linear,
+                     bool over_environment);
     void prepare_environment(const std::shared_ptr<const EnvironmentMap>& map, float roughness);
 
     const GlApi& gl_;
     GLuint program_ = 0;
     GLuint overlay_program_ = 0;
     GLuint background_program_ = 0;
+    GLuint ground_program_ = 0;
+    GLuint ground_texture_ = 0;
+    // What ground_texture_ was computed for (its rays take tens of milliseconds: an orbiting view or a
+    // turntable redraws the same scene): the positions, and the lights as numbers.
+    std::vector<Eigen::Vector3f> ground_positions_;
+    std::vector<double> ground_lights_;
+    GroundPlane ground_plane_;
     GLuint transmittance_lut_ = 0;
     GLuint environment_textures_[2] = {0, 0};  // the background, the prefiltered reflection
     std::shared_ptr<const EnvironmentMap> environment_map_;  // what environment_textures_ hold

@@ -58,8 +58,11 @@ VolumeRender draw_volume_light(const TetMesh& mesh, VolumeLight solved, const Vo
     SurfaceRenderInput input = make_render_input(mesh, result.scene, settings.lighting, settings.image);
     result.view = build_view_geometry(mesh, result.connectivity, result.materials, result.scene, settings.view);
     apply_view(result.view, input);
+    apply_background(settings.background, input);
+    input.ground = settings.ground;
     SurfaceRenderer renderer(context.gl());
     result.image = render_scene(renderer, input);
+    if (settings.linear) result.linear = renderer.render_linear(input);
     result.exposure = input.exposure;
     result.render_ms = milliseconds_since(render_start);
 

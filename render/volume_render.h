@@ -4,6 +4,7 @@
 #pragma once
 
 #include "io/image_io.h"
+#include "render/image_background.h"
 #include "render/render_input.h"
 #include "render/view_modes.h"
 #include "solver/diffusion_solve.h"
@@ -27,6 +28,9 @@ struct VolumeRenderSettings {
     double crease_angle_degrees = kDefaultCreaseAngleDegrees;
     ImageSettings image;
     ViewOptions view;
+    ImageBackground background;
+    bool linear = false;
+    bool ground = false;  // a ground plane with the model's shadows (SurfaceRenderInput::ground)  // also draw VolumeRender::linear (SurfaceRenderer::render_linear)
 };
 
 struct VolumeRender {
@@ -35,6 +39,7 @@ struct VolumeRender {
     SolvedScene scene;
     ViewGeometry view;  // the view's colours, overlays and legend (empty for the radiance view)
     Image image;
+    LinearImage linear;    // when settings.linear: the image before tone mapping
     float exposure = 1;    // the one the image was drawn with
     double render_ms = 0;  // the renderer's input, the view and the drawing
     size_t lights_inside = 0;  // point lights and sphere lights centred inside the volume (they light nothing)

@@ -617,6 +617,22 @@ struct ReplayProgress {
     Json steps = Json::array();  // metrics of the finished steps
 };
 
+// Rethrows the Error being handled with the session and step before its message, keeping its type.
+[[noreturn]] void rethrow_in_step(const std::string& context_name) {
+    try {
+        throw;
+    } catch (const FileError& e) {
+        throw FileError(e.path(), context_name + ": " + e.problem());
+    } catch (const InvalidArgumentError& e) {
+        const std::string what = e.what();
+        throw InvalidArgumentError(what.rfind(context_name, 0) == 0 ? what : context_name + ": " + what);
+    } catch (const InvalidMeshError& e) {
+        throw InvalidMeshError(context_name + ": " + e.what());
+    } catch (const Error& e) {
+        throw AlgorithmError(context_name + ": " + e.what());
+    }
+}
+
 // The replay behind run_session; returns metrics.json's summary without "status" and "written".
 Json replay_session(const Session& session, const fs::path& output_directory, const SessionRunOptions& run_options,
                     SessionResult& result, ReplayProgress& progress) {
@@ -700,15 +716,8 @@ Json replay_session(const Session& session, const fs::path& output_directory, co
                     if (!core.redo()) fail_json(context_name, "nothing left to redo");
                 }
             }
-        } catch (const FileError& e) {
-            throw FileError(e.path(), context_name + ": " + e.problem());
-        } catch (const InvalidArgumentError& e) {
-            const std::string what = e.what();
-            throw InvalidArgumentError(what.rfind(context_name, 0) == 0 ? what : context_name + ": " + what);
-        } catch (const InvalidMeshError& e) {
-            throw InvalidMeshError(context_name + ": " + e.what());
-        } catch (const Error& e) {
-            throw AlgorithmError(context_name + ": " + e.what());
+        } catch (const Error&) {
+            rethrow_in_step(context_name);
         }
         m.milliseconds = milliseconds_since(start);
         m.tets = core.document().mesh().tet_count();
@@ -746,6 +755,44 @@ Json replay_session(const Session& session, const fs::path& output_directory, co
 }
 
 }  // namespace
+
+SessionScene replay_session_scene(const Session& session) {
+    SessionVolume input = load_session_input(session);
+    Session setup = session;
+    setup.scale = input.scale.mm_per_unit;
+    SessionScene out;
+    out.scale = input.scale;
+    out.camera = session.camera;
+    out.width = session.width;
+    out.height = session.height;
+    SceneCore core(Document(std::move(input.mesh), session.material), setup, LiveSceneOptions{});
+    for (size_t i = 0; i < session.steps.size(); ++i) {
+        const SessionStep& step = session.steps[i];
+        const std::string context_name = session.name + ": step " + std::to_string(i) + " (" + step_kind(step) + ")";
+        try {
+            if (const auto* op = std::get_if<EditOperation>(&step)) {
+                core.apply(*op);
+            } else if (const auto* l = std::get_if<LightStep>(&step)) {
+                core.set_lighting(l->lighting);
+            } else if (const auto* c = std::get_if<CameraStep>(&step)) {
+                out.camera = c->camera;
+            } else if (const auto* u = std::get_if<UndoStep>(&step)) {
+                for (int k = 0; k < u->count; ++k)
+                    if (!core.undo()) fail_json(context_name, "nothing left to undo");
+            } else if (const auto* r = std::get_if<RedoStep>(&step)) {
+                for (int k = 0; k < r->count; ++k)
+                    if (!core.redo()) fail_json(context_name, "nothing left to redo");
+            }
+        } catch (const Error&) {
+            rethrow_in_step(context_name);
+        }
+    }
+    core.converge();
+    out.mesh = core.document().mesh();
+    out.scene = core.live().solved_scene();
+    out.lighting = core.live().lighting();
+    return out;
+}
 
 SessionResult run_session(const Session& session, const fs::path& output_directory, const SessionRunOptions& run_options) {
     std::error_code ec;

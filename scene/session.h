@@ -54,6 +54,7 @@
 #include "solver/light_spec.h"
 #include "solver/lighting.h"
 #include "solver/shading_surface.h"
+#include "solver/solved_scene.h"
 #include "tetops/model_scale.h"
 #include "tetops/surface_check.h"
 #include "tetops/tet_mesh.h"
@@ -213,5 +214,19 @@ FrameBudget session_frame_budget(const Session& session, const SessionRunOptions
 // and the frames' time budget (frame_ms; null for an iteration budget).
 SessionResult run_session(const Session& session, const std::filesystem::path& output_directory,
                           const SessionRunOptions& run_options = {});
+
+// What a session's steps leave behind, converged: its edits, lights and camera applied in order, its
+// render and save steps skipped (nothing is written). `waxwork turntable SESSION` draws it. Errors
+// name the session and the step as run_session's do.
+struct SessionScene {
+    TetMesh mesh;
+    SolvedScene scene;
+    Lighting lighting;
+    CameraSettings camera;
+    int width = 640;
+    int height = 480;
+    ModelScale scale;
+};
+SessionScene replay_session_scene(const Session& session);
 
 }  // namespace waxwork

@@ -1,12 +1,14 @@
-// `waxwork render VOLUME -o IMAGE.png`: a volume, its materials and lights -> diffusion -> a PNG.
+// `waxwork render VOLUME -o IMAGE.png|.jpg`: a volume, its materials and lights -> diffusion -> an image.
 // `--method mc` traces the light with the Monte Carlo reference (solver/reference/monte_carlo.h) instead.
 #include "app/commands.h"
 #include "app/options/help_sections.h"
 #include "app/options/scene_light_options.h"
 #include "base/error.h"
 #include "io/file_extension.h"
+#include "io/image_io.h"
 #include "io/volume_file.h"
 #include "render/camera.h"
+#include "render/image_background.h"
 #include "render/radiance_image.h"
 #include "render/render_input.h"
 #include "render/view_modes.h"
@@ -46,6 +48,9 @@ struct RenderCommandOptions {
     std::string slice_normal;
     double slice_offset = 0;
     bool quality_interior = false;
+    std::string background;  // image_background.h's words; "" automatic
+    std::string linear;      // also the linear radiance, a 16-bit PNG
+    bool ground = false;
     // --method mc: the trace stops at the first of the time budget and the error target.
     std::optional<double> mc_seconds;
     std::optional<double> mc_error;
@@ -79,13 +84,27 @@ void check_options(const RenderCommandOptions& o) {
              std::to_string(o.width) + "x" + std::to_string(o.height) + ")");
     }
     check_scene_light_options(o.light);
-    if (lower_extension(o.output) != ".png") fail("-o " + o.output + ": the image must be a .png");
+    if (!is_image_extension(o.output)) fail("-o " + o.output + ": the image must be a .png, .jpg or .jpeg");
+    const BackgroundKind background = parse_background(o.background).kind;
+    if (background == BackgroundKind::Transparent && lower_extension(o.output) != ".png")
+        fail("--background transparent needs a .png output (JPEG has no alpha)");
+    if (background == BackgroundKind::Environment && o.light.environment.empty())
+        fail("--background environment needs --env");
+    if (!o.linear.empty()) {
+        if (lower_extension(o.linear) != ".png") fail("--linear " + o.linear + ": the linear image is a 16-bit .png");
+        if (o.show != "radiance") fail("--linear applies only to --show radiance");
+    }
     // The renderer exposes in float: beyond 1e30 the product with the radiance leaves its range.
     if (o.exposure && !(*o.exposure > 0 && *o.exposure <= 1e30)) fail("--exposure must be positive and at most 1e30");
     if (!o.view.empty()) {
         const Eigen::Vector3d v(o.view[0], o.view[1], o.view[2]);
         if (!v.allFinite() || v.norm() == 0) fail("--view must be a finite, non-zero direction");
     }
+    if (o.ground && o.show != "radiance") fail("--ground applies only to --show radiance");
+    if (o.light.method == "mc" && (o.ground || !o.linear.empty() || background == BackgroundKind::Transparent ||
+                                   background == BackgroundKind::Environment))
+        fail("--method mc draws over a colour: --ground, --linear and --background transparent or environment need "
+             "the diffusion's image");
     if (o.light.method != "mc") {
         if (o.mc_seconds || o.mc_error || o.mc_g || o.mc_photons || o.seed)
             fail("--mc-seconds, --mc-error, --mc-g, --mc-photons and --seed apply only with --method mc");
@@ -221,7 +240,9 @@ TracedRender render_traced(const TetMesh& mesh, const RenderCommandOptions& o, c
     traced.render = render_volume_light(mesh, std::move(light), settings);
     if (settings.view.mode == ViewMode::Radiance) {
         const float exposure = settings.image.exposure ? *settings.image.exposure : radiance_image_exposure(traced.image.image);
-        traced.render.image = tone_mapped_image(traced.image.image, exposure);
+        const ImageBackground& background = settings.background;
+        traced.render.image = tone_mapped_image(traced.image.image, exposure,
+                                                background.kind == BackgroundKind::Colour ? background.colour : kViewBackground);
         traced.render.exposure = exposure;
     }
     return traced;
@@ -252,6 +273,9 @@ void run_render_command(const RenderCommandOptions& o) {
     settings.image.camera = camera_for_view(o.view);
     if (o.exposure) settings.image.exposure = static_cast<float>(*o.exposure);
     settings.view = view;
+    settings.background = parse_background(o.background);
+    settings.linear = !o.linear.empty();
+    settings.ground = o.ground;
 
     const bool traced = o.light.method == "mc";
     std::optional<TracedRender> trace;
@@ -260,7 +284,8 @@ void run_render_command(const RenderCommandOptions& o) {
     const SolvedScene& scene = render.scene;
     if (!scene.diffusion.gpu_fallback_reason.empty())
         std::cerr << "warning: solving on the CPU instead: " << scene.diffusion.gpu_fallback_reason << "\n";
-    write_png(render.image, o.output);
+    write_image(render.image, o.output);
+    if (!o.linear.empty()) write_linear_png(render.linear, o.linear, render.exposure);
     report_chosen_scale(o.volume, scale, mesh);
     if (!o.fields.empty())
         write_fields_csv(o.fields, mesh, render.connectivity, scene, traced ? &trace->fluence.phi_error : nullptr);
@@ -315,6 +340,7 @@ void run_render_command(const RenderCommandOptions& o) {
     }
     if (view.mode != ViewMode::Radiance) summary["legend"] = render.view.legend.title;
     if (!o.fields.empty()) summary["fields"] = o.fields;
+    if (!o.linear.empty()) summary["linear"] = o.linear;
     std::cout << summary.dump() << "\n";
 }
 
@@ -322,9 +348,10 @@ void run_render_command(const RenderCommandOptions& o) {
 
 void add_render_command(CLI::App& app) {
     auto options = std::make_shared<RenderCommandOptions>();
-    CLI::App* cmd = app.add_subcommand("render", "Solve the light diffusion in a volume and render a PNG");
+    CLI::App* cmd = app.add_subcommand("render", "Solve the light diffusion in a volume and render a PNG or JPEG");
     cmd->add_option("volume", options->volume, "Volume file (.vtu, .msh, .mesh, .node/.ele)")->required();
-    cmd->add_option("-o,--output", options->output, "PNG image to write")->required();
+    cmd->add_option("-o,--output", options->output,
+                    "Image to write: .png (8-bit sRGB with alpha) or .jpg/.jpeg (quality 92)")->required();
     add_scene_light_options(*cmd, options->light, true);
     cmd->add_option("--mc-seconds", options->mc_seconds,
                     "--method mc: stop tracing after this many seconds (default 60)");
@@ -343,6 +370,13 @@ void add_render_command(CLI::App& app) {
         ->delimiter(',')
         ->expected(3);
     cmd->add_option("--exposure", options->exposure, "Fixed exposure (default: automatic)");
+    cmd->add_option("--background", options->background,
+                    "Behind the model: R,G,B (0-255) or #RRGGBB, transparent (.png: the coverage as alpha), or "
+                    "environment (needs --env) (default: the environment when --env is drawn, else grey)");
+    cmd->add_flag("--ground", options->ground,
+                  "Put the model on a ground plane lit by the same lights, with its shadows and a soft contact shadow");
+    cmd->add_option("--linear", options->linear,
+                    "Also write the exposed linear radiance, before tone mapping, as a 16-bit PNG (linear, not sRGB)");
     cmd->add_option("--show", options->show,
                     "What to draw: radiance (the image), materials, quality (min dihedral angle), wireframe (tet "
                     "edges), slice (fluence on a plane), levels (multires hierarchy)")

@@ -1,5 +1,6 @@
 // `waxwork render` and `waxwork demo` end to end: the binary meshes, solves, renders and writes files.
 #include "io/image_io.h"
+#include "render/srgb.h"
 #include "render/surface_renderer.h"
 #include "solver/shading_surface.h"
 #include "support/cli_run.h"
@@ -13,6 +14,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 
 namespace waxwork {
 namespace {
@@ -484,6 +486,12 @@ TEST_F(Render, BadInputIsAOneLineError) {
              {" --exposure 1e308", "--exposure must be positive and at most 1e30"},
              {" --env sky:95,0", "bad environment spec 'sky:95,0': sky: sun elevation must be above 0"},
              {" --no-env-background", "--no-env-background needs --env"},
+             {" --background 256,0,0", "background '256,0,0': expected R,G,B (0-255), #RRGGBB, transparent or environment"},
+             {" --background '#12345'", "background '#12345': expected"},
+             {" --background 1,2", "background '1,2': expected"},
+             {" --background environment", "--background environment needs --env"},
+             {" --linear x.jpg", "--linear x.jpg: the linear image is a 16-bit .png"},
+             {" --ground --show materials", "--ground applies only to --show radiance"},
              {" --env studio.hdr:0:-2", "the intensity must be a number between 0 and 1e15"},
              {" --env " + (dir_ / "absent.hdr").string(), (dir_ / "absent.hdr").string() + ": no such file"},
              {" --env " + volume_.string(), volume_.string() + ": not a Radiance .hdr image"}}) {
@@ -491,12 +499,13 @@ TEST_F(Render, BadInputIsAOneLineError) {
         EXPECT_NE(r.exit_code, 0) << args;
         EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
     }
-    // The image is a PNG whatever its name says, so the name must say so (x.jpg held PNG data).
-    const fs::path jpg = image.parent_path() / "x.jpg";
-    const auto named_jpg = run_waxwork("render " + volume_.string() + " -o " + jpg.string() + " --width 32 --height 24");
-    EXPECT_NE(named_jpg.exit_code, 0);
-    EXPECT_NE(named_jpg.err.find(jpg.string() + ": the image must be a .png"), std::string::npos) << named_jpg.err;
-    EXPECT_FALSE(fs::exists(jpg));
+    // The format follows the name, so the name must be one of them.
+    const fs::path bmp = image.parent_path() / "x.bmp";
+    const auto named_bmp = run_waxwork("render " + volume_.string() + " -o " + bmp.string() + " --width 32 --height 24");
+    EXPECT_NE(named_bmp.exit_code, 0);
+    EXPECT_NE(named_bmp.err.find(bmp.string() + ": the image must be a .png, .jpg or .jpeg"), std::string::npos)
+        << named_bmp.err;
+    EXPECT_FALSE(fs::exists(bmp));
     // A huge view direction is still a direction.
     EXPECT_EQ(run_waxwork(base + " --view 1e308,1e308,1e308").exit_code, 0);
     fs::remove(image);
@@ -506,6 +515,116 @@ TEST_F(Render, BadInputIsAOneLineError) {
     const auto missing = run_waxwork("render " + (dir_ / "absent.vtu").string() + " -o " + image.string());
     EXPECT_NE(missing.exit_code, 0);
     EXPECT_NE(missing.err.find("absent.vtu"), std::string::npos) << missing.err;
+}
+
+// The image's four corners, which the cube (framed with a margin) never covers.
+std::vector<const uint8_t*> corners(const Image& image) {
+    return {image.pixel(0, 0), image.pixel(image.width - 1, 0), image.pixel(0, image.height - 1),
+            image.pixel(image.width - 1, image.height - 1)};
+}
+
+TEST_F(Render, TransparentBackgroundIsAlphaZeroAroundTheObjectAndOpaqueOnIt) {
+    const fs::path image = dir_ / "transparent.png";
+    const auto r = run_waxwork("render " + volume_.string() + " -o " + image.string() +
+                               " --width 64 --height 48 --background transparent");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Image png = read_png(image);
+    for (const uint8_t* p : corners(png)) EXPECT_EQ(p[3], 0);
+    const uint8_t* centre = png.pixel(32, 24);
+    EXPECT_EQ(centre[3], 255);
+    EXPECT_GT(centre[0] + centre[1] + centre[2], 0);
+    // The multisampled edges give partial coverage.
+    size_t partial = 0;
+    for (size_t p = 3; p < png.rgba.size(); p += 4) partial += png.rgba[p] > 0 && png.rgba[p] < 255;
+    EXPECT_GT(partial, 0u);
+    // The same render over the default grey is the same where the object covers everything.
+    const fs::path grey = dir_ / "grey.png";
+    ASSERT_EQ(run_waxwork("render " + volume_.string() + " -o " + grey.string() + " --width 64 --height 48").exit_code, 0);
+    const Image opaque = read_png(grey);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(opaque.pixel(32, 24)[c], centre[c]);
+    EXPECT_EQ(opaque.pixel(0, 0)[3], 255);
+}
+
+TEST_F(Render, ColourBackgroundFillsTheCorners) {
+    for (const auto& [words, colour] : std::vector<std::pair<std::string, std::array<int, 3>>>{
+             {"200,30,7", {200, 30, 7}}, {"'#1a2B3c'", {0x1a, 0x2b, 0x3c}}}) {
+        const fs::path image = dir_ / "coloured.png";
+        const auto r = run_waxwork("render " + volume_.string() + " -o " + image.string() +
+                                   " --width 64 --height 48 --background " + words);
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const Image png = read_png(image);
+        for (const uint8_t* p : corners(png)) {
+            EXPECT_EQ(p[0], colour[0]) << words;
+            EXPECT_EQ(p[1], colour[1]) << words;
+            EXPECT_EQ(p[2], colour[2]) << words;
+            EXPECT_EQ(p[3], 255) << words;
+        }
+    }
+    // A colour background replaces the environment's.
+    const fs::path sky = dir_ / "sky_white.png";
+    const auto r = run_waxwork("render " + volume_.string() + " -o " + sky.string() +
+                               " --width 64 --height 48 --env sky:30,40 --background 255,255,255");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (const uint8_t* p : corners(read_png(sky))) EXPECT_EQ(p[0] + p[1] + p[2], 3 * 255);
+}
+
+TEST_F(Render, JpegIsWrittenAndReadsBackAtTheSameSize) {
+    const fs::path png = dir_ / "same.png", jpg = dir_ / "same.JPG";
+    const std::string base = "render " + volume_.string() + " --width 70 --height 50 -o ";
+    const std::string orange = " --background 240,120,20";
+    ASSERT_EQ(run_waxwork(base + png.string() + orange).exit_code, 0);
+    const auto r = run_waxwork(base + jpg.string() + orange);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(jpg, std::ios::binary);
+    char magic[3] = {};
+    in.read(magic, 3);
+    EXPECT_EQ(static_cast<unsigned char>(magic[0]), 0xFF);  // the JPEG SOI marker, not a PNG under another name
+    EXPECT_EQ(static_cast<unsigned char>(magic[1]), 0xD8);
+    const Image a = read_png(png), b = read_image(jpg);
+    ASSERT_EQ(b.width, 70);
+    ASSERT_EQ(b.height, 50);
+    // Quality 92: close to the PNG everywhere on average, the corners' flat colour within a few levels.
+    double error = 0;
+    for (size_t i = 0; i < a.rgba.size(); ++i) error += std::abs(a.rgba[i] - b.rgba[i]);
+    EXPECT_LT(error / a.rgba.size(), 3.0);
+    EXPECT_NEAR(b.pixel(0, 0)[0], 240, 4);
+    EXPECT_NEAR(b.pixel(0, 0)[1], 120, 4);
+    EXPECT_NEAR(b.pixel(0, 0)[2], 20, 4);
+    // JPEG has no alpha to be transparent with.
+    const auto t = run_waxwork(base + jpg.string() + " --background transparent");
+    EXPECT_NE(t.exit_code, 0);
+    EXPECT_NE(t.err.find("--background transparent needs a .png output"), std::string::npos) << t.err;
+}
+
+TEST_F(Render, LinearPngHoldsTheRadianceTheToneMapReceives) {
+    const fs::path image = dir_ / "toned.png", linear = dir_ / "linear.png";
+    const auto r = run_waxwork("render " + volume_.string() + " -o " + image.string() + " --linear " + linear.string() +
+                               " --width 64 --height 48 --background transparent");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["linear"], linear.string());
+    const Image toned = read_png(image);
+    const LinearImage radiance = read_linear_png(linear);
+    ASSERT_EQ(radiance.width, 64);
+    ASSERT_EQ(radiance.height, 48);
+    // ACES (Narkowicz's fit) then sRGB of the linear pixel gives the 8-bit pixel, at fully covered
+    // pixels whose radiance is below the 16-bit file's clamp at 1, away from the cube's edges (there
+    // the multisample resolve averages before tone mapping in one image and after it in the other).
+    auto aces = [](double x) { return std::clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0); };
+    size_t compared = 0;
+    for (int y = 0; y < 48; ++y)
+        for (int x = 0; x < 64; ++x) {
+            const float* l = radiance.pixel(x, y);
+            const uint8_t* t = toned.pixel(x, y);
+            EXPECT_EQ(std::lround(255 * l[3]), t[3]);
+            if (t[3] != 255 || std::max({l[0], l[1], l[2]}) >= 1.0f || x == 0 || y == 0 || x == 63 || y == 47) continue;
+            bool smooth = true;
+            for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}})
+                for (int c = 0; c < 4; ++c) smooth = smooth && std::abs(toned.pixel(x + dx, y + dy)[c] - t[c]) <= 3;
+            if (!smooth) continue;
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(std::lround(255 * srgb_encode(aces(l[c]))), t[c], 1) << x << "," << y;
+            ++compared;
+        }
+    EXPECT_GT(compared, 200u);
 }
 
 TEST(Demo, WritesTheVolumeAndImages) {

@@ -230,6 +230,42 @@ testing::CommandResult run_script(const fs::path& dir, const std::string& script
                           " --frames 2 --screenshot " + (dir / "shot.png").string());
 }
 
+// File > Save image writes the view as shown: with --hide-ui the view fills the window, so the saved
+// PNG equals the screenshot; the JPEG has the view's size; with the panels shown it is the view alone.
+TEST_F(EditorWindow, SaveImageWritesTheViewAsShown) {
+    const fs::path dir = scratch_dir("editor_save_image");
+    const auto r = run_script(dir, R"([{"event": "idle"}, {"event": "save_image", "file": "view.png"},
+        {"event": "save_image", "file": "view.jpg"}, {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Image shot = read_png(dir / "shot.png"), saved = read_png(dir / "view.png");
+    EXPECT_EQ(saved, shot);
+    const Image jpeg = read_image(dir / "view.jpg");
+    EXPECT_EQ(jpeg.width, 400);
+    EXPECT_EQ(jpeg.height, 300);
+    EXPECT_LE(std::abs(testing::mean_brightness(jpeg, 0, 0, 400, 300) - testing::mean_brightness(shot, 0, 0, 400, 300)), 3.0);
+
+    const fs::path panels = scratch_dir("editor_save_image_panels");
+    const fs::path script = panels / "input.json";
+    std::ofstream(script) << R"([{"event": "idle"}, {"event": "save_image", "file": "view.png"}, {"event": "idle"}])";
+    const auto p = run_under_xvfb("edit " + kAssets + "/meshes/cube.obj --max-tets 6000 --width 900 --height 600 --input " +
+                                  script.string() + " --frames 2 --screenshot " + (panels / "shot.png").string());
+    ASSERT_EQ(p.exit_code, 0) << p.err;
+    const Image window = read_png(panels / "shot.png"), view = read_png(panels / "view.png");
+    EXPECT_LT(view.width, window.width);
+    EXPECT_LT(view.height, window.height);
+    // The view's pixels are somewhere in the window: find its top-left corner by its first row.
+    bool found = false;
+    for (int y = 0; y + view.height <= window.height && !found; ++y)
+        for (int x = 0; x + view.width <= window.width && !found; ++x) {
+            bool same = true;
+            for (int k = 0; k < view.width && same; k += 7)
+                same = std::equal(view.pixel(k, view.height / 2), view.pixel(k, view.height / 2) + 4,
+                                  window.pixel(x + k, y + view.height / 2));
+            found = same && std::equal(view.pixel(0, 0), view.pixel(0, 0) + 4, window.pixel(x, y));
+        }
+    EXPECT_TRUE(found) << "the saved view is not a part of the window";
+}
+
 TEST_F(EditorWindow, CutStrokeCutsTheSideDrawnAndTheSessionReplaysIt) {
     const fs::path dir = scratch_dir("editor_cut_stroke");
     // A stroke cancelled with Esc first (it must cut nothing), then a stroke down the middle: going

@@ -146,6 +146,7 @@ TEST(InputScript, BadScriptsGetOneLineErrorsNamingTheFileAndEntry) {
         {R"([{"event": "dialog", "button": "save", "file": ""}])", "field 'file'"},
         {R"([{"event": "open_example"}])", "s.json: entry 0 (open_example): missing field 'name'"},
         {R"([{"event": "quit", "now": true}])", "unknown field 'now'"},
+        {R"([{"event": "save_image"}])", "missing field 'file'"},
     };
     for (const auto& [text, expected] : cases) {
         const std::string message = parse_error(text);
@@ -204,6 +205,7 @@ public:
     void recover(bool accept) override { add(accept ? "recover" : "discard recovery"); }
     void autosave() override { add("autosave"); }
     void kill() override { add("kill"); }
+    void save_image(const std::filesystem::path& f) override { add("save image " + f.filename().string()); }
 
 private:
     void add(const std::string& s) { log.push_back(std::to_string(frame) + ": " + s); }
@@ -262,6 +264,14 @@ TEST(InputScriptPlayer, PlaysTheReferenceEventsWithTheirSettingsAndSnapshot) {
     for (target.frame = 0; target.frame < 6; ++target.frame) player.advance(target);
     EXPECT_EQ(target.log, (std::vector<std::string>{"0: reference 3 7 2", "1: reference - - -", "2: cancel reference",
                                                     "3: save reference r.png", "4: snapshot"}));
+}
+
+TEST(InputScriptPlayer, PlaysSaveImage) {
+    InputScriptPlayer player(parse(R"([{"event": "save_image", "file": "out/view.jpg"}])"));
+    FakeTarget target;
+    target.is_ready = true;
+    for (target.frame = 0; target.frame < 2; ++target.frame) player.advance(target);
+    EXPECT_EQ(target.log, (std::vector<std::string>{"0: save image view.jpg"}));
 }
 
 TEST(InputScript, ExampleScriptsParse) {

@@ -2,6 +2,7 @@
 #include "gl/gl_context.h"
 #include "io/image_io.h"
 #include "render/camera.h"
+#include "render/ground_plane.h"
 #include "render/srgb.h"
 #include "render/surface_renderer.h"
 #include "solver/environment_light.h"
@@ -61,6 +62,56 @@ double mean_luminance(const Image& image) {
 std::filesystem::path temp_path(const std::string& name) {
     return std::filesystem::temp_directory_path() /
            ("waxwork_render_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" + name);
+}
+
+// The ground's irradiance at the texel nearest to world (x, z).
+float ground_irradiance_at(const GroundPlane& plane, float x, float z) {
+    const float texel = 2 * plane.texture_extent / plane.resolution;
+    const int column = static_cast<int>((x - plane.centre.x() + plane.texture_extent) / texel);
+    const int row = static_cast<int>((z - plane.centre.y() + plane.texture_extent) / texel);
+    return plane.irradiance[3 * (static_cast<size_t>(row) * plane.resolution + column)];
+}
+
+TEST(GroundPlane, HoldsTheLightsShadowAndAContactShadow) {
+    SurfaceRenderInput input = make_sphere({0.3f, 0.3f, 0.3f});
+    input.lighting.lights = {{LightType::Directional, {-1, -1, -1}, {2, 2, 2}}};
+    input.lighting.ambient = {0.2, 0.2, 0.2};
+    const GroundPlane plane = ground_plane(input);
+    EXPECT_FLOAT_EQ(plane.height, -1.0f);  // the sphere's lowest point
+    ASSERT_GT(plane.resolution, 0);
+    // Far from the sphere: the light at 54.7 degrees from the normal, the whole sky open.
+    const float open = 2 * std::sqrt(1.0f / 3) + 0.2f;
+    EXPECT_NEAR(ground_irradiance_at(plane, 3, 3), open, 0.01);
+    // The sphere's shadow is centred where the ray from its centre along the light meets the plane,
+    // (-1, -1): only the occluded fill reaches it.
+    EXPECT_LT(ground_irradiance_at(plane, -1, -1), 0.2f);
+    EXPECT_GT(ground_irradiance_at(plane, -1, -1), 0.0f);
+    // Beside the contact on the lit side, the sphere above hides part of the sky: darker than far away,
+    // lighter than the shadow.
+    const float contact = ground_irradiance_at(plane, 0.35f, 0.35f);
+    EXPECT_LT(contact, open - 0.03f);
+    EXPECT_GT(contact, 2 * std::sqrt(1.0f / 3));
+    // Without shadows the light reaches the shadow's place too.
+    input.lighting.shadows = false;
+    EXPECT_GT(ground_irradiance_at(ground_plane(input), -1, -1), 1.0f);
+}
+
+TEST(SurfaceRenderer, GroundPlaneIsDrawnUnderTheModelAndFadesIntoTransparency) {
+    SurfaceRenderInput input = make_sphere({0.3f, 0.3f, 0.3f}, 120, 90);
+    input.lighting.ambient = {0.2, 0.2, 0.2};
+    HeadlessGlContext context;
+    SurfaceRenderer renderer(context.gl());
+    const Image bare = renderer.render(input);
+    input.ground = true;
+    const Image grounded = renderer.render(input);
+    // Seen from above the front, the ground fills the bottom corners; the top ones keep the background.
+    EXPECT_NE(luminance(grounded, 2, 87), luminance(bare, 2, 87));
+    EXPECT_EQ(luminance(grounded, 2, 2), luminance(bare, 2, 2));
+    EXPECT_EQ(luminance(grounded, 60, 45), luminance(bare, 60, 45));  // the sphere in front of it
+    input.transparent_background = true;
+    const Image transparent = renderer.render(input);
+    EXPECT_EQ(transparent.pixel(2, 2)[3], 0);
+    EXPECT_GT(transparent.pixel(60, 88)[3], 0);  // the ground below the sphere
 }
 
 TEST(HeadlessGl, CreatesACoreContextOfAtLeast43) {
