@@ -1,4 +1,7 @@
 #include "editor/editor_app.h"
+#include "io/output_folder.h"
+#include "io/video_encoder.h"
+#include "render/turntable.h"
 
 #include "base/error.h"
 #include "base/progress.h"
@@ -438,6 +441,67 @@ void EditorApp::save_image(const fs::path& path) {
     image_to_save_ = path;
 }
 
+void EditorApp::export_turntable(const fs::path& video, int frames) {
+    if (!scene_->render_input || !camera_) return set_error("export turntable: nothing is shown yet");
+    if (turntable_ || video_task_.busy()) return set_error("export turntable: a turntable is being exported already");
+    if (frames < 1 || frames > 100000) return set_error("export turntable: the frame count must be between 1 and 100000");
+    TurntableExport t;
+    t.video = video;
+    t.folder = video.parent_path() / video.stem();
+    std::error_code error;
+    fs::create_directories(t.folder, error);
+    if (error || !fs::is_directory(t.folder))
+        return set_error("export turntable: " + t.folder.string() + ": cannot create the folder" +
+                         (error ? " (" + error.message() + ")" : ""));
+    t.frames = frames;
+    t.start = recorded_camera();
+    t.input = *scene_->render_input;
+    t.input.width = view_w_;
+    t.input.height = view_h_;
+    t.input.samples = msaa_samples_;
+    t.input.exposure = static_cast<float>(shown_exposure());  // one exposure for all: no flicker
+    t.input.ground = ground_plane_;
+    turntable_ = std::move(t);
+}
+
+void EditorApp::set_background(const std::string& background) {
+    const ImageBackground parsed = background == "automatic" ? ImageBackground{} : parse_background(background);
+    if (parsed.kind == BackgroundKind::Transparent)
+        throw InvalidArgumentError("background: a window cannot show a transparent background");
+    background_ = parsed;
+    view_cache_->invalidate();
+}
+
+void EditorApp::advance_turntable() {
+    TurntableExport& t = *turntable_;
+    try {
+        t.input.camera = orbit_camera(t.start, t.next, t.frames);
+        write_png(render_scene(*renderer_, t.input), contained_output_path(t.folder, turntable_frame_name(t.next)));
+    } catch (const std::exception& e) {
+        turntable_.reset();
+        return set_error(std::string("export turntable: ") + e.what());
+    }
+    status_ = "Turntable: frame " + std::to_string(t.next + 1) + " of " + std::to_string(t.frames) + " (Esc stops)";
+    if (++t.next < t.frames) return;
+    const fs::path folder = t.folder, video = t.video;
+    const int frames = t.frames;
+    turntable_.reset();
+    const std::string ffmpeg = find_on_path("ffmpeg");
+    if (ffmpeg.empty()) {
+        status_ = "Turntable: " + std::to_string(frames) + " frames in " + folder.string() +
+                  " (ffmpeg is not on the PATH: no video; install ffmpeg for one)";
+        return;
+    }
+    video_task_.start("video", [this, ffmpeg, folder, video, frames](TaskProgress& progress) {
+        progress.set_stage("encoding " + video.string());
+        const bool ok = encode_mp4(ffmpeg, folder, video, frames / kDefaultSecondsPerTurn);
+        return BackgroundTask::Apply([this, ok, video, folder] {
+            status_ = ok ? "Turntable: " + video.string() + " and its frames in " + folder.string()
+                         : "Turntable: ffmpeg failed; the frames are in " + folder.string();
+        });
+    });
+}
+
 void EditorApp::write_saved_image() {
     const fs::path path = *image_to_save_;
     image_to_save_.reset();
@@ -517,6 +581,12 @@ void EditorApp::on_key(int key, int mods) {
     }
     switch (key) {
     case GLFW_KEY_ESCAPE: {
+        if (turntable_) {
+            status_ = "Turntable stopped after " + std::to_string(turntable_->next) + " frames in " +
+                      turntable_->folder.string();
+            turntable_.reset();
+            break;
+        }
         const bool deforming = tools_.active() && is_deform_tool(tools_.tool());
         if (!tools_.cancel(viewport_context())) select_tool(Tool::Orbit);
         else if (deforming) queue_cancel_deform();
@@ -553,6 +623,7 @@ void EditorApp::set_crease_angle(double degrees) {
 
 bool EditorApp::idle() const {
     if (load_task_.busy() || tick_task_.busy() || !pending_jobs_.empty() || lighting_dirty_ || crease_angle_dirty_ ||
+        turntable_ || video_task_.busy() ||
         reference_->busy() || reference_snapshot_)
         return false;
     return !scene_->core || (scene_->converged && scene_->render_input && scene_->exposure_locked && !view_dirty_);
@@ -660,6 +731,11 @@ void EditorApp::poll_tasks() {
         reference_snapshot_.reset();
     }
     if (const std::optional<std::string> ended = reference_->poll()) status_ = *ended;
+    try {
+        video_task_.poll();
+    } catch (const std::exception& e) {
+        set_error(std::string("export turntable: ") + e.what());
+    }
     // Keep one tick running while there is anything to do.
     if (scene_->core && !tick_task_.busy() && !load_task_.busy() &&
         (!pending_jobs_.empty() || lighting_dirty_ || crease_angle_dirty_ || !scene_->converged ||
@@ -697,6 +773,11 @@ void EditorApp::frame() {
     gl_.Clear(GL_COLOR_BUFFER_BIT);
     draw_viewport(fb_h);
     if (image_to_save_) write_saved_image();  // the view alone, before the panels are drawn over it
+    if (turntable_) {
+        advance_turntable();  // draws offscreen: the window's framebuffer is bound again below
+        gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
+        gl_.Viewport(0, 0, fb_w, fb_h);
+    }
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 }
 
@@ -735,6 +816,10 @@ void EditorApp::draw_viewport(int fb_h) {
     input.samples = msaa_samples_;
     input.exposure = scene_->automatic_exposure * std::exp2(exposure_stops_);
     input.ground = ground_plane_;
+    // An environment background with no environment lighting the scene falls back to the automatic one.
+    ImageBackground background = background_;
+    if (background.kind == BackgroundKind::Environment && !lighting_.environment) background.kind = BackgroundKind::Automatic;
+    apply_background(background, input);
     const CameraFrame frame = camera_->frame(static_cast<double>(view_w_) / view_h_);
     const ViewKey key{frame.view, frame.projection, view_w_, view_h_, input.samples, input.exposure, scene_version_};
     const int y = fb_h - view_y_ - view_h_;

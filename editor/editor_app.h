@@ -19,6 +19,7 @@
 #include "editor/repair_choices.h"
 #include "editor/view_cache.h"
 #include "editor/viewport_tools.h"
+#include "render/image_background.h"
 #include "render/render_input.h"
 #include "render/surface_renderer.h"
 #include "render/view_modes.h"
@@ -242,6 +243,14 @@ public:
     // File > Save image: the 3D view as shown (its exposure and tone mapping, no panels: read_viewport)
     // as .png or .jpg/.jpeg, written once the current frame's view is drawn.
     void save_image(const std::filesystem::path& path);
+    // File > Export turntable: `frames` pictures of the view circling the model's vertical axis
+    // (render/turntable.h: the camera turned about its up vector) at the view's exposure, one per window
+    // frame so the window keeps responding, into the folder named after `video` without its extension
+    // (frame_0000.png, ...); then `video` itself through ffmpeg when it is on the PATH. Esc stops it.
+    void export_turntable(const std::filesystem::path& video, int frames);
+    // The View panel's background: "automatic", "environment" or a colour as parse_background reads
+    // it (render/image_background.h). Throws InvalidArgumentError for others and for transparent.
+    void set_background(const std::string& background);
     const ReferenceView& reference() const { return *reference_; }
 
     // Document safety (document_safety.cpp). Edits since the last save of the volume or session
@@ -298,9 +307,10 @@ private:
     void apply_theme(float scale);
 
     // What a Save dialog writes when confirmed.
-    enum class SaveKind { Volume, Session, Surface, Reference, Image };
+    enum class SaveKind { Volume, Session, Surface, Reference, Image, Turntable };
     void open_dialog(FileDialog::Mode mode, SaveKind kind = SaveKind::Volume);
     void write_saved_image();  // save_image's file, from the view just drawn
+    void advance_turntable();  // the next frame of export_turntable's orbit
     void relax_last_cut();
     // What loading found out about the model, measured off the UI thread.
     struct LoadedModel {
@@ -454,6 +464,7 @@ private:
     std::vector<PinSphere> pins_;
     bool show_light_gizmos_ = true;
     bool ground_plane_ = false;  // the View panel's: the model on a ground with its shadows
+    ImageBackground background_;  // the View panel's: automatic, a colour, or the environment
 
     // Viewport rectangle in framebuffer pixels (origin top-left) and the scale from window to
     // framebuffer coordinates (HiDPI).
@@ -462,6 +473,14 @@ private:
 
     FileDialog file_dialog_;
     SaveKind saving_ = SaveKind::Volume;
+    struct TurntableExport {
+        std::filesystem::path video, folder;
+        int frames = 0, next = 0;
+        CameraSettings start;        // the view when it began
+        SurfaceRenderInput input;    // the scene as it was then, at the view's size and exposure
+    };
+    std::optional<TurntableExport> turntable_;
+    BackgroundTask video_task_;  // ffmpeg on the frames
     std::optional<std::filesystem::path> image_to_save_;  // save_image's file, written after the view is drawn
     std::string status_;
     std::string last_error_;

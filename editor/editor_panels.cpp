@@ -4,6 +4,7 @@
 #include "editor/editor_app.h"
 
 #include "editor/material_swatch.h"
+#include "render/turntable.h"
 #include "solver/material.h"
 #include "solver/mesh_resolution.h"
 #include "tetops/model_scale.h"
@@ -82,6 +83,9 @@ void EditorApp::open_dialog(FileDialog::Mode mode, SaveKind kind) {
     } else if (kind == SaveKind::Surface) {
         file_dialog_.open(mode, "Export surface", directory, {".ply", ".obj", ".stl"},
                           (stem.empty() ? "surface" : stem) + ".ply");
+    } else if (kind == SaveKind::Turntable) {
+        file_dialog_.open(mode, "Export turntable (frames go to a folder of the same name)", directory, {".mp4"},
+                          (stem.empty() ? "turntable" : stem) + "_turntable.mp4");
     } else if (kind == SaveKind::Image) {
         file_dialog_.open(mode, "Save image", directory, {".png", ".jpg", ".jpeg"}, (stem.empty() ? "view" : stem) + ".png");
     } else if (kind == SaveKind::Reference) {
@@ -101,6 +105,7 @@ void EditorApp::file_dialog_result() {
         else if (saving_ == SaveKind::Surface) export_surface(*chosen);
         else if (saving_ == SaveKind::Reference) save_reference(*chosen);
         else if (saving_ == SaveKind::Image) save_image(*chosen);
+        else if (saving_ == SaveKind::Turntable) export_turntable(*chosen, kDefaultTurntableFrames);
         else save_volume(*chosen);
     }
 }
@@ -163,6 +168,11 @@ void EditorApp::draw_menu_bar() {
             open_dialog(FileDialog::Mode::Save, SaveKind::Surface);
         if (ImGui::MenuItem("Save image...", nullptr, false, scene_->render_input.has_value()))
             open_dialog(FileDialog::Mode::Save, SaveKind::Image);
+        if (ImGui::MenuItem("Export turntable...", nullptr, false, scene_->render_input.has_value() && !turntable_))
+            open_dialog(FileDialog::Mode::Save, SaveKind::Turntable);
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("%d frames of the view circling the model, at its exposure; an MP4 when ffmpeg is installed",
+                              kDefaultTurntableFrames);
         ImGui::Separator();
         if (ImGui::MenuItem("Quit", "Ctrl+Q")) request_quit();
         ImGui::EndMenu();
@@ -396,6 +406,20 @@ void EditorApp::draw_view_panel() {
     if (ImGui::Combo("antialiasing", &msaa, "off\0" "2x MSAA\0" "4x MSAA\0")) msaa_samples_ = msaa == 2 ? 4 : msaa == 1 ? 2 : 1;
     ImGui::Checkbox("show light gizmos", &show_light_gizmos_);
     if (ImGui::Checkbox("ground plane", &ground_plane_)) view_cache_->invalidate();
+    // Behind the model (also in saved images and turntables): what render --background takes, but
+    // transparency, which a window cannot show.
+    int kind = background_.kind == BackgroundKind::Colour ? 1 : background_.kind == BackgroundKind::Environment ? 2 : 0;
+    if (ImGui::Combo("background", &kind, "automatic\0" "colour\0" "environment\0")) {
+        background_.kind = kind == 1 ? BackgroundKind::Colour : kind == 2 ? BackgroundKind::Environment : BackgroundKind::Automatic;
+        view_cache_->invalidate();
+    }
+    if (background_.kind == BackgroundKind::Colour) {
+        float colour[3] = {background_.colour[0] / 255.0f, background_.colour[1] / 255.0f, background_.colour[2] / 255.0f};
+        if (ImGui::ColorEdit3("background colour", colour)) {
+            for (int c = 0; c < 3; ++c) background_.colour[c] = static_cast<uint8_t>(std::lround(std::clamp(colour[c], 0.0f, 1.0f) * 255));
+            view_cache_->invalidate();
+        }
+    }
     if (ImGui::Button("Reset camera (Home)")) camera_.reset();
     if (camera_) {
         const Eigen::Vector3d d = camera_->eye_direction();

@@ -3,6 +3,8 @@
 #include "base/error.h"
 #include "scene/json_fields.h"
 #include "solver/material.h"
+#include "render/image_background.h"
+#include "render/turntable.h"
 #include "solver/shading_surface.h"
 
 #include <GLFW/glfw3.h>
@@ -196,20 +198,42 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
     } else if (kind == "cancel_reference") {
         e.action = ScriptAction::CancelReference;
         events.push_back(e);
+    } else if (kind == "background") {
+        e.action = ScriptAction::SetBackground;
+        const Json& b = in.at("background");
+        if (!b.is_string()) fail_json(in.field("background"), "expected \"automatic\", \"environment\", \"R,G,B\" or \"#RRGGBB\"");
+        e.background = b.get<std::string>();
+        if (e.background != "automatic") {
+            ImageBackground parsed;
+            try {
+                parsed = parse_background(e.background);
+            } catch (const InvalidArgumentError& error) {
+                fail_json(in.field("background"), error.what());
+            }
+            if (parsed.kind == BackgroundKind::Transparent)
+                fail_json(in.field("background"), "a window cannot show a transparent background");
+        }
+        events.push_back(e);
     } else if (kind == "snapshot") {
         e.action = ScriptAction::Snapshot;
         events.push_back(e);
     } else if (kind == "save_session" || kind == "save_volume" || kind == "export_surface" || kind == "open" ||
-               kind == "save_reference" || kind == "save_image") {
+               kind == "save_reference" || kind == "save_image" || kind == "export_turntable") {
         e.action = kind == "save_session"     ? ScriptAction::SaveSession
                    : kind == "save_volume"    ? ScriptAction::SaveVolume
                    : kind == "export_surface" ? ScriptAction::ExportSurface
                    : kind == "save_reference" ? ScriptAction::SaveReference
                    : kind == "save_image"     ? ScriptAction::SaveImage
-                                              : ScriptAction::Open;
+                   : kind == "open"           ? ScriptAction::Open
+                                              : ScriptAction::ExportTurntable;
         const Json& f = in.at("file");
         if (!f.is_string() || f.get<std::string>().empty()) fail_json(in.field("file"), "expected a file path");
         e.file = fs::absolute(base / fs::path(f.get<std::string>()));
+        if (e.action == ScriptAction::ExportTurntable) {
+            const int64_t frames = in.integer("frames", kDefaultTurntableFrames);
+            if (frames < 1 || frames > 100000) fail_json(in.field("frames"), "must be between 1 and 100000");
+            e.frames = static_cast<int>(frames);
+        }
         events.push_back(e);
     } else if (kind == "quit" || kind == "close_window" || kind == "recover" || kind == "discard_recovery" ||
                kind == "autosave" || kind == "kill") {
@@ -254,7 +278,7 @@ void parse_entry(const Json& json, size_t index, const fs::path& base, const std
                              "\" (expected press, move, release, drag, scroll, key, tool, material, crease_angle, "
                              "idle, save_session, save_volume, export_surface, open, cancel_task, repair, render_reference, "
                              "cancel_reference, save_reference, quit, close_window, dialog, open_example, recover, "
-                             "discard_recovery, autosave, kill, snapshot, save_image)");
+                             "discard_recovery, autosave, kill, snapshot, save_image, export_turntable, background)");
     }
     in.finish();
 }
@@ -316,6 +340,8 @@ void InputScriptPlayer::advance(ScriptTarget& target) {
         case ScriptAction::Autosave: target.autosave(); break;
         case ScriptAction::Kill: target.kill(); break;
         case ScriptAction::SaveImage: target.save_image(e.file); break;
+        case ScriptAction::ExportTurntable: target.export_turntable(e.file, e.frames); break;
+        case ScriptAction::SetBackground: target.set_background(e.background); break;
         }
         last_fired_ = frame_;
         ++next_;

@@ -43,7 +43,12 @@
 //     {"event": "kill"},                                      die at once as a crash would (SIGKILL):
 //                                                             the recovery copy stays behind
 //     {"event": "snapshot"},                                  File > Snapshot
-//     {"event": "save_image", "file": "view.png"}             as File > Save image (.png, .jpg, .jpeg)
+//     {"event": "save_image", "file": "view.png"},            as File > Save image (.png, .jpg, .jpeg)
+//     {"event": "background", "background": "30,60,90"},      the View panel's background: "automatic",
+//                                                             "environment", "R,G,B" or "#RRGGBB"
+//     {"event": "export_turntable", "file": "spin.mp4", "frames": 36}
+//                                 File > Export turntable: the frames in spin/, the video spin.mp4
+//                                 when ffmpeg is on the PATH; frames optional (36)
 //   ]
 //
 // Positions are window coordinates (GLFW's: screen units, origin top-left; with --hide-ui the view
@@ -67,7 +72,7 @@ namespace waxwork {
 enum class ScriptAction {
     Move, Press, Release, Scroll, Key, SelectTool, SelectMaterial, SetCreaseAngle, WaitIdle, SaveSession, SaveVolume,
     ExportSurface, Open, CancelTask, Repair, RenderReference, CancelReference, SaveReference, Quit, CloseWindow,
-    Dialog, OpenExample, Recover, DiscardRecovery, Autosave, Kill, Snapshot, SaveImage
+    Dialog, OpenExample, Recover, DiscardRecovery, Autosave, Kill, Snapshot, SaveImage, ExportTurntable, SetBackground
 };
 
 struct ScriptEvent {
@@ -83,6 +88,8 @@ struct ScriptEvent {
     double degrees = 0;          // SetCreaseAngle: in [0, 180]
     std::filesystem::path file;  // SaveSession, SaveVolume, ExportSurface, Open (absolute after parsing)
     std::string repair;          // Repair: a RepairChoice id
+    int frames = 0;              // ExportTurntable
+    std::string background;      // SetBackground: as render --background takes it, but transparent
     std::string name;            // Dialog: "save", "discard" or "cancel"; OpenExample: the example
                                  // (Dialog's optional file is `file`, empty when not given)
     std::optional<double> seconds, noise_percent;  // RenderReference: the Reference window's settings
@@ -140,6 +147,8 @@ public:
     virtual void autosave() = 0;
     virtual void kill() = 0;
     virtual void save_image(const std::filesystem::path& file) = 0;  // File > Save image
+    virtual void export_turntable(const std::filesystem::path& video, int frames) = 0;
+    virtual void set_background(const std::string& background) = 0;  // the View panel's (parse_background)
 };
 
 // Replays a script, a frame at a time.

@@ -346,6 +346,8 @@ public:
     void autosave() override { app_.autosave(); }
     void kill() override { std::raise(SIGKILL); }
     void save_image(const std::filesystem::path& file) override { app_.save_image(file); }
+    void export_turntable(const std::filesystem::path& video, int frames) override { app_.export_turntable(video, frames); }
+    void set_background(const std::string& background) override { app_.set_background(background); }
 
 private:
     GLFWwindow* window_;

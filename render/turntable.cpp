@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 
@@ -32,6 +33,12 @@ CameraSettings orbit_camera(const CameraSettings& start, int index, int frames, 
     CameraSettings camera = start;
     camera.eye_direction = std::cos(elevation) * heading + std::sin(elevation) * up;
     return camera;
+}
+
+std::string turntable_frame_name(int index) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%04d.png", index);
+    return name;
 }
 
 }  // namespace waxwork

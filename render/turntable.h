@@ -6,6 +6,7 @@
 #include "render/camera.h"
 
 #include <optional>
+#include <string>
 
 namespace waxwork {
 
@@ -18,5 +19,13 @@ namespace waxwork {
 // or a start looking straight along its up vector without an elevation.
 CameraSettings orbit_camera(const CameraSettings& start, int index, int frames,
                             std::optional<double> elevation_degrees = std::nullopt);
+
+// One turn's length in a turntable's video, and the frames of the editor's turntable, unless asked
+// otherwise.
+inline constexpr double kDefaultSecondsPerTurn = 6;
+inline constexpr int kDefaultTurntableFrames = 36;
+
+// The frames' file names, frame_0000.png, ... (what io/video_encoder.h encode_mp4 reads).
+std::string turntable_frame_name(int index);
 
 }  // namespace waxwork

@@ -9,6 +9,7 @@
 #include "io/file_extension.h"
 #include "io/image_io.h"
 #include "io/output_folder.h"
+#include "io/video_encoder.h"
 #include "io/volume_file.h"
 #include "render/image_background.h"
 #include "render/render_input.h"
@@ -20,7 +21,6 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -29,8 +29,6 @@
 #include <optional>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <vector>
 
 namespace waxwork {
@@ -44,7 +42,7 @@ struct TurntableOptions {
     SceneLightOptions light;
     int frames = 0;
     std::optional<double> elevation;
-    double seconds_per_turn = 6;
+    double seconds_per_turn = kDefaultSecondsPerTurn;
     std::optional<int> width, height;
     std::optional<double> exposure;
     std::string background;
@@ -111,48 +109,6 @@ TurntableScene solve_turntable_scene(const TurntableOptions& o) {
     return t;
 }
 
-// The ffmpeg executable on the PATH, or "" when there is none.
-std::string find_on_path(const std::string& name) {
-    const char* path = std::getenv("PATH");
-    std::stringstream folders(path ? path : "");
-    std::string folder;
-    while (std::getline(folders, folder, ':')) {
-        const fs::path candidate = fs::path(folder.empty() ? "." : folder) / name;
-        if (::access(candidate.c_str(), X_OK) == 0 && !fs::is_directory(candidate)) return candidate.string();
-    }
-    return "";
-}
-
-// Runs ffmpeg on the frames: H.264 in yuv420p (what players expect; the height and width padded to
-// even numbers as the encoder needs), `fps` frames a second. Its own output goes to stderr only on
-// failure (-loglevel error). Returns whether it succeeded.
-bool encode_mp4(const std::string& ffmpeg, const fs::path& dir, const fs::path& mp4, double fps) {
-    const std::vector<std::string> arguments = {
-        ffmpeg, "-y", "-loglevel", "error", "-framerate", std::to_string(fps), "-i", (dir / "frame_%04d.png").string(),
-        "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p", mp4.string()};
-    std::vector<char*> argv;
-    for (const std::string& a : arguments) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    std::cout.flush();
-    const pid_t child = ::fork();
-    if (child < 0) return false;
-    if (child == 0) {
-        ::execv(argv[0], argv.data());
-        ::_exit(127);
-    }
-    int status = 0;
-    while (::waitpid(child, &status, 0) < 0) {
-        if (errno != EINTR) return false;
-    }
-    return WIFEXITED(status) && WEXITSTATUS(status) == 0;
-}
-
-std::string frame_name(int index) {
-    char name[32];
-    std::snprintf(name, sizeof name, "frame_%04d.png", index);
-    return name;
-}
-
 void run_turntable_command(const TurntableOptions& o) {
     check_options(o);
     const fs::path dir = o.output;
@@ -181,7 +137,7 @@ void run_turntable_command(const TurntableOptions& o) {
         apply_background(background, input);
         input.ground = o.ground;
         exposure = input.exposure;
-        write_png(render_scene(renderer, input), contained_output_path(dir, frame_name(i)));
+        write_png(render_scene(renderer, input), contained_output_path(dir, turntable_frame_name(i)));
     }
     progress.finish();
 

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <cstdlib>
 #include <cmath>
 #include <filesystem>
@@ -337,6 +338,55 @@ TEST_F(EditorWindow, SnapshotsReplayToTheImagesTheEditorShowed) {
     expect_same(dir / "at_snapshot.png", dir / "run" / "session_snapshot_1.png");
     expect_same(dir / "shot.png", dir / "run" / "session.png");
     EXPECT_GT(max_channel_difference(read_png(dir / "run" / "session_snapshot_1.png"), read_png(dir / "run" / "session.png")), 20);
+}
+
+// File > Export turntable writes the view circling the model into the folder named after the video:
+// its first frame is the view itself, the others turn; then ffmpeg (a stand-in that records its
+// arguments and writes its output) makes the video from those frames.
+TEST_F(EditorWindow, ExportTurntableWritesTheOrbitStartingFromTheViewAndTheVideo) {
+    const fs::path dir = scratch_dir("editor_turntable");
+    const fs::path bin = dir / "bin";
+    fs::create_directories(bin);
+    {
+        std::ofstream script(bin / "ffmpeg");
+        script << "#!/bin/sh\necho \"$@\" > \"" << (dir / "ffmpeg_args").string() << "\"\n"
+               << "for last in \"$@\"; do :; done\ntouch \"$last\"\n";
+    }
+    fs::permissions(bin / "ffmpeg", fs::perms::owner_all);
+    std::ofstream(dir / "input.json") << R"([{"frame": 2, "event": "drag", "from": [200, 150], "to": [150, 120],
+        "steps": 5, "button": "right"}, {"event": "idle"},
+        {"event": "export_turntable", "file": "spin.mp4", "frames": 6}, {"event": "idle"}])";
+    const auto r = run_under_xvfb("edit " + kAssets + "/meshes/cube.obj" + kCubeView + " --input " +
+                                      (dir / "input.json").string() + " --frames 2 --screenshot " + (dir / "shot.png").string(),
+                                  "PATH=" + bin.string() + ":$PATH ");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::vector<Image> frames;
+    for (int i = 0; i < 6; ++i) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%04d.png", i);
+        ASSERT_TRUE(fs::exists(dir / "spin" / name)) << name;
+        frames.push_back(read_png(dir / "spin" / name));
+        EXPECT_EQ(frames.back().width, 400);
+        EXPECT_EQ(frames.back().height, 300);
+    }
+    EXPECT_LE(max_channel_difference(frames[0], read_png(dir / "shot.png")), 2);  // frame 0 is the view
+    for (int i = 1; i < 6; ++i) EXPECT_GT(max_channel_difference(frames[i], frames[0]), 20) << i;
+    EXPECT_TRUE(fs::exists(dir / "spin.mp4"));
+    const std::string args = testing::read_text(dir / "ffmpeg_args");
+    EXPECT_NE(args.find((dir / "spin" / "frame_%04d.png").string()), std::string::npos) << args;
+}
+
+// The View panel's background colour fills the view around the model (and so saved images).
+TEST_F(EditorWindow, BackgroundColourFillsTheViewAroundTheModel) {
+    const fs::path dir = scratch_dir("editor_background");
+    const auto r = run_script(dir, R"([{"frame": 1, "event": "background", "background": "30,90,160"}, {"event": "idle"}])");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Image shot = read_png(dir / "shot.png");
+    const uint8_t* corner = shot.pixel(5, 5);
+    EXPECT_EQ(corner[0], 30);
+    EXPECT_EQ(corner[1], 90);
+    EXPECT_EQ(corner[2], 160);
+    EXPECT_GT(mean_brightness(shot, 190, 140, 210, 160), 3 * 200);  // the lit cube in the middle
 }
 
 TEST_F(EditorWindow, PaintStrokeChangesTheMaterialWhereDrawn) {

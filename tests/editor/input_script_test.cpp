@@ -147,6 +147,9 @@ TEST(InputScript, BadScriptsGetOneLineErrorsNamingTheFileAndEntry) {
         {R"([{"event": "open_example"}])", "s.json: entry 0 (open_example): missing field 'name'"},
         {R"([{"event": "quit", "now": true}])", "unknown field 'now'"},
         {R"([{"event": "save_image"}])", "missing field 'file'"},
+        {R"([{"event": "export_turntable", "file": "a.mp4", "frames": 0}])", "field 'frames': must be between 1"},
+        {R"([{"event": "background", "background": "transparent"}])", "field 'background': a window cannot"},
+        {R"([{"event": "background", "background": "300,0,0"}])", "s.json: entry 0 (background): field 'background'"},
     };
     for (const auto& [text, expected] : cases) {
         const std::string message = parse_error(text);
@@ -206,6 +209,10 @@ public:
     void autosave() override { add("autosave"); }
     void kill() override { add("kill"); }
     void save_image(const std::filesystem::path& f) override { add("save image " + f.filename().string()); }
+    void set_background(const std::string& background) override { add("background " + background); }
+    void export_turntable(const std::filesystem::path& f, int frames) override {
+        add("turntable " + f.filename().string() + " " + std::to_string(frames));
+    }
 
 private:
     void add(const std::string& s) { log.push_back(std::to_string(frame) + ": " + s); }
@@ -266,12 +273,14 @@ TEST(InputScriptPlayer, PlaysTheReferenceEventsWithTheirSettingsAndSnapshot) {
                                                     "3: save reference r.png", "4: snapshot"}));
 }
 
-TEST(InputScriptPlayer, PlaysSaveImage) {
-    InputScriptPlayer player(parse(R"([{"event": "save_image", "file": "out/view.jpg"}])"));
+TEST(InputScriptPlayer, PlaysSaveImageAndTurntable) {
+    InputScriptPlayer player(parse(R"([{"event": "save_image", "file": "out/view.jpg"},
+        {"event": "export_turntable", "file": "spin.mp4", "frames": 8}, {"event": "export_turntable", "file": "a.mp4"}])"));
     FakeTarget target;
     target.is_ready = true;
-    for (target.frame = 0; target.frame < 2; ++target.frame) player.advance(target);
-    EXPECT_EQ(target.log, (std::vector<std::string>{"0: save image view.jpg"}));
+    for (target.frame = 0; target.frame < 4; ++target.frame) player.advance(target);
+    EXPECT_EQ(target.log, (std::vector<std::string>{"0: save image view.jpg", "1: turntable spin.mp4 8",
+                                                    "2: turntable a.mp4 36"}));
 }
 
 TEST(InputScript, ExampleScriptsParse) {
