@@ -10,6 +10,7 @@
 #include <iterator>
 #include <limits>
 #include <string>
+#include <string_view>
 
 // stb (Debian libstb-dev) rather than libpng: two self-contained headers cover encoding and robust,
 // bounds-checked decoding. Static linkage keeps the implementation private to this file, so another
@@ -220,24 +221,12 @@ LinearImage read_linear_png(const std::filesystem::path& path) {
 Image read_png(const std::filesystem::path& path) {
     const std::string bytes = read_bytes(path);
     if (bytes.empty()) throw FileError(path.string(), "empty file, not a PNG");
-    if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max())) {
-        throw FileError(path.string(), "file too large for a PNG image");
-    }
-    const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
-    const int length = static_cast<int>(bytes.size());
-    if (stbi_is_hdr_from_memory(data, length)) throw FileError(path.string(), "a Radiance .hdr image, not a PNG");
-    if (!stbi_info_from_memory(data, length, nullptr, nullptr, nullptr)) {
-        throw FileError(path.string(), std::string("not a PNG image (") + stbi_failure_reason() + ")");
-    }
-    int width = 0, height = 0, channels = 0;
-    stbi_uc* pixels = stbi_load_from_memory(data, length, &width, &height, &channels, 4);
-    if (!pixels) throw FileError(path.string(), std::string("corrupt PNG: ") + stbi_failure_reason());
-    Image image;
-    image.width = width;
-    image.height = height;
-    image.rgba.assign(pixels, pixels + 4 * static_cast<size_t>(width) * static_cast<size_t>(height));
-    stbi_image_free(pixels);
-    return image;
+    if (stbi_is_hdr_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), static_cast<int>(std::min<size_t>(bytes.size(), 1 << 20))))
+        throw FileError(path.string(), "a Radiance .hdr image, not a PNG");
+    // stb decodes a dozen formats; a file read as a PNG must be one: its 8-byte signature.
+    static constexpr std::string_view kSignature("\x89PNG\r\n\x1a\n", 8);
+    if (bytes.compare(0, kSignature.size(), kSignature) != 0) throw FileError(path.string(), "not a PNG image (no PNG signature)");
+    return read_image(path);
 }
 
 namespace {

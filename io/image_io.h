@@ -61,7 +61,8 @@ void write_linear_png(const LinearImage& image, const std::filesystem::path& pat
 LinearImage read_linear_png(const std::filesystem::path& path);
 
 // Reads any PNG (grey, grey-alpha, rgb, rgba, palette; 8 or 16 bits) as 8-bit RGBA. Throws
-// FileError("PATH: PROBLEM") for a missing, unreadable, truncated or corrupt file.
+// FileError("PATH: PROBLEM") for a missing, unreadable, truncated or corrupt file, and for one of
+// another format (no PNG signature).
 Image read_png(const std::filesystem::path& path);
 
 // Linear RGB radiance from a Radiance RGBE (.hdr) file, row-major, top row first, 3 floats per pixel.

@@ -75,3 +75,26 @@ TEST(Jpeg, WritesOverTheMatteAndReadsBack) {
 
 }  // namespace
 }  // namespace waxwork
+
+namespace waxwork {
+namespace {
+
+// read_png reads PNGs only: a JPEG (which read_image takes) is refused naming the file.
+TEST(ImageIo, ReadPngRefusesOtherFormats) {
+    const std::filesystem::path dir = testing::scratch_dir("read_png_formats");
+    Image image;
+    image.width = 4;
+    image.height = 3;
+    image.rgba.assign(4 * 12, 200);
+    write_jpeg(image, dir / "a.jpg");
+    EXPECT_EQ(read_image(dir / "a.jpg").width, 4);
+    try {
+        read_png(dir / "a.jpg");
+        ADD_FAILURE() << "read_png accepted a JPEG";
+    } catch (const FileError& e) {
+        EXPECT_NE(std::string(e.what()).find("a.jpg: not a PNG image"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace waxwork
