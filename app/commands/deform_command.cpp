@@ -7,6 +7,7 @@
 // local/global iterations each (tetops/arap_deformation.h). The volume is written atomically with its
 // materials, ids and pieces unchanged (only positions move) and a one-line JSON summary is printed.
 #include "app/commands/edited_volume.h"
+#include "app/options/help_sections.h"
 #include "app/options/number_options.h"
 #include "app/stderr_progress.h"
 #include "base/error.h"
@@ -176,6 +177,7 @@ void add_deform_command(CLI::App& app) {
                 "The rest of the grabbed body follows as rigidly as possible (per-tet rotations, Sorkine and\n"
                 "Alexa 2007); other bodies and pieces stay. A step that would invert a tet or leave one under\n"
                 "0.5 degrees is shortened (halved until it passes): then \"step_shortened\" is true.");
+    organise_help(*cmd, "waxwork deform spot.vtu -o bent.vtu --grab 0,0.4,0.1 --radius 0.2 --move 0,0.1,0", {});
     cmd->callback([options] { run_deform_command(*options); });
 }
 

@@ -2,6 +2,7 @@
 // save the volume, render it in a few materials and lights, a cut and a painted variant, then replay
 // the example editing sessions of assets/sessions/.
 #include "app/commands.h"
+#include "app/options/help_sections.h"
 #include "app/options/surface_meshing_options.h"
 #include "base/error.h"
 #include "editor/editor_app.h"
@@ -249,6 +250,7 @@ void add_demo_command(CLI::App& app) {
     cmd->add_option("--width", options->width, "Image width in pixels")->capture_default_str();
     cmd->add_flag("--no-editor", options->no_editor, "Do not open the interactive editor even when a display is present");
     cmd->add_option("--height", options->height, "Image height in pixels")->capture_default_str();
+    organise_help(*cmd, "waxwork demo -o out/demo", {});
     cmd->callback([options] { run_demo_command(*options); });
 }
 

@@ -9,6 +9,7 @@
 // Each builds the edit operation its options stand for (scene/edit_operation.h) and applies it
 // through a Document, as the editor and sessions do, then writes the volume and prints a one-line JSON
 // summary on stdout.
+#include "app/options/help_sections.h"
 #include "app/options/material_options.h"
 #include "app/options/number_options.h"
 #include "base/error.h"
@@ -275,6 +276,7 @@ void add_cut_command(CLI::App& app) {
                 "--exact: vertices within 20% of an edge from the plane snap onto it (when no tet of their star\n"
                 "drops under 0.5 degrees), every other crossed edge is split, crossed tets are split into tets on\n"
                 "either side and the side n.x > D is removed: the cross-section lies on the plane.");
+    organise_help(*cmd, "waxwork cut spot.vtu -o cut.vtu --plane 1,0,0,0.1 --exact", {});
     cmd->callback([options] { run_cut_command(*options); });
 }
 
@@ -302,6 +304,7 @@ void add_fracture_command(CLI::App& app) {
                      "Exact mode: keep every split (to compare)");
     cmd->footer("Seeds are scattered uniformly in the volume; each cell's part of each piece becomes a piece (a cell\n"
                 "cut in two by a concave volume gives two), with the crack vertices duplicated so pieces move apart.");
+    organise_help(*cmd, "waxwork fracture spot.vtu -o broken.vtu --pieces 5", {});
     cmd->callback([options] { run_fracture_command(*options); });
 }
 
@@ -317,6 +320,7 @@ void add_paint_command(CLI::App& app) {
     add_material_options(*cmd, options->material);
     cmd->footer("Weight w = exp(-d^2 / (2 sigma^2)), d from a tet's centroid to the nearest stroke point; tets with\n"
                 "w < 0.001 are untouched; material <- (1 - w) material + w brush (TransCut Sec. 5).");
+    organise_help(*cmd, "waxwork paint spot.vtu -o painted.vtu --at 0,0.3,0.2 --sigma 0.05 --material ketchup", {});
     cmd->callback([options] { run_paint_command(*options); });
 }
 

@@ -2,6 +2,7 @@
 // for other programs, with `--radiance` its exitant radiance, lit as `render` lights it, baked as
 // sRGB vertex colours.
 #include "app/commands.h"
+#include "app/options/help_sections.h"
 #include "app/options/scene_light_options.h"
 #include "app/stderr_progress.h"
 #include "base/error.h"
@@ -116,6 +117,7 @@ void add_export_command(CLI::App& app) {
         "Faces are outward (counter-clockwise seen from outside). With --radiance each vertex gets the\n"
         "exitant radiance `render --fields` lists as lo, clamped to [0, 1] and sRGB-encoded as the\n"
         "renderer encodes (no exposure or tone mapping); the light options are render's.");
+    organise_help(*cmd, "waxwork export spot.vtu -o spot.ply --radiance", {});
     cmd->callback([options] { run_export_command(*options); });
 }
 

@@ -1,5 +1,6 @@
 // `waxwork info VOLUME [--cells CELLS.csv]`: one JSON object describing a volume.
 #include "app/commands.h"
+#include "app/options/help_sections.h"
 #include "io/atomic_file.h"
 #include "io/volume_file.h"
 #include "solver/material.h"
@@ -85,6 +86,7 @@ void add_info_command(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("info", "Print a JSON summary of a volume (counts, quality, volume, bbox)");
     cmd->add_option("volume", options->volume, "Volume file (.vtu, .msh, .mesh, .node/.ele)")->required();
     cmd->add_option("--cells", options->cells, "Also write one CSV row per tet to this file");
+    organise_help(*cmd, "waxwork info spot.vtu", {});
     cmd->callback([options] { run_info_command(*options); });
 }
 

@@ -2,6 +2,7 @@
 // vertical axis, as DIR/frame_0000.png ..., and DIR/turntable.mp4 when ffmpeg is on the PATH.
 // One light solve, N draws (render/turntable.h), at the first frame's exposure throughout.
 #include "app/commands.h"
+#include "app/options/help_sections.h"
 #include "app/options/scene_light_options.h"
 #include "app/stderr_progress.h"
 #include "base/error.h"
@@ -186,6 +187,7 @@ void add_turntable_command(CLI::App& app) {
         "on the view). With a session, its edits, lights and camera are replayed first; its render and save\n"
         "steps are skipped. turntable.mp4 (H.264) is made when ffmpeg is on the PATH.\n"
         "Example: waxwork turntable spot.vtu -o spin --frames 72 --elevation 20");
+    organise_help(*cmd, "waxwork turntable spot.vtu -o spin --frames 36 --ground", {});
     cmd->callback([options] { run_turntable_command(*options); });
 }
 

@@ -53,6 +53,23 @@ TEST(Cli, HelpStartsWithAnExampleAndTheCommonOptions) {
     }
 }
 
+// Every example a help screen shows runs as written, on spot.vtu in the working folder.
+TEST(Cli, HelpExamplesRunAsWritten) {
+    const fs::path dir = scratch_dir("help_examples");
+    const auto meshed = run_waxwork("mesh " + kAssets + "/meshes/spot.obj -o " + (dir / "spot.vtu").string() + " --max-tets 8000");
+    ASSERT_EQ(meshed.exit_code, 0) << meshed.err;
+    for (const std::string command : {"render", "deform", "cut", "fracture", "paint", "export", "info", "turntable"}) {
+        const auto help = run_waxwork(command + " --help");
+        const std::string marker = "Example:\n  waxwork ";
+        const size_t at = help.out.find(marker);
+        ASSERT_NE(at, std::string::npos) << command;
+        const size_t start = at + marker.size();
+        const std::string example = help.out.substr(start, help.out.find('\n', start) - start);
+        const auto r = run_waxwork(example, "cd " + dir.string() + " && PATH=/nonexistent ");
+        EXPECT_EQ(r.exit_code, 0) << command << ": waxwork " << example << "\n" << r.err;
+    }
+}
+
 TEST(Cli, UnknownCommandAndOptionAreOneLineErrors) {
     for (const std::string args : {"carve", "info --bogus x.vtu", "mesh", "mesh in.obj"}) {
         const auto r = run_waxwork(args);
