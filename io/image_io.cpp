@@ -90,8 +90,8 @@ struct DecodedPixels {
     ~DecodedPixels() { stbi_image_free(pixels); }
 };
 
-void decode(const std::filesystem::path& path, bool sixteen, DecodedPixels& out) {
-    const std::string bytes = read_bytes(path);
+// `bytes` is the file's content (read_bytes(path)); `path` names it in errors.
+void decode(const std::filesystem::path& path, const std::string& bytes, bool sixteen, DecodedPixels& out) {
     if (bytes.empty()) throw FileError(path.string(), "empty file, not an image");
     if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max()))
         throw FileError(path.string(), "file too large for an image");
@@ -136,9 +136,12 @@ void write_jpeg(const Image& image, const std::filesystem::path& path, int quali
     write_bytes_atomically(jpeg, path);
 }
 
-Image read_image(const std::filesystem::path& path) {
+namespace {
+
+// The decoded 8-bit RGBA of a file's content.
+Image decoded_image(const std::filesystem::path& path, const std::string& bytes) {
     DecodedPixels decoded;
-    decode(path, false, decoded);
+    decode(path, bytes, false, decoded);
     Image image;
     image.width = decoded.width;
     image.height = decoded.height;
@@ -146,6 +149,10 @@ Image read_image(const std::filesystem::path& path) {
     image.rgba.assign(pixels, pixels + 4 * static_cast<size_t>(image.width) * static_cast<size_t>(image.height));
     return image;
 }
+
+}  // namespace
+
+Image read_image(const std::filesystem::path& path) { return decoded_image(path, read_bytes(path)); }
 
 namespace {
 
@@ -208,7 +215,7 @@ void write_linear_png(const LinearImage& image, const std::filesystem::path& pat
 
 LinearImage read_linear_png(const std::filesystem::path& path) {
     DecodedPixels decoded;
-    decode(path, true, decoded);
+    decode(path, read_bytes(path), true, decoded);
     LinearImage image;
     image.width = decoded.width;
     image.height = decoded.height;
@@ -221,12 +228,10 @@ LinearImage read_linear_png(const std::filesystem::path& path) {
 Image read_png(const std::filesystem::path& path) {
     const std::string bytes = read_bytes(path);
     if (bytes.empty()) throw FileError(path.string(), "empty file, not a PNG");
-    if (stbi_is_hdr_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), static_cast<int>(std::min<size_t>(bytes.size(), 1 << 20))))
-        throw FileError(path.string(), "a Radiance .hdr image, not a PNG");
     // stb decodes a dozen formats; a file read as a PNG must be one: its 8-byte signature.
     static constexpr std::string_view kSignature("\x89PNG\r\n\x1a\n", 8);
     if (bytes.compare(0, kSignature.size(), kSignature) != 0) throw FileError(path.string(), "not a PNG image (no PNG signature)");
-    return read_image(path);
+    return decoded_image(path, bytes);
 }
 
 namespace {
