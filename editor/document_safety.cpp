@@ -128,12 +128,7 @@ void EditorApp::autosave() {
         // The volume first: it is what a recovery opens (the session beside it replays the edits
         // onto the source, which may have moved since).
         core.save_volume(files.volume());
-        Session setup = core.setup();
-        setup.lighting = current.lighting;
-        setup.camera = current.camera;
-        setup.width = current.width;
-        setup.height = current.height;
-        core.save_session(files.session(), setup);
+        core.save_session(files.session(), with_view(core.setup(), current));
         write_recovered_source(files, source);
         return "Autosaved a recovery copy to " + files.directory.string();
     });

@@ -530,21 +530,24 @@ Session EditorApp::view_session() const {
     return current;
 }
 
+Session EditorApp::with_view(Session setup, const Session& view) {
+    setup.frame_iterations = view.frame_iterations;
+    setup.frame_ms = view.frame_ms;
+    setup.crease_angle_degrees = view.crease_angle_degrees;
+    setup.lighting = view.lighting;
+    setup.camera = view.camera;
+    setup.width = view.width;
+    setup.height = view.height;
+    return setup;
+}
+
 void EditorApp::save_session(const fs::path& path) {
     if (!scene_->core) return set_error("open a file first");
     const Session current = view_session();
     mark_saved(path);
     const double exposure = shown_exposure();
     queue_job("save session", [path, current, snapshots = snapshots_, exposure](SceneCore& core) {
-        Session setup = core.setup();
-        setup.frame_iterations = current.frame_iterations;
-        setup.frame_ms = current.frame_ms;
-        setup.crease_angle_degrees = current.crease_angle_degrees;
-        setup.lighting = current.lighting;
-        setup.camera = current.camera;
-        setup.width = current.width;
-        setup.height = current.height;
-        core.save_session(path, setup, snapshots, exposure);
+        core.save_session(path, with_view(core.setup(), current), snapshots, exposure);
         return "Saved the session (" + std::to_string(core.document().history().size()) + " edits, " +
                std::to_string(snapshots.size()) + " snapshots) to " + path.string();
     });

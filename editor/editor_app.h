@@ -375,6 +375,9 @@ private:
     void draw_open_recent_menu();
     void remove_own_recovery();
     Session view_session() const;   // the view, lights and budget as they are now (saved sessions keep them)
+    // `setup` (the SceneCore's session head) with view_session()'s fields from `view`: the head a saved
+    // or autosaved session starts with.
+    static Session with_view(Session setup, const Session& view);
     void draw_start_screen();       // start_screen.cpp
 
     static constexpr float kToolPaletteWidth = 132;  // logical pixels (times the UI scale)
