@@ -30,7 +30,8 @@ VolumeLight solve_light(const TetMesh& mesh, const std::string& volume_name, con
     DiffusionOptions diffusion = settings.diffusion;
     if (diffusion.backend == SolverBackend::Gpu) diffusion.gl = gl;
     light.scene = solve_scene(mesh, light.connectivity, light.materials, settings.lighting, diffusion,
-                              settings.crease_angle_degrees);
+                              settings.crease_angle_degrees,
+                              settings.alternative ? &*settings.alternative : nullptr);
     return light;
 }
 

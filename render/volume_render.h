@@ -25,6 +25,8 @@ struct VolumeRenderSettings {
     Lighting lighting;
     // backend Gpu: solved in the picture's context; `gl` is then set here and must be left null.
     DiffusionOptions diffusion;
+    // When set, one of the seeds' alternative methods solves instead of TransCut (solve_scene).
+    std::optional<AlternativeMethodSettings> alternative;
     double crease_angle_degrees = kDefaultCreaseAngleDegrees;
     ImageSettings image;
     ViewOptions view;

@@ -12,7 +12,8 @@ namespace waxwork {
 
 SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity,
                         const std::vector<TetMaterial>& materials, const Lighting& lighting,
-                        const DiffusionOptions& options, double crease_angle_degrees) {
+                        const DiffusionOptions& options, double crease_angle_degrees,
+                        const AlternativeMethodSettings* alternative) {
     SolvedScene scene;
     const auto lighting_start = std::chrono::steady_clock::now();
     // The surface and its shadow BVH are built once and shared by the lighting of the solve, the
@@ -29,7 +30,17 @@ SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity
     scene.q = to_volume_vertices(scene.surface, surface_source_q, mesh.vertex_count());
     scene.lighting_ms = milliseconds_since(lighting_start);
 
-    scene.diffusion = solve_diffusion(mesh, connectivity, materials, scene.q, options, corners);
+    if (alternative) {
+        const MethodProblem problem{mesh, connectivity, materials, scene.q, options.mm_per_unit};
+        scene.alternative = solve_alternative(problem, *alternative);
+        scene.diffusion.phi = std::move(scene.alternative->phi);
+        scene.alternative->phi.clear();
+        scene.diffusion.iterations = scene.alternative->iterations;
+        scene.diffusion.assembly_ms = scene.alternative->setup_ms;
+        scene.diffusion.solve_ms = scene.alternative->solve_ms;
+    } else {
+        scene.diffusion = solve_diffusion(mesh, connectivity, materials, scene.q, options, corners);
+    }
     for (size_t v = 0; v < scene.diffusion.phi.size(); ++v) {
         for (int c = 0; c < 3; ++c) {
             if (!std::isfinite(scene.diffusion.phi[v][c]))

@@ -7,11 +7,13 @@
 
 #include "solver/diffusion_solve.h"
 #include "solver/lighting.h"
+#include "solver/methods/alternative_method.h"
 #include "solver/shading_surface.h"
 #include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
 #include <array>
+#include <optional>
 #include <vector>
 
 namespace waxwork {
@@ -27,12 +29,20 @@ struct SolvedScene {
     DiffusionSolution diffusion;                       // phi per volume vertex and solver statistics
     std::vector<std::array<float, 3>> radiance_factor; // E per shading vertex (shading_radiance_factors)
     double lighting_ms = 0;                            // surface extraction, shadow BVH, q and the shading's light
+    // When an alternative method solved (solve_scene's `alternative`): its statistics and warnings; its
+    // phi is diffusion.phi, its setup and solve times diffusion.assembly_ms and solve_ms.
+    std::optional<MethodSolution> alternative;
 };
 
-// Runs lighting, diffusion and radiance. Throws AlgorithmError when phi or E is not finite (never a
-// NaN image), InvalidArgumentError for bad materials, lights, options or crease angle.
+// Runs lighting, diffusion and radiance. With `alternative`, phi comes from that method
+// (solver/methods/alternative_method.h) instead of solve_diffusion, from the same q and materials;
+// the light a crease corner receives apart from its vertex (corner_light) reaches only TransCut's
+// solve, since the alternatives read one q per vertex. Throws AlgorithmError when phi or E is not
+// finite (never a NaN image), InvalidArgumentError for bad materials, lights, options or crease angle,
+// and what the alternative method throws.
 SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity,
                         const std::vector<TetMaterial>& materials, const Lighting& lighting,
-                        const DiffusionOptions& options, double crease_angle_degrees = kDefaultCreaseAngleDegrees);
+                        const DiffusionOptions& options, double crease_angle_degrees = kDefaultCreaseAngleDegrees,
+                        const AlternativeMethodSettings* alternative = nullptr);
 
 }  // namespace waxwork

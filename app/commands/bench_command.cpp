@@ -149,7 +149,7 @@ void add_bench_command(CLI::App& app) {
     bench->add_option("-o,--output", *suite_output, "Output directory of the whole suite");
     bench->add_flag("--quick", suite->quick, "Smaller meshes and fewer samples (under 2 minutes)");
     bench->add_option("--only", suite->only, "Run only these parts (solvers_50k, solvers_500k, coarse_start, accuracy, cut_modes, environment, "
-                                             "table1, stability, resolution, diffusion_vs_transport)")
+                                             "table1, stability, methods, resolution, diffusion_vs_transport)")
         ->delimiter(',');
     bench->add_option("--repeats", suite->repeats,
                       "Report the median of N runs per timed point, with min and max (default: the fastest of 3 "

@@ -284,6 +284,9 @@ void run_render_command(const RenderCommandOptions& o) {
     const SolvedScene& scene = render.scene;
     if (!scene.diffusion.gpu_fallback_reason.empty())
         std::cerr << "warning: solving on the CPU instead: " << scene.diffusion.gpu_fallback_reason << "\n";
+    if (scene.alternative)
+        for (const std::string& warning : scene.alternative->warnings)
+            std::cerr << "warning: " << o.volume << ": " << warning << "\n";
     write_image(render.image, o.output);
     if (!o.linear.empty()) write_linear_png(render.linear, o.linear, render.exposure);
     report_chosen_scale(o.volume, scale, mesh);
@@ -313,6 +316,15 @@ void run_render_command(const RenderCommandOptions& o) {
         {"render_ms", render.render_ms},
         {"view", view_mode_name(view.mode)},
     };
+    if (scene.alternative) {
+        summary.erase("estimated_error");  // CG's estimate; the alternatives have none
+        const MethodSolution& m = *scene.alternative;
+        summary["alternative"] = {{"unknowns", m.unknowns},
+                                  {"setup_ms", m.setup_ms},
+                                  {"solve_ms", m.solve_ms},
+                                  {"iterations", m.iterations},
+                                  {"warnings", m.warnings}};
+    }
     if (traced) {
         const MonteCarloFluence& mc = trace->fluence;
         summary["monte_carlo"] = {
@@ -399,12 +411,14 @@ void add_render_command(CLI::App& app) {
         "lights and shadows) for the fluence (--fields gains phi_err_r,phi_err_g,phi_err_b, standard errors), then\n"
         "camera rays for the image (exitant radiance with single scattering, no highlight), until --mc-seconds\n"
         "(a quarter for the fluence), --mc-error or --mc-photons, with a status line on stderr. The summary's\n"
-        "monte_carlo.over_diffusion compares the fluences, monte_carlo_image.over_diffusion the images.");
+        "monte_carlo.over_diffusion compares the fluences, monte_carlo_image.over_diffusion the images.\n"
+        "--method fd, fd-cg, fvm, fvm-cg, lbm and dipole solve the same light with the seeds' methods\n"
+        "(docs/methods.md); the summary's alternative block gives their unknowns, setup and solve times.");
     organise_help(*cmd, "waxwork render spot.vtu -o spot.png --material skin1 --light dir:1,-1,-1 --view 0.7,0.5,1",
                   {{"Custom material (per mm, instead of --material)", {"--mua", "--musp", "--eta"}},
                    {"Light and shading details", {"--no-env-background", "--ambient", "--crease-angle"}},
                    {"Inspection views and data", {"--slice-normal", "--slice-offset", "--quality-interior", "--fields"}},
-                   {"Solver (docs/solvers.md)", {"--method", "--tol", "--backend"}},
+                   {"Solver (docs/solvers.md, docs/methods.md)", {"--method", "--tol", "--cell", "--backend"}},
                    {"Monte Carlo reference (--method mc; docs/monte_carlo.md)",
                     {"--mc-seconds", "--mc-error", "--mc-g", "--mc-photons", "--seed"}}});
     cmd->callback([options] { run_render_command(*options); });

@@ -5,12 +5,18 @@
 #include "solver/conjugate_gradient.h"
 #include "solver/light_spec.h"
 #include "solver/material.h"
+#include "solver/methods/alternative_method.h"
 
 #include <CLI/CLI.hpp>
 
 #include <iostream>
 
 namespace waxwork {
+
+namespace {
+// A voxel of a kilometre lights nothing; the grid methods cap their voxel count themselves.
+constexpr double kMaxCellMm = 1e6;
+}  // namespace
 
 void add_scene_light_options(CLI::App& command, SceneLightOptions& options, bool monte_carlo) {
     add_material_options(command, options.material);
@@ -30,18 +36,27 @@ void add_scene_light_options(CLI::App& command, SceneLightOptions& options, bool
     command.add_flag("--no-env-background", options.hide_environment,
                      "Draw the background colour behind the model instead of the environment (it still lights and "
                      "is reflected)");
-    if (monte_carlo)
-        command
-            .add_option("--method", options.method,
-                        "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass), or mc: a Monte Carlo "
-                        "path tracer through the volume (the physical reference; see --mc-seconds)")
-            ->check(CLI::IsMember({"transcut", "fem", "mc"}))
-            ->capture_default_str();
-    else
-        command.add_option("--method", options.method, "Discretisation: transcut (lumped, Li et al.) or fem (consistent mass)")
-            ->check(CLI::IsMember({"transcut", "fem"}))
-            ->capture_default_str();
-    command.add_option("--tol", options.tolerance, "Relative tolerance of the diffusion solve")->capture_default_str();
+    std::vector<std::string> methods = {"transcut", "fem"};
+    for (AlternativeMethod method : all_alternative_methods()) methods.push_back(alternative_method_name(method));
+    if (monte_carlo) methods.push_back("mc");
+    command
+        .add_option("--method", options.method,
+                    std::string("Discretisation: transcut (lumped, Li et al.) or fem (consistent mass); or one of the "
+                                "seeds' methods for the same light (docs/methods.md): fd, fd-cg (finite differences "
+                                "on a voxel grid, Jacobi or CG), fvm, fvm-cg (finite volumes on Voronoi cells, "
+                                "relaxation or CG), lbm (lattice Boltzmann on voxels), dipole (surface-only dipole "
+                                "profiles)") +
+                        (monte_carlo ? "; or mc: a Monte Carlo path tracer through the volume (the physical "
+                                       "reference; see --mc-seconds)"
+                                     : ""))
+        ->check(CLI::IsMember(methods))
+        ->capture_default_str();
+    command.add_option("--tol", options.tolerance,
+                       "Relative tolerance of the diffusion solve (default 1e-2 for transcut and fem, 1e-4 for the "
+                       "seeds' methods)");
+    command.add_option("--cell", options.cell_mm,
+                       "--method fd, fd-cg, lbm: the voxel size in mm (default: as many voxels as the volume has "
+                       "vertices)");
     command
         .add_option("--backend", options.backend,
                     "Diffusion solver: cpu, or gpu (float CG on OpenGL 4.3 compute shaders in the render context; "
@@ -64,8 +79,15 @@ void add_scene_light_options(CLI::App& command, SceneLightOptions& options, bool
 void check_scene_light_options(const SceneLightOptions& o) {
     auto fail = [](const std::string& what) { throw InvalidArgumentError(what); };
     if (o.scale) validate_mm_per_unit(*o.scale, "--scale");
-    if (!(o.tolerance >= kMinRelativeTolerance && o.tolerance < 1))
+    if (o.tolerance && !(*o.tolerance >= kMinRelativeTolerance && *o.tolerance < 1))
         fail("--tol must be a relative tolerance in [1e-15, 1)");
+    const std::optional<AlternativeMethod> alternative = parse_alternative_method(o.method);
+    if (o.cell_mm && !(alternative && uses_voxel_grid(*alternative)))
+        fail("--cell applies only to the grid methods (--method fd, fd-cg or lbm)");
+    if (o.cell_mm && !(*o.cell_mm > 0 && *o.cell_mm <= kMaxCellMm))
+        fail("--cell must be a voxel size in mm in (0, 1e6]");
+    if (alternative && o.backend == "gpu")
+        fail(std::string("--backend gpu applies to transcut and fem; --method ") + o.method + " runs on the CPU");
     if (o.ambient && !(*o.ambient >= 0 && *o.ambient <= kMaxLightIntensity))
         fail("--ambient must be non-negative and at most 1e15");
     if (!o.environment.empty()) parse_environment_spec(o.environment);
@@ -92,7 +114,14 @@ VolumeRenderSettings scene_light_settings(const SceneLightOptions& o, const Mode
     settings.material = chosen_material(o.material);
     settings.diffusion.discretization = o.method == "fem" ? Discretization::Fem : Discretization::TransCut;
     settings.diffusion.mm_per_unit = scale.mm_per_unit;
-    settings.diffusion.relative_tolerance = o.tolerance;
+    settings.diffusion.relative_tolerance = o.tolerance.value_or(kTransCutTolerance);
+    if (const std::optional<AlternativeMethod> method = parse_alternative_method(o.method)) {
+        AlternativeMethodSettings alternative;
+        alternative.method = *method;
+        alternative.cell_mm = o.cell_mm.value_or(0.0);
+        alternative.relative_tolerance = o.tolerance.value_or(kAlternativeTolerance);
+        settings.alternative = alternative;
+    }
     if (o.backend == "gpu") settings.diffusion.backend = SolverBackend::Gpu;
     settings.crease_angle_degrees = o.crease_angle;
     return settings;

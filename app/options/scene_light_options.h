@@ -1,6 +1,7 @@
 // The options that decide the light a volume shows, shared by the commands that solve it converged
 // (`render`, `export --radiance`), so both light a volume the same way from the same words:
-//   --material NAME | --mua R,G,B --musp R,G,B --eta N, --light SPEC..., --method transcut|fem,
+//   --material NAME | --mua R,G,B --musp R,G,B --eta N, --light SPEC...,
+//   --method transcut|fem|fd|fd-cg|fvm|fvm-cg|lbm|dipole, --cell MM,
 //   --env SPEC, --tol T, --backend cpu|gpu, --scale S, --ambient A, --crease-angle DEG
 #pragma once
 
@@ -23,17 +24,24 @@ class App;
 
 namespace waxwork {
 
+inline constexpr double kTransCutTolerance = 1e-2;
+inline constexpr double kAlternativeTolerance = 1e-4;
+
 struct SceneLightOptions {
     MaterialOptions material;
     std::vector<std::string> lights;
     std::string environment;  // --env: FILE.hdr[:ROT[:INTENSITY]] or sky:ELEV,AZIM[,TURBIDITY][:ROT[:INTENSITY]]
     bool hide_environment = false;  // --no-env-background: the environment lights but is not drawn
     std::string method = "transcut";
-    // 1e-2: the resolution study (`waxwork bench --only resolution`; docs/accuracy.md) finds the image
-    // at 1e-2 within 0.05% of the image at 1e-3 on spot at 3 and 30 mm per unit, while 1e-1 is visibly
-    // off (1-4%); the estimate bounds the true error from above, so the fluence itself is typically
-    // closer than 1e-2.
-    double tolerance = 1e-2;
+    // --tol; nullopt: the method's default. TransCut's is kTransCutTolerance = 1e-2: the resolution
+    // study (`waxwork bench --only resolution`; docs/accuracy.md) finds the image at 1e-2 within 0.05%
+    // of the image at 1e-3 on spot at 3 and 30 mm per unit, while 1e-1 is visibly off (1-4%); the
+    // estimate bounds the true error from above, so the fluence itself is typically closer than 1e-2.
+    // The seeds' alternative methods (--method fd, lbm, ...) stop on a relative change or residual,
+    // which at 1e-2 leaves a relaxation far from converged: theirs is kAlternativeTolerance.
+    std::optional<double> tolerance;
+    // --cell: the grid methods' (fd, lbm) cell size in mm; nullopt: default_cell_mm.
+    std::optional<double> cell_mm;
     std::optional<double> scale;  // nullopt: the volume's stored scale, else chosen from its size
     std::optional<double> ambient;  // nullopt: kDefaultAmbient, or 0 under an environment
     double crease_angle = kDefaultCreaseAngleDegrees;

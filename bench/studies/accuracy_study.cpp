@@ -234,59 +234,66 @@ std::vector<ConvergenceSeries> study_ball_nested_convergence(const StudySize& si
     return series;
 }
 
+SurfaceSolve solve_at_input_vertices(const TriangleSurface& surface, const std::string& surface_name,
+                                     const TetMaterial& material, double mm_per_unit, double size_factor,
+                                     const AlternativeMethodSettings* alternative) {
+    Lighting lighting;
+    lighting.lights.push_back(default_key_light());
+    MeshingOptions meshing;
+    meshing.mesher = Mesher::TetGen;  // the comparison needs the input's vertices, which CGAL remeshes
+    meshing.sizing = default_mesh_sizing(surface, material, mm_per_unit, {.size_factor = size_factor});
+    const TetMesh mesh = tetrahedralize(surface, meshing).mesh;
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    const std::vector<TetMaterial> materials(mesh.tet_count(), material);
+    DiffusionOptions diffusion;
+    diffusion.mm_per_unit = mm_per_unit;
+    diffusion.relative_tolerance = 1e-8;
+    SolvedScene scene = solve_scene(mesh, connectivity, materials, lighting, diffusion, kDefaultCreaseAngleDegrees,
+                                    alternative);
+    // phi of the input surface's vertices, found by their exact coordinates (TetGen copies input points).
+    using Key = std::tuple<double, double, double>;
+    std::map<Key, size_t> index;
+    for (size_t v = 0; v < mesh.vertex_count(); ++v)
+        index.emplace(Key{mesh.positions[v].x(), mesh.positions[v].y(), mesh.positions[v].z()}, v);
+    SurfaceSolve solve;
+    solve.phi.reserve(surface.points.size());
+    for (const Eigen::Vector3d& p : surface.points) {
+        const auto it = index.find(Key{p.x(), p.y(), p.z()});
+        if (it == index.end()) throw AlgorithmError(surface_name + ": the mesher moved an input vertex; cannot compare");
+        solve.phi.push_back(scene.diffusion.phi[it->second]);
+    }
+    solve.tets = mesh.tet_count();
+    solve.vertices = mesh.vertex_count();
+    solve.tet_size_mm = tet_size_mm(mesh, mm_per_unit);
+    solve.setup_ms = scene.diffusion.assembly_ms;
+    solve.solve_ms = scene.diffusion.solve_ms;
+    solve.alternative = std::move(scene.alternative);
+    return solve;
+}
+
+double relative_l2_error(const std::vector<std::array<double, 3>>& phi, const std::vector<std::array<double, 3>>& reference) {
+    double error = 0, norm = 0;
+    for (size_t v = 0; v < phi.size(); ++v)
+        for (int c = 0; c < 3; ++c) {
+            error += (phi[v][c] - reference[v][c]) * (phi[v][c] - reference[v][c]);
+            norm += reference[v][c] * reference[v][c];
+        }
+    return std::sqrt(error / norm);
+}
+
 ConvergenceSeries study_surface_convergence(const SurfaceConvergenceOptions& options) {
     const TetMaterial material = material_preset(options.material);
     const TriangleSurface surface = load_closed_surface(options.surface).surface;
-    Lighting lighting;
-    lighting.lights.push_back(default_key_light());
-
-    // phi of the input surface's vertices, found by their exact coordinates (TetGen copies input points).
-    using Key = std::tuple<double, double, double>;
-    auto solve_at_surface = [&](double factor, ConvergencePoint* point) {
-        MeshingOptions meshing;
-        meshing.mesher = Mesher::TetGen;  // the comparison needs the input's vertices, which CGAL remeshes
-        meshing.sizing = default_mesh_sizing(surface, material, options.mm_per_unit, {.size_factor = factor});
-        const TetMesh mesh = tetrahedralize(surface, meshing).mesh;
-        const TetConnectivity connectivity = build_connectivity(mesh);
-        const std::vector<TetMaterial> materials(mesh.tet_count(), material);
-        DiffusionOptions diffusion;
-        diffusion.mm_per_unit = options.mm_per_unit;
-        diffusion.relative_tolerance = 1e-8;
-        const SolvedScene scene = solve_scene(mesh, connectivity, materials, lighting, diffusion);
-        std::map<Key, size_t> index;
-        for (size_t v = 0; v < mesh.vertex_count(); ++v)
-            index.emplace(Key{mesh.positions[v].x(), mesh.positions[v].y(), mesh.positions[v].z()}, v);
-        std::vector<std::array<double, 3>> phi;
-        phi.reserve(surface.points.size());
-        for (const Eigen::Vector3d& p : surface.points) {
-            const auto it = index.find(Key{p.x(), p.y(), p.z()});
-            if (it == index.end())
-                throw AlgorithmError(options.surface.string() + ": the mesher moved an input vertex; cannot compare");
-            phi.push_back(scene.diffusion.phi[it->second]);
-        }
-        if (point) {
-            point->tets = mesh.tet_count();
-            point->tet_size_mm = tet_size_mm(mesh, options.mm_per_unit);
-            point->solve_ms = scene.diffusion.assembly_ms + scene.diffusion.solve_ms;
-        }
-        return phi;
-    };
-
-    const auto reference = solve_at_surface(options.reference_size_factor, nullptr);
+    const std::string name = options.surface.string();
+    const SurfaceSolve reference =
+        solve_at_input_vertices(surface, name, material, options.mm_per_unit, options.reference_size_factor);
     ConvergenceSeries series;
     series.name = options.surface.stem().string() + " (" + options.material + ", " +
                   std::to_string(static_cast<int>(std::lround(options.mm_per_unit))) + " mm per unit)";
     for (double factor : options.size_factors) {
-        ConvergencePoint point;
-        const auto phi = solve_at_surface(factor, &point);
-        double error = 0, norm = 0;
-        for (size_t v = 0; v < phi.size(); ++v)
-            for (int c = 0; c < 3; ++c) {
-                error += (phi[v][c] - reference[v][c]) * (phi[v][c] - reference[v][c]);
-                norm += reference[v][c] * reference[v][c];
-            }
-        point.relative_error = std::sqrt(error / norm);
-        series.points.push_back(point);
+        const SurfaceSolve solve = solve_at_input_vertices(surface, name, material, options.mm_per_unit, factor);
+        series.points.push_back({solve.tets, solve.tet_size_mm, relative_l2_error(solve.phi, reference.phi),
+                                 solve.setup_ms + solve.solve_ms});
     }
     return series;
 }

@@ -4,10 +4,14 @@
 #pragma once
 
 #include "bench/studies/stability_study.h"
+#include "solver/methods/alternative_method.h"
+#include "tetops/triangle_surface.h"
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -67,6 +71,24 @@ struct SurfaceConvergenceOptions {
     std::vector<double> size_factors = {3.0, 2.0, 1.5, 1.0};  // x the default mesh size
     double reference_size_factor = 0.5;
 };
+
+// One solve of a surface meshed by TetGen at size_factor x its default size, lit by the default key
+// light (tolerance 1e-8, or the alternative method's own), with phi read at the input surface's
+// vertices, which every TetGen mesh of the surface keeps exactly, so that meshes of any size compare.
+struct SurfaceSolve {
+    std::vector<std::array<double, 3>> phi;  // per input surface vertex
+    size_t tets = 0, vertices = 0;
+    double tet_size_mm = 0;
+    double setup_ms = 0, solve_ms = 0;       // assembly (or the method's setup) and solve
+    std::optional<MethodSolution> alternative;  // with an alternative method: its statistics (phi moved out)
+};
+// Throws AlgorithmError naming `surface_name` if the mesher moved an input vertex.
+SurfaceSolve solve_at_input_vertices(const TriangleSurface& surface, const std::string& surface_name,
+                                     const TetMaterial& material, double mm_per_unit, double size_factor,
+                                     const AlternativeMethodSettings* alternative = nullptr);
+
+// sqrt(sum |phi - reference|^2 / sum |reference|^2) over every vertex and channel.
+double relative_l2_error(const std::vector<std::array<double, 3>>& phi, const std::vector<std::array<double, 3>>& reference);
 
 // phi on the input surface's vertices (which every TetGen mesh of the surface keeps exactly) against
 // the reference mesh's, default key light, tolerance 1e-8. One series: "NAME (MATERIAL, xSCALE mm)".

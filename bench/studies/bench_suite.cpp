@@ -5,6 +5,7 @@
 #include "bench/studies/coarse_start_bound.h"
 #include "bench/studies/cut_study.h"
 #include "bench/studies/environment_study.h"
+#include "bench/studies/method_study.h"
 #include "bench/studies/transport_study.h"
 #include "bench/studies/provenance.h"
 #include "bench/studies/resolution_study.h"
@@ -549,6 +550,68 @@ void run_stability_part(const BenchSuiteOptions& o, Json& index, RunProvenance& 
     index["stability"] = "stability.md";
 }
 
+// The seeds' methods beside TransCut's solvers: error against time on the ball and on spot.
+void run_methods_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
+    MethodStudyOptions options;
+    options.quick = o.quick;
+    options.surface = o.asset_dir / "meshes/spot.obj";
+    options.progress = o.progress;
+    const std::vector<MethodSeries> series = study_methods(options);
+    const Json inputs = {
+        {"ball", "icosphere of radius 10 mm meshed by TetGen (three to four sizes); mu_a 0.01, mu_s' 1 per mm, eta 1.3; "
+                 "grid methods at the voxel size giving as many voxels as the mesh has vertices"},
+        {"surface", {{"mesh_file", options.surface.string()},
+                     {"mesh_sha256", file_sha256(options.surface)},
+                     {"material", "marble"},
+                     {"mm_per_unit", o.quick ? 3.0 : 30.0},
+                     {"reference", "TransCut (Jacobi CG to 1e-8) on a TetGen mesh of 0.5 x the default size (quick: 0.7)"},
+                     {"lighting", lighting_to_json(key_light_only())}}}};
+    const Json definitions = {
+        {"ball_error", "relative L2 error of phi (channel 0, weighted by TransCut's lumped vertex volume) at the mesh "
+                       "vertices against the analytic series (60 Legendre terms for the directional light)"},
+        {"surface_error", "relative L2 error of phi at the input surface's vertices, three channels, against the "
+                          "reference"},
+        {"setup_ms", "grid, graph, profile or hierarchy construction and assembly; one run, wall clock"},
+        {"solve_ms", "iterations (or the direct evaluation) for three channels to relative tolerance 1e-6; one run"},
+        {"resolution_mm", "mean tet size (volume / tets)^(1/3), or the voxel size of fd and lbm"},
+        {"observed_order", "least-squares slope of log(error) against log(resolution_mm) (accuracy.json's fit)"}};
+    write_json(o.output_dir / "methods.json",
+               with_provenance(provenance, inputs, definitions, {{"series", to_json(series)}}));
+    write_text(o.output_dir / "methods.md", "### " + titled(o, "The seeds' methods beside TransCut") +
+                                                "\n\nFinest run of each series; one run each, wall clock.\n\n" +
+                                                method_table_markdown(series));
+    auto chart = [&](const std::string& scene, const std::string& title, const std::filesystem::path& path) {
+        std::vector<ChartSeries> lines;
+        for (const MethodSeries& s : series) {
+            if (s.scene != scene) continue;
+            ChartSeries line;
+            line.name = s.method;
+            if (s.runs.size() > 1) {
+                const OrderFit fit = s.fit_order();
+                char name[160];
+                std::snprintf(name, sizeof name, "%s (order %.2f%s)", s.method.c_str(), fit.order,
+                              fit.reliable ? "" : ", unreliable");
+                line.name = name;
+            }
+            for (const MethodRun& r : s.runs)
+                if (std::isfinite(r.relative_error) && r.relative_error > 0)
+                    line.points.emplace_back(r.setup_ms + r.solve_ms, r.relative_error);
+            if (!line.points.empty()) lines.push_back(std::move(line));
+        }
+        ChartOptions chart_options;
+        chart_options.title = titled(o, title);
+        chart_options.x = {"setup + solve, three channels (ms)", AxisScale::Log};
+        chart_options.y = {"relative L2 error of phi", AxisScale::Log};
+        chart_options.caption = provenance.caption();
+        write_svg_chart(path, lines, chart_options);
+    };
+    chart("ball directional", "Error against time: ball (R = 10 mm), directional light", o.output_dir / "methods.svg");
+    chart("ball uniform", "Error against time: ball (R = 10 mm), uniform light", o.output_dir / "methods_uniform.svg");
+    chart("spot", "Error against time: spot (marble), against TransCut at half the tet size",
+          o.output_dir / "methods_spot.svg");
+    index["methods"] = "methods.json";
+}
+
 void run_resolution_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
     ResolutionStudyOptions options;
     options.surface = o.asset_dir / "meshes/spot.obj";
@@ -634,6 +697,7 @@ void run_bench_suite(const BenchSuiteOptions& o) {
     parts.emplace_back("environment", [&](Json& i, RunProvenance& p) { run_environment_part(o, i, p); });
     parts.emplace_back("table1", [&](Json& i, RunProvenance& p) { run_table1_part(o, i, p); });
     parts.emplace_back("stability", [&](Json& i, RunProvenance& p) { run_stability_part(o, i, p); });
+    parts.emplace_back("methods", [&](Json& i, RunProvenance& p) { run_methods_part(o, i, p); });
     parts.emplace_back("resolution", [&](Json& i, RunProvenance& p) { run_resolution_part(o, i, p); });
     parts.emplace_back("diffusion_vs_transport", [&](Json& i, RunProvenance& p) { run_transport_part(o, i, p); });
 

@@ -10,6 +10,9 @@
 //                         cross-section distance and dihedral angles of remove+relax and exact cuts
 //   table1.json/.md       T_b, T_m, T_s, cut and paint per shipped model beside the paper's Table 1
 //   stability.json/.md    where the methods fail and what Waxwork does (bench/studies/stability_study.h)
+//   methods.json/.md, methods.svg, methods_uniform.svg, methods_spot.svg
+//                         the seeds' methods (fd, fvm, lbm, dipole) beside TransCut's solvers: error against
+//                         setup + solve time on the ball and on spot (bench/studies/method_study.h)
 //   resolution.json/.svg  image error against per-frame cost over mesh size x tolerance
 //   diffusion_vs_transport.json/.md, diffusion_vs_transport_{thickness,albedo,time}.svg
 //                         the live image against the Monte Carlo image (bench/studies/transport_study.h)
@@ -35,7 +38,7 @@ struct BenchSuiteOptions {
     std::filesystem::path asset_dir;                    // holds meshes/spot.obj, torus.obj, skull.obj
     std::function<void(const std::string&)> progress;   // one line per part started; may be empty
     // Run only these parts (names as in bench.json: solvers_50k, solvers_500k, coarse_start, accuracy, cut_modes, environment, table1,
-    // stability, resolution, diffusion_vs_transport); empty: all. An unknown name is an InvalidArgumentError.
+    // stability, methods, resolution, diffusion_vs_transport); empty: all. An unknown name is an InvalidArgumentError.
     std::vector<std::string> only;
     // Timing statistic: 0 keeps each part's own (the solver comparison's fastest of 3 short runs, Table 1's
     // median of 3); N >= 1 makes the solver comparison and Table 1 report the median of N runs (with the
