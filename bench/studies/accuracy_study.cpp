@@ -267,6 +267,7 @@ SurfaceSolve solve_at_input_vertices(const TriangleSurface& surface, const std::
     solve.tet_size_mm = tet_size_mm(mesh, mm_per_unit);
     solve.setup_ms = scene.diffusion.assembly_ms;
     solve.solve_ms = scene.diffusion.solve_ms;
+    solve.iterations = scene.diffusion.iterations[0];
     solve.alternative = std::move(scene.alternative);
     return solve;
 }

@@ -80,6 +80,7 @@ struct SurfaceSolve {
     size_t tets = 0, vertices = 0;
     double tet_size_mm = 0;
     double setup_ms = 0, solve_ms = 0;       // assembly (or the method's setup) and solve
+    int iterations = 0;                      // channel 0
     std::optional<MethodSolution> alternative;  // with an alternative method: its statistics (phi moved out)
 };
 // Throws AlgorithmError naming `surface_name` if the mesher moved an input vertex.

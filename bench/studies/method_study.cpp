@@ -185,10 +185,8 @@ void run_surface(const MethodStudyOptions& options, std::vector<MethodSeries>& a
             run.resolution_mm = solve.tet_size_mm;
             run.setup_ms = solve.setup_ms;
             run.solve_ms = solve.solve_ms;
-            if (solve.alternative) {
-                run.iterations = solve.alternative->iterations[0];
-                run.warnings = solve.alternative->warnings;
-            }
+            run.iterations = solve.iterations;
+            if (solve.alternative) run.warnings = solve.alternative->warnings;
             run.relative_error = relative_l2_error(solve.phi, reference.phi);
         } catch (const InvalidArgumentError& e) {
             run.warnings.push_back(std::string("did not run: ") + e.what());

@@ -181,6 +181,64 @@ TEST_F(Render, FemAgreesWithTransCut) {
     }
 }
 
+// The seeds' methods solve the same light as TransCut (docs/methods.md): on the cube in marble at
+// 10 mm per unit every one of them writes the same --fields columns, lights the same side, and comes
+// within its own accuracy of TransCut's fluence at the boundary, which is what the image shows. The
+// dipole is a semi-infinite approximation, so its bound is the loosest.
+TEST_F(Render, SeedsMethodsWriteTheSameFieldsAndAgreeWithTransCut) {
+    const std::string common = volume_.string() + " --material marble --light dir:-1,-0.5,-0.2 --scale 10 "
+                                                  "--width 64 --height 48";
+    const auto t = run_waxwork("render " + common + " --tol 1e-6 -o " + (dir_ / "tm.png").string() + " --fields " +
+                               (dir_ / "tm.csv").string());
+    ASSERT_EQ(t.exit_code, 0) << t.err;
+    const Fields reference = read_fields(dir_ / "tm.csv");
+    for (const auto& [method, bound] : std::vector<std::pair<std::string, double>>{
+             {"fd", 0.15}, {"fd-cg", 0.15}, {"fvm", 0.1}, {"fvm-cg", 0.1}, {"lbm", 0.15}, {"dipole", 0.4}}) {
+        const fs::path csv = dir_ / ("m_" + method + ".csv");
+        const auto r = run_waxwork("render " + common + " --method " + method + " -o " +
+                                   (dir_ / ("m_" + method + ".png")).string() + " --fields " + csv.string());
+        ASSERT_EQ(r.exit_code, 0) << method << ": " << r.err;
+        const nlohmann::json summary = nlohmann::json::parse(r.out);
+        EXPECT_EQ(summary["method"], method);
+        EXPECT_GT(summary["alternative"]["unknowns"].get<size_t>(), 0u) << method;
+        EXPECT_FALSE(summary.contains("estimated_error")) << method;
+        const Fields f = read_fields(csv);
+        ASSERT_EQ(f.rows.size(), reference.rows.size()) << method;
+        double diff = 0, norm = 0;
+        for (size_t v = 0; v < f.rows.size(); ++v) {
+            if (!f.rows[v].boundary) continue;
+            for (int c = 0; c < 3; ++c) {
+                ASSERT_TRUE(std::isfinite(f.rows[v].phi[c])) << method;
+                diff += std::abs(f.rows[v].phi[c] - reference.rows[v].phi[c]);
+                norm += std::abs(reference.rows[v].phi[c]);
+            }
+        }
+        EXPECT_LT(diff / norm, bound) << method;
+        // The light comes from -x: that side is brighter for every method.
+        EXPECT_GT(mean_lo_near(f, 0, false)[0], 2 * mean_lo_near(f, 0, true)[0]) << method;
+    }
+}
+
+TEST_F(Render, SeedsMethodsBadOptionsAreOneLineErrors) {
+    const std::string base = "render " + volume_.string() + " -o " + (dir_ / "mbad.png").string() +
+                             " --width 32 --height 24 ";
+    for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+             {"--method quadgraph", "--method: quadgraph not in"},
+             {"--method fvm --cell 1", "--cell applies only to the grid methods"},
+             {"--cell 1", "--cell applies only to the grid methods"},
+             {"--method fd --cell 0", "--cell must be a voxel size in mm"},
+             {"--method lbm --cell nan", "--cell must be a voxel size in mm"},
+             {"--method fd --cell -2", "--cell must be a voxel size in mm"},
+             {"--method dipole --backend gpu", "--method dipole runs on the CPU"},
+             {"--method fd --tol 2", "--tol must be a relative tolerance"}}) {
+        const auto r = run_waxwork(base + args);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_EQ(line_count(r.err), 1u) << args << ": " << r.err;
+        EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir_ / "mbad.png"));
+}
+
 TEST_F(Render, MonteCarloWritesPhiWithStandardErrors) {
     // A 4 mm cube of marble (2 model units at 2 mm per unit) traced to 5% relative standard error at the
     // boundary: the fields gain the standard errors, the seed makes the run repeatable, and the traced
