@@ -62,7 +62,7 @@ int relax(const FvmSystem& s, int channel, std::span<const double> b, std::span<
           const MethodProblem& problem, double* final_estimate) {
     const size_t n = s.diagonal.size();
     const std::vector<double>& m = s.values[channel];
-    std::vector<double> next(n, 0.0);
+    std::vector<double> current(n, 0.0), next(n, 0.0);
     std::fill(phi.begin(), phi.end(), 0.0);
     double previous_step = 0, start_step = 0;
     for (int iteration = 1; iteration <= options.max_iterations; ++iteration) {
@@ -77,16 +77,16 @@ int relax(const FvmSystem& s, int channel, std::span<const double> b, std::span<
                     double sum = b[i];
                     const int32_t d = s.diagonal[i];
                     for (int32_t k = s.offsets[i]; k < s.offsets[i + 1]; ++k)
-                        if (k != d) sum -= m[k] * phi[s.columns[k]];
+                        if (k != d) sum -= m[k] * current[s.columns[k]];
                     next[i] = sum / m[d];
-                    const double step = next[i] - phi[i];
+                    const double step = next[i] - current[i];
                     acc.step2 += m[d] * step * step;
                     acc.phi2 += m[d] * next[i] * next[i];
                 }
                 return acc;
             },
             [](Norms a, Norms c) { return Norms{a.step2 + c.step2, a.phi2 + c.phi2}; });
-        std::copy(next.begin(), next.end(), phi.begin());
+        current.swap(next);
         const double step = std::sqrt(norms.step2);
         if (!std::isfinite(step) || (iteration > 1 && step > 1e6 * start_step))
             throw AlgorithmError("fvm: relaxation diverged after " + std::to_string(iteration) +
@@ -95,6 +95,7 @@ int relax(const FvmSystem& s, int channel, std::span<const double> b, std::span<
         if (iteration == 1) start_step = step;
         if (norms.phi2 == 0) {  // no light reaches this channel
             *final_estimate = 0;
+            std::copy(current.begin(), current.end(), phi.begin());
             return iteration;
         }
         // A contraction with ratio rho leaves an error of at most step rho / (1 - rho).
@@ -105,8 +106,12 @@ int relax(const FvmSystem& s, int channel, std::span<const double> b, std::span<
         if (problem.progress && iteration % 64 == 0 && std::isfinite(estimate))
             problem.progress->set_fraction(static_cast<float>(
                 (channel + std::clamp(std::log(estimate) / std::log(options.relative_tolerance), 0.0, 1.0)) / 3.0));
-        if (iteration >= 3 && estimate <= options.relative_tolerance) return iteration;
+        if (iteration >= 3 && estimate <= options.relative_tolerance) {
+            std::copy(current.begin(), current.end(), phi.begin());
+            return iteration;
+        }
     }
+    std::copy(current.begin(), current.end(), phi.begin());
     return options.max_iterations;
 }
 

@@ -2,6 +2,8 @@
 // weights, accuracy on the exact ball, relaxation against CG, and the non-Delaunay failure case.
 #include "base/error.h"
 #include "base/progress.h"
+#include "io/surface_reader.h"
+#include "solver/diffusion_solve.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/material.h"
 #include "solver/methods/fvm.h"
@@ -9,13 +11,14 @@
 #include "solver/reference/analytic_ball.h"
 #include "solver_test_meshes.h"
 #include "tetops/delaunay_check.h"
-#include "tetops/sliver_maker.h"
+#include "tetops/tetrahedralize.h"
 
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <numbers>
 #include <random>
 #include <set>
@@ -270,8 +273,9 @@ struct BallRun {
 };
 
 BallRun run_ball(const Ball& ball, Light light, FvmSolver solver,
-                 NegativeDualCoefficients negative = NegativeDualCoefficients::Clamp) {
+                 NegativeDualCoefficients negative = NegativeDualCoefficients::Clamp, int max_iterations = 200000) {
     FvmOptions options;
+    options.max_iterations = max_iterations;
     options.solver = solver;
     options.negative_coefficients = negative;
     MethodSolution s = solve_fvm(ball.problem(), options);
@@ -472,6 +476,11 @@ TEST(FvmMethod, DISABLED_PrintBallTable) {
                             solver == FvmSolver::Cg ? "CG" : "relaxation", r.setup_ms, r.solve_ms, r.iterations,
                             100 * r.error);
             }
+            // The paper's fixed 30 relaxation sweeps per frame (Table 1), from zero.
+            const BallRun paper = run_ball(ball, light, FvmSolver::Relaxation, NegativeDualCoefficients::Clamp, 30);
+            std::printf("| %zu | %zu | %s | relaxation, 30 sweeps (paper) | %.1f | %.1f | %d | %.3f%% |\n", paper.tets,
+                        paper.unknowns, light == Light::Uniform ? "uniform" : "directional", paper.setup_ms, paper.solve_ms,
+                        paper.iterations, 100 * paper.error);
             DiffusionOptions tc_options;
             tc_options.relative_tolerance = 1e-6;
             const BallComparison tc = compare_with_analytic_ball(
@@ -514,6 +523,47 @@ TEST(FvmMethod, DISABLED_PrintStabilityTable) {
                     moved, st.non_delaunay_faces, st.interior_faces, st.negative_edges, st.edges, st.negative_boundary_edges,
                     st.negative_cells, keep.c_str(), 100 * clamp.error, 100 * fallback.error, 100 * tc);
     }
+}
+
+// Setup and solve cost on spot (50K tets, TetGen, 50 mm long, marble, uniform light), with the
+// relative L2 difference from TransCut's phi (print only).
+TEST(FvmMethod, DISABLED_PrintSpotCost) {
+    MeshingOptions meshing;
+    meshing.sizing.target_tets = 50'000;
+    const TetMesh mesh =
+        tetrahedralize(load_closed_surface(std::filesystem::path(WAXWORK_ASSET_DIR "/meshes/spot.obj")).surface, meshing).mesh;
+    const TetConnectivity conn = build_connectivity(mesh);
+    Eigen::AlignedBox3d box;
+    for (const auto& p : mesh.positions) box.extend(p);
+    const double mm_per_unit = 50.0 / box.sizes().maxCoeff();
+    const std::vector<TetMaterial> materials(mesh.tet_count(), material_preset("marble"));
+    std::vector<std::array<double, 3>> q(mesh.vertex_count(), {0, 0, 0});
+    for (int32_t v : conn.boundary_vertices) q[v] = {1, 1, 1};
+    DiffusionOptions tc_options;
+    tc_options.relative_tolerance = 1e-6;
+    tc_options.mm_per_unit = mm_per_unit;
+    const DiffusionSolution tc = solve_diffusion(mesh, conn, materials, q, tc_options);
+    const std::vector<double> volumes = lumped_vertex_volumes(
+        assemble_diffusion_matrix(mesh, conn, materials, AssemblyOptions{Discretization::TransCut, StiffnessForm::Gradient, mm_per_unit}),
+        conn);
+    std::printf("| spot | tets | unknowns | solver | setup ms | solve ms | iterations (r) | difference from TransCut |\n");
+    std::printf("|---|---:|---:|---|---:|---:|---:|---:|\n");
+    for (FvmSolver solver : {FvmSolver::Relaxation, FvmSolver::Cg}) {
+        FvmOptions options;
+        options.solver = solver;
+        const MethodSolution s = solve_fvm(MethodProblem{mesh, conn, materials, q, mm_per_unit}, options);
+        double difference = 0, norm = 0;
+        for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+            difference += volumes[v] * std::pow(s.phi[v][0] - tc.phi[v][0], 2);
+            norm += volumes[v] * tc.phi[v][0] * tc.phi[v][0];
+        }
+        std::printf("| spot | %zu | %zu | %s | %.1f | %.1f | %d | %.3f%% |\n", mesh.tet_count(), s.unknowns,
+                    solver == FvmSolver::Cg ? "CG" : "relaxation", s.setup_ms, s.solve_ms, s.iterations[0],
+                    100 * std::sqrt(difference / norm));
+        for (const auto& w : s.warnings) std::printf("warning: %s\n", w.c_str());
+    }
+    std::printf("| spot | %zu | %zu | TransCut (solve_diffusion) | %.1f | %.1f | %d | 0 |\n", mesh.tet_count(),
+                mesh.vertex_count(), tc.assembly_ms, tc.solve_ms, tc.iterations[0]);
 }
 
 }  // namespace
