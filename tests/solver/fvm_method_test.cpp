@@ -31,20 +31,18 @@ constexpr double kRadius = 10.0;  // mm
 constexpr double kMua = 0.01, kMusp = 1.0, kEta = 1.3;
 constexpr int kLegendreTerms = 60;
 
-enum class Light { Uniform, Directional };
-
 struct Ball {
     TetMesh mesh;
     TetConnectivity conn;
     std::vector<TetMaterial> materials;
     std::vector<std::array<double, 3>> q;
-    Ball(int level, size_t tets) : mesh(test::make_ball_mesh(level, tets, kRadius)) { rebuild(Light::Uniform); }
-    void rebuild(Light light) {
+    Ball(int level, size_t tets) : mesh(test::make_ball_mesh(level, tets, kRadius)) { rebuild(BallLight::Uniform); }
+    void rebuild(BallLight light) {
         conn = build_connectivity(mesh);
         materials.assign(mesh.tet_count(), TetMaterial{{kMua, kMua, kMua}, {kMusp, kMusp, kMusp}, kEta});
         q.assign(mesh.vertex_count(), {0, 0, 0});
         for (int32_t v : conn.boundary_vertices) {
-            const double value = light == Light::Uniform ? 1.0 : directional_ball_light(mesh.positions[v], kEta);
+            const double value = light == BallLight::Uniform ? 1.0 : directional_ball_light(mesh.positions[v], kEta);
             q[v] = {value, value, value};
         }
     }
@@ -53,9 +51,9 @@ struct Ball {
 
 // Relative L2 error of phi (channel 0) against the exact series, weighted by lumped vertex volume (as
 // compare_with_analytic_ball weighs TransCut's).
-double ball_error(const Ball& ball, const MethodSolution& solution, Light light) {
+double ball_error(const Ball& ball, const MethodSolution& solution, BallLight light) {
     const AnalyticBall exact(kRadius, kMua, kMusp, kEta,
-                             light == Light::Uniform ? std::vector<double>{1.0}
+                             light == BallLight::Uniform ? std::vector<double>{1.0}
                                                      : directional_ball_light_coefficients(kLegendreTerms, kEta));
     const std::vector<double> volumes =
         lumped_vertex_volumes(assemble_diffusion_matrix(ball.mesh, ball.conn, ball.materials), ball.conn);
@@ -251,7 +249,7 @@ TEST(FvmMethod, UniformLightWithoutAbsorptionIsExactOnAnyMesh) {
     // the Robin term balances the source), whatever the dual's signs: also on a mesh of slivers.
     Ball ball(2, 2000);
     ASSERT_GT(push_into_slivers(ball.mesh, 6, 1e-2), 0);
-    ball.rebuild(Light::Uniform);
+    ball.rebuild(BallLight::Uniform);
     ball.materials.assign(ball.mesh.tet_count(), material_preset("spectralon"));
     const double expected = 4.0 / (1.0 - diffuse_fresnel_reflectance(ball.materials[0].eta));
     for (FvmSolver solver : {FvmSolver::Relaxation, FvmSolver::Cg}) {
@@ -272,7 +270,7 @@ struct BallRun {
     std::vector<std::array<double, 3>> phi;
 };
 
-BallRun run_ball(const Ball& ball, Light light, FvmSolver solver,
+BallRun run_ball(const Ball& ball, BallLight light, FvmSolver solver,
                  NegativeDualCoefficients negative = NegativeDualCoefficients::Clamp, int max_iterations = 200000) {
     FvmOptions options;
     options.max_iterations = max_iterations;
@@ -301,12 +299,12 @@ TEST(FvmMethod, BallErrorBounds) {
     };
     for (const Case& c : {Case{2, 2000, 0.008, 0.012}, Case{3, 16000, 0.003, 0.004}}) {
         Ball ball(c.level, c.tets);
-        for (Light light : {Light::Uniform, Light::Directional}) {
+        for (BallLight light : {BallLight::Uniform, BallLight::Directional}) {
             ball.rebuild(light);
             const BallRun r = run_ball(ball, light, FvmSolver::Cg);
-            std::printf("%zu tets, %s light: error %.4f%%\n", r.tets, light == Light::Uniform ? "uniform" : "directional",
+            std::printf("%zu tets, %s light: error %.4f%%\n", r.tets, light == BallLight::Uniform ? "uniform" : "directional",
                         100 * r.error);
-            EXPECT_LT(r.error, light == Light::Uniform ? c.uniform_bound : c.directional_bound);
+            EXPECT_LT(r.error, light == BallLight::Uniform ? c.uniform_bound : c.directional_bound);
         }
     }
 }
@@ -319,23 +317,23 @@ TEST(FvmMethod, ErrorFallsWithResolution) {
     std::array<std::vector<BallRun>, 2> by_light;
     for (auto [level, tets] : levels) {
         Ball ball(level, tets);
-        for (Light light : {Light::Uniform, Light::Directional}) {
+        for (BallLight light : {BallLight::Uniform, BallLight::Directional}) {
             ball.rebuild(light);
-            by_light[static_cast<int>(light)].push_back(run_ball(ball, light, FvmSolver::Cg));
+            by_light[static_cast<size_t>(light)].push_back(run_ball(ball, light, FvmSolver::Cg));
         }
     }
-    for (Light light : {Light::Uniform, Light::Directional}) {
-        const std::vector<BallRun>& runs = by_light[static_cast<int>(light)];
+    for (BallLight light : {BallLight::Uniform, BallLight::Directional}) {
+        const std::vector<BallRun>& runs = by_light[static_cast<size_t>(light)];
         for (size_t k = 1; k < runs.size(); ++k) EXPECT_LT(runs[k].error, runs[k - 1].error);
         const double order = std::log(runs.front().error / runs.back().error) / std::log(runs.front().h / runs.back().h);
-        std::printf("%s light: observed order %.2f\n", light == Light::Uniform ? "uniform" : "directional", order);
+        std::printf("%s light: observed order %.2f\n", light == BallLight::Uniform ? "uniform" : "directional", order);
         EXPECT_GT(order, 1.0);
     }
 }
 
 TEST(FvmMethod, RelaxationAndCgSolveTheSameSystem) {
     Ball ball(2, 2000);
-    ball.rebuild(Light::Directional);
+    ball.rebuild(BallLight::Directional);
     FvmOptions options;
     options.relative_tolerance = 1e-9;
     const MethodSolution relaxed = solve_fvm(ball.problem(), options);
@@ -356,7 +354,7 @@ TEST(FvmMethod, TetGenBallIsNearlyDelaunay) {
     // TetGen's ball: a handful of interior faces fail the exact in-sphere test, and a few of their edges
     // get a negative coefficient, which the default clamps and reports.
     Ball ball(3, 16000);
-    ball.rebuild(Light::Uniform);
+    ball.rebuild(BallLight::Uniform);
     const FvmSystem fvm = assemble_fvm_system(ball.problem(), NegativeDualCoefficients::Clamp);
     const FvmDualStatistics& st = fvm.statistics;
     std::printf("TetGen ball: %zu of %zu interior faces not Delaunay, %zu of %zu coefficients negative\n",
@@ -377,11 +375,11 @@ TEST(FvmMethod, NonDelaunayMeshIsClampedAndReported) {
     // The failure case, built on purpose: interior vertices pushed towards a face of their star (slivers
     // of relative height 0.1) make hundreds of faces non-Delaunay.
     Ball clean(3, 16000);
-    clean.rebuild(Light::Directional);
-    const double clean_error = run_ball(clean, Light::Directional, FvmSolver::Cg).error;
+    clean.rebuild(BallLight::Directional);
+    const double clean_error = run_ball(clean, BallLight::Directional, FvmSolver::Cg).error;
     Ball ball(3, 16000);
     ASSERT_GT(push_into_slivers(ball.mesh, 60, 0.1), 20);
-    ball.rebuild(Light::Directional);
+    ball.rebuild(BallLight::Directional);
 
     const FvmSystem kept = assemble_fvm_system(ball.problem(), NegativeDualCoefficients::Keep);
     const FvmDualStatistics& st = kept.statistics;
@@ -399,7 +397,7 @@ TEST(FvmMethod, NonDelaunayMeshIsClampedAndReported) {
     // Clamp (the default): converges with both solvers, phi stays positive, the warning gives the count
     // and fraction, and the error grows with the clamped consistency error (0.28% -> 1.6% measured).
     for (FvmSolver solver : {FvmSolver::Relaxation, FvmSolver::Cg}) {
-        const BallRun r = run_ball(ball, Light::Directional, solver);
+        const BallRun r = run_ball(ball, BallLight::Directional, solver);
         ASSERT_FALSE(r.warnings.empty());
         EXPECT_NE(r.warnings[0].find(std::to_string(st.negative_edges) + " of " + std::to_string(st.edges)), std::string::npos)
             << r.warnings[0];
@@ -409,14 +407,14 @@ TEST(FvmMethod, NonDelaunayMeshIsClampedAndReported) {
         EXPECT_LT(r.error, 0.03);
     }
     // The cotangent fallback also converges, but measured worse than clamping (2.6%).
-    const BallRun fallback = run_ball(ball, Light::Directional, FvmSolver::Cg, NegativeDualCoefficients::CotangentFallback);
+    const BallRun fallback = run_ball(ball, BallLight::Directional, FvmSolver::Cg, NegativeDualCoefficients::CotangentFallback);
     for (const auto& p : fallback.phi) EXPECT_GT(p[0], 0.0);
     EXPECT_LT(fallback.error, 0.04);
 }
 
 TEST(FvmMethod, RejectsBadOptionsAndInput) {
     Ball ball(2, 2000);
-    ball.rebuild(Light::Uniform);
+    ball.rebuild(BallLight::Uniform);
     const auto expect_rejected = [&](const MethodProblem& problem, const FvmOptions& options) {
         try {
             solve_fvm(problem, options);
@@ -447,7 +445,7 @@ TEST(FvmMethod, RejectsBadOptionsAndInput) {
 
 TEST(FvmMethod, CancelsBetweenIterations) {
     Ball ball(2, 2000);
-    ball.rebuild(Light::Uniform);
+    ball.rebuild(BallLight::Uniform);
     for (FvmSolver solver : {FvmSolver::Relaxation, FvmSolver::Cg}) {
         Progress progress;
         progress.request_cancel();
@@ -467,27 +465,27 @@ TEST(FvmMethod, DISABLED_PrintBallTable) {
     std::printf("|---:|---:|---|---|---:|---:|---:|---:|\n");
     for (auto [level, tets] : {std::pair{2, 2000}, std::pair{3, 16000}, std::pair{4, 128000}}) {
         Ball ball(level, tets);
-        for (Light light : {Light::Uniform, Light::Directional}) {
+        for (BallLight light : {BallLight::Uniform, BallLight::Directional}) {
             ball.rebuild(light);
             for (FvmSolver solver : {FvmSolver::Relaxation, FvmSolver::Cg}) {
                 const BallRun r = run_ball(ball, light, solver);
                 std::printf("| %zu | %zu | %s | %s | %.1f | %.1f | %d | %.3f%% |\n", r.tets, r.unknowns,
-                            light == Light::Uniform ? "uniform" : "directional",
+                            light == BallLight::Uniform ? "uniform" : "directional",
                             solver == FvmSolver::Cg ? "CG" : "relaxation", r.setup_ms, r.solve_ms, r.iterations,
                             100 * r.error);
             }
             // The paper's fixed 30 relaxation sweeps per frame (Table 1), from zero.
             const BallRun paper = run_ball(ball, light, FvmSolver::Relaxation, NegativeDualCoefficients::Clamp, 30);
             std::printf("| %zu | %zu | %s | relaxation, 30 sweeps (paper) | %.1f | %.1f | %d | %.3f%% |\n", paper.tets,
-                        paper.unknowns, light == Light::Uniform ? "uniform" : "directional", paper.setup_ms, paper.solve_ms,
+                        paper.unknowns, light == BallLight::Uniform ? "uniform" : "directional", paper.setup_ms, paper.solve_ms,
                         paper.iterations, 100 * paper.error);
             DiffusionOptions tc_options;
             tc_options.relative_tolerance = 1e-6;
             const BallComparison tc = compare_with_analytic_ball(
                 ball.mesh, ball.conn, ball.materials[0], kRadius,
-                light == Light::Uniform ? BallLight::Uniform : BallLight::Directional, tc_options);
+                light == BallLight::Uniform ? BallLight::Uniform : BallLight::Directional, tc_options);
             std::printf("| %zu | %zu | %s | TransCut (solve_diffusion) | %.1f | %.1f | %d | %.3f%% |\n", ball.mesh.tet_count(),
-                        ball.mesh.vertex_count(), light == Light::Uniform ? "uniform" : "directional",
+                        ball.mesh.vertex_count(), light == BallLight::Uniform ? "uniform" : "directional",
                         tc.solution.assembly_ms, tc.solution.solve_ms, tc.solution.iterations[0], 100 * tc.relative_error);
         }
     }
@@ -500,12 +498,12 @@ TEST(FvmMethod, DISABLED_PrintStabilityTable) {
     for (double flatness : {1.0, 0.3, 0.1, 1e-2, 1e-3}) {
         Ball ball(3, 16000);
         const int moved = flatness < 1 ? push_into_slivers(ball.mesh, 60, flatness) : 0;
-        ball.rebuild(Light::Directional);
+        ball.rebuild(BallLight::Directional);
         const FvmDualStatistics st = assemble_fvm_system(ball.problem(), NegativeDualCoefficients::Keep).statistics;
         std::string keep;
         for (FvmSolver solver : {FvmSolver::Relaxation, FvmSolver::Cg}) {
             try {
-                const BallRun r = run_ball(ball, Light::Directional, solver, NegativeDualCoefficients::Keep);
+                const BallRun r = run_ball(ball, BallLight::Directional, solver, NegativeDualCoefficients::Keep);
                 char text[64];
                 std::snprintf(text, sizeof text, "%s %.3f%%; ", solver == FvmSolver::Cg ? "CG" : "relaxation", 100 * r.error);
                 keep += text;
@@ -513,8 +511,8 @@ TEST(FvmMethod, DISABLED_PrintStabilityTable) {
                 keep += solver == FvmSolver::Cg ? "CG fails; " : "relaxation diverges; ";
             }
         }
-        const BallRun clamp = run_ball(ball, Light::Directional, FvmSolver::Cg);
-        const BallRun fallback = run_ball(ball, Light::Directional, FvmSolver::Cg, NegativeDualCoefficients::CotangentFallback);
+        const BallRun clamp = run_ball(ball, BallLight::Directional, FvmSolver::Cg);
+        const BallRun fallback = run_ball(ball, BallLight::Directional, FvmSolver::Cg, NegativeDualCoefficients::CotangentFallback);
         DiffusionOptions tc_options;
         tc_options.relative_tolerance = 1e-7;
         const double tc = compare_with_analytic_ball(ball.mesh, ball.conn, ball.materials[0], kRadius,
