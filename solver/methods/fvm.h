@@ -29,8 +29,8 @@
 // Relation to TransCut (solver/diffusion_matrix.h). In 2D the circumcentric dual coefficient equals the
 // cotangent weight. In 3D it does not, not even per well-centred tet: on the trirectangular tet the dual
 // gives 1/4 and -1/24 where TransCut's (1/6) |kl| cot(theta_kl) gives 1/6 and 0 (voronoi_dual.h and
-// tests/solver/fvm_method_test.cpp). Both are consistent (per tet, sum_e w_e |e|^2 = 3 V, exact on
-// quadratics) and they coincide on structured meshes such as the six-tet cube grid (the 7-point
+// tests/solver/fvm_method_test.cpp). Both reproduce the Laplacian of |x|^2 / 2 (per tet
+// sum_e w_e |e|^2 = 3 V) and have zero row sums, and they coincide on structured meshes such as the six-tet cube grid (the 7-point
 // stencil); on a TetGen ball they differ by about half the weights' size. So FVM differs from TransCut
 // in its stiffness (Voronoi two-point fluxes instead of P1 gradients: positive on every interior edge
 // of a Delaunay mesh, where TransCut's cotangent weights go negative at every obtuse dihedral angle),
@@ -47,7 +47,7 @@
 // MethodSolution::warnings.
 //
 // Resolution: the tet mesh itself (one unknown per vertex); the study sweeps ball meshes of several
-// sizes. The options hold the solver and its stopping rule only.
+// sizes. The options hold the solver, its stopping rule and the treatment of negative coefficients.
 #pragma once
 
 #include "solver/methods/method_problem.h"
