@@ -11,6 +11,7 @@
 #include "solver/reference/analytic_ball.h"
 #include "solver_test_meshes.h"
 #include "tetops/delaunay_check.h"
+#include "tetops/sliver_maker.h"
 #include "tetops/tetrahedralize.h"
 
 #include <gtest/gtest.h>
@@ -52,19 +53,7 @@ struct Ball {
 // Relative L2 error of phi (channel 0) against the exact series, weighted by lumped vertex volume (as
 // compare_with_analytic_ball weighs TransCut's).
 double ball_error(const Ball& ball, const MethodSolution& solution, BallLight light) {
-    const AnalyticBall exact(kRadius, kMua, kMusp, kEta,
-                             light == BallLight::Uniform ? std::vector<double>{1.0}
-                                                     : directional_ball_light_coefficients(kLegendreTerms, kEta));
-    const std::vector<double> volumes =
-        lumped_vertex_volumes(assemble_diffusion_matrix(ball.mesh, ball.conn, ball.materials), ball.conn);
-    double error = 0, norm = 0;
-    for (size_t v = 0; v < ball.mesh.vertex_count(); ++v) {
-        const double reference = exact(ball.mesh.positions[v]);
-        const double difference = solution.phi[v][0] - reference;
-        error += volumes[v] * difference * difference;
-        norm += volumes[v] * reference * reference;
-    }
-    return std::sqrt(error / norm);
+    return ball_relative_error(ball.mesh, ball.conn, ball.materials[0], kRadius, light, 1.0, solution.phi);
 }
 
 Eigen::Vector3d random_point(std::mt19937& rng) {
@@ -212,36 +201,11 @@ TEST(FvmMethod, CellsAndSurfaceSharesTileTheVolume) {
     EXPECT_NEAR(source, 2 * area / (a * (1 - fdr)), 1e-9 * source);
 }
 
-// A ball made non-Delaunay on purpose: `count` interior vertices (spread through the volume) are pushed
-// towards the opposite face of one of their tets, to a relative height `flatness`, each only where
-// every tet of its star stays positively oriented. Returns the number moved.
+// A ball made non-Delaunay on purpose: `count` interior vertices (spread through the volume) pushed
+// towards the opposite face of one of their tets, to a relative height `flatness`
+// (tetops/sliver_maker.h). Returns the number moved.
 int push_into_slivers(TetMesh& mesh, int count, double flatness) {
-    const TetConnectivity conn = build_connectivity(mesh);
-    std::vector<uint8_t> touched(mesh.vertex_count(), 0);
-    int moved = 0;
-    for (size_t v = 0; v < mesh.vertex_count() && moved < count; v += 37) {
-        if (conn.is_boundary_vertex[v] || touched[v]) continue;
-        const Eigen::Vector3d old = mesh.positions[v];
-        for (int32_t t : conn.vertex_tets.row(v)) {
-            Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-            for (int32_t w : mesh.tets[t])
-                if (w != static_cast<int32_t>(v)) centroid += mesh.positions[w] / 3.0;
-            mesh.positions[v] = centroid + flatness * (old - centroid);
-            bool valid = true;
-            for (int32_t s : conn.vertex_tets.row(v)) {
-                const Tet& tet = mesh.tets[s];
-                const Eigen::Vector3d& p0 = mesh.positions[tet[0]];
-                valid &= (mesh.positions[tet[1]] - p0).dot((mesh.positions[tet[2]] - p0).cross(mesh.positions[tet[3]] - p0)) > 0;
-            }
-            if (valid) break;
-            mesh.positions[v] = old;
-        }
-        if (mesh.positions[v] == old) continue;
-        for (int32_t w : conn.vertex_vertices.row(v)) touched[w] = 1;
-        touched[v] = 1;
-        ++moved;
-    }
-    return moved;
+    return static_cast<int>(flatten_into_slivers(mesh, build_connectivity(mesh), count, flatness).size());
 }
 
 TEST(FvmMethod, UniformLightWithoutAbsorptionIsExactOnAnyMesh) {
