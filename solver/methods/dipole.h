@@ -47,7 +47,7 @@ struct DipoleOptions {
     // A boundary vertex is thin when its nearest back-side vertex (Eqs. 13-14) is closer than this many
     // diffusion lengths (the longest over channels and materials). The paper (Sec. 6) notes that the
     // nearest back-side sample approximates the local thickness. Positive.
-    double thin_diffusion_lengths = 2.0;
+    double thin_diffusion_lengths = 3.0;
     // A warning is issued when the thin vertices cover more than this share of the surface area, or when
     // more than this share of the exitance would cross air. In [0, 1].
     double warning_fraction = 0.05;

@@ -126,5 +126,235 @@ TEST(DipoleMethod, MatchesTheHalfSpaceUnderUniformLight) {
     EXPECT_EQ(diagnostics.through_air_share, 0.0);
 }
 
+
+
+struct BallRun {
+    size_t tets = 0, surface = 0;
+    double volume_error = 0;   // relative L2 over all vertices, weighted by lumped vertex volume
+    double surface_error = 0;  // relative L2 over boundary vertices, weighted by their area
+    MethodSolution solution;
+};
+
+BallRun run_ball(int level, size_t tets, BallLight light, const DipoleOptions& options = {}) {
+    Scene scene(test::make_ball_mesh(level, tets, kRadius));
+    for (int32_t v : scene.conn.boundary_vertices) {
+        const double value = light == BallLight::Uniform ? 1.0 : directional_ball_light(scene.mesh.positions[v], kEta);
+        scene.q[v] = {value, value, value};
+    }
+    BallRun run;
+    run.tets = scene.mesh.tet_count();
+    run.surface = scene.conn.boundary_vertices.size();
+    run.solution = solve_dipole(scene.problem(), options);
+    const AnalyticBall exact(kRadius, kMua, kMusp, kEta,
+                             light == BallLight::Uniform ? std::vector<double>{1.0}
+                                                         : directional_ball_light_coefficients(60, kEta));
+    const std::vector<double> volumes = lumped_vertex_volumes(
+        assemble_diffusion_matrix(scene.mesh, scene.conn, scene.materials, AssemblyOptions{}), scene.conn);
+    std::vector<double> area(scene.mesh.vertex_count(), 0.0);
+    for (const BoundaryFace& f : scene.conn.boundary_faces) {
+        const auto& p = scene.mesh.positions;
+        const double a = (p[f.vertices[1]] - p[f.vertices[0]]).cross(p[f.vertices[2]] - p[f.vertices[0]]).norm() / 6;
+        for (int32_t v : f.vertices) area[v] += a;
+    }
+    double e2 = 0, n2 = 0, s2 = 0, sn2 = 0;
+    for (size_t v = 0; v < scene.mesh.vertex_count(); ++v) {
+        const double reference = exact(scene.mesh.positions[v]);
+        const double d = run.solution.phi[v][0] - reference;
+        e2 += volumes[v] * d * d, n2 += volumes[v] * reference * reference;
+        s2 += area[v] * d * d, sn2 += area[v] * reference * reference;
+    }
+    run.volume_error = std::sqrt(e2 / n2);
+    run.surface_error = std::sqrt(s2 / sn2);
+    return run;
+}
+
+// The table of docs/method_dipole.md; prints only.
+TEST(DipoleMethod, DISABLED_PrintBallTable) {
+    struct Level {
+        int surface;
+        size_t tets;
+    };
+    std::printf("| surface level | tets | surface vertices | setup ms | solve ms | uniform: volume / surface error | directional: volume / surface error |\n");
+    for (const Level& level : {Level{2, 2000}, Level{3, 16000}, Level{4, 40000}, Level{5, 128000}}) {
+        const BallRun u = run_ball(level.surface, level.tets, BallLight::Uniform);
+        const BallRun d = run_ball(level.surface, level.tets, BallLight::Directional);
+        std::printf("| %d | %zu | %zu | %.1f | %.1f | %.2f%% / %.2f%% | %.2f%% / %.2f%% |\n", level.surface, u.tets, u.surface,
+                    d.solution.setup_ms, d.solution.solve_ms, 100 * u.volume_error, 100 * u.surface_error,
+                    100 * d.volume_error, 100 * d.surface_error);
+        std::fflush(stdout);
+    }
+}
+
+// The exact surface value of the uniformly lit ball and the dipole's: on a sphere the area within chord
+// distance r of a point is pi r^2, as on a plane, so the surface integral of R_d over the ball is the
+// half-space's total minus its tail beyond the diameter.
+double exact_ball_surface_uniform() {
+    const AnalyticBall exact(kRadius, kMua, kMusp, kEta, {1.0});
+    return exact(Eigen::Vector3d(0, 0, kRadius));
+}
+double dipole_ball_surface_uniform() {
+    const DipoleProfile p(kMua, kMusp, kEta);
+    return 2 * (boundary_reflection_parameter(kEta) * (p.total_reflectance() - p.reflectance_tail(2 * kRadius)) + 1);
+}
+
+TEST(DipoleMethod, BallErrorPlateausAtTheModelError) {
+    const double plateau = 1 - dipole_ball_surface_uniform() / exact_ball_surface_uniform();
+    std::printf("uniform ball surface: exact %.4f, dipole %.4f: model error %.2f%%\n", exact_ball_surface_uniform(),
+                dipole_ball_surface_uniform(), 100 * plateau);
+    std::vector<BallRun> uniform, directional;
+    for (auto [level, tets] : {std::pair{2, size_t{2000}}, std::pair{3, size_t{16000}}}) {
+        uniform.push_back(run_ball(level, tets, BallLight::Uniform));
+        directional.push_back(run_ball(level, tets, BallLight::Directional));
+        std::printf("%zu tets, %zu surface vertices: uniform %.2f%% (surface %.2f%%), directional %.2f%% (surface %.2f%%)\n",
+                    uniform.back().tets, uniform.back().surface, 100 * uniform.back().volume_error,
+                    100 * uniform.back().surface_error, 100 * directional.back().volume_error,
+                    100 * directional.back().surface_error);
+    }
+    for (size_t k = 0; k < uniform.size(); ++k) {
+        // The surface error is the model's (the dipole misses the light a ball of 3.5 diffusion lengths
+        // keeps), not the quadrature's: it does not fall with resolution.
+        EXPECT_NEAR(uniform[k].surface_error, plateau, 0.01);
+        EXPECT_LT(uniform[k].volume_error, 0.31);
+        EXPECT_LT(directional[k].surface_error, 0.15);
+        EXPECT_LT(directional[k].volume_error, 0.26);
+        // 3.5 diffusion lengths across: thinner than the default 3 diffusion lengths between back sides.
+        EXPECT_EQ(uniform[k].solution.warnings.size(), 1u);
+    }
+    EXPECT_NEAR(uniform[1].surface_error, uniform[0].surface_error, 0.01);
+    EXPECT_NEAR(directional[1].surface_error, directional[0].surface_error, 0.01);
+}
+
+// phi at the centre of the unlit bottom face of a box lit on top, by the dipole and by TransCut.
+struct SlabComparison {
+    double dipole_unlit = 0, transcut_unlit = 0, dipole_lit = 0, transcut_lit = 0;
+    DipoleDiagnostics diagnostics;
+    std::vector<std::string> warnings;
+};
+SlabComparison compare_slab(int thickness_mm) {
+    const std::array<int, 3> cells{30, 30, thickness_mm};
+    const Scene scene = top_lit_box(cells, {30, 30, static_cast<double>(thickness_mm)});
+    SlabComparison out;
+    const MethodSolution dipole = solve_dipole(scene.problem(), {}, &out.diagnostics);
+    DiffusionOptions options;
+    options.relative_tolerance = 1e-6;
+    const DiffusionSolution transcut = solve_diffusion(scene.mesh, scene.conn, scene.materials, scene.q, options);
+    const int32_t unlit = box_vertex_index(cells, 15, 15, 0), lit = box_vertex_index(cells, 15, 15, thickness_mm);
+    out.dipole_unlit = dipole.phi[unlit][0];
+    out.transcut_unlit = transcut.phi[unlit][0];
+    out.dipole_lit = dipole.phi[lit][0];
+    out.transcut_lit = transcut.phi[lit][0];
+    out.warnings = dipole.warnings;
+    return out;
+}
+
+TEST(DipoleMethod, ThinSlabsAreWrongAndWarned) {
+    // Light through a slab: the dipole takes the unlit face for the surface of a semi-infinite medium lit
+    // elsewhere, so the light through the slab is R_d at the distance, which is far too dark. Relative
+    // to the lit side's brightness the error grows as the slab thins (diffusion length 5.8 mm).
+    for (int t : {16, 8, 4, 2}) {
+        const SlabComparison c = compare_slab(t);
+        const double unlit_error = c.dipole_unlit / c.transcut_unlit - 1, lit_error = c.dipole_lit / c.transcut_lit - 1;
+        const double visible_error = (c.dipole_unlit - c.transcut_unlit) / c.transcut_lit;
+        std::printf("slab %2d mm (%.2f diffusion lengths): unlit side dipole %.4f TransCut %.4f (%+.1f%%, %+.1f%% of the lit "
+                    "side); lit side %+.1f%%; thin surface %.0f%%\n",
+                    t, t * effective_transport_coefficient(kMua, kMusp), c.dipole_unlit, c.transcut_unlit,
+                    100 * unlit_error, 100 * visible_error, 100 * lit_error, 100 * c.diagnostics.thin_area_fraction);
+        EXPECT_LT(unlit_error, -0.15);
+        if (t <= 8) {
+            EXPECT_LT(visible_error, -0.05);
+        }
+        // Thinner than 3 diffusion lengths (17.3 mm): most of the surface is flagged.
+        EXPECT_GT(c.diagnostics.thin_area_fraction, 0.5);
+        ASSERT_EQ(c.warnings.size(), 1u);
+        EXPECT_NE(c.warnings[0].find("thinner than"), std::string::npos);
+    }
+}
+
+TEST(DipoleMethod, LightAcrossAnAirGapIsLeftOutAndWarned) {
+    // A U: two 12 mm prongs facing each other across a 6 mm slot, lit everywhere. The prongs' facing
+    // walls are 6 mm apart through air; the diffusion path between them runs around the slot's floor.
+    const std::array<int, 3> cells{30, 10, 20};
+    TetMesh box = make_box_mesh(cells, Eigen::Vector3d::Zero(), Eigen::Vector3d(30, 10, 20));
+    std::vector<Tet> kept;
+    for (const Tet& t : box.tets) {
+        Eigen::Vector3d c = Eigen::Vector3d::Zero();
+        for (int32_t v : t) c += 0.25 * box.positions[v];
+        if (!(c.x() > 12 && c.x() < 18 && c.z() > 4)) kept.push_back(t);
+    }
+    for (bool slot : {false, true}) {
+        Scene scene(slot ? make_tet_mesh(box.positions, kept) : box);
+        for (int32_t v : scene.conn.boundary_vertices) scene.q[v] = {1, 1, 1};
+        DipoleDiagnostics diagnostics;
+        const MethodSolution s = solve_dipole(scene.problem(), {}, &diagnostics);
+        std::printf("%s: %.1f%% of the exitance would cross air\n", slot ? "U" : "box", 100 * diagnostics.through_air_share);
+        if (!slot) {
+            EXPECT_EQ(diagnostics.through_air_share, 0.0);
+            continue;
+        }
+        EXPECT_GT(diagnostics.through_air_share, 0.0);
+        // The default threshold (5%) decides the warning; a zero threshold always warns when light was left out.
+        DipoleOptions strict;
+        strict.warning_fraction = 0;
+        const MethodSolution w = solve_dipole(scene.problem(), strict);
+        bool warned = false;
+        for (const std::string& message : w.warnings) warned |= message.find("cross air") != std::string::npos;
+        EXPECT_TRUE(warned);
+    }
+}
+
+TEST(DipoleMethod, RejectsBadOptionsAndScenes) {
+    Scene scene(make_box_mesh({2, 2, 2}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()));
+    const auto expect_error = [&](const DipoleOptions& options, const char* what) {
+        try {
+            solve_dipole(scene.problem(), options);
+            ADD_FAILURE() << "no error for " << what;
+        } catch (const InvalidArgumentError& e) {
+            EXPECT_EQ(std::string(e.what()).rfind("dipole: ", 0), 0u) << e.what();
+        }
+    };
+    DipoleOptions o;
+    o.profile_tolerance = 0;
+    expect_error(o, "zero tolerance");
+    o.profile_tolerance = 0.9;
+    expect_error(o, "tolerance above 0.5");
+    o = {};
+    o.thin_diffusion_lengths = -1;
+    expect_error(o, "negative thin length");
+    o = {};
+    o.warning_fraction = 2;
+    expect_error(o, "warning fraction above 1");
+    scene.q.pop_back();
+    expect_error({}, "short q");
+}
+
+TEST(DipoleMethod, StopsWhenCancelled) {
+    Scene scene(test::make_ball_mesh(2, 2000, kRadius));
+    for (int32_t v : scene.conn.boundary_vertices) scene.q[v] = {1, 1, 1};
+    Progress progress;
+    progress.request_cancel();
+    EXPECT_THROW(solve_dipole(scene.problem(&progress)), CancelledError);
+}
+
+TEST(DipoleMethod, ChannelsAndScaleAreIndependent) {
+    // The same ball in centimetres with mm_per_unit 10 gives the same phi; a channel lit at half
+    // strength gets half the fluence (the method is linear in q).
+    Scene mm(test::make_ball_mesh(2, 2000, kRadius));
+    Scene cm(mm.mesh);
+    for (auto& p : cm.mesh.positions) p /= 10;
+    for (int32_t v : mm.conn.boundary_vertices) {
+        const double value = directional_ball_light(mm.mesh.positions[v], kEta);
+        mm.q[v] = cm.q[v] = {value, 0.5 * value, 0};
+    }
+    MethodProblem cm_problem = cm.problem();
+    cm_problem.mm_per_unit = 10;
+    const MethodSolution a = solve_dipole(mm.problem()), b = solve_dipole(cm_problem);
+    for (size_t v = 0; v < a.phi.size(); ++v) {
+        EXPECT_NEAR(b.phi[v][0], a.phi[v][0], 1e-9 * std::max(1.0, a.phi[v][0]));
+        EXPECT_NEAR(a.phi[v][1], 0.5 * a.phi[v][0], 1e-12 * std::max(1.0, a.phi[v][0]));
+        EXPECT_EQ(a.phi[v][2], 0.0);
+    }
+    EXPECT_EQ(a.unknowns, mm.conn.boundary_vertices.size());
+}
+
 }  // namespace
 }  // namespace waxwork
