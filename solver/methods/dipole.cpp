@@ -5,8 +5,8 @@
 #include "solver/material.h"
 #include "solver/methods/dipole_profile.h"
 #include "solver/ray_caster.h"
+#include "tetops/point_kd_tree.h"
 
-#include <nanoflann.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -20,17 +20,6 @@
 
 namespace waxwork {
 namespace {
-
-// nanoflann reads the boundary points through this adaptor.
-struct PointCloud {
-    std::span<const Eigen::Vector3d> points;
-    size_t kdtree_get_point_count() const { return points.size(); }
-    double kdtree_get_pt(size_t index, size_t dim) const { return points[index][static_cast<int>(dim)]; }
-    template <class BoundingBox>
-    bool kdtree_get_bbox(BoundingBox&) const { return false; }
-};
-using KdTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloud>, PointCloud, 3, uint32_t>;
 
 // The boundary as the method sees it: one sample per boundary vertex, in mm.
 struct SurfaceSamples {
@@ -177,7 +166,7 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
     const double search_radius = std::max(radius, std::min(thin_length, extent));
 
     const PointCloud cloud{s.x};
-    const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     std::vector<Eigen::Vector3f> bvh_points(mesh.vertex_count());
     for (size_t v = 0; v < mesh.vertex_count(); ++v) bvh_points[v] = (mesh.positions[v] * mm).cast<float>();
     std::vector<std::array<int32_t, 3>> triangles;
