@@ -128,16 +128,58 @@ SurfaceSamples surface_samples(const MethodProblem& problem) {
     return out;
 }
 
-// Whether the light between two boundary samples would cross air: the segment between the dipoles'
-// real sources (each at depth z_r below its vertex) leaves the volume. Only pairs whose chord leaves
-// x_o outwards (into the half-space its normal points to) can, and only those are ray cast.
-bool crosses_air(const SurfaceSamples& s, size_t o, size_t i, const TriangleBvh& bvh) {
-    const Eigen::Vector3d d = s.x[i] - s.x[o];
-    const double length = d.norm();
-    if (length <= 2 * s.rho[o] || d.dot(s.n[o]) <= 0.05 * length) return false;
-    const double depth = s.profile[3 * o].depth_real();
-    const Eigen::Vector3d from = s.x[o] - depth * s.n[o], to = s.x[i] - s.profile[3 * i].depth_real() * s.n[i];
+// Whether the light between a point inside the volume and boundary sample i would cross air: the
+// segment from the point to the dipole's real source (z_r below x_i) leaves the volume. A ray cast
+// against the boundary (the chord of a concave region can leave and re-enter anywhere along it).
+bool crosses_air(const SurfaceSamples& s, const Eigen::Vector3d& from, size_t i, const TriangleBvh& bvh) {
+    const Eigen::Vector3d to = s.x[i] - s.profile[3 * i].depth_real() * s.n[i];
     return bvh.occluded(from.cast<float>(), (to - from).cast<float>(), 1e-4f, 1 - 1e-4f);
+}
+
+// Only the pairs carrying more than this share of a vertex's light are ray cast for air crossings: the
+// casts cost more than the profile, and the many weak pairs cannot change the result visibly.
+constexpr double kAirTestShare = 1e-4;
+
+bool surface_is_convex(const SurfaceSamples& s, const PointKdTree& tree, double radius_sq) {
+    std::atomic<bool> convex{true};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, s.x.size()), [&](const auto& range) {
+        std::vector<std::pair<uint32_t, double>> matches;
+        for (size_t o = range.begin(); o != range.end() && convex.load(std::memory_order_relaxed); ++o) {
+            matches.clear();
+            tree.radiusSearch(s.x[o].data(), radius_sq, matches, nanoflann::SearchParams(32, 0, false));
+            for (const auto& [i, distance_sq] : matches)
+                if ((s.x[i] - s.x[o]).dot(s.n[o]) > 0.05 * std::sqrt(distance_sq)) {
+                    convex = false;
+                    break;
+                }
+        }
+    });
+    return convex.load();
+}
+
+// A source's contribution to one receiver, per channel, before the air test.
+struct Contribution {
+    uint32_t sample;
+    std::array<double, 3> value;
+    bool back_side;
+};
+
+// Sums the contributions into `total`, leaving out (and adding to `dropped`, channel 0) those of
+// weight above kAirTestShare of the sum whose path from `from` crosses air.
+void sum_contributions(const SurfaceSamples& s, std::span<const Contribution> contributions, const Eigen::Vector3d& from,
+                       const TriangleBvh* bvh, std::array<double, 3>& total, double& back, double& dropped) {
+    std::array<double, 3> sum{};
+    for (const Contribution& c : contributions)
+        for (int k = 0; k < 3; ++k) sum[k] += c.value[k];
+    const double threshold = kAirTestShare * (sum[0] + sum[1] + sum[2]);
+    for (const Contribution& c : contributions) {
+        if (bvh && c.value[0] + c.value[1] + c.value[2] > threshold && crosses_air(s, from, c.sample, *bvh)) {
+            dropped += c.value[0];
+            continue;
+        }
+        for (int k = 0; k < 3; ++k) total[k] += c.value[k];
+        if (c.back_side) back += c.value[0];
+    }
 }
 
 }  // namespace
@@ -173,6 +215,11 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
     triangles.reserve(conn.boundary_faces.size());
     for (const BoundaryFace& f : conn.boundary_faces) triangles.push_back(f.vertices);
     const TriangleBvh bvh(bvh_points, triangles);
+    // A path between two points of a convex volume never crosses air; a chord that leaves the volume at
+    // p and re-enters at p' puts p' in front of p's tangent plane. So the ray casts are needed only when
+    // some boundary vertex has another, within the search radius, in front of its tangent plane (by more
+    // than 3 degrees, above the faceting of a curved surface).
+    const bool convex = surface_is_convex(s, tree, search_radius * search_radius);
 
     MethodSolution solution;
     solution.phi.assign(mesh.vertex_count(), {0, 0, 0});
@@ -194,9 +241,11 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
         if (problem.progress) problem.progress->set_fraction(static_cast<float>(begin / total_work));
         tbb::parallel_for(tbb::blocked_range<size_t>(begin, std::min(begin + batch, n)), [&](const auto& range) {
             std::vector<std::pair<uint32_t, double>> matches;
+            std::vector<Contribution> contributions;
             size_t local_pairs = 0;
             for (size_t o = range.begin(); o != range.end(); ++o) {
                 matches.clear();
+                contributions.clear();
                 tree.radiusSearch(s.x[o].data(), search_sq, matches, nanoflann::SearchParams(32, 0, false));
                 local_pairs += matches.size();
                 for (const auto& [i, distance_sq] : matches) {
@@ -216,14 +265,16 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                                    });
                         else
                             k[c] = s.area[i] * p.reflectance(distance);
+                        k[c] *= qi[c];
                     }
-                    if (i != o && crosses_air(s, o, i, bvh)) {
-                        dropped[o] += k[0] * problem.q[s.vertex[i]][0];
+                    if (i == o || distance <= 2 * s.rho[o]) {  // the vertex itself and its neighbours: no air between
+                        for (int c = 0; c < 3; ++c) exitance[o][c] += k[c];
                         continue;
                     }
-                    for (int c = 0; c < 3; ++c) exitance[o][c] += k[c] * problem.q[s.vertex[i]][c];
-                    if (back_side) back[o] += k[0] * problem.q[s.vertex[i]][0];
+                    contributions.push_back({i, k, back_side});
                 }
+                sum_contributions(s, contributions, s.x[o] - s.profile[3 * o].depth_real() * s.n[o],
+                                  options.leave_out_air_crossings && !convex ? &bvh : nullptr, exitance[o], back[o], dropped[o]);
             }
             pairs += local_pairs;
         });
@@ -245,6 +296,7 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
         if (problem.progress) problem.progress->set_fraction(static_cast<float>((n + begin) / total_work));
         tbb::parallel_for(tbb::blocked_range<size_t>(begin, std::min(begin + batch, interior.size())), [&](const auto& range) {
             std::vector<std::pair<uint32_t, double>> matches;
+            std::vector<Contribution> contributions;
             size_t local_pairs = 0;
             for (size_t k = range.begin(); k != range.end(); ++k) {
                 const int32_t v = interior[k];
@@ -259,9 +311,11 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                 tree.radiusSearch(x.data(), reach * reach, matches, nanoflann::SearchParams(32, 0, false));
                 local_pairs += matches.size();
                 std::array<double, 3> phi{};
+                contributions.clear();
                 for (const auto& [i, distance_sq] : matches) {
                     const std::array<double, 3>& qi = problem.q[s.vertex[i]];
                     if (qi[0] == 0 && qi[1] == 0 && qi[2] == 0) continue;
+                    std::array<double, 3> value{};
                     for (int c = 0; c < 3; ++c) {
                         const DipoleProfile& p = s.profile[3 * i + c];
                         // A source's fluence diverges at its real source; spreading the source over its
@@ -271,12 +325,16 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                             const double d_virtual = (x - (y + p.height_virtual() * s.n[i])).norm();
                             return p.fluence(d_real, d_virtual);
                         };
-                        const double value = std::sqrt(distance_sq) < kNearField * s.rho[i] + p.depth_real()
-                                                 ? disk_mean(s.x[i], s.n[i], s.rho[i], kernel)
-                                                 : kernel(s.x[i]);
-                        phi[c] += s.area[i] * value * qi[c];
+                        value[c] = s.area[i] * qi[c] *
+                                   (std::sqrt(distance_sq) < kNearField * s.rho[i] + p.depth_real()
+                                        ? disk_mean(s.x[i], s.n[i], s.rho[i], kernel)
+                                        : kernel(s.x[i]));
                     }
+                    contributions.push_back({i, value, false});
                 }
+                double unused_back = 0, unused_dropped = 0;
+                sum_contributions(s, contributions, x, options.leave_out_air_crossings && !convex ? &bvh : nullptr, phi, unused_back,
+                                  unused_dropped);
                 solution.phi[v] = phi;
             }
             pairs += local_pairs;

@@ -51,6 +51,9 @@ struct DipoleOptions {
     // A warning is issued when the thin vertices cover more than this share of the surface area, or when
     // more than this share of the exitance would cross air. In [0, 1].
     double warning_fraction = 0.05;
+    // Leave out pairs whose light would cross air (concave regions, facing surfaces); false keeps them,
+    // as a plain Euclidean profile sum does (for comparisons).
+    bool leave_out_air_crossings = true;
 };
 
 struct DipoleDiagnostics {

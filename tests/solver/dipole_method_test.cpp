@@ -271,8 +271,9 @@ TEST(DipoleMethod, ThinSlabsAreWrongAndWarned) {
 }
 
 TEST(DipoleMethod, LightAcrossAnAirGapIsLeftOutAndWarned) {
-    // A U: two 12 mm prongs facing each other across a 6 mm slot, lit everywhere. The prongs' facing
-    // walls are 6 mm apart through air; the diffusion path between them runs around the slot's floor.
+    // A U: two 12 mm prongs facing each other across a 6 mm slot 16 mm deep, lit on the top of the
+    // first prong only. The second prong's slot wall is 6-7 mm from the lit face through air; the
+    // diffusion path runs down the first prong, around the slot's floor and up again.
     const std::array<int, 3> cells{30, 10, 20};
     TetMesh box = make_box_mesh(cells, Eigen::Vector3d::Zero(), Eigen::Vector3d(30, 10, 20));
     std::vector<Tet> kept;
@@ -281,25 +282,47 @@ TEST(DipoleMethod, LightAcrossAnAirGapIsLeftOutAndWarned) {
         for (int32_t v : t) c += 0.25 * box.positions[v];
         if (!(c.x() > 12 && c.x() < 18 && c.z() > 4)) kept.push_back(t);
     }
-    for (bool slot : {false, true}) {
-        Scene scene(slot ? make_tet_mesh(box.positions, kept) : box);
+    {
+        Scene scene(box);
         for (int32_t v : scene.conn.boundary_vertices) scene.q[v] = {1, 1, 1};
         DipoleDiagnostics diagnostics;
-        const MethodSolution s = solve_dipole(scene.problem(), {}, &diagnostics);
-        std::printf("%s: %.1f%% of the exitance would cross air\n", slot ? "U" : "box", 100 * diagnostics.through_air_share);
-        if (!slot) {
-            EXPECT_EQ(diagnostics.through_air_share, 0.0);
-            continue;
-        }
-        EXPECT_GT(diagnostics.through_air_share, 0.0);
-        // The default threshold (5%) decides the warning; a zero threshold always warns when light was left out.
-        DipoleOptions strict;
-        strict.warning_fraction = 0;
-        const MethodSolution w = solve_dipole(scene.problem(), strict);
-        bool warned = false;
-        for (const std::string& message : w.warnings) warned |= message.find("cross air") != std::string::npos;
-        EXPECT_TRUE(warned);
+        solve_dipole(scene.problem(), {}, &diagnostics);
+        EXPECT_EQ(diagnostics.through_air_share, 0.0);
     }
+    Scene scene(make_tet_mesh(box.positions, kept));
+    for (int32_t v : scene.conn.boundary_vertices)
+        if (scene.mesh.positions[v].z() > 20 - 1e-9 && scene.mesh.positions[v].x() < 12 + 1e-9) scene.q[v] = {1, 1, 1};
+    DipoleDiagnostics diagnostics;
+    const MethodSolution left_out = solve_dipole(scene.problem(), {}, &diagnostics);
+    DipoleOptions keep;
+    keep.leave_out_air_crossings = false;
+    const MethodSolution kept_in = solve_dipole(scene.problem(), keep);
+    DiffusionOptions options;
+    options.relative_tolerance = 1e-6;
+    const DiffusionSolution transcut = solve_diffusion(scene.mesh, scene.conn, scene.materials, scene.q, options);
+    // The second prong's slot wall 4 mm below the top (x = 18, z = 16) and its outer wall (x = 30).
+    const int32_t slot_wall = box_vertex_index(cells, 18, 5, 16), outer_wall = box_vertex_index(cells, 30, 5, 16);
+    const int32_t lit = box_vertex_index(cells, 6, 5, 20);
+    std::printf("U: %.1f%% of the exitance would cross air; lit top: TransCut %.3g, dipole %.3g; far prong's slot wall: "
+                "TransCut %.3g, dipole %.3g, Euclidean sum %.3g; its outer wall: TransCut %.3g, dipole %.3g, Euclidean sum %.3g\n",
+                100 * diagnostics.through_air_share, transcut.phi[lit][0], left_out.phi[lit][0], transcut.phi[slot_wall][0],
+                left_out.phi[slot_wall][0], kept_in.phi[slot_wall][0], transcut.phi[outer_wall][0],
+                left_out.phi[outer_wall][0], kept_in.phi[outer_wall][0]);
+    EXPECT_GT(diagnostics.through_air_share, 0.01);
+    // Leaving the crossings out brings the far prong close to TransCut (almost dark); the Euclidean sum
+    // lights its slot wall with more than 1% of the lit face's fluence.
+    for (int32_t v : {slot_wall, outer_wall}) {
+        EXPECT_LT(std::abs(left_out.phi[v][0] - transcut.phi[v][0]), 1e-3 * transcut.phi[lit][0]);
+        EXPECT_LT(std::abs(left_out.phi[v][0] - transcut.phi[v][0]), std::abs(kept_in.phi[v][0] - transcut.phi[v][0]));
+    }
+    EXPECT_GT(kept_in.phi[slot_wall][0], 0.01 * transcut.phi[lit][0]);
+    // The default threshold (5%) decides the warning; a zero threshold always warns when light was left out.
+    DipoleOptions strict;
+    strict.warning_fraction = 0;
+    const MethodSolution w = solve_dipole(scene.problem(), strict);
+    bool warned = false;
+    for (const std::string& message : w.warnings) warned |= message.find("cross air") != std::string::npos;
+    EXPECT_TRUE(warned);
 }
 
 TEST(DipoleMethod, RejectsBadOptionsAndScenes) {
