@@ -30,6 +30,7 @@ struct SurfaceSamples {
     std::vector<double> rho;              // radius of the disk of that area
     std::vector<double> a;                // boundary reflection parameter A
     std::vector<DipoleProfile> profile;   // 3 per sample (rgb)
+    std::vector<uint8_t> grey;            // the three channels' coefficients are equal (one profile serves)
 };
 
 // The 7-point degree-5 rule on a disk (Radon): the centre weighs 1/4 and six points on the circle of
@@ -124,6 +125,8 @@ SurfaceSamples surface_samples(const MethodProblem& problem) {
         out.a[s] = boundary_reflection_parameter(e);
         for (int c = 0; c < 3; ++c)
             out.profile.emplace_back(weight > 0 ? mua[s][c] / weight : 0.0, weight > 0 ? musp[s][c] / weight : 1.0, e);
+        out.grey.push_back(mua[s][0] == mua[s][1] && mua[s][0] == mua[s][2] && musp[s][0] == musp[s][1] &&
+                           musp[s][0] == musp[s][2]);
     }
     return out;
 }
@@ -257,7 +260,9 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                     std::array<double, 3> k{};
                     for (int c = 0; c < 3; ++c) {
                         const DipoleProfile& p = s.profile[3 * i + c];
-                        if (i == o)
+                        if (c > 0 && s.grey[i])
+                            k[c] = k[0];
+                        else if (i == o)
                             k[c] = s.area[i] * p.disk_mean_reflectance(s.rho[i]);
                         else if (distance < kNearField * s.rho[i])
                             k[c] = s.area[i] * disk_mean(s.x[i], s.n[i], s.rho[i], [&](const Eigen::Vector3d& y) {
@@ -265,8 +270,8 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                                    });
                         else
                             k[c] = s.area[i] * p.reflectance(distance);
-                        k[c] *= qi[c];
                     }
+                    for (int c = 0; c < 3; ++c) k[c] *= qi[c];
                     if (i == o || distance <= 2 * s.rho[o]) {  // the vertex itself and its neighbours: no air between
                         for (int c = 0; c < 3; ++c) exitance[o][c] += k[c];
                         continue;
@@ -325,11 +330,12 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                             const double d_virtual = (x - (y + p.height_virtual() * s.n[i])).norm();
                             return p.fluence(d_real, d_virtual);
                         };
-                        value[c] = s.area[i] * qi[c] *
-                                   (std::sqrt(distance_sq) < kNearField * s.rho[i] + p.depth_real()
-                                        ? disk_mean(s.x[i], s.n[i], s.rho[i], kernel)
-                                        : kernel(s.x[i]));
+                        value[c] = c > 0 && s.grey[i] ? value[0]
+                                   : s.area[i] * (std::sqrt(distance_sq) < kNearField * s.rho[i] + p.depth_real()
+                                                      ? disk_mean(s.x[i], s.n[i], s.rho[i], kernel)
+                                                      : kernel(s.x[i]));
                     }
+                    for (int c = 0; c < 3; ++c) value[c] *= qi[c];
                     contributions.push_back({i, value, false});
                 }
                 double unused_back = 0, unused_dropped = 0;
