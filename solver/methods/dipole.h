@@ -31,8 +31,10 @@
 // holds no uncollided light), deep inside it decays like the Robin solution (docs).
 //
 // Where it fails: thin parts (the profile assumes a semi-infinite medium: light through a slab thinner
-// than a few diffusion lengths is wrong) and concave regions (Euclidean distances cross air). Both are
-// measured and reported as warnings (DipoleDiagnostics).
+// than a few diffusion lengths is far too dark) and concave regions (Euclidean distances cross air).
+// Thin parts are measured and warned about; pairs whose light would cross air are left out (a ray cast
+// between the dipoles' real sources) and their share is warned about (DipoleDiagnostics,
+// docs/method_dipole.md).
 #pragma once
 
 #include "solver/methods/method_problem.h"

@@ -9,7 +9,9 @@
 #include "solver/methods/dipole_profile.h"
 #include "solver/reference/analytic_ball.h"
 #include "solver_test_meshes.h"
+#include "io/surface_reader.h"
 #include "tetops/box_mesh.h"
+#include "tetops/tetrahedralize.h"
 
 #include <gtest/gtest.h>
 
@@ -398,6 +400,30 @@ TEST(DipoleMethod, EachChannelUsesItsOwnCoefficients) {
         double peak = 0;
         for (const auto& phi : one.phi) peak = std::max(peak, phi[0]);
         for (size_t v = 0; v < all.phi.size(); ++v) EXPECT_NEAR(all.phi[v][c], one.phi[v][0], 1e-3 * peak);
+    }
+}
+
+// Setup and evaluation cost on the shared spot mesh at its default scale (30 mm per unit, a 78 mm
+// figurine) in marble, lit everywhere; prints only (docs/method_dipole.md).
+TEST(DipoleMethod, DISABLED_PrintSpotCost) {
+    const TriangleSurface surface = read_surface_file(std::string(WAXWORK_SHARED_DIR) + "/data/meshes/spot.obj");
+    for (size_t tets : {size_t{60000}, size_t{150000}}) {
+        MeshingOptions meshing;
+        meshing.sizing.target_tets = tets;
+        Scene scene(tetrahedralize(surface, meshing).mesh, material_preset("marble"));
+        for (int32_t v : scene.conn.boundary_vertices) scene.q[v] = {1, 1, 1};
+        MethodProblem problem = scene.problem();
+        problem.mm_per_unit = 30;
+        DipoleDiagnostics diagnostics;
+        const MethodSolution s = solve_dipole(problem, {}, &diagnostics);
+        DiffusionOptions options;
+        options.mm_per_unit = 30;
+        const DiffusionSolution transcut = solve_diffusion(scene.mesh, scene.conn, scene.materials, scene.q, options);
+        std::printf("| %zu | %zu | %.0f | %.0f | %.1f | %zu | %.0f%% | %.1f%% | %.0f |\n", scene.mesh.tet_count(), s.unknowns,
+                    s.setup_ms, s.solve_ms, diagnostics.cutoff_radius_mm, diagnostics.pairs,
+                    100 * diagnostics.thin_area_fraction, 100 * diagnostics.through_air_share,
+                    transcut.assembly_ms + transcut.solve_ms);
+        std::fflush(stdout);
     }
 }
 
