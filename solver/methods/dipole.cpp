@@ -64,6 +64,8 @@ void validate(const MethodProblem& problem, const DipoleOptions& options) {
                                    std::to_string(options.profile_tolerance) + ")");
     if (!(options.thin_diffusion_lengths > 0 && std::isfinite(options.thin_diffusion_lengths)))
         throw InvalidArgumentError("dipole: thin_diffusion_lengths must be positive and finite");
+    if (options.back_side_samples < 0)
+        throw InvalidArgumentError("dipole: back_side_samples must be 0 (all) or a positive count");
     if (!(options.warning_fraction >= 0 && options.warning_fraction <= 1))
         throw InvalidArgumentError("dipole: warning_fraction must be in [0, 1]");
     if (problem.materials.size() != mesh.tet_count())
@@ -223,6 +225,7 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
     // some boundary vertex has another, within the search radius, in front of its tangent plane (by more
     // than 3 degrees, above the faceting of a curved surface).
     const bool convex = surface_is_convex(s, tree, search_radius * search_radius);
+    const bool sam = options.back_side_samples > 0;
 
     MethodSolution solution;
     solution.phi.assign(mesh.vertex_count(), {0, 0, 0});
@@ -245,10 +248,12 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
         tbb::parallel_for(tbb::blocked_range<size_t>(begin, std::min(begin + batch, n)), [&](const auto& range) {
             std::vector<std::pair<uint32_t, double>> matches;
             std::vector<Contribution> contributions;
+            std::vector<std::pair<double, Contribution>> back_candidates;  // (form factor, contribution)
             size_t local_pairs = 0;
             for (size_t o = range.begin(); o != range.end(); ++o) {
                 matches.clear();
                 contributions.clear();
+                back_candidates.clear();
                 tree.radiusSearch(s.x[o].data(), search_sq, matches, nanoflann::SearchParams(32, 0, false));
                 local_pairs += matches.size();
                 for (const auto& [i, distance_sq] : matches) {
@@ -256,7 +261,9 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                     const double distance = std::sqrt(distance_sq);
                     if (back_side) thickness[o] = std::min(thickness[o], distance);
                     const std::array<double, 3>& qi = problem.q[s.vertex[i]];
-                    if (distance_sq >= radius_sq || (qi[0] == 0 && qi[1] == 0 && qi[2] == 0)) continue;
+                    // The SAM picks its back-side samples by form factor alone, lit or not (Eq. 12).
+                    const bool sam_candidate = sam && back_side && i != o;
+                    if (distance_sq >= radius_sq || (!sam_candidate && qi[0] == 0 && qi[1] == 0 && qi[2] == 0)) continue;
                     std::array<double, 3> k{};
                     for (int c = 0; c < 3; ++c) {
                         const DipoleProfile& p = s.profile[3 * i + c];
@@ -271,12 +278,23 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                         else
                             k[c] = s.area[i] * p.reflectance(distance);
                     }
+                    const double form_factor = k[0] + k[1] + k[2];
                     for (int c = 0; c < 3; ++c) k[c] *= qi[c];
+                    if (sam_candidate) {
+                        back_candidates.push_back({form_factor, {i, k, true}});
+                        continue;
+                    }
                     if (i == o || distance <= 2 * s.rho[o]) {  // the vertex itself and its neighbours: no air between
                         for (int c = 0; c < 3; ++c) exitance[o][c] += k[c];
                         continue;
                     }
                     contributions.push_back({i, k, back_side});
+                }
+                if (sam) {
+                    const size_t keep = std::min(back_candidates.size(), static_cast<size_t>(options.back_side_samples));
+                    std::partial_sort(back_candidates.begin(), back_candidates.begin() + static_cast<std::ptrdiff_t>(keep),
+                                      back_candidates.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+                    for (size_t k = 0; k < keep; ++k) contributions.push_back(back_candidates[k].second);
                 }
                 sum_contributions(s, contributions, s.x[o] - s.profile[3 * o].depth_real() * s.n[o],
                                   options.leave_out_air_crossings && !convex ? &bvh : nullptr, exitance[o], back[o], dropped[o]);

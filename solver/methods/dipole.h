@@ -10,7 +10,8 @@
 // unit area: the paper's L_d (Eq. 4). The paper splits each sum into the front side A_+ (a surface blur)
 // and the back side A_- of x_o (Eqs. 6-7, the translucency), with the back side defined by Eqs. 13-14;
 // here both are evaluated with the same profile over Euclidean distance (the paper's ground truth,
-// Sec. 5.1), and the back-side share is reported.
+// Sec. 5.1), or the back side with the SAM's n strongest samples (Eq. 12, back_side_samples), and the
+// back-side share is reported.
 //
 // From exitance to fluence. In the shared physics the bracket of the exitant radiance is 4 J+, with
 // J+ = phi/4 - (D/2) dphi/dn the outgoing partial current just inside the surface: eliminating dphi/dn
@@ -56,6 +57,11 @@ struct DipoleOptions {
     // Leave out pairs whose light would cross air (concave regions, facing surfaces); false keeps them,
     // as a plain Euclidean profile sum does (for comparisons).
     bool leave_out_air_crossings = true;
+    // 0: every back-side vertex within the cut-off contributes (the paper's ground truth, Sec. 5.1).
+    // n > 0: only the n back-side vertices of largest form factor K_oi, as a Spatial Adjacency Map
+    // stores them (Eq. 12; the paper uses n = 3); the front side is still summed in full (the paper's
+    // surface blur). Non-negative.
+    int back_side_samples = 0;
 };
 
 struct DipoleDiagnostics {

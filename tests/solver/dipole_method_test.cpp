@@ -348,6 +348,9 @@ TEST(DipoleMethod, RejectsBadOptionsAndScenes) {
     o = {};
     o.warning_fraction = 2;
     expect_error(o, "warning fraction above 1");
+    o = {};
+    o.back_side_samples = -1;
+    expect_error(o, "negative sample count");
     scene.q.pop_back();
     expect_error({}, "short q");
 }
@@ -401,6 +404,31 @@ TEST(DipoleMethod, EachChannelUsesItsOwnCoefficients) {
         for (const auto& phi : one.phi) peak = std::max(peak, phi[0]);
         for (size_t v = 0; v < all.phi.size(); ++v) EXPECT_NEAR(all.phi[v][c], one.phi[v][0], 1e-3 * peak);
     }
+}
+
+TEST(DipoleMethod, SpatialAdjacencyMapSamplesConvergeToTheFullSum) {
+    // The paper's real-time approximation (Eq. 12): n back-side samples per vertex. On a 4 mm slab lit
+    // on top, the unlit side's light all comes from the back side; more samples converge to the full sum.
+    const std::array<int, 3> cells{30, 30, 4};
+    const Scene scene = top_lit_box(cells, {30, 30, 4});
+    const int32_t unlit = box_vertex_index(cells, 15, 15, 0), lit = box_vertex_index(cells, 15, 15, 4);
+    DipoleDiagnostics diagnostics;
+    const MethodSolution full = solve_dipole(scene.problem(), {}, &diagnostics);
+    std::printf("all back-side vertices: unlit %.4f lit %.4f (back-side share of the exitance %.1f%%)\n", full.phi[unlit][0],
+                full.phi[lit][0], 100 * diagnostics.back_side_share);
+    double previous = 0;
+    for (int n : {1, 3, 20, 100, 1000000}) {
+        DipoleOptions options;
+        options.back_side_samples = n;
+        const MethodSolution sam = solve_dipole(scene.problem(), options);
+        std::printf("%7d back-side samples: unlit %.4f (%+.1f%% of the full sum), lit %.4f\n", n, sam.phi[unlit][0],
+                    100 * (sam.phi[unlit][0] / full.phi[unlit][0] - 1), sam.phi[lit][0]);
+        EXPECT_GT(sam.phi[unlit][0], previous);
+        EXPECT_LE(sam.phi[unlit][0], full.phi[unlit][0] * (1 + 1e-12));
+        EXPECT_NEAR(sam.phi[lit][0], full.phi[lit][0], 1e-9 * full.phi[lit][0]);  // the lit side's light is front side
+        previous = sam.phi[unlit][0];
+    }
+    EXPECT_NEAR(previous, full.phi[unlit][0], 1e-9 * full.phi[unlit][0]);
 }
 
 // Setup and evaluation cost on the shared spot mesh at its default scale (30 mm per unit, a 78 mm
