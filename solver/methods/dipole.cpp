@@ -31,6 +31,9 @@ struct SurfaceSamples {
     std::vector<double> a;                // boundary reflection parameter A
     std::vector<DipoleProfile> profile;   // 3 per sample (rgb)
     std::vector<uint8_t> grey;            // the three channels' coefficients are equal (one profile serves)
+    // Face-connected component (connectivity.h): light diffuses only within one, as in TransCut's
+    // matrix, so pieces of a fractured or cut volume do not light each other through their shared faces.
+    std::vector<int32_t> component;
 };
 
 // The 7-point degree-5 rule on a disk (Radon): the centre weighs 1/4 and six points on the circle of
@@ -95,7 +98,9 @@ SurfaceSamples surface_samples(const MethodProblem& problem) {
     std::vector<Eigen::Vector3d> normal(n, Eigen::Vector3d::Zero());
     std::vector<double> area(n, 0.0), eta(n, 0.0);
     std::vector<std::array<double, 3>> mua(n, {0, 0, 0}), musp(n, {0, 0, 0});
+    std::vector<int32_t> component(n, 0);
     for (const BoundaryFace& f : conn.boundary_faces) {
+        for (int32_t v : f.vertices) component[sample_of[v]] = conn.tet_component[f.tet];
         const auto& p = mesh.positions;
         const Eigen::Vector3d cross =
             (p[f.vertices[1]] - p[f.vertices[0]]).cross(p[f.vertices[2]] - p[f.vertices[0]]) * (mm * mm);
@@ -114,6 +119,7 @@ SurfaceSamples surface_samples(const MethodProblem& problem) {
     out.x.resize(n);
     out.n.resize(n);
     out.area = area;
+    out.component = std::move(component);
     out.rho.resize(n);
     out.a.resize(n);
     out.profile.reserve(3 * n);
@@ -153,7 +159,7 @@ bool surface_is_convex(const SurfaceSamples& s, const PointKdTree& tree, double 
             matches.clear();
             tree.radiusSearch(s.x[o].data(), radius_sq, matches, nanoflann::SearchParams(32, 0, false));
             for (const auto& [i, distance_sq] : matches)
-                if ((s.x[i] - s.x[o]).dot(s.n[o]) > 0.05 * std::sqrt(distance_sq)) {
+                if (s.component[i] == s.component[o] && (s.x[i] - s.x[o]).dot(s.n[o]) > 0.05 * std::sqrt(distance_sq)) {
                     convex = false;
                     break;
                 }
@@ -226,6 +232,7 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
     // than 3 degrees, above the faceting of a curved surface).
     const bool convex = surface_is_convex(s, tree, search_radius * search_radius);
     const bool sam = options.back_side_samples > 0;
+    const TriangleBvh* air_test = options.leave_out_air_crossings && !convex ? &bvh : nullptr;
 
     MethodSolution solution;
     solution.phi.assign(mesh.vertex_count(), {0, 0, 0});
@@ -257,6 +264,7 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                 tree.radiusSearch(s.x[o].data(), search_sq, matches, nanoflann::SearchParams(32, 0, false));
                 local_pairs += matches.size();
                 for (const auto& [i, distance_sq] : matches) {
+                    if (s.component[i] != s.component[o]) continue;
                     const bool back_side = (s.x[i] - s.x[o]).dot(s.n[o]) < 0 && s.n[i].dot(s.n[o]) < 0;
                     const double distance = std::sqrt(distance_sq);
                     if (back_side) thickness[o] = std::min(thickness[o], distance);
@@ -292,12 +300,13 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                 }
                 if (sam) {
                     const size_t keep = std::min(back_candidates.size(), static_cast<size_t>(options.back_side_samples));
-                    std::partial_sort(back_candidates.begin(), back_candidates.begin() + static_cast<std::ptrdiff_t>(keep),
-                                      back_candidates.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+                    const auto middle = back_candidates.begin() + static_cast<std::ptrdiff_t>(keep);
+                    std::partial_sort(back_candidates.begin(), middle, back_candidates.end(),
+                                      [](const auto& a, const auto& b) { return a.first > b.first; });
                     for (size_t k = 0; k < keep; ++k) contributions.push_back(back_candidates[k].second);
                 }
                 sum_contributions(s, contributions, s.x[o] - s.profile[3 * o].depth_real() * s.n[o],
-                                  options.leave_out_air_crossings && !convex ? &bvh : nullptr, exitance[o], back[o], dropped[o]);
+                                  air_test, exitance[o], back[o], dropped[o]);
             }
             pairs += local_pairs;
         });
@@ -317,7 +326,8 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
     for (size_t begin = 0; begin < interior.size(); begin += batch) {
         check_cancelled(problem.progress);
         if (problem.progress) problem.progress->set_fraction(static_cast<float>((n + begin) / total_work));
-        tbb::parallel_for(tbb::blocked_range<size_t>(begin, std::min(begin + batch, interior.size())), [&](const auto& range) {
+        const size_t end = std::min(begin + batch, interior.size());
+        tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
             std::vector<std::pair<uint32_t, double>> matches;
             std::vector<Contribution> contributions;
             size_t local_pairs = 0;
@@ -335,9 +345,10 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                 local_pairs += matches.size();
                 std::array<double, 3> phi{};
                 contributions.clear();
+                const int32_t component = conn.tet_component[conn.vertex_tets.row(v)[0]];
                 for (const auto& [i, distance_sq] : matches) {
                     const std::array<double, 3>& qi = problem.q[s.vertex[i]];
-                    if (qi[0] == 0 && qi[1] == 0 && qi[2] == 0) continue;
+                    if (s.component[i] != component || (qi[0] == 0 && qi[1] == 0 && qi[2] == 0)) continue;
                     std::array<double, 3> value{};
                     for (int c = 0; c < 3; ++c) {
                         const DipoleProfile& p = s.profile[3 * i + c];
@@ -357,8 +368,7 @@ MethodSolution solve_dipole(const MethodProblem& problem, const DipoleOptions& o
                     contributions.push_back({i, value, false});
                 }
                 double unused_back = 0, unused_dropped = 0;
-                sum_contributions(s, contributions, x, options.leave_out_air_crossings && !convex ? &bvh : nullptr, phi, unused_back,
-                                  unused_dropped);
+                sum_contributions(s, contributions, x, air_test, phi, unused_back, unused_dropped);
                 solution.phi[v] = phi;
             }
             pairs += local_pairs;

@@ -431,6 +431,33 @@ TEST(DipoleMethod, SpatialAdjacencyMapSamplesConvergeToTheFullSum) {
     EXPECT_NEAR(previous, full.phi[unlit][0], 1e-9 * full.phi[unlit][0]);
 }
 
+TEST(DipoleMethod, PiecesDoNotLightEachOther) {
+    // Two 10 mm cubes touching along x = 10 (separate vertices, like the pieces of a fracture), the
+    // first lit on top: the second stays dark, as in TransCut, whose matrix couples only shared vertices.
+    TetMesh a = make_box_mesh({10, 10, 10}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(10));
+    const TetMesh b = make_box_mesh({10, 10, 10}, Eigen::Vector3d(10, 0, 0), Eigen::Vector3d(20, 10, 10));
+    const int32_t offset = static_cast<int32_t>(a.positions.size());
+    std::vector<Eigen::Vector3d> positions = a.positions;
+    positions.insert(positions.end(), b.positions.begin(), b.positions.end());
+    std::vector<Tet> tets = a.tets;
+    for (Tet t : b.tets) {
+        for (int32_t& v : t) v += offset;
+        tets.push_back(t);
+    }
+    Scene scene(make_tet_mesh(positions, tets));
+    ASSERT_EQ(scene.conn.component_count, 2);
+    for (int32_t v : scene.conn.boundary_vertices)
+        if (v < offset && scene.mesh.positions[v].z() > 10 - 1e-9) scene.q[v] = {1, 1, 1};
+    const MethodSolution s = solve_dipole(scene.problem());
+    double lit_max = 0, dark_max = 0;
+    for (size_t v = 0; v < s.phi.size(); ++v) {
+        double& peak = static_cast<int32_t>(v) < offset ? lit_max : dark_max;
+        peak = std::max(peak, s.phi[v][0]);
+    }
+    EXPECT_GT(lit_max, 1.0);
+    EXPECT_EQ(dark_max, 0.0);
+}
+
 // Setup and evaluation cost on the shared spot mesh at its default scale (30 mm per unit, a 78 mm
 // figurine) in marble, lit everywhere; prints only (docs/method_dipole.md).
 TEST(DipoleMethod, DISABLED_PrintSpotCost) {
