@@ -458,6 +458,25 @@ TEST(DipoleMethod, PiecesDoNotLightEachOther) {
     EXPECT_EQ(dark_max, 0.0);
 }
 
+TEST(DipoleMethod, WithoutAbsorptionTheBallMissesTheTailBeyondItsDiameter) {
+    // mu_a = 0: the exact phi is 4 q / (1 - F_dr) everywhere; the profile then falls only like 1/r, and
+    // the share of it beyond the ball's diameter (13%) is missing from the surface (same chord-area
+    // argument as BallErrorPlateausAtTheModelError). Finite everywhere.
+    const TetMaterial clear{{0, 0, 0}, {1, 1, 1}, kEta};
+    Scene scene(test::make_ball_mesh(2, 2000, kRadius), clear);
+    for (int32_t v : scene.conn.boundary_vertices) scene.q[v] = {1, 1, 1};
+    const MethodSolution s = solve_dipole(scene.problem());
+    const DipoleProfile p(0, 1, kEta);
+    const double expected = 2 * (boundary_reflection_parameter(kEta) * (1 - p.reflectance_tail(2 * kRadius)) + 1);
+    double mean = 0;
+    for (int32_t v : scene.conn.boundary_vertices) mean += s.phi[v][0];
+    mean /= static_cast<double>(scene.conn.boundary_vertices.size());
+    std::printf("no absorption: surface phi %.4f, dipole on the sphere %.4f, exact %.4f\n", mean, expected,
+                4 / (1 - diffuse_fresnel_reflectance(kEta)));
+    EXPECT_NEAR(mean / expected, 1.0, 0.02);
+    for (const auto& phi : s.phi) EXPECT_TRUE(std::isfinite(phi[0]));
+}
+
 // Setup and evaluation cost on the shared spot mesh at its default scale (30 mm per unit, a 78 mm
 // figurine) in marble, lit everywhere; prints only (docs/method_dipole.md).
 TEST(DipoleMethod, DISABLED_PrintSpotCost) {
