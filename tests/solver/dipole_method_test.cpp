@@ -7,6 +7,7 @@
 #include "solver/material.h"
 #include "solver/methods/dipole.h"
 #include "solver/methods/dipole_profile.h"
+#include "solver/radiance.h"
 #include "solver/reference/analytic_ball.h"
 #include "solver_test_meshes.h"
 #include "io/surface_reader.h"
@@ -58,6 +59,31 @@ double dipole_half_space_depth(double mua, double musp, double eta, double depth
     const double s = p.sigma_tr();
     return p.reduced_albedo() / (2 * p.diffusion_coefficient() * s) * std::exp(-s * depth) *
            (std::exp(s * p.depth_real()) - std::exp(-s * p.height_virtual()));
+}
+
+// The flux per unit area that render's radiance (radiance.h, with its F_t and 1/eta^2) carries out of a
+// boundary vertex: the view-independent factor times the integral of F_t(mu) mu over the hemisphere.
+double rendered_exitance(double phi, double q, double eta) {
+    const int steps = 4000;
+    double integral = 0;
+    for (int k = 0; k < steps; ++k) {
+        const double mu = (k + 0.5) / steps;
+        integral += fresnel_transmittance(mu, eta) * mu / steps;
+    }
+    return exitant_radiance_factor(phi, q, eta, false) * 2 * std::numbers::pi * integral;
+}
+
+TEST(DipoleProfile, RenderDrawsTheDipolesExitance) {
+    // phi = 2 (A M + q) makes render's radiance carry out the dipole's exitance M, for any M and q, up
+    // to the fit of F_dr (the Egan-Hilgeman F_dr against the exact hemispherical Fresnel integral).
+    for (double eta : {1.1, 1.3, 1.5}) {
+        const double a = boundary_reflection_parameter(eta);
+        for (auto [m, q] : {std::pair{0.5, 1.0}, std::pair{0.1, 0.0}, std::pair{0.9, 2.0}}) {
+            const double out = rendered_exitance(2 * (a * m + q), q, eta);
+            std::printf("eta %.1f, M %.1f, q %.1f: render carries out %.4f\n", eta, m, q, out);
+            EXPECT_NEAR(out / m, 1.0, 0.005);
+        }
+    }
 }
 
 TEST(DipoleProfile, IntegratesToTheClosedFormReflectance) {
