@@ -18,7 +18,7 @@
 // with the Robin boundary gives J+ = (1/4) [ (1 + 1/A) phi - 4 q / (1 + F_dr) ], so that
 // L_o = F_t / (4 pi) [ ... ] = F_t J+ / pi. Of J+ the boundary lets (1 - F_dr) J+ out (the rest is the
 // reflected F_dr J+ of the same boundary condition), and the radiance render draws (with its 1 / eta^2,
-// radiance.h) carries exactly that flux out. The dipole's R_d is that escaping flux (Fick's law at the
+// radiance.h), integrated over the hemisphere, carries that flux out (to 0.2%, the fit of F_dr). The dipole's R_d is that escaping flux (Fick's law at the
 // extrapolated boundary, where the inward current is F_dr J+). So M = (1 - F_dr) J+, and
 //     phi = [ 4 M / (1 - F_dr) + 4 q / (1 + F_dr) ] / (1 + 1/A) = 2 (A M + q),
 // using 1 + 1/A = 2 / (1 + F_dr) and A (1 - F_dr) = 1 + F_dr. Without absorption R_d integrates to 1,
