@@ -18,8 +18,9 @@
 // with the Robin boundary gives J+ = (1/4) [ (1 + 1/A) phi - 4 q / (1 + F_dr) ], so that
 // L_o = F_t / (4 pi) [ ... ] = F_t J+ / pi. Of J+ the boundary lets (1 - F_dr) J+ out (the rest is the
 // reflected F_dr J+ of the same boundary condition), and the radiance render draws (with its 1 / eta^2,
-// radiance.h), integrated over the hemisphere, carries that flux out (to 0.2%, the fit of F_dr). The dipole's R_d is that escaping flux (Fick's law at the
-// extrapolated boundary, where the inward current is F_dr J+). So M = (1 - F_dr) J+, and
+// radiance.h), integrated over the hemisphere, carries that flux out (to 0.2%, the fit of F_dr). The
+// dipole's R_d is that escaping flux (Fick's law at the extrapolated boundary, where the inward current
+// is F_dr J+). So M = (1 - F_dr) J+, and
 //     phi = [ 4 M / (1 - F_dr) + 4 q / (1 + F_dr) ] / (1 + 1/A) = 2 (A M + q),
 // using 1 + 1/A = 2 / (1 + F_dr) and A (1 - F_dr) = 1 + F_dr. Without absorption R_d integrates to 1,
 // and a uniformly lit half-space gets phi = 2 (A + 1) q = 4 q / (1 - F_dr): the exact Robin solution.
@@ -29,7 +30,7 @@
 // Interior vertices get the dipole's own fluence at depth: the sum over boundary vertices of
 // q_i area_i phi_dipole(x), with each source's dipole placed along its inward normal. It is the only
 // interior field the method has; near the surface it is lower than 2 (A M + q) (the dipole's fluence
-// holds no uncollided light), deep inside it decays like the Robin solution (docs).
+// holds no uncollided light), deep inside it decays like the Robin solution, 13% above it (docs).
 //
 // Where it fails: thin parts (the profile assumes a semi-infinite medium: light through a slab thinner
 // than a few diffusion lengths is far too dark) and concave regions (Euclidean distances cross air).
