@@ -118,6 +118,10 @@ LbmSetup build_lbm_setup(const VoxelGrid& grid, const MethodProblem& problem, co
     for (int i = 0; i < kLbmDirections; ++i) l.next[i] = grid.neighbor[i];
     l.reflection.resize(grid.boundary_links.size());
     l.source.resize(grid.boundary_links.size());
+    if (options.tangential_correction) {
+        l.tangent.assign(grid.boundary_links.size(), {0, 0, 0});
+        l.tangent_gain.assign(grid.boundary_links.size(), {0, 0, 0});
+    }
     const double cell_size_units = grid.cell_size;
     std::vector<size_t> clamped(grid.boundary_links.size(), 0);
     for_rows(grid.boundary_links.size(), 256, [&](size_t k) {
@@ -141,6 +145,16 @@ LbmSetup build_lbm_setup(const VoxelGrid& grid, const MethodProblem& problem, co
             }
             l.reflection[k][ch] = r;
             l.source[k][ch] = lbm_boundary_source(r, link.q[ch], fdr);
+            // The link imposes phi + K_d d phi/ds = S; K d phi/dn = K_d (ds - t . grad) phi with t the part
+            // of the link direction along the boundary, so S gains K_d t . grad phi.
+            // The gain is at most 1/6 (a population may move by at most a difference of rho): at tau <= 1
+            // it always is, while at larger tau the full correction amplifies checkerboard modes of the
+            // lagged gradient and the iteration diverges (measured on the ball at tau = 3).
+            if (options.tangential_correction) l.tangent_gain[k][ch] = std::min((1 - r) * robin_cells, 1.0) / 6;
+        }
+        if (options.tangential_correction && normal.squaredNorm() > 0) {
+            const Eigen::Vector3d t = dir - normal.dot(dir) * normal;
+            l.tangent[k] = {t.x(), t.y(), t.z()};
         }
     });
     for (size_t k = 0; k < grid.boundary_links.size(); ++k) {

@@ -29,6 +29,10 @@ struct LbmOptions {
     int max_iterations = 500000;
     // The paper's explicit absorption (Eq. 5) instead of the implicit one (lbm_units.h).
     bool explicit_absorption = false;
+    // Correct each boundary link's source by the lagged tangential gradient so that oblique links
+    // impose the Robin condition on the normal derivative (lbm_units.h); off: each link imposes it on
+    // the derivative along itself, first order where phi varies along the boundary.
+    bool tangential_correction = true;
 };
 
 // Solves `problem` on a voxelisation with cells of options.cell_size_mm: phi at the volume's vertices.

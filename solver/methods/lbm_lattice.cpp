@@ -19,10 +19,27 @@ constexpr size_t kGrain = 1024;
 // Populations stored per cell, direction, channel: one cell's 18 doubles are contiguous.
 size_t slot(size_t cell, int direction) { return (cell * kLbmDirections + static_cast<size_t>(direction)) * 3; }
 
+// The gradient of rho at cell c in cells (per unit of cell size), from the neighbours along each axis.
+std::array<std::array<double, 3>, 3> gradient(const LbmLattice& lattice, const std::vector<std::array<double, 3>>& rho,
+                                              size_t c) {
+    std::array<std::array<double, 3>, 3> g{};  // [axis][channel]
+    for (int axis = 0; axis < 3; ++axis) {
+        const int32_t up = lattice.next[2 * axis][c], down = lattice.next[2 * axis + 1][c];
+        for (int ch = 0; ch < 3; ++ch) {
+            if (up >= 0 && down >= 0) g[axis][ch] = 0.5 * (rho[up][ch] - rho[down][ch]);
+            else if (up >= 0) g[axis][ch] = rho[up][ch] - rho[c][ch];
+            else if (down >= 0) g[axis][ch] = rho[c][ch] - rho[down][ch];
+        }
+    }
+    return g;
+}
+
 // One fused collision (Eq. 5) and streaming (Eq. 4) step from `f` into `g`; writes rho of `f` into
-// `rho_out` when given.
+// `rho_out` when given. `rho_previous` (rho of the state before `f`) feeds the boundary's tangential
+// correction when the lattice has one.
 void step(const LbmLattice& lattice, const std::vector<double>& f, std::vector<double>& g,
-          std::vector<std::array<double, 3>>* rho_out) {
+          std::vector<std::array<double, 3>>* rho_out, const std::vector<std::array<double, 3>>* rho_previous) {
+    const bool corrected = !lattice.tangent.empty() && rho_previous;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, lattice.cell_count, kGrain), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t c = r.begin(); c != r.end(); ++c) {
             const double* fc = f.data() + slot(c, 0);
@@ -43,9 +60,16 @@ void step(const LbmLattice& lattice, const std::vector<double>& f, std::vector<d
                     // the opposite direction, and the light entering through the link is added.
                     const size_t link = static_cast<size_t>(-to - 1);
                     double* out = g.data() + slot(c, i ^ 1);
+                    std::array<double, 3> source = lattice.source[link];
+                    if (corrected) {
+                        const auto grad = gradient(lattice, *rho_previous, c);
+                        const auto& t = lattice.tangent[link];
+                        for (int ch = 0; ch < 3; ++ch)
+                            source[ch] += lattice.tangent_gain[link][ch] *
+                                          (t[0] * grad[0][ch] + t[1] * grad[1][ch] + t[2] * grad[2][ch]);
+                    }
                     for (int ch = 0; ch < 3; ++ch)
-                        out[ch] = lattice.reflection[link][ch] * (keep[ch] * fc[i * 3 + ch] + eq[ch]) +
-                                  lattice.source[link][ch];
+                        out[ch] = lattice.reflection[link][ch] * (keep[ch] * fc[i * 3 + ch] + eq[ch]) + source[ch];
                 }
             }
         }
@@ -94,6 +118,9 @@ void validate_lattice(const LbmLattice& lattice) {
                                    " cells, lattice has " + std::to_string(n));
     if (lattice.reflection.size() != lattice.source.size())
         throw InvalidArgumentError("lbm: boundary links need one reflection and one source each");
+    if (!lattice.tangent.empty() &&
+        (lattice.tangent.size() != lattice.source.size() || lattice.tangent_gain.size() != lattice.source.size()))
+        throw InvalidArgumentError("lbm: the tangential correction needs one tangent and one gain per boundary link");
     const int64_t links = static_cast<int64_t>(lattice.reflection.size());
     for (int i = 0; i < kLbmDirections; ++i) {
         if (lattice.next[i].size() != n)
@@ -110,7 +137,9 @@ LbmRun run_lattice_boltzmann(const LbmLattice& lattice, const LbmIterationOption
         throw InvalidArgumentError("lbm: the iteration needs tolerance > 0, max_iterations >= 1 and check_every >= 2");
     const size_t n = lattice.cell_count;
     std::vector<double> f(n * kLbmDirections * 3, 0.0), g(f.size(), 0.0);
-    std::vector<std::array<double, 3>> rho0(n), rho1(n);
+    std::vector<std::array<double, 3>> rho0(n), rho1(n), rho_scratch;
+    const bool corrected = !lattice.tangent.empty();
+    if (corrected) rho_scratch.resize(n);
 
     LbmRun run;
     double previous_diff = -1;
@@ -119,15 +148,21 @@ LbmRun run_lattice_boltzmann(const LbmLattice& lattice, const LbmIterationOption
     while (k < options.max_iterations) {
         // check_every - 2 plain steps, then two that record rho: rho0 and rho1 are consecutive states.
         const int plain = std::min(options.check_every - 2, options.max_iterations - k - 2);
+        // With a tangential correction every step records rho (the next step's gradients need it).
         for (int s = 0; s < plain; ++s, ++k) {
-            step(lattice, f, g, nullptr);
+            if (corrected) {
+                step(lattice, f, g, &rho_scratch, &rho1);
+                rho_scratch.swap(rho1);
+            } else {
+                step(lattice, f, g, nullptr, nullptr);
+            }
             f.swap(g);
         }
-        for (auto* rho : {&rho0, &rho1}) {
-            step(lattice, f, g, rho);
-            f.swap(g);
-            ++k;
-        }
+        step(lattice, f, g, &rho0, corrected ? &rho1 : nullptr);
+        f.swap(g);
+        step(lattice, f, g, &rho1, corrected ? &rho0 : nullptr);
+        f.swap(g);
+        k += 2;
         check_cancelled(options.progress);
         const Change c = measure(rho0, rho1, g);  // g holds the populations of rho1 after the swap
         run.iterations = k - 1;  // rho1 is the state after k - 1 steps

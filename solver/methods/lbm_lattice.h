@@ -37,6 +37,11 @@ struct LbmLattice {
     // Per boundary link and channel: the population re-entering the link's cell is
     // reflection * (the post-collision population that left) + source.
     std::vector<std::array<double, 3>> reflection, source;
+    // Optional (empty, or one per link): a correction of the source by the fluence gradient along the
+    // boundary, source + tangent_gain[ch] * (tangent . grad rho), with grad rho from central (or, at
+    // the boundary, one-sided) differences of the previous step's rho around the link's cell. It lets
+    // an axis link impose a condition on the normal derivative of an oblique boundary (lbm_units.h).
+    std::vector<std::array<double, 3>> tangent, tangent_gain;
 };
 
 // Checks sizes and that every next[] entry is a cell or a link; throws InvalidArgumentError
