@@ -118,6 +118,7 @@ LbmSetup build_lbm_setup(const VoxelGrid& grid, const MethodProblem& problem, co
     for (int i = 0; i < kLbmDirections; ++i) l.next[i] = grid.neighbor[i];
     l.reflection.resize(grid.boundary_links.size());
     l.source.resize(grid.boundary_links.size());
+    l.curvature_gain.resize(grid.boundary_links.size());
     if (options.tangential_correction) {
         l.tangent.assign(grid.boundary_links.size(), {0, 0, 0});
         l.tangent_gain.assign(grid.boundary_links.size(), {0, 0, 0});
@@ -145,6 +146,7 @@ LbmSetup build_lbm_setup(const VoxelGrid& grid, const MethodProblem& problem, co
             }
             l.reflection[k][ch] = r;
             l.source[k][ch] = lbm_boundary_source(r, link.q[ch], fdr);
+            l.curvature_gain[k][ch] = lbm_boundary_curvature_gain(r, robin_cells, link.fraction);
             // The link imposes phi + K_d d phi/ds = S; K d phi/dn = K_d (ds - t . grad) phi with t the part
             // of the link direction along the boundary, so S gains K_d t . grad phi.
             // The gain is at most 1/6 (a population may move by at most a difference of rho): at tau <= 1

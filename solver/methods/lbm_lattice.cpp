@@ -40,6 +40,7 @@ std::array<std::array<double, 3>, 3> gradient(const LbmLattice& lattice, const s
 void step(const LbmLattice& lattice, const std::vector<double>& f, std::vector<double>& g,
           std::vector<std::array<double, 3>>* rho_out, const std::vector<std::array<double, 3>>* rho_previous) {
     const bool corrected = !lattice.tangent.empty() && rho_previous;
+    const bool curved = !lattice.curvature_gain.empty() && rho_previous;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, lattice.cell_count, kGrain), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t c = r.begin(); c != r.end(); ++c) {
             const double* fc = f.data() + slot(c, 0);
@@ -67,6 +68,15 @@ void step(const LbmLattice& lattice, const std::vector<double>& f, std::vector<d
                         for (int ch = 0; ch < 3; ++ch)
                             source[ch] += lattice.tangent_gain[link][ch] *
                                           (t[0] * grad[0][ch] + t[1] * grad[1][ch] + t[2] * grad[2][ch]);
+                    }
+                    if (curved) {
+                        const int32_t in1 = lattice.next[i ^ 1][c];
+                        const int32_t in2 = in1 >= 0 ? lattice.next[i ^ 1][in1] : -1;
+                        if (in2 >= 0) {
+                            const auto& rp = *rho_previous;
+                            for (int ch = 0; ch < 3; ++ch)
+                                source[ch] += lattice.curvature_gain[link][ch] * (rp[c][ch] - 2 * rp[in1][ch] + rp[in2][ch]);
+                        }
                     }
                     for (int ch = 0; ch < 3; ++ch)
                         out[ch] = lattice.reflection[link][ch] * (keep[ch] * fc[i * 3 + ch] + eq[ch]) + source[ch];
@@ -121,6 +131,8 @@ void validate_lattice(const LbmLattice& lattice) {
     if (!lattice.tangent.empty() &&
         (lattice.tangent.size() != lattice.source.size() || lattice.tangent_gain.size() != lattice.source.size()))
         throw InvalidArgumentError("lbm: the tangential correction needs one tangent and one gain per boundary link");
+    if (!lattice.curvature_gain.empty() && lattice.curvature_gain.size() != lattice.source.size())
+        throw InvalidArgumentError("lbm: the curvature correction needs one gain per boundary link");
     const int64_t links = static_cast<int64_t>(lattice.reflection.size());
     for (int i = 0; i < kLbmDirections; ++i) {
         if (lattice.next[i].size() != n)
@@ -138,7 +150,7 @@ LbmRun run_lattice_boltzmann(const LbmLattice& lattice, const LbmIterationOption
     const size_t n = lattice.cell_count;
     std::vector<double> f(n * kLbmDirections * 3, 0.0), g(f.size(), 0.0);
     std::vector<std::array<double, 3>> rho0(n), rho1(n), rho_scratch;
-    const bool corrected = !lattice.tangent.empty();
+    const bool corrected = !lattice.tangent.empty() || !lattice.curvature_gain.empty();
     if (corrected) rho_scratch.resize(n);
 
     LbmRun run;

@@ -42,6 +42,11 @@ struct LbmLattice {
     // the boundary, one-sided) differences of the previous step's rho around the link's cell. It lets
     // an axis link impose a condition on the normal derivative of an oblique boundary (lbm_units.h).
     std::vector<std::array<double, 3>> tangent, tangent_gain;
+    // Optional (empty, or one per link): a correction by the second difference of rho along the link,
+    // source + curvature_gain[ch] * (rho_c - 2 rho_c' + rho_c''), with c' and c'' the next two cells
+    // inward from the link's cell c (previous step's rho; none when the lattice is thinner than three
+    // cells there). It moves the Robin condition from half a cell to the link's crossing (lbm_units.h).
+    std::vector<std::array<double, 3>> curvature_gain;
 };
 
 // Checks sizes and that every next[] entry is a cell or a link; throws InvalidArgumentError

@@ -43,6 +43,12 @@ double lbm_boundary_reflection(double robin_length_cells, double fraction, doubl
     return (l - tau) / (l + tau - 1.0);
 }
 
+double lbm_boundary_curvature_gain(double reflection, double robin_length_cells, double fraction) {
+    // (1 - r) K is below 2 tau - 1 <= 1 for tau <= 1; at larger tau the full gain makes the lagged
+    // correction amplify checkerboard modes (the iteration diverged on the ball at tau = 3).
+    return -std::min((1.0 - reflection) * robin_length_cells, 1.0) * (fraction - 0.5) / 6.0;
+}
+
 double lbm_boundary_source(double reflection, double q, double fresnel_dr) {
     return (1.0 - reflection) * 4.0 * q / (1.0 - fresnel_dr) / 6.0;
 }

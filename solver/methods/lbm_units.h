@@ -60,6 +60,13 @@ std::array<double, 2> lbm_collision(const LbmRelaxation& relaxation, bool explic
 // state f_i = rho / 6 - tau c_i . grad rho / 6 gives r = (L - tau) / (L + tau - 1), exact for linear
 // phi. r < 0 (L < tau: cells coarser than the Robin length) is returned as is; the caller clamps.
 double lbm_boundary_reflection(double robin_length_cells, double fraction, double tau);
+// The reflection is exact for linear phi; where phi curves (absorption, a curved boundary) the
+// populations carry the gradient half a cell out, not at the crossing, an O(dx) error in the boundary
+// flux when fraction != 1/2. The gain of the second difference along the link that moves it there:
+// K d phi/ds at the crossing = K (d phi/ds at half a cell + (fraction - 1/2) d2 phi/ds2), so the source
+// gains -(1 - r) K (fraction - 1/2) d2 rho / 6 (K = robin_length_cells), with (1 - r) K capped at 1
+// (it is below 2 tau - 1 anyway for tau <= 1) so the lagged correction stays stable at large tau.
+double lbm_boundary_curvature_gain(double reflection, double robin_length_cells, double fraction);
 // The matching source per link: s = (1 - r) (4 q / (1 - F_dr)) / 6.
 double lbm_boundary_source(double reflection, double q, double fresnel_dr);
 

@@ -4,7 +4,9 @@
 #include "solver/material.h"
 #include "solver/methods/lbm.h"
 #include "solver/methods/voxel_grid.h"
+#include "io/surface_reader.h"
 #include "solver/reference/analytic_ball.h"
+#include "tetops/tetrahedralize.h"
 #include "solver_test_meshes.h"
 
 #include <gtest/gtest.h>
@@ -29,6 +31,7 @@ struct Slab {
     double tau = 1;
     double s_left = 1, s_right = 0;     // 4 q / (1 - F_dr) at each wall
     bool explicit_absorption = false;
+    bool curvature_correction = true;
 
     LbmLattice lattice() const {
         LbmLattice l;
@@ -42,6 +45,8 @@ struct Slab {
             const double r = lbm_boundary_reflection(k_cells, w == 0 ? fraction_left : fraction_right, tau);
             // q with F_dr = 0 so that the source is (1 - r) S / 6.
             const double s = lbm_boundary_source(r, (w == 0 ? s_left : s_right) / 4.0, 0.0);
+            const double g = lbm_boundary_curvature_gain(r, k_cells, w == 0 ? fraction_left : fraction_right);
+            if (curvature_correction) l.curvature_gain.push_back({g, g, g});
             l.reflection.push_back({r, r, r});
             l.source.push_back({s, s, s});
         }
@@ -168,6 +173,29 @@ BallRun solve_ball(const Ball& ball, BallLight light, const LbmOptions& options,
 }
 
 const char* name(BallLight light) { return light == BallLight::Uniform ? "uniform" : "directional"; }
+
+TEST(LbmMethod, SlabWallsOffTheHalfCellNeedTheCurvatureCorrection) {
+    // With absorption phi curves between the last cell centre and the wall; without the correction the
+    // boundary flux is off by mu_a phi (fraction - 1/2) dx: first order.
+    double with_errors[2], without_errors[2];
+    for (int k = 0; k < 2; ++k) {
+        Slab slab;
+        slab.n = k == 0 ? 20 : 40;
+        slab.dx = 10.0 / slab.n;
+        slab.kappa = 1.0 / (3 * 1.1);
+        slab.mua = 0.1;
+        slab.fraction_left = 0.2;
+        slab.fraction_right = 0.9;
+        with_errors[k] = slab.max_relative_error(run(slab));
+        slab.curvature_correction = false;
+        without_errors[k] = slab.max_relative_error(run(slab));
+        std::printf("n %d: max relative error %.3e with the curvature correction, %.3e without\n", slab.n, with_errors[k],
+                    without_errors[k]);
+    }
+    EXPECT_LT(with_errors[1], 1e-3);
+    EXPECT_LT(with_errors[1], 0.1 * without_errors[1]);
+    EXPECT_LT(std::log2(without_errors[0] / without_errors[1]), 1.2);  // the first order it removes
+}
 
 TEST(LbmMethod, BallErrorBoundsAndSecondOrder) {
     const Ball& ball = shared_ball();
@@ -371,6 +399,65 @@ TEST(LbmMethod, PrintTauTable) {
         std::printf("| %.2f | %d | %.0f | %.3f%% |", tau, d.solution.iterations[0], d.solution.solve_ms, 100 * d.error);
         for (const auto& w : d.solution.warnings) std::printf(" %s;", w.substr(0, w.find(':', 5)).c_str());
         std::printf(" |\n");
+        std::fflush(stdout);
+    }
+}
+
+// The stability table of docs/method_lbm.md: WAXWORK_PRINT_TABLES=1 build/tests/waxwork_solver_tests
+// --gtest_filter=LbmMethod.PrintStabilityTable
+TEST(LbmMethod, PrintStabilityTable) {
+    if (!std::getenv("WAXWORK_PRINT_TABLES")) GTEST_SKIP() << "set WAXWORK_PRINT_TABLES=1 to print the table";
+    std::printf("| case (slab, 10 mm, mu_a 0.1, 0.5 mm cells) | steps | converged | diverged | min rho | min population | max error |\n");
+    std::printf("|---|---|---|---|---|---|---|\n");
+    auto row = [](const char* what, const Slab& s) {
+        const LbmRun r = run(s, 1e-10, 200000);
+        std::printf("| %s | %d | %s | %s | %.2e | %.2e | %s |\n", what, r.iterations, r.converged ? "yes" : "no",
+                    r.diverged ? "yes" : "no", r.min_rho, r.min_population,
+                    r.diverged ? "-" : (std::to_string(100 * s.max_relative_error(r)).substr(0, 5) + "%").c_str());
+    };
+    for (double tau : {0.45, 0.501, 0.51, 0.55, 0.7, 1.0, 2.0, 4.0, 8.0}) {
+        char what[64];
+        std::snprintf(what, sizeof what, "tau %.3g", tau);
+        row(what, absorbing_slab(tau));
+    }
+    for (double mua : {0.5, 2.0})
+        for (bool ex : {true, false}) {
+            Slab s = absorbing_slab(1.0);
+            s.n = 10;
+            s.dx = 1.0;
+            s.mua = mua;
+            s.kappa = 1.0 / (3 * (mua + 1.0));
+            s.explicit_absorption = ex;
+            const double a = lbm_relaxation(s.kappa, s.mua, lbm_time_step(s.kappa, s.dx, 1.0), s.dx).absorption;
+            char what[96];
+            std::snprintf(what, sizeof what, "mu_a %.1f, 1 mm cells (sigma_tr dx %.1f), %s absorption a = %.2f", mua,
+                          std::sqrt(mua / s.kappa), ex ? "explicit" : "implicit", a);
+            row(what, s);
+        }
+}
+
+// Setup and solve cost on spot (50K tets, 10 cm long): WAXWORK_PRINT_TABLES=1
+// build/tests/waxwork_solver_tests --gtest_filter=LbmMethod.PrintSpotCost
+TEST(LbmMethod, PrintSpotCost) {
+    if (!std::getenv("WAXWORK_PRINT_TABLES")) GTEST_SKIP() << "set WAXWORK_PRINT_TABLES=1 to print the table";
+    MeshingOptions meshing;
+    meshing.sizing.target_tets = 50'000;
+    const TetMesh mesh =
+        tetrahedralize(load_closed_surface(std::string(WAXWORK_ASSET_DIR) + "/meshes/spot.obj").surface, meshing).mesh;
+    const TetConnectivity conn = build_connectivity(mesh);
+    Eigen::AlignedBox3d box;
+    for (const auto& p : mesh.positions) box.extend(p);
+    const double mm_per_unit = 100.0 / box.sizes().maxCoeff();
+    const std::vector<TetMaterial> materials(mesh.tet_count(), material_preset("marble"));
+    std::vector<std::array<double, 3>> q(mesh.vertex_count(), {0, 0, 0});
+    for (int32_t v : conn.boundary_vertices) q[v] = {1, 1, 1};
+    std::printf("| cell mm | cells | setup ms | solve ms | steps |\n|---|---|---|---|---|\n");
+    for (double dx : {4.0, 2.0, 1.0}) {
+        LbmOptions options;
+        options.cell_size_mm = dx;
+        const MethodSolution s = solve_lbm({mesh, conn, materials, q, mm_per_unit, nullptr}, options);
+        std::printf("| %.1f | %zu | %.0f | %.0f | %d |\n", dx, s.unknowns, s.setup_ms, s.solve_ms, s.iterations[0]);
+        for (const auto& w : s.warnings) std::printf("  warning: %s\n", w.c_str());
         std::fflush(stdout);
     }
 }
