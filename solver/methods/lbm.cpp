@@ -29,7 +29,7 @@ std::string number(double x) {
 }
 
 // The outward unit normal of the boundary face of `tet` nearest to `point` (the link's crossing), or
-// nullopt-like zero when the tet has no boundary face.
+// the zero vector when the tet has no boundary face.
 Eigen::Vector3d crossing_normal(const MethodProblem& problem, int32_t tet, const Eigen::Vector3d& point) {
     Eigen::Vector3d best = Eigen::Vector3d::Zero();
     if (tet < 0) return best;

@@ -13,18 +13,20 @@
 // mu_a dt = (tau - 1/2) (sigma_tr dx)^2 / 3.
 //
 // Stability and positivity of one collision (f* = keep f + equilibrium rho / 6 per cell):
-// - tau <= 1/2: the non-equilibrium part is multiplied by 1 - 1/tau <= -1 every step: it grows and
-//   alternates in sign (divergence). Waxwork rejects such a tau (InvalidArgumentError).
-// - 1/2 < tau < 1: stable, but 1 - 1/tau < 0 (over-relaxation): populations can go negative and the
-//   change of phi alternates in sign; near 1/2 the oscillation is barely damped and, as D -> 0 per
-//   step, convergence needs ~1/(tau - 1/2) times more steps. Waxwork warns.
+// - tau <= 1/2: the non-equilibrium part is multiplied by 1 - 1/tau <= -1 every step: it alternates in
+//   sign without decaying (tau = 1/2, and D = 0) or grows (divergence). Waxwork rejects such a tau
+//   (InvalidArgumentError).
+// - 1/2 < tau < 1: stable, but 1 - 1/tau < 0 (over-relaxation): populations and phi go negative while
+//   iterating; near 1/2 the alternation is barely damped and, as D -> 0 per step, convergence needs
+//   ~1/(tau - 1/2) times more steps. Waxwork warns.
 // - tau large: stable and positive, but the lattice then resolves a mean free path of ~tau cells, and
 //   the O(dx^2) error grows with tau; Waxwork warns above kLbmLargeTau.
 // - Absorption per step a: with the paper's explicit absorption (Eq. 5: keep = 1 - 1/tau - a)
 //   populations go negative when a > 1 - 1/tau and the run diverges when a > 2 - 1/tau. Waxwork
-//   instead removes the absorbed fraction implicitly, keep = (1 - 1/tau) / (1 + a),
-//   equilibrium = 1 / (tau (1 + a)) (the collision's backward-Euler form), which is positive for every
-//   a >= 0 and tau >= 1 and gives the exact ratio of absorption to diffusion at tau = 1. The explicit
+//   instead removes the absorbed fraction implicitly, keep = (1 - 1/tau) / (1 + b),
+//   equilibrium = 1 / (tau (1 + b)) (the collision's backward-Euler form), which is positive for every
+//   b >= 0 and tau >= 1; b = a at tau = 1 and is matched to the decay rate sigma_tr otherwise
+//   (lbm_collision). The explicit
 //   form stays available (LbmOptions::explicit_absorption) to reproduce the paper: unstable settings are
 //   rejected, non-positive ones warned.
 #pragma once
