@@ -9,6 +9,7 @@
 #include "tetops/tetrahedralize.h"
 #include "solver_test_meshes.h"
 
+#include <Eigen/Dense>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -195,6 +196,73 @@ TEST(LbmMethod, SlabWallsOffTheHalfCellNeedTheCurvatureCorrection) {
     EXPECT_LT(with_errors[1], 1e-3);
     EXPECT_LT(with_errors[1], 0.1 * without_errors[1]);
     EXPECT_LT(std::log2(without_errors[0] / without_errors[1]), 1.2);  // the first order it removes
+}
+
+// Two layers of a slab, kappa 3:1 and different mu_a: one dt for both (lbm_units.h), so the stiffer
+// layer gets a smaller tau, and the steady state must carry the flux kappa dphi/dx across the interface.
+TEST(LbmMethod, TwoMaterialSlabConvergesWithOneTimeStep) {
+    const double kappa[2] = {1.0 / (3 * 1.1), 1.0 / (3 * 3.3)}, mua[2] = {0.1, 0.3}, a_param = 2.0, thickness = 10.0;
+    double previous = 0;
+    for (int n : {20, 40, 80}) {
+        const double dx = thickness / n;
+        const double dt = lbm_time_step(kappa[0], dx, 1.0);
+        LbmLattice l;
+        l.cell_count = static_cast<size_t>(n);
+        for (auto& next : l.next) next.resize(l.cell_count);
+        std::array<double, 2> tau{};
+        for (int c = 0; c < n; ++c) {
+            const int m = c < n / 2 ? 0 : 1;
+            const LbmRelaxation r = lbm_relaxation(kappa[m], mua[m], dt, dx);
+            tau[m] = r.tau;
+            const auto coll = lbm_collision(r, false);
+            l.keep.push_back({coll[0], coll[0], coll[0]});
+            l.equilibrium.push_back({coll[1], coll[1], coll[1]});
+            l.next[0][c] = c + 1 < n ? c + 1 : -2;
+            l.next[1][c] = c > 0 ? c - 1 : -1;
+            for (int i = 2; i < kLbmDirections; ++i) l.next[i][c] = c;
+        }
+        for (int w = 0; w < 2; ++w) {  // light S = 1 enters at the left wall (layer 0) only
+            const double r = lbm_boundary_reflection(2 * a_param * kappa[w] / dx, 0.5, tau[w]);
+            const double src = lbm_boundary_source(r, w == 0 ? 0.25 : 0.0, 0.0);
+            l.reflection.push_back({r, r, r});
+            l.source.push_back({src, src, src});
+        }
+        LbmIterationOptions options;
+        options.tolerance = 1e-12;
+        options.max_iterations = 1000000;
+        const LbmRun run = run_lattice_boltzmann(l, options);
+        ASSERT_TRUE(run.converged);
+        // Exact: phi_m = alpha_m cosh(s_m y) + beta_m sinh(s_m y), y from the interface at thickness / 2;
+        // Robin at both walls, phi and kappa phi' continuous at the interface.
+        const double s0 = std::sqrt(mua[0] / kappa[0]), s1 = std::sqrt(mua[1] / kappa[1]), h = thickness / 2;
+        const double k0 = 2 * a_param * kappa[0], k1 = 2 * a_param * kappa[1];
+        Eigen::Matrix4d m;
+        Eigen::Vector4d rhs(1, 0, 0, 0);
+        // left wall y = -h, outward -x: phi - k0 phi' = 1
+        m.row(0) << std::cosh(-s0 * h) - k0 * s0 * std::sinh(-s0 * h), std::sinh(-s0 * h) - k0 * s0 * std::cosh(-s0 * h), 0, 0;
+        // right wall y = h: phi + k1 phi' = 0
+        m.row(1) << 0, 0, std::cosh(s1 * h) + k1 * s1 * std::sinh(s1 * h), std::sinh(s1 * h) + k1 * s1 * std::cosh(s1 * h);
+        m.row(2) << 1, 0, -1, 0;                                   // phi continuous
+        m.row(3) << 0, kappa[0] * s0, 0, -kappa[1] * s1;           // kappa phi' continuous
+        const Eigen::Vector4d c = m.fullPivLu().solve(rhs);
+        double err = 0, scale = 0;
+        for (int cell = 0; cell < n; ++cell) {
+            const double y = (cell + 0.5) * dx - h;
+            const double exact = cell < n / 2 ? c[0] * std::cosh(s0 * y) + c[1] * std::sinh(s0 * y)
+                                              : c[2] * std::cosh(s1 * y) + c[3] * std::sinh(s1 * y);
+            err = std::max(err, std::abs(run.rho[cell][0] - exact));
+            scale = std::max(scale, std::abs(exact));
+        }
+        err /= scale;
+        std::printf("two layers, n %d: tau %.3f / %.3f, %d steps, max relative error %.3e", n, tau[0], tau[1], run.iterations, err);
+        if (previous > 0) std::printf("  order %.2f", std::log2(previous / err));
+        std::printf("\n");
+        if (n == 80) {
+            EXPECT_LT(err, 0.005);
+            EXPECT_GT(std::log2(previous / err), 1.5);
+        }
+        previous = err;
+    }
 }
 
 TEST(LbmMethod, BallErrorBoundsAndSecondOrder) {
