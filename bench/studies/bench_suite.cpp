@@ -5,6 +5,7 @@
 #include "bench/studies/coarse_start_bound.h"
 #include "bench/studies/cut_study.h"
 #include "bench/studies/environment_study.h"
+#include "bench/studies/method_failures.h"
 #include "bench/studies/method_study.h"
 #include "bench/studies/transport_study.h"
 #include "bench/studies/provenance.h"
@@ -532,7 +533,8 @@ void run_table1_part(const BenchSuiteOptions& o, Json& index, RunProvenance& pro
 }
 
 void run_stability_part(const BenchSuiteOptions& o, Json& index, RunProvenance& provenance) {
-    const std::vector<StudyTable> tables = run_stability_studies({.quick = o.quick});
+    std::vector<StudyTable> tables = run_stability_studies({.quick = o.quick});
+    for (StudyTable& table : run_method_failure_studies({.quick = o.quick})) tables.push_back(std::move(table));
     Json json = Json::array();
     std::string markdown = "## " + titled(o, "Stability studies") +
                            "\n\nValues: one run per row (errors and iteration counts, no timings).\n\n";

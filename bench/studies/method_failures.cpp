@@ -4,15 +4,20 @@
 #include "solver/diffusion_solve.h"
 #include "solver/material.h"
 #include "solver/methods/dipole.h"
+#include "solver/methods/fd.h"
 #include "solver/methods/fvm.h"
+#include "solver/methods/lbm.h"
 #include "solver/reference/analytic_ball.h"
 #include "tetops/box_mesh.h"
 #include "tetops/connectivity.h"
+#include "tetops/fracture.h"
 #include "tetops/icosphere.h"
 #include "tetops/sliver_maker.h"
 #include "tetops/tetrahedralize.h"
 
+#include <cmath>
 #include <cstdio>
+#include <span>
 #include <string>
 
 namespace waxwork {
@@ -85,6 +90,146 @@ StudyTable study_fvm_non_delaunay(const StudySize& size) {
                               std::to_string(statistics.negative_edges) + " of " + std::to_string(statistics.edges),
                               kept(FvmSolver::Relaxation), kept(FvmSolver::Cg), percent(error_of(solve_fvm(problem, clamped))),
                               percent(transcut_error)});
+    }
+    return table;
+}
+
+namespace {
+
+// Two volumes side by side as one mesh (vertices of `b` after those of `a`), for a part the other's
+// grid cannot see.
+TetMesh joined(const TetMesh& a, const TetMesh& b) {
+    std::vector<Eigen::Vector3d> positions = a.positions;
+    positions.insert(positions.end(), b.positions.begin(), b.positions.end());
+    std::vector<Tet> tets = a.tets;
+    const auto offset = static_cast<int32_t>(a.vertex_count());
+    for (Tet tet : b.tets) {
+        for (int32_t& v : tet) v += offset;
+        tets.push_back(tet);
+    }
+    return make_tet_mesh(std::move(positions), std::move(tets));
+}
+
+}  // namespace
+
+StudyTable study_fd_cuts(const StudySize& size) {
+    StudyTable table;
+    table.name = "fd on cut and thin volumes";
+    table.what_fails =
+        "QuadGraph's finite differences live on a graph precomputed from the volume, which a cut cannot update; "
+        "Waxwork's grid is rebuilt from the volume at every solve, and a link between two cells counts only if "
+        "it crosses no boundary face, so cuts and cracks narrower than a cell separate the light as they should; "
+        "what a grid still cannot see is a part thinner than a cell, which has no cell centre inside it";
+    table.how_it_shows =
+        "phi against TransCut on the same volume (relative L2 over every vertex): a ball broken along a plane, "
+        "lit everywhere (crack faces included), and a 4 mm block beside a 0.15 mm plate, at cell sizes above and "
+        "below the plate's thickness";
+    table.what_waxwork_does =
+        "fractured and cut volumes solve without a warning; vertices of parts without a cell keep phi = 0 and "
+        "the solve warns with their count; a volume with no cell at all is an error";
+    table.columns = {"case", "cell_mm", "cells", "outcome", "relative_error_vs_transcut", "warnings"};
+    auto run = [&](const std::string& what, const TetMesh& mesh, double cell_mm) {
+        const TetConnectivity connectivity = build_connectivity(mesh);
+        const std::vector<TetMaterial> materials(mesh.tet_count(), kBallMaterial);
+        std::vector<std::array<double, 3>> q(mesh.vertex_count(), {0, 0, 0});
+        for (int32_t v : connectivity.boundary_vertices) q[v] = {1, 1, 1};
+        std::vector<nlohmann::json> row = {what, cell_mm};
+        try {
+            FdOptions options;
+            options.cell_size_mm = cell_mm;
+            const MethodSolution solution = solve_fd({mesh, connectivity, materials, q, 1.0}, options);
+            DiffusionOptions transcut;
+            transcut.relative_tolerance = 1e-8;
+            const DiffusionSolution reference = solve_diffusion(mesh, connectivity, materials, q, transcut);
+            double error = 0, norm = 0;
+            for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+                error += std::pow(solution.phi[v][0] - reference.phi[v][0], 2);
+                norm += std::pow(reference.phi[v][0], 2);
+            }
+            std::string warnings;
+            for (const std::string& w : solution.warnings) warnings += (warnings.empty() ? "" : "; ") + w;
+            row.insert(row.end(), {solution.unknowns, "solved", percent(std::sqrt(error / norm)), warnings});
+        } catch (const Error& e) {
+            row.insert(row.end(), {0, std::string("error: ") + e.what(), "-", ""});
+        }
+        table.rows.push_back(row);
+    };
+    MeshingOptions meshing;
+    meshing.sizing.target_tets = size.quick ? 3000 : 8000;
+    TetMesh broken = tetrahedralize(make_icosphere(3, kBallRadius), meshing).mesh;
+    run("ball (R = 10 mm), whole", broken, 0.5);
+    const Eigen::Vector4d plane(0, 0, 1, 0.3);
+    fracture_planes(broken, std::span<const Eigen::Vector4d>(&plane, 1));
+    run("ball broken along z = 0.3 mm", broken, 0.5);
+    const TetMesh block_and_plate =
+        joined(make_box_mesh({4, 4, 4}, Eigen::Vector3d::Zero(), Eigen::Vector3d(4, 4, 4)),
+               make_box_mesh({4, 4, 1}, Eigen::Vector3d(0, 0, 4.3), Eigen::Vector3d(4, 4, 4.45)));
+    for (double cell : size.quick ? std::vector<double>{0.5, 0.1} : std::vector<double>{1.0, 0.5, 0.25, 0.1})
+        run("4 mm block and a 0.15 mm plate", block_and_plate, cell);
+    run("a 1 mm tet alone", make_tet_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{0, 1, 2, 3}}), 2.0);
+    return table;
+}
+
+StudyTable study_lbm_relaxation(const StudySize& size) {
+    StudyTable table;
+    table.name = "lbm outside its stable range";
+    table.what_fails =
+        "lattice-Boltzmann diffusion (Bernabei et al.) relaxes with time tau: the diffusion coefficient "
+        "c_s^2 (tau - 1/2) dx^2 / dt needs tau > 1/2, tau near 1/2 makes populations negative while iterating, "
+        "large tau trades accuracy for speed, and the paper's explicit absorption mu_a dt per step turns "
+        "populations negative above 1 - 1/tau and diverges above 2 - 1/tau";
+    table.how_it_shows =
+        "the ball (R = 10 mm, 1 mm cells, directional light) against the analytic solution, and a strongly "
+        "absorbing ball (mu_a 0.5, mu_s' 1 per mm) with the paper's explicit absorption";
+    table.what_waxwork_does =
+        "tau <= 1/2 and explicit absorption beyond 2 - 1/tau are errors; tau under 1 or above 2, cells "
+        "coarser than the diffusion length and explicit absorption beyond 1 - 1/tau are warnings; by default "
+        "tau = 1 for the most diffusive material (dt chosen from it) and absorption is implicit, positive at "
+        "any mu_a dt";
+    table.columns = {"case", "steps", "outcome", "error_vs_analytic", "warnings"};
+    MeshingOptions meshing;
+    meshing.sizing.target_tets = size.quick ? 3000 : 8000;
+    const TetMesh mesh = tetrahedralize(make_icosphere(3, kBallRadius), meshing).mesh;
+    const TetConnectivity connectivity = build_connectivity(mesh);
+    auto run = [&](const std::string& what, const TetMaterial& material, const LbmOptions& options, bool exact) {
+        const std::vector<TetMaterial> materials(mesh.tet_count(), material);
+        const std::vector<std::array<double, 3>> q = ball_light(mesh, connectivity, BallLight::Directional, material.eta);
+        std::vector<nlohmann::json> row = {what};
+        try {
+            const MethodSolution solution = solve_lbm({mesh, connectivity, materials, q, 1.0}, options);
+            std::string warnings;
+            for (const std::string& w : solution.warnings) warnings += (warnings.empty() ? "" : "; ") + w;
+            row.insert(row.end(), {solution.iterations[0], "converged",
+                                   exact ? nlohmann::json(percent(ball_relative_error(mesh, connectivity, material,
+                                                                                      kBallRadius, BallLight::Directional,
+                                                                                      1.0, solution.phi)))
+                                         : nlohmann::json("-"),
+                                   warnings});
+        } catch (const Error& e) {
+            row.insert(row.end(), {0, std::string("error: ") + e.what(), "-", ""});
+        }
+        table.rows.push_back(row);
+    };
+    const std::vector<double> taus = size.quick ? std::vector<double>{0.45, 0.6, 1.0, 4.0}
+                                                : std::vector<double>{0.45, 0.55, 0.7, 1.0, 2.0, 4.0, 8.0};
+    for (double tau : taus) {
+        LbmOptions options;
+        options.cell_size_mm = 1.0;
+        options.tau = tau;
+        char what[48];
+        std::snprintf(what, sizeof what, "tau %.3g", tau);
+        run(what, kBallMaterial, options, true);
+    }
+    // sigma_tr dx = 1.5 at 1 mm cells: the explicit absorption per step a = mu_a dt.
+    const TetMaterial absorbing{{0.5, 0.5, 0.5}, {1.0, 1.0, 1.0}, 1.3};
+    for (const auto& [tau, explicit_absorption] : std::vector<std::pair<double, bool>>{{1.0, true}, {1.0, false}, {0.6, true}}) {
+        LbmOptions options;
+        options.cell_size_mm = 1.0;
+        options.tau = tau;
+        options.explicit_absorption = explicit_absorption;
+        char what[96];
+        std::snprintf(what, sizeof what, "mu_a 0.5, tau %.3g, %s absorption", tau, explicit_absorption ? "explicit" : "implicit");
+        run(what, absorbing, options, true);
     }
     return table;
 }

@@ -75,7 +75,7 @@ MethodSolution solve_alternative(const MethodProblem& problem, const Alternative
         case AlternativeMethod::FdJacobi:
         case AlternativeMethod::FdCg: {
             FdOptions options;
-            options.cell_mm = cell_mm;
+            options.cell_size_mm = cell_mm;
             options.solver = settings.method == AlternativeMethod::FdCg ? FdSolver::Cg : FdSolver::Jacobi;
             options.relative_tolerance = settings.relative_tolerance;
             return solve_fd(problem, options);
@@ -89,8 +89,8 @@ MethodSolution solve_alternative(const MethodProblem& problem, const Alternative
         }
         case AlternativeMethod::Lbm: {
             LbmOptions options;
-            options.cell_mm = cell_mm;
-            options.relative_tolerance = settings.relative_tolerance;
+            options.cell_size_mm = cell_mm;
+            options.tolerance = settings.relative_tolerance;
             return solve_lbm(problem, options);
         }
         case AlternativeMethod::Dipole:
