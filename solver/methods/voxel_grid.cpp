@@ -202,8 +202,8 @@ VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
     // own face even where another piece's face coincides with it (a crack), which a nearest-hit query
     // could not tell apart; the nearest hit along the link is the fallback for a walk that fails. A
     // link the float segment test called blocked can cross a rounding beyond the neighbour's centre:
-    // fraction 1. A link with neither (no face along it at all) keeps fraction 1, its cell's tet and no
-    // incident light.
+    // fraction 1. A link with neither (no face along it at all) keeps fraction 1, its cell's tet, no
+    // incident light and a zero normal.
     std::vector<Eigen::Vector3d> double_points(mesh.positions.begin(), mesh.positions.end());
     const FirstHitGrid first_hit(double_points, triangles);
     std::vector<std::array<int32_t, 4>> face_index(mesh.tets.size(), {-1, -1, -1, -1});
@@ -229,6 +229,10 @@ VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
         const BoundaryFace& crossed = faces[face];
         link.fraction = std::clamp(t, kMinFraction, 1.0);
         link.tet = crossed.tet;
+        const Eigen::Vector3d& a = mesh.positions[crossed.vertices[0]];
+        const Eigen::Vector3d n =
+            (mesh.positions[crossed.vertices[1]] - a).cross(mesh.positions[crossed.vertices[2]] - a).normalized();
+        if (n.allFinite()) link.normal = {n.x(), n.y(), n.z()};
         const std::array<double, 3> w = face_barycentrics(mesh, crossed.vertices, from + t * direction);
         for (int ch = 0; ch < 3; ++ch)
             for (int i = 0; i < 3; ++i) link.q[ch] += w[i] * problem.q[crossed.vertices[i]][ch];

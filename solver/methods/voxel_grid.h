@@ -39,6 +39,10 @@ struct VoxelLink {
     double fraction = 1;          // where the boundary is crossed, in (0, 1] of the cell size from the cell centre
     int32_t tet = -1;             // the tet whose boundary face is crossed (its material gives A, F_dr, eta)
     std::array<double, 3> q{};    // incident light at the crossing (interpolated on the face from vertex q)
+    // Outward unit normal of the crossed face (rest frame). A boundary condition on dphi/dn applied
+    // along an axis link needs n . axis: the axis faces of the cells cover the surface with
+    // |n_x| + |n_y| + |n_z| times its area (1.5 times on average over a sphere).
+    std::array<double, 3> normal{};
 };
 
 struct VoxelGrid {

@@ -2,6 +2,7 @@
 // across cracks and slits whose faces coincide), crossings, and sampling back at the vertices.
 #include "base/error.h"
 #include "solver/methods/voxel_grid.h"
+#include "grid_test_meshes.h"
 #include "solver_test_meshes.h"
 #include "tetops/box_mesh.h"
 
@@ -34,44 +35,6 @@ struct Scene {
         return MethodProblem{mesh, connectivity, materials, q, mm_per_unit};
     }
 };
-
-// Two meshes as one volume (vertices not shared): pieces side by side.
-TetMesh join(const TetMesh& a, const TetMesh& b) {
-    std::vector<Eigen::Vector3d> positions = a.positions;
-    positions.insert(positions.end(), b.positions.begin(), b.positions.end());
-    std::vector<Tet> tets = a.tets;
-    const int32_t offset = static_cast<int32_t>(a.vertex_count());
-    for (Tet t : b.tets) {
-        for (int32_t& v : t) v += offset;
-        tets.push_back(t);
-    }
-    return make_tet_mesh(std::move(positions), std::move(tets));
-}
-
-// The box [0,4]^3 in 8^3 cubes with a slit of zero width: the faces on the plane x = 2 with y < `depth`
-// are split (the tets on the x > 2 side get their own copies of those vertices), so the two sides
-// touch there only through coincident boundary faces, and stay connected for y > depth.
-TetMesh make_slit_box(double depth) {
-    TetMesh box = make_box_mesh({8, 8, 8}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(4));
-    std::vector<Eigen::Vector3d> positions = box.positions;
-    std::vector<int32_t> copy(positions.size(), -1);
-    for (size_t v = 0; v < box.positions.size(); ++v) {
-        const Eigen::Vector3d& p = box.positions[v];
-        if (std::abs(p.x() - 2) < 1e-12 && p.y() < depth - 1e-12) {
-            copy[v] = static_cast<int32_t>(positions.size());
-            positions.push_back(p);
-        }
-    }
-    std::vector<Tet> tets = box.tets;
-    for (Tet& t : tets) {
-        double x = 0;
-        for (int32_t v : t) x += box.positions[v].x() / 4;
-        if (x > 2)
-            for (int32_t& v : t)
-                if (copy[v] >= 0) v = copy[v];
-    }
-    return make_tet_mesh(std::move(positions), std::move(tets));
-}
 
 bool tet_contains(const TetMesh& mesh, int32_t t, const Eigen::Vector3d& p) {
     const Tet& tet = mesh.tets[t];
@@ -160,7 +123,7 @@ TEST(VoxelGrid, CrackBetweenPiecesSeparatesCells) {
     // have cells next to the crack, and no link joins them.
     const TetMesh left = make_box_mesh({2, 4, 4}, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(2, 4, 4));
     const TetMesh right = make_box_mesh({2, 4, 4}, Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(4, 4, 4));
-    const Scene scene(join(left, right));
+    const Scene scene(test::join_meshes(left, right));
     const VoxelGrid grid = voxelize(scene.problem(), 0.5);
     ASSERT_EQ(grid.cell_count(), 512u);
     int crack_links = 0;
@@ -183,7 +146,7 @@ TEST(VoxelGrid, CrackBetweenPiecesSeparatesCells) {
 }
 
 TEST(VoxelGrid, SlitNarrowerThanACellSeparatesCellsOnlyWhereItIs) {
-    const Scene scene(make_slit_box(2.0));
+    const Scene scene(test::make_slit_box(2.0));
     ASSERT_EQ(scene.connectivity.component_count, 1);
     const VoxelGrid grid = voxelize(scene.problem(), 0.5);
     for (size_t c = 0; c < grid.cell_count(); ++c) {
@@ -217,7 +180,7 @@ TEST(VoxelGrid, SamplingDoesNotLeakAcrossCracksOrSlits) {
     const TetMesh left = make_box_mesh({2, 4, 4}, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(2, 4, 4));
     const TetMesh right = make_box_mesh({2, 4, 4}, Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(4, 4, 4));
     for (const bool crack : {true, false}) {
-        const Scene scene(crack ? join(left, right) : make_slit_box(2.0));
+        const Scene scene(crack ? test::join_meshes(left, right) : test::make_slit_box(2.0));
         const VoxelGrid grid = voxelize(scene.problem(), 0.5);
         std::vector<std::array<double, 3>> values(grid.cell_count());
         for (size_t c = 0; c < values.size(); ++c) {
@@ -241,7 +204,7 @@ TEST(VoxelGrid, PartThinnerThanACellIsReportedUnsampled) {
     // A plate between two planes of cell centres, apart from a box: no cell of its own.
     const TetMesh box = make_box_mesh({4, 4, 4}, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 4, 4));
     const TetMesh plate = make_box_mesh({4, 4, 1}, Eigen::Vector3d(0, 0, 4.3), Eigen::Vector3d(4, 4, 4.45));
-    const Scene scene(join(box, plate));
+    const Scene scene(test::join_meshes(box, plate));
     const VoxelGrid grid = voxelize(scene.problem(), 0.5);
     for (size_t c = 0; c < grid.cell_count(); ++c) EXPECT_LT(static_cast<size_t>(grid.cell_tet[c]), box.tet_count());
     const std::vector<std::array<double, 3>> values(grid.cell_count(), {1, 1, 1});
