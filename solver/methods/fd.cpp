@@ -183,6 +183,7 @@ MethodSolution solve_fd(const MethodProblem& problem, const FdOptions& options) 
                                    number_text(options.cell_size_mm) +
                                    " mm (the volume is thinner than a cell); use a smaller cell size");
     const FdSystem system = assemble(grid, problem, options.boundary);
+    const VertexSampling sampling = build_vertex_sampling(grid, problem);
     solution.unknowns = grid.cell_count();
     solution.setup_ms = milliseconds_since(setup_start);
 
@@ -214,11 +215,10 @@ MethodSolution solve_fd(const MethodProblem& problem, const FdOptions& options) 
         for (size_t c = 0; c < x.size(); ++c) cell_phi[c][ch] = x[c];
         if (problem.progress) problem.progress->set_fraction(static_cast<float>((ch + 1) / 3.0));
     }
-    VertexSamplingStats stats;
-    solution.phi = sample_at_vertices(grid, problem, cell_phi, &stats);
+    solution.phi = apply_vertex_sampling(sampling, cell_phi);
     solution.solve_ms = milliseconds_since(solve_start);
-    if (stats.unsampled > 0)
-        solution.warnings.push_back("fd: " + std::to_string(stats.unsampled) +
+    if (sampling.stats.unsampled > 0)
+        solution.warnings.push_back("fd: " + std::to_string(sampling.stats.unsampled) +
                                     " vertices lie in parts thinner than a cell (" +
                                     number_text(options.cell_size_mm) +
                                     " mm) with no cell of their own; they are left dark (phi = 0): use a smaller cell size");

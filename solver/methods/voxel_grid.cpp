@@ -240,17 +240,13 @@ VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
     return grid;
 }
 
-std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, const MethodProblem& problem,
-                                                      const std::vector<std::array<double, 3>>& cell_values,
-                                                      VertexSamplingStats* stats) {
+VertexSampling build_vertex_sampling(const VoxelGrid& grid, const MethodProblem& problem) {
     const TetMesh& mesh = problem.mesh;
     const TetConnectivity& connectivity = problem.connectivity;
-    if (cell_values.size() != grid.cell_count())
-        throw InvalidArgumentError("voxel grid: " + std::to_string(cell_values.size()) + " cell values for " +
-                                   std::to_string(grid.cell_count()) + " cells");
-    std::vector<std::array<double, 3>> phi(mesh.positions.size(), std::array<double, 3>{});
     enum Case : uint8_t { kNone, kTrilinear, kFitted, kNearest, kUnsampled };
     std::vector<uint8_t> how(mesh.positions.size(), kNone);
+    // Per vertex, up to 64 (cell, weight) pairs, gathered in parallel and packed below.
+    std::vector<std::vector<std::pair<int32_t, double>>> stencils(mesh.positions.size());
     const double h = grid.cell_size;
     const TriangleBvh* bvh = grid.boundary_bvh.get();
 
@@ -278,8 +274,8 @@ std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, con
                                          static_cast<int>(std::floor(u[2]))};
         const Eigen::Vector3d f = u - Eigen::Vector3d(base[0], base[1], base[2]);
 
+        std::vector<std::pair<int32_t, double>>& stencil = stencils[v];
         // Trilinear over the eight surrounding cells when all count.
-        std::array<double, 3> value{};
         bool all = true;
         for (int corner = 0; corner < 8 && all; ++corner) {
             const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
@@ -289,17 +285,19 @@ std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, con
                 break;
             }
             const double w = (di ? f[0] : 1 - f[0]) * (dj ? f[1] : 1 - f[1]) * (dk ? f[2] : 1 - f[2]);
-            for (int ch = 0; ch < 3; ++ch) value[ch] += w * cell_values[cell][ch];
+            stencil.emplace_back(cell, w);
         }
         if (all) {
-            phi[v] = value;
             how[v] = kTrilinear;
             return;
         }
+        stencil.clear();
 
         // A weighted linear fit over the usable cells of the 4x4x4 block around the vertex.
+        // The fitted value at the vertex is linear in the cell values: cell k's weight is
+        // w_k e0^T N^-1 (1, offset_k) with N the weighted normal matrix.
         Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
-        Eigen::Matrix<double, 4, 3> rhs = Eigen::Matrix<double, 4, 3>::Zero();
+        std::vector<std::pair<int32_t, Eigen::Vector4d>> rows;
         double weight_sum = 0;
         Eigen::Vector3d mean_offset = Eigen::Vector3d::Zero();
         int count = 0;
@@ -313,7 +311,7 @@ std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, con
                                      (1 - std::abs(offset[2]) / 2.5);
                     const Eigen::Vector4d row(1, offset[0], offset[1], offset[2]);
                     normal += w * row * row.transpose();
-                    for (int ch = 0; ch < 3; ++ch) rhs.col(ch) += w * cell_values[cell][ch] * row;
+                    rows.emplace_back(cell, w * row);
                     weight_sum += w;
                     mean_offset += w * offset;
                     ++count;
@@ -328,10 +326,10 @@ std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, con
                                         .eigenvalues()
                                         .minCoeff();
             if (count >= 4 && smallest > 0.05) {
-                const Eigen::Matrix<double, 4, 3> fit = normal.ldlt().solve(rhs);
-                for (int ch = 0; ch < 3; ++ch) phi[v][ch] = std::max(0.0, fit(0, ch));
+                const Eigen::Vector4d e0 = normal.ldlt().solve(Eigen::Vector4d::UnitX());  // N symmetric
+                for (const auto& [cell, row] : rows) stencil.emplace_back(cell, e0.dot(row));
             } else {
-                for (int ch = 0; ch < 3; ++ch) phi[v][ch] = rhs(0, ch) / weight_sum;
+                for (const auto& [cell, row] : rows) stencil.emplace_back(cell, row[0] / weight_sum);
             }
             how[v] = kFitted;
             return;
@@ -355,7 +353,7 @@ std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, con
                         }
                     }
             if (best >= 0) {
-                phi[v] = cell_values[best];
+                stencil.emplace_back(best, 1.0);
                 how[v] = kNearest;
                 return;
             }
@@ -363,16 +361,46 @@ std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, con
         how[v] = kUnsampled;
     });
 
-    if (stats) {
-        *stats = {};
-        for (uint8_t c : how) {
-            stats->trilinear += c == kTrilinear;
-            stats->fitted += c == kFitted;
-            stats->nearest += c == kNearest;
-            stats->unsampled += c == kUnsampled;
+    VertexSampling sampling;
+    sampling.cell_count = grid.cell_count();
+    sampling.offsets.assign(mesh.positions.size() + 1, 0);
+    for (size_t v = 0; v < stencils.size(); ++v) {
+        sampling.offsets[v + 1] = sampling.offsets[v] + static_cast<int32_t>(stencils[v].size());
+        for (const auto& [cell, weight] : stencils[v]) {
+            sampling.cells.push_back(cell);
+            sampling.weights.push_back(weight);
         }
     }
+    for (uint8_t c : how) {
+        sampling.stats.trilinear += c == kTrilinear;
+        sampling.stats.fitted += c == kFitted;
+        sampling.stats.nearest += c == kNearest;
+        sampling.stats.unsampled += c == kUnsampled;
+    }
+    return sampling;
+}
+
+std::vector<std::array<double, 3>> apply_vertex_sampling(const VertexSampling& sampling,
+                                                         const std::vector<std::array<double, 3>>& cell_values) {
+    if (cell_values.size() != sampling.cell_count)
+        throw InvalidArgumentError("voxel grid: " + std::to_string(cell_values.size()) + " cell values for " +
+                                   std::to_string(sampling.cell_count) + " cells");
+    std::vector<std::array<double, 3>> phi(sampling.offsets.size() - 1, std::array<double, 3>{});
+    tbb::parallel_for(size_t{0}, phi.size(), [&](size_t v) {
+        for (int32_t k = sampling.offsets[v]; k < sampling.offsets[v + 1]; ++k)
+            for (int ch = 0; ch < 3; ++ch) phi[v][ch] += sampling.weights[k] * cell_values[sampling.cells[k]][ch];
+        // A linear fit can extrapolate below zero next to a steep boundary layer; phi >= 0.
+        for (int ch = 0; ch < 3; ++ch) phi[v][ch] = std::max(0.0, phi[v][ch]);
+    });
     return phi;
+}
+
+std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, const MethodProblem& problem,
+                                                      const std::vector<std::array<double, 3>>& cell_values,
+                                                      VertexSamplingStats* stats) {
+    const VertexSampling sampling = build_vertex_sampling(grid, problem);
+    if (stats) *stats = sampling.stats;
+    return apply_vertex_sampling(sampling, cell_values);
 }
 
 }  // namespace waxwork

@@ -93,18 +93,34 @@ struct VertexSamplingStats {
     size_t unsampled = 0;     // its piece has no inside cell within reach: phi = 0
 };
 
-// Per-cell values (one rgb triple per inside cell) back at the volume's vertices, with the same
-// visibility as the links: a cell counts for a vertex only when the segment from its centre to (a
-// point a hair inside the vertex's own tets from) the vertex crosses no boundary face, so values do
-// not leak across a cut or crack.
+// How per-cell values (one rgb triple per inside cell) go back to the volume's vertices: per vertex,
+// weights over cells, precomputed once per grid (they depend on geometry only) so that a solve only
+// applies them. A cell counts for a vertex only when the segment from its centre to (a point a hair
+// inside the vertex's own tets from) the vertex crosses no boundary face, the same visibility as the
+// links, so values do not leak across a cut or crack.
 //  - All eight cells whose centres surround the vertex count: trilinear interpolation (O(h^2)).
 //  - Some of the 4x4x4 cells around it count: a linear least-squares fit over them with tent weights
 //    (O(h^2) where the fit is well posed; near the boundary the vertex lies up to a cell beyond the
 //    last centres, and a weighted mean there would be only O(h)); with fewer than four cells or a
-//    degenerate spread, their weighted mean. Fitted values are clamped at zero (phi >= 0).
-//  - None: the nearest inside cell of the vertex's component within 8 cells; otherwise phi = 0 and
-//    the vertex counts as unsampled (a part thinner than a cell; the method decides how to report it).
-// Vertices of no tet get 0. `stats` (optional) receives the counts per case.
+//    degenerate spread, their weighted mean. Sampled values are clamped at zero (phi >= 0).
+//  - None: the nearest inside cell of the vertex's component within 8 cells; otherwise no weights
+//    (phi = 0) and the vertex counts as unsampled (a part thinner than a cell; the method decides how
+//    to report it).
+// Vertices of no tet get no weights.
+struct VertexSampling {
+    std::vector<int32_t> offsets{0};  // per vertex: its weights are [offsets[v], offsets[v+1])
+    std::vector<int32_t> cells;
+    std::vector<double> weights;
+    size_t cell_count = 0;
+    VertexSamplingStats stats;
+};
+VertexSampling build_vertex_sampling(const VoxelGrid& grid, const MethodProblem& problem);
+
+// phi per vertex from per-cell values (InvalidArgumentError when their count is not the grid's).
+std::vector<std::array<double, 3>> apply_vertex_sampling(const VertexSampling& sampling,
+                                                         const std::vector<std::array<double, 3>>& cell_values);
+
+// Both at once; `stats` (optional) receives the counts per case.
 std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, const MethodProblem& problem,
                                                       const std::vector<std::array<double, 3>>& cell_values,
                                                       VertexSamplingStats* stats = nullptr);

@@ -2,12 +2,16 @@
 // solution, Jacobi against CG, cracks and parts thinner than a cell, bad options and cancellation.
 #include "base/error.h"
 #include "base/progress.h"
+#include "io/surface_reader.h"
+#include "solver/diffusion_solve.h"
+#include "solver/lighting.h"
 #include "solver/material.h"
 #include "solver/methods/fd.h"
 #include "solver/methods/voxel_grid.h"
 #include "solver/reference/analytic_ball.h"
 #include "grid_test_meshes.h"
 #include "solver_test_meshes.h"
+#include "tetops/tetrahedralize.h"
 #include "tetops/box_mesh.h"
 
 #include <gtest/gtest.h>
@@ -25,29 +29,13 @@ constexpr double kMua = 0.01, kMusp = 1.0, kEta = 1.3;
 constexpr int kLegendreTerms = 60;
 const TetMaterial kMaterial{{kMua, kMua, kMua}, {kMusp, kMusp, kMusp}, kEta};
 
-struct Scene {
-    TetMesh mesh;
-    TetConnectivity connectivity;
-    std::vector<TetMaterial> materials;
-    std::vector<std::array<double, 3>> q;
-
-    explicit Scene(TetMesh m) : mesh(std::move(m)) {
-        connectivity = build_connectivity(mesh);
-        materials.assign(mesh.tet_count(), kMaterial);
-        q.assign(mesh.vertex_count(), std::array<double, 3>{});
-    }
-    MethodProblem problem(Progress* progress = nullptr) const {
-        return MethodProblem{mesh, connectivity, materials, q, 1.0, progress};
-    }
-};
-
-enum class Light { Uniform, Directional };
+using Scene = test::MethodScene;
 
 // The ball of radius 10 mm with a fine surface (icosphere level 4: the polyhedron's own solution is
 // within 0.1% of the sphere's), shared by the tests that need it.
-const Scene& ball(Light light) {
+const Scene& ball(BallLight light) {
     static const TetMesh mesh = test::make_ball_mesh(4, 40000, kRadius);
-    static Scene uniform(mesh), directional(mesh);
+    static Scene uniform(mesh, kMaterial), directional(mesh, kMaterial);
     static const bool lit = [] {
         for (int32_t v : uniform.connectivity.boundary_vertices) {
             uniform.q[v] = {1, 1, 1};
@@ -57,7 +45,7 @@ const Scene& ball(Light light) {
         return true;
     }();
     (void)lit;
-    return light == Light::Uniform ? uniform : directional;
+    return light == BallLight::Uniform ? uniform : directional;
 }
 
 struct BallError {
@@ -66,12 +54,12 @@ struct BallError {
     MethodSolution solution;
 };
 
-BallError ball_error(Light light, const FdOptions& options) {
+BallError ball_error(BallLight light, const FdOptions& options) {
     const Scene& scene = ball(light);
     BallError result;
     result.solution = solve_fd(scene.problem(), options);
     const AnalyticBall exact(kRadius, kMua, kMusp, kEta,
-                             light == Light::Uniform ? std::vector<double>{1.0}
+                             light == BallLight::Uniform ? std::vector<double>{1.0}
                                                      : directional_ball_light_coefficients(kLegendreTerms, kEta));
     std::vector<double> volume(scene.mesh.vertex_count(), 0.0);
     for (size_t t = 0; t < scene.mesh.tet_count(); ++t)
@@ -110,8 +98,8 @@ TEST(FdMethod, PrintBallTable) {
                 if (solver == FdSolver::Jacobi && cell < 0.5) continue;
                 FdOptions options = with_cell(cell, boundary, solver);
                 options.relative_tolerance = 1e-6;
-                const BallError u = ball_error(Light::Uniform, options);
-                const BallError d = ball_error(Light::Directional, options);
+                const BallError u = ball_error(BallLight::Uniform, options);
+                const BallError d = ball_error(BallLight::Directional, options);
                 std::printf("| %s | %s | %.2f | %zu | %.0f | %.0f | %d | %.2e | %.2e | %.2e | %.2e |\n",
                             boundary == FdBoundary::Fraction ? "fraction" : "staircase",
                             solver == FdSolver::Cg ? "CG" : "Jacobi", cell, u.solution.unknowns, u.solution.setup_ms,
@@ -122,14 +110,14 @@ TEST(FdMethod, PrintBallTable) {
 
 TEST(FdMethod, BallErrorAtFixedResolutions) {
     // Measured: 3.7e-3 (uniform) and 1.1e-2 (directional) at 1 mm, 1.9e-2 and 2.5e-2 at 2 mm.
-    const BallError u1 = ball_error(Light::Uniform, with_cell(1.0));
-    const BallError d1 = ball_error(Light::Directional, with_cell(1.0));
+    const BallError u1 = ball_error(BallLight::Uniform, with_cell(1.0));
+    const BallError d1 = ball_error(BallLight::Directional, with_cell(1.0));
     EXPECT_LT(u1.all, 6e-3);
     EXPECT_LT(d1.all, 1.6e-2);
     EXPECT_EQ(u1.solution.unknowns, 4224u);
     EXPECT_TRUE(u1.solution.warnings.empty());
-    const BallError u2 = ball_error(Light::Uniform, with_cell(2.0));
-    const BallError d2 = ball_error(Light::Directional, with_cell(2.0));
+    const BallError u2 = ball_error(BallLight::Uniform, with_cell(2.0));
+    const BallError d2 = ball_error(BallLight::Directional, with_cell(2.0));
     EXPECT_LT(u2.all, 3e-2);
     EXPECT_LT(d2.all, 4e-2);
 }
@@ -142,8 +130,8 @@ TEST(FdMethod, BallErrorFallsWithTheCellSize) {
     double uniform[3], directional[3];
     const double cells[3] = {2.0, 1.0, 0.5};
     for (int i = 0; i < 3; ++i) {
-        uniform[i] = ball_error(Light::Uniform, with_cell(cells[i])).all;
-        directional[i] = ball_error(Light::Directional, with_cell(cells[i])).all;
+        uniform[i] = ball_error(BallLight::Uniform, with_cell(cells[i])).all;
+        directional[i] = ball_error(BallLight::Directional, with_cell(cells[i])).all;
     }
     for (int i = 0; i < 2; ++i) {
         EXPECT_GT(uniform[i] / uniform[i + 1], 3.2) << cells[i + 1];
@@ -155,8 +143,8 @@ TEST(FdMethod, JacobiAndCgSolveTheSameSystem) {
     FdOptions jacobi = with_cell(2.0, FdBoundary::Fraction, FdSolver::Jacobi);
     FdOptions cg = with_cell(2.0, FdBoundary::Fraction, FdSolver::Cg);
     jacobi.relative_tolerance = cg.relative_tolerance = 1e-9;
-    const MethodSolution a = solve_fd(ball(Light::Directional).problem(), jacobi);
-    const MethodSolution b = solve_fd(ball(Light::Directional).problem(), cg);
+    const MethodSolution a = solve_fd(ball(BallLight::Directional).problem(), jacobi);
+    const MethodSolution b = solve_fd(ball(BallLight::Directional).problem(), cg);
     EXPECT_GT(a.iterations[0], 5 * b.iterations[0]);  // the relaxation needs many more sweeps
     double largest = 0, difference = 0;
     for (size_t v = 0; v < a.phi.size(); ++v) {
@@ -289,7 +277,7 @@ TEST(FdMethod, RejectsBadOptionsAndInputs) {
 TEST(FdMethod, StopsAtMaxIterationsWithAWarning) {
     FdOptions options = with_cell(2.0, FdBoundary::Fraction, FdSolver::Jacobi);
     options.max_iterations = 3;
-    const MethodSolution solution = solve_fd(ball(Light::Uniform).problem(), options);
+    const MethodSolution solution = solve_fd(ball(BallLight::Uniform).problem(), options);
     EXPECT_EQ(solution.iterations, (std::array<int, 3>{3, 3, 3}));
     EXPECT_EQ(solution.warnings.size(), 3u);
 }
@@ -309,12 +297,50 @@ private:
 };
 
 TEST(FdMethod, Cancels) {
-    const Scene& scene = ball(Light::Uniform);
+    const Scene& scene = ball(BallLight::Uniform);
     for (const auto& [solver, stage] :
          {std::pair{FdSolver::Cg, "fd: CG"}, std::pair{FdSolver::Jacobi, "fd: Jacobi"}, std::pair{FdSolver::Cg, "fd: grid"}}) {
         CancelAtStage progress(stage);
-        EXPECT_THROW(solve_fd(scene.problem(&progress), with_cell(1.0, FdBoundary::Fraction, solver)), CancelledError)
+        EXPECT_THROW(solve_fd(scene.problem(1.0, &progress), with_cell(1.0, FdBoundary::Fraction, solver)), CancelledError)
             << stage;
+    }
+}
+
+TEST(FdMethod, PrintSpotCost) {
+    // Setup and solve cost on spot (100K tets, marble, 100 mm long, lit from +z without shadows, as
+    // the benchmarks light it) and the difference from TransCut's solve on the same tets.
+    if (!std::getenv("WAXWORK_PRINT_TABLES")) GTEST_SKIP() << "set WAXWORK_PRINT_TABLES=1 to print the table";
+    const LoadedSurface surface = load_closed_surface(std::string(WAXWORK_SHARED_DIR) + "/data/meshes/spot.obj");
+    MeshingOptions meshing;
+    meshing.sizing.target_tets = 100000;
+    Scene scene(tetrahedralize(surface.surface, meshing).mesh);
+    const auto box = bounding_box(scene.mesh);
+    const double mm_per_unit = 100.0 / (box[1] - box[0]).maxCoeff();
+    scene.materials.assign(scene.mesh.tet_count(), material_preset("marble"));
+    Lighting lighting;
+    lighting.lights.push_back(Light{LightType::Directional, Eigen::Vector3d(0, 0, -1), {1, 1, 1}});
+    lighting.shadows = false;
+    scene.q = incident_light(scene.mesh, scene.connectivity, scene.materials, lighting);
+    DiffusionOptions transcut;
+    transcut.mm_per_unit = mm_per_unit;
+    transcut.relative_tolerance = 1e-6;
+    const DiffusionSolution reference = solve_diffusion(scene.mesh, scene.connectivity, scene.materials, scene.q, transcut);
+    std::printf("spot: %zu tets, %zu vertices\n", scene.mesh.tet_count(), scene.mesh.vertex_count());
+    std::printf("| cell mm | cells | setup ms | solve ms | CG iterations | relative L2 difference from TransCut (vertices) |\n");
+    std::printf("|---|---|---|---|---|---|\n");
+    for (const double cell : {4.0, 2.0, 1.0, 0.5}) {
+        FdOptions options = with_cell(cell);
+        options.relative_tolerance = 1e-5;
+        const MethodProblem problem{scene.mesh, scene.connectivity, scene.materials, scene.q, mm_per_unit};
+        const MethodSolution solution = solve_fd(problem, options);
+        double difference = 0, norm = 0;
+        for (size_t v = 0; v < solution.phi.size(); ++v) {
+            difference += std::pow(solution.phi[v][0] - reference.phi[v][0], 2);
+            norm += std::pow(reference.phi[v][0], 2);
+        }
+        std::printf("| %.1f | %zu | %.0f | %.0f | %d | %.3f |\n", cell, solution.unknowns, solution.setup_ms,
+                    solution.solve_ms, solution.iterations[0], std::sqrt(difference / norm));
+        std::fflush(stdout);
     }
 }
 

@@ -1,13 +1,31 @@
-// Volumes with cracks and slits narrower than any cell, shared by the grid methods' tests.
+// The problems the grid methods' tests solve: volumes with cracks and slits narrower than any cell.
 #pragma once
 
+#include "solver/methods/method_problem.h"
 #include "tetops/box_mesh.h"
+#include "tetops/connectivity.h"
 #include "tetops/tet_mesh.h"
 
 #include <cmath>
 #include <vector>
 
 namespace waxwork::test {
+
+// A volume with everything a MethodProblem refers to: one material everywhere (the ball's standard
+// one unless given), no light until a test sets q.
+struct MethodScene {
+    TetMesh mesh;
+    TetConnectivity connectivity;
+    std::vector<TetMaterial> materials;
+    std::vector<std::array<double, 3>> q;
+
+    explicit MethodScene(TetMesh m, const TetMaterial& material = {{0.01, 0.01, 0.01}, {1, 1, 1}, 1.3})
+        : mesh(std::move(m)), connectivity(build_connectivity(mesh)), materials(mesh.tet_count(), material),
+          q(mesh.vertex_count(), std::array<double, 3>{}) {}
+    MethodProblem problem(double mm_per_unit = 1.0, Progress* progress = nullptr) const {
+        return MethodProblem{mesh, connectivity, materials, q, mm_per_unit, progress};
+    }
+};
 
 // Two meshes as one volume (vertices not shared): pieces side by side, their touching faces a crack
 // of zero width, as a fracture leaves them in the rest frame.

@@ -14,25 +14,12 @@
 namespace waxwork {
 namespace {
 
-// A mesh with everything a MethodProblem refers to; q is a given function of position on the
-// boundary vertices (zero inside).
-struct Scene {
-    TetMesh mesh;
-    TetConnectivity connectivity;
-    std::vector<TetMaterial> materials;
-    std::vector<std::array<double, 3>> q;
+std::array<double, 3> linear_q(const Eigen::Vector3d& p) { return {1 + p.x(), 2 + 2 * p.y(), 3 + 3 * p.z()}; }
 
-    explicit Scene(TetMesh m) : mesh(std::move(m)) {
-        connectivity = build_connectivity(mesh);
-        materials.assign(mesh.tet_count(), TetMaterial{{0.01, 0.01, 0.01}, {1, 1, 1}, 1.3});
-        q.assign(mesh.vertex_count(), std::array<double, 3>{});
+// A volume whose q is linear in position on the boundary vertices (zero inside).
+struct Scene : test::MethodScene {
+    explicit Scene(TetMesh m) : MethodScene(std::move(m)) {
         for (int32_t v : connectivity.boundary_vertices) q[v] = linear_q(mesh.positions[v]);
-    }
-    static std::array<double, 3> linear_q(const Eigen::Vector3d& p) {
-        return {1 + p.x(), 2 + 2 * p.y(), 3 + 3 * p.z()};
-    }
-    MethodProblem problem(double mm_per_unit = 1.0) const {
-        return MethodProblem{mesh, connectivity, materials, q, mm_per_unit};
     }
 };
 
@@ -76,7 +63,7 @@ TEST(VoxelGrid, BoxCellsLinksAndCrossings) {
         const Eigen::Vector3d x = crossing(grid, link);
         EXPECT_TRUE(tet_contains(scene.mesh, link.tet, x));
         // q is linear on the boundary, so its interpolation on the crossed face is exact.
-        const auto expected = Scene::linear_q(x);
+        const auto expected = linear_q(x);
         for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(link.q[ch], expected[ch], 1e-9);
     }
     // Model units: 2 mm per unit halves the cells per axis.
