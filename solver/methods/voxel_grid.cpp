@@ -249,6 +249,26 @@ VertexSampling build_vertex_sampling(const VoxelGrid& grid, const MethodProblem&
     std::vector<std::vector<std::pair<int32_t, double>>> stencils(mesh.positions.size());
     const double h = grid.cell_size;
     const TriangleBvh* bvh = grid.boundary_bvh.get();
+    // Voxels that a boundary face's box overlaps: a segment inside voxels none of which is marked
+    // crosses no face, and needs no ray (most vertices inside).
+    std::vector<uint8_t> near_face(grid.voxel_count(), 0);
+    tbb::parallel_for(size_t{0}, connectivity.boundary_faces.size(), [&](size_t f) {
+        Eigen::Vector3d lo = mesh.positions[connectivity.boundary_faces[f].vertices[0]], hi = lo;
+        for (int32_t w : connectivity.boundary_faces[f].vertices) {
+            lo = lo.cwiseMin(mesh.positions[w]);
+            hi = hi.cwiseMax(mesh.positions[w]);
+        }
+        std::array<int, 3> first{}, last{};
+        for (int k = 0; k < 3; ++k) {
+            first[k] = std::clamp(static_cast<int>(std::floor((lo[k] - grid.origin[k]) / h)) - 1, 0, grid.dims[k] - 1);
+            last[k] = std::clamp(static_cast<int>(std::floor((hi[k] - grid.origin[k]) / h)) + 1, 0, grid.dims[k] - 1);
+        }
+        for (int k = first[2]; k <= last[2]; ++k)
+            for (int j = first[1]; j <= last[1]; ++j)
+                for (int i = first[0]; i <= last[0]; ++i)
+                    std::atomic_ref<uint8_t>(near_face[i + static_cast<size_t>(grid.dims[0]) * (j + static_cast<size_t>(grid.dims[1]) * k)])
+                        .store(1, std::memory_order_relaxed);
+    });
 
     tbb::parallel_for(size_t{0}, mesh.positions.size(), [&](size_t v) {
         const auto tets = connectivity.vertex_tets.row(v);
@@ -262,9 +282,10 @@ VertexSampling build_vertex_sampling(const VoxelGrid& grid, const MethodProblem&
         centroid /= 4.0 * static_cast<double>(tets.size());
         const Eigen::Vector3f target = to_float(p + 1e-3 * (centroid - p));
         const int32_t component = connectivity.tet_component[tets[0]];
+        bool clear = false;  // the eight voxels around the vertex are away from every face
         const auto usable = [&](int32_t cell) {
             if (cell < 0 || connectivity.tet_component[grid.cell_tet[cell]] != component) return false;
-            if (!bvh) return true;
+            if (!bvh || clear) return true;
             const Eigen::Vector3f from = to_float(grid.cell_centre(cell));
             return !bvh->occluded(from, target - from, 0.0f, 1.0f);
         };
@@ -275,6 +296,12 @@ VertexSampling build_vertex_sampling(const VoxelGrid& grid, const MethodProblem&
         const Eigen::Vector3d f = u - Eigen::Vector3d(base[0], base[1], base[2]);
 
         std::vector<std::pair<int32_t, double>>& stencil = stencils[v];
+        clear = (target.cast<double>() - p).norm() < 0.25 * h;
+        for (int corner = 0; corner < 8 && clear; ++corner) {
+            const int i = base[0] + (corner & 1), j = base[1] + ((corner >> 1) & 1), k = base[2] + ((corner >> 2) & 1);
+            clear = i >= 0 && j >= 0 && k >= 0 && i < grid.dims[0] && j < grid.dims[1] && k < grid.dims[2] &&
+                    !near_face[i + static_cast<size_t>(grid.dims[0]) * (j + static_cast<size_t>(grid.dims[1]) * k)];
+        }
         // Trilinear over the eight surrounding cells when all count.
         bool all = true;
         for (int corner = 0; corner < 8 && all; ++corner) {
@@ -292,45 +319,56 @@ VertexSampling build_vertex_sampling(const VoxelGrid& grid, const MethodProblem&
             return;
         }
         stencil.clear();
+        clear = false;
 
-        // A weighted linear fit over the usable cells of the 4x4x4 block around the vertex.
-        // The fitted value at the vertex is linear in the cell values: cell k's weight is
-        // w_k e0^T N^-1 (1, offset_k) with N the weighted normal matrix.
-        Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
-        std::vector<std::pair<int32_t, Eigen::Vector4d>> rows;
-        double weight_sum = 0;
-        Eigen::Vector3d mean_offset = Eigen::Vector3d::Zero();
-        int count = 0;
-        for (int dk = -1; dk <= 2; ++dk)
-            for (int dj = -1; dj <= 2; ++dj)
-                for (int di = -1; di <= 2; ++di) {
-                    const int32_t cell = grid.cell_at(base[0] + di, base[1] + dj, base[2] + dk);
-                    if (!usable(cell)) continue;
-                    const Eigen::Vector3d offset = (grid.cell_centre(cell) - p) / h;  // in cells
-                    const double w = (1 - std::abs(offset[0]) / 2.5) * (1 - std::abs(offset[1]) / 2.5) *
-                                     (1 - std::abs(offset[2]) / 2.5);
-                    const Eigen::Vector4d row(1, offset[0], offset[1], offset[2]);
-                    normal += w * row * row.transpose();
-                    rows.emplace_back(cell, w * row);
-                    weight_sum += w;
-                    mean_offset += w * offset;
-                    ++count;
-                }
-        if (count > 0) {
+        // A weighted linear fit over the usable cells of a block: first the 3x3x3 block around the
+        // nearest voxel (clamped into the grid), then, where that does not determine a plane, the
+        // 4x4x4 block around the vertex. The fitted value at the vertex is linear in the cell values:
+        // cell k's weight is w_k e0^T N^-1 (1, offset_k) with N the weighted normal matrix. Where no
+        // block determines a plane, the weighted mean of the larger block's cells.
+        const auto fit = [&](const std::array<int, 3>& first, int size, bool accept_mean) {
+            Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+            std::vector<std::pair<int32_t, Eigen::Vector4d>> rows;
+            double weight_sum = 0;
+            Eigen::Vector3d mean_offset = Eigen::Vector3d::Zero();
+            for (int dk = 0; dk < size; ++dk)
+                for (int dj = 0; dj < size; ++dj)
+                    for (int di = 0; di < size; ++di) {
+                        const int32_t cell = grid.cell_at(first[0] + di, first[1] + dj, first[2] + dk);
+                        if (!usable(cell)) continue;
+                        const Eigen::Vector3d offset = (grid.cell_centre(cell) - p) / h;  // in cells
+                        const double w = (1 - std::abs(offset[0]) / 2.5) * (1 - std::abs(offset[1]) / 2.5) *
+                                         (1 - std::abs(offset[2]) / 2.5);
+                        const Eigen::Vector4d row(1, offset[0], offset[1], offset[2]);
+                        normal += w * row * row.transpose();
+                        rows.emplace_back(cell, w * row);
+                        weight_sum += w;
+                        mean_offset += w * offset;
+                    }
+            if (rows.empty()) return false;
             // The spread of the cells (weighted covariance, in cells^2) decides whether a plane is
-            // determined; otherwise the weighted mean.
+            // determined.
             mean_offset /= weight_sum;
             const Eigen::Matrix3d spread =
                 normal.bottomRightCorner<3, 3>() / weight_sum - mean_offset * mean_offset.transpose();
             const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(spread, Eigen::EigenvaluesOnly)
                                         .eigenvalues()
                                         .minCoeff();
-            if (count >= 4 && smallest > 0.05) {
+            if (rows.size() >= 4 && smallest > 0.05) {
                 const Eigen::Vector4d e0 = normal.ldlt().solve(Eigen::Vector4d::UnitX());  // N symmetric
                 for (const auto& [cell, row] : rows) stencil.emplace_back(cell, e0.dot(row));
-            } else {
-                for (const auto& [cell, row] : rows) stencil.emplace_back(cell, row[0] / weight_sum);
+                return true;
             }
+            if (!accept_mean) return false;
+            for (const auto& [cell, row] : rows) stencil.emplace_back(cell, row[0] / weight_sum);
+            return true;
+        };
+        std::array<int, 3> around_nearest{}, around_base{};
+        for (int k = 0; k < 3; ++k) {
+            around_nearest[k] = std::clamp(static_cast<int>(std::lround(u[k])), 0, grid.dims[k] - 1) - 1;
+            around_base[k] = base[k] - 1;
+        }
+        if (fit(around_nearest, 3, false) || fit(around_base, 4, true)) {
             how[v] = kFitted;
             return;
         }

@@ -97,12 +97,14 @@ struct VertexSamplingStats {
 // weights over cells, precomputed once per grid (they depend on geometry only) so that a solve only
 // applies them. A cell counts for a vertex only when the segment from its centre to (a point a hair
 // inside the vertex's own tets from) the vertex crosses no boundary face, the same visibility as the
-// links, so values do not leak across a cut or crack.
+// links, so values do not leak across a cut or crack (no segment is tested where no boundary face
+// comes near the eight voxels around the vertex).
 //  - All eight cells whose centres surround the vertex count: trilinear interpolation (O(h^2)).
-//  - Some of the 4x4x4 cells around it count: a linear least-squares fit over them with tent weights
-//    (O(h^2) where the fit is well posed; near the boundary the vertex lies up to a cell beyond the
-//    last centres, and a weighted mean there would be only O(h)); with fewer than four cells or a
-//    degenerate spread, their weighted mean. Sampled values are clamped at zero (phi >= 0).
+//  - Some count: a linear least-squares fit with tent weights over the usable cells of the 3x3x3
+//    block around the nearest voxel, or of the 4x4x4 block around the vertex where the first does not
+//    determine a plane (O(h^2) where the fit is well posed; near the boundary the vertex lies up to a
+//    cell beyond the last centres, and a weighted mean there would be only O(h)); with fewer than four
+//    cells or a degenerate spread, their weighted mean. Sampled values are clamped at zero (phi >= 0).
 //  - None: the nearest inside cell of the vertex's component within 8 cells; otherwise no weights
 //    (phi = 0) and the vertex counts as unsampled (a part thinner than a cell; the method decides how
 //    to report it).
