@@ -92,8 +92,11 @@ FdSystem assemble(const VoxelGrid& grid, const MethodProblem& problem, FdBoundar
             // Eq. 6 along the link: its one-sided difference is the derivative along the axis, which
             // is n . axis times dphi/dn, so the Robin resistance 2A grows by 1 / (n . axis).
             const auto& axis = kVoxelDirections[link.direction];
-            const double cosine = std::max(
-                1e-6, std::abs(link.normal[0] * axis[0] + link.normal[1] * axis[1] + link.normal[2] * axis[2]));
+            const double cosine =
+                boundary == FdBoundary::Cubes
+                    ? 1.0
+                    : std::max(1e-6, std::abs(link.normal[0] * axis[0] + link.normal[1] * axis[1] +
+                                              link.normal[2] * axis[2]));
             for (int ch = 0; ch < 3; ++ch) {
                 const double conductance = h * h / (distance / kappa_of(link.tet, ch) + 2 * a / cosine);
                 system.values[ch][diagonal] += conductance;
