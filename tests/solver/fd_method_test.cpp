@@ -112,7 +112,7 @@ TEST(FdMethod, PrintBallTable) {
 }
 
 TEST(FdMethod, BallErrorAtFixedResolutions) {
-    // Measured: 3.7e-3 (uniform) and 1.1e-2 (directional) at 1 mm, 1.9e-2 and 2.5e-2 at 2 mm.
+    // Measured: 3.1e-3 (uniform) and 1.2e-2 (directional) at 1 mm, 1.6e-2 and 2.4e-2 at 2 mm.
     const BallError u1 = ball_error(BallLight::Uniform, with_cell(1.0));
     const BallError d1 = ball_error(BallLight::Directional, with_cell(1.0));
     EXPECT_LT(u1.all, 6e-3);
@@ -126,8 +126,8 @@ TEST(FdMethod, BallErrorAtFixedResolutions) {
 }
 
 TEST(FdMethod, BallErrorFallsWithTheCellSize) {
-    // Uniform light: second order (ratios 5.1 and 4.7 per halving measured) while the solution has no
-    // tangential gradient at the boundary. Directional light: first order (2.3 and 2.1), because each
+    // Uniform light: second order (ratios 5.0 and 4.1 per halving measured) while the solution has no
+    // tangential gradient at the boundary. Directional light: first order (2.0 and 2.0), because each
     // boundary link imposes Eq. 6 with its axis derivative taken as (n . axis) dphi/dn, which drops the
     // tangential part of the gradient (docs/method_fd.md).
     double uniform[3], directional[3];
@@ -144,8 +144,8 @@ TEST(FdMethod, BallErrorFallsWithTheCellSize) {
 
 TEST(FdMethod, TheCubesOwnBoundaryDoesNotConverge) {
     // Without the crossed face's normal the Robin exchange is counted over the staircase's area
-    // (1.5 times the sphere's): about 4.4% error at every cell size (measured 4.5% at 1 mm, 4.4% at
-    // 0.5 mm), against 0.37% and 0.08% with it.
+    // (1.5 times the sphere's): about 4.4% error at every cell size (measured 4.3% at 1 mm, 4.4% at
+    // 0.5 mm), against 0.31% and 0.075% with it.
     const double at_1 = ball_error(BallLight::Uniform, with_cell(1.0, FdBoundary::Cubes)).all;
     const double at_half = ball_error(BallLight::Uniform, with_cell(0.5, FdBoundary::Cubes)).all;
     EXPECT_GT(at_1, 3e-2);
