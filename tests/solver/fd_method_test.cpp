@@ -54,8 +54,7 @@ struct BallError {
     MethodSolution solution;
 };
 
-BallError ball_error(BallLight light, const FdOptions& options) {
-    const Scene& scene = ball(light);
+BallError ball_error(const Scene& scene, BallLight light, const FdOptions& options) {
     BallError result;
     result.solution = solve_fd(scene.problem(), options);
     const AnalyticBall exact(kRadius, kMua, kMusp, kEta,
@@ -78,6 +77,8 @@ BallError ball_error(BallLight light, const FdOptions& options) {
     result.interior = std::sqrt(error[1] / norm[1]);
     return result;
 }
+
+BallError ball_error(BallLight light, const FdOptions& options) { return ball_error(ball(light), light, options); }
 
 FdOptions with_cell(double cell_size_mm, FdBoundary boundary = FdBoundary::Fraction, FdSolver solver = FdSolver::Cg) {
     FdOptions options;
@@ -317,6 +318,20 @@ TEST(FdMethod, Cancels) {
         CancelAtStage progress(stage);
         EXPECT_THROW(solve_fd(scene.problem(1.0, &progress), with_cell(1.0, FdBoundary::Fraction, solver)), CancelledError)
             << stage;
+    }
+}
+
+TEST(FdMethod, PrintFinerSurface) {
+    // The uniform-light error at 0.5 and 0.25 mm with the level-4 surface of the other tests and a
+    // level-5 one: whether the floor at 0.25 mm is the polyhedral surface's.
+    if (!std::getenv("WAXWORK_PRINT_TABLES")) GTEST_SKIP() << "set WAXWORK_PRINT_TABLES=1 to print the table";
+    std::printf("| surface | tets | cell mm | uniform err |\n|---|---|---|---|\n");
+    for (const int level : {4, 5}) {
+        Scene scene(test::make_ball_mesh(level, level == 4 ? 40000 : 150000, kRadius), kMaterial);
+        for (int32_t v : scene.connectivity.boundary_vertices) scene.q[v] = {1, 1, 1};
+        for (const double cell : {0.5, 0.25})
+            std::printf("| icosphere level %d | %zu | %.2f | %.2e |\n", level, scene.mesh.tet_count(), cell,
+                        ball_error(scene, BallLight::Uniform, with_cell(cell)).all);
     }
 }
 
