@@ -205,7 +205,12 @@ MethodSolution solve_fd(const MethodProblem& problem, const FdOptions& options) 
             cg.relative_tolerance = options.relative_tolerance;
             cg.max_iterations = options.max_iterations;
             if (problem.progress)
-                cg.on_iteration = [&](int, double) { check_cancelled(problem.progress); };
+                cg.on_iteration = [&](int, double estimate) {
+                    check_cancelled(problem.progress);
+                    const double done = std::clamp(std::log(std::max(estimate, 1e-300)) /
+                                                       std::log(options.relative_tolerance), 0.0, 1.0);
+                    problem.progress->set_fraction(static_cast<float>((ch + done) / 3.0));
+                };
             const ConjugateGradientResult result =
                 solve_jacobi_cg<double>(system.view(ch), system.rhs[ch], x, cg);
             solution.iterations[ch] = result.iterations;
