@@ -11,9 +11,8 @@
 // What is built here, and why it differs:
 //  - The graph is a regular grid over the volume (voxel_grid.h) instead of the tets' dual graph. On
 //    a grid the 7-point stencil is a consistent second-order Laplacian; the paper's 1/d^2 weights on
-//    4 irregular neighbours are not consistent on a graph whose edges are neither equal nor
-//    orthogonal, and its refinement of node positions (reaction-diffusion, Sec. 4.1) exists only to
-//    make them nearly so. The grid also decouples the resolution from the mesh (one knob, the cell
+//    4 neighbours are not (4 equal links in the regular tetrahedral directions give 2/3 of the
+//    Laplacian, and the factor varies over an irregular graph). The grid also decouples the resolution from the mesh (one knob, the cell
 //    size) and is rebuilt from the current tets on every solve, so cuts and fractures are followed,
 //    which the paper's precomputed graph cannot do (Sec. 6.4, 7: "we cannot change the topology").
 //  - Conservative form with the harmonic mean of kappa on links between cells of different
