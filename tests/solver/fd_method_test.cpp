@@ -11,6 +11,7 @@
 #include "solver/reference/analytic_ball.h"
 #include "grid_test_meshes.h"
 #include "solver_test_meshes.h"
+#include "tetops/fracture.h"
 #include "tetops/tetrahedralize.h"
 #include "tetops/box_mesh.h"
 
@@ -242,6 +243,36 @@ TEST(FdMethod, CrackNarrowerThanACellStopsTheLight) {
             EXPECT_GT(b.phi[v][0], 0.05);
         }
     EXPECT_TRUE(a.warnings.empty());
+}
+
+TEST(FdMethod, FracturedBallAgreesWithTransCut) {
+    // The ball broken along z = 0.3 mm (an exact crack, zero width in the rest frame, off the cell
+    // planes) and lit everywhere, crack faces included: two independent bodies. fd must treat them
+    // so, as TransCut's solve does (0.22% apart at 0.5 mm); near the crack phi is well above the
+    // unbroken ball's.
+    TetMesh broken = ball(BallLight::Uniform).mesh;
+    const Eigen::Vector4d plane(0, 0, 1, 0.3);
+    fracture_planes(broken, std::span<const Eigen::Vector4d>(&plane, 1));
+    Scene scene(std::move(broken), kMaterial);
+    ASSERT_EQ(scene.connectivity.component_count, 2);
+    for (int32_t v : scene.connectivity.boundary_vertices) scene.q[v] = {1, 1, 1};
+    DiffusionOptions transcut;
+    transcut.relative_tolerance = 1e-8;
+    const DiffusionSolution reference = solve_diffusion(scene.mesh, scene.connectivity, scene.materials, scene.q, transcut);
+    const MethodSolution solution = solve_fd(scene.problem(), with_cell(0.5));
+    EXPECT_TRUE(solution.warnings.empty());
+    double error = 0, norm = 0;
+    for (size_t v = 0; v < solution.phi.size(); ++v) {
+        error += std::pow(solution.phi[v][0] - reference.phi[v][0], 2);
+        norm += std::pow(reference.phi[v][0], 2);
+    }
+    EXPECT_LT(std::sqrt(error / norm), 0.01);
+    // Light entering through the crack raises phi near it well above the unbroken ball's.
+    const AnalyticBall whole(kRadius, kMua, kMusp, kEta, {1.0});
+    for (size_t v = 0; v < solution.phi.size(); ++v)
+        if (std::abs(scene.mesh.positions[v].z() - 0.3) < 1e-9 && scene.mesh.positions[v].norm() < 5) {
+            EXPECT_GT(solution.phi[v][0], 1.2 * whole(scene.mesh.positions[v]));
+        }
 }
 
 TEST(FdMethod, PartsThinnerThanACellAreLeftDarkWithAWarning) {
