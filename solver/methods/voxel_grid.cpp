@@ -95,6 +95,11 @@ VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
         throw InvalidArgumentError("voxel grid: mm per unit " + number_text(problem.mm_per_unit) +
                                    " must be a positive finite number");
     if (mesh.tets.empty()) throw InvalidArgumentError("voxel grid: the volume has no tets");
+    if (problem.q.size() != mesh.vertex_count() || problem.connectivity.tet_neighbors.size() != mesh.tet_count())
+        throw InvalidArgumentError("voxel grid: " + std::to_string(problem.q.size()) + " q values and connectivity of " +
+                                   std::to_string(problem.connectivity.tet_neighbors.size()) + " tets for " +
+                                   std::to_string(mesh.vertex_count()) + " vertices and " +
+                                   std::to_string(mesh.tet_count()) + " tets");
 
     VoxelGrid grid;
     const double h = cell_size_mm / problem.mm_per_unit;

@@ -82,7 +82,8 @@ struct VoxelGrid {
 // face, not the coincident face of the piece across), with the nearest boundary face along the link
 // (FirstHitGrid, solver/reference/first_hit_grid.h) as the fallback when the walk stalls. q is
 // interpolated on that face. Throws InvalidArgumentError ("voxel grid: ...") for a cell size or scale
-// that is not a positive finite number, a mesh with no tets, or more than kMaxVoxelGridVoxels voxels.
+// that is not a positive finite number, a mesh with no tets, q or connectivity not of this mesh, or
+// more than kMaxVoxelGridVoxels voxels.
 VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm);
 
 // How sample_at_vertices found each vertex's value.

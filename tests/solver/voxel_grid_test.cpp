@@ -207,6 +207,9 @@ TEST(VoxelGrid, RejectsBadCellSizes) {
     for (const double size : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()})
         EXPECT_THROW(voxelize(scene.problem(), size), InvalidArgumentError) << size;
     EXPECT_THROW(voxelize(scene.problem(), 1e-3), InvalidArgumentError);  // 10^9 voxels
+    const std::vector<std::array<double, 3>> short_q(3);
+    EXPECT_THROW(voxelize(MethodProblem{scene.mesh, scene.connectivity, scene.materials, short_q, 1.0}, 0.5),
+                 InvalidArgumentError);
     try {
         voxelize(scene.problem(), -1);
     } catch (const InvalidArgumentError& e) {
