@@ -220,6 +220,15 @@ TEST(FdMethod, ConstantSolutionWithoutAbsorptionIsExact) {
         }
 }
 
+TEST(FdMethod, NoLightGivesZeroWithoutWarnings) {
+    const Scene scene(make_box_mesh({2, 2, 2}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(2)), kMaterial);
+    for (const FdSolver solver : {FdSolver::Cg, FdSolver::Jacobi}) {
+        const MethodSolution solution = solve_fd(scene.problem(), with_cell(0.5, FdBoundary::Fraction, solver));
+        EXPECT_TRUE(solution.warnings.empty());
+        for (const auto& phi : solution.phi) EXPECT_EQ(phi, (std::array<double, 3>{0, 0, 0}));
+    }
+}
+
 // Light only on the face x = 0.
 void light_left_face(Scene& scene) {
     for (int32_t v : scene.connectivity.boundary_vertices)
