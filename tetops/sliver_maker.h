@@ -1,7 +1,7 @@
 // Deliberately degenerate tets for stability tests and studies ("slivers, min dihedral 0.01
 // to 1 degree"): interior vertices are pushed towards the opposite face of one tet of their star, which
 // flattens that tet into a cap of relative height `flatness` while every tet stays positively oriented
-// (the star of an interior vertex of a convex-celled mesh is star-shaped from the face's centroid).
+// (the first tet of the star for which that holds; a vertex for which none does is left where it is).
 #pragma once
 
 #include "tetops/connectivity.h"

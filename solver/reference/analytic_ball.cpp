@@ -78,34 +78,47 @@ std::vector<double> directional_ball_light_coefficients(int lmax, double eta) {
     return q;
 }
 
-BallComparison compare_with_analytic_ball(const TetMesh& mesh, const TetConnectivity& connectivity,
-                                          const TetMaterial& material, double radius_mm, BallLight light,
-                                          const DiffusionOptions& options) {
-    constexpr int kLegendreTerms = 60;
-    const double mm = options.mm_per_unit;
+std::vector<std::array<double, 3>> ball_light(const TetMesh& mesh, const TetConnectivity& connectivity, BallLight light,
+                                              double eta) {
     std::vector<std::array<double, 3>> q(mesh.vertex_count(), {0, 0, 0});
     for (int32_t v : connectivity.boundary_vertices) {
-        const double value = light == BallLight::Uniform ? 1.0 : directional_ball_light(mesh.positions[v], material.eta);
+        const double value = light == BallLight::Uniform ? 1.0 : directional_ball_light(mesh.positions[v], eta);
         q[v] = {value, value, value};
     }
-    const std::vector<TetMaterial> materials(mesh.tet_count(), material);
-    BallComparison comparison;
-    comparison.solution = solve_diffusion(mesh, connectivity, materials, q, options);
+    return q;
+}
+
+double ball_relative_error(const TetMesh& mesh, const TetConnectivity& connectivity, const TetMaterial& material,
+                           double radius_mm, BallLight light, double mm_per_unit,
+                           const std::vector<std::array<double, 3>>& phi) {
+    constexpr int kLegendreTerms = 60;
     const AnalyticBall exact(radius_mm, material.mua[0], material.musp[0], material.eta,
                              light == BallLight::Uniform ? std::vector<double>{1.0}
                                                          : directional_ball_light_coefficients(kLegendreTerms, material.eta));
+    const std::vector<TetMaterial> materials(mesh.tet_count(), material);
     AssemblyOptions assembly;
-    assembly.mm_per_unit = mm;
+    assembly.mm_per_unit = mm_per_unit;
     const std::vector<double> volumes =
         lumped_vertex_volumes(assemble_diffusion_matrix(mesh, connectivity, materials, assembly), connectivity);
     double error = 0, norm = 0;
     for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-        const double reference = exact(mesh.positions[v] * mm);
-        const double difference = comparison.solution.phi[v][0] - reference;
+        const double reference = exact(mesh.positions[v] * mm_per_unit);
+        const double difference = phi[v][0] - reference;
         error += volumes[v] * difference * difference;
         norm += volumes[v] * reference * reference;
     }
-    comparison.relative_error = std::sqrt(error / norm);
+    return std::sqrt(error / norm);
+}
+
+BallComparison compare_with_analytic_ball(const TetMesh& mesh, const TetConnectivity& connectivity,
+                                          const TetMaterial& material, double radius_mm, BallLight light,
+                                          const DiffusionOptions& options) {
+    const std::vector<std::array<double, 3>> q = ball_light(mesh, connectivity, light, material.eta);
+    const std::vector<TetMaterial> materials(mesh.tet_count(), material);
+    BallComparison comparison;
+    comparison.solution = solve_diffusion(mesh, connectivity, materials, q, options);
+    comparison.relative_error =
+        ball_relative_error(mesh, connectivity, material, radius_mm, light, options.mm_per_unit, comparison.solution.phi);
     return comparison;
 }
 

@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <vector>
 
 namespace waxwork {
@@ -58,6 +59,16 @@ enum class BallLight {
     Uniform,      // q = 1 everywhere on the boundary
     Directional,  // directional_ball_light (a light travelling along -z)
 };
+
+// q per volume vertex for the ball's light (on boundary vertices; zero inside).
+std::vector<std::array<double, 3>> ball_light(const TetMesh& mesh, const TetConnectivity& connectivity, BallLight light,
+                                              double eta);
+
+// The relative L2 error of channel 0 of `phi` (per volume vertex) against the series, weighted by the
+// lumped vertex volume: the measure every accuracy test and study reports.
+double ball_relative_error(const TetMesh& mesh, const TetConnectivity& connectivity, const TetMaterial& material,
+                           double radius_mm, BallLight light, double mm_per_unit,
+                           const std::vector<std::array<double, 3>>& phi);
 
 struct BallComparison {
     double relative_error = 0;  // channel 0, relative L2 weighted by lumped vertex volume
