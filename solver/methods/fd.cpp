@@ -33,11 +33,12 @@ struct FdSystem {
     }
 };
 
-// Assembles the finite-volume form of Eqs. 5-6 multiplied by the cell volume h^3 (all lengths in mm):
-//   sum_links kappa_ij h (phi_i - phi_j) + sum_boundary links h^2 (phi_i - g) / (d / kappa + 2 A)
+// Assembles the finite-volume form of Eqs. 5-6 multiplied by the cell volume (all lengths in mm):
+//   sum_links kappa_ij h (phi_i - phi_j) + sum_boundary links h^2 (phi_i - g) / (d / kappa + 2 A / (n . axis))
 //     + mu_a V_i phi_i = 0,   g = 4 q / (1 - F_dr),
-// where d is the distance from the centre to the surface node and V_i = h^3 (staircase) or the
-// product over the axes of the cell's extent along it (fraction).
+// where kappa_ij is the harmonic mean of the two cells' kappa, d the distance from the centre to the
+// surface node, and V_i = h^3 (staircase, cubes) or the product over the axes of the cell's extent
+// along it (fraction).
 FdSystem assemble(const VoxelGrid& grid, const MethodProblem& problem, FdBoundary boundary) {
     const size_t cells = grid.cell_count();
     const double h = grid.cell_size * problem.mm_per_unit;

@@ -12,9 +12,10 @@
 //  - The graph is a regular grid over the volume (voxel_grid.h) instead of the tets' dual graph. On
 //    a grid the 7-point stencil is a consistent second-order Laplacian; the paper's 1/d^2 weights on
 //    4 neighbours are not (4 equal links in the regular tetrahedral directions give 2/3 of the
-//    Laplacian, and the factor varies over an irregular graph). The grid also decouples the resolution from the mesh (one knob, the cell
-//    size) and is rebuilt from the current tets on every solve, so cuts and fractures are followed,
-//    which the paper's precomputed graph cannot do (Sec. 6.4, 7: "we cannot change the topology").
+//    Laplacian, and the factor varies over an irregular graph). The grid also decouples the
+//    resolution from the mesh (one knob, the cell size) and is rebuilt from the current tets on every
+//    solve, so cuts and fractures are followed, which the paper's precomputed graph cannot do
+//    (Sec. 6.4, 7: "we cannot change the topology").
 //  - Conservative form with the harmonic mean of kappa on links between cells of different
 //    materials, instead of Eq. 5's kappa(n_j) phi(n_j) - kappa(n_i) phi(n_i) (which discretises
 //    laplace(kappa phi), not div(kappa grad phi), and is not symmetric).
@@ -30,13 +31,16 @@
 //    FdBoundary::Staircase puts every surface node on the cell face (d = h/2); FdBoundary::Fraction
 //    (default) puts it at the crossing and gives the cell the absorbing volume it really has along
 //    each axis (h/2 + d per boundary side instead of h), which makes the boundary cell a consistent
-//    1D finite volume along its boundary links.
+//    1D finite volume along its boundary links. Observed orders (docs/method_fd.md): second under
+//    uniform light on the ball, first under directional light (each link drops the tangential part of
+//    the gradient) and on a box whose faces keep one fraction (the links along a boundary cell's face
+//    keep full h x h faces).
 //  - The system is symmetric positive definite, so besides the paper's Jacobi relaxation the same
 //    system is solved with Jacobi-preconditioned CG (conjugate_gradient.h) for a fair comparison. The
-//    paper's multi-resolution start (Eq. 10) is not built: CG makes it unnecessary for comparison.
+//    paper's multi-resolution start (Eq. 10) is not built.
 //
 // Failure cases (docs/method_fd.md measures them): a cut or crack narrower than a cell still separates
-// cells (links are ray-tested), so light does not leak across it. A part thinner than a cell has no
+// cells (links are segment-tested against the boundary faces), so light does not leak across it. A part thinner than a cell has no
 // cell of its own: its vertices cannot be sampled, keep phi = 0 and the solution carries a warning
 // naming the cell size to go below; a volume with no cell at all is an InvalidArgumentError.
 #pragma once
