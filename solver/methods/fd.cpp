@@ -181,7 +181,7 @@ MethodSolution solve_fd(const MethodProblem& problem, const FdOptions& options) 
     MethodSolution solution;
     const auto setup_start = std::chrono::steady_clock::now();
     report_stage(problem.progress, "fd: grid");
-    VoxelGrid grid = naming_context("fd", [&] { return voxelize(problem, options.cell_size_mm); });
+    VoxelGrid grid = naming_context("fd", [&] { return voxelize(problem, options.cell_size_mm, kMaxFdCells); });
     if (grid.cell_count() == 0)
         throw InvalidArgumentError("fd: no cell centre lies inside the volume at cell size " +
                                    number_text(options.cell_size_mm) +

@@ -64,6 +64,9 @@ enum class FdBoundary {
     Cubes,
 };
 
+// The most cells a solve takes: 2^22, about 1 GB for the system, the CG vectors and the grid.
+inline constexpr size_t kMaxFdCells = size_t{1} << 22;
+
 struct FdOptions {
     // The resolution knob: the cell size in millimetres (problem.mm_per_unit converts the mesh).
     // Cells cover the volume's bounding box; at most kMaxVoxelGridVoxels voxels (voxel_grid.h).
@@ -78,8 +81,9 @@ struct FdOptions {
 };
 
 // phi at the volume's vertices (voxel_grid.h sample_at_vertices), unknowns = inside cells. Throws
-// InvalidArgumentError ("fd: ...") for options out of range, inputs of the wrong size, or a volume
-// in which no cell centre lies; CancelledError when problem.progress asks.
+// InvalidArgumentError ("fd: ...") for options out of range, inputs of the wrong size, a volume in
+// which no cell centre lies, or more than kMaxFdCells cells (naming a cell size that fits);
+// CancelledError when problem.progress asks.
 MethodSolution solve_fd(const MethodProblem& problem, const FdOptions& options);
 
 }  // namespace waxwork

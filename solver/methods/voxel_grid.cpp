@@ -86,7 +86,7 @@ std::array<double, 3> face_barycentrics(const TetMesh& mesh, const std::array<in
 
 }  // namespace
 
-VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
+VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm, size_t max_cells) {
     const TetMesh& mesh = problem.mesh;
     if (!(cell_size_mm > 0) || !std::isfinite(cell_size_mm))
         throw InvalidArgumentError("voxel grid: cell size " + number_text(cell_size_mm) +
@@ -106,15 +106,19 @@ VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
     grid.cell_size = h;
     const auto [lo, hi] = bounding_box(mesh);
     const Eigen::Vector3d extent = hi - lo;
-    double voxels = 1;
-    for (int k = 0; k < 3; ++k) {
-        const double n = std::max(1.0, std::ceil(extent[k] / h));
-        voxels *= n;
-        if (voxels > static_cast<double>(kMaxVoxelGridVoxels))
-            throw InvalidArgumentError("voxel grid: cell size " + number_text(cell_size_mm) + " mm gives more than " +
-                                       std::to_string(kMaxVoxelGridVoxels) + " voxels over the volume's box");
-        grid.dims[k] = static_cast<int>(n);
-    }
+    // A cell size that brings `count` under `cap` (cells scale as the inverse cube of the size).
+    const auto fitting_size = [&](double count, size_t cap) {
+        return number_text(cell_size_mm * std::cbrt(count / static_cast<double>(cap)) * 1.01);
+    };
+    std::array<double, 3> counts{};
+    for (int k = 0; k < 3; ++k) counts[k] = std::max(1.0, std::ceil(extent[k] / h));
+    const double voxels = counts[0] * counts[1] * counts[2];  // in double: no overflow for tiny cells
+    if (voxels > static_cast<double>(kMaxVoxelGridVoxels))
+        throw InvalidArgumentError("voxel grid: cell size " + number_text(cell_size_mm) + " mm gives " +
+                                   number_text(voxels) + " voxels over the volume's box, more than " +
+                                   std::to_string(kMaxVoxelGridVoxels) + "; use " +
+                                   fitting_size(voxels, kMaxVoxelGridVoxels) + " mm or more");
+    for (int k = 0; k < 3; ++k) grid.dims[k] = static_cast<int>(counts[k]);
     grid.origin = 0.5 * (lo + hi) - 0.5 * h * Eigen::Vector3d(grid.dims[0], grid.dims[1], grid.dims[2]);
     const size_t voxel_count = static_cast<size_t>(grid.dims[0]) * grid.dims[1] * grid.dims[2];
     const auto voxel_index = [&](int i, int j, int k) {
@@ -167,6 +171,11 @@ VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
             }
     voxel_tet = {};
     const size_t cells = grid.cell_tet.size();
+    if (cells > max_cells)
+        throw InvalidArgumentError("voxel grid: cell size " + number_text(cell_size_mm) + " mm gives " +
+                                   std::to_string(cells) + " cells inside the volume, more than " +
+                                   std::to_string(max_cells) + "; use " + fitting_size(static_cast<double>(cells), max_cells) +
+                                   " mm or more");
 
     // The boundary faces, for segment tests (float BVH, any hit) and crossings (double, nearest hit).
     const std::vector<BoundaryFace>& faces = problem.connectivity.boundary_faces;

@@ -25,8 +25,9 @@
 
 namespace waxwork {
 
-// The most voxels (inside or not) a grid may have: 2^25 (a 320^3 box), about 130 MB of voxel table.
-inline constexpr size_t kMaxVoxelGridVoxels = size_t{1} << 25;
+// The most voxels (inside or not) a grid may have: 2^24 (a 256^3 box). The voxel table is then 64 MB
+// (twice that while cells are located), and a box filled with cells needs about 1 GB of links.
+inline constexpr size_t kMaxVoxelGridVoxels = size_t{1} << 24;
 
 // Unit steps of the six link directions: +x, -x, +y, -y, +z, -z.
 inline constexpr std::array<std::array<int, 3>, 6> kVoxelDirections = {
@@ -82,9 +83,10 @@ struct VoxelGrid {
 // face, not the coincident face of the piece across), with the nearest boundary face along the link
 // (FirstHitGrid, solver/reference/first_hit_grid.h) as the fallback when the walk stalls. q is
 // interpolated on that face. Throws InvalidArgumentError ("voxel grid: ...") for a cell size or scale
-// that is not a positive finite number, a mesh with no tets, q or connectivity not of this mesh, or
-// more than kMaxVoxelGridVoxels voxels.
-VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm);
+// that is not a positive finite number, a mesh with no tets, q or connectivity not of this mesh, more
+// than kMaxVoxelGridVoxels voxels or more than max_cells inside cells (found before the links are
+// built; both messages name a cell size that fits).
+VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm, size_t max_cells = kMaxVoxelGridVoxels);
 
 // How sample_at_vertices found each vertex's value.
 struct VertexSamplingStats {

@@ -207,6 +207,15 @@ TEST(VoxelGrid, RejectsBadCellSizes) {
     for (const double size : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()})
         EXPECT_THROW(voxelize(scene.problem(), size), InvalidArgumentError) << size;
     EXPECT_THROW(voxelize(scene.problem(), 1e-3), InvalidArgumentError);  // 10^9 voxels
+    // 8 cells at 0.5 mm: a cap of 7 refuses them and names a size that fits.
+    EXPECT_EQ(voxelize(scene.problem(), 0.5, 8).cell_count(), 8u);
+    try {
+        voxelize(scene.problem(), 0.5, 7);
+        ADD_FAILURE() << "no error";
+    } catch (const InvalidArgumentError& e) {
+        EXPECT_NE(std::string(e.what()).find("gives 8 cells inside the volume, more than 7; use 0.52"), std::string::npos)
+            << e.what();
+    }
     const std::vector<std::array<double, 3>> short_q(3);
     EXPECT_THROW(voxelize(MethodProblem{scene.mesh, scene.connectivity, scene.materials, short_q, 1.0}, 0.5),
                  InvalidArgumentError);
