@@ -149,6 +149,19 @@ TEST(FdMethod, TheCubesOwnBoundaryDoesNotConverge) {
     EXPECT_LT(at_1 / at_half, 1.2);
 }
 
+TEST(FdMethod, ModelUnitsDoNotChangeTheResult) {
+    // The ball in half-millimetre units with mm_per_unit = 2 is the same ball: the same phi.
+    const Scene& mm = ball(BallLight::Directional);
+    TetMesh halved = mm.mesh;
+    for (Eigen::Vector3d& p : halved.positions) p /= 2;
+    Scene units(std::move(halved), kMaterial);
+    units.q = mm.q;
+    const MethodSolution a = solve_fd(mm.problem(), with_cell(2.0));
+    const MethodSolution b = solve_fd(units.problem(2.0), with_cell(2.0));
+    EXPECT_EQ(a.unknowns, b.unknowns);
+    for (size_t v = 0; v < a.phi.size(); ++v) EXPECT_NEAR(a.phi[v][0], b.phi[v][0], 1e-6 * (1 + a.phi[v][0]));
+}
+
 TEST(FdMethod, JacobiAndCgSolveTheSameSystem) {
     FdOptions jacobi = with_cell(2.0, FdBoundary::Fraction, FdSolver::Jacobi);
     FdOptions cg = with_cell(2.0, FdBoundary::Fraction, FdSolver::Cg);
