@@ -5,12 +5,12 @@
 #include "tetops/cut.h"
 #include "tetops/disjoint_sets.h"
 #include "tetops/exact_cut.h"
+#include "tetops/point_kd_tree.h"
 #include "tetops/quality.h"
 #include "tetops/split_coarsening.h"
 #include "tetops/split_quality.h"
 #include "tetops/vertex_map.h"
 
-#include <nanoflann.hpp>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -25,17 +25,6 @@
 
 namespace waxwork {
 namespace {
-
-// nanoflann reads the seed points through this adaptor.
-struct PointCloud {
-    std::span<const Eigen::Vector3d> points;
-    size_t kdtree_get_point_count() const { return points.size(); }
-    double kdtree_get_pt(size_t index, size_t dim) const { return points[index][static_cast<int>(dim)]; }
-    template <class BoundingBox>
-    bool kdtree_get_bbox(BoundingBox&) const { return false; }
-};
-using KdTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloud>, PointCloud, 3, uint32_t>;
 
 Eigen::Vector3d tet_centroid(const std::vector<Eigen::Vector3d>& points, const Tet& tet) {
     return 0.25 * (points[tet[0]] + points[tet[1]] + points[tet[2]] + points[tet[3]]);
@@ -316,7 +305,7 @@ FractureResult fracture_voronoi(TetMesh& mesh, std::span<const Eigen::Vector3d> 
                                    std::to_string(tets_before / static_cast<size_t>(options.min_piece_tets)));
 
     PointCloud cloud{seeds};
-    const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+    const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
     auto nearest = [&](const Eigen::Vector3d& x) {
         uint32_t index = 0;
         double distance = 0;
@@ -480,7 +469,7 @@ WeldResult weld_touching_pieces(TetMesh& mesh, double tolerance) {
     std::vector<Eigen::Vector3d> boundary_points(boundary.size());
     for (size_t i = 0; i < boundary.size(); ++i) boundary_points[i] = world[boundary[i]];
     PointCloud cloud{boundary_points};
-    const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    const PointKdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     const double radius_sq = std::nextafter(tolerance * tolerance, std::numeric_limits<double>::infinity());
     struct Candidate {
         double distance_sq;
