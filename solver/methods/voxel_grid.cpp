@@ -86,7 +86,7 @@ std::array<double, 3> face_barycentrics(const TetMesh& mesh, const std::array<in
 
 }  // namespace
 
-VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
+VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm, size_t max_cells) {
     const TetMesh& mesh = problem.mesh;
     if (!(cell_size_mm > 0) || !std::isfinite(cell_size_mm))
         throw InvalidArgumentError("voxel grid: cell size " + number_text(cell_size_mm) +
@@ -95,21 +95,30 @@ VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
         throw InvalidArgumentError("voxel grid: mm per unit " + number_text(problem.mm_per_unit) +
                                    " must be a positive finite number");
     if (mesh.tets.empty()) throw InvalidArgumentError("voxel grid: the volume has no tets");
+    if (problem.q.size() != mesh.vertex_count() || problem.connectivity.tet_neighbors.size() != mesh.tet_count())
+        throw InvalidArgumentError("voxel grid: " + std::to_string(problem.q.size()) + " q values and connectivity of " +
+                                   std::to_string(problem.connectivity.tet_neighbors.size()) + " tets for " +
+                                   std::to_string(mesh.vertex_count()) + " vertices and " +
+                                   std::to_string(mesh.tet_count()) + " tets");
 
     VoxelGrid grid;
     const double h = cell_size_mm / problem.mm_per_unit;
     grid.cell_size = h;
     const auto [lo, hi] = bounding_box(mesh);
     const Eigen::Vector3d extent = hi - lo;
-    double voxels = 1;
-    for (int k = 0; k < 3; ++k) {
-        const double n = std::max(1.0, std::ceil(extent[k] / h));
-        voxels *= n;
-        if (voxels > static_cast<double>(kMaxVoxelGridVoxels))
-            throw InvalidArgumentError("voxel grid: cell size " + number_text(cell_size_mm) + " mm gives more than " +
-                                       std::to_string(kMaxVoxelGridVoxels) + " voxels over the volume's box");
-        grid.dims[k] = static_cast<int>(n);
-    }
+    // A cell size that brings `count` under `cap` (cells scale as the inverse cube of the size).
+    const auto fitting_size = [&](double count, size_t cap) {
+        return number_text(cell_size_mm * std::cbrt(count / static_cast<double>(cap)) * 1.01);
+    };
+    std::array<double, 3> counts{};
+    for (int k = 0; k < 3; ++k) counts[k] = std::max(1.0, std::ceil(extent[k] / h));
+    const double voxels = counts[0] * counts[1] * counts[2];  // in double: no overflow for tiny cells
+    if (voxels > static_cast<double>(kMaxVoxelGridVoxels))
+        throw InvalidArgumentError("voxel grid: cell size " + number_text(cell_size_mm) + " mm gives " +
+                                   number_text(voxels) + " voxels over the volume's box, more than " +
+                                   std::to_string(kMaxVoxelGridVoxels) + "; use " +
+                                   fitting_size(voxels, kMaxVoxelGridVoxels) + " mm or more");
+    for (int k = 0; k < 3; ++k) grid.dims[k] = static_cast<int>(counts[k]);
     grid.origin = 0.5 * (lo + hi) - 0.5 * h * Eigen::Vector3d(grid.dims[0], grid.dims[1], grid.dims[2]);
     const size_t voxel_count = static_cast<size_t>(grid.dims[0]) * grid.dims[1] * grid.dims[2];
     const auto voxel_index = [&](int i, int j, int k) {
@@ -162,6 +171,11 @@ VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
             }
     voxel_tet = {};
     const size_t cells = grid.cell_tet.size();
+    if (cells > max_cells)
+        throw InvalidArgumentError("voxel grid: cell size " + number_text(cell_size_mm) + " mm gives " +
+                                   std::to_string(cells) + " cells inside the volume, more than " +
+                                   std::to_string(max_cells) + "; use " + fitting_size(static_cast<double>(cells), max_cells) +
+                                   " mm or more");
 
     // The boundary faces, for segment tests (float BVH, any hit) and crossings (double, nearest hit).
     const std::vector<BoundaryFace>& faces = problem.connectivity.boundary_faces;
@@ -202,8 +216,8 @@ VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
     // own face even where another piece's face coincides with it (a crack), which a nearest-hit query
     // could not tell apart; the nearest hit along the link is the fallback for a walk that fails. A
     // link the float segment test called blocked can cross a rounding beyond the neighbour's centre:
-    // fraction 1. A link with neither (no face along it at all) keeps fraction 1, its cell's tet and no
-    // incident light.
+    // fraction 1. A link with neither (no face along it at all) keeps fraction 1, its cell's tet, no
+    // incident light and a zero normal.
     std::vector<Eigen::Vector3d> double_points(mesh.positions.begin(), mesh.positions.end());
     const FirstHitGrid first_hit(double_points, triangles);
     std::vector<std::array<int32_t, 4>> face_index(mesh.tets.size(), {-1, -1, -1, -1});
@@ -229,6 +243,10 @@ VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
         const BoundaryFace& crossed = faces[face];
         link.fraction = std::clamp(t, kMinFraction, 1.0);
         link.tet = crossed.tet;
+        const Eigen::Vector3d& a = mesh.positions[crossed.vertices[0]];
+        const Eigen::Vector3d n =
+            (mesh.positions[crossed.vertices[1]] - a).cross(mesh.positions[crossed.vertices[2]] - a).normalized();
+        if (n.allFinite()) link.normal = {n.x(), n.y(), n.z()};
         const std::array<double, 3> w = face_barycentrics(mesh, crossed.vertices, from + t * direction);
         for (int ch = 0; ch < 3; ++ch)
             for (int i = 0; i < 3; ++i) link.q[ch] += w[i] * problem.q[crossed.vertices[i]][ch];
@@ -236,19 +254,35 @@ VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm) {
     return grid;
 }
 
-std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, const MethodProblem& problem,
-                                                      const std::vector<std::array<double, 3>>& cell_values,
-                                                      VertexSamplingStats* stats) {
+VertexSampling build_vertex_sampling(const VoxelGrid& grid, const MethodProblem& problem) {
     const TetMesh& mesh = problem.mesh;
     const TetConnectivity& connectivity = problem.connectivity;
-    if (cell_values.size() != grid.cell_count())
-        throw InvalidArgumentError("voxel grid: " + std::to_string(cell_values.size()) + " cell values for " +
-                                   std::to_string(grid.cell_count()) + " cells");
-    std::vector<std::array<double, 3>> phi(mesh.positions.size(), std::array<double, 3>{});
     enum Case : uint8_t { kNone, kTrilinear, kFitted, kNearest, kUnsampled };
     std::vector<uint8_t> how(mesh.positions.size(), kNone);
+    // Per vertex, up to 64 (cell, weight) pairs, gathered in parallel and packed below.
+    std::vector<std::vector<std::pair<int32_t, double>>> stencils(mesh.positions.size());
     const double h = grid.cell_size;
     const TriangleBvh* bvh = grid.boundary_bvh.get();
+    // Voxels that a boundary face's box overlaps: a segment inside voxels none of which is marked
+    // crosses no face, and needs no ray (most vertices inside).
+    std::vector<uint8_t> near_face(grid.voxel_count(), 0);
+    tbb::parallel_for(size_t{0}, connectivity.boundary_faces.size(), [&](size_t f) {
+        Eigen::Vector3d lo = mesh.positions[connectivity.boundary_faces[f].vertices[0]], hi = lo;
+        for (int32_t w : connectivity.boundary_faces[f].vertices) {
+            lo = lo.cwiseMin(mesh.positions[w]);
+            hi = hi.cwiseMax(mesh.positions[w]);
+        }
+        std::array<int, 3> first{}, last{};
+        for (int k = 0; k < 3; ++k) {
+            first[k] = std::clamp(static_cast<int>(std::floor((lo[k] - grid.origin[k]) / h)) - 1, 0, grid.dims[k] - 1);
+            last[k] = std::clamp(static_cast<int>(std::floor((hi[k] - grid.origin[k]) / h)) + 1, 0, grid.dims[k] - 1);
+        }
+        for (int k = first[2]; k <= last[2]; ++k)
+            for (int j = first[1]; j <= last[1]; ++j)
+                for (int i = first[0]; i <= last[0]; ++i)
+                    std::atomic_ref<uint8_t>(near_face[i + static_cast<size_t>(grid.dims[0]) * (j + static_cast<size_t>(grid.dims[1]) * k)])
+                        .store(1, std::memory_order_relaxed);
+    });
 
     tbb::parallel_for(size_t{0}, mesh.positions.size(), [&](size_t v) {
         const auto tets = connectivity.vertex_tets.row(v);
@@ -262,9 +296,10 @@ std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, con
         centroid /= 4.0 * static_cast<double>(tets.size());
         const Eigen::Vector3f target = to_float(p + 1e-3 * (centroid - p));
         const int32_t component = connectivity.tet_component[tets[0]];
+        bool clear = false;  // the eight voxels around the vertex are away from every face
         const auto usable = [&](int32_t cell) {
             if (cell < 0 || connectivity.tet_component[grid.cell_tet[cell]] != component) return false;
-            if (!bvh) return true;
+            if (!bvh || clear) return true;
             const Eigen::Vector3f from = to_float(grid.cell_centre(cell));
             return !bvh->occluded(from, target - from, 0.0f, 1.0f);
         };
@@ -274,8 +309,14 @@ std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, con
                                          static_cast<int>(std::floor(u[2]))};
         const Eigen::Vector3d f = u - Eigen::Vector3d(base[0], base[1], base[2]);
 
+        std::vector<std::pair<int32_t, double>>& stencil = stencils[v];
+        clear = (target.cast<double>() - p).norm() < 0.25 * h;
+        for (int corner = 0; corner < 8 && clear; ++corner) {
+            const int i = base[0] + (corner & 1), j = base[1] + ((corner >> 1) & 1), k = base[2] + ((corner >> 2) & 1);
+            clear = i >= 0 && j >= 0 && k >= 0 && i < grid.dims[0] && j < grid.dims[1] && k < grid.dims[2] &&
+                    !near_face[i + static_cast<size_t>(grid.dims[0]) * (j + static_cast<size_t>(grid.dims[1]) * k)];
+        }
         // Trilinear over the eight surrounding cells when all count.
-        std::array<double, 3> value{};
         bool all = true;
         for (int corner = 0; corner < 8 && all; ++corner) {
             const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
@@ -285,50 +326,63 @@ std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, con
                 break;
             }
             const double w = (di ? f[0] : 1 - f[0]) * (dj ? f[1] : 1 - f[1]) * (dk ? f[2] : 1 - f[2]);
-            for (int ch = 0; ch < 3; ++ch) value[ch] += w * cell_values[cell][ch];
+            stencil.emplace_back(cell, w);
         }
         if (all) {
-            phi[v] = value;
             how[v] = kTrilinear;
             return;
         }
+        stencil.clear();
+        clear = false;
 
-        // A weighted linear fit over the usable cells of the 4x4x4 block around the vertex.
-        Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
-        Eigen::Matrix<double, 4, 3> rhs = Eigen::Matrix<double, 4, 3>::Zero();
-        double weight_sum = 0;
-        Eigen::Vector3d mean_offset = Eigen::Vector3d::Zero();
-        int count = 0;
-        for (int dk = -1; dk <= 2; ++dk)
-            for (int dj = -1; dj <= 2; ++dj)
-                for (int di = -1; di <= 2; ++di) {
-                    const int32_t cell = grid.cell_at(base[0] + di, base[1] + dj, base[2] + dk);
-                    if (!usable(cell)) continue;
-                    const Eigen::Vector3d offset = (grid.cell_centre(cell) - p) / h;  // in cells
-                    const double w = (1 - std::abs(offset[0]) / 2.5) * (1 - std::abs(offset[1]) / 2.5) *
-                                     (1 - std::abs(offset[2]) / 2.5);
-                    const Eigen::Vector4d row(1, offset[0], offset[1], offset[2]);
-                    normal += w * row * row.transpose();
-                    for (int ch = 0; ch < 3; ++ch) rhs.col(ch) += w * cell_values[cell][ch] * row;
-                    weight_sum += w;
-                    mean_offset += w * offset;
-                    ++count;
-                }
-        if (count > 0) {
+        // A weighted linear fit over the usable cells of a block: first the 3x3x3 block around the
+        // nearest voxel (clamped into the grid), then, where that does not determine a plane, the
+        // 4x4x4 block around the vertex. The fitted value at the vertex is linear in the cell values:
+        // cell k's weight is w_k e0^T N^-1 (1, offset_k) with N the weighted normal matrix. Where no
+        // block determines a plane, the weighted mean of the larger block's cells.
+        const auto fit = [&](const std::array<int, 3>& first, int size, bool accept_mean) {
+            Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+            std::vector<std::pair<int32_t, Eigen::Vector4d>> rows;
+            double weight_sum = 0;
+            Eigen::Vector3d mean_offset = Eigen::Vector3d::Zero();
+            for (int dk = 0; dk < size; ++dk)
+                for (int dj = 0; dj < size; ++dj)
+                    for (int di = 0; di < size; ++di) {
+                        const int32_t cell = grid.cell_at(first[0] + di, first[1] + dj, first[2] + dk);
+                        if (!usable(cell)) continue;
+                        const Eigen::Vector3d offset = (grid.cell_centre(cell) - p) / h;  // in cells
+                        const double w = (1 - std::abs(offset[0]) / 2.5) * (1 - std::abs(offset[1]) / 2.5) *
+                                         (1 - std::abs(offset[2]) / 2.5);
+                        const Eigen::Vector4d row(1, offset[0], offset[1], offset[2]);
+                        normal += w * row * row.transpose();
+                        rows.emplace_back(cell, w * row);
+                        weight_sum += w;
+                        mean_offset += w * offset;
+                    }
+            if (rows.empty()) return false;
             // The spread of the cells (weighted covariance, in cells^2) decides whether a plane is
-            // determined; otherwise the weighted mean.
+            // determined.
             mean_offset /= weight_sum;
             const Eigen::Matrix3d spread =
                 normal.bottomRightCorner<3, 3>() / weight_sum - mean_offset * mean_offset.transpose();
             const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(spread, Eigen::EigenvaluesOnly)
                                         .eigenvalues()
                                         .minCoeff();
-            if (count >= 4 && smallest > 0.05) {
-                const Eigen::Matrix<double, 4, 3> fit = normal.ldlt().solve(rhs);
-                for (int ch = 0; ch < 3; ++ch) phi[v][ch] = std::max(0.0, fit(0, ch));
-            } else {
-                for (int ch = 0; ch < 3; ++ch) phi[v][ch] = rhs(0, ch) / weight_sum;
+            if (rows.size() >= 4 && smallest > 0.05) {
+                const Eigen::Vector4d e0 = normal.ldlt().solve(Eigen::Vector4d::UnitX());  // N symmetric
+                for (const auto& [cell, row] : rows) stencil.emplace_back(cell, e0.dot(row));
+                return true;
             }
+            if (!accept_mean) return false;
+            for (const auto& [cell, row] : rows) stencil.emplace_back(cell, row[0] / weight_sum);
+            return true;
+        };
+        std::array<int, 3> around_nearest{}, around_base{};
+        for (int k = 0; k < 3; ++k) {
+            around_nearest[k] = std::clamp(static_cast<int>(std::lround(u[k])), 0, grid.dims[k] - 1) - 1;
+            around_base[k] = base[k] - 1;
+        }
+        if (fit(around_nearest, 3, false) || fit(around_base, 4, true)) {
             how[v] = kFitted;
             return;
         }
@@ -351,7 +405,7 @@ std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, con
                         }
                     }
             if (best >= 0) {
-                phi[v] = cell_values[best];
+                stencil.emplace_back(best, 1.0);
                 how[v] = kNearest;
                 return;
             }
@@ -359,16 +413,46 @@ std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, con
         how[v] = kUnsampled;
     });
 
-    if (stats) {
-        *stats = {};
-        for (uint8_t c : how) {
-            stats->trilinear += c == kTrilinear;
-            stats->fitted += c == kFitted;
-            stats->nearest += c == kNearest;
-            stats->unsampled += c == kUnsampled;
+    VertexSampling sampling;
+    sampling.cell_count = grid.cell_count();
+    sampling.offsets.assign(mesh.positions.size() + 1, 0);
+    for (size_t v = 0; v < stencils.size(); ++v) {
+        sampling.offsets[v + 1] = sampling.offsets[v] + static_cast<int32_t>(stencils[v].size());
+        for (const auto& [cell, weight] : stencils[v]) {
+            sampling.cells.push_back(cell);
+            sampling.weights.push_back(weight);
         }
     }
+    for (uint8_t c : how) {
+        sampling.stats.trilinear += c == kTrilinear;
+        sampling.stats.fitted += c == kFitted;
+        sampling.stats.nearest += c == kNearest;
+        sampling.stats.unsampled += c == kUnsampled;
+    }
+    return sampling;
+}
+
+std::vector<std::array<double, 3>> apply_vertex_sampling(const VertexSampling& sampling,
+                                                         const std::vector<std::array<double, 3>>& cell_values) {
+    if (cell_values.size() != sampling.cell_count)
+        throw InvalidArgumentError("voxel grid: " + std::to_string(cell_values.size()) + " cell values for " +
+                                   std::to_string(sampling.cell_count) + " cells");
+    std::vector<std::array<double, 3>> phi(sampling.offsets.size() - 1, std::array<double, 3>{});
+    tbb::parallel_for(size_t{0}, phi.size(), [&](size_t v) {
+        for (int32_t k = sampling.offsets[v]; k < sampling.offsets[v + 1]; ++k)
+            for (int ch = 0; ch < 3; ++ch) phi[v][ch] += sampling.weights[k] * cell_values[sampling.cells[k]][ch];
+        // A linear fit can extrapolate below zero next to a steep boundary layer; phi >= 0.
+        for (int ch = 0; ch < 3; ++ch) phi[v][ch] = std::max(0.0, phi[v][ch]);
+    });
     return phi;
+}
+
+std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, const MethodProblem& problem,
+                                                      const std::vector<std::array<double, 3>>& cell_values,
+                                                      VertexSamplingStats* stats) {
+    const VertexSampling sampling = build_vertex_sampling(grid, problem);
+    if (stats) *stats = sampling.stats;
+    return apply_vertex_sampling(sampling, cell_values);
 }
 
 }  // namespace waxwork

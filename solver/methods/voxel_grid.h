@@ -25,8 +25,9 @@
 
 namespace waxwork {
 
-// The most voxels (inside or not) a grid may have: 2^25 (a 320^3 box), about 130 MB of voxel table.
-inline constexpr size_t kMaxVoxelGridVoxels = size_t{1} << 25;
+// The most voxels (inside or not) a grid may have: 2^24 (a 256^3 box). The voxel table is then 64 MB
+// (twice that while cells are located), and a box filled with cells needs about 1 GB of links.
+inline constexpr size_t kMaxVoxelGridVoxels = size_t{1} << 24;
 
 // Unit steps of the six link directions: +x, -x, +y, -y, +z, -z.
 inline constexpr std::array<std::array<int, 3>, 6> kVoxelDirections = {
@@ -39,6 +40,10 @@ struct VoxelLink {
     double fraction = 1;          // where the boundary is crossed, in (0, 1] of the cell size from the cell centre
     int32_t tet = -1;             // the tet whose boundary face is crossed (its material gives A, F_dr, eta)
     std::array<double, 3> q{};    // incident light at the crossing (interpolated on the face from vertex q)
+    // Outward unit normal of the crossed face (rest frame). A boundary condition on dphi/dn applied
+    // along an axis link needs n . axis: the axis faces of the cells cover the surface with
+    // |n_x| + |n_y| + |n_z| times its area (1.5 times on average over a sphere).
+    std::array<double, 3> normal{};
 };
 
 struct VoxelGrid {
@@ -78,8 +83,10 @@ struct VoxelGrid {
 // face, not the coincident face of the piece across), with the nearest boundary face along the link
 // (FirstHitGrid, solver/reference/first_hit_grid.h) as the fallback when the walk stalls. q is
 // interpolated on that face. Throws InvalidArgumentError ("voxel grid: ...") for a cell size or scale
-// that is not a positive finite number, a mesh with no tets, or more than kMaxVoxelGridVoxels voxels.
-VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm);
+// that is not a positive finite number, a mesh with no tets, q or connectivity not of this mesh, more
+// than kMaxVoxelGridVoxels voxels or more than max_cells inside cells (found before the links are
+// built; both messages name a cell size that fits).
+VoxelGrid voxelize(const MethodProblem& problem, double cell_size_mm, size_t max_cells = kMaxVoxelGridVoxels);
 
 // How sample_at_vertices found each vertex's value.
 struct VertexSamplingStats {
@@ -89,18 +96,36 @@ struct VertexSamplingStats {
     size_t unsampled = 0;     // its piece has no inside cell within reach: phi = 0
 };
 
-// Per-cell values (one rgb triple per inside cell) back at the volume's vertices, with the same
-// visibility as the links: a cell counts for a vertex only when the segment from its centre to (a
-// point a hair inside the vertex's own tets from) the vertex crosses no boundary face, so values do
-// not leak across a cut or crack.
+// How per-cell values (one rgb triple per inside cell) go back to the volume's vertices: per vertex,
+// weights over cells, precomputed once per grid (they depend on geometry only) so that a solve only
+// applies them. A cell counts for a vertex only when the segment from its centre to (a point a hair
+// inside the vertex's own tets from) the vertex crosses no boundary face, the same visibility as the
+// links, so values do not leak across a cut or crack (no segment is tested where no boundary face
+// comes near the eight voxels around the vertex).
 //  - All eight cells whose centres surround the vertex count: trilinear interpolation (O(h^2)).
-//  - Some of the 4x4x4 cells around it count: a linear least-squares fit over them with tent weights
-//    (O(h^2) where the fit is well posed; near the boundary the vertex lies up to a cell beyond the
-//    last centres, and a weighted mean there would be only O(h)); with fewer than four cells or a
-//    degenerate spread, their weighted mean. Fitted values are clamped at zero (phi >= 0).
-//  - None: the nearest inside cell of the vertex's component within 8 cells; otherwise phi = 0 and
-//    the vertex counts as unsampled (a part thinner than a cell; the method decides how to report it).
-// Vertices of no tet get 0. `stats` (optional) receives the counts per case.
+//  - Some count: a linear least-squares fit with tent weights over the usable cells of the 3x3x3
+//    block around the nearest voxel, or of the 4x4x4 block around the vertex where the first does not
+//    determine a plane (O(h^2) where the fit is well posed; near the boundary the vertex lies up to a
+//    cell beyond the last centres, and a weighted mean there would be only O(h)); with fewer than four
+//    cells or a degenerate spread, their weighted mean. Sampled values are clamped at zero (phi >= 0).
+//  - None: the nearest inside cell of the vertex's component within 8 cells; otherwise no weights
+//    (phi = 0) and the vertex counts as unsampled (a part thinner than a cell; the method decides how
+//    to report it).
+// Vertices of no tet get no weights.
+struct VertexSampling {
+    std::vector<int32_t> offsets{0};  // per vertex: its weights are [offsets[v], offsets[v+1])
+    std::vector<int32_t> cells;
+    std::vector<double> weights;
+    size_t cell_count = 0;
+    VertexSamplingStats stats;
+};
+VertexSampling build_vertex_sampling(const VoxelGrid& grid, const MethodProblem& problem);
+
+// phi per vertex from per-cell values (InvalidArgumentError when their count is not the grid's).
+std::vector<std::array<double, 3>> apply_vertex_sampling(const VertexSampling& sampling,
+                                                         const std::vector<std::array<double, 3>>& cell_values);
+
+// Both at once; `stats` (optional) receives the counts per case.
 std::vector<std::array<double, 3>> sample_at_vertices(const VoxelGrid& grid, const MethodProblem& problem,
                                                       const std::vector<std::array<double, 3>>& cell_values,
                                                       VertexSamplingStats* stats = nullptr);

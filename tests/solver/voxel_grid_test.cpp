@@ -2,6 +2,7 @@
 // across cracks and slits whose faces coincide), crossings, and sampling back at the vertices.
 #include "base/error.h"
 #include "solver/methods/voxel_grid.h"
+#include "grid_test_meshes.h"
 #include "solver_test_meshes.h"
 #include "tetops/box_mesh.h"
 
@@ -13,65 +14,14 @@
 namespace waxwork {
 namespace {
 
-// A mesh with everything a MethodProblem refers to; q is a given function of position on the
-// boundary vertices (zero inside).
-struct Scene {
-    TetMesh mesh;
-    TetConnectivity connectivity;
-    std::vector<TetMaterial> materials;
-    std::vector<std::array<double, 3>> q;
+std::array<double, 3> linear_q(const Eigen::Vector3d& p) { return {1 + p.x(), 2 + 2 * p.y(), 3 + 3 * p.z()}; }
 
-    explicit Scene(TetMesh m) : mesh(std::move(m)) {
-        connectivity = build_connectivity(mesh);
-        materials.assign(mesh.tet_count(), TetMaterial{{0.01, 0.01, 0.01}, {1, 1, 1}, 1.3});
-        q.assign(mesh.vertex_count(), std::array<double, 3>{});
+// A volume whose q is linear in position on the boundary vertices (zero inside).
+struct Scene : test::MethodScene {
+    explicit Scene(TetMesh m) : MethodScene(std::move(m)) {
         for (int32_t v : connectivity.boundary_vertices) q[v] = linear_q(mesh.positions[v]);
     }
-    static std::array<double, 3> linear_q(const Eigen::Vector3d& p) {
-        return {1 + p.x(), 2 + 2 * p.y(), 3 + 3 * p.z()};
-    }
-    MethodProblem problem(double mm_per_unit = 1.0) const {
-        return MethodProblem{mesh, connectivity, materials, q, mm_per_unit};
-    }
 };
-
-// Two meshes as one volume (vertices not shared): pieces side by side.
-TetMesh join(const TetMesh& a, const TetMesh& b) {
-    std::vector<Eigen::Vector3d> positions = a.positions;
-    positions.insert(positions.end(), b.positions.begin(), b.positions.end());
-    std::vector<Tet> tets = a.tets;
-    const int32_t offset = static_cast<int32_t>(a.vertex_count());
-    for (Tet t : b.tets) {
-        for (int32_t& v : t) v += offset;
-        tets.push_back(t);
-    }
-    return make_tet_mesh(std::move(positions), std::move(tets));
-}
-
-// The box [0,4]^3 in 8^3 cubes with a slit of zero width: the faces on the plane x = 2 with y < `depth`
-// are split (the tets on the x > 2 side get their own copies of those vertices), so the two sides
-// touch there only through coincident boundary faces, and stay connected for y > depth.
-TetMesh make_slit_box(double depth) {
-    TetMesh box = make_box_mesh({8, 8, 8}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(4));
-    std::vector<Eigen::Vector3d> positions = box.positions;
-    std::vector<int32_t> copy(positions.size(), -1);
-    for (size_t v = 0; v < box.positions.size(); ++v) {
-        const Eigen::Vector3d& p = box.positions[v];
-        if (std::abs(p.x() - 2) < 1e-12 && p.y() < depth - 1e-12) {
-            copy[v] = static_cast<int32_t>(positions.size());
-            positions.push_back(p);
-        }
-    }
-    std::vector<Tet> tets = box.tets;
-    for (Tet& t : tets) {
-        double x = 0;
-        for (int32_t v : t) x += box.positions[v].x() / 4;
-        if (x > 2)
-            for (int32_t& v : t)
-                if (copy[v] >= 0) v = copy[v];
-    }
-    return make_tet_mesh(std::move(positions), std::move(tets));
-}
 
 bool tet_contains(const TetMesh& mesh, int32_t t, const Eigen::Vector3d& p) {
     const Tet& tet = mesh.tets[t];
@@ -113,7 +63,7 @@ TEST(VoxelGrid, BoxCellsLinksAndCrossings) {
         const Eigen::Vector3d x = crossing(grid, link);
         EXPECT_TRUE(tet_contains(scene.mesh, link.tet, x));
         // q is linear on the boundary, so its interpolation on the crossed face is exact.
-        const auto expected = Scene::linear_q(x);
+        const auto expected = linear_q(x);
         for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(link.q[ch], expected[ch], 1e-9);
     }
     // Model units: 2 mm per unit halves the cells per axis.
@@ -160,7 +110,7 @@ TEST(VoxelGrid, CrackBetweenPiecesSeparatesCells) {
     // have cells next to the crack, and no link joins them.
     const TetMesh left = make_box_mesh({2, 4, 4}, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(2, 4, 4));
     const TetMesh right = make_box_mesh({2, 4, 4}, Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(4, 4, 4));
-    const Scene scene(join(left, right));
+    const Scene scene(test::join_meshes(left, right));
     const VoxelGrid grid = voxelize(scene.problem(), 0.5);
     ASSERT_EQ(grid.cell_count(), 512u);
     int crack_links = 0;
@@ -183,7 +133,7 @@ TEST(VoxelGrid, CrackBetweenPiecesSeparatesCells) {
 }
 
 TEST(VoxelGrid, SlitNarrowerThanACellSeparatesCellsOnlyWhereItIs) {
-    const Scene scene(make_slit_box(2.0));
+    const Scene scene(test::make_slit_box(2.0));
     ASSERT_EQ(scene.connectivity.component_count, 1);
     const VoxelGrid grid = voxelize(scene.problem(), 0.5);
     for (size_t c = 0; c < grid.cell_count(); ++c) {
@@ -217,7 +167,7 @@ TEST(VoxelGrid, SamplingDoesNotLeakAcrossCracksOrSlits) {
     const TetMesh left = make_box_mesh({2, 4, 4}, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(2, 4, 4));
     const TetMesh right = make_box_mesh({2, 4, 4}, Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(4, 4, 4));
     for (const bool crack : {true, false}) {
-        const Scene scene(crack ? join(left, right) : make_slit_box(2.0));
+        const Scene scene(crack ? test::join_meshes(left, right) : test::make_slit_box(2.0));
         const VoxelGrid grid = voxelize(scene.problem(), 0.5);
         std::vector<std::array<double, 3>> values(grid.cell_count());
         for (size_t c = 0; c < values.size(); ++c) {
@@ -241,7 +191,7 @@ TEST(VoxelGrid, PartThinnerThanACellIsReportedUnsampled) {
     // A plate between two planes of cell centres, apart from a box: no cell of its own.
     const TetMesh box = make_box_mesh({4, 4, 4}, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 4, 4));
     const TetMesh plate = make_box_mesh({4, 4, 1}, Eigen::Vector3d(0, 0, 4.3), Eigen::Vector3d(4, 4, 4.45));
-    const Scene scene(join(box, plate));
+    const Scene scene(test::join_meshes(box, plate));
     const VoxelGrid grid = voxelize(scene.problem(), 0.5);
     for (size_t c = 0; c < grid.cell_count(); ++c) EXPECT_LT(static_cast<size_t>(grid.cell_tet[c]), box.tet_count());
     const std::vector<std::array<double, 3>> values(grid.cell_count(), {1, 1, 1});
@@ -257,6 +207,18 @@ TEST(VoxelGrid, RejectsBadCellSizes) {
     for (const double size : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()})
         EXPECT_THROW(voxelize(scene.problem(), size), InvalidArgumentError) << size;
     EXPECT_THROW(voxelize(scene.problem(), 1e-3), InvalidArgumentError);  // 10^9 voxels
+    // 8 cells at 0.5 mm: a cap of 7 refuses them and names a size that fits.
+    EXPECT_EQ(voxelize(scene.problem(), 0.5, 8).cell_count(), 8u);
+    try {
+        voxelize(scene.problem(), 0.5, 7);
+        ADD_FAILURE() << "no error";
+    } catch (const InvalidArgumentError& e) {
+        EXPECT_NE(std::string(e.what()).find("gives 8 cells inside the volume, more than 7; use 0.52"), std::string::npos)
+            << e.what();
+    }
+    const std::vector<std::array<double, 3>> short_q(3);
+    EXPECT_THROW(voxelize(MethodProblem{scene.mesh, scene.connectivity, scene.materials, short_q, 1.0}, 0.5),
+                 InvalidArgumentError);
     try {
         voxelize(scene.problem(), -1);
     } catch (const InvalidArgumentError& e) {
