@@ -214,8 +214,8 @@ TEST_F(Render, SeedsMethodsWriteTheSameFieldsAndAgreeWithTransCut) {
             }
         }
         EXPECT_LT(diff / norm, bound) << method;
-        // The light comes from -x: that side is brighter for every method.
-        EXPECT_GT(mean_lo_near(f, 0, false)[0], 2 * mean_lo_near(f, 0, true)[0]) << method;
+        // The light travels towards -x, so it comes from +x: that side is brighter for every method.
+        EXPECT_GT(mean_lo_near(f, 0, true)[0], 2 * mean_lo_near(f, 0, false)[0]) << method;
     }
 }
 
