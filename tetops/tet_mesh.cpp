@@ -11,6 +11,18 @@
 
 namespace waxwork {
 
+TetMesh join_meshes(const TetMesh& a, const TetMesh& b) {
+    std::vector<Eigen::Vector3d> positions = a.positions;
+    positions.insert(positions.end(), b.positions.begin(), b.positions.end());
+    std::vector<Tet> tets = a.tets;
+    const auto offset = static_cast<int32_t>(a.vertex_count());
+    for (Tet tet : b.tets) {
+        for (int32_t& v : tet) v += offset;
+        tets.push_back(tet);
+    }
+    return make_tet_mesh(std::move(positions), std::move(tets));
+}
+
 double signed_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                      const Eigen::Vector3d& d) {
     return (b - a).dot((c - a).cross(d - a)) / 6.0;

@@ -85,6 +85,10 @@ struct TetMesh {
 // no materials. Reorients negatively oriented tets; throws InvalidMeshError on degenerate ones.
 TetMesh make_tet_mesh(std::vector<Eigen::Vector3d> positions, std::vector<Tet> tets);
 
+// Two meshes as one volume: b's vertices and tets after a's (b's indices shifted), nothing shared, so
+// touching faces stay two boundary faces (a crack of zero width, as a fracture leaves its pieces in
+// the rest frame). Bare geometry as make_tet_mesh gives it: piece 0, no materials.
+TetMesh join_meshes(const TetMesh& a, const TetMesh& b);
 // Signed volume of tet t (positive for a correctly oriented tet).
 double signed_volume(const TetMesh& mesh, size_t t);
 double signed_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,

@@ -94,24 +94,6 @@ StudyTable study_fvm_non_delaunay(const StudySize& size) {
     return table;
 }
 
-namespace {
-
-// Two volumes side by side as one mesh (vertices of `b` after those of `a`), for a part the other's
-// grid cannot see.
-TetMesh joined(const TetMesh& a, const TetMesh& b) {
-    std::vector<Eigen::Vector3d> positions = a.positions;
-    positions.insert(positions.end(), b.positions.begin(), b.positions.end());
-    std::vector<Tet> tets = a.tets;
-    const auto offset = static_cast<int32_t>(a.vertex_count());
-    for (Tet tet : b.tets) {
-        for (int32_t& v : tet) v += offset;
-        tets.push_back(tet);
-    }
-    return make_tet_mesh(std::move(positions), std::move(tets));
-}
-
-}  // namespace
-
 StudyTable study_fd_cuts(const StudySize& size) {
     StudyTable table;
     table.name = "fd on cut and thin volumes";
@@ -162,7 +144,7 @@ StudyTable study_fd_cuts(const StudySize& size) {
     fracture_planes(broken, std::span<const Eigen::Vector4d>(&plane, 1));
     run("ball broken along z = 0.3 mm", broken, 0.5);
     const TetMesh block_and_plate =
-        joined(make_box_mesh({4, 4, 4}, Eigen::Vector3d::Zero(), Eigen::Vector3d(4, 4, 4)),
+        join_meshes(make_box_mesh({4, 4, 4}, Eigen::Vector3d::Zero(), Eigen::Vector3d(4, 4, 4)),
                make_box_mesh({4, 4, 1}, Eigen::Vector3d(0, 0, 4.3), Eigen::Vector3d(4, 4, 4.45)));
     for (double cell : size.quick ? std::vector<double>{0.5, 0.1} : std::vector<double>{1.0, 0.5, 0.25, 0.1})
         run("4 mm block and a 0.15 mm plate", block_and_plate, cell);

@@ -553,7 +553,7 @@ TEST_F(EditorWindow, KeyDRemovesFragmentsUnderTheSizeSetAndUndoRestoresThem) {
     const fs::path dir = scratch_dir("editor_fragments");
     // A cube of 1296 tets and, apart from it, a speck of 6 tets and 0.0125% of the volume (under the
     // default 0.1%).
-    const TetMesh volume = testing::concatenate(testing::make_cube_mesh(6, Eigen::Vector3d::Constant(-1), 2.0),
+    const TetMesh volume = join_meshes(testing::make_cube_mesh(6, Eigen::Vector3d::Constant(-1), 2.0),
                                                 testing::make_cube_mesh(1, Eigen::Vector3d(1.5, 0, 0), 0.1));
     write_volume(volume, dir / "speck.vtu");
     std::ofstream(dir / "input.json") << R"([

@@ -444,7 +444,7 @@ PlaneCutOp cut_the_bridge() {
 TEST(Document, ACutThatLeavesASpeckSaysSoInItsDetails) {
     // A cube of 1296 tets and, apart from it, a speck of 0.0125% of the volume; a cut of the cube
     // leaves the speck, and the details point at Remove fragments.
-    Document doc(testing::concatenate(testing::make_cube_mesh(6), testing::make_cube_mesh(1, Eigen::Vector3d(-3, 0, 0), 0.05)),
+    Document doc(join_meshes(testing::make_cube_mesh(6), testing::make_cube_mesh(1, Eigen::Vector3d(-3, 0, 0), 0.05)),
                  material_preset("marble"));
     for (const bool exact : {false, true}) {
         PlaneCutOp cut = plane_cut(0.55);

@@ -30,16 +30,7 @@ using testing::run_waxwork;
 // The boxes [lo0, hi0] and [lo1, hi1] as one volume (two components, one piece).
 TetMesh two_boxes(const std::array<int, 3>& cells0, const Eigen::Vector3d& lo0, const Eigen::Vector3d& hi0,
                   const std::array<int, 3>& cells1, const Eigen::Vector3d& lo1, const Eigen::Vector3d& hi1) {
-    const TetMesh a = make_box_mesh(cells0, lo0, hi0), b = make_box_mesh(cells1, lo1, hi1);
-    std::vector<Eigen::Vector3d> positions = a.positions;
-    positions.insert(positions.end(), b.positions.begin(), b.positions.end());
-    std::vector<Tet> tets = a.tets;
-    const auto offset = static_cast<int32_t>(a.vertex_count());
-    for (Tet t : b.tets) {
-        for (auto& v : t) v += offset;
-        tets.push_back(t);
-    }
-    return make_tet_mesh(std::move(positions), std::move(tets));
+    return join_meshes(make_box_mesh(cells0, lo0, hi0), make_box_mesh(cells1, lo1, hi1));
 }
 
 DiffusionOptions quick_solve() {

@@ -197,7 +197,7 @@ TEST(AreaLight, PointsInsideASphereOrBehindAnEmitterGetNothing) {
 TEST(AreaLight, AHalfCoveredVertexIsPartlyVisibleAndTheResultIsDeterministic) {
     // The cube [0,1]^3 under a slab covering x < 0.5 at z in [2, 2.3], lit by a disk above facing down:
     // the slab's edge passes over the middle of the top face, which sees half the disk.
-    const TetMesh mesh = testing::concatenate(testing::make_box_mesh(4, {0, 0, 0}, {1, 1, 1}),
+    const TetMesh mesh = join_meshes(testing::make_box_mesh(4, {0, 0, 0}, {1, 1, 1}),
                                               testing::make_box_mesh(2, {-1, -1, 2}, {0.5, 2, 2.3}));
     const TetConnectivity connectivity = build_connectivity(mesh);
     const BoundarySurface surface = extract_boundary_surface(mesh, connectivity, {});

@@ -247,7 +247,7 @@ TEST(FdMethod, CrackNarrowerThanACellStopsTheLight) {
     // its two sides are not linked, so the unlit piece stays dark, as it must.
     const TetMesh left = make_box_mesh({2, 4, 4}, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(2, 4, 4));
     const TetMesh right = make_box_mesh({2, 4, 4}, Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(4, 4, 4));
-    Scene cracked(test::join_meshes(left, right));
+    Scene cracked(join_meshes(left, right));
     Scene whole(make_box_mesh({4, 4, 4}, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(4)));
     light_left_face(cracked);
     light_left_face(whole);
@@ -296,7 +296,7 @@ TEST(FdMethod, PartsThinnerThanACellAreLeftDarkWithAWarning) {
     // vertices keep phi = 0 and the solution says so; alone it is an error.
     const TetMesh box = make_box_mesh({4, 4, 4}, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 4, 4));
     const TetMesh plate = make_box_mesh({4, 4, 1}, Eigen::Vector3d(0, 0, 4.3), Eigen::Vector3d(4, 4, 4.45));
-    Scene scene(test::join_meshes(box, plate));
+    Scene scene(join_meshes(box, plate));
     for (int32_t v : scene.connectivity.boundary_vertices) scene.q[v] = {1, 1, 1};
     const MethodSolution solution = solve_fd(scene.problem(), with_cell(0.5));
     ASSERT_EQ(solution.warnings.size(), 1u);

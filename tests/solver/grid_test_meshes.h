@@ -27,20 +27,6 @@ struct MethodScene {
     }
 };
 
-// Two meshes as one volume (vertices not shared): pieces side by side, their touching faces a crack
-// of zero width, as a fracture leaves them in the rest frame.
-inline TetMesh join_meshes(const TetMesh& a, const TetMesh& b) {
-    std::vector<Eigen::Vector3d> positions = a.positions;
-    positions.insert(positions.end(), b.positions.begin(), b.positions.end());
-    std::vector<Tet> tets = a.tets;
-    const int32_t offset = static_cast<int32_t>(a.vertex_count());
-    for (Tet t : b.tets) {
-        for (int32_t& v : t) v += offset;
-        tets.push_back(t);
-    }
-    return make_tet_mesh(std::move(positions), std::move(tets));
-}
-
 // The box [0,4]^3 in 8^3 cubes with a slit of zero width, as a cut leaves it: the faces on the plane
 // x = 2 with y < `depth` are split (the tets on the x > 2 side get their own copies of those
 // vertices), so the two sides touch there only through coincident boundary faces, and stay connected

@@ -327,7 +327,7 @@ TEST(RayCaster, EmptyAndInvalidInput) {
 
 TEST(Lighting, UpdatingSomeVerticesEqualsTheFullComputationThere) {
     // Two boxes, one shadowing the other, and a point light: the update must reproduce shadows too.
-    const TetMesh mesh = testing::concatenate(testing::make_box_mesh(3, {0, 0, 0}, {1, 1, 1}),
+    const TetMesh mesh = join_meshes(testing::make_box_mesh(3, {0, 0, 0}, {1, 1, 1}),
                                               testing::make_box_mesh(2, {-0.5, 1.5, -0.5}, {1.5, 1.8, 1.5}));
     const TetConnectivity connectivity = build_connectivity(mesh);
     BoundarySurface surface = extract_boundary_surface(mesh, connectivity, {});

@@ -110,7 +110,7 @@ TEST(VoxelGrid, CrackBetweenPiecesSeparatesCells) {
     // have cells next to the crack, and no link joins them.
     const TetMesh left = make_box_mesh({2, 4, 4}, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(2, 4, 4));
     const TetMesh right = make_box_mesh({2, 4, 4}, Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(4, 4, 4));
-    const Scene scene(test::join_meshes(left, right));
+    const Scene scene(join_meshes(left, right));
     const VoxelGrid grid = voxelize(scene.problem(), 0.5);
     ASSERT_EQ(grid.cell_count(), 512u);
     int crack_links = 0;
@@ -167,7 +167,7 @@ TEST(VoxelGrid, SamplingDoesNotLeakAcrossCracksOrSlits) {
     const TetMesh left = make_box_mesh({2, 4, 4}, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(2, 4, 4));
     const TetMesh right = make_box_mesh({2, 4, 4}, Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(4, 4, 4));
     for (const bool crack : {true, false}) {
-        const Scene scene(crack ? test::join_meshes(left, right) : test::make_slit_box(2.0));
+        const Scene scene(crack ? join_meshes(left, right) : test::make_slit_box(2.0));
         const VoxelGrid grid = voxelize(scene.problem(), 0.5);
         std::vector<std::array<double, 3>> values(grid.cell_count());
         for (size_t c = 0; c < values.size(); ++c) {
@@ -191,7 +191,7 @@ TEST(VoxelGrid, PartThinnerThanACellIsReportedUnsampled) {
     // A plate between two planes of cell centres, apart from a box: no cell of its own.
     const TetMesh box = make_box_mesh({4, 4, 4}, Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(4, 4, 4));
     const TetMesh plate = make_box_mesh({4, 4, 1}, Eigen::Vector3d(0, 0, 4.3), Eigen::Vector3d(4, 4, 4.45));
-    const Scene scene(test::join_meshes(box, plate));
+    const Scene scene(join_meshes(box, plate));
     const VoxelGrid grid = voxelize(scene.problem(), 0.5);
     for (size_t c = 0; c < grid.cell_count(); ++c) EXPECT_LT(static_cast<size_t>(grid.cell_tet[c]), box.tet_count());
     const std::vector<std::array<double, 3>> values(grid.cell_count(), {1, 1, 1});

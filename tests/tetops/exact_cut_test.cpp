@@ -290,7 +290,7 @@ TEST(ExactCut, StrokeCutFollowsTheStroke) {
 }
 
 TEST(ExactCut, MovedPiecesAreCutInWorldSpace) {
-    TetMesh mesh = testing::concatenate(make_cube_mesh(4), make_cube_mesh(4, Eigen::Vector3d(0, 0, 3)));
+    TetMesh mesh = join_meshes(make_cube_mesh(4), make_cube_mesh(4, Eigen::Vector3d(0, 0, 3)));
     for (size_t t = mesh.tet_count() / 2; t < mesh.tet_count(); ++t) mesh.piece_ids[t] = 1;
     RigidTransform moved;
     moved.rotation = Eigen::AngleAxisd(0.5 * M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();

@@ -342,7 +342,7 @@ TEST(FractureVoronoi, OneSeedGivesOnePieceAndFracturesEachExistingPiece) {
 
     // Two pieces (already apart), a cell wall through both: four pieces, each with its parent's
     // transform.
-    TetMesh two = testing::concatenate(make_cube_mesh(4), make_cube_mesh(4, Eigen::Vector3d(0, 0, 2)));
+    TetMesh two = join_meshes(make_cube_mesh(4), make_cube_mesh(4, Eigen::Vector3d(0, 0, 2)));
     for (size_t t = two.tet_count() / 2; t < two.tet_count(); ++t) two.piece_ids[t] = 1;
     RigidTransform moved;
     moved.translation = Eigen::Vector3d(5, 0, 0);

@@ -14,14 +14,12 @@
 
 namespace waxwork {
 namespace {
-
-using testing::concatenate;
 using testing::make_cell_mesh;
 using testing::make_cube_mesh;
 
 // A unit cube of 4^3 cells (384 tets) and, apart from it, a cube 0.1 across (6 tets, volume 0.001).
 TetMesh body_and_speck() {
-    TetMesh mesh = concatenate(make_cube_mesh(4), make_cube_mesh(1, Eigen::Vector3d(3, 0, 0), 0.1));
+    TetMesh mesh = join_meshes(make_cube_mesh(4), make_cube_mesh(1, Eigen::Vector3d(3, 0, 0), 0.1));
     mesh.materials.resize(mesh.tet_count());
     for (size_t t = 0; t < mesh.tet_count(); ++t) mesh.materials[t] = TetMaterial{{0.1, 0.1, 0.1}, {1, 1, 1}, 1.0 + 0.001 * static_cast<double>(t)};
     return mesh;
@@ -70,14 +68,14 @@ TEST(RemoveSmallFragments, KeepsPartsAtOrAboveTheFraction) {
 
 TEST(RemoveSmallFragments, AlwaysKeepsTheLargestPart) {
     // Three parts of 6, 48 and 6 tets: a fraction no part reaches still keeps the middle one.
-    TetMesh mesh = concatenate(concatenate(make_cube_mesh(1, Eigen::Vector3d(-3, 0, 0)), make_cube_mesh(2, Eigen::Vector3d::Zero(), 2.0)),
+    TetMesh mesh = join_meshes(join_meshes(make_cube_mesh(1, Eigen::Vector3d(-3, 0, 0)), make_cube_mesh(2, Eigen::Vector3d::Zero(), 2.0)),
                                make_cube_mesh(1, Eigen::Vector3d(5, 0, 0)));
     const FragmentRemoval result = remove_small_fragments(mesh, 0.99);
     EXPECT_EQ(result.fragments_removed, 2u);
     ASSERT_EQ(mesh.tet_count(), 48u);
     EXPECT_NEAR(total_volume(mesh), 8.0, 1e-12);
     // Equal parts: the lowest-numbered stays.
-    TetMesh twins = concatenate(make_cube_mesh(1), make_cube_mesh(1, Eigen::Vector3d(3, 0, 0)));
+    TetMesh twins = join_meshes(make_cube_mesh(1), make_cube_mesh(1, Eigen::Vector3d(3, 0, 0)));
     remove_small_fragments(twins, 0.9);
     ASSERT_EQ(twins.tet_count(), 6u);
     EXPECT_LT(twins.positions[twins.tets[0][0]].x(), 2.0);

@@ -18,19 +18,6 @@ inline TetMesh make_cube_mesh(int n, const Eigen::Vector3d& origin = Eigen::Vect
     return make_box_mesh(n, origin, origin + Eigen::Vector3d::Constant(size));
 }
 
-// Appends mesh b to mesh a as further tets (vertex indices shifted), keeping piece 0.
-inline TetMesh concatenate(const TetMesh& a, const TetMesh& b) {
-    std::vector<Eigen::Vector3d> points = a.positions;
-    points.insert(points.end(), b.positions.begin(), b.positions.end());
-    std::vector<Tet> tets = a.tets;
-    const auto shift = static_cast<int32_t>(a.positions.size());
-    for (Tet t : b.tets) {
-        for (int32_t& v : t) v += shift;
-        tets.push_back(t);
-    }
-    return make_tet_mesh(std::move(points), std::move(tets));
-}
-
 // Unit cells of a grid (Kuhn subdivision, as make_cube_mesh) where `inside(i, j, k)` holds, with
 // unused grid points dropped: lets a test build a U or any other blocky shape that conforms.
 template <class Inside>

@@ -17,8 +17,6 @@
 
 namespace waxwork {
 namespace {
-
-using testing::concatenate;
 using testing::make_cube_mesh;
 
 TEST(TetMesh, MakeReorientsNegativeTets) {
@@ -218,7 +216,7 @@ TEST(Connectivity, OneRingsMatchEdges) {
 }
 
 TEST(Connectivity, TwoComponents) {
-    TetMesh mesh = concatenate(make_cube_mesh(2), make_cube_mesh(2, Eigen::Vector3d(3, 0, 0)));
+    TetMesh mesh = join_meshes(make_cube_mesh(2), make_cube_mesh(2, Eigen::Vector3d(3, 0, 0)));
     const TetConnectivity c = build_connectivity(mesh);
     EXPECT_EQ(c.component_count, 2);
     const size_t half = mesh.tet_count() / 2;

@@ -12,7 +12,7 @@ namespace {
 
 TEST(VertexPieces, EachVertexTakesThePieceOfItsTets) {
     // Two cubes side by side as pieces 0 and 1; a vertex no tet names has no piece.
-    TetMesh mesh = testing::concatenate(testing::make_cube_mesh(1), testing::make_cube_mesh(1, Eigen::Vector3d(2, 0, 0)));
+    TetMesh mesh = join_meshes(testing::make_cube_mesh(1), testing::make_cube_mesh(1, Eigen::Vector3d(2, 0, 0)));
     const size_t first = testing::make_cube_mesh(1).vertex_count();
     mesh.piece_transforms.resize(2);
     for (size_t t = testing::make_cube_mesh(1).tet_count(); t < mesh.tet_count(); ++t) mesh.piece_ids[t] = 1;
