@@ -560,8 +560,9 @@ void run_methods_part(const BenchSuiteOptions& o, Json& index, RunProvenance& pr
     options.progress = o.progress;
     const std::vector<MethodSeries> series = study_methods(options);
     const Json inputs = {
-        {"ball", "icosphere of radius 10 mm meshed by TetGen (three to four sizes); mu_a 0.01, mu_s' 1 per mm, eta 1.3; "
-                 "grid methods at the voxel size giving as many voxels as the mesh has vertices"},
+        {"ball", "icosphere of radius 10 mm meshed by TetGen (2K to 300K tets; quick: 2K to 16K); mu_a 0.01, mu_s' 1 "
+                 "per mm, eta 1.3; grid methods at the voxel size giving as many voxels as the mesh has vertices; the "
+                 "dipole up to 120K tets (it is quadratic in the vertices)"},
         {"surface", {{"mesh_file", options.surface.string()},
                      {"mesh_sha256", file_sha256(options.surface)},
                      {"material", "marble"},

@@ -1,8 +1,9 @@
 // The seeds' methods side by side (solver/methods/alternative_method.h) with TransCut's own solvers,
 // on the same problems against the same exact references:
 //   - the analytic ball (R = 10 mm, mu_a 0.01, mu_s' 1 per mm, eta 1.3) under uniform and directional
-//     light, at three or more resolutions (TetGen meshes; the grid methods at the cell size that gives
-//     as many cells as the mesh has vertices), against the series (analytic_ball.h);
+//     light, at three (quick) or five resolutions, 2K to 300K tets (TetGen meshes; the grid methods at
+//     the cell size that gives as many cells as the mesh has vertices; the dipole, quadratic in the
+//     vertices, up to 120K), against the series (analytic_ball.h);
 //   - a shipped surface (spot in marble) at its default mesh, against TransCut on a mesh of half the
 //     default size, compared at the input surface's vertices.
 // Each run records its setup (grid, graph, hierarchy or assembly) and solve times apart, its unknowns,
