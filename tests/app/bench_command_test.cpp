@@ -13,6 +13,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -375,6 +376,23 @@ TEST(BenchSuiteCommand, UnwritableOutputIsAClearError) {
     EXPECT_NE(result.err.find("cannot create the output directory"), std::string::npos) << result.err;
 }
 
+TEST(BenchSuiteCommand, MethodsPartChartsEveryMethodBesideTransCut) {
+    const auto dir = scratch_dir("bench_suite_methods");
+    const auto result = run_waxwork("bench --quick --only methods -o " + dir.string());
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const auto methods = nlohmann::json::parse(testing::read_text(dir / "methods.json"));
+    ASSERT_TRUE(methods.contains("provenance"));
+    std::set<std::string> charted;
+    for (const auto& series : methods["series"]) charted.insert(series["method"].get<std::string>());
+    for (const char* method : {"transcut_cg", "transcut_multigrid_cg", "fd", "fd-cg", "fvm", "fvm-cg", "lbm", "dipole"})
+        EXPECT_TRUE(charted.count(method)) << method;
+    for (const char* file : {"methods.md", "methods.svg", "methods_uniform.svg", "methods_spot.svg"})
+        EXPECT_TRUE(std::filesystem::exists(dir / file)) << file;
+    const std::string svg = testing::read_text(dir / "methods.svg");
+    EXPECT_NE(svg.find("lbm"), std::string::npos);
+    EXPECT_NE(svg.find("transcut_cg"), std::string::npos);
+}
+
 TEST(BenchSuiteCommand, OnlyRunsTheNamedParts) {
     const auto dir = scratch_dir("bench_suite_only");
     const auto result = run_waxwork("bench --quick --only stability -o " + dir.string());
@@ -383,9 +401,10 @@ TEST(BenchSuiteCommand, OnlyRunsTheNamedParts) {
     EXPECT_EQ(index["parts"].size(), 1u);
     EXPECT_EQ(index["parts"]["stability"]["status"], "ok");
     const auto stability = nlohmann::json::parse(testing::read_text(dir / "stability.json"));
-    EXPECT_EQ(stability["tables"].size(), 7u);
+    EXPECT_EQ(stability["tables"].size(), 11u);  // TransCut's seven, then the four seeds' methods'
     EXPECT_EQ(stability["provenance"]["machine"]["threads_used"].get<unsigned>(), index["parts"]["stability"]["threads"].get<unsigned>());
     EXPECT_NE(testing::read_text(dir / "stability.md").find("### slivers"), std::string::npos);
+    EXPECT_NE(testing::read_text(dir / "stability.md").find("### dipole on thin parts"), std::string::npos);
     const auto unknown = run_waxwork("bench --quick --only nonsense -o " + dir.string());
     EXPECT_NE(unknown.exit_code, 0);
     EXPECT_NE(unknown.err.find("unknown part 'nonsense'"), std::string::npos) << unknown.err;
