@@ -59,8 +59,7 @@ void run_export_command(const ExportCommandOptions& o) {
     if (o.radiance) {
         progress.set_stage("solving the light");
         light = solve_volume_light(mesh, o.volume, settings);
-        if (!light->scene.diffusion.gpu_fallback_reason.empty())
-            std::cerr << "warning: solving on the CPU instead: " << light->scene.diffusion.gpu_fallback_reason << "\n";
+        report_solve_warnings(o.volume, light->scene);
     } else {
         connectivity = build_connectivity(mesh);
     }
@@ -88,8 +87,7 @@ void run_export_command(const ExportCommandOptions& o) {
         summary["mm_per_unit"] = scale.mm_per_unit;
         summary["scale_source"] = scale_source_name(scale.source);
         summary["lights"] = settings.lighting.lights.size();
-        summary["iterations"] = s.iterations;
-        summary["estimated_error"] = s.estimated_relative_error;
+        add_solve_summary(summary, light->scene);
     }
     summary["milliseconds"] = milliseconds_since(start);
     std::cout << summary.dump() << "\n";

@@ -282,11 +282,7 @@ void run_render_command(const RenderCommandOptions& o) {
     if (traced) trace.emplace(render_traced(mesh, o, settings));
     const VolumeRender render = traced ? std::move(trace->render) : render_volume(mesh, o.volume, settings);
     const SolvedScene& scene = render.scene;
-    if (!scene.diffusion.gpu_fallback_reason.empty())
-        std::cerr << "warning: solving on the CPU instead: " << scene.diffusion.gpu_fallback_reason << "\n";
-    if (scene.alternative)
-        for (const std::string& warning : scene.alternative->warnings)
-            std::cerr << "warning: " << o.volume << ": " << warning << "\n";
+    report_solve_warnings(o.volume, scene);
     write_image(render.image, o.output);
     if (!o.linear.empty()) write_linear_png(render.linear, o.linear, render.exposure);
     report_chosen_scale(o.volume, scale, mesh);
@@ -305,8 +301,6 @@ void run_render_command(const RenderCommandOptions& o) {
         {"scale_source", scale_source_name(scale.source)},
         {"lights", lighting.lights.size()},
         {"lights_inside", render.lights_inside},
-        {"iterations", s.iterations},
-        {"estimated_error", s.estimated_relative_error},
         {"exposure", render.exposure},
         {"crease_angle_deg", o.light.crease_angle},
         {"shading_copies", scene.shading.size() - scene.surface.vertices.size()},
@@ -316,15 +310,7 @@ void run_render_command(const RenderCommandOptions& o) {
         {"render_ms", render.render_ms},
         {"view", view_mode_name(view.mode)},
     };
-    if (scene.alternative) {
-        summary.erase("estimated_error");  // CG's estimate; the alternatives have none
-        const MethodSolution& m = *scene.alternative;
-        summary["alternative"] = {{"unknowns", m.unknowns},
-                                  {"setup_ms", m.setup_ms},
-                                  {"solve_ms", m.solve_ms},
-                                  {"iterations", m.iterations},
-                                  {"warnings", m.warnings}};
-    }
+    add_solve_summary(summary, scene);
     if (traced) {
         const MonteCarloFluence& mc = trace->fluence;
         summary["monte_carlo"] = {

@@ -101,8 +101,7 @@ TurntableScene solve_turntable_scene(const TurntableOptions& o) {
     const ModelScale scale = chosen_scale(o.light, file);
     const VolumeRenderSettings settings = scene_light_settings(o.light, scale);
     VolumeLight light = solve_volume_light(file.mesh, o.input, settings);
-    if (!light.scene.diffusion.gpu_fallback_reason.empty())
-        std::cerr << "warning: solving on the CPU instead: " << light.scene.diffusion.gpu_fallback_reason << "\n";
+    report_solve_warnings(o.input, light.scene);
     t.mesh = std::move(file.mesh);
     t.scene = std::move(light.scene);
     t.lighting = settings.lighting;

@@ -137,4 +137,24 @@ void report_chosen_scale(const std::string& file, const ModelScale& scale, const
                   << "\n";
 }
 
+void report_solve_warnings(const std::string& file, const SolvedScene& scene) {
+    if (!scene.diffusion.gpu_fallback_reason.empty())
+        std::cerr << "warning: " << file << ": solving on the CPU instead: " << scene.diffusion.gpu_fallback_reason << "\n";
+    if (scene.alternative)
+        for (const std::string& warning : scene.alternative->warnings) std::cerr << "warning: " << file << ": " << warning << "\n";
+}
+
+void add_solve_summary(nlohmann::ordered_json& summary, const SolvedScene& scene) {
+    summary["iterations"] = scene.diffusion.iterations;
+    if (!scene.alternative) {
+        summary["estimated_error"] = scene.diffusion.estimated_relative_error;
+        return;
+    }
+    const MethodSolution& m = *scene.alternative;
+    summary["alternative"] = {{"unknowns", m.unknowns},
+                              {"setup_ms", m.setup_ms},
+                              {"solve_ms", m.solve_ms},
+                              {"warnings", m.warnings}};
+}
+
 }  // namespace waxwork

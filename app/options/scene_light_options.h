@@ -14,6 +14,8 @@
 #include "io/volume_file.h"
 #include "tetops/model_scale.h"
 
+#include <nlohmann/json.hpp>
+
 #include <optional>
 #include <string>
 #include <vector>
@@ -72,5 +74,13 @@ ModelScale chosen_scale(const SceneLightOptions& options, const VolumeFile& file
 // Says on stderr ("waxwork: FILE: scale: ...") a scale chosen from the model's size (nothing for a
 // given or stored one). Called once the output is written, so that an error stays one line.
 void report_chosen_scale(const std::string& file, const ModelScale& scale, const TetMesh& mesh);
+
+// Warnings of a solve on stderr: the GPU solve that fell back to the CPU, and the alternative method's
+// (a scene outside its valid range), each naming `file`.
+void report_solve_warnings(const std::string& file, const SolvedScene& scene);
+
+// The solver's part of a command's JSON summary: iterations, and CG's estimated error for TransCut, or
+// the alternative method's unknowns, setup and solve times and warnings.
+void add_solve_summary(nlohmann::ordered_json& summary, const SolvedScene& scene);
 
 }  // namespace waxwork
