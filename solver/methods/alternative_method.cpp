@@ -46,12 +46,6 @@ std::optional<AlternativeMethod> parse_alternative_method(std::string_view name)
     return std::nullopt;
 }
 
-std::string alternative_method_names() {
-    std::string names;
-    for (const NamedMethod& m : kMethods) names += (names.empty() ? "" : ", ") + std::string(m.name);
-    return names;
-}
-
 bool uses_voxel_grid(AlternativeMethod method) {
     return method == AlternativeMethod::FdJacobi || method == AlternativeMethod::FdCg || method == AlternativeMethod::Lbm;
 }

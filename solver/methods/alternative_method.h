@@ -28,8 +28,6 @@ const char* alternative_method_name(AlternativeMethod method);
 std::vector<AlternativeMethod> all_alternative_methods();
 // The method of a name above; nullopt for any other word (transcut, fem, mc are not alternatives).
 std::optional<AlternativeMethod> parse_alternative_method(std::string_view name);
-// The names above joined by ", " (for help and errors).
-std::string alternative_method_names();
 
 // Whether the method lives on a voxel grid (fd, lbm): then cell_mm sets its resolution; the others
 // take the volume's own vertices.
@@ -39,7 +37,9 @@ struct AlternativeMethodSettings {
     AlternativeMethod method = AlternativeMethod::FdCg;
     // Grid methods: the cell size in mm; 0 chooses it from the volume (default_cell_mm).
     double cell_mm = 0;
-    // Stopping rule of the iterative methods: relative change (relaxation, LBM) or relative residual (CG).
+    // The iterative methods' stopping rule (each option struct's tolerance): the estimated relative
+    // error of phi, from CG's Lanczos bound, the relaxations' contraction of their updates, or LBM's
+    // distance to its steady state.
     double relative_tolerance = 1e-4;
 };
 
