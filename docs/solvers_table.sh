@@ -20,6 +20,8 @@ labels = {
     "cascadic_cg": "cascadic CG (the paper's pass on Galerkin coarse systems)",
     "multigrid_cg_rgb": "multigrid-preconditioned CG, three channels in one pass (the editor's frame solver)",
     "eigen_ic_cg": "Eigen CG + IncompleteCholesky",
+    "petsc_cg_gamg": "PETSc CG + GAMG (smoothed aggregation)",
+    "petsc_cg_boomeramg": "PETSc CG + hypre BoomerAMG (HMIS, ext+i)",
     "gpu_cg": "GPU CG on llvmpipe (a CPU: not GPU speed)",
     "gpu_multires": "GPU multires on llvmpipe",
     "gpu_multigrid_cg": "GPU multigrid CG on llvmpipe",

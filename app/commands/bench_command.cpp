@@ -113,6 +113,7 @@ void run_solvers_command(const SolversCommandOptions& o) {
     chart.include_setup = o.include_setup;
     if (context) provenance.set_gl_renderer(context->renderer());
     if (const std::string busy = busy_machine_warning(comparison); !busy.empty()) provenance.warn(busy);
+    if (const std::string peers = missing_peers_warning(comparison); !peers.empty()) provenance.warn(peers);
     nlohmann::ordered_json inputs = mesh_inputs(o.mesh, mesh, options.mm_per_unit);
     inputs["meshing"] = meshing;
     inputs["material"] = material_name;

@@ -125,6 +125,7 @@ void run_solver_part(const BenchSuiteOptions& o, size_t target_tets, Json& index
     chart.quick = o.quick;
     if (context) provenance.set_gl_renderer(context->renderer());
     if (const std::string busy = busy_machine_warning(comparison); !busy.empty()) provenance.warn(busy);
+    if (const std::string peers = missing_peers_warning(comparison); !peers.empty()) provenance.warn(peers);
     const Json block = provenance.to_json(scene_inputs(o, scene, solver_scene_mm_per_unit),
                                           solver_comparison_definitions(options));
     write_solver_comparison(o.output_dir, stem, {"assets/meshes/spot.obj", "marble", solver_scene_mm_per_unit},

@@ -11,6 +11,8 @@ const std::vector<MethodStyle>& method_styles() {
         {"cascadic_cg", "Cascadic CG", "#E69F00", Marker::TriangleDown, false},
         {"multigrid_cg_rgb", "Multigrid CG (RGB frame solver)", "#CC79A7", Marker::Square, false},
         {"eigen_ic_cg", "Eigen IC-CG", "#000000", Marker::Cross, false},
+        {"petsc_cg_gamg", "PETSc CG + GAMG", "#AA4499", Marker::TriangleDown, false},
+        {"petsc_cg_boomeramg", "PETSc CG + hypre BoomerAMG", "#332288", Marker::TriangleUp, false},
         {"gpu_cg", "GPU Jacobi CG", "#882255", Marker::Circle, true},
         {"gpu_multires", "GPU multires", "#44AA99", Marker::TriangleUp, true},
         {"gpu_multigrid_cg", "GPU multigrid CG", "#117733", Marker::Diamond, true},

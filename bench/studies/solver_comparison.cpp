@@ -16,6 +16,7 @@
 #include "solver/conjugate_gradient.h"
 #include "solver/diffusion_matrix.h"
 #include "solver/gpu/gpu_conjugate_gradient.h"
+#include "solver/petsc_peers.h"
 #include "solver/reference/reference_solvers.h"
 
 #include <Eigen/IterativeLinearSolvers>
@@ -48,6 +49,16 @@ double relative_error(const Fields& x, const Fields& reference) {
             r += reference[c][i] * reference[c][i];
         }
     return r > 0 ? std::sqrt(e / r) : std::sqrt(e);
+}
+
+// The JSON's peers.petsc: the PETSc version the peers ran with, or why they did not run.
+std::string petsc_status(const SolverComparison& comparison) {
+    if (!comparison.peers_missing_reason.empty()) return "not run: " + comparison.peers_missing_reason;
+#ifdef WAXWORK_HAVE_PETSC
+    return petsc_version();
+#else
+    return "not run: " + petsc_unavailable_reason();
+#endif
 }
 
 struct Run {
@@ -332,6 +343,40 @@ SolverComparison compare_solvers(const TetMesh& mesh, const TetConnectivity& con
         result.solvers.back().setup_ms = ic_setup_ms;
     }
 
+    // The PETSc peers (solver/petsc_peers.h): CG with GAMG or BoomerAMG on the same matrices; cap = CG
+    // iterations per channel, tolerance 0 so that only the cap stops a run.
+    // PETSc failing to start (MPI unable to run as a singleton) leaves the peers out with the reason,
+    // as the GPU curves are left out without a GPU.
+#ifdef WAXWORK_HAVE_PETSC
+    for (const PetscPeer peer : {PetscPeer::CgGamg, PetscPeer::CgBoomerAmg}) {
+        try {
+            PetscPeerSolver solver(matrix, peer);
+            PeerSetup setup;
+            setup.name = petsc_peer_name(peer);
+            setup.conversion_ms = solver.setup_times().conversion_ms;
+            setup.preconditioner_ms = solver.setup_times().preconditioner_ms;
+            setup.rebuild_ms = median_rebuild_ms([&] {
+                solver.rebuild(matrix);
+                return solver.setup_times().conversion_ms + solver.setup_times().preconditioner_ms;
+            });
+            setup.settings = petsc_peer_settings(peer);
+            result.solvers.push_back(measurer.curve(setup.name, [&](int cap, Fields& x) {
+                PetscSolveOptions solve;
+                solve.relative_tolerance = 0;
+                solve.max_iterations = cap;
+                for (size_t c = 0; c < 3; ++c) solver.solve(static_cast<int>(c), b_copy[c], x[c], solve);
+            }));
+            result.solvers.back().setup_ms = setup.conversion_ms + setup.preconditioner_ms;
+            result.peers.push_back(std::move(setup));
+        } catch (const AlgorithmError& e) {
+            result.peers_missing_reason = e.what();
+            break;
+        }
+    }
+#else
+    result.peers_missing_reason = petsc_unavailable_reason();
+#endif
+
     // The GPU path: CG, the multires scheme and the multigrid CG in float on compute shaders, matrices
     // resident (the upload is per-mesh setup, excluded); cap = level-0 CG iterations (V-cycles for the
     // multigrid CG).
@@ -438,6 +483,10 @@ std::string busy_machine_warning(const SolverComparison& comparison) {
            "other processes kept busy on average): " + busy;
 }
 
+std::string missing_peers_warning(const SolverComparison& comparison) {
+    return comparison.peers_missing_reason.empty() ? "" : "PETSc peer rows missing: " + comparison.peers_missing_reason;
+}
+
 std::vector<std::pair<std::string, double>> setup_times(const SolverComparison& comparison) {
     return {{"hierarchy_ms", comparison.hierarchy_ms},
             {"hierarchy_rebuild_ms", comparison.hierarchy_rebuild_ms},
@@ -476,7 +525,8 @@ nlohmann::ordered_json solver_comparison_definitions(const SolverComparisonOptio
         {"curve", "each iterative solver runs from a cold start (phi = 0; multires: its coarse-to-fine pass) with "
                   "an increasing cap (0, 1, 2, then growing by a quarter), all three channels per run; a point is "
                   "(time of that run, its error); a point slower than a later one is dropped"},
-        {"cap", "jacobi_cg, jacobi_cg_double, eigen_ic_cg, gpu_cg: CG iterations per channel; multires, cascadic_cg, "
+        {"cap", "jacobi_cg, jacobi_cg_double, eigen_ic_cg, petsc_cg_gamg, petsc_cg_boomeramg, gpu_cg: CG iterations "
+                "per channel; multires, cascadic_cg, "
                 "gpu_multires: level-0 CG iterations after the coarse levels; multigrid_cg: V-cycle-preconditioned CG "
                 "iterations; multigrid_cg_rgb, gpu_multigrid_cg: V-cycles (three channels at once)"},
         {"stopping_rule", "a curve ends when its error falls below floor_error, when four caps in a row past cap 16 "
@@ -490,7 +540,13 @@ nlohmann::ordered_json solver_comparison_definitions(const SolverComparisonOptio
         {"times", "milliseconds of wall clock for all three channels, solve only; statistic: " +
                       timing_statistic(options.repeats)},
         {"setup_ms", "per solver, milliseconds of per-mesh setup not in its curve (hierarchy, Galerkin operators, "
-                     "incomplete or direct factorisation, GPU uploads); setup + solve = setup_ms + a point's time"},
+                     "incomplete or direct factorisation, GPU uploads, PETSc's matrix conversion and AMG setup); "
+                     "setup + solve = setup_ms + a point's time"},
+        {"peers", "petsc_cg_gamg, petsc_cg_boomeramg: CG (unpreconditioned residual norm) with PETSc's GAMG or hypre's "
+                  "BoomerAMG through PETSc, one process and one thread; setup_ms: first build (the three channels "
+                  "converted to AIJ, then the three preconditioners set up; PETSc and MPI start-up excluded); "
+                  "setup_rebuild_ms: median of three rebuilds (the same values copied in again, the preconditioners "
+                  "set up from scratch); settings: the PETSc options"},
         {"parallelism", "per solver, this process's CPU seconds per wall second over all of its measurements"},
         {"other_load_cores", "per solver, the cores other processes kept busy on average during its measurements"},
     };
@@ -559,6 +615,17 @@ void write_solver_comparison(const std::filesystem::path& dir, const std::string
     json["statistic"] = timing_statistic(comparison.repeats);
     json["repeats"] = comparison.repeats;
     json["solvers"] = solvers;
+    Json peers = {{"petsc", petsc_status(comparison)}};
+    for (const PeerSetup& peer : comparison.peers) {
+        Json settings = Json::object();
+        for (const auto& [key, value] : peer.settings) settings[key] = value;
+        peers[peer.name] = {{"setup_ms", peer.conversion_ms + peer.preconditioner_ms},
+                            {"setup_rebuild_ms", peer.rebuild_ms},
+                            {"conversion_ms", peer.conversion_ms},
+                            {"preconditioner_setup_ms", peer.preconditioner_ms},
+                            {"settings", settings}};
+    }
+    json["peers"] = peers;
     write_file_atomically(dir / (stem + ".json"), [&](std::ostream& out) { out << json.dump(2) << "\n"; });
 
     ChartOptions chart;

@@ -31,6 +31,13 @@
 // separately, as their first run in the process and as a rebuild (SolverComparison); setup_ms uses the
 // first run for those and the statistic for the two factorisations. The float copies of the matrices
 // and the Eigen sparse matrices are not timed.
+//
+// Peers (builds with PETSc, solver/petsc_peers.h): petsc_cg_gamg and petsc_cg_boomeramg, CG with
+// PETSc's GAMG or hypre's BoomerAMG on the same three matrices and right-hand sides; cap = CG
+// iterations per channel, measured like every other curve. Their setup_ms is the first build: the
+// conversion of the three channels to PETSc's AIJ matrices plus the preconditioners' setup (PETSc's
+// and MPI's start-up excluded); the rebuild copies the same values in again and sets the
+// preconditioners up from scratch (SolverComparison::peers). PETSc runs one thread per process.
 #pragma once
 
 #include "gl/gl_context.h"
@@ -74,6 +81,15 @@ struct SolverCurve {
                                                    // or no cap, as for direct)
 };
 
+// A PETSc peer's setup (solver/petsc_peers.h): the first build and a rebuild, with its settings.
+struct PeerSetup {
+    std::string name;              // its row in `solvers`, e.g. "petsc_cg_gamg"
+    double conversion_ms = 0;      // first build: the three channels into AIJ matrices
+    double preconditioner_ms = 0;  // first build: the three preconditioners' setup
+    double rebuild_ms = 0;         // median of three rebuilds: values copied in again + setup again
+    std::vector<std::pair<std::string, std::string>> settings;  // PETSc options, e.g. {"pc_type", "gamg"}
+};
+
 struct SolverComparison {
     size_t tets = 0, vertices = 0, levels = 0;
     // Per-mesh setup, each twice: its first run in the process (which also maps every fresh page it
@@ -84,14 +100,21 @@ struct SolverComparison {
     // MultigridFrameSolver's constructor (its own hierarchy included).
     double multigrid_rgb_setup_ms = 0, multigrid_rgb_setup_rebuild_ms = 0;
     std::vector<SolverCurve> solvers;  // jacobi_cg, jacobi_cg_double, multires, multigrid_cg, cascadic_cg, multigrid_cg_rgb,
-                                       // eigen_ic_cg, [gpu_cg, gpu_multires, gpu_multigrid_cg,] direct
+                                       // eigen_ic_cg, [petsc_cg_gamg, petsc_cg_boomeramg,]
+                                       // [gpu_cg, gpu_multires, gpu_multigrid_cg,] direct
     std::string gpu_fallback_reason;   // options.gl given but the GPU could not run (curves left out)
+    std::vector<PeerSetup> peers;      // petsc_cg_gamg, petsc_cg_boomeramg (builds with PETSc)
+    std::string peers_missing_reason;  // why there are no PETSc rows ("" when there are)
     int repeats = 0;                   // options.repeats, for timing_statistic
 };
 
 // One warning naming every solver during whose measurements other processes kept more than
 // kBusyMachineCores cores busy on average (provenance.h), or "" when none.
 std::string busy_machine_warning(const SolverComparison& comparison);
+
+// The warning for a comparison without the PETSc peers ("PETSc peer rows missing: REASON"), or "" when
+// they ran.
+std::string missing_peers_warning(const SolverComparison& comparison);
 
 // The statistic a comparison's times are, in words, e.g. "median of 5 runs after one warm-up".
 std::string timing_statistic(int repeats);
@@ -130,7 +153,9 @@ nlohmann::ordered_json solver_comparison_definitions(const SolverComparisonOptio
 // "tets", "vertices", "levels", setup_times..., "statistic", "repeats", "solvers": {NAME:
 // {"time_to_1pct_ms", "time_to_1pct_ms_min", "time_to_1pct_ms_max", "cap_to_1pct", "setup_ms",
 // "setup_plus_time_to_1pct_ms", "parallelism", "other_load_cores", "curve": [[ms, rel_error], ...], "curve_ms_min": [...],
-// "curve_ms_max": [...]}}} (ms: the statistic; _min, _max: the fastest and slowest run), and
+// "curve_ms_max": [...]}}, "peers": {"petsc": version or "not run: REASON", NAME: {"setup_ms",
+// "setup_rebuild_ms", "conversion_ms", "preconditioner_setup_ms", "settings": {option: value}}}}
+// (ms: the statistic; _min, _max: the fastest and slowest run), and
 // DIR/STEM.svg and STEM.pdf (error against time, one line per solver, the direct solve pinned to the
 // bottom edge, the 1% target dashed, the caption from the provenance), atomically.
 void write_solver_comparison(const std::filesystem::path& dir, const std::string& stem, const ComparedScene& scene,

@@ -19,7 +19,8 @@ TEST(MethodStyle, EveryMethodHasItsOwnColourAndLabel) {
     }
     EXPECT_GT(colours.size(), 8u);
     for (const char* key : {"jacobi_cg", "jacobi_cg_double", "multires", "multigrid_cg", "cascadic_cg", "multigrid_cg_rgb",
-                            "eigen_ic_cg", "gpu_cg", "gpu_multires", "gpu_multigrid_cg", "direct"})
+                            "eigen_ic_cg", "petsc_cg_gamg", "petsc_cg_boomeramg", "gpu_cg", "gpu_multires", "gpu_multigrid_cg",
+                            "direct"})
         EXPECT_NE(find_method_style(key), nullptr) << key;
     EXPECT_EQ(find_method_style("no_such_solver"), nullptr);
     EXPECT_EQ(find_method_style("jacobi_cg")->label, "Jacobi CG (float)");
