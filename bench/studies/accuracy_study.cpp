@@ -22,10 +22,6 @@
 namespace waxwork {
 namespace {
 
-double tet_size_mm(const TetMesh& mesh, double mm_per_unit) {
-    return mm_per_unit * std::cbrt(total_volume(mesh) / static_cast<double>(mesh.tet_count()));
-}
-
 // Student's t for a two-sided 95% interval, t_{0.975}(dof), dof = 1..30; the normal 1.96 beyond.
 double student_t_975(size_t dof) {
     static constexpr double kTable[30] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
@@ -41,6 +37,16 @@ std::string two_digits(double value) {
 }
 
 }  // namespace
+
+TetMesh study_ball_mesh(int surface_level, size_t target_tets) {
+    MeshingOptions meshing;
+    meshing.sizing.target_tets = target_tets;
+    return tetrahedralize(make_icosphere(surface_level, kStudyBallRadiusMm), meshing).mesh;
+}
+
+double mean_tet_size_mm(const TetMesh& mesh, double mm_per_unit) {
+    return mm_per_unit * std::cbrt(total_volume(mesh) / static_cast<double>(mesh.tet_count()));
+}
 
 OrderFit ConvergenceSeries::fit_order() const {
     constexpr size_t kMinPoints = 4;
@@ -140,8 +146,8 @@ std::string order_table_markdown(const std::vector<ConvergenceSeries>& series) {
 
 namespace {
 
-constexpr double kBallRadius = 10.0;
-const TetMaterial kBallMaterial{{0.01, 0.01, 0.01}, {1.0, 1.0, 1.0}, 1.3};
+constexpr double kBallRadius = kStudyBallRadiusMm;
+const TetMaterial& kBallMaterial = kStudyBallMaterial;
 const std::pair<Discretization, const char*> kBallMethods[] = {{Discretization::TransCut, "transcut"},
                                                                {Discretization::Fem, "fem"}};
 const std::pair<BallLight, const char*> kBallLights[] = {{BallLight::Uniform, "uniform"},
@@ -167,7 +173,7 @@ void add_ball_points(const TetMesh& mesh, std::vector<ConvergenceSeries>& series
             options.relative_tolerance = 1e-8;
             const BallComparison comparison =
                 compare_with_analytic_ball(mesh, connectivity, kBallMaterial, kBallRadius, light, options);
-            series[s++].points.push_back({mesh.tet_count(), tet_size_mm(mesh, 1.0), comparison.relative_error,
+            series[s++].points.push_back({mesh.tet_count(), mean_tet_size_mm(mesh, 1.0), comparison.relative_error,
                                           comparison.solution.assembly_ms + comparison.solution.solve_ms});
         }
 }
@@ -213,9 +219,7 @@ std::vector<ConvergenceSeries> study_ball_convergence(const StudySize& size) {
                                                  : std::vector<Level>{{2, 2000}, {3, 6000}, {3, 16000}, {4, 48000}, {4, 128000}};
     std::vector<ConvergenceSeries> series = ball_series("ball");
     for (const Level& level : levels) {
-        MeshingOptions meshing;
-        meshing.sizing.target_tets = level.tets;
-        add_ball_points(tetrahedralize(make_icosphere(level.surface_level, kBallRadius), meshing).mesh, series);
+        add_ball_points(study_ball_mesh(level.surface_level, level.tets), series);
     }
     return series;
 }
@@ -264,7 +268,7 @@ SurfaceSolve solve_at_input_vertices(const TriangleSurface& surface, const std::
     }
     solve.tets = mesh.tet_count();
     solve.vertices = mesh.vertex_count();
-    solve.tet_size_mm = tet_size_mm(mesh, mm_per_unit);
+    solve.tet_size_mm = mean_tet_size_mm(mesh, mm_per_unit);
     solve.setup_ms = scene.diffusion.assembly_ms;
     solve.solve_ms = scene.diffusion.solve_ms;
     solve.iterations = scene.diffusion.iterations[0];

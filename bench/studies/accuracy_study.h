@@ -17,6 +17,16 @@
 
 namespace waxwork {
 
+// The ball every study measures against the analytic series: radius 10 mm (one model unit per mm),
+// mu_a 0.01 and mu_s' 1 per mm, eta 1.3.
+inline constexpr double kStudyBallRadiusMm = 10.0;
+inline const TetMaterial kStudyBallMaterial{{0.01, 0.01, 0.01}, {1.0, 1.0, 1.0}, 1.3};
+// TetGen's mesh of the icosphere of that radius at `surface_level`, aiming at `target_tets`.
+TetMesh study_ball_mesh(int surface_level, size_t target_tets);
+
+// The mean tet size (volume / tets)^(1/3), in mm.
+double mean_tet_size_mm(const TetMesh& mesh, double mm_per_unit);
+
 struct ConvergencePoint {
     size_t tets = 0;
     double tet_size_mm = 0;  // (volume / tets)^(1/3)

@@ -1,5 +1,7 @@
 #include "bench/studies/method_failures.h"
 
+#include "bench/studies/accuracy_study.h"
+
 #include "base/error.h"
 #include "solver/diffusion_solve.h"
 #include "solver/material.h"
@@ -11,9 +13,7 @@
 #include "tetops/box_mesh.h"
 #include "tetops/connectivity.h"
 #include "tetops/fracture.h"
-#include "tetops/icosphere.h"
 #include "tetops/sliver_maker.h"
-#include "tetops/tetrahedralize.h"
 
 #include <cmath>
 #include <cstdio>
@@ -23,8 +23,8 @@
 namespace waxwork {
 namespace {
 
-constexpr double kBallRadius = 10.0;  // mm, one model unit per mm
-const TetMaterial kBallMaterial{{0.01, 0.01, 0.01}, {1.0, 1.0, 1.0}, 1.3};
+constexpr double kBallRadius = kStudyBallRadiusMm;
+const TetMaterial& kBallMaterial = kStudyBallMaterial;
 
 std::string percent(double value) {
     char text[32];
@@ -52,9 +52,7 @@ StudyTable study_fvm_non_delaunay(const StudySize& size) {
                      "kept_relaxation", "kept_cg", "clamped_error", "transcut_error"};
     const std::vector<double> heights = size.quick ? std::vector<double>{1.0, 0.1} : std::vector<double>{1.0, 0.1, 1e-2, 1e-3};
     for (double height : heights) {
-        MeshingOptions meshing;
-        meshing.sizing.target_tets = size.quick ? 6000 : 16000;
-        TetMesh mesh = tetrahedralize(make_icosphere(3, kBallRadius), meshing).mesh;
+        TetMesh mesh = study_ball_mesh(3, size.quick ? 6000 : 16000);
         size_t moved = 0;
         if (height < 1) moved = flatten_into_slivers(mesh, build_connectivity(mesh), 60, height).size();
         const TetConnectivity connectivity = build_connectivity(mesh);
@@ -136,9 +134,7 @@ StudyTable study_fd_cuts(const StudySize& size) {
         }
         table.rows.push_back(row);
     };
-    MeshingOptions meshing;
-    meshing.sizing.target_tets = size.quick ? 3000 : 8000;
-    TetMesh broken = tetrahedralize(make_icosphere(3, kBallRadius), meshing).mesh;
+    TetMesh broken = study_ball_mesh(3, size.quick ? 3000 : 8000);
     run("ball (R = 10 mm), whole", broken, 0.5);
     const Eigen::Vector4d plane(0, 0, 1, 0.3);
     fracture_planes(broken, std::span<const Eigen::Vector4d>(&plane, 1));
@@ -169,9 +165,7 @@ StudyTable study_lbm_relaxation(const StudySize& size) {
         "tau = 1 for the most diffusive material (dt chosen from it) and absorption is implicit, positive at "
         "any mu_a dt";
     table.columns = {"case", "steps", "outcome", "error_vs_analytic", "warnings"};
-    MeshingOptions meshing;
-    meshing.sizing.target_tets = size.quick ? 3000 : 8000;
-    const TetMesh mesh = tetrahedralize(make_icosphere(3, kBallRadius), meshing).mesh;
+    const TetMesh mesh = study_ball_mesh(3, size.quick ? 3000 : 8000);
     const TetConnectivity connectivity = build_connectivity(mesh);
     auto run = [&](const std::string& what, const TetMaterial& material, const LbmOptions& options, bool exact) {
         const std::vector<TetMaterial> materials(mesh.tet_count(), material);

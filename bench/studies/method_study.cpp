@@ -11,8 +11,6 @@
 #include "solver/material.h"
 #include "solver/reference/analytic_ball.h"
 #include "tetops/connectivity.h"
-#include "tetops/icosphere.h"
-#include "tetops/tetrahedralize.h"
 
 #include <chrono>
 #include <cmath>
@@ -21,13 +19,9 @@
 namespace waxwork {
 namespace {
 
-constexpr double kBallRadius = 10.0;  // mm, one model unit per mm
-const TetMaterial kBallMaterial{{0.01, 0.01, 0.01}, {1.0, 1.0, 1.0}, 1.3};
+constexpr double kBallRadius = kStudyBallRadiusMm;
+const TetMaterial& kBallMaterial = kStudyBallMaterial;
 constexpr size_t kDipoleMaxTets = 120'000;
-
-double mean_tet_size(const TetMesh& mesh, double mm_per_unit) {
-    return mm_per_unit * std::cbrt(total_volume(mesh) / static_cast<double>(mesh.tet_count()));
-}
 
 // The runs of one method on one mesh of the ball, or the reason it could not run.
 struct BallProblem {
@@ -124,9 +118,7 @@ void run_ball(const MethodStudyOptions& options, std::vector<MethodSeries>& all)
     const std::vector<Level> levels = options.quick ? std::vector<Level>{{2, 2000}, {3, 6000}, {3, 16000}}
                                                     : std::vector<Level>{{2, 2000}, {3, 8000}, {4, 32000}, {4, 96000}, {5, 300000}};
     for (const Level& level : levels) {
-        MeshingOptions meshing;
-        meshing.sizing.target_tets = level.tets;
-        const TetMesh mesh = tetrahedralize(make_icosphere(level.surface_level, kBallRadius), meshing).mesh;
+        const TetMesh mesh = study_ball_mesh(level.surface_level, level.tets);
         const TetConnectivity connectivity = build_connectivity(mesh);
         const std::vector<TetMaterial> materials(mesh.tet_count(), kBallMaterial);
         for (BallLight light : {BallLight::Uniform, BallLight::Directional}) {
@@ -152,7 +144,7 @@ void run_ball(const MethodStudyOptions& options, std::vector<MethodSeries>& all)
                     run.relative_error = std::nan("");
                 }
                 run.tets = mesh.tet_count();
-                if (run.resolution_mm == 0) run.resolution_mm = mean_tet_size(mesh, 1.0);
+                if (run.resolution_mm == 0) run.resolution_mm = mean_tet_size_mm(mesh, 1.0);
                 series.runs.push_back(std::move(run));
             }
         }
