@@ -123,7 +123,9 @@ TEST(OwnedRows, EdgeCountsSumToTheMeshsEdgesAndTheirCut) {
         for (const auto& [a, b] : box.connectivity.edges) cut += owner(a) != owner(b);
         EXPECT_EQ(total.edges, static_cast<int64_t>(box.connectivity.edges.size())) << ranks << " ranks";
         EXPECT_EQ(total.cut, cut) << ranks << " ranks";
-        if (ranks == 1) EXPECT_EQ(total.cut, 0);
+        if (ranks == 1) {
+            EXPECT_EQ(total.cut, 0);
+        }
     }
 }
 
