@@ -34,6 +34,19 @@ size_t occurrences(const std::string& text, const std::string& what) {
     return count;
 }
 
+// The largest difference of any channel of any pixel between two images of the same size.
+int largest_pixel_difference(const fs::path& a_path, const fs::path& b_path) {
+    const Image a = read_png(a_path), b = read_png(b_path);
+    EXPECT_EQ(a.width, b.width);
+    EXPECT_EQ(a.height, b.height);
+    if (a.width != b.width || a.height != b.height) return 255;
+    int largest = 0;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x)
+            for (int c = 0; c < 4; ++c) largest = std::max(largest, std::abs(int(a.pixel(x, y)[c]) - int(b.pixel(x, y)[c])));
+    return largest;
+}
+
 class MpiRender : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
@@ -96,14 +109,8 @@ TEST_F(MpiRender, OneAndTwoProcessesMatchTheSerialSolve) {
 
         const Fields f = read_fields(dir_ / (name + ".csv"));
         EXPECT_LT(phi_difference(f), 1e-4) << processes << " processes";
-        const Image a = read_png(dir_ / "serial.png"), b = read_png(dir_ / (name + ".png"));
-        ASSERT_EQ(a.width, b.width);
-        ASSERT_EQ(a.height, b.height);
-        int largest = 0;
-        for (int y = 0; y < a.height; ++y)
-            for (int x = 0; x < a.width; ++x)
-                for (int c = 0; c < 4; ++c) largest = std::max(largest, std::abs(int(a.pixel(x, y)[c]) - int(b.pixel(x, y)[c])));
-        EXPECT_LE(largest, 1) << "pixels of the " << processes << "-process image against the serial one";
+        EXPECT_LE(largest_pixel_difference(dir_ / "serial.png", dir_ / (name + ".png")), 1)
+            << "pixels of the " << processes << "-process image against the serial one";
     }
 }
 
@@ -150,6 +157,35 @@ TEST_F(MpiRender, ABadOptionFailsWithOneMessage) {
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(occurrences(r.err, "waxwork: "), 1u) << r.err;
     EXPECT_NE(r.err.find("--pc"), std::string::npos) << r.err;
+}
+
+TEST_F(MpiRender, ASessionOfRendersAndSavesMatchesTheCpuReplay) {
+    const fs::path session = dir_ / "session.json";
+    std::ofstream(session) << R"({"input": {"volume": ")" << volume_.string() << R"("}, "material": "skin1",
+        "image": {"width": 96, "height": 72}, "tolerance": 1e-6, "steps": [{"render": "a.png"},
+        {"light": {"lights": [{"direction": [1, -0.3, -0.5]}]}}, {"camera": {"eye_direction": [1, 0.5, 1]}},
+        {"render": "b.png"}, {"save": "c.vtu"}]})";
+    const auto cpu = run_waxwork("run " + session.string() + " -o " + (dir_ / "session_cpu").string());
+    ASSERT_EQ(cpu.exit_code, 0) << cpu.err;
+    const auto petsc = run_waxwork("run " + session.string() + " -o " + (dir_ / "session_petsc").string() + " --engine petsc",
+                                   mpirun(2));
+    ASSERT_EQ(petsc.exit_code, 0) << petsc.err;
+    EXPECT_NE(petsc.out.find("on each of 2 processes"), std::string::npos) << petsc.out;
+    for (const char* image : {"a.png", "b.png"})
+        EXPECT_LE(largest_pixel_difference(dir_ / "session_cpu" / image, dir_ / "session_petsc" / image), 1) << image;
+    EXPECT_EQ(read_text(dir_ / "session_cpu" / "c.vtu"), read_text(dir_ / "session_petsc" / "c.vtu"));
+}
+
+TEST_F(MpiRender, ASessionWithAnEditIsRefusedOnce) {
+    const fs::path session = dir_ / "edit_session.json";
+    std::ofstream(session) << R"({"input": {"volume": ")" << volume_.string() << R"("}, "steps": [
+        {"op": "plane_cut", "normal": [1, 0, 0], "offset": 0}, {"render": "a.png"}]})";
+    const auto r = run_waxwork("run " + session.string() + " -o " + (dir_ / "edit_session").string() + " --engine petsc",
+                               mpirun(2));
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.exit_code, 124) << "timed out: a process hung";
+    EXPECT_EQ(occurrences(r.err, "waxwork: "), 1u) << r.err;
+    EXPECT_NE(r.err.find("step 0: --engine petsc replays converged renders"), std::string::npos) << r.err;
 }
 
 #endif  // WAXWORK_MPIRUN
