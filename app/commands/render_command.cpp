@@ -3,6 +3,7 @@
 // `--engine petsc` solves with several processes under mpirun (render/distributed_render.h).
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/options/engine_options.h"
 #include "app/options/help_sections.h"
 #include "app/options/scene_light_options.h"
 #include "base/error.h"
@@ -63,8 +64,7 @@ struct RenderCommandOptions {
     std::optional<double> mc_g;
     std::optional<int64_t> mc_photons;
     std::optional<uint64_t> seed;
-    std::string engine = "cpu";     // cpu: this process; petsc: the processes mpirun started
-    std::optional<std::string> pc;  // --engine petsc: gamg or boomeramg (the default)
+    EngineOptions engine;
 };
 
 // Defaults of the trace: a minute at most, 1% relative standard error (of phi at the boundary, of the
@@ -109,13 +109,11 @@ void check_options(const RenderCommandOptions& o) {
         if (!v.allFinite() || v.norm() == 0) fail("--view must be a finite, non-zero direction");
     }
     if (o.ground && o.show != "radiance") fail("--ground applies only to --show radiance");
-    if (o.engine == "petsc") {
-        if (!kPetscBuilt) fail("--engine petsc: " + petsc_unavailable_reason());
+    check_engine_options(o.engine);
+    if (o.engine.petsc()) {
         if (o.light.method != "transcut" && o.light.method != "fem")
             fail("--engine petsc solves --method transcut or fem (got " + o.light.method + ")");
         if (o.light.backend != "cpu") fail("--engine petsc solves on the CPU processes: it cannot take --backend gpu");
-    } else if (o.pc) {
-        fail("--pc applies only with --engine petsc");
     }
     if (o.light.method == "mc" && (o.ground || !o.linear.empty() || background == BackgroundKind::Transparent ||
                                    background == BackgroundKind::Environment))
@@ -301,7 +299,7 @@ nlohmann::ordered_json render_summary(const RenderCommandOptions& o, const TetMe
         {"materials", settings.material ? "option" : mesh.has_materials() ? "stored" : "marble default"},
         {"method", o.light.method},
         {"backend", s.backend == SolverBackend::Gpu ? "gpu" : "cpu"},
-        {"engine", o.engine},
+        {"engine", o.engine.engine},
         {"mm_per_unit", scale.mm_per_unit},
         {"scale_source", scale_source_name(scale.source)},
         {"lights", settings.lighting.lights.size()},
@@ -335,7 +333,7 @@ void run_petsc_render(const RenderCommandOptions& o, const ViewOptions& view) {
         settings = render_settings(o, *scale, view);
     });
     const TetMesh& mesh = file->mesh;
-    const PetscPeer pc = o.pc.value_or("boomeramg") == "gamg" ? PetscPeer::CgGamg : PetscPeer::CgBoomerAmg;
+    const PetscPeer pc = chosen_preconditioner(o.engine);
     const DistributedRender distributed = render_volume_distributed(mesh, o.volume, settings, pc);
     const std::vector<int64_t> peak_kib = gather_from_all(static_cast<int64_t>(peak_resident_mib() * 1024));
     agreed_step([&] {
@@ -351,7 +349,7 @@ void run_petsc_render(const RenderCommandOptions& o, const ViewOptions& view) {
         const DistributedSolveReport& solve = distributed.solve;
         summary["petsc"] = {
             {"processes", distributed.processes},
-            {"preconditioner", pc == PetscPeer::CgGamg ? "gamg" : "boomeramg"},
+            {"preconditioner", preconditioner_word(pc)},
             {"partition", "contiguous vertex ranges of the mesh order"},
             {"rows_per_process", distributed.rows_per_process},
             {"tets_per_process", distributed.tets_per_process},
@@ -376,7 +374,7 @@ void run_render_command(const RenderCommandOptions& o) {
     check_options(o);
     const ViewOptions view = view_options(o);
 #ifdef WAXWORK_HAVE_PETSC
-    if (o.engine == "petsc") return run_petsc_render(o, view);
+    if (o.engine.petsc()) return run_petsc_render(o, view);
 #endif
     const VolumeFile file = read_volume_file(o.volume);
     const TetMesh& mesh = file.mesh;
@@ -446,13 +444,7 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--mc-photons", options->mc_photons,
                     "--method mc: stop each trace after this many photons (camera paths for the image) per channel");
     cmd->add_option("--seed", options->seed, "--method mc: random seed; the same seed gives the same result (default 1)");
-    cmd->add_option("--engine", options->engine,
-                    "cpu: solve in this process; petsc: solve with the processes mpirun started (mpirun -n N waxwork "
-                    "render ... --engine petsc; a build with PETSc)")
-        ->check(CLI::IsMember({"cpu", "petsc"}))
-        ->capture_default_str();
-    cmd->add_option("--pc", options->pc, "--engine petsc: CG's preconditioner, boomeramg (hypre) or gamg (default boomeramg)")
-        ->check(CLI::IsMember({"gamg", "boomeramg"}));
+    add_engine_options(*cmd, options->engine, "the diffusion");
     cmd->add_option("--width", options->width, "Image width in pixels")->capture_default_str();
     cmd->add_option("--height", options->height, "Image height in pixels")->capture_default_str();
     cmd->add_option("--fields", options->fields, "Also write q, phi and exitant radiance per vertex to this CSV");

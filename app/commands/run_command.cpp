@@ -3,6 +3,7 @@
 // mpirun, sessions of renders, saves, lights and cameras solve with the processes (distributed_session.h).
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/options/engine_options.h"
 #include "app/options/help_sections.h"
 #include "app/options/live_solver_options.h"
 #include "base/error.h"
@@ -25,9 +26,20 @@ struct RunCommandOptions {
     std::string session;
     std::string output;
     LiveSolverChoice solver;
-    std::string engine = "cpu";
-    std::optional<std::string> pc;
+    EngineOptions engine;
 };
+
+// One line per step, then the files written.
+void print_steps(const std::vector<StepMetrics>& steps, const std::vector<std::filesystem::path>& written) {
+    for (size_t i = 0; i < steps.size(); ++i) {
+        const StepMetrics& m = steps[i];
+        std::cout << "step " << i << " " << m.name << ": " << m.milliseconds << " ms, " << m.tets << " tets, "
+                  << m.vertices << " vertices";
+        if (m.solver_iterations > 0) std::cout << ", " << m.solver_iterations << " CG iterations";
+        std::cout << "\n";
+    }
+    for (const auto& path : written) std::cout << "wrote " << path.string() << "\n";
+}
 
 #ifdef WAXWORK_HAVE_PETSC
 // `--engine petsc`: the session read by every process (errors agreed), its renders solved together,
@@ -37,26 +49,18 @@ void run_distributed(const RunCommandOptions& o) {
     ensure_petsc_runtime(arguments.argc, arguments.argv);
     std::optional<Session> session;
     agreed_step([&] { session.emplace(read_session(o.session)); });
-    const PetscPeer pc = o.pc.value_or("boomeramg") == "gamg" ? PetscPeer::CgGamg : PetscPeer::CgBoomerAmg;
-    const DistributedSessionResult result = run_session_distributed(*session, o.output, pc);
+    const DistributedSessionResult result = run_session_distributed(*session, o.output, chosen_preconditioner(o.engine));
     if (result.rank != 0) return;
     std::cout << std::fixed << std::setprecision(1) << "loaded the input in " << result.load_ms << " ms ("
               << result.input_tets << " tets) on each of " << result.processes << " processes; edge cut "
               << result.edge_cut << " of " << result.edges << " edges\n";
-    for (size_t i = 0; i < result.steps.size(); ++i) {
-        const StepMetrics& m = result.steps[i];
-        std::cout << "step " << i << " " << m.name << ": " << m.milliseconds << " ms, " << m.tets << " tets, "
-                  << m.vertices << " vertices";
-        if (m.solver_iterations > 0) std::cout << ", " << m.solver_iterations << " CG iterations";
-        std::cout << "\n";
-    }
-    for (const auto& path : result.written) std::cout << "wrote " << path.string() << "\n";
+    print_steps(result.steps, result.written);
 }
 #endif
 
 void run_run_command(const RunCommandOptions& o) {
-    if (o.engine == "petsc") {
-        if (!kPetscBuilt) throw InvalidArgumentError("--engine petsc: " + petsc_unavailable_reason());
+    check_engine_options(o.engine);
+    if (o.engine.petsc()) {
         if (o.solver.backend != "cpu" || o.solver.method != "jacobi" || o.solver.frame_ms)
             throw InvalidArgumentError("--engine petsc solves converged renders with PETSc: --backend, --method and "
                                        "--frame-ms choose the live solver of --engine cpu");
@@ -64,7 +68,6 @@ void run_run_command(const RunCommandOptions& o) {
         return run_distributed(o);
 #endif
     }
-    if (o.pc) throw InvalidArgumentError("--pc applies only with --engine petsc");
     const Session session = read_session(o.session);
     if (!writes_outputs(session))
         std::cerr << "waxwork: " << o.session << ": warning: no render or save step, so only metrics.json is written "
@@ -80,14 +83,7 @@ void run_run_command(const RunCommandOptions& o) {
         std::cerr << "warning: " << result.method_fallback_reason << "\n";
     std::cout << std::fixed << std::setprecision(1) << "loaded the input in " << result.load_ms << " ms ("
               << result.input_tets << " tets)\n";
-    for (size_t i = 0; i < result.steps.size(); ++i) {
-        const StepMetrics& m = result.steps[i];
-        std::cout << "step " << i << " " << m.name << ": " << m.milliseconds << " ms, " << m.tets << " tets, "
-                  << m.vertices << " vertices";
-        if (m.solver_iterations > 0) std::cout << ", " << m.solver_iterations << " CG iterations";
-        std::cout << "\n";
-    }
-    for (const auto& path : result.written) std::cout << "wrote " << path.string() << "\n";
+    print_steps(result.steps, result.written);
 }
 
 }  // namespace
@@ -99,13 +95,7 @@ void add_run_command(CLI::App& app) {
     cmd->add_option("-o,--output", options->output, "Directory for the frames, saved volumes and metrics.json")
         ->required();
     add_live_solver_options(*cmd, options->solver, "in the renderer's OSMesa context");
-    cmd->add_option("--engine", options->engine,
-                    "cpu: replay in this process; petsc: solve the renders with the processes mpirun started (sessions "
-                    "of renders, saves, lights and cameras; a build with PETSc)")
-        ->check(CLI::IsMember({"cpu", "petsc"}))
-        ->capture_default_str();
-    cmd->add_option("--pc", options->pc, "--engine petsc: CG's preconditioner, boomeramg (hypre) or gamg (default boomeramg)")
-        ->check(CLI::IsMember({"gamg", "boomeramg"}));
+    add_engine_options(*cmd, options->engine, "the renders of a session of renders, saves, lights and cameras");
     cmd->footer("Steps: edit operations ({\"op\": \"plane_cut\", ...}), {\"render\": \"a.png\"}, {\"save\": \"a.vtu\"},\n"
                 "{\"light\": {...}}, {\"camera\": {...}}, {\"undo\": 1}, {\"redo\": 1}. See assets/sessions/.");
     organise_help(*cmd, "waxwork run assets/sessions/carve.json -o carve", {});
