@@ -6,7 +6,9 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
+#include <ostream>
 #include <string>
 
 namespace waxwork {
@@ -43,9 +45,30 @@ void refuse_empty_values(CLI::App& app) {
     for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; })) refuse_empty_values(*command);
 }
 
+ProgramArguments& arguments() {
+    static ProgramArguments kept;
+    return kept;
+}
+
+// A process that mpirun started with a rank other than 0 (Open MPI's, MPICH's or PMIx's variable).
+bool is_secondary_mpi_rank() {
+    for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"})
+        if (const char* rank = std::getenv(name)) return std::string(rank) != "0";
+    return false;
+}
+
+// Where an error message goes: stderr, or nowhere on a secondary rank (rank 0 prints it).
+std::ostream& error_stream() {
+    static std::ostream discard(nullptr);
+    return is_secondary_mpi_rank() ? discard : std::cerr;
+}
+
 }  // namespace
 
+ProgramArguments program_arguments() { return arguments(); }
+
 int run_cli(int argc, char** argv) {
+    arguments() = {argc, argv};
     CLI::App app{"Waxwork: carve, fracture and paint translucent solids with live subsurface light.", "waxwork"};
     app.set_version_flag("--version", "waxwork 0.1.0");
     app.require_subcommand(1);
@@ -61,7 +84,7 @@ int run_cli(int argc, char** argv) {
         }
     };
     if (argc > 1 && argv[1][0] != '-' && !is_command(argv[1])) {
-        std::cerr << "waxwork: unknown command '" << argv[1] << "' (see waxwork --help)\n";
+        error_stream() << "waxwork: unknown command '" << argv[1] << "' (see waxwork --help)\n";
         return 2;
     }
     try {
@@ -73,13 +96,13 @@ int run_cli(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        std::cerr << "waxwork: " << e.what() << " (see --help)\n";
+        error_stream() << "waxwork: " << e.what() << " (see --help)\n";
         return 2;
     } catch (const Error& e) {
-        std::cerr << "waxwork: " << printable(e.what()) << "\n";
+        error_stream() << "waxwork: " << printable(e.what()) << "\n";
         return 1;
     } catch (const std::exception& e) {
-        std::cerr << "waxwork: internal error: " << printable(e.what()) << "\n";
+        error_stream() << "waxwork: internal error: " << printable(e.what()) << "\n";
         return 1;
     }
     return 0;

@@ -20,14 +20,7 @@ namespace {
 
 static_assert(std::is_same_v<PetscScalar, double>, "the peers need PETSc built with real double scalars");
 
-// A failed PETSc call as an AlgorithmError naming the call and PETSc's message for the code.
-void check(PetscErrorCode code, const char* call) {
-    if (code == 0) return;
-    const char* text = nullptr;
-    PetscErrorMessage(code, &text, nullptr);
-    throw AlgorithmError(std::string("PETSc: ") + call + " failed (" + (text ? text : "error") + ", code " +
-                         std::to_string(static_cast<int>(code)) + ")");
-}
+void check(PetscErrorCode code, const char* call) { check_petsc(code, call); }
 
 const char* option_prefix(PetscPeer peer) {
     return peer == PetscPeer::CgGamg ? "waxwork_gamg_" : "waxwork_boomeramg_";

@@ -45,4 +45,17 @@ SolvedScene solve_scene(const TetMesh& mesh, const TetConnectivity& connectivity
                         const DiffusionOptions& options, double crease_angle_degrees = kDefaultCreaseAngleDegrees,
                         const AlternativeMethodSettings* alternative = nullptr);
 
+// solve_scene in its two halves, for a solve that happens elsewhere (the distributed render): the
+// lighting (surface, shading, q and lighting_ms; diffusion and radiance_factor left empty) with the
+// crease corners' light for the right-hand side, and then, once scene.diffusion.phi is set, the
+// radiance. They throw as solve_scene does.
+struct LitScene {
+    SolvedScene scene;
+    std::vector<CornerLight> corners;
+};
+LitScene light_scene(const TetMesh& mesh, const TetConnectivity& connectivity,
+                     const std::vector<TetMaterial>& materials, const Lighting& lighting,
+                     double crease_angle_degrees = kDefaultCreaseAngleDegrees);
+void shade_scene(SolvedScene& scene);
+
 }  // namespace waxwork

@@ -1,13 +1,18 @@
 // `waxwork render VOLUME -o IMAGE.png|.jpg`: a volume, its materials and lights -> diffusion -> an image.
 // `--method mc` traces the light with the Monte Carlo reference (solver/reference/monte_carlo.h) instead.
+// `--engine petsc` solves with several processes under mpirun (render/distributed_render.h).
+#include "app/cli.h"
 #include "app/commands.h"
+#include "app/options/engine_options.h"
 #include "app/options/help_sections.h"
 #include "app/options/scene_light_options.h"
 #include "base/error.h"
+#include "base/peak_memory.h"
 #include "io/file_extension.h"
 #include "io/image_io.h"
 #include "io/volume_file.h"
 #include "render/camera.h"
+#include "render/distributed_render.h"
 #include "render/image_background.h"
 #include "render/radiance_image.h"
 #include "render/render_input.h"
@@ -16,6 +21,8 @@
 #include "scene/fields_csv.h"
 #include "solver/lighting.h"
 #include "solver/material.h"
+#include "solver/petsc_peers.h"
+#include "solver/petsc_runtime.h"
 #include "solver/radiance.h"
 #include "solver/reference/camera_rays.h"
 #include "solver/reference/monte_carlo.h"
@@ -57,6 +64,7 @@ struct RenderCommandOptions {
     std::optional<double> mc_g;
     std::optional<int64_t> mc_photons;
     std::optional<uint64_t> seed;
+    EngineOptions engine;
 };
 
 // Defaults of the trace: a minute at most, 1% relative standard error (of phi at the boundary, of the
@@ -101,6 +109,12 @@ void check_options(const RenderCommandOptions& o) {
         if (!v.allFinite() || v.norm() == 0) fail("--view must be a finite, non-zero direction");
     }
     if (o.ground && o.show != "radiance") fail("--ground applies only to --show radiance");
+    check_engine_options(o.engine);
+    if (o.engine.petsc()) {
+        if (o.light.method != "transcut" && o.light.method != "fem")
+            fail("--engine petsc solves --method transcut or fem (got " + o.light.method + ")");
+        if (o.light.backend != "cpu") fail("--engine petsc solves on the CPU processes: it cannot take --backend gpu");
+    }
     if (o.light.method == "mc" && (o.ground || !o.linear.empty() || background == BackgroundKind::Transparent ||
                                    background == BackgroundKind::Environment))
         fail("--method mc draws over a colour: --ground, --linear and --background transparent or environment need "
@@ -259,15 +273,9 @@ CameraSettings camera_for_view(const std::vector<double>& view) {
     return camera;
 }
 
-void run_render_command(const RenderCommandOptions& o) {
-    check_options(o);
-    const ViewOptions view = view_options(o);
-    const VolumeFile file = read_volume_file(o.volume);
-    const TetMesh& mesh = file.mesh;
-    const ModelScale scale = chosen_scale(o.light, file);
+// The picture's settings from the options, at the volume's scale.
+VolumeRenderSettings render_settings(const RenderCommandOptions& o, const ModelScale& scale, const ViewOptions& view) {
     VolumeRenderSettings settings = scene_light_settings(o.light, scale);
-    const Lighting& lighting = settings.lighting;
-    const std::optional<TetMaterial>& chosen = settings.material;
     settings.image.width = o.width;
     settings.image.height = o.height;
     settings.image.camera = camera_for_view(o.view);
@@ -276,6 +284,102 @@ void run_render_command(const RenderCommandOptions& o) {
     settings.background = parse_background(o.background);
     settings.linear = !o.linear.empty();
     settings.ground = o.ground;
+    return settings;
+}
+
+// The summary line's fields that every engine reports.
+nlohmann::ordered_json render_summary(const RenderCommandOptions& o, const TetMesh& mesh, const VolumeRender& render,
+                                      const VolumeRenderSettings& settings, const ModelScale& scale) {
+    const SolvedScene& scene = render.scene;
+    const DiffusionSolution& s = scene.diffusion;
+    nlohmann::ordered_json summary = {
+        {"output", o.output},
+        {"vertices", mesh.vertex_count()},
+        {"tets", mesh.tet_count()},
+        {"materials", settings.material ? "option" : mesh.has_materials() ? "stored" : "marble default"},
+        {"method", o.light.method},
+        {"backend", s.backend == SolverBackend::Gpu ? "gpu" : "cpu"},
+        {"engine", o.engine.engine},
+        {"mm_per_unit", scale.mm_per_unit},
+        {"scale_source", scale_source_name(scale.source)},
+        {"lights", settings.lighting.lights.size()},
+        {"lights_inside", render.lights_inside},
+        {"exposure", render.exposure},
+        {"crease_angle_deg", o.light.crease_angle},
+        {"shading_copies", scene.shading.size() - scene.surface.vertices.size()},
+        {"lighting_ms", scene.lighting_ms},
+        {"assembly_ms", s.assembly_ms},
+        {"solve_ms", s.solve_ms},
+        {"render_ms", render.render_ms},
+        {"view", view_mode_name(settings.view.mode)},
+    };
+    add_solve_summary(summary, scene);
+    return summary;
+}
+
+#ifdef WAXWORK_HAVE_PETSC
+// `--engine petsc`: every process reads the volume (errors agreed across processes), the processes solve
+// together, and rank 0 draws, writes and prints as the CPU engine does, with the partition, the solve's
+// phases and every process's peak memory in the summary.
+void run_petsc_render(const RenderCommandOptions& o, const ViewOptions& view) {
+    const ProgramArguments arguments = program_arguments();
+    ensure_petsc_runtime(arguments.argc, arguments.argv);
+    std::optional<VolumeFile> file;
+    std::optional<ModelScale> scale;
+    VolumeRenderSettings settings;
+    agreed_step([&] {
+        file.emplace(read_volume_file(o.volume));
+        scale.emplace(chosen_scale(o.light, *file));
+        settings = render_settings(o, *scale, view);
+    });
+    const TetMesh& mesh = file->mesh;
+    const PetscPeer pc = chosen_preconditioner(o.engine);
+    const DistributedRender distributed = render_volume_distributed(mesh, o.volume, settings, pc);
+    const std::vector<int64_t> peak_kib = gather_from_all(static_cast<int64_t>(peak_resident_mib() * 1024));
+    agreed_step([&] {
+        if (distributed.rank != 0) return;
+        const VolumeRender& render = distributed.render;
+        write_image(render.image, o.output);
+        if (!o.linear.empty()) write_linear_png(render.linear, o.linear, render.exposure);
+        report_chosen_scale(o.volume, *scale, mesh);
+        if (!o.fields.empty()) write_fields_csv(o.fields, mesh, render.connectivity, render.scene, nullptr);
+        nlohmann::ordered_json summary = render_summary(o, mesh, render, settings, *scale);
+        std::vector<double> peak_mib;
+        for (const int64_t kib : peak_kib) peak_mib.push_back(static_cast<double>(kib) / 1024);
+        const DistributedSolveReport& solve = distributed.solve;
+        summary["petsc"] = {
+            {"processes", distributed.processes},
+            {"preconditioner", preconditioner_word(pc)},
+            {"partition", "contiguous vertex ranges of the mesh order"},
+            {"rows_per_process", distributed.rows_per_process},
+            {"tets_per_process", distributed.tets_per_process},
+            {"edges", distributed.edges},
+            {"edge_cut", distributed.edge_cut},
+            {"owned_rows_assembly_ms", distributed.assembly_ms},
+            {"conversion_ms", solve.conversion_ms},
+            {"preconditioner_setup_ms", solve.preconditioner_ms},
+            {"cg_ms", solve.solve_ms},
+            {"gather_ms", solve.gather_ms},
+            {"peak_rss_mib_per_process", peak_mib},
+        };
+        if (view.mode != ViewMode::Radiance) summary["legend"] = render.view.legend.title;
+        if (!o.fields.empty()) summary["fields"] = o.fields;
+        if (!o.linear.empty()) summary["linear"] = o.linear;
+        std::cout << summary.dump() << "\n";
+    });
+}
+#endif
+
+void run_render_command(const RenderCommandOptions& o) {
+    check_options(o);
+    const ViewOptions view = view_options(o);
+#ifdef WAXWORK_HAVE_PETSC
+    if (o.engine.petsc()) return run_petsc_render(o, view);
+#endif
+    const VolumeFile file = read_volume_file(o.volume);
+    const TetMesh& mesh = file.mesh;
+    const ModelScale scale = chosen_scale(o.light, file);
+    const VolumeRenderSettings settings = render_settings(o, scale, view);
 
     const bool traced = o.light.method == "mc";
     std::optional<TracedRender> trace;
@@ -289,28 +393,7 @@ void run_render_command(const RenderCommandOptions& o) {
     if (!o.fields.empty())
         write_fields_csv(o.fields, mesh, render.connectivity, scene, traced ? &trace->fluence.phi_error : nullptr);
 
-    const DiffusionSolution& s = scene.diffusion;
-    nlohmann::ordered_json summary = {
-        {"output", o.output},
-        {"vertices", mesh.vertex_count()},
-        {"tets", mesh.tet_count()},
-        {"materials", chosen ? "option" : mesh.has_materials() ? "stored" : "marble default"},
-        {"method", o.light.method},
-        {"backend", s.backend == SolverBackend::Gpu ? "gpu" : "cpu"},
-        {"mm_per_unit", scale.mm_per_unit},
-        {"scale_source", scale_source_name(scale.source)},
-        {"lights", lighting.lights.size()},
-        {"lights_inside", render.lights_inside},
-        {"exposure", render.exposure},
-        {"crease_angle_deg", o.light.crease_angle},
-        {"shading_copies", scene.shading.size() - scene.surface.vertices.size()},
-        {"lighting_ms", scene.lighting_ms},
-        {"assembly_ms", s.assembly_ms},
-        {"solve_ms", s.solve_ms},
-        {"render_ms", render.render_ms},
-        {"view", view_mode_name(view.mode)},
-    };
-    add_solve_summary(summary, scene);
+    nlohmann::ordered_json summary = render_summary(o, mesh, render, settings, scale);
     if (traced) {
         const MonteCarloFluence& mc = trace->fluence;
         summary["monte_carlo"] = {
@@ -361,6 +444,7 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("--mc-photons", options->mc_photons,
                     "--method mc: stop each trace after this many photons (camera paths for the image) per channel");
     cmd->add_option("--seed", options->seed, "--method mc: random seed; the same seed gives the same result (default 1)");
+    add_engine_options(*cmd, options->engine, "the diffusion");
     cmd->add_option("--width", options->width, "Image width in pixels")->capture_default_str();
     cmd->add_option("--height", options->height, "Image height in pixels")->capture_default_str();
     cmd->add_option("--fields", options->fields, "Also write q, phi and exitant radiance per vertex to this CSV");
@@ -405,6 +489,7 @@ void add_render_command(CLI::App& app) {
                    {"Light and shading details", {"--no-env-background", "--ambient", "--crease-angle"}},
                    {"Inspection views and data", {"--slice-normal", "--slice-offset", "--quality-interior", "--fields"}},
                    {"Solver (docs/solvers.md, docs/methods.md)", {"--method", "--tol", "--cell", "--backend"}},
+                   {"Several processes (docs/scaling.md)", {"--engine", "--pc"}},
                    {"Monte Carlo reference (--method mc; docs/monte_carlo.md)",
                     {"--mc-seconds", "--mc-error", "--mc-g", "--mc-photons", "--seed"}}});
     cmd->callback([options] { run_render_command(*options); });
