@@ -623,7 +623,8 @@ TEST_F(Render, ColourBackgroundFillsTheCorners) {
     const auto r = run_waxwork("render " + volume_.string() + " -o " + sky.string() +
                                " --width 64 --height 48 --env sky:30,40 --background 255,255,255");
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    for (const uint8_t* p : corners(read_png(sky))) EXPECT_EQ(p[0] + p[1] + p[2], 3 * 255);
+    const Image sky_image = read_png(sky);  // named: corners() points into it
+    for (const uint8_t* p : corners(sky_image)) EXPECT_EQ(p[0] + p[1] + p[2], 3 * 255);
 }
 
 TEST_F(Render, JpegIsWrittenAndReadsBackAtTheSameSize) {
