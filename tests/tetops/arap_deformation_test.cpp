@@ -453,6 +453,23 @@ TEST(ArapDeformation, FloatRotationsStayCloseToTheDoubleOnes) {
     const double ea = a.solve(targets, 1).energy, eb = b.solve(targets, 1).energy;
     EXPECT_NEAR(eb, ea, 1e-4 * ea);
     for (size_t v = 0; v < bar.vertex_count(); ++v) ASSERT_LT((a.positions()[v] - b.positions()[v]).norm(), 1e-5) << v;
+
+    // Far-stretched tets: the float batch's unscaled Newton takes more steps (x30), or leaves them to
+    // the double path when it would need too many (x1e9).
+    for (const double stretch : {30.0, 1e9}) {
+        std::vector<Eigen::Vector3d> stretched = bar.positions;
+        for (Eigen::Vector3d& p : stretched) p.x() *= stretch;
+        ArapDeformer c(bar, all_tets(bar)), d(bar, all_tets(bar), in_float);
+        std::vector<Eigen::Vector3d> stretched_targets;
+        for (int32_t v : ends) stretched_targets.push_back(stretched[v]);
+        for (ArapDeformer* deformer : {&c, &d}) {
+            deformer->set_constrained(ends);
+            deformer->set_positions(stretched);
+        }
+        const double ec = c.solve(stretched_targets, 1).energy, ed = d.solve(stretched_targets, 1).energy;
+        EXPECT_GT(ec, 1);
+        EXPECT_NEAR(ed, ec, 1e-4 * ec) << stretch;
+    }
 }
 
 }  // namespace
