@@ -126,6 +126,7 @@ private:
     struct Factor;
     void local_step();
     void global_step(std::span<const Eigen::Vector3d> targets);
+    void reset_rotations();  // every R_t = I
 
     ArapOptions options_;
     std::vector<Eigen::Vector3d> rest_;
@@ -141,7 +142,6 @@ private:
     std::vector<Eigen::Matrix<double, 4, 3>> rhs_shares_;
     bool rotations_current_ = false;        // rhs_shares_ fit positions_ (saves a local step per frame)
     double energy_ = 0;                     // E for positions_ when rotations_current_
-    void reset_rotations();                 // every R_t = I
     CompressedRows vertex_tets_;            // per body vertex (local index): its body tets (local index)
     std::vector<int32_t> local_index_;      // mesh vertex -> index in body_vertices_, or -1
     std::vector<int32_t> constrained_;
