@@ -17,6 +17,8 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <memory>
+#include <string>
 
 namespace waxwork {
 namespace {
@@ -55,41 +57,125 @@ void add_size_counters(benchmark::State& state, const DragSetup& s) {
     state.counters["constrained"] = static_cast<double>(s.region.handle.size() + s.region.pinned.size());
 }
 
-// What a change of handle costs: the per-tet operators and the Cholesky factorisation.
+// Benchmark arguments for ArapOptions: the factor (0 CHOLMOD simplicial solves, 1 CHOLMOD supernodal,
+// 2 Eigen SimplicialLLT) and the rotations (0 double, 1 float).
+ArapOptions arap_options(int64_t factor, int64_t rotations) {
+    ArapOptions o;
+    o.factor = factor == 0 ? ArapFactor::CholmodSimplicialSolves
+                           : factor == 1 ? ArapFactor::CholmodSupernodal : ArapFactor::EigenSimplicialLLT;
+    o.rotations = rotations == 0 ? ArapRotations::Double : ArapRotations::Float;
+    return o;
+}
+
+// The handle's fraction of the move in drag frame `frame`: 1/30 more per frame, back and forth.
+double drag_phase(int frame) {
+    const int phase = frame % 60;
+    return (phase < 30 ? phase + 1 : 60 - phase) / 30.0;
+}
+
+// What a change of handle costs: the per-tet operators and the Cholesky factorisation (range(1): the
+// factor, as arap_options).
 void BM_ArapFactorize(benchmark::State& state) {
     const DragSetup& s = drag_setup(static_cast<size_t>(state.range(0)));
     for (auto _ : state) {
-        ArapDeformer deformer(s.mesh, s.region.body_tets);
+        ArapDeformer deformer(s.mesh, s.region.body_tets, arap_options(state.range(1), 0));
         deformer.set_constrained(s.region.constrained());
         benchmark::DoNotOptimize(deformer.positions().data());
     }
     add_size_counters(state, s);
+    state.counters["factor"] = static_cast<double>(state.range(1));
 }
-BENCHMARK(BM_ArapFactorize)->Arg(100'000)->Arg(500'000)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ArapFactorize)
+    ->Args({100'000, 0})
+    ->Args({100'000, 1})
+    ->Args({100'000, 2})
+    ->Args({500'000, 0})
+    ->Args({500'000, 1})
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // One drag frame: range(1) local/global iterations warm-started from the previous frame, the handle
-// advancing by 1/30 of the move per frame (back and forth).
+// advancing by 1/30 of the move per frame (back and forth); range(2) and range(3) the options (as
+// arap_options).
 void BM_ArapDragFrame(benchmark::State& state) {
     const DragSetup& s = drag_setup(static_cast<size_t>(state.range(0)));
     const int iterations = static_cast<int>(state.range(1));
-    ArapDeformer deformer(s.mesh, s.region.body_tets);
+    ArapDeformer deformer(s.mesh, s.region.body_tets, arap_options(state.range(2), state.range(3)));
     deformer.set_constrained(s.region.constrained());
     int frame = 0;
     for (auto _ : state) {
-        const int phase = frame++ % 60;
-        const double t = (phase < 30 ? phase + 1 : 60 - phase) / 30.0;
-        const std::vector<Eigen::Vector3d> targets = drag_targets(s.region, s.mesh.positions, t);
+        const std::vector<Eigen::Vector3d> targets = drag_targets(s.region, s.mesh.positions, drag_phase(frame++));
         benchmark::DoNotOptimize(deformer.solve(targets, iterations).energy);
     }
     add_size_counters(state, s);
     state.counters["iterations"] = iterations;
+    state.counters["factor"] = static_cast<double>(state.range(2));
+    state.counters["float_rotations"] = static_cast<double>(state.range(3));
 }
 BENCHMARK(BM_ArapDragFrame)
-    ->Args({100'000, 1})
-    ->Args({100'000, 4})
-    ->Args({500'000, 1})
-    ->Args({500'000, 4})
+    ->Args({100'000, 1, 1, 0})
+    ->Args({100'000, 1, 0, 1})
+    ->Args({100'000, 4, 1, 0})
+    ->Args({100'000, 4, 0, 1})
+    ->Args({500'000, 1, 1, 0})
+    ->Args({500'000, 1, 0, 1})
+    ->Args({500'000, 4, 1, 0})
+    ->Args({500'000, 4, 0, 1})
     ->Iterations(10)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The options side by side on one machine state: a drag of one iteration per frame run by each
+// variant in turn, frame after frame (the machine's load changes alike for all of them). Counters:
+// each variant's median milliseconds per frame (`<name>_ms`), and how far the float rotations' drag
+// is from the double one after the frames (energy relative to it, largest vertex distance relative to
+// the bounding-box diagonal).
+void BM_ArapVariantsInterleaved(benchmark::State& state) {
+    const DragSetup& s = drag_setup(static_cast<size_t>(state.range(0)));
+    struct Variant {
+        const char* name;
+        ArapOptions options;
+        std::unique_ptr<ArapDeformer> deformer;
+        std::vector<double> ms;
+        double energy = 0;
+    };
+    std::vector<Variant> variants;
+    variants.push_back({"supernodal_double", arap_options(1, 0), {}, {}});
+    variants.push_back({"simplicial_double", arap_options(0, 0), {}, {}});
+    variants.push_back({"simplicial_float", arap_options(0, 1), {}, {}});
+    if (state.range(1)) variants.push_back({"eigen_llt_double", arap_options(2, 0), {}, {}});
+    for (Variant& v : variants) {
+        v.deformer = std::make_unique<ArapDeformer>(s.mesh, s.region.body_tets, v.options);
+        v.deformer->set_constrained(s.region.constrained());
+    }
+    int frame = 0;
+    for (auto _ : state) {
+        const std::vector<Eigen::Vector3d> targets = drag_targets(s.region, s.mesh.positions, drag_phase(frame++));
+        for (Variant& v : variants) {
+            const auto start = Clock::now();
+            v.energy = v.deformer->solve(targets, 1).energy;
+            v.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+        }
+    }
+    add_size_counters(state, s);
+    for (Variant& v : variants) {
+        std::nth_element(v.ms.begin(), v.ms.begin() + v.ms.size() / 2, v.ms.end());
+        state.counters[std::string(v.name) + "_ms"] = v.ms[v.ms.size() / 2];
+    }
+    const ArapDeformer& dbl = *variants[1].deformer;
+    const ArapDeformer& flt = *variants[2].deformer;
+    const auto box = bounding_box(s.mesh);
+    double farthest = 0;
+    for (size_t v = 0; v < s.mesh.vertex_count(); ++v)
+        farthest = std::max(farthest, (dbl.positions()[v] - flt.positions()[v]).norm());
+    state.counters["float_energy_relative"] = variants[2].energy / variants[1].energy - 1;
+    state.counters["float_farthest_relative"] = farthest / (box[1] - box[0]).norm();
+}
+BENCHMARK(BM_ArapVariantsInterleaved)
+    ->Args({100'000, 1})
+    ->Args({500'000, 0})
+    ->Iterations(20)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -160,8 +246,7 @@ void BM_DeformDragFrameWithLight(benchmark::State& state) {
     double arap_ms = 0, scene_ms = 0, solve_ms = 0;
     int frame = 0;
     const auto advance = [&] {
-        const int phase = frame++ % 60;
-        op.motion = HandleMotion::translation((phase < 30 ? phase + 1 : 60 - phase) / 30.0 * move);
+        op.motion = HandleMotion::translation(drag_phase(frame++) * move);
     };
     // The press: region, operators and factorisation (BM_ArapFactorize), not part of a drag frame.
     advance();

@@ -89,7 +89,7 @@ struct Document::DeformCache {
     DragRegion region;
     std::optional<ArapDeformer> deformer;
     bool previewing = false;  // a drag is shown: the mesh holds preview positions, `rest` the ones before
-    std::vector<double> guard_floors;  // while previewing: per body tet, guard_floors at `rest`
+    std::vector<double> guard_floors;  // while previewing: per body tet, guard_floors (cosines) at `rest`
     double guard_deg = 0;              // ... for this guard
 };
 
@@ -239,6 +239,7 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry, Progress* 
         GuardOptions guard;
         guard.min_dihedral_guard_deg = o->guard_deg;
         c.deformer->reset();  // from the rest shape, as a fresh deformer: the result depends on `op` only
+        c.deformer->set_rotations(ArapRotations::Double);  // a preview may have left it in float
         const DragReport drag =
             run_drag(*c.deformer, mesh_, c.region, mesh_.positions, o->steps, o->iterations, guard, progress);
         record_moved_vertices(mesh_.positions, c.deformer->positions());
@@ -434,6 +435,8 @@ ChangeReport Document::preview_deform(const DeformOp& op, int iterations) {
         validate_handle_motion(op.motion);
     }
     DeformCache& c = *deform_cache_;
+    // The preview's rotations in float (ArapRotations); the release commits from the rest shape in double.
+    c.deformer->set_rotations(ArapRotations::Float);
     c.region.motion_rest = op.motion.in_rest_frame(mesh_.piece_transforms[c.region.piece]);
     GuardOptions guard;
     guard.min_dihedral_guard_deg = op.guard_deg;

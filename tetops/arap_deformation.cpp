@@ -8,11 +8,10 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #ifdef WAXWORK_HAVE_CHOLMOD
 #include <Eigen/CholmodSupport>
-#else
-#include <Eigen/SparseCholesky>
 #endif
 
 #include <algorithm>
@@ -20,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <sstream>
 
 namespace waxwork {
@@ -64,6 +64,83 @@ Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& f) {
     return nearest_rotation_svd(f);
 }
 
+// The float local step's batch: Newton's iteration above on kLanes tets at once, each 3x3 entry one
+// vector of kLanes floats (GCC's and Clang's vector extensions: one SSE register, so every operation
+// below is one instruction for all lanes; Eigen's 3x3 types are not vectorised, and GCC did not
+// vectorise the same loops written over arrays). Written by hand because no Debian library
+// vectorises many small polar decompositions (McAdams et al. 2011 do it for the SVD with hand-written
+// intrinsics).
+using Lanes = float __attribute__((vector_size(16)));
+using LaneMask = int32_t __attribute__((vector_size(16)));
+constexpr int kLanes = 4;
+
+// Cofactors C of each lane's X (C_ij = (-1)^(i+j) minor_ij, so X^-T = C / det X; entry (i, j) at
+// 3 i + j) and determinants.
+inline void lane_cofactors(const Lanes (&x)[9], Lanes (&c)[9], Lanes& det) {
+    c[0] = x[4] * x[8] - x[5] * x[7];
+    c[1] = x[5] * x[6] - x[3] * x[8];
+    c[2] = x[3] * x[7] - x[4] * x[6];
+    c[3] = x[2] * x[7] - x[1] * x[8];
+    c[4] = x[0] * x[8] - x[2] * x[6];
+    c[5] = x[1] * x[6] - x[0] * x[7];
+    c[6] = x[1] * x[5] - x[2] * x[4];
+    c[7] = x[2] * x[3] - x[0] * x[5];
+    c[8] = x[0] * x[4] - x[1] * x[3];
+    det = x[0] * c[0] + x[1] * c[1] + x[2] * c[2];
+}
+
+// The polar factors of f[0..count) in float; bit l of the result is set when lane l needs the double
+// path instead (det F <= 0, an iterate that lost its positive determinant, no convergence). Unscaled
+// Newton (X <- (X + X^-T) / 2): ARAP's F_t are near rotations (singular values near 1), where
+// scaling saves little, and it would cost a root per lane and step; a far-stretched tet only takes
+// more steps (each halves a large singular value), up to kMaxSteps, then the double path.
+uint32_t nearest_rotations_float(const std::array<Eigen::Matrix3d, kLanes>& f, int count,
+                                 std::array<Eigen::Matrix3d, kLanes>& r) {
+    // A change under 1e-4 leaves an error near 1e-8 after one more step (quadratic convergence),
+    // below float's precision.
+    constexpr float kTolerance = 1e-4f;
+    constexpr int kMaxSteps = 24;
+    const Lanes zero = {0, 0, 0, 0}, one = {1, 1, 1, 1};
+    Lanes x[9], c[9], det;
+    for (int k = 0; k < 9; ++k)
+        for (int l = 0; l < kLanes; ++l)
+            x[k][l] = l < count ? static_cast<float>(f[l](k / 3, k % 3)) : (k % 4 == 0 ? 1.f : 0.f);
+    LaneMask bad = {0, 0, 0, 0};
+    bool converged = false;
+    for (int step = 0; step < kMaxSteps && !converged; ++step) {
+        lane_cofactors(x, c, det);
+        // A lane that lost its positive determinant (or became NaN) goes on harmlessly with det 1;
+        // its result is dropped.
+        const LaneMask positive = det > zero;
+        bad |= ~positive;
+        det = positive ? det : one;
+        const Lanes half_inverse = 0.5f / det;
+        Lanes change = zero;
+        for (int k = 0; k < 9; ++k) {
+            const Lanes next = 0.5f * x[k] + half_inverse * c[k];
+            const Lanes diff = next - x[k];
+            const Lanes size = diff < zero ? -diff : diff;
+            change = size > change ? size : change;
+            x[k] = next;
+        }
+        change = bad ? zero : change;
+        float largest = 0;
+        for (int l = 0; l < kLanes; ++l) largest = std::max(largest, change[l]);
+        converged = largest < kTolerance;
+    }
+    lane_cofactors(x, c, det);
+    uint32_t fallback = 0;
+    for (int l = 0; l < count; ++l) {
+        if (!converged || bad[l] || !(det[l] > 0)) {
+            fallback |= 1u << l;
+            continue;
+        }
+        const double half_inverse = 0.5 / double(det[l]);
+        for (int k = 0; k < 9; ++k) r[l](k / 3, k % 3) = 0.5 * double(x[k][l]) + half_inverse * double(c[k][l]);
+    }
+    return fallback;
+}
+
 std::string point_text(const Eigen::Vector3d& p) {
     std::ostringstream out;
     out << p.x() << "," << p.y() << "," << p.z();
@@ -73,20 +150,54 @@ std::string point_text(const Eigen::Vector3d& p) {
 }  // namespace
 
 struct ArapDeformer::Factor {
+    using Matrix = Eigen::SparseMatrix<double>;
 #ifdef WAXWORK_HAVE_CHOLMOD
-    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> solver;
-#else
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower> solver;
+    std::unique_ptr<Eigen::CholmodSupernodalLLT<Matrix, Eigen::Lower>> cholmod;
 #endif
-    Eigen::SparseMatrix<double> k_fc;  // free rows, constrained columns: moves to the right-hand side
+    std::unique_ptr<Eigen::SimplicialLLT<Matrix, Eigen::Lower>> eigen;
+    Matrix k_fc;  // free rows, constrained columns: moves to the right-hand side
+
+    // Factors k_ff as `kind` asks; false when the factorisation failed.
+    bool compute(const Matrix& k_ff, ArapFactor kind) {
+#ifdef WAXWORK_HAVE_CHOLMOD
+        if (kind != ArapFactor::EigenSimplicialLLT) {
+            cholmod = std::make_unique<Eigen::CholmodSupernodalLLT<Matrix, Eigen::Lower>>();
+            if (kind == ArapFactor::CholmodSimplicialSolves) {
+                // After the supernodal factorisation, cholmod_factorize converts the factor (CHOLMOD's
+                // Common->final_* options): simplicial, LL^T, packed, the amalgamation's zeros removed.
+                cholmod_common& common = cholmod->cholmod();
+                common.final_asis = 0;
+                common.final_super = 0;
+                common.final_ll = 1;
+                common.final_pack = 1;
+                common.final_monotonic = 1;
+                common.final_resymbol = 1;
+            }
+            cholmod->compute(k_ff);
+            return cholmod->info() == Eigen::Success;
+        }
+#else
+        (void)kind;
+#endif
+        eigen = std::make_unique<Eigen::SimplicialLLT<Matrix, Eigen::Lower>>();
+        eigen->compute(k_ff);
+        return eigen->info() == Eigen::Success;
+    }
+
+    Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const {
+#ifdef WAXWORK_HAVE_CHOLMOD
+        if (cholmod) return cholmod->solve(rhs);
+#endif
+        return eigen->solve(rhs);
+    }
 };
 
 ArapDeformer::~ArapDeformer() = default;
 ArapDeformer::ArapDeformer(ArapDeformer&&) noexcept = default;
 ArapDeformer& ArapDeformer::operator=(ArapDeformer&&) noexcept = default;
 
-ArapDeformer::ArapDeformer(const TetMesh& mesh, std::vector<int32_t> body_tets)
-    : rest_(mesh.positions), positions_(mesh.positions), body_tets_(std::move(body_tets)) {
+ArapDeformer::ArapDeformer(const TetMesh& mesh, std::vector<int32_t> body_tets, ArapOptions options)
+    : options_(options), rest_(mesh.positions), positions_(mesh.positions), body_tets_(std::move(body_tets)) {
     if (body_tets_.empty()) throw InvalidArgumentError("ARAP deformation: the body has no tets");
     local_index_.assign(mesh.vertex_count(), -1);
     tets_.reserve(body_tets_.size());
@@ -140,8 +251,13 @@ ArapDeformer::ArapDeformer(const TetMesh& mesh, std::vector<int32_t> body_tets)
             vertex_tets_.indices[i] = 4 * t + corner;
         }
     });
-    rotations_.assign(tets_.size(), Eigen::Matrix3d::Identity());
-    rotations_current_ = true;  // the rest shape: every F_t = I
+    reset_rotations();  // the rest shape: every F_t = I
+}
+
+void ArapDeformer::reset_rotations() {
+    rhs_shares_.resize(tets_.size());
+    for_rows(tets_.size(), kTetGrain, [&](size_t t) { rhs_shares_[t] = weights_[t] * gradients_[t]; });
+    rotations_current_ = true;
     energy_ = 0;
 }
 
@@ -199,8 +315,7 @@ void ArapDeformer::set_constrained(std::vector<int32_t> constrained) {
     k_ff.setFromTriplets(ff.begin(), ff.end());
     factor->k_fc.resize(static_cast<Eigen::Index>(free_vertices_.size()), static_cast<Eigen::Index>(constrained_.size()));
     factor->k_fc.setFromTriplets(fc.begin(), fc.end());
-    factor->solver.compute(k_ff);
-    if (factor->solver.info() != Eigen::Success)
+    if (!factor->compute(k_ff, options_.factor))
         throw AlgorithmError("ARAP deformation: the Cholesky factorisation of the stiffness matrix failed "
                              "(is a part of the body without a constrained vertex?)");
     factor_ = std::move(factor);
@@ -208,14 +323,37 @@ void ArapDeformer::set_constrained(std::vector<int32_t> constrained) {
 }
 
 void ArapDeformer::local_step() {
-    energy_ = sum_rows(tets_.size(), kTetGrain, [&](size_t t) {
+    auto gradient = [&](size_t t) {
         const Tet& tet = tets_[t];
         Eigen::Matrix<double, 3, 4> x;
         for (int k = 0; k < 4; ++k) x.col(k) = positions_[tet[k]];
-        const Eigen::Matrix3d f = x * gradients_[t];
-        rotations_[t] = nearest_rotation(f);
-        return weights_[t] * (f - rotations_[t]).squaredNorm();
-    });
+        return Eigen::Matrix3d(x * gradients_[t]);
+    };
+    if (options_.rotations == ArapRotations::Double) {
+        energy_ = sum_rows(tets_.size(), kTetGrain, [&](size_t t) {
+            const Eigen::Matrix3d f = gradient(t);
+            const Eigen::Matrix3d r = nearest_rotation(f);
+            rhs_shares_[t] = weights_[t] * gradients_[t] * r.transpose();
+            return weights_[t] * (f - r).squaredNorm();
+        });
+    } else {
+        const size_t batches = (tets_.size() + kLanes - 1) / kLanes;
+        energy_ = sum_rows(batches, kTetGrain / kLanes, [&](size_t batch) {
+            const size_t first = batch * kLanes;
+            const int count = static_cast<int>(std::min<size_t>(kLanes, tets_.size() - first));
+            std::array<Eigen::Matrix3d, kLanes> f, r;
+            for (int l = 0; l < count; ++l) f[l] = gradient(first + l);
+            const uint32_t fallback = nearest_rotations_float(f, count, r);
+            double energy = 0;
+            for (int l = 0; l < count; ++l) {
+                const size_t t = first + l;
+                if ((fallback >> l) & 1) r[l] = nearest_rotation(f[l]);
+                rhs_shares_[t] = weights_[t] * gradients_[t] * r[l].transpose();
+                energy += weights_[t] * (f[l] - r[l]).squaredNorm();
+            }
+            return energy;
+        });
+    }
     rotations_current_ = true;
 }
 
@@ -229,14 +367,14 @@ void ArapDeformer::global_step(std::span<const Eigen::Vector3d> targets) {
         for (int32_t i = vertex_tets_.offsets[v]; i < vertex_tets_.offsets[v + 1]; ++i) {
             const int32_t code = vertex_tets_.indices[i];
             const int32_t t = code / 4, corner = code % 4;
-            sum += weights_[t] * gradients_[t].row(corner) * rotations_[t].transpose();
+            sum += rhs_shares_[t].row(corner);
         }
         rhs.row(static_cast<Eigen::Index>(f)) = sum;
     });
     Eigen::MatrixXd constrained_positions(static_cast<Eigen::Index>(targets.size()), 3);
     for (size_t c = 0; c < targets.size(); ++c) constrained_positions.row(static_cast<Eigen::Index>(c)) = targets[c].transpose();
     rhs -= factor_->k_fc * constrained_positions;
-    const Eigen::MatrixXd x = factor_->solver.solve(rhs);
+    const Eigen::MatrixXd x = factor_->solve(rhs);
     for_rows(free_count, kVertexGrain, [&](size_t f) {
         positions_[body_vertices_[free_vertices_[f]]] = x.row(static_cast<Eigen::Index>(f)).transpose();
     });
@@ -271,9 +409,7 @@ void ArapDeformer::set_positions(std::vector<Eigen::Vector3d> positions) {
 
 void ArapDeformer::reset() {
     positions_ = rest_;
-    std::fill(rotations_.begin(), rotations_.end(), Eigen::Matrix3d::Identity());
-    rotations_current_ = true;
-    energy_ = 0;
+    reset_rotations();
 }
 
 double ArapDeformer::energy() const {
@@ -469,19 +605,19 @@ std::vector<Eigen::Vector3d> twist_about_axis(std::span<const Eigen::Vector3d> p
 
 std::vector<double> guard_floors(std::span<const int32_t> tets, const std::vector<Tet>& mesh_tets,
                                  std::span<const Eigen::Vector3d> positions, const GuardOptions& options) {
-    std::vector<double> floor_deg(tets.size());
+    std::vector<double> floor_cosine(tets.size());
     for_rows(tets.size(), kTetGrain, [&](size_t i) {
         const Tet& tet = mesh_tets[tets[i]];
         const double before = min_dihedral_angle_deg(positions[tet[0]], positions[tet[1]], positions[tet[2]],
                                                      positions[tet[3]]);
-        floor_deg[i] = std::min(options.min_dihedral_guard_deg, before) - 1e-9;
+        floor_cosine[i] = std::cos((std::min(options.min_dihedral_guard_deg, before) - 1e-9) * std::numbers::pi / 180);
     });
-    return floor_deg;
+    return floor_cosine;
 }
 
 GuardedStep guard_step(const TetMesh& mesh, std::span<const int32_t> tets,
                        std::span<const Eigen::Vector3d> old_positions, std::span<const Eigen::Vector3d> new_positions,
-                       const GuardOptions& options, std::span<const double> given_floor_deg) {
+                       const GuardOptions& options, std::span<const double> given_floor_cosine) {
     if (old_positions.size() != mesh.vertex_count() || new_positions.size() != mesh.vertex_count())
         throw InvalidArgumentError("guard_step: one old and one new position per vertex are needed");
     if (!(options.min_dihedral_guard_deg >= 0) || options.max_halvings < 0)
@@ -489,23 +625,23 @@ GuardedStep guard_step(const TetMesh& mesh, std::span<const int32_t> tets,
     for (int32_t t : tets)
         if (t < 0 || static_cast<size_t>(t) >= mesh.tet_count())
             throw InvalidArgumentError("guard_step: tet index " + std::to_string(t) + " out of range");
-    if (!given_floor_deg.empty() && given_floor_deg.size() != tets.size())
+    if (!given_floor_cosine.empty() && given_floor_cosine.size() != tets.size())
         throw InvalidArgumentError("guard_step: one floor per checked tet is needed");
     // Per tet, the least angle it may end with: the guard, or its own angle when it was already below.
-    std::vector<double> computed_floor_deg;
-    if (given_floor_deg.empty()) computed_floor_deg = guard_floors(tets, mesh.tets, old_positions, options);
-    const std::span<const double> floor_deg = given_floor_deg.empty() ? std::span<const double>(computed_floor_deg)
-                                                                      : given_floor_deg;
+    std::vector<double> computed_floor_cosine;
+    if (given_floor_cosine.empty()) computed_floor_cosine = guard_floors(tets, mesh.tets, old_positions, options);
+    const std::span<const double> floor_cosine =
+        given_floor_cosine.empty() ? std::span<const double>(computed_floor_cosine) : given_floor_cosine;
     auto at = [&](int32_t v, double f) { return Eigen::Vector3d(old_positions[v] + f * (new_positions[v] - old_positions[v])); };
-    std::vector<double> angle(tets.size());
-    std::vector<uint8_t> inverted(tets.size()), failing(tets.size());
+    // Per tet, the cosine of its smallest angle (2 for an inverted tet: below every angle).
+    std::vector<double> cosine(tets.size());
+    std::vector<uint8_t> failing(tets.size());
     auto check = [&](double f) {
         for_rows(tets.size(), kTetGrain, [&](size_t i) {
             const Tet& tet = mesh.tets[tets[i]];
             const Eigen::Vector3d a = at(tet[0], f), b = at(tet[1], f), c = at(tet[2], f), d = at(tet[3], f);
-            inverted[i] = !(signed_volume(a, b, c, d) > 0);
-            angle[i] = inverted[i] ? 0.0 : min_dihedral_angle_deg(a, b, c, d);
-            failing[i] = inverted[i] || angle[i] < floor_deg[i];
+            cosine[i] = signed_volume(a, b, c, d) > 0 ? max_dihedral_cosine(a, b, c, d) : 2.0;
+            failing[i] = cosine[i] > floor_cosine[i];
         });
         return std::count(failing.begin(), failing.end(), 1) == 0;
     };
@@ -521,8 +657,12 @@ GuardedStep guard_step(const TetMesh& mesh, std::span<const int32_t> tets,
         ++step.halvings;
     }
     step.fraction = fraction;
-    step.min_dihedral_deg = tets.empty() ? 0 : *std::min_element(angle.begin(), angle.end());
-    step.inverted_tets = static_cast<size_t>(std::count(inverted.begin(), inverted.end(), 1));
+    step.inverted_tets = static_cast<size_t>(std::count(cosine.begin(), cosine.end(), 2.0));
+    if (!tets.empty()) {
+        // The smallest angle as min_dihedral_angle_deg gives it, or 0 when a tet is inverted.
+        const double worst = *std::max_element(cosine.begin(), cosine.end());
+        step.min_dihedral_deg = worst > 1 ? 0.0 : 180.0 - std::acos(-worst) * 180.0 / std::numbers::pi;
+    }
     step.positions.assign(old_positions.begin(), old_positions.end());
     if (fraction > 0)
         for (int32_t t : tets)

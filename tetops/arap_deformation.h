@@ -27,9 +27,9 @@ inline constexpr double kStiffSliverAngleDeg = 10;
 // polar factor by Newton's iteration where det F_t > 0, by Jacobi SVD elsewhere); with the
 // rotations fixed, the positions solve K x = sum_t vol_t R_t B_t^T, K fixed for a fixed set of
 // constrained vertices (Eq. 9: constrained vertices move to the right-hand side). K is factored once
-// per constraint set (sparse Cholesky: CHOLMOD supernodal when the build found it, Eigen's
-// SimplicialLDLT otherwise), so a drag frame costs only SVDs and triangular solves. Each frame starts
-// from the previous frame's positions (warm start), so a few iterations per frame keep up with a drag.
+// per constraint set (sparse Cholesky, ArapFactor), so a drag frame costs only polar decompositions
+// and triangular solves. Each frame starts from the previous frame's positions (warm start), so a few
+// iterations per frame keep up with a drag.
 #pragma once
 
 #include "tetops/connectivity.h"
@@ -46,6 +46,31 @@ namespace waxwork {
 
 class Progress;
 
+// How K is factored and the global step's triangular solves run. The three coordinates share K, so
+// a solve has three right-hand sides. Without CHOLMOD in the build every choice is Eigen's.
+enum class ArapFactor {
+    // CHOLMOD's supernodal factorisation (dense BLAS kernels per supernode), then converted to a
+    // simplicial LL^T without the explicit zeros of relaxed amalgamation: its solves take the three
+    // columns in one pass over L with no BLAS call, where the supernodal solves make two small BLAS
+    // calls (triangular solve, product) per supernode and per direction.
+    CholmodSimplicialSolves,
+    // CHOLMOD's supernodal factor and solves.
+    CholmodSupernodal,
+    // Eigen's SimplicialLLT (its own AMD ordering, up-looking factorisation, one pass per column).
+    EigenSimplicialLLT,
+};
+
+// The local step's arithmetic. Float runs Newton's polar iteration in single precision on four tets
+// at once (vectorised) and is meant for previews: its rotations are orthogonal to float precision, so
+// the energy and positions differ slightly from the double ones (the tests bound it); anything
+// committed or replayed uses Double.
+enum class ArapRotations { Double, Float };
+
+struct ArapOptions {
+    ArapFactor factor = ArapFactor::CholmodSimplicialSolves;
+    ArapRotations rotations = ArapRotations::Double;
+};
+
 // The energy after an ARAP solve, and what ran.
 struct ArapSolveReport {
     int iterations = 0;
@@ -60,7 +85,7 @@ public:
     // `body_tets`: the tets deformed (indices into mesh.tets, typically one connected body of one
     // piece: select_deform_body). Positions are in the piece's rest frame. Throws InvalidArgumentError
     // for an empty body, an index out of range or a tet with non-positive volume.
-    ArapDeformer(const TetMesh& mesh, std::vector<int32_t> body_tets);
+    ArapDeformer(const TetMesh& mesh, std::vector<int32_t> body_tets, ArapOptions options = {});
     ~ArapDeformer();
     ArapDeformer(ArapDeformer&&) noexcept;
     ArapDeformer& operator=(ArapDeformer&&) noexcept;
@@ -89,6 +114,10 @@ public:
     // E of the current positions (one local step).
     double energy() const;
 
+    const ArapOptions& options() const { return options_; }
+    // The local step's arithmetic from now on (the factor is kept).
+    void set_rotations(ArapRotations rotations) { options_.rotations = rotations; }
+
     const std::vector<int32_t>& body_tets() const { return body_tets_; }
     // Vertices of the body's tets, ascending.
     const std::vector<int32_t>& body_vertices() const { return body_vertices_; }
@@ -97,7 +126,9 @@ private:
     struct Factor;
     void local_step();
     void global_step(std::span<const Eigen::Vector3d> targets);
+    void reset_rotations();  // every R_t = I
 
+    ArapOptions options_;
     std::vector<Eigen::Vector3d> rest_;
     std::vector<Eigen::Vector3d> positions_;
     std::vector<Tet> tets_;                 // the body's tets, mesh vertex indices
@@ -105,8 +136,11 @@ private:
     std::vector<int32_t> body_vertices_;
     std::vector<Eigen::Matrix<double, 4, 3>> gradients_;  // B_t: F_t = [x0 x1 x2 x3] B_t
     std::vector<double> weights_;           // w_t: the volume, larger for slivers (see the top)
-    std::vector<Eigen::Matrix3d> rotations_;
-    bool rotations_current_ = false;        // rotations_ fit positions_ (saves a local step per frame)
+    // Per tet, w_t B_t R_t^T: its corners' shares of the global step's right-hand side, made where R_t is
+    // found (the local step streams over the tets with B_t at hand; the global step then gathers
+    // 3 numbers per corner instead of B_t, R_t and a product).
+    std::vector<Eigen::Matrix<double, 4, 3>> rhs_shares_;
+    bool rotations_current_ = false;        // rhs_shares_ fit positions_ (saves a local step per frame)
     double energy_ = 0;                     // E for positions_ when rotations_current_
     CompressedRows vertex_tets_;            // per body vertex (local index): its body tets (local index)
     std::vector<int32_t> local_index_;      // mesh vertex -> index in body_vertices_, or -1
@@ -213,14 +247,16 @@ struct GuardedStep {
 // whose vertices may move): halves the step until no tet is inverted and no tet's minimum dihedral
 // angle is under the guard, or under its value at `old_positions` when it was already below (a tet
 // already under the guard may not get worse). Both arrays hold one position per mesh vertex.
-// `floor_deg`, when not empty, gives per tet of `tets` the least angle it may end with instead (from
-// guard_floors): a drag previewed frame by frame holds its tets to the angles they had before the
-// drag, computed once, rather than measuring the previous frame's angles every frame.
+// `floor_cosine`, when not empty, gives per tet of `tets` the cosine of the least angle it may end with
+// instead (from guard_floors): a drag previewed frame by frame holds its tets to the angles they had
+// before the drag, computed once, rather than measuring the previous frame's angles every frame.
+// Angles are compared through their cosines (max_dihedral_cosine), so a check costs no arc cosine.
 GuardedStep guard_step(const TetMesh& mesh, std::span<const int32_t> tets,
                        std::span<const Eigen::Vector3d> old_positions, std::span<const Eigen::Vector3d> new_positions,
-                       const GuardOptions& options = {}, std::span<const double> floor_deg = {});
-// Per tet of `tets`, the least angle guard_step lets it end with from `positions`: the guard, or its
-// angle there when that is lower (less 1e-9 degrees: a rigid motion changes the angles by rounding).
+                       const GuardOptions& options = {}, std::span<const double> floor_cosine = {});
+// Per tet of `tets`, the cosine of the least angle guard_step lets it end with from `positions`: the
+// guard, or its angle there when that is lower (less 1e-9 degrees: a rigid motion changes the angles
+// by rounding).
 std::vector<double> guard_floors(std::span<const int32_t> tets, const std::vector<Tet>& mesh_tets,
                                  std::span<const Eigen::Vector3d> positions, const GuardOptions& options);
 

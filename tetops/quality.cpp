@@ -12,8 +12,6 @@
 
 namespace waxwork {
 
-namespace {
-
 // Cosine of the smallest interior dihedral angle of a tet (the largest cosine over its six edges):
 // the same geometry as dihedral_angles_deg without the six arc cosines, so a whole-mesh minimum costs
 // one acos instead of six per tet. A degenerate face gives 1 (a zero angle).
@@ -34,8 +32,6 @@ double max_dihedral_cosine(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
         for (int l = k + 1; l < 4; ++l) worst = std::max(worst, -normal[k].dot(normal[l]) / (length[k] * length[l]));
     return std::min(worst, 1.0);
 }
-
-}  // namespace
 
 std::array<double, 6> dihedral_angles_deg(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
                                           const Eigen::Vector3d& p2, const Eigen::Vector3d& p3) {

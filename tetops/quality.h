@@ -15,6 +15,11 @@ double min_dihedral_angle_deg(const Eigen::Vector3d& p0, const Eigen::Vector3d& 
                               const Eigen::Vector3d& p2, const Eigen::Vector3d& p3);
 // The same for a tet of `mesh` (its vertex indices need not be one of mesh.tets: a candidate tet).
 double min_dihedral_angle_deg(const TetMesh& mesh, const Tet& tet);
+// The cosine of the smallest dihedral angle (the largest over the six edges; 1 for a degenerate
+// face): the smallest angle is 180 degrees minus acos(-cosine), and comparing cosines compares angles
+// without the arc cosine.
+double max_dihedral_cosine(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
+                           const Eigen::Vector3d& p3);
 
 // Circumradius divided by the shortest edge (sqrt(6)/4 ~ 0.612 for the regular tet; infinite for
 // degenerate tets).

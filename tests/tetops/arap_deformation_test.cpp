@@ -374,5 +374,103 @@ TEST(ArapDeformation, PaintedMaterialsStayWithTheirTetsAndSaveAndReloadIdentical
     EXPECT_EQ(read_volume(path), bar);
 }
 
+// Every factorisation solves the same system: their drags agree to rounding.
+TEST(ArapDeformation, EveryFactorGivesTheSameDrag) {
+    const TetMesh bar = make_bar();
+    const TetConnectivity connectivity = build_connectivity(bar);
+    const PinSphere pin{Eigen::Vector3d(0, 0.5, 0.5), 0.6};
+    const DragRegion region = select_drag_region(bar, connectivity, Eigen::Vector3d(4, 0.5, 0.5), 1.0,
+                                                 HandleMotion::translation(Eigen::Vector3d(0, 0.8, 0.4)), std::span(&pin, 1));
+    std::vector<std::vector<Eigen::Vector3d>> results;
+    std::vector<double> energies;
+    for (const ArapFactor factor :
+         {ArapFactor::CholmodSimplicialSolves, ArapFactor::CholmodSupernodal, ArapFactor::EigenSimplicialLLT}) {
+        ArapOptions options;
+        options.factor = factor;
+        ArapDeformer deformer(bar, region.body_tets, options);
+        energies.push_back(run_drag(deformer, bar, region, bar.positions, 3, 4).energy);
+        results.push_back(deformer.positions());
+    }
+    EXPECT_GT(energies[0], 1e-4);
+    for (size_t k = 1; k < results.size(); ++k) {
+        EXPECT_NEAR(energies[k], energies[0], 1e-9 * energies[0]) << k;
+        for (size_t v = 0; v < bar.vertex_count(); ++v) ASSERT_LT((results[k][v] - results[0][v]).norm(), 1e-9) << k << " " << v;
+    }
+}
+
+// The float local step (previews) against the double one: a translation stays exact, a bend of the
+// bar in six steps ends within 1e-5 of the bar's length of the double drag with the energy within
+// 1e-4 of it, and inverted tets (det F < 0, which the float batch leaves to the double SVD) get the
+// same rotations.
+TEST(ArapDeformation, FloatRotationsStayCloseToTheDoubleOnes) {
+    const TetMesh bar = make_bar();
+    ArapOptions in_float;
+    in_float.rotations = ArapRotations::Float;
+    {
+        ArapDeformer deformer(bar, all_tets(bar), in_float);
+        const std::vector<int32_t> handle = vertices_where(bar, [](const Eigen::Vector3d& p) { return p.x() >= 3.5; });
+        deformer.set_constrained(handle);
+        const Eigen::Vector3d shift(0.3, -1.7, 2.25);
+        std::vector<Eigen::Vector3d> targets;
+        for (int32_t v : handle) targets.push_back(bar.positions[v] + shift);
+        EXPECT_LT(deformer.solve(targets, 2).energy, 1e-18);
+        for (size_t v = 0; v < bar.vertex_count(); ++v)
+            EXPECT_LT((deformer.positions()[v] - bar.positions[v] - shift).norm(), 1e-9) << v;
+    }
+    const TetConnectivity connectivity = build_connectivity(bar);
+    const PinSphere pin{Eigen::Vector3d(0, 0.5, 0.5), 0.6};
+    const DragRegion region = select_drag_region(
+        bar, connectivity, Eigen::Vector3d(4, 0.5, 0.5), 1.0,
+        HandleMotion::bend(Eigen::Vector3d(2, 0.5, 0.5), Eigen::Vector3d(0, 0, 1), std::numbers::pi / 4), std::span(&pin, 1));
+    ArapDeformer in_double_deformer(bar, region.body_tets), in_float_deformer(bar, region.body_tets, in_float);
+    const DragReport d = run_drag(in_double_deformer, bar, region, bar.positions, 6, 10);
+    const DragReport f = run_drag(in_float_deformer, bar, region, bar.positions, 6, 10);
+    EXPECT_GT(d.energy, 1e-3);
+    EXPECT_NEAR(f.energy, d.energy, 1e-4 * d.energy);
+    double farthest = 0;
+    for (size_t v = 0; v < bar.vertex_count(); ++v)
+        farthest = std::max(farthest, (in_float_deformer.positions()[v] - in_double_deformer.positions()[v]).norm());
+    EXPECT_LT(farthest, 1e-5 * 4);
+    EXPECT_GT(farthest, 0);  // the float path ran
+
+    // Inverted tets: one interior vertex pushed through its neighbours.
+    std::vector<Eigen::Vector3d> pushed = bar.positions;
+    const int32_t inner = box_vertex_index({16, 4, 4}, 8, 2, 2);
+    pushed[inner] += Eigen::Vector3d(0.6, 0.1, 0);
+    const TetMesh pushed_mesh = with_positions(bar, pushed);
+    size_t inverted = 0;
+    for (size_t t = 0; t < bar.tet_count(); ++t) inverted += signed_volume(pushed_mesh, t) <= 0;
+    ASSERT_GT(inverted, 0u);
+    const std::vector<int32_t> ends =
+        vertices_where(bar, [](const Eigen::Vector3d& p) { return p.x() <= 0.25 || p.x() >= 3.75; });
+    std::vector<Eigen::Vector3d> targets;
+    for (int32_t v : ends) targets.push_back(pushed[v]);
+    ArapDeformer a(bar, all_tets(bar)), b(bar, all_tets(bar), in_float);
+    for (ArapDeformer* deformer : {&a, &b}) {
+        deformer->set_constrained(ends);
+        deformer->set_positions(pushed);
+    }
+    const double ea = a.solve(targets, 1).energy, eb = b.solve(targets, 1).energy;
+    EXPECT_NEAR(eb, ea, 1e-4 * ea);
+    for (size_t v = 0; v < bar.vertex_count(); ++v) ASSERT_LT((a.positions()[v] - b.positions()[v]).norm(), 1e-5) << v;
+
+    // Far-stretched tets: the float batch's unscaled Newton takes more steps (x30), or leaves them to
+    // the double path when it would need too many (x1e9).
+    for (const double stretch : {30.0, 1e9}) {
+        std::vector<Eigen::Vector3d> stretched = bar.positions;
+        for (Eigen::Vector3d& p : stretched) p.x() *= stretch;
+        ArapDeformer c(bar, all_tets(bar)), d(bar, all_tets(bar), in_float);
+        std::vector<Eigen::Vector3d> stretched_targets;
+        for (int32_t v : ends) stretched_targets.push_back(stretched[v]);
+        for (ArapDeformer* deformer : {&c, &d}) {
+            deformer->set_constrained(ends);
+            deformer->set_positions(stretched);
+        }
+        const double ec = c.solve(stretched_targets, 1).energy, ed = d.solve(stretched_targets, 1).energy;
+        EXPECT_GT(ec, 1);
+        EXPECT_NEAR(ed, ec, 1e-4 * ec) << stretch;
+    }
+}
+
 }  // namespace
 }  // namespace waxwork
