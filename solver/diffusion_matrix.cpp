@@ -310,7 +310,10 @@ DiffusionMatrix assemble_diffusion_matrix(const TetMesh& mesh, const TetConnecti
     if (bad_tet >= 0) throw_inverted_tet(bad_tet);
     const auto& faces = conn.boundary_faces;
     m.boundary_face_area.resize(faces.size());
-    for (size_t f = 0; f < faces.size(); ++f) m.boundary_face_area[f] = boundary_face_area_mm(mesh, faces[f].vertices, scale);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, faces.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t f = r.begin(); f != r.end(); ++f)
+            m.boundary_face_area[f] = boundary_face_area_mm(mesh, faces[f].vertices, scale);
+    });
 
     assemble_diffusion_values(m, conn, materials);
     return m;

@@ -147,16 +147,19 @@ std::vector<std::array<int32_t, 4>> build_tet_neighbors(const TetMesh& mesh, con
             table.used.clear();
             for (int32_t t : star) {
                 const Tet& tet = mesh.tets[t];
+                // Bit k: tet[k] > v. v is the minimum of face f (opposite corner f, f not v's corner)
+                // when the two corners other than f and v's are both above it.
+                int above = 0, own = 0;
+                for (int k = 0; k < 4; ++k) {
+                    above |= (tet[k] > self ? 1 : 0) << k;
+                    own |= (tet[k] == self ? 1 : 0) << k;
+                }
                 for (int f = 0; f < 4; ++f) {
-                    if (tet[f] == self) continue;  // face f is opposite vertex f
+                    if (((above | own | (1 << f)) != 0xf) || (own >> f & 1)) continue;
                     int32_t others[2], n = 0;
-                    bool v_is_min = true;
-                    for (int k : kTetFaces[f]) {
-                        if (tet[k] == self) continue;
-                        if (tet[k] < self) v_is_min = false;
-                        others[n++] = tet[k];
-                    }
-                    if (!v_is_min) continue;
+                    for (int k : kTetFaces[f])
+                        if (!(own >> k & 1) && n < 2) others[n++] = tet[k];
+                    if (n != 2) continue;  // a degenerate tet naming v twice
                     const auto lo = static_cast<uint32_t>(std::min(others[0], others[1]));
                     const auto hi = static_cast<uint32_t>(std::max(others[0], others[1]));
                     const uint64_t key = (uint64_t{lo} << 32) | hi;
@@ -253,7 +256,8 @@ std::vector<BoundaryFace> build_boundary_faces(const TetMesh& mesh,
 // Face-connected components by a concurrent union-find (Anderson and Woll's, without ranks): a union
 // links the larger of two roots below the smaller with a compare-and-swap and starts again when
 // another thread moved that root first, so each class ends rooted at its lowest tet whatever the
-// interleaving; finds halve their paths (a benign race: any value written is an ancestor). Labels
+// interleaving; finds halve their paths with plain stores (a benign race: a tet that is not a root
+// never becomes one again, and any value stored is one of its ancestors). Labels
 // follow the roots in tet order, as DisjointSets::label_classes numbers them.
 void label_components(const std::vector<std::array<int32_t, 4>>& neighbors, TetConnectivity& out) {
     const size_t n = neighbors.size();
@@ -265,7 +269,7 @@ void label_components(const std::vector<std::array<int32_t, 4>>& neighbors, TetC
         int32_t p = parent[x].load(std::memory_order_relaxed);
         while (p != x) {
             const int32_t g = parent[p].load(std::memory_order_relaxed);
-            if (g != p) parent[x].compare_exchange_weak(p, g, std::memory_order_relaxed);
+            if (g != p) parent[x].store(g, std::memory_order_relaxed);
             x = g;
             p = parent[x].load(std::memory_order_relaxed);
         }
