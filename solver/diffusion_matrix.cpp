@@ -4,6 +4,7 @@
 #include "solver/material.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -21,13 +22,6 @@ constexpr std::array<std::array<int, 3>, 4> kOthers = {{{1, 2, 3}, {0, 2, 3}, {0
 constexpr size_t kRowGrain = 512;
 // Materials are compared bitwise (assemble_diffusion_values): valid only without padding bytes.
 static_assert(sizeof(TetMaterial) == 7 * sizeof(double), "TetMaterial must have no padding");
-
-int32_t find_slot(const std::vector<int32_t>& offsets, const std::vector<int32_t>& columns, int32_t row, int32_t col) {
-    const auto begin = columns.begin() + offsets[row];
-    const auto end = columns.begin() + offsets[row + 1];
-    const auto it = std::lower_bound(begin, end, col);
-    return static_cast<int32_t>(it - columns.begin());
-}
 
 }  // namespace
 
@@ -245,56 +239,55 @@ DiffusionMatrix assemble_diffusion_pattern(const TetMesh& mesh, const TetConnect
     DiffusionMatrix m;
     m.options = options;
 
+    // Boundary faces per vertex, ascending (a parallel counting sort, connectivity.h).
+    const auto& faces = conn.boundary_faces;
+    std::vector<std::array<int32_t, 3>> face_vertices(faces.size());
+    for (size_t f = 0; f < faces.size(); ++f) face_vertices[f] = faces[f].vertices;
+    CompressedRows vertex_faces = vertex_elements(face_vertices, n);
+    m.vertex_face_offsets = std::move(vertex_faces.offsets);
+    m.vertex_faces = std::move(vertex_faces.indices);
+    m.vertex_face_slots.resize(m.vertex_faces.size());
+
     // Pattern: the one-ring plus the diagonal, columns ascending.
-    m.offsets.assign(n + 1, 0);
+    m.offsets.resize(n + 1);
+    m.offsets[0] = 0;
     for (size_t i = 0; i < n; ++i)
         m.offsets[i + 1] = m.offsets[i] + static_cast<int32_t>(conn.vertex_vertices.row(i).size()) + 1;
-    m.columns.resize(m.offsets.back());
+    m.columns.resize(static_cast<size_t>(m.offsets.back()));
     m.diagonal.resize(n);
+    m.tet_incidences.resize(conn.vertex_tets.indices.size());
+    // Row by row: the columns, then the slots of the row's tet and face incidences, looked up in a
+    // per-thread table of where each column of the row sits (written once per entry of the row) rather
+    // than by a binary search per slot. Only the row's own columns are read back, so the table is never
+    // cleared.
+    tbb::enumerable_thread_specific<std::vector<int32_t>> slot_tables([n] { return std::vector<int32_t>(n); });
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kRowGrain), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<int32_t>& slot_of = slot_tables.local();
         for (size_t i = r.begin(); i != r.end(); ++i) {
+            const auto self = static_cast<int32_t>(i);
             const auto ring = conn.vertex_vertices.row(i);
-            const auto split = std::lower_bound(ring.begin(), ring.end(), static_cast<int32_t>(i));
+            const auto split = std::lower_bound(ring.begin(), ring.end(), self);
             int32_t* out = m.columns.data() + m.offsets[i];
             out = std::copy(ring.begin(), split, out);
             m.diagonal[i] = static_cast<int32_t>(out - m.columns.data());
-            *out++ = static_cast<int32_t>(i);
+            *out++ = self;
             std::copy(split, ring.end(), out);
-        }
-    });
+            for (int32_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) slot_of[static_cast<size_t>(m.columns[k])] = k;
 
-    // Per tet incidence: the slots of the tet's other vertices in the row of each of its vertices.
-    m.tet_incidences.resize(conn.vertex_tets.indices.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kRowGrain), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) {
             for (int32_t k = conn.vertex_tets.offsets[i]; k < conn.vertex_tets.offsets[i + 1]; ++k) {
-                const Tet& tet = mesh.tets[conn.vertex_tets.indices[k]];
-                auto& inc = m.tet_incidences[k];
-                inc.local = static_cast<int32_t>(std::find(tet.begin(), tet.end(), static_cast<int32_t>(i)) - tet.begin());
-                for (int s = 0; s < 3; ++s)
-                    inc.slots[s] = find_slot(m.offsets, m.columns, static_cast<int32_t>(i), tet[kOthers[inc.local][s]]);
+                const Tet& tet = mesh.tets[static_cast<size_t>(conn.vertex_tets.indices[k])];
+                auto& inc = m.tet_incidences[static_cast<size_t>(k)];
+                inc.local = static_cast<int32_t>(std::find(tet.begin(), tet.end(), self) - tet.begin());
+                for (int s = 0; s < 3; ++s) inc.slots[s] = slot_of[static_cast<size_t>(tet[kOthers[inc.local][s]])];
+            }
+            for (int32_t k = m.vertex_face_offsets[i]; k < m.vertex_face_offsets[i + 1]; ++k) {
+                const auto& v = faces[static_cast<size_t>(m.vertex_faces[k])].vertices;
+                const int a = v[0] == self ? 0 : v[1] == self ? 1 : 2;
+                m.vertex_face_slots[static_cast<size_t>(k)] = {slot_of[static_cast<size_t>(v[(a + 1) % 3])],
+                                                               slot_of[static_cast<size_t>(v[(a + 2) % 3])]};
             }
         }
     });
-
-    // Boundary faces per vertex (serial counting sort: boundary faces are few).
-    const auto& faces = conn.boundary_faces;
-    m.vertex_face_offsets.assign(n + 1, 0);
-    for (const auto& f : faces)
-        for (int32_t v : f.vertices) ++m.vertex_face_offsets[v + 1];
-    for (size_t i = 0; i < n; ++i) m.vertex_face_offsets[i + 1] += m.vertex_face_offsets[i];
-    m.vertex_faces.resize(m.vertex_face_offsets.back());
-    m.vertex_face_slots.resize(m.vertex_faces.size());
-    std::vector<int32_t> cursor(m.vertex_face_offsets.begin(), m.vertex_face_offsets.end() - 1);
-    for (size_t f = 0; f < faces.size(); ++f) {
-        const auto& v = faces[f].vertices;
-        for (int a = 0; a < 3; ++a) {
-            const int32_t k = cursor[v[a]]++;
-            m.vertex_faces[k] = static_cast<int32_t>(f);
-            m.vertex_face_slots[k] = {find_slot(m.offsets, m.columns, v[a], v[(a + 1) % 3]),
-                                      find_slot(m.offsets, m.columns, v[a], v[(a + 2) % 3])};
-        }
-    }
     return m;
 }
 
@@ -317,7 +310,10 @@ DiffusionMatrix assemble_diffusion_matrix(const TetMesh& mesh, const TetConnecti
     if (bad_tet >= 0) throw_inverted_tet(bad_tet);
     const auto& faces = conn.boundary_faces;
     m.boundary_face_area.resize(faces.size());
-    for (size_t f = 0; f < faces.size(); ++f) m.boundary_face_area[f] = boundary_face_area_mm(mesh, faces[f].vertices, scale);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, faces.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t f = r.begin(); f != r.end(); ++f)
+            m.boundary_face_area[f] = boundary_face_area_mm(mesh, faces[f].vertices, scale);
+    });
 
     assemble_diffusion_values(m, conn, materials);
     return m;

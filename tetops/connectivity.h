@@ -72,8 +72,19 @@ struct TetConnectivity {
     int32_t component_count = 0;
 };
 
-// Builds all derived data. Throws InvalidMeshError when a face is shared by more than two tets.
-TetConnectivity build_connectivity(const TetMesh& mesh);
+// Where one build_connectivity call spent its time, in milliseconds of wall clock, by phase (the
+// benchmarks' roofline in docs/performance.md reads them).
+struct ConnectivityBuildTimes {
+    double vertex_tets = 0;     // the index check and the counting sort of the tets by vertex
+    double tet_neighbors = 0;   // faces matched around their smallest vertex
+    double one_rings = 0;       // one-rings and the edge list
+    double boundary = 0;        // boundary faces and vertices
+    double components = 0;      // face-connected components
+};
+
+// Builds all derived data. Throws InvalidMeshError when a face is shared by more than two tets or a
+// tet names a vertex out of range. `times`, when given, receives the phases' times.
+TetConnectivity build_connectivity(const TetMesh& mesh, ConnectivityBuildTimes* times = nullptr);
 
 // Only TetConnectivity::tet_neighbors (what fracture needs), at a fraction of the full build's cost.
 std::vector<std::array<int32_t, 4>> build_face_neighbors(const TetMesh& mesh);

@@ -4,6 +4,9 @@
 #include "tetops/box_mesh.h"
 #include "tetops/tet_mesh.h"
 
+#include <algorithm>
+#include <numeric>
+#include <random>
 #include <vector>
 
 namespace waxwork::testing {
@@ -51,6 +54,32 @@ inline TetMesh make_cell_mesh(int nx, int ny, int nz, Inside inside) {
                 }
             }
     return make_tet_mesh(std::move(points), std::move(tets));
+}
+
+// A cube of n^3 Kuhn cells with its vertices and tets shuffled and a share of its tets dropped (which
+// leaves holes, several components, edges and vertices shared by otherwise separate parts, and
+// vertices without tets).
+inline TetMesh shuffled_holed_cube(int n, double drop, uint32_t seed) {
+    const TetMesh cube = make_cube_mesh(n);
+    std::mt19937 rng(seed);
+    std::vector<int32_t> order(cube.vertex_count());
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), rng);
+    std::vector<Eigen::Vector3d> positions(cube.vertex_count());
+    for (size_t v = 0; v < order.size(); ++v) positions[order[v]] = cube.positions[v];
+    std::vector<Tet> tets;
+    std::bernoulli_distribution dropped(drop);
+    for (const Tet& tet : cube.tets) {
+        if (dropped(rng)) continue;
+        Tet renamed;
+        for (int k = 0; k < 4; ++k) renamed[k] = order[tet[k]];
+        // An even permutation of the corners keeps the orientation.
+        const int turns = static_cast<int>(rng() % 3);
+        for (int r = 0; r < turns; ++r) renamed = {renamed[0], renamed[2], renamed[3], renamed[1]};
+        tets.push_back(renamed);
+    }
+    std::shuffle(tets.begin(), tets.end(), rng);
+    return make_tet_mesh(std::move(positions), std::move(tets));
 }
 
 }  // namespace waxwork::testing
