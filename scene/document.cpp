@@ -302,16 +302,8 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry, Progress* 
         RefineResult result = o->points.empty()
                                   ? refine_tets(*after, o->tets, options, progress)
                                   : refine_near_points(*after, o->points, o->radius, o->edge_length, options, progress);
-        if (result.bisections > 0) {
-            report.old_to_new_vertex.resize(mesh_.vertex_count());
-            std::iota(report.old_to_new_vertex.begin(), report.old_to_new_vertex.end(), 0);
-            entry.snapshot_vertex = inverse_vertex_map(report.old_to_new_vertex, after->vertex_count());
-            report.vertex_origins = std::move(result.vertex_origins);
-            entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
-            mesh_ = std::move(*after);
-            min_dihedral_deg_ = result.min_dihedral_deg;
-            report.topology = true;
-        }
+        if (result.bisections > 0)
+            adopt_appended(std::move(*after), std::move(result.vertex_origins), result.min_dihedral_deg, entry, report);
         details << result.marks_refined << " of " << result.marks << " marked tets refined, " << result.bisections
                 << " bisections";
         if (result.marks_skipped_guard > 0) details << ", " << result.marks_skipped_guard << " skipped by the angle guard";
@@ -543,6 +535,18 @@ std::optional<ChangeReport> Document::cancel_deform() {
     return report;
 }
 
+void Document::adopt_appended(TetMesh after, std::vector<VertexOrigin> origins, double min_dihedral_deg,
+                              UndoEntry& entry, ChangeReport& report) {
+    report.old_to_new_vertex.resize(mesh_.vertex_count());
+    std::iota(report.old_to_new_vertex.begin(), report.old_to_new_vertex.end(), 0);
+    entry.snapshot_vertex = inverse_vertex_map(report.old_to_new_vertex, after.vertex_count());
+    report.vertex_origins = std::move(origins);
+    entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
+    mesh_ = std::move(after);
+    min_dihedral_deg_ = min_dihedral_deg;
+    report.topology = true;
+}
+
 // Fracture, piece moves and welds (tetops/fracture.h).
 void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, ChangeReport& report,
                                    std::ostringstream& details) {
@@ -556,14 +560,7 @@ void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, Ch
         auto after = std::make_shared<TetMesh>(mesh_);
         FractureResult result = fracture_voronoi(*after, seeds, options);
         // Vertices before keep their index; the fracture only appends.
-        report.old_to_new_vertex.resize(mesh_.vertex_count());
-        std::iota(report.old_to_new_vertex.begin(), report.old_to_new_vertex.end(), 0);
-        entry.snapshot_vertex = inverse_vertex_map(report.old_to_new_vertex, after->vertex_count());
-        report.vertex_origins = std::move(result.vertex_origins);
-        entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
-        mesh_ = std::move(*after);
-        min_dihedral_deg_ = result.min_dihedral_deg;
-        report.topology = true;
+        adopt_appended(std::move(*after), std::move(result.vertex_origins), result.min_dihedral_deg, entry, report);
         report.tets_under_guard = result.tets_under_guard;
         details << result.pieces_before << " -> " << result.pieces_after << " pieces, " << result.tets_split
                 << " tets split, " << result.vertices_collapsed << " vertices of swallowed walls collapsed, "

@@ -189,6 +189,11 @@ private:
     void run_piece_operation(const EditOperation& op, UndoEntry& entry, ChangeReport& report,
                              std::ostringstream& details);
     void push_undo(UndoEntry entry, ChangeReport& report);
+    // Makes `after` the mesh, from an edit that kept every vertex at its index and appended the others
+    // (fracture, refine): the vertex maps are identities, `origins` says where each vertex comes from,
+    // and the mesh before becomes the undo snapshot.
+    void adopt_appended(TetMesh after, std::vector<VertexOrigin> origins, double min_dihedral_deg, UndoEntry& entry,
+                        ChangeReport& report);
 
     TetMesh mesh_;
     // Tet centroids for painting, built on the first stroke and kept until the geometry changes
