@@ -3,9 +3,10 @@
 #include "base/error.h"
 #include "base/progress.h"
 #include "tetops/connectivity.h"
-#include "tetops/paint.h"
 #include "tetops/quality.h"
 #include "tetops/split_quality.h"
+
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -26,7 +27,7 @@ bool contains(const Tet& tet, int32_t v) { return tet[0] == v || tet[1] == v || 
 class Bisector {
 public:
     Bisector(TetMesh& mesh, double guard_deg, RefineResult& result)
-        : mesh_(mesh), guard_deg_(guard_deg), tets_before_(mesh.tet_count()), result_(result) {
+        : mesh_(mesh), guard_deg_(guard_deg), result_(result) {
         const CompressedRows rows = vertex_elements(mesh.tets, mesh.vertex_count());
         vertex_tets_.resize(mesh.vertex_count());
         for (size_t v = 0; v < mesh.vertex_count(); ++v) {
@@ -34,7 +35,7 @@ public:
             vertex_tets_[v].assign(row.begin(), row.end());
         }
         reference_deg_.assign(mesh.tet_count(), std::numeric_limits<double>::quiet_NaN());
-        bisected_.assign(mesh.tet_count(), 0);
+        stamp_.assign(mesh.tet_count(), 0);
         result_.new_to_old_tet.resize(mesh.tet_count());
         std::iota(result_.new_to_old_tet.begin(), result_.new_to_old_tet.end(), 0);
         result_.vertex_origins.resize(mesh.vertex_count());
@@ -42,13 +43,55 @@ public:
             result_.vertex_origins[v] = VertexOrigin::vertex(static_cast<int32_t>(v));
     }
 
-    bool bisected(int32_t t) const { return bisected_[t] != 0; }
+    // Marks name tets of the mesh as a round starts; a round's marks of tets its earlier marks already
+    // bisected do nothing more.
+    void next_round() { ++round_; }
+    bool bisected(int32_t t) const { return stamp_[t] == round_; }
 
+    // The tets bisected (in place or appended) since the last call, ascending, each once.
+    std::vector<int32_t> take_touched() {
+        std::vector<int32_t> touched = std::move(touched_);
+        touched_.clear();
+        std::sort(touched.begin(), touched.end());
+        touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+        return touched;
+    }
+
+    // Refines the marks in order, each a transaction; counts into the result.
+    void apply_marks(std::span<const int32_t> marks, size_t budget, Progress* progress) {
+        result_.marks += marks.size();
+        for (size_t i = 0; i < marks.size(); ++i) {
+            if (i % 256 == 0) {
+                check_cancelled(progress);
+                if (progress) progress->set_fraction(static_cast<float>(i) / static_cast<float>(marks.size()));
+            }
+            const int32_t t = marks[i];
+            if (bisected(t)) {
+                ++result_.marks_refined;
+                continue;
+            }
+            begin();
+            if (!refine(t)) {
+                rollback();
+                ++result_.marks_skipped_guard;
+                continue;
+            }
+            if (mesh_.tet_count() > budget) {
+                rollback();
+                result_.marks_skipped_budget += marks.size() - i;
+                break;
+            }
+            ++result_.marks_refined;
+        }
+    }
+
+private:
     void begin() {
         journal_.tets = mesh_.tet_count();
         journal_.vertices = mesh_.vertex_count();
+        journal_.touched = touched_.size();
         journal_.modified.clear();
-        journal_.flagged.clear();
+        journal_.stamps.clear();
     }
 
     void rollback() {
@@ -65,14 +108,15 @@ public:
         // Lists of the vertices before may name tets that no longer exist, or whose slot a later tet
         // reuses: tets_around filters them by content, so they can stay.
         vertex_tets_.resize(journal_.vertices);
-        for (const int32_t t : journal_.flagged) bisected_[t] = 0;
+        stamp_.resize(n);
+        for (auto it = journal_.stamps.rbegin(); it != journal_.stamps.rend(); ++it) stamp_[it->first] = it->second;
+        touched_.resize(journal_.touched);
     }
 
     // Bisects tet t along its longest edge, with the propagation that keeps the mesh conforming. False
     // when a tet would be created under the guard (the caller rolls back).
     bool refine(int32_t t) { return split_edge(longest_edge(mesh_.tets[t])); }
 
-private:
     // Edges in a strict total order: longer first, ties broken by the vertex indices, so that every tet
     // around an edge agrees on which of its edges is the longest and the propagation cannot cycle (it
     // climbs strictly in this order).
@@ -154,9 +198,9 @@ private:
             if (guard_deg_ > 0 && min_dihedral_angle_deg(mesh_, child) < floor_deg) return false;
         }
         journal_.modified.emplace_back(t, old);
-        if (static_cast<size_t>(t) < tets_before_ && !bisected_[t]) {
-            bisected_[t] = 1;
-            journal_.flagged.push_back(t);
+        if (stamp_[t] != round_) {
+            journal_.stamps.emplace_back(t, stamp_[t]);
+            stamp_[t] = round_;
         }
         const auto n = static_cast<int32_t>(mesh_.tet_count());
         mesh_.tets[t] = kept;
@@ -166,34 +210,37 @@ private:
         mesh_.piece_ids.push_back(mesh_.piece_ids[t]);
         result_.new_to_old_tet.push_back(result_.new_to_old_tet[t]);
         reference_deg_.push_back(reference);
+        stamp_.push_back(round_);
+        touched_.push_back(t);
+        touched_.push_back(n);
         vertex_tets_[m].push_back(t);
         for (const int32_t v : added) vertex_tets_[v].push_back(n);
         return true;
     }
 
     struct Journal {
-        size_t tets = 0, vertices = 0;
-        std::vector<std::pair<int32_t, Tet>> modified;  // tets changed in place, with their content before
-        std::vector<int32_t> flagged;                   // tets before marked as bisected
+        size_t tets = 0, vertices = 0, touched = 0;
+        std::vector<std::pair<int32_t, Tet>> modified;    // tets changed in place, with their content before
+        std::vector<std::pair<int32_t, uint32_t>> stamps; // tets stamped, with their stamp before
     };
 
     TetMesh& mesh_;
     double guard_deg_;
-    size_t tets_before_;
     RefineResult& result_;
     // Per vertex: every tet that has it, and possibly tets that no longer do (bisection only appends,
     // so a superset costs nothing to keep and nothing to roll back).
     std::vector<std::vector<int32_t>> vertex_tets_;
     // Per tet: the minimum dihedral angle of the tet before it came from (NaN until it is first split).
     std::vector<double> reference_deg_;
-    std::vector<uint8_t> bisected_;  // per tet before: bisected by this call
+    // Per tet: the round in which it was last bisected (0: never, in this call).
+    std::vector<uint32_t> stamp_;
+    uint32_t round_ = 0;
+    std::vector<int32_t> touched_;
     Journal journal_;
 };
 
-}  // namespace
-
-RefineResult refine_tets(TetMesh& mesh, std::span<const int32_t> marks, const RefineOptions& options,
-                         Progress* progress) {
+// Throws for options refine_tets refuses; returns the budget (kMaxRefinedTets for none).
+size_t checked_budget(const TetMesh& mesh, const RefineOptions& options) {
     if (!(options.guard_deg >= 0 && options.guard_deg < 60))
         throw InvalidArgumentError("refine: the angle guard must be in [0, 60) degrees, got " +
                                    number_text(options.guard_deg));
@@ -206,41 +253,26 @@ RefineResult refine_tets(TetMesh& mesh, std::span<const int32_t> marks, const Re
     if (mesh.original_ids.size() != mesh.tet_count() || mesh.piece_ids.size() != mesh.tet_count() ||
         (mesh.has_materials() && mesh.materials.size() != mesh.tet_count()))
         throw InvalidArgumentError("refine: the per-tet arrays do not match the tets");
+    return options.max_tets != 0 ? options.max_tets : kMaxRefinedTets;
+}
+
+}  // namespace
+
+RefineResult refine_tets(TetMesh& mesh, std::span<const int32_t> marks, const RefineOptions& options,
+                         Progress* progress) {
+    const size_t budget = checked_budget(mesh, options);
     for (const int32_t t : marks)
         if (t < 0 || static_cast<size_t>(t) >= mesh.tet_count())
             throw InvalidArgumentError("refine: marked tet " + std::to_string(t) + " is out of range (the mesh has " +
                                        std::to_string(mesh.tet_count()) + " tets)");
-    const size_t budget = options.max_tets != 0 ? options.max_tets : kMaxRefinedTets;
 
     const size_t tets_before = mesh.tet_count();
     RefineResult result;
-    result.marks = marks.size();
     report_stage(progress, "refining");
     {
         Bisector bisector(mesh, options.guard_deg, result);
-        for (size_t i = 0; i < marks.size(); ++i) {
-            if (i % 256 == 0) {
-                check_cancelled(progress);
-                if (progress) progress->set_fraction(static_cast<float>(i) / static_cast<float>(marks.size()));
-            }
-            const int32_t t = marks[i];
-            if (bisector.bisected(t)) {
-                ++result.marks_refined;
-                continue;
-            }
-            bisector.begin();
-            if (!bisector.refine(t)) {
-                bisector.rollback();
-                ++result.marks_skipped_guard;
-                continue;
-            }
-            if (mesh.tet_count() > budget) {
-                bisector.rollback();
-                result.marks_skipped_budget = marks.size() - i;
-                break;
-            }
-            ++result.marks_refined;
-        }
+        bisector.next_round();
+        bisector.apply_marks(marks, budget, progress);
     }
     result.bisections = mesh.tet_count() - tets_before;
     result.min_dihedral_deg = mesh_min_dihedral_deg(mesh);
@@ -257,38 +289,70 @@ RefineResult refine_near_points(TetMesh& mesh, std::span<const Eigen::Vector3d> 
     if (!(edge_length > 0) || !std::isfinite(edge_length))
         throw InvalidArgumentError("refine: the edge length must be a positive number, got " + number_text(edge_length));
 
-    RefineResult total;
-    total.new_to_old_tet.resize(mesh.tet_count());
-    std::iota(total.new_to_old_tet.begin(), total.new_to_old_tet.end(), 0);
-    total.vertex_origins.resize(mesh.vertex_count());
-    for (size_t v = 0; v < mesh.vertex_count(); ++v) total.vertex_origins[v] = VertexOrigin::vertex(static_cast<int32_t>(v));
-    const double longest_allowed_sq = edge_length * edge_length;
-    constexpr int kMaxRounds = 200;  // 3 generations per halving: far beyond any double's range of sizes
-    for (int round = 0; round < kMaxRounds; ++round) {
+    const size_t budget = checked_budget(mesh, options);
+
+    // Inside when the tet's centroid (world space) is within `radius` of a point: a box around the
+    // points first, then the points one by one.
+    Eigen::Vector3d lo = points[0], hi = points[0];
+    for (const Eigen::Vector3d& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    lo.array() -= radius;
+    hi.array() += radius;
+    const double radius_sq = radius * radius, longest_allowed_sq = edge_length * edge_length;
+    const RigidTransform identity;
+    const auto wanted = [&](int32_t t) {
+        const Tet& tet = mesh.tets[t];
+        const int32_t piece = mesh.piece_ids[t];
+        const RigidTransform& frame =
+            piece >= 0 && static_cast<size_t>(piece) < mesh.piece_transforms.size() ? mesh.piece_transforms[piece] : identity;
+        const Eigen::Vector3d c = frame.rotation * (0.25 * (mesh.positions[tet[0]] + mesh.positions[tet[1]] +
+                                                            mesh.positions[tet[2]] + mesh.positions[tet[3]])) +
+                                  frame.translation;
+        if ((c.array() < lo.array()).any() || (c.array() > hi.array()).any()) return false;
+        double longest_sq = 0;
+        for (const auto& [i, j] : kTetEdges)
+            longest_sq = std::max(longest_sq, (mesh.positions[tet[i]] - mesh.positions[tet[j]]).squaredNorm());
+        if (!(longest_sq > longest_allowed_sq)) return false;
+        for (const Eigen::Vector3d& p : points)
+            if ((c - p).squaredNorm() < radius_sq) return true;
+        return false;
+    };
+
+    const auto marks_among = [&](const std::vector<int32_t>& candidates) {
+        std::vector<uint8_t> keep(candidates.size());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 4096), [&](const auto& range) {
+            for (size_t i = range.begin(); i != range.end(); ++i) keep[i] = wanted(candidates[i]);
+        });
         std::vector<int32_t> marks;
-        for (const auto& [t, distance_sq] : PaintIndex(mesh).nearest_within(points, radius)) {
-            const Tet& tet = mesh.tets[t];
-            double longest_sq = 0;
-            for (const auto& [i, j] : kTetEdges)
-                longest_sq = std::max(longest_sq, (mesh.positions[tet[i]] - mesh.positions[tet[j]]).squaredNorm());
-            if (longest_sq > longest_allowed_sq) marks.push_back(static_cast<int32_t>(t));
+        for (size_t i = 0; i < candidates.size(); ++i)
+            if (keep[i]) marks.push_back(candidates[i]);
+        return marks;
+    };
+
+    const size_t tets_before = mesh.tet_count();
+    RefineResult total;
+    report_stage(progress, "refining");
+    // The first round looks at every tet; later ones only at those the previous round bisected (the
+    // others were too short, out of reach, or skipped by the guard, and are unchanged).
+    std::vector<int32_t> all(mesh.tet_count());
+    std::iota(all.begin(), all.end(), 0);
+    std::vector<int32_t> marks = marks_among(all);
+    if (marks.empty()) {
+        // Nothing to do: no bisection state to build.
+        total.new_to_old_tet = std::move(all);
+        total.vertex_origins.resize(mesh.vertex_count());
+        for (size_t v = 0; v < mesh.vertex_count(); ++v) total.vertex_origins[v] = VertexOrigin::vertex(static_cast<int32_t>(v));
+    } else {
+        Bisector bisector(mesh, options.guard_deg, total);
+        constexpr int kMaxRounds = 200;  // 3 generations per halving: far beyond any double's range of sizes
+        for (int round = 0; round < kMaxRounds && !marks.empty(); ++round) {
+            const size_t skipped_budget = total.marks_skipped_budget;
+            bisector.next_round();
+            bisector.apply_marks(marks, budget, progress);
+            if (total.marks_skipped_budget > skipped_budget) break;
+            marks = marks_among(bisector.take_touched());
         }
-        if (marks.empty()) break;
-        const size_t vertices_before = mesh.vertex_count();
-        RefineResult step = refine_tets(mesh, marks, options, progress);
-        total.marks += step.marks;
-        total.marks_refined += step.marks_refined;
-        total.marks_skipped_guard += step.marks_skipped_guard;
-        total.marks_skipped_budget += step.marks_skipped_budget;
-        total.bisections += step.bisections;
-        for (int32_t& parent : step.new_to_old_tet) parent = total.new_to_old_tet[parent];
-        total.new_to_old_tet = std::move(step.new_to_old_tet);
-        // Vertices keep their indices: the new ones' origins name vertices of this round's mesh, which
-        // are the final mesh's.
-        total.vertex_origins.insert(total.vertex_origins.end(), step.vertex_origins.begin() + static_cast<std::ptrdiff_t>(vertices_before),
-                                    step.vertex_origins.end());
-        if (step.bisections == 0 || step.marks_skipped_budget > 0) break;
     }
+    total.bisections = mesh.tet_count() - tets_before;
     total.min_dihedral_deg = mesh_min_dihedral_deg(mesh);
     return total;
 }

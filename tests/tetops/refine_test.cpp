@@ -225,6 +225,39 @@ TEST(Refine, IsDeterministicAndKeepsPiecesApart) {
     testing::expect_pieces_separate_and_connected(a, build_connectivity(a));
 }
 
+TEST(Refine, RefinesAroundPointsUntilTheTetsThereAreShortEnough) {
+    const TetMesh before = painted_cube(3);
+    TetMesh mesh = before;
+    const std::vector<Eigen::Vector3d> points = {Eigen::Vector3d(0.3, 0.4, 0.5), Eigen::Vector3d(0.5, 0.4, 0.5)};
+    const double radius = 0.2, edge = 0.06;
+    const RefineResult result = refine_near_points(mesh, points, radius, edge);
+    EXPECT_GT(result.bisections, 0u);
+    EXPECT_EQ(result.marks_skipped_guard, 0u);
+    expect_refinement_of(before, mesh, result);
+    size_t reached = 0, far_and_long = 0;
+    for (size_t t = 0; t < mesh.tet_count(); ++t) {
+        const Tet& tet = mesh.tets[t];
+        double longest = 0;
+        for (const auto& [i, j] : kTetEdges) longest = std::max(longest, (mesh.positions[tet[i]] - mesh.positions[tet[j]]).norm());
+        const Eigen::Vector3d c = centroid(mesh, t);
+        const bool near = (c - points[0]).norm() < radius || (c - points[1]).norm() < radius;
+        if (near) {
+            ++reached;
+            EXPECT_LE(longest, edge) << t;
+        } else if (longest > 2 * edge) {
+            ++far_and_long;
+        }
+    }
+    EXPECT_GT(reached, 100u);
+    EXPECT_GT(far_and_long, 0u);  // local: the rest of the cube keeps its long edges
+    TetMesh unchanged = before;
+    EXPECT_THROW(refine_near_points(unchanged, {}, radius, edge), InvalidArgumentError);
+    EXPECT_THROW(refine_near_points(unchanged, points, 0, edge), InvalidArgumentError);
+    EXPECT_THROW(refine_near_points(unchanged, points, radius, std::numeric_limits<double>::quiet_NaN()),
+                 InvalidArgumentError);
+    EXPECT_TRUE(unchanged == before);
+}
+
 TEST(Refine, RefusesBadInputWithAClearError) {
     TetMesh mesh = testing::make_cube_mesh(2);
     const TetMesh before = mesh;
