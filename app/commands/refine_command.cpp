@@ -172,7 +172,7 @@ void add_refine_command(CLI::App& app) {
         "fluence's flux across its faces (Kelly et al. 1983) and bisects the marked tets along their longest\n"
         "edges, with the neighbours the mesh needs to stay conforming; children keep their parent's material.\n"
         "No tet is made under 0.5 degrees (or under its parent's angle, if lower). Stops at the budget.");
-    organise_help(*cmd, "waxwork refine spot.vtu -o spot_refined.vtu --max-tets 200000", {});
+    organise_help(*cmd, "waxwork refine spot.vtu -o spot_refined.vtu --max-tets 20000", {});
     cmd->callback([options] { run_refine_command(*options); });
 }
 
