@@ -22,6 +22,14 @@ using Edge = std::array<int32_t, 2>;  // lo < hi
 
 bool contains(const Tet& tet, int32_t v) { return tet[0] == v || tet[1] == v || tet[2] == v || tet[3] == v; }
 
+// The maps of a refinement that has not changed anything yet: every tet and vertex is itself.
+void start_maps(const TetMesh& mesh, RefineResult& result) {
+    result.new_to_old_tet.resize(mesh.tet_count());
+    std::iota(result.new_to_old_tet.begin(), result.new_to_old_tet.end(), 0);
+    result.vertex_origins.resize(mesh.vertex_count());
+    for (size_t v = 0; v < mesh.vertex_count(); ++v) result.vertex_origins[v] = VertexOrigin::vertex(static_cast<int32_t>(v));
+}
+
 // The bisection state of one refine_tets call. Every change of one mark's refinement is journalled so
 // that it can be undone whole (a child under the guard, or the budget passed).
 class Bisector {
@@ -36,11 +44,7 @@ public:
         }
         reference_deg_.assign(mesh.tet_count(), std::numeric_limits<double>::quiet_NaN());
         stamp_.assign(mesh.tet_count(), 0);
-        result_.new_to_old_tet.resize(mesh.tet_count());
-        std::iota(result_.new_to_old_tet.begin(), result_.new_to_old_tet.end(), 0);
-        result_.vertex_origins.resize(mesh.vertex_count());
-        for (size_t v = 0; v < mesh.vertex_count(); ++v)
-            result_.vertex_origins[v] = VertexOrigin::vertex(static_cast<int32_t>(v));
+        start_maps(mesh, result_);
     }
 
     // Marks name tets of the mesh as a round starts; a round's marks of tets its earlier marks already
@@ -337,10 +341,7 @@ RefineResult refine_near_points(TetMesh& mesh, std::span<const Eigen::Vector3d> 
     std::iota(all.begin(), all.end(), 0);
     std::vector<int32_t> marks = marks_among(all);
     if (marks.empty()) {
-        // Nothing to do: no bisection state to build.
-        total.new_to_old_tet = std::move(all);
-        total.vertex_origins.resize(mesh.vertex_count());
-        for (size_t v = 0; v < mesh.vertex_count(); ++v) total.vertex_origins[v] = VertexOrigin::vertex(static_cast<int32_t>(v));
+        start_maps(mesh, total);  // nothing to do: no bisection state to build
     } else {
         Bisector bisector(mesh, options.guard_deg, total);
         constexpr int kMaxRounds = 200;  // 3 generations per halving: far beyond any double's range of sizes
