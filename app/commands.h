@@ -18,6 +18,7 @@ void add_cut_command(CLI::App& app);
 void add_fracture_command(CLI::App& app);
 void add_paint_command(CLI::App& app);
 void add_deform_command(CLI::App& app);
+void add_refine_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_edit_command(CLI::App& app);
@@ -32,6 +33,7 @@ inline void register_commands(CLI::App& app) {
     add_fracture_command(app);
     add_paint_command(app);
     add_deform_command(app);
+    add_refine_command(app);
     add_run_command(app);
     add_demo_command(app);
     add_bench_command(app);

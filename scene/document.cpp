@@ -8,6 +8,7 @@
 #include "tetops/fragments.h"
 #include "tetops/paint.h"
 #include "tetops/quality.h"
+#include "tetops/refine.h"
 #include "tetops/relaxation.h"
 
 #include <algorithm>
@@ -61,6 +62,11 @@ WeldResult without_arrays(WeldResult r) {
 }
 FragmentRemoval without_arrays(FragmentRemoval r) {
     r.removed = without_arrays(std::move(r.removed));
+    return r;
+}
+RefineResult without_arrays(RefineResult r) {
+    r.new_to_old_tet = {};
+    r.vertex_origins = {};
     return r;
 }
 PaintResult without_arrays(PaintResult r) {
@@ -288,6 +294,22 @@ ChangeReport Document::run(const EditOperation& op, UndoEntry& entry, Progress* 
         }
         report.changed_material_tets = entry.material_tets;
         details << report.changed_material_tets.size() << " tets changed";
+    } else if (const auto* o = std::get_if<RefineOp>(&op)) {
+        // Bisection only appends vertices: each vertex before keeps its index, so the maps are identities.
+        auto after = std::make_shared<TetMesh>(mesh_);
+        RefineOptions options;
+        options.max_tets = o->max_tets;
+        options.guard_deg = o->guard_deg;
+        RefineResult result = o->points.empty()
+                                  ? refine_tets(*after, o->tets, options, progress)
+                                  : refine_near_points(*after, o->points, o->radius, o->edge_length, options, progress);
+        if (result.bisections > 0)
+            adopt_appended(std::move(*after), std::move(result.vertex_origins), result.min_dihedral_deg, entry, report);
+        details << result.marks_refined << " of " << result.marks << " marked tets refined, " << result.bisections
+                << " bisections";
+        if (result.marks_skipped_guard > 0) details << ", " << result.marks_skipped_guard << " skipped by the angle guard";
+        if (result.marks_skipped_budget > 0) details << ", " << result.marks_skipped_budget << " left by the budget";
+        report.result = without_arrays(std::move(result));
     } else if (const auto* o = std::get_if<RemoveFragmentsOp>(&op)) {
         auto after = std::make_shared<TetMesh>(mesh_);
         FragmentRemoval removal = remove_small_fragments(*after, o->max_volume_fraction);
@@ -516,6 +538,18 @@ std::optional<ChangeReport> Document::cancel_deform() {
     return report;
 }
 
+void Document::adopt_appended(TetMesh after, std::vector<VertexOrigin> origins, double min_dihedral_deg,
+                              UndoEntry& entry, ChangeReport& report) {
+    report.old_to_new_vertex.resize(mesh_.vertex_count());
+    std::iota(report.old_to_new_vertex.begin(), report.old_to_new_vertex.end(), 0);
+    entry.snapshot_vertex = inverse_vertex_map(report.old_to_new_vertex, after.vertex_count());
+    report.vertex_origins = std::move(origins);
+    entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
+    mesh_ = std::move(after);
+    min_dihedral_deg_ = min_dihedral_deg;
+    report.topology = true;
+}
+
 // Fracture, piece moves and welds (tetops/fracture.h).
 void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, ChangeReport& report,
                                    std::ostringstream& details) {
@@ -529,14 +563,7 @@ void Document::run_piece_operation(const EditOperation& op, UndoEntry& entry, Ch
         auto after = std::make_shared<TetMesh>(mesh_);
         FractureResult result = fracture_voronoi(*after, seeds, options);
         // Vertices before keep their index; the fracture only appends.
-        report.old_to_new_vertex.resize(mesh_.vertex_count());
-        std::iota(report.old_to_new_vertex.begin(), report.old_to_new_vertex.end(), 0);
-        entry.snapshot_vertex = inverse_vertex_map(report.old_to_new_vertex, after->vertex_count());
-        report.vertex_origins = std::move(result.vertex_origins);
-        entry.snapshot = std::make_shared<const TetMesh>(std::move(mesh_));
-        mesh_ = std::move(*after);
-        min_dihedral_deg_ = result.min_dihedral_deg;
-        report.topology = true;
+        adopt_appended(std::move(*after), std::move(result.vertex_origins), result.min_dihedral_deg, entry, report);
         report.tets_under_guard = result.tets_under_guard;
         details << result.pieces_before << " -> " << result.pieces_after << " pieces, " << result.tets_split
                 << " tets split, " << result.vertices_collapsed << " vertices of swallowed walls collapsed, "

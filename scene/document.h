@@ -6,8 +6,8 @@
 //   paint, set_material   the changed tets and their old materials
 //   move_piece            the piece's old transform
 //   relax, deform         the moved vertices and their old positions
-//   cut, fracture, weld   a snapshot of the mesh before (every array changes: tets are removed or
-//                         split, vertices renumbered or duplicated)
+//   cut, fracture, weld,  a snapshot of the mesh before (every array changes: tets are removed or
+//   refine                split, vertices renumbered or duplicated)
 // Redo re-runs the operation: every operation is deterministic, so the result is identical, and the
 // redo stack costs only the operations themselves.
 //
@@ -30,6 +30,7 @@
 #include "tetops/fracture.h"
 #include "tetops/fragments.h"
 #include "tetops/paint.h"
+#include "tetops/refine.h"
 #include "tetops/relaxation.h"
 #include "tetops/tet_mesh.h"
 
@@ -57,12 +58,13 @@ struct RelaxedCutResult {
 // What an operation's tetops algorithm reported, for callers that summarise it (the command line's
 // JSON): RelaxedCutResult (plane and stroke cuts), ExactCutResult (exact cuts), RelaxationReport
 // (relax), FractureResult, WeldResult, FragmentRemoval (remove_fragments), PaintResult, DragReport
-// (deform); monostate for
+// (deform), RefineResult; monostate for
 // move_piece, set_material and undo. Only the counts: the per-vertex and per-tet arrays are left empty
 // (the ones the scene needs are ChangeReport's own old_to_new_vertex, vertex_origins and
 // changed_material_tets), so a report stays small.
 using OperationResult = std::variant<std::monostate, RelaxedCutResult, ExactCutResult, RelaxationReport,
-                                     FractureResult, WeldResult, FragmentRemoval, PaintResult, DragReport>;
+                                     FractureResult, WeldResult, FragmentRemoval, PaintResult, DragReport,
+                                     RefineResult>;
 
 // What an applied (or undone, or redone) operation changed. The live scene reacts to the flags.
 struct ChangeReport {
@@ -84,10 +86,10 @@ struct ChangeReport {
     // Set by operations that build the new mesh's connectivity anyway (cut with relaxation): the
     // live scene reuses it instead of rebuilding. Null otherwise.
     std::shared_ptr<const TetConnectivity> connectivity;
-    // Cut (exact or not), fracture, weld, and undoing any of them: per vertex before, its index after
+    // Cut (exact or not), fracture, weld, refine, and undoing any of them: per vertex before, its index after
     // or -1 (lets the solver keep its warm start and rebuild its hierarchy around the change).
     std::vector<int32_t> old_to_new_vertex;
-    // Exact cut and fracture: per vertex after, where it comes from (vertex v, or the point of edge ab
+    // Exact cut, fracture and refine: per vertex after, where it comes from (vertex v, or the point of edge ab
     // it was made on). An index below vertices_before names a vertex before the change; a fracture's appended
     // vertices (crack copies, vertices on walls that cross earlier walls) may also name vertices after
     // with a lower index than their own (FractureResult::vertex_origins), so read in index order.
@@ -187,6 +189,11 @@ private:
     void run_piece_operation(const EditOperation& op, UndoEntry& entry, ChangeReport& report,
                              std::ostringstream& details);
     void push_undo(UndoEntry entry, ChangeReport& report);
+    // Makes `after` the mesh, from an edit that kept every vertex at its index and appended the others
+    // (fracture, refine): the vertex maps are identities, `origins` says where each vertex comes from,
+    // and the mesh before becomes the undo snapshot.
+    void adopt_appended(TetMesh after, std::vector<VertexOrigin> origins, double min_dihedral_deg, UndoEntry& entry,
+                        ChangeReport& report);
 
     TetMesh mesh_;
     // Tet centroids for painting, built on the first stroke and kept until the geometry changes

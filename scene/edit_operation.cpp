@@ -5,6 +5,7 @@
 #include "base/error.h"
 #include "solver/material.h"
 #include "tetops/fracture.h"
+#include "tetops/refine.h"
 
 #include <nlohmann/json.hpp>
 
@@ -19,7 +20,7 @@ using Json = nlohmann::ordered_json;
 
 // Listed in errors about a missing or unknown "op".
 constexpr const char* kOperationNames =
-    "plane_cut, stroke_cut, relax, fracture, move_piece, weld, remove_fragments, paint, set_material, deform";
+    "plane_cut, stroke_cut, relax, fracture, move_piece, weld, remove_fragments, paint, set_material, deform, refine";
 
 
 Json relax_to_json(const RelaxSettings& r) {
@@ -219,7 +220,48 @@ struct ToJson {
         j["guard_deg"] = op.guard_deg;
         return j;
     }
+    Json operator()(const RefineOp& op) const {
+        Json j{{"op", "refine"}};
+        if (op.points.empty()) {
+            j["tets"] = op.tets;
+        } else {
+            j["points"] = points_to_json(op.points);
+            j["radius"] = op.radius;
+            j["edge_length"] = op.edge_length;
+        }
+        j["max_tets"] = op.max_tets;
+        j["guard_deg"] = op.guard_deg;
+        return j;
+    }
 };
+
+RefineOp refine_from_fields(FieldReader& in) {
+    RefineOp op;
+    if (in.has("tets") == in.has("points")) fail_json(in.context(), "give exactly one of 'tets' and 'points'");
+    if (in.has("points")) {
+        op.points = in.points("points");
+        if (op.points.empty()) fail_json(in.field("points"), "needs at least one point");
+        op.radius = in.number("radius");
+        if (!(op.radius > 0)) fail_json(in.field("radius"), "must be a positive number (world units)");
+        op.edge_length = in.number("edge_length");
+        if (!(op.edge_length > 0)) fail_json(in.field("edge_length"), "must be a positive number (model units)");
+    }
+    const Json& tets = in.has("tets") ? in.at("tets") : Json::array();
+    if (!tets.is_array()) fail_json(in.field("tets"), "expected an array of tet indices");
+    op.tets.reserve(tets.size());
+    for (size_t i = 0; i < tets.size(); ++i) {
+        if (!tets[i].is_number_integer() || tets[i].get<int64_t>() < 0 || tets[i].get<int64_t>() > INT32_MAX)
+            fail_json(in.field("tets") + " entry " + std::to_string(i), "expected a tet index >= 0");
+        op.tets.push_back(static_cast<int32_t>(tets[i].get<int64_t>()));
+    }
+    const int64_t max_tets = in.integer("max_tets", 0);
+    if (max_tets < 0 || static_cast<uint64_t>(max_tets) > kMaxRefinedTets)
+        fail_json(in.field("max_tets"), "must be between 0 (no budget) and " + std::to_string(kMaxRefinedTets));
+    op.max_tets = static_cast<size_t>(max_tets);
+    op.guard_deg = in.number("guard_deg", op.guard_deg);
+    if (op.guard_deg < 0 || op.guard_deg >= 60) fail_json(in.field("guard_deg"), "must be in [0, 60) degrees");
+    return op;
+}
 
 }  // namespace
 
@@ -376,6 +418,8 @@ EditOperation edit_operation_from_json(const Json& json, const std::string& cont
         result = op;
     } else if (name == "deform") {
         result = deform_from_fields(in);
+    } else if (name == "refine") {
+        result = refine_from_fields(in);
     } else {
         fail_json(context, "unknown op '" + name + "' (" + kOperationNames + ")");
     }

@@ -21,6 +21,8 @@
 //   {"op": "deform", "grab": [...], "radius": r, "move": [...] | "bend": {"axis_point": [...], "axis": [...],
 //    "angle": radians} | "twist": {"axis_point": [...], "axis": [...], "angle_per_length": radians},
 //    "pins": [{"center": [...], "radius": r}, ...], "iterations": 10, "steps": 10, "guard_deg": 0.5}
+//   {"op": "refine", "tets": [t, ...] | "points": [[...], ...], "radius": r, "edge_length": h,
+//    "max_tets": 0, "guard_deg": 0.5}
 // with "relax": {"iterations": 10, "step": 0.1, "guard_deg": 0.5}.
 #pragma once
 
@@ -149,8 +151,22 @@ struct DeformOp {
     friend bool operator==(const DeformOp&, const DeformOp&) = default;
 };
 
+// Conforming longest-edge bisection (tetops/refine.h) within a budget of `max_tets` (0: none), of
+// either the listed tets (indices into the mesh the op applies to, in priority order: refine_tets) or,
+// when `points` is given, the tets within `radius` of them until their longest edge is at most
+// `edge_length` (refine_near_points: what `paint --refine` asks under a stroke).
+struct RefineOp {
+    std::vector<int32_t> tets;
+    std::vector<Eigen::Vector3d> points;  // world space
+    double radius = 0;
+    double edge_length = 0;
+    size_t max_tets = 0;
+    double guard_deg = 0.5;
+    friend bool operator==(const RefineOp&, const RefineOp&) = default;
+};
+
 using EditOperation = std::variant<PlaneCutOp, StrokeCutOp, RelaxOp, FractureOp, MovePieceOp, WeldOp,
-                                   RemoveFragmentsOp, PaintOp, SetMaterialOp, DeformOp>;
+                                   RemoveFragmentsOp, PaintOp, SetMaterialOp, DeformOp, RefineOp>;
 
 // The "op" name of an operation ("plane_cut", "paint", ...).
 std::string operation_name(const EditOperation& op);

@@ -5,7 +5,7 @@
 //   waxwork fracture VOLUME -o OUT --pieces N [--seed K] [--exact|--no-exact] [--min-piece-tets M]
 //                    [--collapse|--no-collapse]
 //   waxwork paint VOLUME -o OUT --at "X,Y,Z;X,Y,Z" (--material NAME | --mua R,G,B --musp R,G,B --eta N)
-//                 --sigma S [--base NAME]
+//                 --sigma S [--base NAME] [--refine [--max-tets N]]
 // Each builds the edit operation its options stand for (scene/edit_operation.h) and applies it
 // through a Document, as the editor and sessions do, then writes the volume and prints a one-line JSON
 // summary on stdout.
@@ -21,7 +21,9 @@
 #include "solver/material.h"
 #include "tetops/cut.h"
 #include "tetops/fracture.h"
+#include "tetops/paint.h"
 #include "tetops/quality.h"
+#include "tetops/refine.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -186,7 +188,13 @@ struct PaintCommandOptions {
     double sigma = 0;
     std::string base = "marble";
     MaterialOptions material;
+    bool refine = false;
+    std::optional<size_t> max_tets;  // --refine's budget; default kPaintRefineGrowth times the tets
 };
+
+// --refine's default budget, as a multiple of the volume's tets: room for a few strokes' worth of
+// refinement, and a bound on what a tiny sigma can ask for.
+constexpr size_t kPaintRefineGrowth = 8;
 
 std::vector<Eigen::Vector3d> parse_points(const std::string& text) {
     std::vector<Eigen::Vector3d> points;
@@ -219,16 +227,41 @@ void run_paint_command(const PaintCommandOptions& o) {
     op.material = *brush_material;
     const TetMaterial base = material_preset(o.base);
 
+    if (o.max_tets && !o.refine) throw InvalidArgumentError("paint --max-tets: only with --refine");
+    if (o.max_tets && (*o.max_tets == 0 || *o.max_tets > kMaxRefinedTets))
+        throw InvalidArgumentError("paint --max-tets: must be between 1 and " + std::to_string(kMaxRefinedTets) +
+                                   ", got " + std::to_string(*o.max_tets));
+
     EditedVolume volume(o.input, base, /*write_base=*/true);
     const auto start = Clock::now();
+    std::optional<ChangeReport> refined;
+    size_t refine_budget = 0;
+    if (o.refine) {
+        // The tets the brush reaches, down to the brush's width: its Gaussian then varies by at most
+        // about one standard deviation across a tet.
+        RefineOp refine;
+        refine.points = op.points;
+        PaintBrush brush;
+        brush.sigma = op.sigma;
+        brush.cutoff_weight = op.cutoff_weight;
+        refine.radius = paint_radius(brush);
+        refine.edge_length = op.sigma;
+        const size_t tets = volume.mesh().tet_count();
+        refine.max_tets = o.max_tets.value_or(std::min(kMaxRefinedTets, kPaintRefineGrowth * std::max<size_t>(tets, 1)));
+        if (refine.max_tets < tets)
+            throw InvalidArgumentError("paint --max-tets: " + std::to_string(refine.max_tets) + " is below the volume's " +
+                                       std::to_string(tets) + " tets (refinement only adds tets)");
+        refine_budget = refine.max_tets;
+        refined = volume.apply(refine);
+    }
     const ChangeReport report = volume.apply(op);
     const double elapsed = milliseconds_since(start);
 
     volume.write(o.output);
     nlohmann::ordered_json summary = {
         {"output", o.output},
-        {"tets_before", report.tets_before},
-        {"vertices_before", report.vertices_before},
+        {"tets_before", refined ? refined->tets_before : report.tets_before},
+        {"vertices_before", refined ? refined->vertices_before : report.vertices_before},
         {"tets_after", report.tets_after},
         {"vertices_after", report.vertices_after},
         {"stroke_points", op.points.size()},
@@ -236,6 +269,14 @@ void run_paint_command(const PaintCommandOptions& o) {
         {"min_dihedral_deg", mesh_min_dihedral_deg(volume.mesh())},
         {"milliseconds", elapsed},
     };
+    if (refined) {
+        const auto& result = std::get<RefineResult>(refined->result);
+        summary["refined"] = {{"max_tets", refine_budget},
+                              {"bisections", result.bisections},
+                              {"marks_skipped_guard", result.marks_skipped_guard},
+                              {"budget_reached", result.marks_skipped_budget > 0},
+                              {"milliseconds", refined->milliseconds}};
+    }
     std::cout << summary.dump() << "\n";
 }
 
@@ -318,6 +359,11 @@ void add_paint_command(CLI::App& app) {
     cmd->add_option("--base", options->base, "Material of every tet when the volume stores none")
         ->capture_default_str();
     add_material_options(*cmd, options->material);
+    cmd->add_flag("--refine", options->refine,
+                  "First bisect the tets the brush reaches until their longest edge is at most sigma (conforming; "
+                  "children keep their parent's material), so the stroke's Gaussian is resolved");
+    cmd->add_option("--max-tets", options->max_tets,
+                    "--refine: tet budget of the refined volume (default: 8 times the tets it has)");
     cmd->footer("Weight w = exp(-d^2 / (2 sigma^2)), d from a tet's centroid to the nearest stroke point; tets with\n"
                 "w < 0.001 are untouched; material <- (1 - w) material + w brush (TransCut Sec. 5).");
     organise_help(*cmd, "waxwork paint spot.vtu -o painted.vtu --at 0,0.3,0.2 --sigma 0.05 --material ketchup", {});

@@ -17,6 +17,8 @@ public:
     // written out only with `write_base`: a painted volume needs them, a cut or a fracture adds no
     // materials the input did not have.
     EditedVolume(const std::string& input, const TetMaterial& base, bool write_base);
+    // The same for a volume already read from `input` (a command that needs its scale first).
+    EditedVolume(const std::string& input, VolumeFile file, const TetMaterial& base, bool write_base);
 
     const TetMesh& mesh() const { return document_.mesh(); }
 
@@ -28,8 +30,6 @@ public:
     void write(const std::string& output) const;
 
 private:
-    EditedVolume(const std::string& input, VolumeFile file, const TetMaterial& base, bool write_base);
-
     std::string input_;
     bool keep_materials_;
     VolumeMetadata metadata_;

@@ -22,8 +22,8 @@ namespace fs = std::filesystem;
 const std::string kShared = WAXWORK_SHARED_DIR;
 
 TEST(Cli, HelpOnEveryCommand) {
-    for (const std::string command : {"", "mesh", "info", "render", "cut", "fracture", "paint", "deform", "export",
-                                      "run", "edit", "bench", "demo"}) {
+    for (const std::string command : {"", "mesh", "info", "render", "cut", "fracture", "paint", "deform", "refine",
+                                      "export", "run", "edit", "bench", "demo"}) {
         const auto r = run_waxwork(command + " --help");
         EXPECT_EQ(r.exit_code, 0) << command;
         EXPECT_NE(r.out.find("Usage"), std::string::npos) << command;
@@ -58,7 +58,8 @@ TEST(Cli, HelpExamplesRunAsWritten) {
     const fs::path dir = scratch_dir("help_examples");
     const auto meshed = run_waxwork("mesh " + kAssets + "/meshes/spot.obj -o " + (dir / "spot.vtu").string() + " --max-tets 8000");
     ASSERT_EQ(meshed.exit_code, 0) << meshed.err;
-    for (const std::string command : {"render", "deform", "cut", "fracture", "paint", "export", "info", "turntable"}) {
+    for (const std::string command :
+         {"render", "deform", "cut", "fracture", "paint", "refine", "export", "info", "turntable"}) {
         const auto help = run_waxwork(command + " --help");
         const std::string marker = "Example:\n  waxwork ";
         const size_t at = help.out.find(marker);

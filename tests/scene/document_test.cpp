@@ -59,9 +59,15 @@ std::vector<EditOperation> material_and_geometry_ops() {
     grab.steps = 2;
     DeformOp twist = grab;
     twist.motion = HandleMotion::twist(Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(1, 0, 0), 0.6);
+    RefineOp refine_marked;
+    refine_marked.tets = {100, 0, 17, 40, 5, 17};
+    RefineOp refine_near;
+    refine_near.points = {Eigen::Vector3d(0.4, 0.5, 0.5), Eigen::Vector3d(0.5, 0.5, 0.5)};
+    refine_near.radius = 0.2;
+    refine_near.edge_length = 0.08;
     return {grab, twist, plane_cut(0.55), exact, stroke, relax, paint_at({0.3, 0.3, 0.3}),
             SetMaterialOp{material_preset("skin1"), std::nullopt}, SetMaterialOp{material_preset("marble"), 0},
-            scattered, seeded, move};
+            scattered, seeded, move, refine_marked, refine_near};
 }
 
 TEST(Document, LoadingWithoutMaterialsAssignsTheDefault) {

@@ -52,8 +52,17 @@ std::vector<EditOperation> one_of_each() {
     bend.guard_deg = 0;
     DeformOp twist = grab;
     twist.motion = HandleMotion::twist(Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(1, 0, 0), -1.0 / 3.0);
+    RefineOp refine;
+    refine.tets = {12, 3, 2147483647};
+    refine.max_tets = 5000;
+    refine.guard_deg = 0.25;
+    RefineOp near;
+    near.points = {Eigen::Vector3d(0.5, 0.25, 1.0 / 3.0)};
+    near.radius = 0.3;
+    near.edge_length = 0.05;
     return {plane,        stroke,      relax_plane, relax_stroke, scattered, seeded,
-            move,         WeldOp{1e-5}, RemoveFragmentsOp{0.0025}, paint, all,   one, grab, bend, twist};
+            move,         WeldOp{1e-5}, RemoveFragmentsOp{0.0025}, paint, all,   one, grab, bend, twist,
+            refine,       RefineOp{},   near};
 }
 
 TEST(EditOperation, EveryKindRoundTripsThroughJsonText) {
@@ -125,6 +134,19 @@ TEST(EditOperation, ErrorsNameTheContextAndTheField) {
     EXPECT_NE(error_of(R"({"op":"relax","relax":{}})").find("exactly one of"), std::string::npos);
     EXPECT_NE(error_of(R"({"op":"fracture","pieces":3,"collapse":0})").find("field 'collapse': expected true or false"),
               std::string::npos);
+}
+
+TEST(EditOperation, RefineErrorsNameTheField) {
+    EXPECT_NE(error_of(R"({"op":"refine"})").find("exactly one of 'tets' and 'points'"), std::string::npos);
+    EXPECT_NE(error_of(R"({"op":"refine","points":[[0,0,0]],"radius":1})").find("missing field 'edge_length'"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"op":"refine","points":[[0,0,0]],"radius":1,"edge_length":0})").find("field 'edge_length'"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"({"op":"refine","tets":[1,-2]})").find("field 'tets' entry 1"), std::string::npos);
+    EXPECT_NE(error_of(R"({"op":"refine","tets":[1.5]})").find("field 'tets' entry 0"), std::string::npos);
+    EXPECT_NE(error_of(R"({"op":"refine","tets":[],"max_tets":-3})").find("field 'max_tets'"), std::string::npos);
+    EXPECT_NE(error_of(R"({"op":"refine","tets":[],"max_tets":1e30})").find("field 'max_tets'"), std::string::npos);
+    EXPECT_NE(error_of(R"({"op":"refine","tets":[],"guard_deg":60})").find("field 'guard_deg'"), std::string::npos);
 }
 
 TEST(EditOperation, DeformErrorsNameTheField) {

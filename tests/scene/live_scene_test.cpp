@@ -103,6 +103,32 @@ TEST(LiveScene, FollowsEveryKindOfChangeToTheFreshSolution) {
     }
 }
 
+// A refinement appends vertices at edge midpoints and splits tets: every method carries phi through the
+// new vertices' origins and rebuilds around the change, and the solve after it, and after its undo, is
+// the fresh solve of the mesh.
+TEST(LiveScene, FollowsARefinementToTheFreshSolutionWithEveryMethod) {
+    for (const LiveMethod method : {LiveMethod::JacobiCg, LiveMethod::MultigridCg, LiveMethod::Multires}) {
+        const std::string what = live_method_name(method);
+        Document doc(testing::make_cube_mesh(6), material_preset("marble"));
+        doc.apply(paint_at({0.3, 0.5, 0.5}));
+        const Lighting lighting = key_lighting();
+        LiveSceneOptions o = options();
+        o.method = method;
+        LiveScene scene(doc.mesh(), lighting, o);
+        expect_matches_fresh_solve(scene, doc.mesh(), lighting, what + ": before");
+        RefineOp refine;
+        for (int32_t t = 0; t < 400; t += 3) refine.tets.push_back(t);
+        const ChangeReport report = doc.apply(refine);
+        ASSERT_GT(doc.mesh().tet_count(), report.tets_before) << what;
+        const SceneUpdate update = scene.apply_change(doc.mesh(), report);
+        EXPECT_TRUE(update.reassembled_matrix) << what;
+        EXPECT_TRUE(update.warm_start) << what;
+        expect_matches_fresh_solve(scene, doc.mesh(), lighting, what + ": refined");
+        scene.apply_change(doc.mesh(), *doc.undo());
+        expect_matches_fresh_solve(scene, doc.mesh(), lighting, what + ": undone");
+    }
+}
+
 // A deformation keeps the tets: only the rows of the moved vertices' tets are rewritten on the kept
 // pattern (the other piece's rows are not touched), every method's hierarchy keeps its graph, and the
 // solve after the deformation, and after its undo, is the fresh solve of the deformed mesh, under a key
