@@ -4,6 +4,9 @@
 
 #include "base/error.h"
 #include "solver/mesh_resolution.h"
+#ifdef WAXWORK_HAVE_PETSC
+#include "solver/petsc_peers.h"
+#endif
 #include "tetops/quality.h"
 
 #include <CGAL/version.h>
@@ -149,6 +152,22 @@ std::string file_sha256(const std::filesystem::path& file) {
     return hex;
 }
 
+namespace {
+
+// The BLAS this process runs on. Debian picks libblas.so.3 at install time (update-alternatives: the
+// reference BLAS or OpenBLAS), and CHOLMOD's factorisation speed depends on it, so the mapped file is
+// what a reader needs, not what the build linked against.
+std::string loaded_blas() {
+    std::ifstream maps("/proc/self/maps");
+    for (std::string line; std::getline(maps, line);) {
+        const size_t path = line.find('/');
+        if (path != std::string::npos && line.find("blas", path) != std::string::npos) return line.substr(path);
+    }
+    return "unknown";
+}
+
+}  // namespace
+
 Json build_provenance() {
     Json libraries = {
         {"cgal", CGAL_VERSION_STR},
@@ -166,7 +185,12 @@ Json build_provenance() {
         {"tetgen", WAXWORK_TETGEN_VERSION},
         {"openmesh", std::to_string(OM_GET_VER) + "." + std::to_string(OM_GET_MAJ) + "." + std::to_string(OM_GET_MIN)},
         {"openssl", OpenSSL_version(OPENSSL_VERSION)},
+#ifdef WAXWORK_HAVE_PETSC
+        {"petsc", petsc_version()},
+#else
         {"petsc", "not built"},
+#endif
+        {"blas", loaded_blas()},
     };
     return {{"commit", kSourceCommit},
             {"dirty", kSourceDirty},

@@ -213,8 +213,13 @@ TEST(BenchSolversCommand, RecordsProvenanceAndRunsOnOneThread) {
     EXPECT_TRUE(build["dirty"].is_boolean());
     EXPECT_NE(build["compiler"].get<std::string>().find("GNU"), std::string::npos);
     EXPECT_NE(build["flags"].get<std::string>().find("-O"), std::string::npos);
-    for (const char* library : {"cgal", "eigen", "cholmod", "onetbb", "tetgen", "petsc"})
+    for (const char* library : {"cgal", "eigen", "cholmod", "onetbb", "tetgen", "petsc", "blas"})
         EXPECT_TRUE(build["libraries"].contains(library)) << library;
+#ifdef WAXWORK_HAVE_PETSC
+    EXPECT_EQ(build["libraries"]["petsc"].get<std::string>().rfind("PETSc 3.", 0), 0u) << build["libraries"]["petsc"];
+#endif
+    // CHOLMOD loads a BLAS, and the record names the file the process mapped.
+    EXPECT_NE(build["libraries"]["blas"].get<std::string>().find("blas"), std::string::npos) << build["libraries"]["blas"];
     const auto& inputs = p["inputs"];
     EXPECT_EQ(inputs["mesh_file"], (out.parent_path() / "cube.vtu").string());
     EXPECT_EQ(inputs["mesh_sha256"].get<std::string>().size(), 64u);
