@@ -202,8 +202,9 @@ TEST(BenchSolversCommand, RecordsProvenanceAndRunsOnOneThread) {
         EXPECT_EQ(machine["threads_by_library"][library], 1) << library;
     EXPECT_EQ(machine["load_average_start"].size(), 3u);
     EXPECT_EQ(machine["load_average_end"].size(), 3u);
-    // One thread: the whole run's CPU time is at most its wall time (plus a little for the kernel).
-    EXPECT_GT(machine["parallelism"].get<double>(), 0.5);
+    // One thread: the whole run's CPU time is at most its wall time (plus a little for the kernel). How
+    // much of a core the process got depends on what else the machine runs, so only "some" is asserted.
+    EXPECT_GT(machine["parallelism"].get<double>(), 0.0);
     EXPECT_LT(machine["parallelism"].get<double>(), 1.15);
     EXPECT_GE(machine["other_load_cores"].get<double>(), 0.0);
     const auto& build = p["build"];
