@@ -17,7 +17,7 @@ build="${WAXWORK_BUILD_DIR:-$here/build}"
 packages=(
   build-essential cmake pkg-config
   libeigen3-dev libtbb-dev libcgal-dev libgmp-dev libmpfr-dev libboost-dev libssl-dev
-  libtet1.5-dev libopenmesh-dev libsuitesparse-dev libopenblas0-pthread petsc-dev
+  libtet1.5-dev libopenmesh-dev libsuitesparse-dev petsc-dev
   libglfw3-dev libosmesa6-dev libgl-dev libegl-dev libimgui-dev libstb-dev libpng-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libpugixml-dev libnanoflann-dev
   xvfb xauth

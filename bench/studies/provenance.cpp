@@ -152,22 +152,6 @@ std::string file_sha256(const std::filesystem::path& file) {
     return hex;
 }
 
-namespace {
-
-// The BLAS this process runs on. Debian picks libblas.so.3 at install time (update-alternatives: the
-// reference BLAS or OpenBLAS), and CHOLMOD's factorisation speed depends on it, so the mapped file is
-// what a reader needs, not what the build linked against.
-std::string loaded_blas() {
-    std::ifstream maps("/proc/self/maps");
-    for (std::string line; std::getline(maps, line);) {
-        const size_t path = line.find('/');
-        if (path != std::string::npos && line.find("blas", path) != std::string::npos) return line.substr(path);
-    }
-    return "unknown";
-}
-
-}  // namespace
-
 Json build_provenance() {
     Json libraries = {
         {"cgal", CGAL_VERSION_STR},
@@ -190,7 +174,6 @@ Json build_provenance() {
 #else
         {"petsc", "not built"},
 #endif
-        {"blas", loaded_blas()},
     };
     return {{"commit", kSourceCommit},
             {"dirty", kSourceDirty},

@@ -58,7 +58,11 @@ void expect_valid_curve(const nlohmann::json& solvers, const std::string& name) 
     // wall time (how much of a core it got depends on the machine's other load).
     ASSERT_TRUE(s["parallelism"].is_number()) << name;
     EXPECT_GT(s["parallelism"].get<double>(), 0.0) << name;
-    EXPECT_LT(s["parallelism"].get<double>(), 1.15) << name;
+    // llvmpipe's one rasteriser thread works beside the thread that submits and waits for it, so the
+    // GPU rows' CPU time can exceed their wall time by that overlap (measured up to 1.18 on two busy
+    // cores); two free-running threads would give 2.
+    const double most = name.rfind("gpu_", 0) == 0 ? 1.4 : 1.15;
+    EXPECT_LT(s["parallelism"].get<double>(), most) << name;
     if (s["time_to_1pct_ms"].is_number()) {
         EXPECT_DOUBLE_EQ(s["setup_plus_time_to_1pct_ms"].get<double>(),
                          s["setup_ms"].get<double>() + s["time_to_1pct_ms"].get<double>())
@@ -215,13 +219,14 @@ TEST(BenchSolversCommand, RecordsProvenanceAndRunsOnOneThread) {
     EXPECT_TRUE(build["dirty"].is_boolean());
     EXPECT_NE(build["compiler"].get<std::string>().find("GNU"), std::string::npos);
     EXPECT_NE(build["flags"].get<std::string>().find("-O"), std::string::npos);
-    for (const char* library : {"cgal", "eigen", "cholmod", "onetbb", "tetgen", "petsc", "blas"})
+    for (const char* library : {"cgal", "eigen", "cholmod", "onetbb", "tetgen", "petsc"})
         EXPECT_TRUE(build["libraries"].contains(library)) << library;
 #ifdef WAXWORK_HAVE_PETSC
     EXPECT_EQ(build["libraries"]["petsc"].get<std::string>().rfind("PETSc 3.", 0), 0u) << build["libraries"]["petsc"];
 #endif
-    // CHOLMOD loads a BLAS, and the record names the file the process mapped.
-    EXPECT_NE(build["libraries"]["blas"].get<std::string>().find("blas"), std::string::npos) << build["libraries"]["blas"];
+    // CHOLMOD loads a BLAS, and the machine record names the file the process mapped.
+    EXPECT_NE(machine["threads_by_library"]["blas_library"].get<std::string>().find("blas"), std::string::npos)
+        << machine["threads_by_library"]["blas_library"];
     const auto& inputs = p["inputs"];
     EXPECT_EQ(inputs["mesh_file"], (out.parent_path() / "cube.vtu").string());
     EXPECT_EQ(inputs["mesh_sha256"].get<std::string>().size(), 64u);
